@@ -1,0 +1,84 @@
+// Building trees in bulk: quantize -> keys -> radix sort -> unique -> one pass that
+// emits every level's words.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/frame.hpp"
+#include "vola/key.hpp"
+#include "vola/tree.hpp"
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+// The payload a block gets when a cloud asks for payload words but carries none:
+// seven bytes of 0xFF, as the reference writes.
+inline constexpr std::uint64_t kDefaultPayload = 0x00FFFFFFFFFFFFFFull;
+
+// One value per point, reduced to one value per voxel.
+struct PointAttribute {
+  std::string name;
+  ValueType type = ValueType::f32;
+  Reduction reduction = Reduction::mean;
+  std::vector<double> values;  // one per point
+};
+
+struct PointCloud {
+  std::vector<double> xyz;              // x0 y0 z0 x1 y1 z1 ...
+  std::vector<std::uint64_t> payload;   // empty, or one reference payload word per point
+  std::vector<PointAttribute> attributes;
+
+  std::size_t size() const noexcept { return xyz.size() / 3; }
+  // Per-axis min and max of the finite points (a zero box when there are none).
+  Box bounds() const noexcept;
+};
+
+struct BuildOptions {
+  Quantization quantization = Quantization::toolkit;
+  // Toolkit: required. Grid: 0 = the smallest depth that covers the points.
+  int depth = 0;
+  // Grid: the voxel edge; 0 = derived from the depth so that the bbox fits.
+  double voxel_size = 0.0;
+  // Grid: world position of voxel (0,0,0)'s corner; default: the bbox minimum,
+  // snapped down to a multiple of the voxel size so that grids of one voxel size
+  // line up voxel for voxel.
+  std::optional<Point> origin;
+  // Default: the points' per-axis bounds (the header records it either way).
+  std::optional<Box> bbox;
+  // Store one reference payload word per block (header nbits = 1).
+  bool payload = false;
+  std::uint32_t epsg = 2000;
+};
+
+struct BuildReport {
+  std::uint64_t points_in = 0;
+  std::uint64_t points_outside = 0;  // grid mode: outside the grid; any mode: not finite
+  std::uint64_t voxels = 0;
+};
+
+// Points -> tree, with the reference's payload rules and our attribute reductions.
+Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* report = nullptr);
+
+// Keys in any order, duplicates allowed (the vector is sorted in place).
+Tree build_from_keys(std::vector<Key> keys, int depth);
+// Keys already sorted and unique (throws InvalidArgument otherwise).
+Tree build_from_sorted_keys(std::span<const Key> keys, int depth);
+// Integer voxel coordinates, each below 4^depth (throws InvalidArgument otherwise).
+Tree build_from_voxels(std::span<const Voxel> voxels, int depth);
+
+// LSD radix sort of keys of `key_bits` significant bits. `index`, if not empty, is
+// permuted along (stable: equal keys keep their input order).
+void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int key_bits);
+
+// The frame BuildOptions resolve to for a cloud with bounds `bbox` (exposed so that a
+// streaming reader can quantize chunk by chunk with the same grid).
+Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options);
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

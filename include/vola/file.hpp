@@ -1,0 +1,81 @@
+// .vol files: the reference's 80-byte header and levels (sparse or dense), then, when
+// there is something the header cannot say, our extension (docs/FILE_FORMAT.md).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vola/frame.hpp"
+#include "vola/tree.hpp"
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+inline constexpr std::size_t kHeaderSize = 80;
+// Version 1: the reference's layout. Version 2 (ours): the levels are zstd-compressed
+// inside the extension, so no level words follow the header.
+inline constexpr std::uint16_t kVersionPlain = 1;
+inline constexpr std::uint16_t kVersionCompressed = 2;
+
+enum class Layout : std::uint8_t { sparse = 0, dense = 1 };
+
+struct Header {
+  std::uint32_t header_size = kHeaderSize;
+  std::uint16_t version = kVersionPlain;
+  Layout layout = Layout::sparse;
+  std::uint8_t depth = 1;
+  std::uint32_t nbits = 0;
+  std::uint32_t epsg = 2000;
+  double lat = 0.0;
+  double lon = 0.0;
+  Box bbox;
+};
+
+// Where things are in a file, for `vola info` and tests.
+struct FileLayout {
+  Header header;
+  std::uint64_t file_size = 0;
+  std::uint64_t level_bytes = 0;       // occupancy + payload words as stored
+  std::uint64_t extension_offset = 0;  // 0 when there is no extension
+  std::uint64_t extension_bytes = 0;
+  std::uint32_t extension_version = 0;
+  bool compressed_levels = false;
+  std::uint64_t compressed_level_bytes = 0;
+};
+
+struct WriteOptions {
+  Layout layout = Layout::sparse;
+  // zstd-compress the levels (sparse only): a version-2 file only vola reads.
+  bool compress = false;
+  int compression_level = 19;
+  // Dense files hold 64^(depth-1) leaf words: refuse beyond this depth.
+  int max_dense_depth = 5;
+};
+
+// Whether this build can write compressed files.
+bool compression_available() noexcept;
+
+// The file's bytes. The extension is written only when the tree carries something the
+// reference header cannot say (a grid frame, a CRS in WKT, attribute columns) or when
+// compressing, so a toolkit-mode tree serializes exactly as the reference writes it.
+std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& options = {});
+// Writes through a temporary file and a rename: no half-written file on failure.
+void write(const Tree& tree, const std::string& path, const WriteOptions& options = {});
+
+// Parses bytes (copied into the tree). `name` labels errors.
+Tree parse(std::span<const std::uint8_t> bytes, const std::string& name = {},
+           FileLayout* layout = nullptr);
+// Reads a file into memory.
+Tree read(const std::string& path, FileLayout* layout = nullptr);
+// Maps a file: a sparse uncompressed file's levels are used in place, never copied.
+// Dense and compressed files are decoded into memory.
+Tree open_mapped(const std::string& path, FileLayout* layout = nullptr);
+
+Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name);
+void encode_header(const Header& header, std::uint8_t* out);
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,38 @@
+// NumPy .npy arrays (format versions 1-3): numeric dtypes of either byte order,
+// C or Fortran order. Used for point arrays (N, 3+) and dense occupancy grids.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vola/builder.hpp"
+
+namespace vola::io {
+
+struct NpyArray {
+  char kind = 'f';          // 'f' float, 'i' signed, 'u' unsigned, 'b' bool
+  int item_size = 8;        // bytes per value
+  bool big_endian = false;
+  bool fortran_order = false;
+  std::vector<std::uint64_t> shape;
+  std::vector<std::uint8_t> data;
+
+  std::uint64_t size() const noexcept;
+  // Value at a C-order multi-index flattened to `index` (Fortran-order files are
+  // addressed the same way), converted to double.
+  double value(std::uint64_t index) const noexcept;
+  std::string dtype() const;
+};
+
+// Throws FormatError with the file name and offset on anything malformed; never
+// allocates more than the file holds.
+NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name);
+NpyArray read_npy(const std::string& path);
+
+// An (N, C>=3) array as points: columns 0..2 are x y z, columns 3.. become payload
+// bytes (byte k = column 3+k, each 0..255) when `payload_columns` is set.
+PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns);
+
+}  // namespace vola::io

@@ -1,0 +1,213 @@
+// The frozen VOLA tree: levels of 64-bit occupancy words laid out exactly as in a
+// sparse .vol file, plus an in-memory rank directory so that finding a child, a
+// voxel's rank or a coarser node takes `depth` steps and no allocation.
+//
+// Build one with vola::build (builder.hpp) or open one with vola::read /
+// vola::open_mapped (file.hpp). A tree is immutable; edit by building anew or by the
+// set operations (setops.hpp), which merge sorted key lists.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/frame.hpp"
+#include "vola/key.hpp"
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+// Popcount rank over one level's words: a 64-bit count every 512 words and a 16-bit
+// count (relative to it) every 8 words, 2.1 bits of directory per 64-bit word. The
+// remaining words of a group of 8 are counted with popcount.
+class RankDirectory {
+ public:
+  RankDirectory() = default;
+  explicit RankDirectory(std::span<const std::uint64_t> words);
+
+  // Number of set bits in words[0 .. index).
+  std::uint64_t before(std::span<const std::uint64_t> words, std::size_t index) const noexcept {
+    const std::size_t group = index & ~std::size_t{7};
+    std::uint64_t count = super_[index >> 9] + sub_[index >> 3];
+    for (std::size_t i = group; i < index; ++i) count += std::popcount(words[i]);
+    return count;
+  }
+  std::uint64_t total() const noexcept { return total_; }
+  std::size_t memory_bytes() const noexcept {
+    return super_.capacity() * sizeof(std::uint64_t) + sub_.capacity() * sizeof(std::uint16_t);
+  }
+
+ private:
+  std::vector<std::uint64_t> super_;
+  std::vector<std::uint16_t> sub_;
+  std::uint64_t total_ = 0;
+};
+
+class Tree {
+ public:
+  // An empty tree of depth 1 (one zero root word).
+  Tree();
+
+  // Takes the level words in sparse file order (for each level: occupancy words,
+  // then payload words when has_payload) and checks them: level 0 is one word,
+  // each level has as many words as the level above has set bits, no word below
+  // the root is zero. Throws FormatError naming `source` otherwise.
+  static Tree from_levels(int depth, bool has_payload, std::vector<std::uint64_t> words,
+                          const std::string& source = {});
+  // The same over bytes kept alive by `keeper` (a memory map): nothing is copied.
+  static Tree view_levels(int depth, bool has_payload, std::span<const std::uint64_t> words,
+                          std::shared_ptr<const void> keeper, const std::string& source = {},
+                          std::uint64_t file_offset = 0);
+
+  int depth() const noexcept { return depth_; }
+  std::uint32_t side() const noexcept { return side_of(depth_); }
+  std::uint64_t voxel_count() const noexcept { return counts_[depth_ - 1]; }
+  bool empty() const noexcept { return voxel_count() == 0; }
+  // Occupied cells at `level` (level depth-1 = voxels).
+  std::uint64_t node_count(int level) const noexcept { return counts_[level]; }
+  std::span<const std::uint64_t> occupancy(int level) const noexcept { return occupancy_[level]; }
+  // Block payload words of `level` (empty when the tree has none).
+  std::span<const std::uint64_t> payload(int level) const noexcept { return payload_[level]; }
+  bool has_payload() const noexcept { return has_payload_; }
+  // All level words in sparse file order.
+  std::span<const std::uint64_t> words() const noexcept { return all_words_; }
+
+  bool contains(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
+    return locate(encode(x, y, z), depth_ - 1).has_value();
+  }
+  bool contains(const Voxel& v) const noexcept { return contains(v.x, v.y, v.z); }
+  // Is the level-`level` cell (coordinates on the 4^(level+1) grid) occupied?
+  bool contains_node(int level, const Voxel& cell) const noexcept {
+    return locate(encode(cell.x, cell.y, cell.z), level).has_value();
+  }
+  // The voxel's index among all voxels in key order, if occupied: the row of its
+  // attribute values.
+  std::optional<std::uint64_t> rank(const Voxel& v) const noexcept;
+  // The payload word of the voxel's leaf block (reference semantics), if occupied.
+  std::optional<std::uint64_t> block_payload(const Voxel& v) const noexcept;
+  // The voxel's own payload: the per-voxel payloads of a tree built from points or
+  // read from a dense file, else its leaf block's payload word.
+  std::optional<std::uint64_t> voxel_payload(const Voxel& v) const noexcept;
+  std::uint64_t voxel_payload_at_rank(std::uint64_t rank, std::size_t leaf_block) const noexcept;
+
+  // Visits every voxel in key order: f(const Voxel&).
+  template <class F>
+  void for_each_voxel(F&& f) const {
+    for_each_node(depth_ - 1, std::forward<F>(f));
+  }
+  // Visits every occupied cell of `level` in key order: f(const Voxel& cell).
+  template <class F>
+  void for_each_node(int level, F&& f) const {
+    for_each_block(level, [&](std::size_t, std::uint64_t word, std::uint32_t ox, std::uint32_t oy,
+                              std::uint32_t oz) {
+      while (word) {
+        const unsigned b = static_cast<unsigned>(std::countr_zero(word));
+        word &= word - 1;
+        f(Voxel{ox + (b & 3u), oy + ((b >> 2) & 3u), oz + (b >> 4)});
+      }
+    });
+  }
+  // Visits every block (word) of `level` in order:
+  // f(block index, occupancy word, origin x, origin y, origin z), where the origin is
+  // the block's first cell on the level's 4^(level+1) grid. No rank lookups: blocks
+  // of a level are visited in storage order.
+  template <class F>
+  void for_each_block(int level, F&& f) const {
+    if (empty()) return;
+    std::array<std::size_t, kMaxDepth> next{};  // next unvisited block per level
+    visit_block(0, level, next, 0, 0, 0, f);
+  }
+  // All voxel keys, sorted.
+  std::vector<Key> keys() const;
+
+  // The first `depth` levels as a tree of that depth: each voxel is one level-(depth-1)
+  // cell of this tree. Shares this tree's words; the frame's voxel size grows by 4 per
+  // level dropped.
+  Tree level_of_detail(int depth) const;
+
+  // Bytes held in memory: owned words, rank directory, attributes (a memory-mapped
+  // tree's words are not counted: they live in the page cache).
+  std::size_t memory_bytes() const noexcept;
+  bool is_mapped() const noexcept { return mapped_; }
+
+  // Metadata carried in the header and our extension.
+  Georef& georef() noexcept { return georef_; }
+  const Georef& georef() const noexcept { return georef_; }
+  // The header's nbits value, kept as read (0 without payload).
+  std::uint32_t nbits() const noexcept { return nbits_; }
+  void set_nbits(std::uint32_t nbits) noexcept { nbits_ = has_payload_ ? (nbits ? nbits : 1) : 0; }
+  // nullopt when the file had no extension (a reference file): its grid is then the
+  // toolkit's, from the header bbox.
+  const std::optional<Frame>& stored_frame() const noexcept { return frame_; }
+  void set_frame(const Frame& frame) { frame_ = frame; }
+  // The grid in world coordinates, whichever way it is known.
+  Frame frame() const noexcept;
+  Quantizer quantizer() const;
+  Attributes& attributes() noexcept { return attributes_; }
+  const Attributes& attributes() const noexcept { return attributes_; }
+  std::span<const std::uint64_t> voxel_payloads() const noexcept { return voxel_payloads_; }
+  // One payload per voxel in rank order (size voxel_count()).
+  void set_voxel_payloads(std::vector<std::uint64_t> payloads);
+
+ private:
+  struct Location {
+    std::size_t block;  // block index within the level
+    unsigned bit;       // bit within the block
+  };
+  // Walks from the root to `level` along `key` (a key of a depth-(level+1) tree).
+  std::optional<Location> locate(Key node_key, int level) const noexcept {
+    std::size_t block = 0;
+    for (int l = 0;; ++l) {
+      const std::uint64_t word = occupancy_[l][block];
+      const unsigned bit = static_cast<unsigned>(node_key >> (6 * (level - l))) & 63u;
+      if (!((word >> bit) & 1u)) return std::nullopt;
+      if (l == level) return Location{block, bit};
+      block = rank_[l].before(occupancy_[l], block) +
+              std::popcount(word & ((std::uint64_t{1} << bit) - 1));
+    }
+  }
+
+  template <class F>
+  void visit_block(int level, int last_level, std::array<std::size_t, kMaxDepth>& next,
+                   std::uint32_t ox, std::uint32_t oy, std::uint32_t oz, F& f) const {
+    const std::size_t block = next[level]++;
+    std::uint64_t word = occupancy_[level][block];
+    if (level == last_level) {
+      f(block, word, ox, oy, oz);
+      return;
+    }
+    while (word) {
+      const unsigned b = static_cast<unsigned>(std::countr_zero(word));
+      word &= word - 1;
+      visit_block(level + 1, last_level, next, (ox + (b & 3u)) * 4, (oy + ((b >> 2) & 3u)) * 4,
+                  (oz + (b >> 4)) * 4, f);
+    }
+  }
+
+  void index(const std::string& source, std::uint64_t file_offset);
+
+  int depth_ = 1;
+  bool has_payload_ = false;
+  bool mapped_ = false;
+  std::uint32_t nbits_ = 0;
+  std::shared_ptr<const void> keeper_;  // owns or maps the words
+  std::span<const std::uint64_t> all_words_;
+  std::array<std::span<const std::uint64_t>, kMaxDepth> occupancy_{};
+  std::array<std::span<const std::uint64_t>, kMaxDepth> payload_{};
+  std::array<RankDirectory, kMaxDepth> rank_{};
+  std::array<std::uint64_t, kMaxDepth> counts_{};
+  Georef georef_;
+  std::optional<Frame> frame_;
+  Attributes attributes_;
+  std::vector<std::uint64_t> voxel_payloads_;
+};
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

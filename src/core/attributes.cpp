@@ -1,0 +1,124 @@
+#include "vola/attributes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+constexpr std::string_view kTypeNames[] = {"u8", "u16", "u32", "u64", "i8",
+                                           "i16", "i32", "i64", "f32", "f64"};
+constexpr std::string_view kReductionNames[] = {"last", "mean", "max", "min", "majority"};
+
+template <class T>
+T load(const std::byte* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+template <class T>
+void store(std::byte* p, double value) {
+  T v;
+  if constexpr (std::is_floating_point_v<T>) {
+    v = static_cast<T>(value);
+  } else {
+    // Round to nearest and clamp, so that a mean of integers stays in range.
+    double r = std::isnan(value) ? 0.0 : std::nearbyint(value);
+    r = std::clamp(r, static_cast<double>(std::numeric_limits<T>::lowest()),
+                   static_cast<double>(std::numeric_limits<T>::max()));
+    v = r >= static_cast<double>(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::max()
+                                                                 : static_cast<T>(r);
+  }
+  std::memcpy(p, &v, sizeof(T));
+}
+}  // namespace
+
+std::size_t size_of(ValueType type) noexcept {
+  switch (type) {
+    case ValueType::u8: case ValueType::i8: return 1;
+    case ValueType::u16: case ValueType::i16: return 2;
+    case ValueType::u32: case ValueType::i32: case ValueType::f32: return 4;
+    case ValueType::u64: case ValueType::i64: case ValueType::f64: return 8;
+  }
+  return 1;
+}
+
+std::string_view name_of(ValueType type) noexcept { return kTypeNames[static_cast<int>(type)]; }
+std::string_view name_of(Reduction r) noexcept { return kReductionNames[static_cast<int>(r)]; }
+
+std::optional<ValueType> parse_value_type(std::string_view name) noexcept {
+  for (int i = 0; i < 10; ++i)
+    if (kTypeNames[i] == name) return static_cast<ValueType>(i);
+  return std::nullopt;
+}
+
+std::optional<Reduction> parse_reduction(std::string_view name) noexcept {
+  for (int i = 0; i < 5; ++i)
+    if (kReductionNames[i] == name) return static_cast<Reduction>(i);
+  return std::nullopt;
+}
+
+AttributeColumn::AttributeColumn(std::string name, ValueType type, Reduction reduction,
+                                 std::size_t count)
+    : name_(std::move(name)), type_(type), reduction_(reduction), bytes_(count * size_of(type)) {
+  if (static_cast<int>(type) > 9) throw InvalidArgument("attribute " + name_ + ": unknown value type");
+  if (static_cast<int>(reduction) > 4)
+    throw InvalidArgument("attribute " + name_ + ": unknown reduction");
+}
+
+double AttributeColumn::get(std::size_t rank) const {
+  const std::byte* p = bytes_.data() + rank * size_of(type_);
+  switch (type_) {
+    case ValueType::u8: return load<std::uint8_t>(p);
+    case ValueType::u16: return load<std::uint16_t>(p);
+    case ValueType::u32: return load<std::uint32_t>(p);
+    case ValueType::u64: return static_cast<double>(load<std::uint64_t>(p));
+    case ValueType::i8: return load<std::int8_t>(p);
+    case ValueType::i16: return load<std::int16_t>(p);
+    case ValueType::i32: return load<std::int32_t>(p);
+    case ValueType::i64: return static_cast<double>(load<std::int64_t>(p));
+    case ValueType::f32: return load<float>(p);
+    case ValueType::f64: return load<double>(p);
+  }
+  return 0.0;
+}
+
+void AttributeColumn::set(std::size_t rank, double value) {
+  std::byte* p = bytes_.data() + rank * size_of(type_);
+  switch (type_) {
+    case ValueType::u8: return store<std::uint8_t>(p, value);
+    case ValueType::u16: return store<std::uint16_t>(p, value);
+    case ValueType::u32: return store<std::uint32_t>(p, value);
+    case ValueType::u64: return store<std::uint64_t>(p, value);
+    case ValueType::i8: return store<std::int8_t>(p, value);
+    case ValueType::i16: return store<std::int16_t>(p, value);
+    case ValueType::i32: return store<std::int32_t>(p, value);
+    case ValueType::i64: return store<std::int64_t>(p, value);
+    case ValueType::f32: return store<float>(p, value);
+    case ValueType::f64: return store<double>(p, value);
+  }
+}
+
+const AttributeColumn* Attributes::find(std::string_view name) const noexcept {
+  for (const auto& c : columns_)
+    if (c.name() == name) return &c;
+  return nullptr;
+}
+
+AttributeColumn* Attributes::find(std::string_view name) noexcept {
+  for (auto& c : columns_)
+    if (c.name() == name) return &c;
+  return nullptr;
+}
+
+AttributeColumn& Attributes::add(AttributeColumn column) {
+  if (find(column.name())) throw InvalidArgument("attribute '" + column.name() + "' exists already");
+  columns_.push_back(std::move(column));
+  return columns_.back();
+}
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

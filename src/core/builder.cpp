@@ -1,0 +1,271 @@
+#include "vola/builder.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "vola/error.hpp"
+#include "emit.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+
+constexpr int kRadixBits = 11;
+constexpr std::size_t kBuckets = std::size_t{1} << kRadixBits;
+
+void check_depth(int depth) {
+  if (depth < kMinDepth || depth > kMaxDepth)
+    throw InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
+}
+
+// Reduces the values of one voxel's points (indices in input order) to one value.
+double reduce(const std::vector<double>& values, std::span<const std::uint32_t> points,
+              Reduction reduction, std::vector<double>& scratch) {
+  switch (reduction) {
+    case Reduction::last: return values[points.back()];
+    case Reduction::mean: {
+      double sum = 0.0;
+      for (auto p : points) sum += values[p];
+      return sum / static_cast<double>(points.size());
+    }
+    case Reduction::max: {
+      double m = values[points.front()];
+      for (auto p : points) m = std::max(m, values[p]);
+      return m;
+    }
+    case Reduction::min: {
+      double m = values[points.front()];
+      for (auto p : points) m = std::min(m, values[p]);
+      return m;
+    }
+    case Reduction::majority: {
+      if (points.size() == 1) return values[points.front()];
+      scratch.clear();
+      for (auto p : points) scratch.push_back(values[p]);
+      std::sort(scratch.begin(), scratch.end());
+      // The most frequent value; ties go to the smallest value, so the result does not
+      // depend on input order.
+      double best = scratch[0];
+      std::size_t best_run = 0;
+      for (std::size_t s = 0; s < scratch.size();) {
+        std::size_t e = s;
+        while (e < scratch.size() && scratch[e] == scratch[s]) ++e;
+        if (e - s > best_run) {
+          best_run = e - s;
+          best = scratch[s];
+        }
+        s = e;
+      }
+      return best;
+    }
+  }
+  return values[points.back()];
+}
+
+}  // namespace
+
+Box PointCloud::bounds() const noexcept {
+  Box box;
+  bool first = true;
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    if (!std::isfinite(xyz[i]) || !std::isfinite(xyz[i + 1]) || !std::isfinite(xyz[i + 2])) continue;
+    for (int a = 0; a < 3; ++a) {
+      const double v = xyz[i + a];
+      if (first) {
+        box.min[a] = box.max[a] = v;
+      } else {
+        box.min[a] = std::min(box.min[a], v);
+        box.max[a] = std::max(box.max[a], v);
+      }
+    }
+    first = false;
+  }
+  return box;
+}
+
+void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int key_bits) {
+  const std::size_t n = keys.size();
+  const bool with_index = index && !index->empty();
+  if (with_index && index->size() != n) throw InvalidArgument("radix_sort: index size differs");
+  if (n < 2) return;
+  const int passes = (key_bits + kRadixBits - 1) / kRadixBits;
+  std::vector<std::size_t> counts(kBuckets * static_cast<std::size_t>(passes), 0);
+  for (const Key k : keys)
+    for (int p = 0; p < passes; ++p) ++counts[p * kBuckets + ((k >> (p * kRadixBits)) & (kBuckets - 1))];
+  std::vector<Key> key_buffer(n);
+  std::vector<std::uint32_t> index_buffer(with_index ? n : 0);
+  for (int p = 0; p < passes; ++p) {
+    std::size_t* count = &counts[p * kBuckets];
+    const int shift = p * kRadixBits;
+    // A digit that is the same in every key moves nothing.
+    if (count[(keys[0] >> shift) & (kBuckets - 1)] == n) continue;
+    std::size_t offset = 0;
+    for (std::size_t b = 0; b < kBuckets; ++b) {
+      const std::size_t c = count[b];
+      count[b] = offset;
+      offset += c;
+    }
+    if (with_index) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t dst = count[(keys[i] >> shift) & (kBuckets - 1)]++;
+        key_buffer[dst] = keys[i];
+        index_buffer[dst] = (*index)[i];
+      }
+      index->swap(index_buffer);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) key_buffer[count[(keys[i] >> shift) & (kBuckets - 1)]++] = keys[i];
+    }
+    keys.swap(key_buffer);
+  }
+}
+
+Tree build_from_sorted_keys(std::span<const Key> keys, int depth) {
+  check_depth(depth);
+  const Key limit = Key{1} << (6 * depth);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i] >= limit) throw InvalidArgument("key " + std::to_string(keys[i]) + " is too large for depth " + std::to_string(depth));
+    if (i > 0 && keys[i] <= keys[i - 1]) throw InvalidArgument("keys are not sorted and unique");
+  }
+  return detail::emit_levels(keys, depth, {}, false);
+}
+
+Tree build_from_keys(std::vector<Key> keys, int depth) {
+  check_depth(depth);
+  const Key limit = Key{1} << (6 * depth);
+  for (const Key k : keys)
+    if (k >= limit) throw InvalidArgument("key " + std::to_string(k) + " is too large for depth " + std::to_string(depth));
+  radix_sort(keys, nullptr, 6 * depth);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return detail::emit_levels(keys, depth, {}, false);
+}
+
+Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
+  check_depth(depth);
+  const std::uint32_t side = side_of(depth);
+  std::vector<Key> keys(voxels.size());
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    const Voxel& v = voxels[i];
+    if (v.x >= side || v.y >= side || v.z >= side)
+      throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
+                            std::to_string(v.z) + ") is outside the depth-" + std::to_string(depth) +
+                            " grid of side " + std::to_string(side));
+    keys[i] = encode(v);
+  }
+  radix_sort(keys, nullptr, 6 * depth);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return detail::emit_levels(keys, depth, {}, false);
+}
+
+Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options) {
+  if (options.quantization == Quantization::toolkit) {
+    if (options.depth == 0) throw InvalidArgument("toolkit quantization needs a depth");
+    return Quantizer::toolkit(bbox, options.depth);
+  }
+  double extent_from_min = 0.0;
+  for (int a = 0; a < 3; ++a) extent_from_min = std::max(extent_from_min, bbox.max[a] - bbox.min[a]);
+  if (options.voxel_size <= 0.0) {
+    if (options.depth == 0) throw InvalidArgument("grid quantization needs a voxel size or a depth");
+    // The largest extent spans all but a sliver of the grid, so the max point lands
+    // in the last voxel.
+    const double side = static_cast<double>(side_of(options.depth));
+    options.voxel_size = extent_from_min > 0.0 ? extent_from_min / side * (1.0 + 1e-9) : 1.0;
+    if (!options.origin) options.origin = bbox.min;
+  }
+  if (!options.origin) {
+    Point o;
+    for (int a = 0; a < 3; ++a) o[a] = std::floor(bbox.min[a] / options.voxel_size) * options.voxel_size;
+    options.origin = o;
+  }
+  if (options.depth == 0) {
+    double extent = 0.0;
+    for (int a = 0; a < 3; ++a) extent = std::max(extent, bbox.max[a] - (*options.origin)[a]);
+    options.depth = depth_for_extent(extent, options.voxel_size);
+  }
+  return Quantizer::grid(*options.origin, options.voxel_size, options.depth);
+}
+
+Tree build(const PointCloud& cloud, const BuildOptions& requested, BuildReport* report) {
+  BuildOptions options = requested;
+  const std::size_t n = cloud.size();
+  if (cloud.xyz.size() != 3 * n) throw InvalidArgument("point cloud: xyz size is not a multiple of 3");
+  if (!cloud.payload.empty() && cloud.payload.size() != n)
+    throw InvalidArgument("point cloud: " + std::to_string(cloud.payload.size()) + " payloads for " +
+                          std::to_string(n) + " points");
+  for (const auto& a : cloud.attributes)
+    if (a.values.size() != n)
+      throw InvalidArgument("attribute '" + a.name + "': " + std::to_string(a.values.size()) +
+                            " values for " + std::to_string(n) + " points");
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument("more than 2^32 points in one build: split the input (vola tile)");
+
+  const Box bbox = options.bbox ? *options.bbox : cloud.bounds();
+  const Quantizer quantizer = resolve_quantizer(bbox, options);
+  const int depth = options.depth;
+
+  const bool per_point = options.payload || !cloud.attributes.empty();
+  std::vector<Key> keys;
+  keys.reserve(n);
+  std::vector<std::uint32_t> index;
+  if (per_point) index.reserve(n);
+  std::uint64_t outside = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    Voxel v;
+    if (!quantizer.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v)) {
+      ++outside;
+      continue;
+    }
+    keys.push_back(encode(v));
+    if (per_point) index.push_back(static_cast<std::uint32_t>(i));
+  }
+  radix_sort(keys, per_point ? &index : nullptr, 6 * depth);
+
+  Tree tree;
+  if (!per_point) {
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    tree = detail::emit_levels(keys, depth, {}, false);
+  } else {
+    // Runs of equal keys hold one voxel's points in input order.
+    std::vector<std::size_t> run_start;
+    std::vector<Key> unique_keys;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (i == 0 || keys[i] != keys[i - 1]) {
+        run_start.push_back(i);
+        unique_keys.push_back(keys[i]);
+      }
+    }
+    run_start.push_back(keys.size());
+    const std::size_t voxels = unique_keys.size();
+    std::vector<std::uint64_t> voxel_payloads;
+    if (options.payload) {
+      voxel_payloads.resize(voxels, kDefaultPayload);
+      if (!cloud.payload.empty())
+        for (std::size_t v = 0; v < voxels; ++v) voxel_payloads[v] = cloud.payload[index[run_start[v + 1] - 1]];
+    }
+    tree = detail::emit_levels(unique_keys, depth, voxel_payloads, options.payload);
+    if (options.payload) tree.set_voxel_payloads(std::move(voxel_payloads));
+    std::vector<double> scratch;
+    for (const auto& attribute : cloud.attributes) {
+      AttributeColumn column(attribute.name, attribute.type, attribute.reduction, voxels);
+      for (std::size_t v = 0; v < voxels; ++v) {
+        const std::span<const std::uint32_t> points(index.data() + run_start[v], run_start[v + 1] - run_start[v]);
+        column.set(v, reduce(attribute.values, points, attribute.reduction, scratch));
+      }
+      tree.attributes().add(std::move(column));
+    }
+  }
+  tree.georef().bbox = bbox;
+  tree.georef().epsg = options.epsg;
+  tree.set_frame(quantizer.frame());
+  if (report) {
+    report->points_in = n;
+    report->points_outside = outside;
+    report->voxels = tree.voxel_count();
+  }
+  return tree;
+}
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

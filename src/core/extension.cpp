@@ -1,0 +1,199 @@
+#include "extension.hpp"
+
+#include <cstring>
+
+#include "bytes.hpp"
+#include "codec.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+namespace detail {
+
+namespace {
+
+// A compressed record may claim at most this many raw bytes per stored byte (plus a
+// little), so a lying length cannot make us allocate far beyond the file's size.
+constexpr std::uint64_t kMaxRatio = 8192;
+constexpr std::uint64_t kRatioSlack = 1 << 20;
+constexpr std::uint32_t kShuffled = 1;  // levels record flag
+
+void begin_record(ByteWriter& w, RecordTag tag, std::uint32_t flags, std::uint64_t length) {
+  w.put(static_cast<std::uint32_t>(tag));
+  w.put(flags);
+  w.put(length);
+}
+
+std::span<const std::uint8_t> as_bytes(const std::string& s) {
+  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
+}
+
+void check_ratio(ByteReader& r, std::uint64_t raw, std::uint64_t packed) {
+  if (raw > packed * kMaxRatio + kRatioSlack)
+    r.fail("record claims " + std::to_string(raw) + " bytes from " + std::to_string(packed) +
+           " compressed bytes, more than any real data compresses");
+}
+
+}  // namespace
+
+bool needs_extension(const Tree& tree) noexcept {
+  const auto& frame = tree.stored_frame();
+  return (frame && frame->quantization == Quantization::grid) || !tree.georef().crs_wkt.empty() ||
+         !tree.attributes().empty();
+}
+
+bool starts_extension(std::span<const std::uint8_t> bytes) noexcept {
+  return bytes.size() >= 8 && std::memcmp(bytes.data(), kExtensionMagic, 8) == 0;
+}
+
+void append_extension(const Tree& tree, bool compress_levels, int level, std::vector<std::uint8_t>& out) {
+  ByteWriter w(out);
+  w.put_bytes(kExtensionMagic);
+  w.put(kExtensionVersion);
+  const std::uint32_t records = 1 + (tree.georef().crs_wkt.empty() ? 0 : 1) +
+                                static_cast<std::uint32_t>(tree.attributes().size()) + (compress_levels ? 1 : 0);
+  w.put(records);
+
+  const Frame frame = tree.frame();
+  begin_record(w, RecordTag::frame, 0, 40);
+  w.put(static_cast<std::uint8_t>(frame.quantization));
+  for (int i = 0; i < 7; ++i) w.put(std::uint8_t{0});
+  for (double o : frame.origin) w.put(o);
+  w.put(frame.voxel_size);
+
+  if (!tree.georef().crs_wkt.empty()) {
+    const auto& wkt = tree.georef().crs_wkt;
+    begin_record(w, RecordTag::crs_wkt, 0, wkt.size());
+    w.put_bytes(as_bytes(wkt));
+    w.pad_to(8);
+  }
+
+  for (const auto& column : tree.attributes().columns()) {
+    const auto raw = column.bytes();
+    std::vector<std::uint8_t> packed;
+    const bool compress = compress_levels && zstd_available();
+    if (compress)
+      packed = zstd_compress({reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()}, level);
+    const std::uint64_t data_size = compress ? packed.size() : raw.size();
+    begin_record(w, RecordTag::attribute, 0, 16 + column.name().size() + data_size);
+    w.put(static_cast<std::uint8_t>(column.type()));
+    w.put(static_cast<std::uint8_t>(column.reduction()));
+    w.put(static_cast<std::uint8_t>(compress ? 1 : 0));
+    w.put(std::uint8_t{0});
+    w.put(static_cast<std::uint32_t>(column.name().size()));
+    w.put(static_cast<std::uint64_t>(raw.size()));
+    w.put_bytes(as_bytes(column.name()));
+    if (compress) w.put_bytes(packed);
+    else w.put_bytes({reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()});
+    w.pad_to(8);
+  }
+
+  if (compress_levels) {
+    const auto shuffled = shuffle_words(tree.words());
+    const auto packed = zstd_compress(shuffled, level);
+    begin_record(w, RecordTag::levels, kShuffled, 8 + packed.size());
+    w.put(static_cast<std::uint64_t>(shuffled.size()));
+    w.put_bytes(packed);
+    w.pad_to(8);
+  }
+}
+
+ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
+                                   std::uint64_t base) {
+  ByteReader r(bytes, name, base);
+  const auto magic = r.take(8, "extension magic");
+  if (std::memcmp(magic.data(), kExtensionMagic, 8) != 0)
+    r.fail_at(base, "bytes after the levels are neither nothing nor a vola extension");
+  ExtensionContents out;
+  out.version = r.get<std::uint32_t>("extension version");
+  if (out.version == 0 || out.version > kExtensionVersion)
+    r.fail_at(base + 8, "extension version " + std::to_string(out.version) +
+                            " is not known to this vola (knows 1.." + std::to_string(kExtensionVersion) + ")");
+  const auto records = r.get<std::uint32_t>("extension record count");
+  for (std::uint32_t i = 0; i < records; ++i) {
+    const std::uint64_t record_offset = r.offset();
+    const auto tag = r.get<std::uint32_t>("record tag");
+    const auto flags = r.get<std::uint32_t>("record flags");
+    const auto length = r.get<std::uint64_t>("record length");
+    ByteReader body(r.take(length, "record body"), name, record_offset + 16);
+    r.skip_padding(8);
+    switch (static_cast<RecordTag>(tag)) {
+      case RecordTag::frame: {
+        Frame f;
+        const auto mode = body.get<std::uint8_t>("frame quantization");
+        if (mode > 1) body.fail_at(record_offset + 16, "unknown quantization mode " + std::to_string(mode));
+        f.quantization = static_cast<Quantization>(mode);
+        body.take(7, "frame padding");
+        for (double& o : f.origin) o = body.get<double>("frame origin");
+        f.voxel_size = body.get<double>("frame voxel size");
+        if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
+        out.frame = f;
+        break;
+      }
+      case RecordTag::crs_wkt: {
+        const auto text = body.take(length, "CRS WKT");
+        out.crs_wkt.assign(text.begin(), text.end());
+        break;
+      }
+      case RecordTag::attribute: {
+        const auto type = body.get<std::uint8_t>("attribute type");
+        const auto reduction = body.get<std::uint8_t>("attribute reduction");
+        const auto encoding = body.get<std::uint8_t>("attribute encoding");
+        body.get<std::uint8_t>("attribute reserved byte");
+        const auto name_length = body.get<std::uint32_t>("attribute name length");
+        const auto raw_size = body.get<std::uint64_t>("attribute size");
+        const auto column_name = body.take(name_length, "attribute name");
+        if (type > 9) body.fail_at(record_offset + 16, "unknown attribute value type " + std::to_string(type));
+        if (reduction > 4) body.fail_at(record_offset + 17, "unknown attribute reduction " + std::to_string(reduction));
+        if (encoding > 1) body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
+        AttributeColumn column(std::string(column_name.begin(), column_name.end()), static_cast<ValueType>(type),
+                               static_cast<Reduction>(reduction));
+        if (raw_size % size_of(column.type()) != 0)
+          body.fail_at(record_offset + 24, "attribute size " + std::to_string(raw_size) +
+                                               " is not a whole number of values");
+        const auto data = body.take(body.remaining(), "attribute data");
+        std::vector<std::uint8_t> raw;
+        if (encoding == 1) {
+          check_ratio(body, raw_size, data.size());
+          raw = zstd_decompress(data, raw_size, name, record_offset + 32 + name_length);
+        } else {
+          if (data.size() != raw_size)
+            body.fail_at(record_offset + 24, "attribute holds " + std::to_string(data.size()) +
+                                                 " bytes, its header says " + std::to_string(raw_size));
+          raw.assign(data.begin(), data.end());
+        }
+        column.resize(raw_size / size_of(column.type()));
+        if (!raw.empty()) std::memcpy(column.bytes().data(), raw.data(), raw.size());
+        for (const auto& other : out.attributes)
+          if (other.name() == column.name())
+            body.fail_at(record_offset, "attribute '" + column.name() + "' appears twice");
+        out.attributes.push_back(std::move(column));
+        break;
+      }
+      case RecordTag::levels: {
+        const auto raw_size = body.get<std::uint64_t>("levels size");
+        if (raw_size % 8 != 0) body.fail_at(record_offset + 16, "levels size is not a whole number of words");
+        const auto data = body.take(body.remaining(), "levels data");
+        check_ratio(body, raw_size, data.size());
+        auto raw = zstd_decompress(data, raw_size, name, record_offset + 24);
+        if (flags & kShuffled) {
+          out.levels = unshuffle_words(raw);
+        } else {
+          out.levels.resize(raw.size() / 8);
+          if (!raw.empty()) std::memcpy(out.levels.data(), raw.data(), raw.size());
+        }
+        out.has_levels = true;
+        out.compressed_level_bytes = data.size();
+        break;
+      }
+      default:
+        break;  // a record of a later version: skipped
+    }
+  }
+  if (r.remaining() != 0)
+    r.fail(std::to_string(r.remaining()) + " bytes follow the last extension record");
+  return out;
+}
+
+}  // namespace detail
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,277 @@
+#include "vola/file.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "bytes.hpp"
+#include "codec.hpp"
+#include "dense.hpp"
+#include "extension.hpp"
+#include "mapped_file.hpp"
+#include "vola/error.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+
+// The pieces of a file, so that write() can stream them without one big copy.
+struct Pieces {
+  std::uint8_t header[kHeaderSize];
+  std::span<const std::uint64_t> body;
+  std::vector<std::uint64_t> owned_body;  // dense bodies are made, sparse ones viewed
+  std::vector<std::uint8_t> extension;
+};
+
+Pieces assemble(const Tree& tree, const WriteOptions& options) {
+  Pieces p;
+  Header h;
+  h.layout = options.layout;
+  h.depth = static_cast<std::uint8_t>(tree.depth());
+  h.epsg = tree.georef().epsg;
+  h.lat = tree.georef().lat;
+  h.lon = tree.georef().lon;
+  h.bbox = tree.georef().bbox;
+  if (options.layout == Layout::dense) {
+    if (options.compress) throw InvalidArgument("compression applies to sparse files only");
+    if (tree.depth() > options.max_dense_depth)
+      throw InvalidArgument("a dense file of depth " + std::to_string(tree.depth()) + " holds " +
+                            std::to_string(detail::dense_level_words(tree.depth() - 1)) +
+                            " leaf words; write it sparse (dense is allowed up to depth " +
+                            std::to_string(options.max_dense_depth) + ")");
+    const bool payload = tree.has_payload() || !tree.voxel_payloads().empty();
+    h.nbits = payload ? (tree.nbits() ? tree.nbits() : 1) : 0;
+    p.owned_body = detail::encode_dense(tree);
+    p.body = p.owned_body;
+  } else {
+    h.nbits = tree.has_payload() ? tree.nbits() : 0;
+    if (options.compress) {
+      if (!compression_available()) throw Error("this vola was built without zstd: cannot compress");
+      h.version = kVersionCompressed;
+    } else {
+      p.body = tree.words();
+    }
+  }
+  if (options.compress || detail::needs_extension(tree))
+    detail::append_extension(tree, options.compress, options.compression_level, p.extension);
+  encode_header(h, p.header);
+  return p;
+}
+
+// Sparse levels: N_0 = 1, N_{L+1} = popcount of level L. Returns the number of words
+// the levels take, or throws naming the level that runs past the end.
+std::uint64_t sparse_extent(std::span<const std::uint8_t> bytes, int depth, bool payload, const std::string& name) {
+  const std::uint64_t available = (bytes.size() - kHeaderSize) / 8;
+  const std::uint8_t* base = bytes.data() + kHeaderSize;
+  std::uint64_t at = 0;
+  std::uint64_t blocks = 1;
+  for (int level = 0; level < depth; ++level) {
+    const std::uint64_t need = blocks * (payload ? 2 : 1);
+    if (need > available - at)
+      throw FormatError(name, kHeaderSize + 8 * at,
+                        "level " + std::to_string(level) + " needs " + std::to_string(blocks) + " blocks (" +
+                            std::to_string(8 * need) + " bytes) but the file ends at byte " +
+                            std::to_string(bytes.size()) + " (truncated file" +
+                            (payload ? ", or a payload word dropped by the reference writer's zero-payload bug"
+                                     : "") +
+                            ")");
+    std::uint64_t next = 0;
+    for (std::uint64_t i = 0; i < blocks; ++i) {
+      std::uint64_t word;
+      std::memcpy(&word, base + 8 * (at + i), 8);
+      next += static_cast<std::uint64_t>(std::popcount(word));
+    }
+    at += need;
+    blocks = next;
+  }
+  return at;
+}
+
+void apply_extension(Tree& tree, detail::ExtensionContents& ext, const std::string& name, std::uint64_t offset) {
+  if (ext.frame) tree.set_frame(*ext.frame);
+  tree.georef().crs_wkt = std::move(ext.crs_wkt);
+  for (auto& column : ext.attributes) {
+    if (column.size() != tree.voxel_count())
+      throw FormatError(name, offset,
+                        "attribute '" + column.name() + "' has " + std::to_string(column.size()) +
+                            " values for " + std::to_string(tree.voxel_count()) + " voxels");
+    tree.attributes().add(std::move(column));
+  }
+}
+
+Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::shared_ptr<const void> keeper,
+            FileLayout* layout) {
+  const Header h = decode_header(bytes, name);
+  FileLayout info;
+  info.header = h;
+  info.file_size = bytes.size();
+  const bool payload = h.nbits > 0;
+  Tree tree;
+  std::uint64_t extension_at = kHeaderSize;
+  if (h.version == kVersionCompressed) {
+    if (h.layout == Layout::dense)
+      throw FormatError(name, 6, "a compressed (version 2) file must be sparse");
+    auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize);
+    if (!ext.has_levels)
+      throw FormatError(name, kHeaderSize, "a version-2 file must hold its levels in the extension");
+    tree = Tree::from_levels(h.depth, payload, std::move(ext.levels), name + " (compressed levels)");
+    info.compressed_levels = true;
+    info.compressed_level_bytes = ext.compressed_level_bytes;
+    info.level_bytes = 8 * tree.words().size();
+    info.extension_offset = kHeaderSize;
+    info.extension_bytes = bytes.size() - kHeaderSize;
+    info.extension_version = ext.version;
+    apply_extension(tree, ext, name, kHeaderSize);
+    extension_at = bytes.size();
+  } else if (h.layout == Layout::sparse) {
+    const std::uint64_t words = sparse_extent(bytes, h.depth, payload, name);
+    const std::uint8_t* first = bytes.data() + kHeaderSize;
+    if (keeper && reinterpret_cast<std::uintptr_t>(first) % alignof(std::uint64_t) == 0) {
+      tree = Tree::view_levels(h.depth, payload, {reinterpret_cast<const std::uint64_t*>(first), words},
+                               std::move(keeper), name, kHeaderSize);
+    } else {
+      std::vector<std::uint64_t> copy(words);
+      if (words) std::memcpy(copy.data(), first, 8 * words);
+      tree = Tree::from_levels(h.depth, payload, std::move(copy), name);
+    }
+    info.level_bytes = 8 * words;
+    extension_at = kHeaderSize + 8 * words;
+  } else {
+    const std::uint64_t words = detail::dense_body_words(h.depth, payload);
+    const std::uint64_t available = (bytes.size() - kHeaderSize) / 8;
+    if (words > available)
+      throw FormatError(name, bytes.size(),
+                        "a dense file of depth " + std::to_string(h.depth) + (payload ? " with payload" : "") +
+                            " needs " + std::to_string(kHeaderSize + 8 * words) + " bytes, the file has " +
+                            std::to_string(bytes.size()) + " (truncated file)");
+    std::vector<std::uint64_t> copy(words);
+    std::memcpy(copy.data(), bytes.data() + kHeaderSize, 8 * words);
+    tree = detail::decode_dense(copy, h.depth, payload, name, kHeaderSize);
+    info.level_bytes = 8 * words;
+    extension_at = kHeaderSize + 8 * words;
+  }
+  if (extension_at < bytes.size()) {
+    const auto rest = bytes.subspan(extension_at);
+    if (!detail::starts_extension(rest))
+      throw FormatError(name, extension_at,
+                        std::to_string(rest.size()) +
+                            " bytes follow the last level and are not a vola extension (trailing garbage)");
+    auto ext = detail::decode_extension(rest, name, extension_at);
+    if (ext.has_levels)
+      throw FormatError(name, extension_at, "compressed levels in the extension of a version-1 file");
+    apply_extension(tree, ext, name, extension_at);
+    info.extension_offset = extension_at;
+    info.extension_bytes = rest.size();
+    info.extension_version = ext.version;
+  }
+  tree.georef().epsg = h.epsg;
+  tree.georef().lat = h.lat;
+  tree.georef().lon = h.lon;
+  tree.georef().bbox = h.bbox;
+  tree.set_nbits(h.nbits);
+  if (layout) *layout = info;
+  return tree;
+}
+
+void write_all(std::FILE* f, const void* data, std::size_t size, const std::string& path) {
+  if (size && std::fwrite(data, 1, size, f) != size)
+    throw IoError(path + ": write failed: " + std::strerror(errno));
+}
+
+}  // namespace
+
+bool compression_available() noexcept { return detail::zstd_available(); }
+
+void encode_header(const Header& h, std::uint8_t* out) {
+  std::vector<std::uint8_t> bytes;
+  detail::ByteWriter w(bytes);
+  w.put(h.header_size);
+  w.put(h.version);
+  w.put(static_cast<std::uint8_t>(h.layout));
+  w.put(h.depth);
+  w.put(h.nbits);
+  w.put(h.epsg);
+  w.put(h.lat);
+  w.put(h.lon);
+  for (double v : h.bbox.min) w.put(v);
+  for (double v : h.bbox.max) w.put(v);
+  std::memcpy(out, bytes.data(), kHeaderSize);
+}
+
+Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name) {
+  if (bytes.size() < kHeaderSize)
+    throw FormatError(name, bytes.size(),
+                      "the file is " + std::to_string(bytes.size()) + " bytes, shorter than the 80-byte header");
+  detail::ByteReader r(bytes.first(kHeaderSize), name, 0);
+  Header h;
+  h.header_size = r.get<std::uint32_t>("header size");
+  if (h.header_size != kHeaderSize)
+    throw FormatError(name, 0, "header size " + std::to_string(h.header_size) + " is not the 80 this format knows");
+  h.version = r.get<std::uint16_t>("version");
+  if (h.version != kVersionPlain && h.version != kVersionCompressed)
+    throw FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)");
+  const auto mode = r.get<std::uint8_t>("mode");
+  if (mode > 1) throw FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)");
+  h.layout = static_cast<Layout>(mode);
+  h.depth = r.get<std::uint8_t>("depth");
+  if (h.depth < kMinDepth || h.depth > kMaxDepth)
+    throw FormatError(name, 7, "depth " + std::to_string(h.depth) + " is outside 1..10");
+  h.nbits = r.get<std::uint32_t>("nbits");
+  h.epsg = r.get<std::uint32_t>("crs");
+  h.lat = r.get<double>("lat");
+  h.lon = r.get<double>("lon");
+  for (double& v : h.bbox.min) v = r.get<double>("bbox");
+  for (double& v : h.bbox.max) v = r.get<double>("bbox");
+  return h;
+}
+
+std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& options) {
+  const Pieces p = assemble(tree, options);
+  std::vector<std::uint8_t> out(kHeaderSize + 8 * p.body.size() + p.extension.size());
+  std::memcpy(out.data(), p.header, kHeaderSize);
+  if (!p.body.empty()) std::memcpy(out.data() + kHeaderSize, p.body.data(), 8 * p.body.size());
+  if (!p.extension.empty())
+    std::memcpy(out.data() + kHeaderSize + 8 * p.body.size(), p.extension.data(), p.extension.size());
+  return out;
+}
+
+void write(const Tree& tree, const std::string& path, const WriteOptions& options) {
+  const Pieces p = assemble(tree, options);
+  const std::string temporary = path + ".part";
+  std::FILE* f = std::fopen(temporary.c_str(), "wb");
+  if (!f) throw IoError(path + ": cannot create: " + std::strerror(errno));
+  try {
+    write_all(f, p.header, kHeaderSize, path);
+    write_all(f, p.body.data(), 8 * p.body.size(), path);
+    write_all(f, p.extension.data(), p.extension.size(), path);
+    if (std::fclose(f) != 0) {
+      f = nullptr;
+      throw IoError(path + ": write failed: " + std::strerror(errno));
+    }
+    f = nullptr;
+    if (std::rename(temporary.c_str(), path.c_str()) != 0)
+      throw IoError(path + ": cannot rename from " + temporary + ": " + std::strerror(errno));
+  } catch (...) {
+    if (f) std::fclose(f);
+    std::remove(temporary.c_str());
+    throw;
+  }
+}
+
+Tree parse(std::span<const std::uint8_t> bytes, const std::string& name, FileLayout* layout) {
+  return decode(bytes, name, nullptr, layout);
+}
+
+Tree read(const std::string& path, FileLayout* layout) {
+  const auto file = detail::MappedFile::open(path);
+  return decode(file->bytes(), path, nullptr, layout);
+}
+
+Tree open_mapped(const std::string& path, FileLayout* layout) {
+  const auto file = detail::MappedFile::open(path);
+  return decode(file->bytes(), path, file, layout);
+}
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,200 @@
+#include "vola/io/npy.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "vola/error.hpp"
+
+namespace vola::io {
+
+namespace {
+
+std::string_view find_value(std::string_view dict, std::string_view key, const std::string& name,
+                            std::uint64_t offset) {
+  const std::string quoted1 = "'" + std::string(key) + "'";
+  const std::string quoted2 = "\"" + std::string(key) + "\"";
+  std::size_t at = dict.find(quoted1);
+  std::size_t len = quoted1.size();
+  if (at == std::string_view::npos) {
+    at = dict.find(quoted2);
+    len = quoted2.size();
+  }
+  if (at == std::string_view::npos) throw FormatError(name, offset, "npy header has no '" + std::string(key) + "'");
+  std::size_t colon = dict.find(':', at + len);
+  if (colon == std::string_view::npos) throw FormatError(name, offset, "npy header: no ':' after " + std::string(key));
+  std::string_view rest = dict.substr(colon + 1);
+  while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
+  return rest;
+}
+
+}  // namespace
+
+std::uint64_t NpyArray::size() const noexcept {
+  std::uint64_t n = 1;
+  for (auto s : shape) n *= s;
+  return n;
+}
+
+std::string NpyArray::dtype() const {
+  return std::string(big_endian ? ">" : "<") + kind + std::to_string(item_size);
+}
+
+double NpyArray::value(std::uint64_t index) const noexcept {
+  std::uint64_t at = index;
+  if (fortran_order && shape.size() > 1) {
+    // C-order index -> Fortran-order storage position.
+    std::uint64_t rest = index, position = 0, stride = 1;
+    std::vector<std::uint64_t> digits(shape.size());
+    for (std::size_t d = shape.size(); d-- > 0;) {
+      digits[d] = rest % shape[d];
+      rest /= shape[d];
+    }
+    for (std::size_t d = 0; d < shape.size(); ++d) {
+      position += digits[d] * stride;
+      stride *= shape[d];
+    }
+    at = position;
+  }
+  std::uint8_t raw[8];
+  std::memcpy(raw, data.data() + at * item_size, item_size);
+  if (big_endian) std::reverse(raw, raw + item_size);
+  switch (kind) {
+    case 'f':
+      if (item_size == 4) { float f; std::memcpy(&f, raw, 4); return f; }
+      else { double d; std::memcpy(&d, raw, 8); return d; }
+    case 'b': return raw[0] ? 1.0 : 0.0;
+    case 'u': {
+      std::uint64_t u = 0;
+      std::memcpy(&u, raw, item_size);
+      return static_cast<double>(u);
+    }
+    default: {
+      std::uint64_t u = 0;
+      std::memcpy(&u, raw, item_size);
+      const int bits = 8 * item_size;
+      if (bits < 64 && (u >> (bits - 1)) & 1u) u |= ~std::uint64_t{0} << bits;  // sign-extend
+      return static_cast<double>(static_cast<std::int64_t>(u));
+    }
+  }
+}
+
+NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name) {
+  static const std::uint8_t magic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
+  if (bytes.size() < 10 || std::memcmp(bytes.data(), magic, 6) != 0)
+    throw FormatError(name, 0, "not a .npy file (no \\x93NUMPY magic)");
+  const int major = bytes[6];
+  std::uint64_t header_length = 0;
+  std::uint64_t header_start = 0;
+  if (major == 1) {
+    header_length = bytes[8] | (std::uint64_t{bytes[9]} << 8);
+    header_start = 10;
+  } else if (major == 2 || major == 3) {
+    if (bytes.size() < 12) throw FormatError(name, bytes.size(), "npy header is truncated");
+    header_length = bytes[8] | (std::uint64_t{bytes[9]} << 8) | (std::uint64_t{bytes[10]} << 16) |
+                    (std::uint64_t{bytes[11]} << 24);
+    header_start = 12;
+  } else {
+    throw FormatError(name, 6, "npy format version " + std::to_string(major) + " is not known (1..3)");
+  }
+  if (header_length > bytes.size() - header_start)
+    throw FormatError(name, header_start, "npy header of " + std::to_string(header_length) + " bytes runs past the end");
+  const std::string_view dict(reinterpret_cast<const char*>(bytes.data() + header_start), header_length);
+
+  NpyArray a;
+  std::string_view descr = find_value(dict, "descr", name, header_start);
+  if (descr.size() < 5 || (descr[0] != '\'' && descr[0] != '"'))
+    throw FormatError(name, header_start, "npy descr is not a simple dtype string");
+  const char order = descr[1];
+  a.kind = descr[2];
+  const std::size_t close = descr.find(descr[0], 1);
+  if (close == std::string_view::npos) throw FormatError(name, header_start, "npy descr is not terminated");
+  const std::string size_text(descr.substr(3, close - 3));
+  a.item_size = size_text == "1" ? 1 : size_text == "2" ? 2 : size_text == "4" ? 4 : size_text == "8" ? 8 : 0;
+  const bool kind_ok = (a.kind == 'f' && (a.item_size == 4 || a.item_size == 8)) ||
+                       ((a.kind == 'i' || a.kind == 'u') && a.item_size > 0) || (a.kind == 'b' && a.item_size == 1);
+  if (!kind_ok || (order != '<' && order != '>' && order != '|' && order != '='))
+    throw FormatError(name, header_start,
+                      "npy dtype " + std::string(descr.substr(0, close + 1)) +
+                          " is not supported (float32/64, int8..64, uint8..64, bool)");
+  a.big_endian = order == '>';
+
+  const std::string_view fortran = find_value(dict, "fortran_order", name, header_start);
+  a.fortran_order = fortran.substr(0, 4) == "True";
+
+  std::string_view shape = find_value(dict, "shape", name, header_start);
+  if (shape.empty() || shape.front() != '(') throw FormatError(name, header_start, "npy shape is not a tuple");
+  const std::size_t end = shape.find(')');
+  if (end == std::string_view::npos) throw FormatError(name, header_start, "npy shape is not terminated");
+  std::uint64_t count = 1;
+  std::uint64_t value = 0;
+  bool in_number = false;
+  for (std::size_t i = 1; i <= end; ++i) {
+    const char c = shape[i];
+    if (c >= '0' && c <= '9') {
+      if (value > (std::numeric_limits<std::uint64_t>::max() - 9) / 10)
+        throw FormatError(name, header_start, "npy shape dimension is too large");
+      value = value * 10 + static_cast<std::uint64_t>(c - '0');
+      in_number = true;
+    } else if (c == ',' || c == ')') {
+      if (in_number) {
+        a.shape.push_back(value);
+        if (value && count > std::numeric_limits<std::uint64_t>::max() / value)
+          throw FormatError(name, header_start, "npy shape is too large");
+        count *= value;
+      }
+      value = 0;
+      in_number = false;
+    } else if (c != ' ' && c != 'L') {
+      throw FormatError(name, header_start, std::string("npy shape has an unexpected '") + c + "'");
+    }
+  }
+  const std::uint64_t data_start = header_start + header_length;
+  const std::uint64_t available = bytes.size() - data_start;
+  if (count > available / static_cast<std::uint64_t>(a.item_size))
+    throw FormatError(name, bytes.size(),
+                      "npy shape promises " + std::to_string(count) + " values of " + std::to_string(a.item_size) +
+                          " bytes but only " + std::to_string(available) + " bytes follow the header (truncated)");
+  a.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(data_start),
+                bytes.begin() + static_cast<std::ptrdiff_t>(data_start + count * a.item_size));
+  return a;
+}
+
+NpyArray read_npy(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open");
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_npy(bytes, path);
+}
+
+PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns) {
+  if (array.shape.size() != 2 || array.shape[1] < 3)
+    throw FormatError(name, {}, "expected an (N, 3) or (N, >3) point array, got shape with " +
+                                    std::to_string(array.shape.size()) + " dimensions" +
+                                    (array.shape.size() == 2 ? " and " + std::to_string(array.shape[1]) + " columns" : ""));
+  const std::uint64_t n = array.shape[0];
+  const std::uint64_t columns = array.shape[1];
+  PointCloud cloud;
+  cloud.xyz.resize(3 * n);
+  for (std::uint64_t i = 0; i < n; ++i)
+    for (std::uint64_t c = 0; c < 3; ++c) cloud.xyz[3 * i + c] = array.value(i * columns + c);
+  if (payload_columns && columns > 3) {
+    if (columns - 3 > 8) throw FormatError(name, {}, "more than 8 payload columns do not fit a 64-bit payload word");
+    cloud.payload.resize(n);
+    for (std::uint64_t i = 0; i < n; ++i) {
+      std::uint64_t word = 0;
+      for (std::uint64_t c = 3; c < columns; ++c) {
+        const double v = array.value(i * columns + c);
+        if (!(v >= 0 && v <= 255) || v != static_cast<double>(static_cast<int>(v)))
+          throw FormatError(name, {}, "row " + std::to_string(i) + " column " + std::to_string(c) + ": payload byte " +
+                                          std::to_string(v) + " is not an integer 0..255");
+        word |= static_cast<std::uint64_t>(v) << (8 * (c - 3));
+      }
+      cloud.payload[i] = word;
+    }
+  }
+  return cloud;
+}
+
+}  // namespace vola::io
