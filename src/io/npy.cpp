@@ -13,8 +13,10 @@ namespace {
 
 std::string_view find_value(std::string_view dict, std::string_view key, const std::string& name,
                             std::uint64_t offset) {
-  const std::string quoted1 = "'" + std::string(key) + "'";
-  const std::string quoted2 = "\"" + std::string(key) + "\"";
+  std::string quoted1(1, '\'');
+  quoted1.append(key).push_back('\'');
+  std::string quoted2(1, '"');
+  quoted2.append(key).push_back('"');
   std::size_t at = dict.find(quoted1);
   std::size_t len = quoted1.size();
   if (at == std::string_view::npos) {
@@ -57,9 +59,9 @@ double NpyArray::value(std::uint64_t index) const noexcept {
     }
     at = position;
   }
-  std::uint8_t raw[8];
-  std::memcpy(raw, data.data() + at * item_size, item_size);
-  if (big_endian) std::reverse(raw, raw + item_size);
+  std::uint8_t raw[8] = {};
+  const std::size_t n = static_cast<std::size_t>(item_size) & 15u;
+  for (std::size_t b = 0; b < n && b < 8; ++b) raw[b] = data[at * n + (big_endian ? n - 1 - b : b)];
   switch (kind) {
     case 'f':
       if (item_size == 4) { float f; std::memcpy(&f, raw, 4); return f; }

@@ -86,6 +86,27 @@ class LineParser {
 
 }  // namespace
 
+int count_text_columns(const std::string& path, int skip_lines) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open");
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    if (++line_number <= skip_lines) continue;
+    std::size_t i = 0;
+    while (i < line.size() && is_separator(line[i])) ++i;
+    if (i == line.size() || line[i] == '#' || line.compare(i, 2, "//") == 0) continue;
+    int columns = 0;
+    while (i < line.size()) {
+      ++columns;
+      while (i < line.size() && !is_separator(line[i])) ++i;
+      while (i < line.size() && is_separator(line[i])) ++i;
+    }
+    return columns;
+  }
+  return 0;
+}
+
 PointCloud read_text_points(const std::string& path, const TextColumns& columns,
                             const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   std::ifstream in(path, std::ios::binary);

@@ -23,6 +23,9 @@ struct TextColumns {
   int skip_lines = 0;  // header lines to skip (txt2vola skips 1)
 };
 
+// Number of columns on the first data line after `skip_lines` lines (0 for none).
+int count_text_columns(const std::string& path, int skip_lines);
+
 // Reads the whole file; `progress(bytes_done, bytes_total)` is called now and then.
 // Throws FormatError "<file>: line N: ..." (with the byte offset) on a bad line.
 PointCloud read_text_points(const std::string& path, const TextColumns& columns,

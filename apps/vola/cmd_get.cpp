@@ -1,0 +1,58 @@
+// vola get: one voxel's occupancy, rank, payload and attributes.
+#include <cstdio>
+#include <string>
+
+#include "commands.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct GetArgs {
+  std::string file;
+  std::vector<double> position;
+  bool world = false;
+};
+
+void run_get(const GetArgs& a) {
+  const Tree tree = open_mapped(a.file);
+  Voxel v;
+  if (a.world) {
+    if (!tree.quantizer().to_voxel({a.position[0], a.position[1], a.position[2]}, v))
+      throw InvalidArgument("world point (" + std::to_string(a.position[0]) + ", " + std::to_string(a.position[1]) +
+                            ", " + std::to_string(a.position[2]) + ") is outside the grid");
+  } else {
+    std::uint32_t c[3];
+    for (int i = 0; i < 3; ++i) {
+      const double p = a.position[i];
+      if (!(p >= 0 && p < tree.side()) || p != static_cast<double>(static_cast<std::uint64_t>(p)))
+        throw InvalidArgument("voxel coordinate " + std::to_string(p) + " is not an integer in 0.." +
+                              std::to_string(tree.side() - 1) + " (use --world for CRS coordinates)");
+      c[i] = static_cast<std::uint32_t>(p);
+    }
+    v = Voxel{c[0], c[1], c[2]};
+  }
+  const auto rank = tree.rank(v);
+  std::printf("voxel %u %u %u: %s\n", v.x, v.y, v.z, rank ? "occupied" : "empty");
+  if (!rank) return;
+  std::printf("rank %llu\n", static_cast<unsigned long long>(*rank));
+  if (const auto p = tree.voxel_payload(v)) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*p));
+  for (const auto& c : tree.attributes().columns()) std::printf("%s %.17g\n", c.name().c_str(), c.get(*rank));
+}
+
+}  // namespace
+
+void add_get(CLI::App& app) {
+  auto args = std::make_shared<GetArgs>();
+  auto* cmd = app.add_subcommand("get", "Is voxel X Y Z occupied? Prints its rank, payload and attributes");
+  cmd->footer("Example: vola get scan.vol 120 455 31      vola get scan.vol 315420.5 234010.2 42.0 --world");
+  cmd->add_option("file", args->file, ".vol file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("position", args->position, "X Y Z: voxel coordinates (or world coordinates with --world)")
+      ->required()->expected(3)->allow_extra_args(false);
+  cmd->add_flag("--world", args->world, "X Y Z are in the file's CRS units, not voxel indices");
+  cmd->callback([args] { run_get(*args); });
+}
+
+}  // namespace vola::cli

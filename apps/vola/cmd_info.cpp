@@ -1,0 +1,108 @@
+// vola info: what a .vol file holds, level by level.
+#include <cstdio>
+#include <string>
+
+#include "commands.hpp"
+#include "vola/file.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct InfoArgs {
+  std::string file;
+  bool json = false;
+};
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') { out += "\\n"; continue; }
+    out += c;
+  }
+  return out + "\"";
+}
+
+void run_info(const InfoArgs& a) {
+  FileLayout layout;
+  const Tree tree = open_mapped(a.file, &layout);
+  const Header& h = layout.header;
+  const Frame frame = tree.frame();
+  const double voxels = static_cast<double>(tree.voxel_count());
+  const double bits = voxels > 0 ? 8.0 * static_cast<double>(layout.file_size) / voxels : 0.0;
+  const char* mode = h.layout == Layout::dense ? "dense" : "sparse";
+  if (a.json) {
+    std::printf("{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
+                "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %.17g,\n"
+                "  \"lon\": %.17g,\n  \"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g],\n"
+                "  \"voxels\": %llu,\n  \"bits_per_voxel\": %.4f,\n  \"quantization\": \"%s\",\n"
+                "  \"voxel_size\": %.17g,\n  \"origin\": [%.17g, %.17g, %.17g],\n  \"levels\": [",
+                quoted(a.file).c_str(), static_cast<unsigned long long>(layout.file_size), h.version, mode,
+                tree.depth(), tree.side(), h.nbits, h.epsg, h.lat, h.lon, h.bbox.min[0], h.bbox.min[1],
+                h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2],
+                static_cast<unsigned long long>(tree.voxel_count()), bits,
+                frame.quantization == Quantization::grid ? "grid" : "toolkit", frame.voxel_size, frame.origin[0],
+                frame.origin[1], frame.origin[2]);
+    for (int l = 0; l < tree.depth(); ++l)
+      std::printf("%s\n    {\"level\": %d, \"blocks\": %zu, \"occupied\": %llu}", l ? "," : "", l,
+                  tree.occupancy(l).size(), static_cast<unsigned long long>(tree.node_count(l)));
+    std::printf("\n  ],\n  \"attributes\": [");
+    const auto& columns = tree.attributes().columns();
+    for (std::size_t i = 0; i < columns.size(); ++i)
+      std::printf("%s\n    {\"name\": %s, \"type\": \"%s\", \"reduction\": \"%s\"}", i ? "," : "",
+                  quoted(columns[i].name()).c_str(), std::string(name_of(columns[i].type())).c_str(),
+                  std::string(name_of(columns[i].reduction())).c_str());
+    std::printf("\n  ],\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s\n}\n",
+                layout.compressed_levels ? "true" : "false", static_cast<unsigned long long>(layout.extension_bytes),
+                quoted(tree.georef().crs_wkt).c_str());
+    return;
+  }
+  std::printf("file:        %s (%llu bytes)\n", a.file.c_str(), static_cast<unsigned long long>(layout.file_size));
+  std::printf("header:      version %u, %s, depth %d (%u^3 voxels), nbits %u\n", h.version, mode, tree.depth(),
+              tree.side(), h.nbits);
+  std::printf("crs:         EPSG:%u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
+  std::printf("bbox:        min (%.17g, %.17g, %.17g)\n             max (%.17g, %.17g, %.17g)\n", h.bbox.min[0],
+              h.bbox.min[1], h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2]);
+  std::printf("grid:        %s quantization, voxel size %.9g, origin (%.9g, %.9g, %.9g)%s\n",
+              frame.quantization == Quantization::grid ? "grid" : "toolkit", frame.voxel_size, frame.origin[0],
+              frame.origin[1], frame.origin[2], tree.stored_frame() ? "" : " (from the header bbox)");
+  std::printf("voxels:      %llu occupied, %.2f bits per occupied voxel (whole file)\n",
+              static_cast<unsigned long long>(tree.voxel_count()), bits);
+  std::printf("levels:      level  blocks      occupied cells  bytes\n");
+  for (int l = 0; l < tree.depth(); ++l) {
+    const std::size_t blocks = h.layout == Layout::dense ? (std::size_t{1} << (6 * l)) : tree.occupancy(l).size();
+    std::printf("             %-5d  %-10zu  %-14llu  %llu\n", l, blocks,
+                static_cast<unsigned long long>(tree.node_count(l)),
+                static_cast<unsigned long long>(8 * blocks * (h.nbits ? 2 : 1)));
+  }
+  std::printf("level bytes: %llu%s\n", static_cast<unsigned long long>(layout.level_bytes),
+              layout.compressed_levels
+                  ? (" (zstd: " + std::to_string(layout.compressed_level_bytes) + " bytes in the file)").c_str()
+                  : "");
+  if (layout.extension_bytes) {
+    std::printf("extension:   %llu bytes, version %u\n", static_cast<unsigned long long>(layout.extension_bytes),
+                layout.extension_version);
+    for (const auto& c : tree.attributes().columns())
+      std::printf("attribute:   %s (%s, %s per voxel)\n", c.name().c_str(), std::string(name_of(c.type())).c_str(),
+                  std::string(name_of(c.reduction())).c_str());
+    if (!tree.georef().crs_wkt.empty()) {
+      const auto& wkt = tree.georef().crs_wkt;
+      std::printf("crs wkt:     %s%s\n", wkt.substr(0, wkt.find('\n')).c_str(), wkt.find('\n') != std::string::npos ? " ..." : "");
+    }
+  } else {
+    std::printf("extension:   none (a reference-format file)\n");
+  }
+}
+
+}  // namespace
+
+void add_info(CLI::App& app) {
+  auto args = std::make_shared<InfoArgs>();
+  auto* cmd = app.add_subcommand("info", "Header, depth, mode, per-level block and voxel counts, bytes, bits per voxel, metadata");
+  cmd->add_option("file", args->file, ".vol file")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--json", args->json, "Print JSON instead of a table");
+  cmd->callback([args] { run_info(*args); });
+}
+
+}  // namespace vola::cli

@@ -1,0 +1,45 @@
+// vola lod: a coarser copy (level of detail): each voxel is one cell of a coarser level.
+#include <cstdio>
+#include <string>
+
+#include "commands.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct LodArgs {
+  std::string input, output;
+  int depth = 0;
+  bool quiet = false;
+};
+
+void run_lod(const LodArgs& a) {
+  const Tree tree = open_mapped(a.input);
+  if (a.depth > tree.depth())
+    throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
+                          std::to_string(tree.depth()));
+  const Tree coarse = tree.level_of_detail(a.depth);
+  write(coarse, a.output);
+  if (!a.quiet)
+    std::printf("depth %d -> %d: %llu voxels -> %llu voxels, voxel size %.9g\n", tree.depth(), a.depth,
+                static_cast<unsigned long long>(tree.voxel_count()), static_cast<unsigned long long>(coarse.voxel_count()),
+                coarse.frame().voxel_size);
+}
+
+}  // namespace
+
+void add_lod(CLI::App& app) {
+  auto args = std::make_shared<LodArgs>();
+  auto* cmd = app.add_subcommand("lod", "Write a coarser copy: the first DEPTH levels, each voxel a 4^k-voxel cell");
+  cmd->footer("Example: vola lod city.vol --depth 4 city_lod4.vol");
+  cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--depth", args->depth, "Depth of the copy, 1..depth of the input")->required()->check(CLI::Range(1, 10));
+  cmd->add_option("output", args->output, "Output .vol")->required();
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->callback([args] { run_lod(*args); });
+}
+
+}  // namespace vola::cli

@@ -1,0 +1,15 @@
+// One function per subcommand file: each adds its subcommand to the app.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace vola::cli {
+
+void add_convert(CLI::App& app);
+void add_info(CLI::App& app);
+void add_voxels(CLI::App& app);  // voxels and coords
+void add_get(CLI::App& app);
+void add_lod(CLI::App& app);
+void add_setops(CLI::App& app);  // union, intersect, diff
+
+}  // namespace vola::cli

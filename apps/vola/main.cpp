@@ -1,0 +1,47 @@
+// vola: the command-line tool. Each subcommand lives in its own file; errors from the
+// library become one line on stderr and exit status 1 (2 for usage errors).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+#include "vola/error.hpp"
+#include "vola/version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "vola " VOLA_VERSION_STRING
+      " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
+      "one word per 4x4x4 block, one bit per voxel, children found by counting bits.\n\n"
+      "Examples:\n"
+      "  vola convert scan.xyz scan.vol --voxel-size 0.25 --crs 29902   # GIS grid, 25 cm voxels\n"
+      "  vola convert pts.txt pts.vol --quantize toolkit --depth 5         # as the reference toolkit\n"
+      "  vola info scan.vol\n"
+      "  vola get scan.vol 10 20 3\n"
+      "  vola lod scan.vol --depth 4 coarse.vol\n"
+      "  vola diff after.vol before.vol added.vol\n"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", VOLA_VERSION_STRING);
+  app.footer("Run 'vola SUBCOMMAND --help' for the options of one subcommand.");
+  vola::cli::add_convert(app);
+  vola::cli::add_info(app);
+  vola::cli::add_voxels(app);
+  vola::cli::add_get(app);
+  vola::cli::add_lod(app);
+  vola::cli::add_setops(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const vola::Error& e) {
+    std::fprintf(stderr, "vola: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "vola: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vola: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
