@@ -11,5 +11,6 @@ void add_voxels(CLI::App& app);  // voxels and coords
 void add_get(CLI::App& app);
 void add_lod(CLI::App& app);
 void add_setops(CLI::App& app);  // union, intersect, diff
+void add_generate(CLI::App& app);
 
 }  // namespace vola::cli

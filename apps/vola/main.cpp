@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
       "  vola info scan.vol\n"
       "  vola get scan.vol 10 20 3\n"
       "  vola lod scan.vol --depth 4 coarse.vol\n"
-      "  vola diff after.vol before.vol added.vol\n"};
+      "  vola diff after.vol before.vol added.vol\n"
+      "  vola generate city city.xyz --points 1000000\n"};
   app.require_subcommand(1);
   app.set_version_flag("--version", VOLA_VERSION_STRING);
   app.footer("Run 'vola SUBCOMMAND --help' for the options of one subcommand.");
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   vola::cli::add_get(app);
   vola::cli::add_lod(app);
   vola::cli::add_setops(app);
+  vola::cli::add_generate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,30 @@
+# Shared by the scripts: where things are, and installing Debian packages when missing.
+# shellcheck shell=bash
+set -euo pipefail
+
+VOLA_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+export VOLA_ROOT
+export VOLA_SHARED=${VOLA_SHARED:-$(cd "$VOLA_ROOT/.." && pwd)/shared}
+
+# Packages every build needs (the core needs none; the CLI, tests and geo do).
+VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-data libgtest-dev libgmock-dev
+  nlohmann-json3-dev python3 python3-numpy gzip)
+
+# install_packages PKG...: apt-get installs the ones that are missing (as root), or
+# says exactly what to install.
+install_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "vola: missing Debian packages: ${missing[*]}" >&2
+    echo "      run as root, or: sudo apt-get install ${missing[*]}" >&2
+    exit 1
+  fi
+  echo "vola: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
