@@ -10,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/io/las.hpp"
 #include "vola/io/npy.hpp"
 #include "vola/io/text_points.hpp"
 
@@ -30,6 +31,14 @@ struct ConvertArgs {
   std::vector<int> payload_columns;
   std::vector<std::string> attributes;
   int skip_lines = 0;
+  bool no_attributes = false;
+};
+
+// What a reader found: the points and, when the input says, its CRS.
+struct LoadedPoints {
+  PointCloud cloud;
+  std::optional<std::uint32_t> epsg;
+  std::string wkt;
 };
 
 std::string format_of(const ConvertArgs& a) {
@@ -37,6 +46,7 @@ std::string format_of(const ConvertArgs& a) {
   std::string ext = std::filesystem::path(a.input).extension().string();
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".npy") return "npy";
+  if (ext == ".las" || ext == ".laz") return "las";
   if (ext == ".xyz" || ext == ".txt" || ext == ".csv" || ext == ".pts" || ext == ".asc") return "text";
   throw InvalidArgument(a.input + ": cannot tell the format from the extension '" + ext +
                         "'; say --format text or --format npy (LAS, PLY, PCD and meshes come with a later release)");
@@ -77,15 +87,25 @@ void parse_attribute(const std::string& spec, io::TextColumns& columns) {
   columns.attribute_columns.push_back(column - 1);
 }
 
-PointCloud load_points(const ConvertArgs& a) {
+LoadedPoints load_las(const ConvertArgs& a) {
+  io::LasReader reader(a.input);
+  LoadedPoints out;
+  out.epsg = reader.header().epsg;
+  out.wkt = reader.header().wkt;
+  if (!out.epsg && !out.wkt.empty()) out.epsg = geo::epsg_from_wkt(out.wkt);
+  Progress progress("reading " + a.input);
+  out.cloud = io::las_points(reader, !a.no_attributes, a.nbits > 0,
+                             [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); });
+  return out;
+}
+
+LoadedPoints load_points(const ConvertArgs& a) {
   const std::string format = format_of(a);
-  if (format == "npy") {
-    if (!a.attributes.empty()) throw InvalidArgument("--attribute applies to text input only");
-    const auto array = io::read_npy(a.input);
-    return io::npy_points(array, a.input, a.nbits > 0);
-  }
+  if (format != "text" && !a.attributes.empty()) throw InvalidArgument("--attribute applies to text input only");
+  if (format == "npy") return {io::npy_points(io::read_npy(a.input), a.input, a.nbits > 0), {}, {}};
+  if (format == "las") return load_las(a);
   if (format != "text" && format != "xyz" && format != "txt")
-    throw InvalidArgument("--format " + format + " is not known (text, npy)");
+    throw InvalidArgument("--format " + format + " is not known (text, npy, las)");
   io::TextColumns columns;
   if (a.columns.size() != 3) throw InvalidArgument("--columns takes three column numbers (x y z)");
   for (int c : a.columns)
@@ -106,7 +126,10 @@ PointCloud load_points(const ConvertArgs& a) {
   }
   for (const auto& spec : a.attributes) parse_attribute(spec, columns);
   Progress progress("reading " + a.input);
-  return io::read_text_points(a.input, columns, [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); });
+  return {io::read_text_points(a.input, columns,
+                               [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); }),
+          {},
+          {}};
 }
 
 void run_convert(const ConvertArgs& a) {
@@ -135,19 +158,31 @@ void run_convert(const ConvertArgs& a) {
     options.bbox = b;
   }
   options.payload = a.nbits > 0;
-  options.epsg = a.crs;
 
   // Fail on a CRS PROJ does not know before reading gigabytes.
-  geo::crs_wkt(a.crs);
+  if (a.crs_given) geo::crs_wkt(a.crs);
 
-  PointCloud cloud = load_points(a);
-  if (cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
+  LoadedPoints loaded = load_points(a);
+  if (loaded.cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
+  // --crs wins over what the input says; without either the header keeps the
+  // reference's default code and says so.
+  const std::optional<std::uint32_t> epsg = a.crs_given ? std::optional<std::uint32_t>(a.crs) : loaded.epsg;
+  options.epsg = epsg.value_or(a.crs);
   BuildReport report;
-  Tree tree = build(cloud, options, &report);
-  const auto [lat, lon] = geo::centre_lat_lon(a.crs, tree.georef().bbox);
-  tree.georef().lat = lat;
-  tree.georef().lon = lon;
-  if (a.crs_given && options.quantization == Quantization::grid) tree.georef().crs_wkt = geo::crs_wkt(a.crs);
+  Tree tree = build(loaded.cloud, options, &report);
+  // lat/lon of the bbox centre through PROJ, from the code or else the input's WKT.
+  // A CRS PROJ cannot place leaves them 0 rather than failing the conversion, unless the
+  // user named it.
+  try {
+    const auto [lat, lon] = epsg || loaded.wkt.empty() ? geo::centre_lat_lon(options.epsg, tree.georef().bbox)
+                                                       : geo::centre_lat_lon(loaded.wkt, tree.georef().bbox);
+    tree.georef().lat = lat;
+    tree.georef().lon = lon;
+  } catch (const Error&) {
+    if (a.crs_given) throw;
+  }
+  if (!loaded.wkt.empty()) tree.georef().crs_wkt = loaded.wkt;
+  else if (epsg && (loaded.epsg || options.quantization == Quantization::grid)) tree.georef().crs_wkt = geo::crs_wkt(*epsg);
   if (a.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(a.nbits));
 
   WriteOptions w;
@@ -159,6 +194,11 @@ void run_convert(const ConvertArgs& a) {
   const auto in_bytes = std::filesystem::file_size(a.input);
   const auto out_bytes = std::filesystem::file_size(a.output);
   const Frame frame = tree.frame();
+  if (!epsg && !loaded.wkt.empty())
+    std::printf("crs:            WKT from the input, no EPSG code for it (kept in the extension; header code %u)\n", options.epsg);
+  else if (!epsg)
+    std::printf("crs:            none known (header carries the reference's default EPSG:%u)\n", options.epsg);
+  else std::printf("crs:            EPSG:%u\n", *epsg);
   std::printf("points in:      %llu (%s)\n", static_cast<unsigned long long>(report.points_in), a.input.c_str());
   if (report.points_outside)
     std::printf("points dropped: %llu (outside the grid or not finite)\n",
@@ -191,9 +231,9 @@ void add_convert(CLI::App& app) {
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
       "  vola convert scan.csv scan.vol --voxel-size 0.1 --attribute intensity=4:u16:mean\n"
       "  vola convert points.npy points.vol --depth 5 --compress");
-  cmd->add_option("input", args->input, "Input points: .xyz .txt .csv .pts .asc (text) or .npy")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", args->input, "Input points: .las (LAS 1.0-1.4), .xyz .txt .csv .pts .asc (text) or .npy")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file")->required();
-  cmd->add_option("--format", args->format, "Input format: auto (from the extension), text, npy")->capture_default_str();
+  cmd->add_option("--format", args->format, "Input format: auto (from the extension), las, text, npy")->capture_default_str();
   cmd->add_option("--depth", args->depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size")
       ->check(CLI::Range(1, 10));
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge in input units (grid mode)")->check(CLI::PositiveNumber);
@@ -215,6 +255,7 @@ void add_convert(CLI::App& app) {
                   "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "
                   "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean)");
   cmd->add_option("--skip-lines", args->skip_lines, "Text: header lines to skip")->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-attributes", args->no_attributes, "LAS: keep occupancy only, no per-voxel attribute columns");
   cmd->add_flag("--compress", args->compress, "zstd-compress the levels and attributes (a file only vola reads)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_convert(*args); });

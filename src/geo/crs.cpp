@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "vola/error.hpp"
 
@@ -33,18 +34,21 @@ std::string last_error(PJ_CONTEXT* ctx) {
 }  // namespace
 
 std::pair<double, double> centre_lat_lon(std::uint32_t epsg, const Box& bbox) {
+  return centre_lat_lon("EPSG:" + std::to_string(epsg), bbox);
+}
+
+std::pair<double, double> centre_lat_lon(const std::string& source, const Box& bbox) {
   Context ctx = make_context();
-  const std::string source = "EPSG:" + std::to_string(epsg);
   Pj transform(proj_create_crs_to_crs(ctx.get(), source.c_str(), "EPSG:4326", nullptr));
-  if (!transform) throw Error("CRS " + source + " is not known to PROJ: " + last_error(ctx.get()));
+  if (!transform) throw Error("CRS " + source.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
   Pj normalized(proj_normalize_for_visualization(ctx.get(), transform.get()));
   if (!normalized) throw Error("PROJ cannot normalise the axis order of " + source);
   const double cx = (bbox.min[0] + bbox.max[0]) / 2.0;
   const double cy = (bbox.min[1] + bbox.max[1]) / 2.0;
   const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, 0, 0));
   if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
-    throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source +
-                " to WGS84: " + last_error(ctx.get()));
+    throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source.substr(0, 60) +
+                " to WGS84: " + last_error(ctx.get()));  // NOLINT
   return {out.xy.y, out.xy.x};
 }
 
@@ -56,6 +60,47 @@ std::string crs_wkt(std::uint32_t epsg) {
   const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT2_2019, nullptr);
   if (!wkt) throw Error("PROJ cannot write " + source + " as WKT");
   return wkt;
+}
+
+std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
+  Context ctx = make_context();
+  Pj crs(proj_create(ctx.get(), wkt.c_str()));
+  if (!crs) return std::nullopt;
+  // Down to the horizontal CRS: a TOWGS84 clause makes a bound CRS, a vertical part a
+  // compound one.
+  for (int guard = 0; crs && guard < 4; ++guard) {
+    const PJ_TYPE type = proj_get_type(crs.get());
+    if (type == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx.get(), crs.get()));
+    else if (type == PJ_TYPE_COMPOUND_CRS) crs.reset(proj_crs_get_sub_crs(ctx.get(), crs.get(), 0));
+    else break;
+  }
+  if (!crs) return std::nullopt;
+  auto to_code = [](const char* auth, const char* code) -> std::optional<std::uint32_t> {
+    if (!auth || !code || std::string(auth) != "EPSG") return std::nullopt;
+    try {
+      return static_cast<std::uint32_t>(std::stoul(code));
+    } catch (...) {
+      return std::nullopt;
+    }
+  };
+  if (auto c = to_code(proj_get_id_auth_name(crs.get(), 0), proj_get_id_code(crs.get(), 0))) return c;
+  int* confidence = nullptr;
+  PJ_OBJ_LIST* candidates = proj_identify(ctx.get(), crs.get(), "EPSG", nullptr, &confidence);
+  std::optional<std::uint32_t> best;
+  if (candidates) {
+    int best_confidence = 69;
+    for (int i = 0; i < proj_list_get_count(candidates); ++i) {
+      if (confidence[i] <= best_confidence) continue;
+      Pj candidate(proj_list_get(ctx.get(), candidates, i));
+      if (auto c = to_code(proj_get_id_auth_name(candidate.get(), 0), proj_get_id_code(candidate.get(), 0))) {
+        best = c;
+        best_confidence = confidence[i];
+      }
+    }
+    proj_int_list_destroy(confidence);
+    proj_list_destroy(candidates);
+  }
+  return best;
 }
 
 }  // namespace vola::geo

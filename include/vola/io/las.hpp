@@ -1,0 +1,95 @@
+// ASPRS LAS 1.0-1.4, point data record formats 0-10, read natively from the
+// specification (no LAS library is packaged for Debian 12). Streaming: points come in
+// chunks of a chosen size, so a file larger than memory can be read in bounded memory.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vola/builder.hpp"
+
+namespace vola::io {
+
+struct LasVlr {
+  std::string user_id;
+  std::uint16_t record_id = 0;
+  std::string description;
+  bool extended = false;  // an EVLR (LAS 1.4)
+  std::uint64_t offset = 0;  // file offset of the record's data
+  std::vector<std::uint8_t> data;
+};
+
+// One "extra bytes" field (LASF_Spec record 4) of each point record.
+struct LasExtraField {
+  std::string name;
+  std::uint8_t data_type = 0;  // 1 u8, 2 i8, 3 u16, 4 i16, 5 u32, 6 i32, 7 u64, 8 i64, 9 f32, 10 f64; 0 raw bytes
+  std::uint32_t offset = 0;    // byte offset inside the record
+  std::uint32_t size = 0;
+  double scale = 1.0, add = 0.0;
+};
+
+struct LasHeader {
+  std::uint8_t version_major = 1, version_minor = 2;
+  std::string system_identifier, generating_software;
+  std::uint16_t header_size = 227;
+  std::uint32_t offset_to_points = 0;
+  std::uint8_t point_format = 0;
+  std::uint16_t record_length = 20;
+  std::uint64_t point_count = 0;  // the 1.4 64-bit count when present and non-zero
+  std::array<double, 3> scale{1, 1, 1}, offset{0, 0, 0}, min{}, max{};
+  std::uint16_t global_encoding = 0;
+  std::vector<LasVlr> vlrs;  // VLRs and EVLRs with their data
+  std::vector<LasExtraField> extra_fields;
+  std::optional<std::uint32_t> epsg;  // from the GeoKeyDirectory (not user-defined 32767)
+  std::string wkt;                    // OGC WKT record (LASF_Projection 2112), if any
+  bool has_rgb() const noexcept;
+  bool has_gps_time() const noexcept;
+  bool extended_format() const noexcept { return point_format >= 6; }
+  std::string version() const { return std::to_string(version_major) + "." + std::to_string(version_minor); }
+};
+
+// Structure of arrays for one chunk of points.
+struct LasChunk {
+  std::vector<double> xyz;  // x0 y0 z0 x1 ...
+  std::vector<std::uint16_t> intensity;
+  std::vector<std::uint8_t> return_number, number_of_returns, classification, user_data;
+  std::vector<std::uint16_t> point_source_id;
+  std::vector<double> gps_time;            // empty without GPS time
+  std::vector<std::uint16_t> red, green, blue;  // empty without RGB
+  std::vector<std::vector<double>> extra;  // one vector per LasHeader::extra_fields entry
+  std::size_t size() const noexcept { return xyz.size() / 3; }
+  void clear();
+};
+
+class LasReader {
+ public:
+  // Reads and checks the header and (E)VLRs. A LAZ file gets an error that says so and
+  // what to do. Throws FormatError with file and offset on anything malformed.
+  explicit LasReader(const std::string& path);
+  const LasHeader& header() const noexcept { return header_; }
+  // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end.
+  std::size_t read(LasChunk& chunk, std::size_t max_points);
+  std::uint64_t points_read() const noexcept { return next_; }
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  std::uint64_t file_size_ = 0;
+  LasHeader header_;
+  std::uint64_t next_ = 0;
+  std::vector<std::uint8_t> buffer_;
+};
+
+// The whole file as a point cloud with the attribute columns vola keeps from LAS:
+// red/green/blue (mean), intensity (mean), classification (majority), height (mean z),
+// number_of_returns (max), extra-bytes fields (mean); and, with `payload`, the
+// reference's 7-byte payload word per point (FORMAT.md section 8).
+PointCloud las_points(LasReader& reader, bool attributes, bool payload,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+
+}  // namespace vola::io

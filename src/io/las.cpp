@@ -1,0 +1,366 @@
+#include "vola/io/las.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "vola/error.hpp"
+
+namespace vola::io {
+
+namespace {
+
+template <class T>
+T load(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+std::string text(const std::uint8_t* p, std::size_t n) {
+  std::string s(reinterpret_cast<const char*>(p), n);
+  const auto end = s.find('\0');
+  if (end != std::string::npos) s.resize(end);
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+// Minimum record length of each point data record format (ASPRS LAS 1.4 R15).
+constexpr std::uint16_t kMinRecordLength[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+constexpr std::uint32_t kUserDefined = 32767;
+
+// Bytes of one value of a scalar extra-bytes type 1..10.
+std::size_t extra_size(std::uint8_t type) {
+  static constexpr std::size_t sizes[11] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+  return type <= 10 ? sizes[type] : 0;
+}
+
+double extra_value(const std::uint8_t* p, std::uint8_t type) {
+  switch (type) {
+    case 1: return load<std::uint8_t>(p);
+    case 2: return load<std::int8_t>(p);
+    case 3: return load<std::uint16_t>(p);
+    case 4: return load<std::int16_t>(p);
+    case 5: return load<std::uint32_t>(p);
+    case 6: return load<std::int32_t>(p);
+    case 7: return static_cast<double>(load<std::uint64_t>(p));
+    case 8: return static_cast<double>(load<std::int64_t>(p));
+    case 9: return load<float>(p);
+    case 10: return load<double>(p);
+    default: return 0.0;
+  }
+}
+
+}  // namespace
+
+bool LasHeader::has_rgb() const noexcept {
+  return point_format == 2 || point_format == 3 || point_format == 5 || point_format == 7 || point_format == 8 ||
+         point_format == 10;
+}
+
+bool LasHeader::has_gps_time() const noexcept { return point_format != 0 && point_format != 2; }
+
+void LasChunk::clear() {
+  xyz.clear();
+  intensity.clear();
+  return_number.clear();
+  number_of_returns.clear();
+  classification.clear();
+  user_data.clear();
+  point_source_id.clear();
+  gps_time.clear();
+  red.clear();
+  green.clear();
+  blue.clear();
+  for (auto& e : extra) e.clear();
+}
+
+LasReader::LasReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  if (!in_) throw IoError(path + ": cannot open");
+  in_.seekg(0, std::ios::end);
+  file_size_ = static_cast<std::uint64_t>(in_.tellg());
+  in_.seekg(0);
+  auto fail = [&](std::uint64_t offset, const std::string& cause) -> void { throw FormatError(path_, offset, cause); };
+  auto read_at = [&](std::uint64_t offset, std::uint64_t size, const char* what) {
+    if (offset > file_size_ || size > file_size_ - offset)
+      fail(offset, std::string(what) + " of " + std::to_string(size) + " bytes runs past the end of the " +
+                       std::to_string(file_size_) + "-byte file");
+    std::vector<std::uint8_t> bytes(size);
+    in_.seekg(static_cast<std::streamoff>(offset));
+    in_.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+    if (static_cast<std::uint64_t>(in_.gcount()) != size) fail(offset, std::string("cannot read ") + what);
+    return bytes;
+  };
+
+  if (file_size_ < 227) fail(file_size_, "a LAS file has at least a 227-byte header; this file has " + std::to_string(file_size_) + " bytes");
+  const auto h = read_at(0, std::min<std::uint64_t>(file_size_, 375), "header");
+  if (std::memcmp(h.data(), "LASF", 4) != 0) fail(0, "not a LAS file (no LASF signature)");
+  LasHeader& hd = header_;
+  hd.global_encoding = load<std::uint16_t>(&h[6]);
+  hd.version_major = h[24];
+  hd.version_minor = h[25];
+  if (hd.version_major != 1 || hd.version_minor > 4)
+    fail(24, "LAS version " + hd.version() + " is not known (1.0 to 1.4)");
+  hd.system_identifier = text(&h[26], 32);
+  hd.generating_software = text(&h[58], 32);
+  hd.header_size = load<std::uint16_t>(&h[94]);
+  hd.offset_to_points = load<std::uint32_t>(&h[96]);
+  const std::uint32_t vlr_count = load<std::uint32_t>(&h[100]);
+  const std::uint8_t raw_format = h[104];
+  hd.record_length = load<std::uint16_t>(&h[105]);
+  const std::uint32_t legacy_count = load<std::uint32_t>(&h[107]);
+  for (int a = 0; a < 3; ++a) {
+    hd.scale[a] = load<double>(&h[131 + 8 * a]);
+    hd.offset[a] = load<double>(&h[155 + 8 * a]);
+    hd.max[a] = load<double>(&h[179 + 16 * a]);
+    hd.min[a] = load<double>(&h[187 + 16 * a]);
+  }
+  const std::uint16_t min_header = hd.version_minor >= 4 ? 375 : hd.version_minor == 3 ? 235 : 227;
+  if (hd.header_size < min_header || hd.header_size > file_size_)
+    fail(94, "header size " + std::to_string(hd.header_size) + " does not fit LAS " + hd.version() +
+                 " (at least " + std::to_string(min_header) + ") or the file");
+  hd.point_count = legacy_count;
+  std::uint64_t evlr_start = 0;
+  std::uint32_t evlr_count = 0;
+  if (hd.version_minor >= 4) {
+    evlr_start = load<std::uint64_t>(&h[235]);
+    evlr_count = load<std::uint32_t>(&h[243]);
+    const std::uint64_t count64 = load<std::uint64_t>(&h[247]);
+    if (count64 != 0) hd.point_count = count64;
+  }
+
+  // VLRs, then EVLRs.
+  std::uint64_t at = hd.header_size;
+  bool laszip = false;
+  for (std::uint32_t i = 0; i < vlr_count; ++i) {
+    const auto v = read_at(at, 54, "VLR header");
+    LasVlr vlr;
+    vlr.user_id = text(&v[2], 16);
+    vlr.record_id = load<std::uint16_t>(&v[18]);
+    vlr.description = text(&v[22], 32);
+    vlr.offset = at + 54;
+    const std::uint16_t length = load<std::uint16_t>(&v[20]);
+    vlr.data = read_at(at + 54, length, "VLR data");
+    if (vlr.user_id == "laszip encoded") laszip = true;
+    hd.vlrs.push_back(std::move(vlr));
+    at += 54 + length;
+  }
+  if (raw_format & 0xC0 || laszip)
+    fail(104, "this is a LAZ (compressed LAS) file; no LAZ library is packaged for this system. Decompress it "
+              "first (e.g. `laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`) and convert the .las");
+  hd.point_format = raw_format;
+  if (hd.point_format > 10) fail(104, "point data record format " + std::to_string(hd.point_format) + " is not known (0..10)");
+  if (hd.record_length < kMinRecordLength[hd.point_format])
+    fail(105, "record length " + std::to_string(hd.record_length) + " is shorter than format " +
+                  std::to_string(hd.point_format) + " needs (" + std::to_string(kMinRecordLength[hd.point_format]) + ")");
+  if (hd.offset_to_points < at || hd.offset_to_points > file_size_)
+    fail(96, "offset to point data " + std::to_string(hd.offset_to_points) + " is before the end of the VLRs (" +
+                 std::to_string(at) + ") or past the end of the file");
+  for (std::uint32_t i = 0; i < evlr_count; ++i) {
+    const auto v = read_at(evlr_start, 60, "EVLR header");
+    LasVlr vlr;
+    vlr.extended = true;
+    vlr.user_id = text(&v[2], 16);
+    vlr.record_id = load<std::uint16_t>(&v[18]);
+    vlr.description = text(&v[28], 32);
+    const std::uint64_t length = load<std::uint64_t>(&v[20]);
+    vlr.offset = evlr_start + 60;
+    // Waveform data can be huge and is not needed: only keep what describes the points.
+    if (vlr.user_id == "LASF_Projection" || vlr.user_id == "LASF_Spec") vlr.data = read_at(evlr_start + 60, length, "EVLR data");
+    else if (length > file_size_ - std::min(file_size_, evlr_start + 60)) fail(evlr_start + 20, "EVLR length runs past the end of the file");
+    hd.vlrs.push_back(std::move(vlr));
+    evlr_start += 60 + length;
+  }
+  const std::uint64_t point_bytes = file_size_ - hd.offset_to_points;
+  if (hd.point_count > point_bytes / hd.record_length)
+    fail(hd.offset_to_points, "the header promises " + std::to_string(hd.point_count) + " points of " +
+                                  std::to_string(hd.record_length) + " bytes but only " + std::to_string(point_bytes) +
+                                  " bytes follow the point data offset (truncated file)");
+
+  // CRS and extra bytes.
+  for (const auto& vlr : hd.vlrs) {
+    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8) {
+      const std::size_t keys = load<std::uint16_t>(&vlr.data[6]);
+      std::optional<std::uint32_t> projected, geographic;
+      for (std::size_t k = 0; k < keys && 8 + 8 * k + 8 <= vlr.data.size(); ++k) {
+        const std::uint8_t* e = &vlr.data[8 + 8 * k];
+        const std::uint16_t id = load<std::uint16_t>(e), location = load<std::uint16_t>(e + 2);
+        const std::uint16_t value = load<std::uint16_t>(e + 6);
+        if (location != 0) continue;
+        if (id == 3072) projected = value;
+        if (id == 2048) geographic = value;
+      }
+      if (projected && *projected != kUserDefined && *projected != 0) hd.epsg = *projected;
+      else if (geographic && *geographic != kUserDefined && *geographic != 0) hd.epsg = *geographic;
+    } else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) {
+      hd.wkt = text(vlr.data.data(), vlr.data.size());
+    } else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) {
+      std::uint32_t offset = kMinRecordLength[hd.point_format];
+      for (std::size_t d = 0; d + 192 <= vlr.data.size(); d += 192) {
+        const std::uint8_t* e = &vlr.data[d];
+        const std::uint8_t type = e[2], options = e[3];
+        const std::string name = text(e + 4, 32);
+        if (type == 0) {  // undocumented bytes: options holds their count
+          offset += options;
+          continue;
+        }
+        // Types 11..30 (LAS 1.4 R13, deprecated since) are arrays of 2 or 3 values of
+        // type ((t - 1) % 10) + 1; each element becomes its own field.
+        if (type > 30) fail(vlr.offset + d + 2, "extra bytes field '" + name + "' has unknown data type " + std::to_string(type));
+        const std::uint8_t base = static_cast<std::uint8_t>((type - 1) % 10 + 1);
+        const int count = (type - 1) / 10 + 1;
+        for (int k = 0; k < count; ++k) {
+          LasExtraField f;
+          f.name = count == 1 ? name : name + "_" + std::to_string(k);
+          f.data_type = base;
+          f.size = static_cast<std::uint32_t>(extra_size(base));
+          f.offset = offset;
+          if (options & 8) f.scale = load<double>(e + 112 + 8 * k);
+          if (options & 16) f.add = load<double>(e + 136 + 8 * k);
+          hd.extra_fields.push_back(f);
+          offset += f.size;
+        }
+      }
+      if (offset > hd.record_length)
+        fail(vlr.offset, "extra bytes fields need " + std::to_string(offset) + " bytes per record, records have " +
+                             std::to_string(hd.record_length));
+    }
+  }
+  in_.seekg(hd.offset_to_points);
+}
+
+std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points) {
+  chunk.clear();
+  const LasHeader& hd = header_;
+  chunk.extra.resize(hd.extra_fields.size());
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  if (n == 0) return 0;
+  const std::size_t length = hd.record_length;
+  buffer_.resize(n * length);
+  in_.seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
+  in_.read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
+  if (static_cast<std::size_t>(in_.gcount()) != buffer_.size())
+    throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
+  const bool extended = hd.extended_format();
+  const bool rgb = hd.has_rgb(), gps = hd.has_gps_time();
+  // Byte offsets of the optional fields inside a record.
+  const std::size_t gps_at = extended ? 22 : 20;
+  const std::size_t rgb_at = extended ? 30 : (hd.point_format == 2 ? 20 : 28);
+  chunk.xyz.resize(3 * n);
+  chunk.intensity.resize(n);
+  chunk.return_number.resize(n);
+  chunk.number_of_returns.resize(n);
+  chunk.classification.resize(n);
+  chunk.user_data.resize(n);
+  chunk.point_source_id.resize(n);
+  if (gps) chunk.gps_time.resize(n);
+  if (rgb) {
+    chunk.red.resize(n);
+    chunk.green.resize(n);
+    chunk.blue.resize(n);
+  }
+  for (auto& e : chunk.extra) e.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* r = buffer_.data() + i * length;
+    for (int a = 0; a < 3; ++a)
+      chunk.xyz[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+    chunk.intensity[i] = load<std::uint16_t>(r + 12);
+    if (extended) {
+      chunk.return_number[i] = r[14] & 15u;
+      chunk.number_of_returns[i] = r[14] >> 4;
+      chunk.classification[i] = r[16];
+      chunk.user_data[i] = r[17];
+      chunk.point_source_id[i] = load<std::uint16_t>(r + 20);
+    } else {
+      chunk.return_number[i] = r[14] & 7u;
+      chunk.number_of_returns[i] = (r[14] >> 3) & 7u;
+      chunk.classification[i] = r[15] & 31u;  // bits 5-7 are synthetic/key-point/withheld flags
+      chunk.user_data[i] = r[17];
+      chunk.point_source_id[i] = load<std::uint16_t>(r + 18);
+    }
+    if (gps) chunk.gps_time[i] = load<double>(r + gps_at);
+    if (rgb) {
+      chunk.red[i] = load<std::uint16_t>(r + rgb_at);
+      chunk.green[i] = load<std::uint16_t>(r + rgb_at + 2);
+      chunk.blue[i] = load<std::uint16_t>(r + rgb_at + 4);
+    }
+    for (std::size_t f = 0; f < hd.extra_fields.size(); ++f) {
+      const auto& field = hd.extra_fields[f];
+      chunk.extra[f][i] = extra_value(r + field.offset, field.data_type) * field.scale + field.add;
+    }
+  }
+  next_ += n;
+  return n;
+}
+
+namespace {
+
+// The reference's las2vola payload: int(255 * clip((v - lo) / (hi - lo), 0, 1)).
+std::uint64_t payload_byte(double v, double lo, double hi) {
+  const double n = hi > lo ? std::clamp((v - lo) / (hi - lo), 0.0, 1.0) : 0.0;
+  return static_cast<std::uint64_t>(255.0 * n);
+}
+
+}  // namespace
+
+PointCloud las_points(LasReader& reader, bool attributes, bool payload,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  PointCloud cloud;
+  const std::uint64_t total = hd.point_count;
+  cloud.xyz.reserve(3 * total);
+  if (attributes) {
+    if (hd.has_rgb()) {
+      cloud.attributes.push_back({"red", ValueType::u16, Reduction::mean, {}});
+      cloud.attributes.push_back({"green", ValueType::u16, Reduction::mean, {}});
+      cloud.attributes.push_back({"blue", ValueType::u16, Reduction::mean, {}});
+    }
+    cloud.attributes.push_back({"intensity", ValueType::u16, Reduction::mean, {}});
+    cloud.attributes.push_back({"classification", ValueType::u8, Reduction::majority, {}});
+    cloud.attributes.push_back({"height", ValueType::f32, Reduction::mean, {}});
+    cloud.attributes.push_back({"number_of_returns", ValueType::u8, Reduction::max, {}});
+    for (const auto& f : hd.extra_fields) cloud.attributes.push_back({f.name, ValueType::f64, Reduction::mean, {}});
+    for (auto& a : cloud.attributes) a.values.reserve(total);
+  }
+  if (payload) cloud.payload.reserve(total);
+  const std::size_t rgb_columns = hd.has_rgb() ? 3 : 0;
+  LasChunk chunk;
+  while (const std::size_t n = reader.read(chunk, 1 << 20)) {
+    cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
+    if (attributes) {
+      auto& a = cloud.attributes;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (rgb_columns) {
+          a[0].values.push_back(chunk.red[i]);
+          a[1].values.push_back(chunk.green[i]);
+          a[2].values.push_back(chunk.blue[i]);
+        }
+        // Columns in the order pushed above: [red green blue] intensity classification height returns extra...
+        a[rgb_columns + 0].values.push_back(chunk.intensity[i]);
+        a[rgb_columns + 1].values.push_back(chunk.classification[i]);
+        a[rgb_columns + 2].values.push_back(chunk.xyz[3 * i + 2]);
+        a[rgb_columns + 3].values.push_back(chunk.number_of_returns[i]);
+        for (std::size_t f = 0; f < chunk.extra.size(); ++f) a[rgb_columns + 4 + f].values.push_back(chunk.extra[f][i]);
+      }
+    }
+    if (payload) {
+      for (std::size_t i = 0; i < n; ++i) {
+        std::uint64_t r = 200, g = 200, b = 200;
+        if (hd.has_rgb() && (chunk.red[i] | chunk.green[i] | chunk.blue[i])) {
+          r = chunk.red[i] / 256u;
+          g = chunk.green[i] / 256u;
+          b = chunk.blue[i] / 256u;
+        }
+        const std::uint64_t word = r | g << 8 | b << 16 | payload_byte(chunk.xyz[3 * i + 2], 0.0, hd.max[2]) << 24 |
+                                   payload_byte(chunk.number_of_returns[i], 1.0, 7.0) << 32 |
+                                   payload_byte(chunk.intensity[i], 0.0, 1000.0) << 40 |
+                                   payload_byte(chunk.classification[i], 0.0, 31.0) << 48;
+        cloud.payload.push_back(word);
+      }
+    }
+    if (progress) progress(reader.points_read(), total);
+  }
+  return cloud;
+}
+
+}  // namespace vola::io
