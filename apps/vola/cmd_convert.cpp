@@ -10,9 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
-#include "vola/io/las.hpp"
-#include "vola/io/npy.hpp"
-#include "vola/io/text_points.hpp"
+#include "vola/io/input.hpp"
 
 namespace vola::cli {
 
@@ -34,23 +32,6 @@ struct ConvertArgs {
   bool no_attributes = false;
 };
 
-// What a reader found: the points and, when the input says, its CRS.
-struct LoadedPoints {
-  PointCloud cloud;
-  std::optional<std::uint32_t> epsg;
-  std::string wkt;
-};
-
-std::string format_of(const ConvertArgs& a) {
-  if (a.format != "auto") return a.format;
-  std::string ext = std::filesystem::path(a.input).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".npy") return "npy";
-  if (ext == ".las" || ext == ".laz") return "las";
-  if (ext == ".xyz" || ext == ".txt" || ext == ".csv" || ext == ".pts" || ext == ".asc") return "text";
-  throw InvalidArgument(a.input + ": cannot tell the format from the extension '" + ext +
-                        "'; say --format text or --format npy (LAS, PLY, PCD and meshes come with a later release)");
-}
 
 // NAME=COLUMN[:TYPE[:REDUCTION]], e.g. intensity=4:u16:mean
 void parse_attribute(const std::string& spec, io::TextColumns& columns) {
@@ -87,25 +68,7 @@ void parse_attribute(const std::string& spec, io::TextColumns& columns) {
   columns.attribute_columns.push_back(column - 1);
 }
 
-LoadedPoints load_las(const ConvertArgs& a) {
-  io::LasReader reader(a.input);
-  LoadedPoints out;
-  out.epsg = reader.header().epsg;
-  out.wkt = reader.header().wkt;
-  if (!out.epsg && !out.wkt.empty()) out.epsg = geo::epsg_from_wkt(out.wkt);
-  Progress progress("reading " + a.input);
-  out.cloud = io::las_points(reader, !a.no_attributes, a.nbits > 0,
-                             [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); });
-  return out;
-}
-
-LoadedPoints load_points(const ConvertArgs& a) {
-  const std::string format = format_of(a);
-  if (format != "text" && !a.attributes.empty()) throw InvalidArgument("--attribute applies to text input only");
-  if (format == "npy") return {io::npy_points(io::read_npy(a.input), a.input, a.nbits > 0), {}, {}};
-  if (format == "las") return load_las(a);
-  if (format != "text" && format != "xyz" && format != "txt")
-    throw InvalidArgument("--format " + format + " is not known (text, npy, las)");
+io::TextColumns text_columns(const ConvertArgs& a) {
   io::TextColumns columns;
   if (a.columns.size() != 3) throw InvalidArgument("--columns takes three column numbers (x y z)");
   for (int c : a.columns)
@@ -125,19 +88,77 @@ LoadedPoints load_points(const ConvertArgs& a) {
     }
   }
   for (const auto& spec : a.attributes) parse_attribute(spec, columns);
+  return columns;
+}
+
+io::Input load_input(const ConvertArgs& a) {
+  const io::InputFormat& format = io::find_input_format(a.input, a.format);
+  if (format.name != "text" && !a.attributes.empty()) throw InvalidArgument("--attribute applies to text input only");
+  io::InputOptions options;
+  options.attributes = !a.no_attributes;
+  options.payload = a.nbits > 0;
+  if (format.name == "text") options.text = text_columns(a);
   Progress progress("reading " + a.input);
-  return {io::read_text_points(a.input, columns,
-                               [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); }),
-          {},
-          {}};
+  options.progress = [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); };
+  io::Input input = format.read(a.input, options);
+  if (!input.epsg && !input.wkt.empty()) input.epsg = geo::epsg_from_wkt(input.wkt);
+  return input;
+}
+
+// Voxel-grid inputs map one cell to one voxel unless the user asked for another grid:
+// then their cell centres are quantized like points.
+bool maps_one_to_one(const io::Input& input, const ConvertArgs& a) {
+  return input.grid && a.quantize.empty() && a.voxel_size <= 0.0 && a.origin.empty() && a.bbox.empty();
+}
+
+Tree build_from_grid(const io::VoxelGrid& grid, int requested_depth, BuildReport& report) {
+  const std::uint32_t largest = std::max({grid.dims[0], grid.dims[1], grid.dims[2], 1u});
+  int depth = requested_depth;
+  if (depth == 0)
+    for (depth = 1; depth < kMaxDepth && side_of(depth) < largest; ++depth) {
+    }
+  if (side_of(depth) < largest)
+    throw InvalidArgument("a " + std::to_string(largest) + "-cell grid does not fit depth " + std::to_string(depth) +
+                          " (" + std::to_string(side_of(depth)) + " voxels per axis)");
+  Tree tree = build_from_voxels(grid.voxels, depth);
+  Frame frame;
+  frame.quantization = Quantization::grid;
+  frame.origin = grid.origin;
+  frame.voxel_size = grid.voxel_size;
+  tree.set_frame(frame);
+  Box box{grid.origin, grid.origin};
+  for (int i = 0; i < 3; ++i) box.max[i] += grid.voxel_size * grid.dims[i];
+  tree.georef().bbox = box;
+  report.points_in = grid.voxels.size();
+  report.voxels = tree.voxel_count();
+  return tree;
+}
+
+// Cell centres of a voxel-grid input, as points.
+PointCloud grid_centres(const io::VoxelGrid& grid) {
+  PointCloud cloud;
+  cloud.xyz.reserve(3 * grid.voxels.size());
+  for (const Voxel& v : grid.voxels) {
+    cloud.xyz.push_back(grid.origin[0] + (v.x + 0.5) * grid.voxel_size);
+    cloud.xyz.push_back(grid.origin[1] + (v.y + 0.5) * grid.voxel_size);
+    cloud.xyz.push_back(grid.origin[2] + (v.z + 0.5) * grid.voxel_size);
+  }
+  return cloud;
 }
 
 void run_convert(const ConvertArgs& a) {
   const auto start = std::chrono::steady_clock::now();
+  // Fail on a CRS PROJ does not know before reading gigabytes.
+  if (a.crs_given) geo::crs_wkt(a.crs);
+  io::Input loaded = load_input(a);
+  const bool one_to_one = maps_one_to_one(loaded, a);
+
   BuildOptions options;
   const bool grid_hint = a.voxel_size > 0.0 || !a.origin.empty();
   const std::string quantize = a.quantize.empty() ? (grid_hint ? "grid" : "toolkit") : a.quantize;
-  if (quantize == "toolkit") {
+  if (one_to_one) {
+    options.quantization = Quantization::grid;
+  } else if (quantize == "toolkit") {
     options.quantization = Quantization::toolkit;
     if (a.depth == 0) throw InvalidArgument("--quantize toolkit needs --depth (1..10)");
     if (a.voxel_size > 0.0 || !a.origin.empty())
@@ -158,18 +179,22 @@ void run_convert(const ConvertArgs& a) {
     options.bbox = b;
   }
   options.payload = a.nbits > 0;
-
-  // Fail on a CRS PROJ does not know before reading gigabytes.
-  if (a.crs_given) geo::crs_wkt(a.crs);
-
-  LoadedPoints loaded = load_points(a);
-  if (loaded.cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
   // --crs wins over what the input says; without either the header keeps the
   // reference's default code and says so.
   const std::optional<std::uint32_t> epsg = a.crs_given ? std::optional<std::uint32_t>(a.crs) : loaded.epsg;
   options.epsg = epsg.value_or(a.crs);
   BuildReport report;
-  Tree tree = build(loaded.cloud, options, &report);
+  Tree tree;
+  if (one_to_one) {
+    tree = build_from_grid(*loaded.grid, a.depth, report);
+  } else {
+    if (loaded.grid) loaded.cloud = grid_centres(*loaded.grid);
+    if (loaded.is_mesh())
+      throw InvalidArgument(a.input + ": mesh input needs the mesh voxelizer, which this build lacks");
+    if (loaded.cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
+    tree = build(loaded.cloud, options, &report);
+  }
+  tree.georef().epsg = options.epsg;
   // lat/lon of the bbox centre through PROJ, from the code or else the input's WKT.
   // A CRS PROJ cannot place leaves them 0 rather than failing the conversion, unless the
   // user named it.
@@ -181,8 +206,15 @@ void run_convert(const ConvertArgs& a) {
   } catch (const Error&) {
     if (a.crs_given) throw;
   }
-  if (!loaded.wkt.empty()) tree.georef().crs_wkt = loaded.wkt;
-  else if (epsg && (loaded.epsg || options.quantization == Quantization::grid)) tree.georef().crs_wkt = geo::crs_wkt(*epsg);
+  // The CRS as WKT goes into the extension whenever we know it, except for a toolkit
+  // conversion of CRS-less input, which stays byte-identical to the reference's file.
+  const bool input_has_crs = loaded.epsg || !loaded.wkt.empty();
+  if (a.crs_given && (input_has_crs || options.quantization == Quantization::grid))
+    tree.georef().crs_wkt = geo::crs_wkt(a.crs);
+  else if (!a.crs_given && !loaded.wkt.empty())
+    tree.georef().crs_wkt = loaded.wkt;
+  else if (!a.crs_given && loaded.epsg)
+    tree.georef().crs_wkt = geo::crs_wkt(*loaded.epsg);
   if (a.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(a.nbits));
 
   WriteOptions w;

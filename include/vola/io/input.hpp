@@ -1,0 +1,59 @@
+// One entry point for every input format: `read_input` picks the reader by format
+// name or file extension and returns points, voxels or triangles, plus the CRS the
+// input states. `vola convert` turns any of them into a tree.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vola/builder.hpp"
+#include "vola/io/text_points.hpp"
+
+namespace vola::io {
+
+struct InputOptions {
+  bool attributes = true;  // keep per-point attributes the format carries
+  bool payload = false;    // build the reference's payload word per point where the format defines one
+  TextColumns text;        // text formats: which columns are what
+  std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
+};
+
+// Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).
+struct VoxelGrid {
+  std::array<std::uint32_t, 3> dims{0, 0, 0};  // cells per axis
+  Point origin{0, 0, 0};                       // world position of cell (0,0,0)'s corner
+  double voxel_size = 1.0;                     // world size of one cell
+  std::vector<Voxel> voxels;                   // occupied cells, any order
+};
+
+using Triangle = std::array<Point, 3>;
+
+struct Input {
+  std::string format;                  // the reader that produced it
+  PointCloud cloud;                    // point formats
+  std::optional<VoxelGrid> grid;       // voxel formats
+  std::vector<Triangle> triangles;     // mesh formats
+  std::optional<std::uint32_t> epsg;   // what the input says its CRS is
+  std::string wkt;
+  bool is_mesh() const noexcept { return !triangles.empty(); }
+};
+
+struct InputFormat {
+  std::string name;
+  std::vector<std::string> extensions;  // lower case, with the dot
+  std::string description;
+  std::function<Input(const std::string& path, const InputOptions&)> read;
+};
+
+// Every format this build reads.
+const std::vector<InputFormat>& input_formats();
+// The format for `path` ("auto" looks at the extension); throws InvalidArgument
+// listing what is known otherwise.
+const InputFormat& find_input_format(const std::string& path, const std::string& name = "auto");
+Input read_input(const std::string& path, const std::string& format, const InputOptions& options);
+
+}  // namespace vola::io

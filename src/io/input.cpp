@@ -1,0 +1,74 @@
+#include "vola/io/input.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include "vola/error.hpp"
+#include "vola/io/las.hpp"
+#include "vola/io/npy.hpp"
+
+namespace vola::io {
+
+namespace {
+
+Input read_las_input(const std::string& path, const InputOptions& options) {
+  LasReader reader(path);
+  Input in;
+  in.format = "las";
+  in.epsg = reader.header().epsg;
+  in.wkt = reader.header().wkt;
+  in.cloud = las_points(reader, options.attributes, options.payload, options.progress);
+  return in;
+}
+
+Input read_text_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "text";
+  in.cloud = read_text_points(path, options.text, options.progress);
+  return in;
+}
+
+Input read_npy_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "npy";
+  in.cloud = npy_points(read_npy(path), path, options.payload);
+  return in;
+}
+
+std::vector<InputFormat> make_formats() {
+  return {
+      {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10 (LAZ: a clear error)", read_las_input},
+      {"text", {".xyz", ".txt", ".csv", ".pts", ".asc"}, "points as text columns (x y z ...)", read_text_input},
+      {"npy", {".npy"}, "NumPy (N,3+) point arrays", read_npy_input},
+  };
+}
+
+}  // namespace
+
+const std::vector<InputFormat>& input_formats() {
+  static const std::vector<InputFormat> formats = make_formats();
+  return formats;
+}
+
+const InputFormat& find_input_format(const std::string& path, const std::string& name) {
+  const auto& formats = input_formats();
+  std::string known;
+  for (const auto& f : formats) known += (known.empty() ? "" : ", ") + f.name;
+  if (name != "auto") {
+    for (const auto& f : formats)
+      if (f.name == name) return f;
+    throw InvalidArgument("--format " + name + " is not known (" + known + ")");
+  }
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const auto& f : formats)
+    if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) return f;
+  throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext + "'; say --format (" + known + ")");
+}
+
+Input read_input(const std::string& path, const std::string& format, const InputOptions& options) {
+  return find_input_format(path, format).read(path, options);
+}
+
+}  // namespace vola::io
