@@ -1,0 +1,32 @@
+// Seed inputs for fuzzing: the golden reference files plus files written by vola
+// itself that reach what the reference never produces (extension records, attribute
+// columns, compressed levels, dense payloads, depth 10).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace vola_fuzz {
+
+struct Seed {
+  std::string name;
+  std::vector<std::uint8_t> bytes;
+};
+
+// Outcomes of LLVMFuzzerTestOneInput so far.
+struct Stats {
+  std::uint64_t parsed = 0;
+  std::uint64_t refused = 0;
+};
+Stats& stats();
+
+// Files written by the library.
+std::vector<Seed> synthetic_seeds();
+// Every .vol / .dvol / .dvol.gz below `golden` (gunzipped with gzip -dc). Throws
+// std::runtime_error when a file cannot be read.
+std::vector<Seed> golden_seeds(const std::filesystem::path& golden);
+
+}  // namespace vola_fuzz
