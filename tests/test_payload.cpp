@@ -197,6 +197,9 @@ TEST(PayloadDefaults, EmptyVoxelsHaveNoPayload) {
   vola::Tree tree = vola::build(cloud, {.depth = 2, .payload = true});
   EXPECT_FALSE(tree.voxel_payload({1, 0, 0}).has_value());
   EXPECT_FALSE(tree.block_payload({1, 0, 0}).has_value());
+  // Outside the 16^3 grid: (16, 0, 0) must not alias onto (0, 0, 0).
+  EXPECT_FALSE(tree.voxel_payload({16, 0, 0}).has_value());
+  EXPECT_FALSE(tree.block_payload({16, 0, 0}).has_value());
   EXPECT_THROW(tree.set_voxel_payloads({1, 2, 3}), vola::InvalidArgument);
 }
 

@@ -124,12 +124,14 @@ TEST_P(TreeProperty, ContainsIsFalseOutsideTheGrid) {
     int n = 0;
     for (const Xyz& v : voxels) {
       if (++n > 200) break;
+      // side << 2 at depth 10 is 2^22: past the 20 bits per axis a key holds.
       for (std::uint32_t offset : {side, 2 * side, side << 2}) {
-        if (offset >= (1u << 20)) continue;  // keys hold 20 bits per axis
         EXPECT_FALSE(tree.contains(v[0] + offset, v[1], v[2]));
         EXPECT_FALSE(tree.contains(v[0], v[1] + offset, v[2]));
         EXPECT_FALSE(tree.contains(v[0], v[1], v[2] + offset));
         EXPECT_FALSE(tree.rank(vola::Voxel{v[0], v[1], v[2] + offset}).has_value());
+        const Xyz cell = coarse_cell(v, 0, s.depth);
+        EXPECT_FALSE(tree.contains_node(0, vola::Voxel{cell[0] + 4, cell[1], cell[2]}));
       }
     }
   });

@@ -42,7 +42,8 @@ void exercise(const vola::Tree& tree) {
     // A neighbour that may or may not be occupied, and one outside the grid.
     const vola::Voxel next{v.x ^ 1u, v.y, v.z};
     check(tree.contains(next) == tree.rank(next).has_value());
-    check(!tree.contains(v.x + tree.side(), v.y, v.z) || tree.side() >= (1u << 20));
+    check(!tree.contains(v.x + tree.side(), v.y, v.z));
+    check(!tree.rank(vola::Voxel{v.x, v.y, v.z + tree.side()}).has_value());
   }
   for (int level = 0; level < tree.depth(); ++level) {
     std::uint64_t cells = 0;
