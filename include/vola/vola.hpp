@@ -8,5 +8,6 @@
 #include "vola/frame.hpp"
 #include "vola/key.hpp"
 #include "vola/setops.hpp"
+#include "vola/stream_builder.hpp"
 #include "vola/tree.hpp"
 #include "vola/version.hpp"

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "vola/error.hpp"
+#include "vola/stream_builder.hpp"
 
 namespace vola::io {
 
@@ -303,64 +304,138 @@ std::uint64_t payload_byte(double v, double lo, double hi) {
 
 }  // namespace
 
+std::vector<AttributeSpec> las_attributes(const LasHeader& hd) {
+  std::vector<AttributeSpec> specs;
+  if (hd.has_rgb()) {
+    specs.push_back({"red", ValueType::u16, Reduction::mean});
+    specs.push_back({"green", ValueType::u16, Reduction::mean});
+    specs.push_back({"blue", ValueType::u16, Reduction::mean});
+  }
+  specs.push_back({"intensity", ValueType::u16, Reduction::mean});
+  specs.push_back({"classification", ValueType::u8, Reduction::majority});
+  specs.push_back({"height", ValueType::f32, Reduction::mean});
+  specs.push_back({"number_of_returns", ValueType::u8, Reduction::max});
+  for (const auto& f : hd.extra_fields) specs.push_back({f.name, ValueType::f64, Reduction::mean});
+  return specs;
+}
+
+void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vector<std::vector<double>>& values) {
+  const std::size_t n = chunk.size();
+  values.resize(las_attributes(hd).size());
+  std::size_t c = 0;
+  auto column = [&](auto&& value_of) {
+    auto& v = values[c++];
+    v.resize(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = value_of(i);
+  };
+  if (hd.has_rgb()) {
+    column([&](std::size_t i) { return static_cast<double>(chunk.red[i]); });
+    column([&](std::size_t i) { return static_cast<double>(chunk.green[i]); });
+    column([&](std::size_t i) { return static_cast<double>(chunk.blue[i]); });
+  }
+  column([&](std::size_t i) { return static_cast<double>(chunk.intensity[i]); });
+  column([&](std::size_t i) { return static_cast<double>(chunk.classification[i]); });
+  column([&](std::size_t i) { return chunk.xyz[3 * i + 2]; });
+  column([&](std::size_t i) { return static_cast<double>(chunk.number_of_returns[i]); });
+  for (const auto& extra : chunk.extra) column([&](std::size_t i) { return extra[i]; });
+}
+
+void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::uint64_t>& payloads) {
+  const std::size_t n = chunk.size();
+  payloads.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t r = 200, g = 200, b = 200;  // the reference's grey for points without colour
+    if (hd.has_rgb() && (chunk.red[i] | chunk.green[i] | chunk.blue[i])) {
+      r = chunk.red[i] / 256u;
+      g = chunk.green[i] / 256u;
+      b = chunk.blue[i] / 256u;
+    }
+    payloads[i] = r | g << 8 | b << 16 | payload_byte(chunk.xyz[3 * i + 2], 0.0, hd.max[2]) << 24 |
+                  payload_byte(chunk.number_of_returns[i], 1.0, 7.0) << 32 |
+                  payload_byte(chunk.intensity[i], 0.0, 1000.0) << 40 |
+                  payload_byte(chunk.classification[i], 0.0, 31.0) << 48;
+  }
+}
+
+void LasReader::rewind() {
+  next_ = 0;
+  in_.clear();
+  in_.seekg(header_.offset_to_points);
+}
+
 PointCloud las_points(LasReader& reader, bool attributes, bool payload,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   PointCloud cloud;
   const std::uint64_t total = hd.point_count;
   cloud.xyz.reserve(3 * total);
-  if (attributes) {
-    if (hd.has_rgb()) {
-      cloud.attributes.push_back({"red", ValueType::u16, Reduction::mean, {}});
-      cloud.attributes.push_back({"green", ValueType::u16, Reduction::mean, {}});
-      cloud.attributes.push_back({"blue", ValueType::u16, Reduction::mean, {}});
-    }
-    cloud.attributes.push_back({"intensity", ValueType::u16, Reduction::mean, {}});
-    cloud.attributes.push_back({"classification", ValueType::u8, Reduction::majority, {}});
-    cloud.attributes.push_back({"height", ValueType::f32, Reduction::mean, {}});
-    cloud.attributes.push_back({"number_of_returns", ValueType::u8, Reduction::max, {}});
-    for (const auto& f : hd.extra_fields) cloud.attributes.push_back({f.name, ValueType::f64, Reduction::mean, {}});
-    for (auto& a : cloud.attributes) a.values.reserve(total);
-  }
-  if (payload) cloud.payload.reserve(total);
-  const std::size_t rgb_columns = hd.has_rgb() ? 3 : 0;
+  if (attributes)
+    for (const auto& spec : las_attributes(hd)) cloud.attributes.push_back({spec.name, spec.type, spec.reduction, {}});
   LasChunk chunk;
-  while (const std::size_t n = reader.read(chunk, 1 << 20)) {
+  std::vector<std::vector<double>> values;
+  std::vector<std::uint64_t> payloads;
+  while (reader.read(chunk, 1 << 20) > 0) {
     cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
     if (attributes) {
-      auto& a = cloud.attributes;
-      for (std::size_t i = 0; i < n; ++i) {
-        if (rgb_columns) {
-          a[0].values.push_back(chunk.red[i]);
-          a[1].values.push_back(chunk.green[i]);
-          a[2].values.push_back(chunk.blue[i]);
-        }
-        // Columns in the order pushed above: [red green blue] intensity classification height returns extra...
-        a[rgb_columns + 0].values.push_back(chunk.intensity[i]);
-        a[rgb_columns + 1].values.push_back(chunk.classification[i]);
-        a[rgb_columns + 2].values.push_back(chunk.xyz[3 * i + 2]);
-        a[rgb_columns + 3].values.push_back(chunk.number_of_returns[i]);
-        for (std::size_t f = 0; f < chunk.extra.size(); ++f) a[rgb_columns + 4 + f].values.push_back(chunk.extra[f][i]);
-      }
+      las_attribute_values(hd, chunk, values);
+      for (std::size_t a = 0; a < values.size(); ++a)
+        cloud.attributes[a].values.insert(cloud.attributes[a].values.end(), values[a].begin(), values[a].end());
     }
     if (payload) {
-      for (std::size_t i = 0; i < n; ++i) {
-        std::uint64_t r = 200, g = 200, b = 200;
-        if (hd.has_rgb() && (chunk.red[i] | chunk.green[i] | chunk.blue[i])) {
-          r = chunk.red[i] / 256u;
-          g = chunk.green[i] / 256u;
-          b = chunk.blue[i] / 256u;
-        }
-        const std::uint64_t word = r | g << 8 | b << 16 | payload_byte(chunk.xyz[3 * i + 2], 0.0, hd.max[2]) << 24 |
-                                   payload_byte(chunk.number_of_returns[i], 1.0, 7.0) << 32 |
-                                   payload_byte(chunk.intensity[i], 0.0, 1000.0) << 40 |
-                                   payload_byte(chunk.classification[i], 0.0, 31.0) << 48;
-        cloud.payload.push_back(word);
-      }
+      las_payloads(hd, chunk, payloads);
+      cloud.payload.insert(cloud.payload.end(), payloads.begin(), payloads.end());
     }
     if (progress) progress(reader.points_read(), total);
   }
   return cloud;
+}
+
+Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  LasChunk chunk;
+  constexpr std::size_t kChunk = 1 << 20;
+  const std::uint64_t passes = options.bbox ? 1 : 2;
+  // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
+  if (!options.bbox) {
+    Box box;
+    bool first = true;
+    reader.rewind();
+    while (const std::size_t n = reader.read(chunk, kChunk)) {
+      for (std::size_t i = 0; i < n; ++i)
+        for (int a = 0; a < 3; ++a) {
+          const double v = chunk.xyz[3 * i + a];
+          if (first || v < box.min[a]) box.min[a] = v;
+          if (first || v > box.max[a]) box.max[a] = v;
+          first = a < 2 && first;
+        }
+      if (progress) progress(reader.points_read(), passes * hd.point_count);
+    }
+    options.bbox = box;
+  }
+  const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
+  std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
+  StreamBuilder builder(quantizer, specs, payload);
+  std::vector<std::vector<double>> values;
+  std::vector<std::span<const double>> views;
+  std::vector<std::uint64_t> payloads;
+  reader.rewind();
+  while (const std::size_t n = reader.read(chunk, kChunk)) {
+    if (attributes) las_attribute_values(hd, chunk, values);
+    views.assign(values.begin(), values.end());
+    if (payload) las_payloads(hd, chunk, payloads);
+    builder.add(chunk.xyz, views, payload ? std::span<const std::uint64_t>(payloads) : std::span<const std::uint64_t>{});
+    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+  }
+  Tree tree = builder.finish();
+  tree.georef().bbox = *options.bbox;
+  tree.georef().epsg = options.epsg;
+  if (report) {
+    report->points_in = builder.points_in();
+    report->points_outside = builder.points_outside();
+    report->voxels = tree.voxel_count();
+  }
+  return tree;
 }
 
 }  // namespace vola::io

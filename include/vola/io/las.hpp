@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/stream_builder.hpp"
 
 namespace vola::io {
 
@@ -75,6 +76,8 @@ class LasReader {
   // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end.
   std::size_t read(LasChunk& chunk, std::size_t max_points);
   std::uint64_t points_read() const noexcept { return next_; }
+  // Back to the first point (for a second pass).
+  void rewind();
 
  private:
   std::string path_;
@@ -91,5 +94,18 @@ class LasReader {
 // reference's 7-byte payload word per point (FORMAT.md section 8).
 PointCloud las_points(LasReader& reader, bool attributes, bool payload,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+
+// The attribute columns vola keeps from a LAS file, and their per-point values for a
+// chunk (one vector per column, in the same order).
+std::vector<AttributeSpec> las_attributes(const LasHeader& header);
+void las_attribute_values(const LasHeader& header, const LasChunk& chunk, std::vector<std::vector<double>>& values);
+// The reference's payload word per point.
+void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<std::uint64_t>& payloads);
+
+// The file straight into a tree in memory bounded by the voxels, not the points
+// (vola::StreamBuilder): one pass for the bounds (unless options.bbox is set), one to
+// build. Resolves `options` (depth, voxel size, origin) like vola::build.
+Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
 }  // namespace vola::io

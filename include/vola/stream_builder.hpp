@@ -1,0 +1,60 @@
+// Building a tree from points that arrive in chunks, in memory bounded by the number
+// of distinct voxels rather than the number of points: each chunk is sorted and
+// reduced to one record per voxel at once, and the reduced runs are merged like a
+// binary counter (a run merges with the previous one when it has grown as large), so
+// every voxel record is merged O(log chunks) times.
+//
+// The result equals vola::build over all the points at once with the same quantizer:
+// the same voxels, the same attribute values for every reduction (majorities from
+// exact counts; means from sums and counts, equal up to the order of floating-point
+// summation), and the same payloads (the last point of a voxel in input order wins, as
+// the reference's dict does).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/builder.hpp"
+#include "vola/frame.hpp"
+#include "vola/tree.hpp"
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+struct AttributeSpec {
+  std::string name;
+  ValueType type = ValueType::f32;
+  Reduction reduction = Reduction::mean;
+};
+
+class StreamBuilder {
+ public:
+  StreamBuilder(const Quantizer& quantizer, std::vector<AttributeSpec> attributes, bool payload);
+  ~StreamBuilder();
+  StreamBuilder(StreamBuilder&&) noexcept;
+  StreamBuilder& operator=(StreamBuilder&&) noexcept;
+
+  // One chunk: xyz holds 3 values per point; values[a] one value per point for
+  // attribute a (in the order given to the constructor); payloads one word per point
+  // when building payloads (else empty).
+  void add(std::span<const double> xyz, std::span<const std::span<const double>> values,
+           std::span<const std::uint64_t> payloads);
+  // All chunks added: the tree (frame set from the quantizer; georef left to the caller).
+  Tree finish();
+
+  std::uint64_t points_in() const noexcept;
+  std::uint64_t points_outside() const noexcept;
+  // Bytes held by the reduced runs now (the memory bound: ~ voxels, not points).
+  std::size_t memory_bytes() const noexcept;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,278 @@
+#include "vola/stream_builder.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "emit.hpp"
+#include "vola/error.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+
+// One attribute's partial reduction over the voxels of a run.
+struct Partial {
+  std::vector<double> value;          // mean: sum; max, min, last: the value
+  std::vector<std::uint32_t> count;   // mean: number of points
+  // majority: for voxel i, (histogram_value, histogram_count)[offsets[i] .. offsets[i+1])
+  // sorted by value
+  std::vector<std::uint64_t> offsets;
+  std::vector<double> histogram_value;
+  std::vector<std::uint32_t> histogram_count;
+
+  std::size_t memory_bytes() const noexcept {
+    return value.capacity() * 8 + count.capacity() * 4 + offsets.capacity() * 8 + histogram_value.capacity() * 8 +
+           histogram_count.capacity() * 4;
+  }
+};
+
+// Sorted unique voxel keys with their partial reductions.
+struct Run {
+  std::vector<Key> keys;
+  std::vector<std::uint64_t> payloads;
+  std::vector<Partial> partials;
+
+  std::size_t memory_bytes() const noexcept {
+    std::size_t bytes = keys.capacity() * 8 + payloads.capacity() * 8;
+    for (const auto& p : partials) bytes += p.memory_bytes();
+    return bytes;
+  }
+};
+
+// Appends voxel `i` of `from` to `to` (as a new voxel).
+void append(const Run& from, std::size_t i, Run& to, std::span<const AttributeSpec> specs) {
+  to.keys.push_back(from.keys[i]);
+  if (!from.payloads.empty()) to.payloads.push_back(from.payloads[i]);
+  for (std::size_t a = 0; a < specs.size(); ++a) {
+    const Partial& p = from.partials[a];
+    Partial& q = to.partials[a];
+    if (specs[a].reduction == Reduction::majority) {
+      q.histogram_value.insert(q.histogram_value.end(), p.histogram_value.begin() + p.offsets[i],
+                               p.histogram_value.begin() + p.offsets[i + 1]);
+      q.histogram_count.insert(q.histogram_count.end(), p.histogram_count.begin() + p.offsets[i],
+                               p.histogram_count.begin() + p.offsets[i + 1]);
+      q.offsets.push_back(q.histogram_value.size());
+    } else {
+      q.value.push_back(p.value[i]);
+      if (specs[a].reduction == Reduction::mean) q.count.push_back(p.count[i]);
+    }
+  }
+}
+
+// Appends the combination of voxel i of `older` and voxel j of `newer` (same key).
+void append_combined(const Run& older, std::size_t i, const Run& newer, std::size_t j, Run& to,
+                     std::span<const AttributeSpec> specs) {
+  to.keys.push_back(older.keys[i]);
+  if (!older.payloads.empty()) to.payloads.push_back(newer.payloads[j]);  // the later point wins
+  for (std::size_t a = 0; a < specs.size(); ++a) {
+    const Partial& p = older.partials[a];
+    const Partial& r = newer.partials[a];
+    Partial& q = to.partials[a];
+    switch (specs[a].reduction) {
+      case Reduction::mean:
+        q.value.push_back(p.value[i] + r.value[j]);
+        q.count.push_back(p.count[i] + r.count[j]);
+        break;
+      case Reduction::max: q.value.push_back(std::max(p.value[i], r.value[j])); break;
+      case Reduction::min: q.value.push_back(std::min(p.value[i], r.value[j])); break;
+      case Reduction::last: q.value.push_back(r.value[j]); break;
+      case Reduction::majority: {
+        std::uint64_t x = p.offsets[i], y = r.offsets[j];
+        const std::uint64_t x_end = p.offsets[i + 1], y_end = r.offsets[j + 1];
+        while (x < x_end || y < y_end) {
+          if (y == y_end || (x < x_end && p.histogram_value[x] < r.histogram_value[y])) {
+            q.histogram_value.push_back(p.histogram_value[x]);
+            q.histogram_count.push_back(p.histogram_count[x++]);
+          } else if (x == x_end || r.histogram_value[y] < p.histogram_value[x]) {
+            q.histogram_value.push_back(r.histogram_value[y]);
+            q.histogram_count.push_back(r.histogram_count[y++]);
+          } else {
+            q.histogram_value.push_back(p.histogram_value[x]);
+            q.histogram_count.push_back(p.histogram_count[x++] + r.histogram_count[y++]);
+          }
+        }
+        q.offsets.push_back(q.histogram_value.size());
+        break;
+      }
+    }
+  }
+}
+
+Run empty_run(std::span<const AttributeSpec> specs) {
+  Run run;
+  run.partials.resize(specs.size());
+  for (std::size_t a = 0; a < specs.size(); ++a)
+    if (specs[a].reduction == Reduction::majority) run.partials[a].offsets.push_back(0);
+  return run;
+}
+
+Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs) {
+  Run out = empty_run(specs);
+  out.keys.reserve(older.keys.size() + newer.keys.size());
+  std::size_t i = 0, j = 0;
+  while (i < older.keys.size() || j < newer.keys.size()) {
+    if (j == newer.keys.size() || (i < older.keys.size() && older.keys[i] < newer.keys[j])) {
+      append(older, i++, out, specs);
+    } else if (i == older.keys.size() || newer.keys[j] < older.keys[i]) {
+      append(newer, j++, out, specs);
+    } else {
+      append_combined(older, i++, newer, j++, out, specs);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+struct StreamBuilder::State {
+  Quantizer quantizer;
+  std::vector<AttributeSpec> specs;
+  bool payload = false;
+  std::vector<Run> runs;  // oldest first; sizes roughly halve towards the back
+  std::uint64_t points_in = 0;
+  std::uint64_t points_outside = 0;
+  // Scratch reused across chunks.
+  std::vector<Key> keys;
+  std::vector<std::uint32_t> index;
+};
+
+StreamBuilder::StreamBuilder(const Quantizer& quantizer, std::vector<AttributeSpec> attributes, bool payload)
+    : state_(std::make_unique<State>(State{quantizer, std::move(attributes), payload, {}, 0, 0, {}, {}})) {}
+StreamBuilder::~StreamBuilder() = default;
+StreamBuilder::StreamBuilder(StreamBuilder&&) noexcept = default;
+StreamBuilder& StreamBuilder::operator=(StreamBuilder&&) noexcept = default;
+
+std::uint64_t StreamBuilder::points_in() const noexcept { return state_->points_in; }
+std::uint64_t StreamBuilder::points_outside() const noexcept { return state_->points_outside; }
+
+std::size_t StreamBuilder::memory_bytes() const noexcept {
+  std::size_t bytes = state_->keys.capacity() * 8 + state_->index.capacity() * 4;
+  for (const auto& run : state_->runs) bytes += run.memory_bytes();
+  return bytes;
+}
+
+void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<const double>> values,
+                        std::span<const std::uint64_t> payloads) {
+  State& s = *state_;
+  const std::size_t n = xyz.size() / 3;
+  if (xyz.size() != 3 * n) throw InvalidArgument("stream builder: xyz size is not a multiple of 3");
+  if (values.size() != s.specs.size())
+    throw InvalidArgument("stream builder: " + std::to_string(values.size()) + " attribute arrays for " +
+                          std::to_string(s.specs.size()) + " attributes");
+  for (const auto& v : values)
+    if (v.size() != n) throw InvalidArgument("stream builder: an attribute array's length differs from the points'");
+  if (s.payload && payloads.size() != n) throw InvalidArgument("stream builder: one payload per point, please");
+  if (n > std::numeric_limits<std::uint32_t>::max()) throw InvalidArgument("stream builder: chunk too large");
+  s.points_in += n;
+
+  s.keys.clear();
+  s.index.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    Voxel v;
+    if (!s.quantizer.to_voxel({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}, v)) {
+      ++s.points_outside;
+      continue;
+    }
+    s.keys.push_back(encode(v));
+    s.index.push_back(static_cast<std::uint32_t>(i));
+  }
+  radix_sort(s.keys, &s.index, 6 * s.quantizer.depth());
+
+  // Reduce the chunk: runs of equal keys hold one voxel's points in input order.
+  Run run = empty_run(s.specs);
+  std::vector<std::pair<double, std::uint32_t>> scratch;
+  for (std::size_t b = 0; b < s.keys.size();) {
+    std::size_t e = b + 1;
+    while (e < s.keys.size() && s.keys[e] == s.keys[b]) ++e;
+    run.keys.push_back(s.keys[b]);
+    if (s.payload) run.payloads.push_back(payloads[s.index[e - 1]]);
+    for (std::size_t a = 0; a < s.specs.size(); ++a) {
+      const auto& v = values[a];
+      Partial& p = run.partials[a];
+      switch (s.specs[a].reduction) {
+        case Reduction::mean: {
+          double sum = 0.0;
+          for (std::size_t k = b; k < e; ++k) sum += v[s.index[k]];
+          p.value.push_back(sum);
+          p.count.push_back(static_cast<std::uint32_t>(e - b));
+          break;
+        }
+        case Reduction::max: {
+          double m = v[s.index[b]];
+          for (std::size_t k = b; k < e; ++k) m = std::max(m, v[s.index[k]]);
+          p.value.push_back(m);
+          break;
+        }
+        case Reduction::min: {
+          double m = v[s.index[b]];
+          for (std::size_t k = b; k < e; ++k) m = std::min(m, v[s.index[k]]);
+          p.value.push_back(m);
+          break;
+        }
+        case Reduction::last: p.value.push_back(v[s.index[e - 1]]); break;
+        case Reduction::majority: {
+          scratch.clear();
+          for (std::size_t k = b; k < e; ++k) scratch.emplace_back(v[s.index[k]], 1u);
+          std::sort(scratch.begin(), scratch.end());
+          for (std::size_t k = 0; k < scratch.size();) {
+            std::size_t l = k;
+            while (l < scratch.size() && scratch[l].first == scratch[k].first) ++l;
+            p.histogram_value.push_back(scratch[k].first);
+            p.histogram_count.push_back(static_cast<std::uint32_t>(l - k));
+            k = l;
+          }
+          p.offsets.push_back(p.histogram_value.size());
+          break;
+        }
+      }
+    }
+    b = e;
+  }
+  s.runs.push_back(std::move(run));
+  // Binary-counter merging keeps O(log chunks) runs and merges each record O(log) times.
+  while (s.runs.size() >= 2 && s.runs[s.runs.size() - 2].keys.size() <= 2 * s.runs.back().keys.size()) {
+    Run merged = merge(s.runs[s.runs.size() - 2], s.runs.back(), s.specs);
+    s.runs.pop_back();
+    s.runs.back() = std::move(merged);
+  }
+}
+
+Tree StreamBuilder::finish() {
+  State& s = *state_;
+  Run all = empty_run(s.specs);
+  for (auto& run : s.runs) {
+    all = merge(all, run, s.specs);
+    run = Run{};
+  }
+  s.runs.clear();
+  const int depth = s.quantizer.depth();
+  Tree tree = detail::emit_levels(all.keys, depth, all.payloads, s.payload);
+  if (s.payload) tree.set_voxel_payloads(std::move(all.payloads));
+  const std::size_t voxels = all.keys.size();
+  for (std::size_t a = 0; a < s.specs.size(); ++a) {
+    const AttributeSpec& spec = s.specs[a];
+    const Partial& p = all.partials[a];
+    AttributeColumn column(spec.name, spec.type, spec.reduction, voxels);
+    for (std::size_t v = 0; v < voxels; ++v) {
+      switch (spec.reduction) {
+        case Reduction::mean: column.set(v, p.value[v] / p.count[v]); break;
+        case Reduction::majority: {
+          // The most frequent value; ties go to the smallest (the histogram is sorted).
+          std::uint64_t best = p.offsets[v];
+          for (std::uint64_t k = p.offsets[v]; k < p.offsets[v + 1]; ++k)
+            if (p.histogram_count[k] > p.histogram_count[best]) best = k;
+          column.set(v, p.histogram_value[best]);
+          break;
+        }
+        default: column.set(v, p.value[v]); break;
+      }
+    }
+    tree.attributes().add(std::move(column));
+  }
+  tree.set_frame(s.quantizer.frame());
+  return tree;
+}
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola
