@@ -110,6 +110,15 @@ TEST(BuildToolkit, ZeroExtentPutsEveryPointInVoxelZero) {
   EXPECT_EQ(voxel_set(tree), (XyzSet{{0, 0, 0}}));
 }
 
+TEST(BuildToolkit, AxisWhoseScaleRoundsToZeroLandsInVoxelZero) {
+  // z = 1e20 with Lmax = 1: (1e20 + 1) - 1e20 == 0, so the reference computes 0/0 = NaN
+  // on z and lands in voxel 0 (README: single_point). Casting that NaN to an integer
+  // was undefined behaviour (UBSan: "-nan is outside the range of representable
+  // values"); without a sanitizer it happened to give 0 on x86-64.
+  const vola::Tree tree = vola::build(cloud_of({{0, 0, 1e20}, {1, 1, 1e20}, {0.5, 1, 1e20}}), {.depth = 2});
+  EXPECT_EQ(voxel_set(tree), (XyzSet{{0, 0, 0}, {15, 15, 0}, {8, 15, 0}}));
+}
+
 TEST(BuildToolkit, NonFinitePointsAreSkippedAndCounted) {
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();

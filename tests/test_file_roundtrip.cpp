@@ -31,7 +31,7 @@ class FileRoundTrip : public ::testing::TestWithParam<Shape> {
  protected:
   template <class Check>
   void for_each_scenario(Check check) {
-    for (std::uint64_t seed : seeds_for(GetParam(), 1)) {
+    for (std::uint64_t seed : seeds_for(GetParam(), 2)) {
       const Scenario s = make_scenario(seed);
       SCOPED_TRACE(s.describe());
       check(s, s.unique(), build_tree(s));

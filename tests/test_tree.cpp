@@ -12,7 +12,7 @@
 namespace vola_test {
 namespace {
 
-constexpr int kRepeats = 2;  // scenarios per (shape, depth)
+constexpr int kRepeats = 3;  // scenarios per (shape, depth)
 
 vola::Tree build_tree(const Scenario& s) {
   std::vector<vola::Voxel> input;

@@ -3,6 +3,7 @@
 #include <stdlib.h>  // mkdtemp
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -183,7 +184,9 @@ Scenario make_scenario(std::uint64_t seed) {
   s.depth = 1 + static_cast<int>(seed % 10);
   std::mt19937_64 rng(0x9E3779B97F4A7C15ull ^ (seed * 0x100000001B3ull));
   s.shape = static_cast<Shape>((seed / 10) % 6);
-  const std::size_t count = 1 + rng() % 3000;
+  // Log-uniform 1..20000: small sets (one block, a few blocks) as often as large ones.
+  const double log_count = std::uniform_real_distribution<double>(0.0, std::log(20000.0))(rng);
+  const std::size_t count = static_cast<std::size_t>(std::exp(log_count));
   s.voxels = random_voxels(rng, s.depth, s.shape, count);
   return s;
 }
