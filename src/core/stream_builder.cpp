@@ -99,6 +99,33 @@ void append_combined(const Run& older, std::size_t i, const Run& newer, std::siz
   }
 }
 
+// Majority partials of one chunk: per voxel, the sorted distinct values and their counts.
+void reduce_majority(const double* values, const std::uint32_t* index, const std::vector<std::uint32_t>& starts,
+                     Partial& p) {
+  std::vector<double> scratch;
+  const std::size_t voxels = starts.size() - 1;
+  p.offsets.reserve(voxels + 1);
+  for (std::size_t v = 0; v < voxels; ++v) {
+    const std::uint32_t b = starts[v], e = starts[v + 1];
+    if (e - b == 1) {  // the common case: one point
+      p.histogram_value.push_back(values[index[b]]);
+      p.histogram_count.push_back(1);
+    } else {
+      scratch.clear();
+      for (std::uint32_t k = b; k < e; ++k) scratch.push_back(values[index[k]]);
+      std::sort(scratch.begin(), scratch.end());
+      for (std::size_t k = 0; k < scratch.size();) {
+        std::size_t l = k;
+        while (l < scratch.size() && scratch[l] == scratch[k]) ++l;
+        p.histogram_value.push_back(scratch[k]);
+        p.histogram_count.push_back(static_cast<std::uint32_t>(l - k));
+        k = l;
+      }
+    }
+    p.offsets.push_back(p.histogram_value.size());
+  }
+}
+
 Run empty_run(std::span<const AttributeSpec> specs) {
   Run run;
   run.partials.resize(specs.size());
@@ -109,6 +136,13 @@ Run empty_run(std::span<const AttributeSpec> specs) {
 
 Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs) {
   Run out = empty_run(specs);
+  if (specs.empty() && older.payloads.empty()) {  // occupancy only: a plain sorted union
+    out.keys.resize(older.keys.size() + newer.keys.size());
+    const auto end = std::set_union(older.keys.begin(), older.keys.end(), newer.keys.begin(), newer.keys.end(),
+                                    out.keys.begin());
+    out.keys.resize(static_cast<std::size_t>(end - out.keys.begin()));
+    return out;
+  }
   out.keys.reserve(older.keys.size() + newer.keys.size());
   std::size_t i = 0, j = 0;
   while (i < older.keys.size() || j < newer.keys.size()) {
@@ -135,10 +169,11 @@ struct StreamBuilder::State {
   // Scratch reused across chunks.
   std::vector<Key> keys;
   std::vector<std::uint32_t> index;
+  std::vector<std::uint32_t> starts;
 };
 
 StreamBuilder::StreamBuilder(const Quantizer& quantizer, std::vector<AttributeSpec> attributes, bool payload)
-    : state_(std::make_unique<State>(State{quantizer, std::move(attributes), payload, {}, 0, 0, {}, {}})) {}
+    : state_(std::make_unique<State>(State{quantizer, std::move(attributes), payload, {}, 0, 0, {}, {}, {}})) {}
 StreamBuilder::~StreamBuilder() = default;
 StreamBuilder::StreamBuilder(StreamBuilder&&) noexcept = default;
 StreamBuilder& StreamBuilder::operator=(StreamBuilder&&) noexcept = default;
@@ -166,6 +201,7 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   if (n > std::numeric_limits<std::uint32_t>::max()) throw InvalidArgument("stream builder: chunk too large");
   s.points_in += n;
 
+  const bool per_point = s.payload || !s.specs.empty();
   s.keys.clear();
   s.index.clear();
   for (std::size_t i = 0; i < n; ++i) {
@@ -175,59 +211,60 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
       continue;
     }
     s.keys.push_back(encode(v));
-    s.index.push_back(static_cast<std::uint32_t>(i));
+    if (per_point) s.index.push_back(static_cast<std::uint32_t>(i));
   }
-  radix_sort(s.keys, &s.index, 6 * s.quantizer.depth());
+  radix_sort(s.keys, per_point ? &s.index : nullptr, 6 * s.quantizer.depth());
 
-  // Reduce the chunk: runs of equal keys hold one voxel's points in input order.
   Run run = empty_run(s.specs);
-  std::vector<std::pair<double, std::uint32_t>> scratch;
-  for (std::size_t b = 0; b < s.keys.size();) {
-    std::size_t e = b + 1;
-    while (e < s.keys.size() && s.keys[e] == s.keys[b]) ++e;
-    run.keys.push_back(s.keys[b]);
-    if (s.payload) run.payloads.push_back(payloads[s.index[e - 1]]);
-    for (std::size_t a = 0; a < s.specs.size(); ++a) {
-      const auto& v = values[a];
-      Partial& p = run.partials[a];
-      switch (s.specs[a].reduction) {
-        case Reduction::mean: {
-          double sum = 0.0;
-          for (std::size_t k = b; k < e; ++k) sum += v[s.index[k]];
-          p.value.push_back(sum);
-          p.count.push_back(static_cast<std::uint32_t>(e - b));
-          break;
-        }
-        case Reduction::max: {
-          double m = v[s.index[b]];
-          for (std::size_t k = b; k < e; ++k) m = std::max(m, v[s.index[k]]);
-          p.value.push_back(m);
-          break;
-        }
-        case Reduction::min: {
-          double m = v[s.index[b]];
-          for (std::size_t k = b; k < e; ++k) m = std::min(m, v[s.index[k]]);
-          p.value.push_back(m);
-          break;
-        }
-        case Reduction::last: p.value.push_back(v[s.index[e - 1]]); break;
-        case Reduction::majority: {
-          scratch.clear();
-          for (std::size_t k = b; k < e; ++k) scratch.emplace_back(v[s.index[k]], 1u);
-          std::sort(scratch.begin(), scratch.end());
-          for (std::size_t k = 0; k < scratch.size();) {
-            std::size_t l = k;
-            while (l < scratch.size() && scratch[l].first == scratch[k].first) ++l;
-            p.histogram_value.push_back(scratch[k].first);
-            p.histogram_count.push_back(static_cast<std::uint32_t>(l - k));
-            k = l;
-          }
-          p.offsets.push_back(p.histogram_value.size());
-          break;
-        }
+  if (!per_point) {
+    run.keys.assign(s.keys.begin(), std::unique(s.keys.begin(), s.keys.end()));
+  } else {
+    // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
+    std::vector<std::uint32_t>& starts = s.starts;
+    starts.clear();
+    for (std::size_t k = 0; k < s.keys.size(); ++k) {
+      if (k == 0 || s.keys[k] != s.keys[k - 1]) {
+        starts.push_back(static_cast<std::uint32_t>(k));
+        run.keys.push_back(s.keys[k]);
       }
     }
-    b = e;
+    starts.push_back(static_cast<std::uint32_t>(s.keys.size()));
+    const std::size_t voxels = run.keys.size();
+    const std::uint32_t* index = s.index.data();
+    if (s.payload) {
+      run.payloads.resize(voxels);
+      for (std::size_t v = 0; v < voxels; ++v) run.payloads[v] = payloads[index[starts[v + 1] - 1]];
+    }
+    // Attribute by attribute, each with a tight loop over the voxels.
+    for (std::size_t a = 0; a < s.specs.size(); ++a) {
+      const double* values_of = values[a].data();
+      Partial& p = run.partials[a];
+      const Reduction reduction = s.specs[a].reduction;
+      if (reduction == Reduction::majority) {
+        reduce_majority(values_of, index, starts, p);
+        continue;
+      }
+      p.value.resize(voxels);
+      if (reduction == Reduction::mean) p.count.resize(voxels);
+      for (std::size_t v = 0; v < voxels; ++v) {
+        const std::uint32_t b = starts[v], e = starts[v + 1];
+        double r = values_of[index[reduction == Reduction::last ? e - 1 : b]];
+        switch (reduction) {
+          case Reduction::mean:
+            for (std::uint32_t k = b + 1; k < e; ++k) r += values_of[index[k]];
+            p.count[v] = e - b;
+            break;
+          case Reduction::max:
+            for (std::uint32_t k = b + 1; k < e; ++k) r = std::max(r, values_of[index[k]]);
+            break;
+          case Reduction::min:
+            for (std::uint32_t k = b + 1; k < e; ++k) r = std::min(r, values_of[index[k]]);
+            break;
+          default: break;
+        }
+        p.value[v] = r;
+      }
+    }
   }
   s.runs.push_back(std::move(run));
   // Binary-counter merging keeps O(log chunks) runs and merges each record O(log) times.
