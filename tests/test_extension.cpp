@@ -2,6 +2,7 @@
 // header cannot (so toolkit files stay byte-compatible), present and round-tripping
 // for grid frames, CRS WKT and attributes; unknown records are skipped.
 #include <cstring>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -94,6 +95,32 @@ TEST(Extension, CrsWktRoundTrips) {
   tree.georef().crs_wkt = "LOCAL_CS[\"x\"]";
   const vola::Tree odd = vola::parse(vola::serialize(tree), "wkt");
   EXPECT_EQ(odd.georef().crs_wkt, "LOCAL_CS[\"x\"]");
+}
+
+TEST(Extension, ToolkitTreesWithoutAUsableScaleStillWriteReadableFiles) {
+  // The toolkit frame's voxel size is the x scale (min + Lmax) - min over S - 1. With
+  // x = 1e20 and Lmax = 1 that is 0, and with a NaN in the header bbox it is NaN: the
+  // frame record of the extension must still be one the reader accepts.
+  // (Found by scripts/fuzz: a parsed file re-serialized into one parse refused.)
+  vola::PointCloud cloud;
+  cloud.xyz = {1e20, 0, 0, 1e20, 1, 1, 1e20, 0.5, 0.25};
+  cloud.attributes.push_back({"i", vola::ValueType::u8, vola::Reduction::last, {1, 2, 3}});
+  const vola::Tree tree = vola::build(cloud, {.depth = 2});
+  EXPECT_EQ(voxel_set(tree), (XyzSet{{0, 0, 0}, {0, 15, 15}, {0, 8, 4}}));
+  const vola::Tree back = vola::parse(vola::serialize(tree), "x-scale-0");
+  EXPECT_EQ(voxel_set(back), voxel_set(tree));
+  EXPECT_GT(back.frame().voxel_size, 0.0);
+
+  auto bytes = vola::serialize(vola::build(sample_cloud(), {.depth = 2}));
+  put_le<double>(bytes, 32, std::numeric_limits<double>::quiet_NaN());  // header min x
+  vola::Tree nan_box = vola::parse(bytes, "nan-bbox");
+  nan_box.attributes().add(vola::AttributeColumn("a", vola::ValueType::u8, vola::Reduction::last,
+                                                 nan_box.voxel_count()));
+  const auto rewritten = vola::serialize(nan_box);  // now with an extension
+  EXPECT_GT(rewritten.size(), level_bytes(nan_box));
+  const vola::Tree again = vola::parse(rewritten, "nan-bbox rewritten");
+  EXPECT_EQ(voxel_set(again), voxel_set(nan_box));
+  EXPECT_NO_THROW((void)again.quantizer());
 }
 
 TEST(Extension, UnknownRecordsAreSkipped) {

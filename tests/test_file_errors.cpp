@@ -1,6 +1,7 @@
 // Malformed files: each must throw vola::FormatError naming the right byte offset
 // and cause, through parse(), read() and open_mapped() alike.
 #include <chrono>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -188,6 +189,21 @@ TEST(FileErrors, ExtensionFrameWithANonPositiveVoxelSize) {
   // Frame body: quantization (1), padding (7), origin (24), voxel size (8).
   put_le<double>(bytes, at + 32 + 32, -1.0);
   expect_format_error(bytes, at + 16 + 48, "voxel size is not positive");
+}
+
+TEST(FileErrors, ExtensionFrameThatIsNotFinite) {
+  // A grid the library cannot use (Quantizer::grid refuses it) is refused when read.
+  std::uint64_t at = 0;
+  const auto valid = file_with_extension(at);
+  const double inf = std::numeric_limits<double>::infinity();
+  auto bytes = valid;
+  put_le<double>(bytes, at + 32 + 32, inf);  // voxel size
+  expect_format_error(bytes, at + 16 + 48, "voxel size is not finite");
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    bytes = valid;
+    put_le<double>(bytes, at + 32 + 8 + 8 * axis, axis == 1 ? -inf : std::numeric_limits<double>::quiet_NaN());
+    expect_format_error(bytes, at + 16 + 24 + 8 * axis, "frame origin is not finite");  // record + 24
+  }
 }
 
 TEST(FileErrors, AttributeValueCountDiffersFromTheVoxelCount) {

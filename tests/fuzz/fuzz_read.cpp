@@ -62,6 +62,18 @@ void exercise(const vola::Tree& tree) {
   for (int depth = 1; depth < tree.depth(); ++depth)
     check(tree.level_of_detail(depth).voxel_count() == tree.node_count(depth - 1));
 
+  // The grid the file describes must be usable: the reader has accepted its frame.
+  const vola::Quantizer quantizer = tree.quantizer();
+  for (const vola::Voxel& v : first) {
+    vola::Voxel back;
+    (void)quantizer.to_voxel(quantizer.center(v), back);
+  }
+
+  // Set operations of a tree with itself.
+  check(vola::unite(tree, tree).keys() == keys);
+  check(vola::intersect(tree, tree).keys() == keys);
+  check(vola::subtract(tree, tree).empty());
+
   // What we write, we read back identically.
   const auto bytes = vola::serialize(tree);
   const vola::Tree back = vola::parse(bytes, "reserialized");

@@ -3,8 +3,11 @@
 // bytes, header field changes, word overwrites). Used by ctest under the normal
 // compiler; a crash or an abort (broken invariant) fails the test.
 //
-//   fuzz_replay [--mutations N] [--seed S] [--golden DIR] [FILE...]
-//   fuzz_replay --write-corpus DIR [--golden DIR]     (seed corpus for scripts/fuzz)
+//   fuzz_replay [--mutations N] [--seed S] [--golden DIR] [--regressions DIR] [FILE...]
+//   fuzz_replay --write-corpus DIR [--golden DIR] [--regressions DIR]   (for scripts/fuzz)
+//
+// --regressions: a folder of inputs that once failed (tests/fuzz/regressions), replayed
+// and mutated like the other seeds.
 //
 // With FILEs (e.g. libFuzzer crash artifacts) only those are replayed. The golden
 // folder defaults to $VOLA_SHARED/golden; when it is missing the run is skipped
@@ -134,6 +137,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   fs::path golden = default_golden();
   fs::path corpus;
+  fs::path regressions;
   std::vector<fs::path> files;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -148,6 +152,7 @@ int main(int argc, char** argv) {
     else if (arg == "--seed") seed = std::stoull(value());
     else if (arg == "--golden") golden = value();
     else if (arg == "--write-corpus") corpus = value();
+    else if (arg == "--regressions") regressions = value();
     else files.push_back(arg);
   }
 
@@ -166,6 +171,17 @@ int main(int argc, char** argv) {
   }
 
   std::vector<vola_fuzz::Seed> seeds = vola_fuzz::synthetic_seeds();
+  if (!regressions.empty()) {
+    if (!fs::is_directory(regressions)) {
+      std::cerr << "no regressions folder " << regressions << "\n";
+      return 1;
+    }
+    for (const auto& entry : fs::directory_iterator(regressions)) {
+      std::ifstream in(entry.path(), std::ios::binary);
+      seeds.push_back({std::string("regression_") + entry.path().filename().string(),
+                       Bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}});
+    }
+  }
   const bool have_golden = fs::is_directory(golden);
   if (have_golden) {
     auto g = vola_fuzz::golden_seeds(golden);
