@@ -5,8 +5,12 @@
 #include <filesystem>
 
 #include "vola/error.hpp"
+#include "vola/io/binvox.hpp"
+#include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/npy.hpp"
+#include "vola/io/pcd.hpp"
+#include "vola/io/ply.hpp"
 
 namespace vola::io {
 
@@ -30,9 +34,27 @@ Input read_text_input(const std::string& path, const InputOptions& options) {
 }
 
 Input read_npy_input(const std::string& path, const InputOptions& options) {
+  return npy_input(read_npy(path), path, options);
+}
+
+Input read_pcd_input(const std::string& path, const InputOptions& options) {
   Input in;
-  in.format = "npy";
-  in.cloud = npy_points(read_npy(path), path, options.payload);
+  in.format = "pcd";
+  in.cloud = read_pcd(path, options);
+  return in;
+}
+
+Input read_kitti_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "kitti";
+  in.cloud = read_kitti(path, options);
+  return in;
+}
+
+Input read_binvox_input(const std::string& path, const InputOptions&) {
+  Input in;
+  in.format = "binvox";
+  in.grid = read_binvox(path);
   return in;
 }
 
@@ -40,7 +62,11 @@ std::vector<InputFormat> make_formats() {
   return {
       {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10 (LAZ: a clear error)", read_las_input},
       {"text", {".xyz", ".txt", ".csv", ".pts", ".asc"}, "points as text columns (x y z ...)", read_text_input},
-      {"npy", {".npy"}, "NumPy (N,3+) point arrays", read_npy_input},
+      {"npy", {".npy"}, "NumPy (N,3+) point arrays or (X,Y,Z) occupancy grids", read_npy_input},
+      {"ply", {".ply"}, "PLY ascii/binary points, vertex colours, faces as a mesh", read_ply},
+      {"pcd", {".pcd"}, "PCD .5-0.7 ascii/binary/binary_compressed points", read_pcd_input},
+      {"kitti", {".bin"}, "KITTI velodyne float32 x y z reflectance", read_kitti_input},
+      {"binvox", {".binvox"}, "binvox occupancy grids", read_binvox_input},
   };
 }
 
