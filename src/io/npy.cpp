@@ -200,3 +200,59 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
 }
 
 }  // namespace vola::io
+
+namespace vola::io {
+
+VoxelGrid npy_grid(const NpyArray& array, const std::string& name) {
+  if (array.shape.size() != 3)
+    throw FormatError(name, {}, "an occupancy grid is a 3-D array, this one has " + std::to_string(array.shape.size()) +
+                                    " dimensions");
+  VoxelGrid grid;
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (array.shape[a] > std::numeric_limits<std::uint32_t>::max())
+      throw FormatError(name, {}, "grid dimension " + std::to_string(array.shape[a]) + " does not fit 32 bits");
+    grid.dims[a] = static_cast<std::uint32_t>(array.shape[a]);
+  }
+  const std::uint64_t nx = array.shape[0], ny = array.shape[1], nz = array.shape[2];
+  const auto item = static_cast<std::size_t>(array.item_size);
+  // A float is zero when every bit but the sign is: mask the sign in its most
+  // significant byte. Integers and bools are zero when every byte is.
+  const std::size_t top = array.big_endian ? 0 : item - 1;
+  const std::uint8_t top_mask = array.kind == 'f' ? 0x7F : 0xFF;
+  const std::uint64_t count = array.size();
+  for (std::uint64_t s = 0; s < count; ++s) {
+    const std::uint8_t* value = array.data.data() + s * item;
+    bool occupied = (value[top] & top_mask) != 0;
+    for (std::size_t b = 0; b < item && !occupied; ++b) occupied = b != top && value[b] != 0;
+    if (!occupied) continue;
+    // Storage position -> (x, y, z): C order runs the last index fastest, Fortran the first.
+    const Voxel v = array.fortran_order
+                        ? Voxel{static_cast<std::uint32_t>(s % nx), static_cast<std::uint32_t>(s / nx % ny),
+                                static_cast<std::uint32_t>(s / (nx * ny))}
+                        : Voxel{static_cast<std::uint32_t>(s / (ny * nz)), static_cast<std::uint32_t>(s / nz % ny),
+                                static_cast<std::uint32_t>(s % nz)};
+    grid.voxels.push_back(v);
+  }
+  return grid;
+}
+
+Input npy_input(const NpyArray& array, const std::string& name, const InputOptions& options) {
+  Input in;
+  in.format = "npy";
+  if (array.shape.size() == 3) {
+    in.grid = npy_grid(array, name);
+  } else if (array.shape.size() == 2) {
+    in.cloud = npy_points(array, name, options.payload);
+  } else {
+    std::string shape;
+    for (auto d : array.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(d);
+    throw FormatError(name, {},
+                      "an array of shape (" + shape + ") is neither points (N, 3+) nor one occupancy grid (X, Y, Z)" +
+                          (array.shape.size() > 3 ? "; for a stack of grids, pick one first, e.g. numpy.save('one.npy', "
+                                                    "a[i]) (or a[i, 0] for (N, 1, X, Y, Z))"
+                                                  : ""));
+  }
+  return in;
+}
+
+}  // namespace vola::io

@@ -1,5 +1,5 @@
 // NumPy .npy arrays (format versions 1-3): numeric dtypes of either byte order,
-// C or Fortran order. Used for point arrays (N, 3+) and dense occupancy grids.
+// C or Fortran order. Used for point arrays (N, 3+) and dense occupancy grids (X, Y, Z).
 #pragma once
 
 #include <cstdint>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/io/input.hpp"
 
 namespace vola::io {
 
@@ -34,5 +35,14 @@ NpyArray read_npy(const std::string& path);
 // An (N, C>=3) array as points: columns 0..2 are x y z, columns 3.. become payload
 // bytes (byte k = column 3+k, each 0..255) when `payload_columns` is set.
 PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns);
+
+// A 3-D array as an occupancy grid: cell (i, j, k) is array[i][j][k] (x = first index,
+// y = second, z = third), occupied where the value is not zero (NaN is not zero, as in
+// numpy.count_nonzero); origin 0, voxel size 1.
+VoxelGrid npy_grid(const NpyArray& array, const std::string& name);
+
+// (N, 3+) arrays become points, 3-D arrays grids; any other shape gets an error that
+// says which shapes are read (a stack of grids: pick one).
+Input npy_input(const NpyArray& array, const std::string& name, const InputOptions& options);
 
 }  // namespace vola::io

@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# `vola convert` on one file of each format read by src/io/{ply,pcd,kitti,npy,binvox}.cpp.
+#
+#   cli_io_formats.sh VOLA_BINARY DATA_DIR       ($VOLA_SHARED/data wins when set)
+#
+# Each converts with `--quantize toolkit --depth 5` into a non-empty tree of at most as
+# many voxels as points; binvox and NPY grids convert one cell to one voxel by default
+# (the voxel count equals the file's occupied count: EXPECTED.txt for the binvox).
+# Exit status: 0 all good, 1 failures, 77 data folder missing (outside CI).
+set -uo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 VOLA_BINARY DATA_DIR" >&2
+  exit 2
+fi
+vola=$1
+data=${VOLA_SHARED:+$VOLA_SHARED/data}
+data=${data:-$2}
+if [[ ! -d $data/binvox || ! -d $data/ply ]]; then
+  if [[ -n ${CI:-} ]]; then
+    echo "FAIL: data folder $data is missing (CI is set)" >&2
+    exit 1
+  fi
+  echo "SKIP: data folder $data is missing" >&2
+  exit 77
+fi
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+
+# voxels FILE.vol: the occupied count `vola info --json` reports.
+voxels() {
+  "$vola" info --json "$1" | sed -n 's/^ *"voxels": *\([0-9]*\).*/\1/p'
+}
+
+# convert_toolkit INPUT POINTS [options...]: depth-5 toolkit conversion, 1..POINTS voxels.
+convert_toolkit() {
+  local input=$1 points=$2
+  shift 2
+  local out=$tmp/$(basename "$input").vol
+  if ! "$vola" convert "$input" "$out" --quantize toolkit --depth 5 -q "$@"; then
+    fail "vola convert $input --quantize toolkit --depth 5 $*"
+    return
+  fi
+  local n
+  n=$(voxels "$out")
+  if [[ -z $n || $n -lt 1 || $n -gt $points ]]; then
+    fail "$input: $n voxels from $points points"
+  else
+    echo "ok: $(basename "$input") -> $n voxels (depth 5, toolkit)"
+  fi
+}
+
+# Point counts from EXPECTED.txt.
+convert_toolkit "$data/ply/pdal_simple_binary.ply" 3 --nbits 1
+convert_toolkit "$data/pcd/pcl_milk_color.pcd" 13704 --nbits 1
+convert_toolkit "$data/kitti/mmdet3d_000008_fov_reduced.bin" 17238 --nbits 1
+
+# A 2x3x4 uint8 NPY grid with cells [0][0][0], [1][2][3] and [1][0][2] occupied.
+npy=$tmp/grid.npy
+header="{'descr': '|u1', 'fortran_order': False, 'shape': (2, 3, 4), }"
+while (((10 + ${#header} + 1) % 64 != 0)); do header+=" "; done
+{
+  printf '\x93NUMPY\x01\x00'
+  printf "\\x$(printf %02x $((${#header} + 1)))\\x00"
+  printf '%s\n' "$header"
+  printf '\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x01'
+} > "$npy"
+convert_toolkit "$npy" 3
+if "$vola" convert "$npy" "$tmp/grid.vol" -q; then
+  [[ $(voxels "$tmp/grid.vol") == 3 ]] || fail "grid.npy: $(voxels "$tmp/grid.vol") voxels, expected 3 (one per cell)"
+else
+  fail "vola convert grid.npy"
+fi
+
+# binvox: one voxel per occupied cell by default.
+chair=$data/binvox/trimesh_chair_model.binvox
+occupied=$(sed -n 's/^trimesh_chair_model.binvox .* occupied=\([0-9]*\).*/\1/p' "$data/EXPECTED.txt")
+convert_toolkit "$chair" "$occupied"
+if "$vola" convert "$chair" "$tmp/chair.vol" -q; then
+  n=$(voxels "$tmp/chair.vol")
+  if [[ $n != "$occupied" ]]; then fail "$chair: $n voxels, EXPECTED.txt says occupied=$occupied"
+  else echo "ok: chair binvox -> $n voxels, one per occupied cell"; fi
+else
+  fail "vola convert $chair"
+fi
+
+if ((failures > 0)); then
+  echo "$failures failure(s)" >&2
+  exit 1
+fi
+echo "all conversions passed"

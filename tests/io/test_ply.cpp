@@ -1,0 +1,342 @@
+// PLY reader: the shared files against EXPECTED.txt and against a slow istream-based
+// reader written here from the PLY description; hand-made files of each encoding;
+// truncated and corrupted input.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "io_test_data.hpp"
+#include "vola/io/input.hpp"
+#include "vola/io/ply.hpp"
+
+namespace {
+
+using namespace vola_io_test;
+
+// ---- Slow reference: every value through an istream, one at a time ----
+struct SlowPly {
+  std::vector<double> xyz;
+  std::vector<double> rgb;  // empty without uchar red/green/blue
+  std::vector<std::vector<std::int64_t>> faces;
+};
+
+double read_value(std::istream& in, const std::string& type, bool ascii, bool big) {
+  if (ascii) {
+    double v;
+    in >> v;
+    if (!in) throw std::runtime_error("slow reader: bad ascii value");
+    return type == "float" || type == "float32" ? static_cast<float>(v) : v;
+  }
+  const std::map<std::string, int> sizes = {{"char", 1},  {"uchar", 1}, {"short", 2}, {"ushort", 2},
+                                            {"int", 4},   {"uint", 4},  {"float", 4}, {"double", 8},
+                                            {"int8", 1},  {"uint8", 1}, {"int16", 2}, {"uint16", 2},
+                                            {"int32", 4}, {"uint32", 4}, {"float32", 4}, {"float64", 8}};
+  const int n = sizes.at(type);
+  unsigned char raw[8];
+  for (int i = 0; i < n; ++i) {
+    const int c = in.get();
+    if (c == EOF) throw std::runtime_error("slow reader: truncated");
+    raw[big ? n - 1 - i : i] = static_cast<unsigned char>(c);
+  }
+  auto as = [&](auto v) {
+    std::memcpy(&v, raw, sizeof v);
+    return static_cast<double>(v);
+  };
+  if (type == "char" || type == "int8") return as(std::int8_t{});
+  if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
+  if (type == "short" || type == "int16") return as(std::int16_t{});
+  if (type == "ushort" || type == "uint16") return as(std::uint16_t{});
+  if (type == "int" || type == "int32") return as(std::int32_t{});
+  if (type == "uint" || type == "uint32") return as(std::uint32_t{});
+  if (type == "float" || type == "float32") return as(float{});
+  return as(double{});
+}
+
+SlowPly slow_read(const Bytes& bytes) {
+  std::istringstream in(std::string(bytes.begin(), bytes.end()));
+  struct Prop {
+    std::string name, type, count_type;
+    bool list = false;
+  };
+  std::vector<std::pair<std::string, std::size_t>> elements;
+  std::vector<std::vector<Prop>> props;
+  std::string line, format;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    if (key == "format") words >> format;
+    if (key == "element") {
+      std::string name;
+      std::size_t count;
+      words >> name >> count;
+      elements.push_back({name, count});
+      props.emplace_back();
+    }
+    if (key == "property") {
+      Prop p;
+      words >> p.type;
+      if (p.type == "list") {
+        p.list = true;
+        words >> p.count_type >> p.type;
+      }
+      words >> p.name;
+      props.back().push_back(p);
+    }
+    if (key == "end_header") break;
+  }
+  const bool ascii = format == "ascii", big = format == "binary_big_endian";
+  SlowPly out;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    bool has_rgb = false;
+    for (const auto& p : props[e]) has_rgb |= p.name == "red" && p.type == "uchar";
+    for (std::size_t i = 0; i < elements[e].second; ++i) {
+      std::map<std::string, double> scalars;
+      for (const auto& p : props[e]) {
+        if (!p.list) {
+          scalars[p.name] = read_value(in, p.type, ascii, big);
+          continue;
+        }
+        const auto n = static_cast<std::size_t>(read_value(in, p.count_type, ascii, big));
+        std::vector<std::int64_t> items;
+        for (std::size_t k = 0; k < n; ++k) items.push_back(static_cast<std::int64_t>(read_value(in, p.type, ascii, big)));
+        if (elements[e].first == "face" && (p.name == "vertex_indices" || p.name == "vertex_index")) out.faces.push_back(items);
+      }
+      if (elements[e].first == "vertex") {
+        for (const char* a : {"x", "y", "z"}) out.xyz.push_back(scalars.at(a));
+        if (has_rgb)
+          for (const char* c : {"red", "green", "blue"}) out.rgb.push_back(scalars.at(c));
+      }
+    }
+  }
+  return out;
+}
+
+// The reader's output must equal the slow reader's, value for value.
+void expect_same_as_slow(const Bytes& bytes, const std::string& label) {
+  SCOPED_TRACE(label);
+  vola::io::InputOptions options;
+  options.payload = true;
+  const vola::io::Input in = vola::io::parse_ply(bytes, label, options);
+  const SlowPly slow = slow_read(bytes);
+  ASSERT_EQ(in.cloud.xyz, slow.xyz);
+  if (slow.rgb.empty()) {
+    EXPECT_TRUE(in.cloud.attributes.empty());
+    EXPECT_TRUE(in.cloud.payload.empty());
+  } else {
+    ASSERT_EQ(in.cloud.attributes.size(), 3u);
+    ASSERT_EQ(in.cloud.payload.size(), in.cloud.size());
+    for (std::size_t i = 0; i < in.cloud.size(); ++i) {
+      for (std::size_t c = 0; c < 3; ++c) ASSERT_EQ(in.cloud.attributes[c].values[i], slow.rgb[3 * i + c]) << i;
+      const auto word = static_cast<std::uint64_t>(slow.rgb[3 * i]) | static_cast<std::uint64_t>(slow.rgb[3 * i + 1]) << 8 |
+                        static_cast<std::uint64_t>(slow.rgb[3 * i + 2]) << 16;
+      ASSERT_EQ(in.cloud.payload[i], word) << i;
+    }
+  }
+  std::size_t expected_triangles = 0;
+  for (const auto& f : slow.faces) expected_triangles += f.size() >= 3 ? f.size() - 2 : 0;
+  ASSERT_EQ(in.triangles.size(), expected_triangles);
+  std::size_t t = 0;
+  for (const auto& f : slow.faces)
+    for (std::size_t k = 1; k + 1 < f.size(); ++k, ++t) {
+      const std::int64_t corners[3] = {f[0], f[k], f[k + 1]};
+      for (std::size_t c = 0; c < 3; ++c)
+        for (std::size_t a = 0; a < 3; ++a)
+          ASSERT_EQ(in.triangles[t][c][a], slow.xyz[3 * static_cast<std::size_t>(corners[c]) + a]) << "triangle " << t;
+    }
+}
+
+TEST(Ply, SharedFilesMatchExpectedAndTheSlowReader) {
+  VOLA_REQUIRE_DATA(data);
+  const auto files = files_ending(data / "ply", ".ply");
+  ASSERT_FALSE(files.empty());
+  for (const auto& path : files) {
+    SCOPED_TRACE(path.string());
+    const std::string line = expected_line(data, path.filename().string());
+    const vola::io::Input in = vola::io::read_input(path.string(), "auto", {});
+    EXPECT_EQ(in.format, "ply");
+    // EXPECTED.txt: "elements=[('vertex', N, [...]), ('face', F, [...])] bbox=[min]..[max]".
+    EXPECT_EQ(in.cloud.size(), expected_integer(line, "('vertex', ").value());
+    const auto faces = expected_integer(line, "('face', ");
+    // Every face in these files is a triangle, so triangles = faces (0 without faces).
+    EXPECT_EQ(in.triangles.size(), faces.value_or(0));
+    const auto min = expected_numbers(line, "bbox=").value();
+    const auto max = expected_numbers(line, "]..").value();
+    const vola::Box box = in.cloud.bounds();
+    for (std::size_t a = 0; a < 3; ++a) {
+      EXPECT_NEAR(box.min[a], min[a], 5.1e-5) << "axis " << a;  // EXPECTED rounds to 4 decimals
+      EXPECT_NEAR(box.max[a], max[a], 5.1e-5) << "axis " << a;
+    }
+    expect_same_as_slow(vola_test::read_bytes(path), path.filename().string());
+  }
+}
+
+TEST(Ply, VertexColoursOfTheCycloidBecomeAttributes) {
+  VOLA_REQUIRE_DATA(data);
+  const auto in = vola::io::read_ply((data / "ply" / "trimesh_cycloidal_binle.ply").string());
+  ASSERT_EQ(in.cloud.attributes.size(), 3u);
+  EXPECT_EQ(in.cloud.attributes[0].name, "red");
+  EXPECT_EQ(in.cloud.attributes[0].type, vola::ValueType::u16);
+  EXPECT_EQ(in.cloud.attributes[0].reduction, vola::Reduction::mean);
+  EXPECT_EQ(in.cloud.attributes[2].values.size(), in.cloud.size());
+}
+
+TEST(Ply, HandMadeFilesOfEveryEncodingAndCountType) {
+  const PlySample sample = ply_sample();
+  const auto triangles = fan_triangles(sample.faces);
+  for (const std::string encoding : {"ascii", "binary_little_endian", "binary_big_endian"})
+    for (const bool int_counts : {false, true}) {
+      SCOPED_TRACE(encoding + (int_counts ? " int counts" : " uchar counts"));
+      const Bytes bytes = ply_bytes(sample, encoding, int_counts);
+      vola::io::InputOptions options;
+      options.payload = true;
+      const vola::io::Input in = vola::io::parse_ply(bytes, "sample.ply", options);
+      ASSERT_EQ(in.cloud.size(), sample.xyz.size());
+      for (std::size_t i = 0; i < sample.xyz.size(); ++i) {
+        for (std::size_t a = 0; a < 3; ++a) EXPECT_EQ(in.cloud.xyz[3 * i + a], static_cast<double>(sample.xyz[i][a]));
+        for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(in.cloud.attributes[c].values[i], sample.rgb[i][c]);
+        EXPECT_EQ(in.cloud.payload[i], sample.rgb[i][0] | sample.rgb[i][1] << 8 | sample.rgb[i][2] << 16);
+      }
+      ASSERT_EQ(in.triangles.size(), triangles.size());  // the two-corner face makes none
+      for (std::size_t t = 0; t < triangles.size(); ++t)
+        for (std::size_t c = 0; c < 3; ++c)
+          for (std::size_t a = 0; a < 3; ++a)
+            EXPECT_EQ(in.triangles[t][c][a], static_cast<double>(sample.xyz[static_cast<std::size_t>(triangles[t][c])][a]));
+      expect_same_as_slow(bytes, "sample");
+    }
+}
+
+TEST(Ply, OptionsLeaveOutAttributesAndPayload) {
+  const Bytes bytes = ply_bytes(ply_sample(), "binary_little_endian", false);
+  vola::io::InputOptions options;
+  options.attributes = false;
+  const auto in = vola::io::parse_ply(bytes, "sample.ply", options);
+  EXPECT_TRUE(in.cloud.attributes.empty());
+  EXPECT_TRUE(in.cloud.payload.empty());
+  EXPECT_EQ(in.cloud.size(), 5u);
+}
+
+TEST(Ply, SixteenBitColoursGiveTheHighByteAsPayload) {
+  Bytes b;
+  put_text(b, "ply\r\nformat binary_big_endian 1.0\r\nelement vertex 2\r\nproperty double x\r\nproperty double y\r\n"
+              "property double z\r\nproperty ushort red\r\nproperty ushort green\r\nproperty ushort blue\r\nend_header\r\n");
+  for (int i = 0; i < 2; ++i) {
+    for (int a = 0; a < 3; ++a) put<double>(b, i * 10.0 + a, true);
+    for (std::uint16_t c : {std::uint16_t(65535), std::uint16_t(256), std::uint16_t(255 + i)}) put<std::uint16_t>(b, c, true);
+  }
+  vola::io::InputOptions options;
+  options.payload = true;
+  const auto in = vola::io::parse_ply(b, "u16.ply", options);
+  ASSERT_EQ(in.cloud.size(), 2u);
+  EXPECT_EQ(in.cloud.xyz[5], 12.0);
+  EXPECT_EQ(in.cloud.attributes[0].values[0], 65535.0);
+  EXPECT_EQ(in.cloud.attributes[2].values[1], 256.0);
+  EXPECT_EQ(in.cloud.payload[0], 0xFFu | 1u << 8 | 0u << 16);
+  EXPECT_EQ(in.cloud.payload[1], 0xFFu | 1u << 8 | 1u << 16);
+}
+
+TEST(Ply, FacesBeforeVerticesAndPointsWithoutFaces) {
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uint uint vertex_index\nelement vertex 4\n"
+      "property double z\nproperty double y\nproperty double x\nend_header\n4 0 1 2 3\n0 0 0\n0 1 0\n1 1 0\n1 0 0\n";
+  const auto in = vola::io::parse_ply(Bytes(text.begin(), text.end()), "faces_first.ply");
+  ASSERT_EQ(in.cloud.size(), 4u);
+  EXPECT_EQ(in.cloud.xyz[3 * 2], 0.0);      // x of vertex 2 is the third column
+  EXPECT_EQ(in.cloud.xyz[3 * 2 + 2], 1.0);  // z of vertex 2 is the first
+  ASSERT_EQ(in.triangles.size(), 2u);
+  EXPECT_EQ(in.triangles[1][2], (vola::Point{0, 0, 1}));
+  const std::string points = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                             "property float z\nend_header\n1 2 3\n";
+  const auto p = vola::io::parse_ply(Bytes(points.begin(), points.end()), "points.ply");
+  EXPECT_FALSE(p.is_mesh());
+  EXPECT_EQ(p.cloud.xyz, (std::vector<double>{1, 2, 3}));
+}
+
+TEST(Ply, EveryTruncationOfABinaryFileIsAFormatError) {
+  for (const std::string encoding : {"binary_little_endian", "binary_big_endian"}) {
+    const Bytes full = ply_bytes(ply_sample(), encoding, true);
+    for (std::size_t n = 0; n < full.size(); ++n) {
+      const Bytes cut(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(n));
+      const auto error = vola_test::format_error_of([&] { vola::io::parse_ply(cut, "cut.ply"); });
+      ASSERT_TRUE(error.has_value()) << encoding << " cut at " << n;
+      EXPECT_EQ(error->file(), "cut.ply");
+    }
+  }
+}
+
+TEST(Ply, TruncatedAsciiIsAFormatErrorWithTheLine) {
+  const Bytes full = ply_bytes(ply_sample(), "ascii", false);
+  // Cut inside the last line but one: the last face is missing.
+  const std::string text(full.begin(), full.end());
+  const std::size_t last_line = text.rfind('\n', text.size() - 2);
+  for (std::size_t n = 0; n < last_line; ++n) {
+    const Bytes cut(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(n));
+    ASSERT_TRUE(vola_test::format_error_of([&] { vola::io::parse_ply(cut, "cut.ply"); })) << "cut at " << n;
+  }
+  const Bytes cut(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(last_line));
+  const auto error = vola_test::format_error_of([&] { vola::io::parse_ply(cut, "cut.ply"); });
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->cause().find("truncated"), std::string::npos) << error->what();
+}
+
+std::optional<vola::FormatError> error_of_text(const std::string& text) {
+  return vola_test::format_error_of([&] { vola::io::parse_ply(Bytes(text.begin(), text.end()), "bad.ply"); });
+}
+
+TEST(Ply, CorruptedInputIsAFormatErrorNamingTheProblem) {
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 1 1\n";
+  struct Case {
+    std::string text, cause;
+  } cases[] = {
+      {"plx\n", "not a PLY file"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n", "without end_header"},
+      {"ply\nformat ebcdic 1.0\nend_header\n", "unknown encoding"},
+      {"ply\nformat ascii 2.0\nend_header\n", "version"},
+      {"ply\nproperty float x\nformat ascii 1.0\nend_header\n", "before any element"},
+      {"ply\nformat ascii 1.0\nelement vertex -1\nend_header\n", "element count"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n", "unknown property type"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n", "integer type"},
+      {"ply\nformat ascii 1.0\nbogus line\nend_header\n", "unknown header keyword"},
+      {"ply\nformat ascii 1.0\nelement face 0\nend_header\n", "no vertex element"},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n", "no scalar property z"},
+      {head + faces + "3 0 1 2\n", "refers to vertex 2"},
+      {head + faces + "3 0 1 -1\n", "vertex index"},
+      {head + faces + "3 0 1 0.5\n", "vertex index"},
+      {head + faces + "-3 0 1 0\n", "list length"},
+      {head + faces.substr(0, faces.find("0 0 0")) + "0 zero 0\n", "'zero' is not a number"},
+      {"ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty double x\nproperty double y\n"
+       "property double z\nend_header\n",
+       "truncated"},
+  };
+  for (const auto& c : cases) {
+    const auto error = error_of_text(c.text);
+    ASSERT_TRUE(error) << c.text;
+    EXPECT_NE(error->cause().find(c.cause), std::string::npos) << error->what() << "\nexpected: " << c.cause;
+    EXPECT_TRUE(error->offset().has_value()) << error->what();
+  }
+  // A binary list whose count claims 4 billion indices, and an ascii error's line.
+  Bytes b;
+  put_text(b, "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+              "element face 1\nproperty list uint int vertex_indices\nend_header\n");
+  for (int i = 0; i < 3; ++i) put<float>(b, 0.0f);
+  put<std::uint32_t>(b, 0xFFFFFFFFu);
+  const auto huge = vola_test::format_error_of([&] { vola::io::parse_ply(b, "huge.ply"); });
+  ASSERT_TRUE(huge);
+  EXPECT_NE(huge->cause().find("runs past the end"), std::string::npos) << huge->what();
+  const auto line = error_of_text(head + faces + "3 0 1 5\n");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->cause().find("line 12"), std::string::npos) << line->what();
+}
+
+TEST(Ply, ElementsWithoutPropertiesTakeNoTimeWhateverTheirCount) {
+  const std::string text = "ply\nformat ascii 1.0\nelement nothing 18446744073709551615\nelement vertex 1\n"
+                           "property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
+  const auto in = vola::io::parse_ply(Bytes(text.begin(), text.end()), "empty_elements.ply");
+  EXPECT_EQ(in.cloud.size(), 1u);
+}
+
+}  // namespace
