@@ -59,8 +59,9 @@ class Tree {
   // then payload words when has_payload) and checks them: level 0 is one word,
   // each level has as many words as the level above has set bits, no word below
   // the root is zero. Throws FormatError naming `source` otherwise.
+  // `file_offset` = where the words start in `source`, for the error's byte offset.
   static Tree from_levels(int depth, bool has_payload, std::vector<std::uint64_t> words,
-                          const std::string& source = {});
+                          const std::string& source = {}, std::uint64_t file_offset = 0);
   // The same over bytes kept alive by `keeper` (a memory map): nothing is copied.
   static Tree view_levels(int depth, bool has_payload, std::span<const std::uint64_t> words,
                           std::shared_ptr<const void> keeper, const std::string& source = {},
@@ -80,12 +81,12 @@ class Tree {
   std::span<const std::uint64_t> words() const noexcept { return all_words_; }
 
   bool contains(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
-    return locate(encode(x, y, z), depth_ - 1).has_value();
+    return inside(Voxel{x, y, z}, depth_ - 1) && locate(encode(x, y, z), depth_ - 1).has_value();
   }
   bool contains(const Voxel& v) const noexcept { return contains(v.x, v.y, v.z); }
   // Is the level-`level` cell (coordinates on the 4^(level+1) grid) occupied?
   bool contains_node(int level, const Voxel& cell) const noexcept {
-    return locate(encode(cell.x, cell.y, cell.z), level).has_value();
+    return inside(cell, level) && locate(encode(cell.x, cell.y, cell.z), level).has_value();
   }
   // The voxel's index among all voxels in key order, if occupied: the row of its
   // attribute values.
@@ -161,6 +162,11 @@ class Tree {
     std::size_t block;  // block index within the level
     unsigned bit;       // bit within the block
   };
+  // Is the cell on the level's 4^(level+1) grid? Cells past it would alias onto cells
+  // inside it, since a key keeps only the low 2 bits per level of each coordinate.
+  static bool inside(const Voxel& cell, int level) noexcept {
+    return ((cell.x | cell.y | cell.z) >> (2 * (level + 1))) == 0;
+  }
   // Walks from the root to `level` along `key` (a key of a depth-(level+1) tree).
   std::optional<Location> locate(Key node_key, int level) const noexcept {
     std::size_t block = 0;

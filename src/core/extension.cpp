@@ -1,5 +1,6 @@
 #include "extension.hpp"
 
+#include <cmath>
 #include <cstring>
 
 #include "bytes.hpp"
@@ -126,6 +127,10 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         for (double& o : f.origin) o = body.get<double>("frame origin");
         f.voxel_size = body.get<double>("frame voxel size");
         if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
+        if (!std::isfinite(f.voxel_size)) body.fail_at(record_offset + 48, "voxel size is not finite");
+        for (int a = 0; a < 3; ++a)
+          if (!std::isfinite(f.origin[a]))
+            body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a), "frame origin is not finite");
         out.frame = f;
         break;
       }

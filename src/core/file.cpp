@@ -133,7 +133,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     } else {
       std::vector<std::uint64_t> copy(words);
       if (words) std::memcpy(copy.data(), first, 8 * words);
-      tree = Tree::from_levels(h.depth, payload, std::move(copy), name);
+      tree = Tree::from_levels(h.depth, payload, std::move(copy), name, kHeaderSize);
     }
     info.level_bytes = 8 * words;
     extension_at = kHeaderSize + 8 * words;

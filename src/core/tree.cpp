@@ -38,9 +38,9 @@ Tree::Tree() {
 }
 
 Tree Tree::from_levels(int depth, bool has_payload, std::vector<std::uint64_t> words,
-                       const std::string& source) {
+                       const std::string& source, std::uint64_t file_offset) {
   auto owned = std::make_shared<std::vector<std::uint64_t>>(std::move(words));
-  Tree tree = view_levels(depth, has_payload, *owned, owned, source, 0);
+  Tree tree = view_levels(depth, has_payload, *owned, owned, source, file_offset);
   tree.mapped_ = false;
   return tree;
 }
@@ -111,6 +111,7 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
 }
 
 std::optional<std::uint64_t> Tree::rank(const Voxel& v) const noexcept {
+  if (!inside(v, depth_ - 1)) return std::nullopt;
   const auto at = locate(encode(v), depth_ - 1);
   if (!at) return std::nullopt;
   const auto& leaf = occupancy_[depth_ - 1];
@@ -120,6 +121,7 @@ std::optional<std::uint64_t> Tree::rank(const Voxel& v) const noexcept {
 
 std::optional<std::uint64_t> Tree::block_payload(const Voxel& v) const noexcept {
   if (!has_payload_) return std::nullopt;
+  if (!inside(v, depth_ - 1)) return std::nullopt;
   const auto at = locate(encode(v), depth_ - 1);
   if (!at) return std::nullopt;
   return payload_[depth_ - 1][at->block];
@@ -133,6 +135,7 @@ std::uint64_t Tree::voxel_payload_at_rank(std::uint64_t rank, std::size_t leaf_b
 
 std::optional<std::uint64_t> Tree::voxel_payload(const Voxel& v) const noexcept {
   if (!has_payload_ && voxel_payloads_.empty()) return std::nullopt;
+  if (!inside(v, depth_ - 1)) return std::nullopt;
   const auto at = locate(encode(v), depth_ - 1);
   if (!at) return std::nullopt;
   std::uint64_t r = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "vola/error.hpp"
 #include "vola/stream_builder.hpp"
@@ -230,7 +231,7 @@ LasReader::LasReader(const std::string& path) : path_(path), in_(path, std::ios:
   in_.seekg(hd.offset_to_points);
 }
 
-std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points) {
+std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_only) {
   chunk.clear();
   const LasHeader& hd = header_;
   chunk.extra.resize(hd.extra_fields.size());
@@ -242,6 +243,16 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points) {
   in_.read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
   if (static_cast<std::size_t>(in_.gcount()) != buffer_.size())
     throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
+  if (xyz_only) {
+    chunk.xyz.resize(3 * n);
+    double* out = chunk.xyz.data();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint8_t* r = buffer_.data() + i * length;
+      for (int a = 0; a < 3; ++a) out[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+    }
+    next_ += n;
+    return n;
+  }
   const bool extended = hd.extended_format();
   const bool rgb = hd.has_rgb(), gps = hd.has_gps_time();
   // Byte offsets of the optional fields inside a record.
@@ -398,20 +409,18 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   const std::uint64_t passes = options.bbox ? 1 : 2;
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
-    Box box;
-    bool first = true;
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
     reader.rewind();
-    while (const std::size_t n = reader.read(chunk, kChunk)) {
+    while (const std::size_t n = reader.read(chunk, kChunk, true)) {
       for (std::size_t i = 0; i < n; ++i)
         for (int a = 0; a < 3; ++a) {
-          const double v = chunk.xyz[3 * i + a];
-          if (first || v < box.min[a]) box.min[a] = v;
-          if (first || v > box.max[a]) box.max[a] = v;
-          first = a < 2 && first;
+          box.min[a] = std::min(box.min[a], chunk.xyz[3 * i + a]);
+          box.max[a] = std::max(box.max[a], chunk.xyz[3 * i + a]);
         }
       if (progress) progress(reader.points_read(), passes * hd.point_count);
     }
-    options.bbox = box;
+    options.bbox = reader.points_read() > 0 ? box : Box{};
   }
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
   std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
@@ -420,7 +429,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
   reader.rewind();
-  while (const std::size_t n = reader.read(chunk, kChunk)) {
+  while (reader.read(chunk, kChunk, !attributes && !payload) > 0) {
     if (attributes) las_attribute_values(hd, chunk, values);
     views.assign(values.begin(), values.end());
     if (payload) las_payloads(hd, chunk, payloads);

@@ -73,8 +73,9 @@ class LasReader {
   // what to do. Throws FormatError with file and offset on anything malformed.
   explicit LasReader(const std::string& path);
   const LasHeader& header() const noexcept { return header_; }
-  // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end.
-  std::size_t read(LasChunk& chunk, std::size_t max_points);
+  // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end. With
+  // `xyz_only`, only the coordinates are decoded.
+  std::size_t read(LasChunk& chunk, std::size_t max_points, bool xyz_only = false);
   std::uint64_t points_read() const noexcept { return next_; }
   // Back to the first point (for a second pass).
   void rewind();
