@@ -11,6 +11,8 @@
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
+#include "vola/mesh/terrain.hpp"
+#include "vola/mesh/voxelize.hpp"
 
 namespace vola::cli {
 
@@ -30,6 +32,9 @@ struct ConvertArgs {
   std::vector<std::string> attributes;
   int skip_lines = 0;
   bool no_attributes = false;
+  bool solid = false;
+  double dem_base = 0.0;
+  bool dem_base_given = false, dem_surface_only = false;
 };
 
 
@@ -98,6 +103,10 @@ io::Input load_input(const ConvertArgs& a) {
   options.attributes = !a.no_attributes;
   options.payload = a.nbits > 0;
   if (format.name == "text") options.text = text_columns(a);
+  if (format.name != "dem" && (a.dem_base_given || a.dem_surface_only))
+    throw InvalidArgument("--dem-base and --dem-surface-only apply to DEM input");
+  if (a.dem_base_given) options.dem_base = a.dem_base;
+  options.dem_surface_only = a.dem_surface_only;
   Progress progress("reading " + a.input);
   options.progress = [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); };
   io::Input input = format.read(a.input, options);
@@ -146,11 +155,48 @@ PointCloud grid_centres(const io::VoxelGrid& grid) {
   return cloud;
 }
 
+// Triangles -> surface voxels (and the inside with --solid). Toolkit mode frames the
+// vertices' bbox, like the points' bbox of a point cloud.
+Tree build_from_mesh(const io::Input& input, BuildOptions options, bool solid, BuildReport& report) {
+  if (options.payload) throw InvalidArgument("--nbits: mesh input carries no payload");
+  const Box bbox = options.bbox ? *options.bbox : mesh::triangle_bounds(input.triangles);
+  const Quantizer quantizer = resolve_quantizer(bbox, options);
+  mesh::VoxelizeOptions voxelize;
+  voxelize.solid = solid;
+  mesh::VoxelizeReport voxels;
+  Tree tree = mesh::voxelize(input.triangles, quantizer, voxelize, &voxels);
+  tree.georef().bbox = bbox;
+  report.points_in = voxels.triangles;
+  report.points_outside = voxels.skipped + voxels.outside;
+  report.voxels = tree.voxel_count();
+  return tree;
+}
+
+// DEM cells -> columns of voxels from the base height to each cell's height. The frame
+// covers the base too, so that the columns fit.
+Tree build_from_terrain(const io::Input& input, BuildOptions options, BuildReport& report) {
+  if (options.payload) throw InvalidArgument("--nbits: DEM input carries no payload");
+  Box bbox = input.cloud.bounds();
+  if (!input.terrain_surface_only) {
+    bbox.min[2] = std::min(bbox.min[2], input.terrain_base);
+    bbox.max[2] = std::max(bbox.max[2], input.terrain_base);
+  }
+  if (options.bbox) bbox = *options.bbox;
+  const Quantizer quantizer = resolve_quantizer(bbox, options);
+  mesh::TerrainOptions columns;
+  columns.base = input.terrain_base;
+  columns.surface_only = input.terrain_surface_only;
+  Tree tree = mesh::terrain_columns(input.cloud, quantizer, columns, &report);
+  tree.georef().bbox = bbox;
+  return tree;
+}
+
 void run_convert(const ConvertArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   // Fail on a CRS PROJ does not know before reading gigabytes.
   if (a.crs_given) geo::crs_wkt(a.crs);
   io::Input loaded = load_input(a);
+  if (a.solid && !loaded.is_mesh()) throw InvalidArgument("--solid applies to mesh input (triangles)");
   const bool one_to_one = maps_one_to_one(loaded, a);
 
   BuildOptions options;
@@ -189,10 +235,12 @@ void run_convert(const ConvertArgs& a) {
     tree = build_from_grid(*loaded.grid, a.depth, report);
   } else {
     if (loaded.grid) loaded.cloud = grid_centres(*loaded.grid);
-    if (loaded.is_mesh())
-      throw InvalidArgument(a.input + ": mesh input needs the mesh voxelizer, which this build lacks");
-    if (loaded.cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
-    tree = build(loaded.cloud, options, &report);
+    if (loaded.is_mesh()) {
+      tree = build_from_mesh(loaded, options, a.solid, report);
+    } else {
+      if (loaded.cloud.size() == 0) throw InvalidArgument(a.input + ": no points");
+      tree = loaded.terrain ? build_from_terrain(loaded, options, report) : build(loaded.cloud, options, &report);
+    }
   }
   tree.georef().epsg = options.epsg;
   // lat/lon of the bbox centre through PROJ, from the code or else the input's WKT.
@@ -231,9 +279,11 @@ void run_convert(const ConvertArgs& a) {
   else if (!epsg)
     std::printf("crs:            none known (header carries the reference's default EPSG:%u)\n", options.epsg);
   else std::printf("crs:            EPSG:%u\n", *epsg);
-  std::printf("points in:      %llu (%s)\n", static_cast<unsigned long long>(report.points_in), a.input.c_str());
+  const char* unit = loaded.is_mesh() ? "triangles" : (loaded.terrain ? "cells" : "points");
+  std::printf("%-16s%llu (%s)\n", (std::string(unit) + " in:").c_str(), static_cast<unsigned long long>(report.points_in),
+              a.input.c_str());
   if (report.points_outside)
-    std::printf("points dropped: %llu (outside the grid or not finite)\n",
+    std::printf("%s dropped: %llu (outside the grid or not finite)\n", unit,
                 static_cast<unsigned long long>(report.points_outside));
   std::printf("voxels out:     %llu at depth %d (%u^3 grid, %s quantization, voxel %.6g)\n",
               static_cast<unsigned long long>(report.voxels), tree.depth(), tree.side(),
@@ -262,7 +312,9 @@ void add_convert(CLI::App& app) {
       "  vola convert city.xyz city.vol --voxel-size 0.5 --crs 32633\n"
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
       "  vola convert scan.csv scan.vol --voxel-size 0.1 --attribute intensity=4:u16:mean\n"
-      "  vola convert points.npy points.vol --depth 5 --compress");
+      "  vola convert points.npy points.vol --depth 5 --compress\n"
+      "  vola convert part.stl part.vol --quantize toolkit --depth 5 --solid\n"
+      "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0");
   cmd->add_option("input", args->input, "Input points: .las (LAS 1.0-1.4), .xyz .txt .csv .pts .asc (text) or .npy")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file")->required();
   cmd->add_option("--format", args->format, "Input format: auto (from the extension), las, text, npy")->capture_default_str();
@@ -289,6 +341,10 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--skip-lines", args->skip_lines, "Text: header lines to skip")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-attributes", args->no_attributes, "LAS: keep occupancy only, no per-voxel attribute columns");
   cmd->add_flag("--compress", args->compress, "zstd-compress the levels and attributes (a file only vola reads)");
+  cmd->add_flag("--solid", args->solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
+  cmd->add_option("--dem-base", args->dem_base, "DEM: height the voxel columns start from (default: the lowest cell)")
+      ->each([args](const std::string&) { args->dem_base_given = true; });
+  cmd->add_flag("--dem-surface-only", args->dem_surface_only, "DEM: one voxel per cell at its height, no columns");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_convert(*args); });
 }

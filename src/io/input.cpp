@@ -6,8 +6,10 @@
 
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
+#include "vola/io/dem.hpp"
 #include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/mesh.hpp"
 #include "vola/io/npy.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
@@ -58,6 +60,26 @@ Input read_binvox_input(const std::string& path, const InputOptions&) {
   return in;
 }
 
+Input read_mesh_input(const std::string& path, const InputOptions&) {
+  Input in;
+  in.format = "mesh";
+  in.triangles = read_mesh_triangles(path);
+  return in;
+}
+
+Input read_dem_input(const std::string& path, const InputOptions& options) {
+  DemRaster dem = read_dem(path, options.progress);
+  Input in;
+  in.format = "dem";
+  in.cloud = std::move(dem.cells);
+  in.epsg = dem.epsg;
+  in.wkt = std::move(dem.wkt);
+  in.terrain = true;
+  in.terrain_base = options.dem_base.value_or(dem.minimum);
+  in.terrain_surface_only = options.dem_surface_only;
+  return in;
+}
+
 std::vector<InputFormat> make_formats() {
   return {
       {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10 (LAZ: a clear error)", read_las_input},
@@ -67,6 +89,10 @@ std::vector<InputFormat> make_formats() {
       {"pcd", {".pcd"}, "PCD .5-0.7 ascii/binary/binary_compressed points", read_pcd_input},
       {"kitti", {".bin"}, "KITTI velodyne float32 x y z reflectance", read_kitti_input},
       {"binvox", {".binvox"}, "binvox occupancy grids", read_binvox_input},
+      {"mesh", {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"},
+       "meshes through Assimp: STL, OBJ, OFF, glTF, COLLADA, 3DS", read_mesh_input},
+      {"dem", {".tif", ".tiff", ".dem", ".img"}, "elevation rasters through GDAL (GeoTIFF, ...): cells as columns",
+       read_dem_input},
   };
 }
 

@@ -20,6 +20,8 @@ struct InputOptions {
   bool payload = false;    // build the reference's payload word per point where the format defines one
   TextColumns text;        // text formats: which columns are what
   std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
+  std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
+  bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
 };
 
 // Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).
@@ -39,6 +41,12 @@ struct Input {
   std::vector<Triangle> triangles;     // mesh formats
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
+  // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,
+  // each to become a column of voxels down (or up) to terrain_base, or only the voxel
+  // of its height when terrain_surface_only.
+  bool terrain = false;
+  double terrain_base = 0.0;
+  bool terrain_surface_only = false;
   bool is_mesh() const noexcept { return !triangles.empty(); }
 };
 

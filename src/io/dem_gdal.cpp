@@ -1,0 +1,124 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <gdal_priv.h>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <ogr_spatialref.h>
+#include <vector>
+
+#include "vola/error.hpp"
+#include "vola/io/dem.hpp"
+
+namespace vola::io {
+
+namespace {
+
+// GDAL reports through a global handler that prints; the library never prints, so
+// errors are kept quiet while we read and taken from CPLGetLastErrorMsg.
+class QuietGdalErrors {
+ public:
+  QuietGdalErrors() {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdalErrors() { CPLPopErrorHandler(); }
+  QuietGdalErrors(const QuietGdalErrors&) = delete;
+  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
+};
+
+std::string gdal_message(const char* what) {
+  const char* message = CPLGetLastErrorMsg();
+  return std::string(what) + (message && *message ? std::string(": ") + message : std::string());
+}
+
+struct DatasetCloser {
+  void operator()(GDALDataset* d) const { GDALClose(d); }
+};
+
+void crs_of(const GDALDataset& dataset, DemRaster& dem) {
+  const OGRSpatialReference* srs = dataset.GetSpatialRef();
+  if (!srs) return;
+  char* wkt = nullptr;
+  if (srs->exportToWkt(&wkt) == OGRERR_NONE && wkt) dem.wkt = wkt;
+  CPLFree(wkt);
+  OGRSpatialReference identified(*srs);
+  identified.AutoIdentifyEPSG();
+  const char* authority = identified.GetAuthorityName(nullptr);
+  const char* code = identified.GetAuthorityCode(nullptr);
+  if (authority && code && std::string(authority) == "EPSG") {
+    char* end = nullptr;
+    const unsigned long value = std::strtoul(code, &end, 10);
+    if (end != code && *end == '\0' && value > 0 && value <= std::numeric_limits<std::uint32_t>::max())
+      dem.epsg = static_cast<std::uint32_t>(value);
+  }
+}
+
+}  // namespace
+
+DemRaster read_dem(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  static std::once_flag registered;
+  std::call_once(registered, [] { GDALAllRegister(); });
+  QuietGdalErrors quiet;
+  std::unique_ptr<GDALDataset, DatasetCloser> dataset(
+      GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr)));
+  if (!dataset) throw FormatError(path, std::nullopt, gdal_message("GDAL cannot open it as a raster"));
+  if (dataset->GetRasterCount() < 1) throw FormatError(path, std::nullopt, "the raster has no band");
+
+  DemRaster dem;
+  dem.width = static_cast<std::uint64_t>(dataset->GetRasterXSize());
+  dem.height = static_cast<std::uint64_t>(dataset->GetRasterYSize());
+  if (dem.width * dem.height > kMaxDemCells)
+    throw InvalidArgument(path + ": " + std::to_string(dem.width) + " x " + std::to_string(dem.height) +
+                          " cells is more than " + std::to_string(kMaxDemCells) + "; crop or resample it first");
+  crs_of(*dataset, dem);
+  double gt[6];
+  // Without a geotransform GDAL fills the identity: cell (i, j) is at (i, j).
+  (void)dataset->GetGeoTransform(gt);
+
+  GDALRasterBand* band = dataset->GetRasterBand(1);
+  int has_scale = 0, has_offset = 0;
+  double scale = band->GetScale(&has_scale), offset = band->GetOffset(&has_offset);
+  if (!has_scale) scale = 1.0;
+  if (!has_offset) offset = 0.0;
+  GDALRasterBand* mask = band->GetMaskBand();
+  const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
+
+  // Whole rows at a time, about a million cells per read.
+  const std::uint64_t rows_per_read = std::max<std::uint64_t>(1, (std::uint64_t{1} << 20) / std::max<std::uint64_t>(dem.width, 1));
+  std::vector<double> values;
+  std::vector<std::uint8_t> valid;
+  double minimum = std::numeric_limits<double>::infinity();
+  for (std::uint64_t row = 0; row < dem.height; row += rows_per_read) {
+    const std::uint64_t rows = std::min(rows_per_read, dem.height - row);
+    values.resize(rows * dem.width);
+    const int x_size = static_cast<int>(dem.width), y_off = static_cast<int>(row), y_size = static_cast<int>(rows);
+    if (band->RasterIO(GF_Read, 0, y_off, x_size, y_size, values.data(), x_size, y_size, GDT_Float64, 0, 0) != CE_None)
+      throw FormatError(path, std::nullopt, gdal_message(("cannot read rows " + std::to_string(row) + "..").c_str()));
+    if (!all_valid) {
+      valid.resize(rows * dem.width);
+      if (mask->RasterIO(GF_Read, 0, y_off, x_size, y_size, valid.data(), x_size, y_size, GDT_Byte, 0, 0) != CE_None)
+        throw FormatError(path, std::nullopt, gdal_message(("cannot read the mask of rows " + std::to_string(row) + "..").c_str()));
+    }
+    for (std::uint64_t r = 0; r < rows; ++r)
+      for (std::uint64_t c = 0; c < dem.width; ++c) {
+        const std::uint64_t i = r * dem.width + c;
+        const double z = values[i] * scale + offset;
+        if ((!all_valid && valid[i] == 0) || !std::isfinite(z)) {
+          ++dem.invalid_cells;
+          continue;
+        }
+        const double px = static_cast<double>(c) + 0.5, py = static_cast<double>(row + r) + 0.5;
+        dem.cells.xyz.push_back(gt[0] + px * gt[1] + py * gt[2]);
+        dem.cells.xyz.push_back(gt[3] + px * gt[4] + py * gt[5]);
+        dem.cells.xyz.push_back(z);
+        minimum = std::min(minimum, z);
+      }
+    if (progress) progress(row + rows, dem.height);
+  }
+  dem.minimum = dem.cells.size() ? minimum : 0.0;
+  return dem;
+}
+
+}  // namespace vola::io

@@ -1,0 +1,166 @@
+// DEM rasters through GDAL: rasters written here with known cells, and the shared
+// GeoTIFFs against their raw cells read the plain way.
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+#include <gtest/gtest.h>
+
+#include "../mesh/mesh_test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/io/dem.hpp"
+#include "vola/io/input.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Raster {
+  int width, height;
+  GDALDataType type;
+  std::vector<double> values;  // row by row, north first
+  double geotransform[6];
+  std::optional<double> nodata;
+  double scale = 1.0, offset = 0.0;
+  int epsg = 0;  // 0: no CRS
+};
+
+void write_geotiff(const fs::path& path, const Raster& r) {
+  GDALAllRegister();
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  ASSERT_NE(driver, nullptr);
+  GDALDataset* d = driver->Create(path.c_str(), r.width, r.height, 1, r.type, nullptr);
+  ASSERT_NE(d, nullptr);
+  double gt[6];
+  std::copy(r.geotransform, r.geotransform + 6, gt);
+  d->SetGeoTransform(gt);
+  if (r.epsg) {
+    OGRSpatialReference srs;
+    srs.importFromEPSG(r.epsg);
+    d->SetSpatialRef(&srs);
+  }
+  GDALRasterBand* band = d->GetRasterBand(1);
+  if (r.nodata) band->SetNoDataValue(*r.nodata);
+  band->SetScale(r.scale);
+  band->SetOffset(r.offset);
+  std::vector<double> values = r.values;
+  ASSERT_EQ(band->RasterIO(GF_Write, 0, 0, r.width, r.height, values.data(), r.width, r.height, GDT_Float64, 0, 0),
+            CE_None);
+  GDALClose(d);
+}
+
+TEST(DemGdal, CellsCentresHeightsAndCrsOfAWrittenRaster) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Raster r{4, 3, GDT_Float32,
+           {1, 2, 3, 4,
+            5, -9999, 7, 8,
+            9, 10, nan, 12},
+           {500000, 10, 2, 4000000, 1, -10}, -9999.0, 0.5, 100.0, 32633};
+  vola_test::TempDir dir;
+  write_geotiff(dir / "dem.tif", r);
+  const vola::io::DemRaster dem = vola::io::read_dem((dir / "dem.tif").string());
+  EXPECT_EQ(dem.width, 4u);
+  EXPECT_EQ(dem.height, 3u);
+  EXPECT_EQ(dem.invalid_cells, 2u);
+  EXPECT_EQ(dem.epsg, std::optional<std::uint32_t>(32633));
+  EXPECT_NE(dem.wkt.find("UTM zone 33N"), std::string::npos) << dem.wkt;
+  std::vector<double> expected;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const double v = r.values[j * 4 + i];
+      if (v == -9999 || std::isnan(v)) continue;
+      const double px = i + 0.5, py = j + 0.5;
+      expected.insert(expected.end(), {500000 + px * 10 + py * 2, 4000000 + px * 1 - py * 10, v * 0.5 + 100});
+    }
+  EXPECT_EQ(dem.cells.xyz, expected);
+  EXPECT_EQ(dem.minimum, 100.5);
+}
+
+TEST(DemGdal, InputIsATerrainWithItsBase) {
+  Raster r{2, 2, GDT_Int16, {-32768, 20, 30, 40}, {0, 1, 0, 2, 0, -1}, -32768.0, 1.0, 0.0, 0};
+  vola_test::TempDir dir;
+  write_geotiff(dir / "small.tiff", r);
+  const std::string path = (dir / "small.tiff").string();
+  vola::io::Input in = vola::io::read_input(path, "auto", {});
+  EXPECT_EQ(in.format, "dem");
+  EXPECT_TRUE(in.terrain);
+  EXPECT_EQ(in.terrain_base, 20.0);
+  EXPECT_FALSE(in.terrain_surface_only);
+  EXPECT_FALSE(in.epsg.has_value());
+  EXPECT_TRUE(in.wkt.empty());
+  EXPECT_EQ(in.cloud.xyz, (std::vector<double>{1.5, 1.5, 20, 0.5, 0.5, 30, 1.5, 0.5, 40}));
+  vola::io::InputOptions options;
+  options.dem_base = -5.0;
+  options.dem_surface_only = true;
+  in = vola::io::read_input(path, "dem", options);
+  EXPECT_EQ(in.terrain_base, -5.0);
+  EXPECT_TRUE(in.terrain_surface_only);
+}
+
+// The raw band as int16 without GDAL's mask: what the reader must agree with.
+std::uint64_t raw_valid_cells(const fs::path& path, std::int16_t nodata, int& width, int& height) {
+  GDALAllRegister();
+  GDALDataset* d = static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly));
+  if (!d) return 0;
+  width = d->GetRasterXSize();
+  height = d->GetRasterYSize();
+  std::vector<std::int16_t> cells(static_cast<std::size_t>(width) * height);
+  std::uint64_t valid = 0;
+  if (d->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, width, height, cells.data(), width, height, GDT_Int16, 0, 0) == CE_None)
+    for (std::int16_t c : cells) valid += c != nodata;
+  GDALClose(d);
+  return valid;
+}
+
+TEST(DemGdal, SharedGeoTiffs) {
+  VOLA_REQUIRE_DATA(data);
+  struct Case {
+    const char* file;
+    std::uint32_t epsg;
+    double first_x, first_y;  // centre of the north-west cell, from EXPECTED.txt's tiepoint and scale
+    bool declares_nodata;
+  };
+  const Case cases[] = {
+      {"dem/pdal_gdal_int16_epsg26711.tif", 26711, 440720.0 + 30.0, 3751320.0 - 30.0, false},
+      {"dem/pysheds_dem_int16_tiled_epsg4326.tif", 4326, -97.4849999999961 + 0.0008333333333333 / 2,
+       32.82166666666536 - 0.0008333333333333 / 2, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const vola::io::DemRaster dem = vola::io::read_dem((data / c.file).string());
+    int width = 0, height = 0;
+    const std::uint64_t valid = raw_valid_cells(data / c.file, c.declares_nodata ? -32768 : 0x7fff, width, height);
+    EXPECT_EQ(dem.width, static_cast<std::uint64_t>(width));
+    EXPECT_EQ(dem.height, static_cast<std::uint64_t>(height));
+    EXPECT_EQ(dem.cells.size(), valid);
+    EXPECT_EQ(dem.cells.size() + dem.invalid_cells, dem.width * dem.height);
+    EXPECT_EQ(dem.epsg, std::optional<std::uint32_t>(c.epsg));
+    EXPECT_FALSE(dem.wkt.empty());
+    ASSERT_GT(dem.cells.size(), 0u);
+    EXPECT_NEAR(dem.cells.xyz[0], c.first_x, 1e-6);
+    EXPECT_NEAR(dem.cells.xyz[1], c.first_y, 1e-6);
+    EXPECT_EQ(dem.minimum, dem.cells.bounds().min[2]);
+  }
+}
+
+TEST(DemGdal, FilesGdalCannotReadThrowFormatErrors) {
+  vola_test::TempDir dir;
+  std::ofstream(dir / "text.tif") << "not a raster at all\n";
+  for (const fs::path& p : {dir / "text.tif", dir / "missing.tif"}) {
+    const auto error = vola_test::format_error_of([&] { vola::io::read_dem(p.string()); });
+    ASSERT_TRUE(error.has_value()) << p;
+    EXPECT_EQ(error->file(), p.string());
+    EXPECT_FALSE(error->cause().empty());
+  }
+  // A truncated GeoTIFF: the header survives, the cells do not.
+  Raster r{64, 64, GDT_Int16, std::vector<double>(64 * 64, 7.0), {0, 1, 0, 0, 0, -1}, std::nullopt, 1.0, 0.0, 0};
+  write_geotiff(dir / "whole.tif", r);
+  auto bytes = vola_test::read_bytes(dir / "whole.tif");
+  bytes.resize(bytes.size() / 2);
+  vola_test::write_bytes(dir / "half.tif", bytes);
+  EXPECT_THROW(vola::io::read_dem((dir / "half.tif").string()), vola::FormatError);
+}
+
+}  // namespace

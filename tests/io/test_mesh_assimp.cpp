@@ -1,0 +1,286 @@
+// Meshes through Assimp: the shared files against EXPECTED.txt, and small files written
+// here whose triangles are known exactly.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../mesh/mesh_test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/io/input.hpp"
+#include "vola/io/mesh.hpp"
+#include "vola/mesh/voxelize.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using vola::Point;
+using vola::io::Triangle;
+
+struct Expected {
+  std::uint64_t triangles = 0;
+  Point min{}, max{};
+};
+
+// The EXPECTED.txt line of `name`: triangles=N (STL), tri=N (OFF) or f=N (OBJ, whose
+// faces in these files are all triangles), and bbox=[..]..[..].
+std::optional<Expected> expected_for(const fs::path& data, const std::string& name) {
+  std::ifstream in(data / "EXPECTED.txt");
+  std::string line;
+  const std::regex count(R"((?:triangles=|\(tri=| f=)(\d+))");
+  const std::regex box(R"(bbox=\[([-\d.e]+), ([-\d.e]+), ([-\d.e]+)\]\.\.\[([-\d.e]+), ([-\d.e]+), ([-\d.e]+)\])");
+  while (std::getline(in, line)) {
+    if (line.rfind(name + " ", 0) != 0) continue;
+    std::smatch c, b;
+    if (!std::regex_search(line, c, count) || !std::regex_search(line, b, box)) return std::nullopt;
+    Expected e;
+    e.triangles = std::stoull(c[1]);
+    for (int a = 0; a < 3; ++a) {
+      e.min[a] = std::stod(b[1 + a]);
+      e.max[a] = std::stod(b[4 + a]);
+    }
+    return e;
+  }
+  return std::nullopt;
+}
+
+vola::Box bounds(const std::vector<Triangle>& triangles) { return vola::mesh::triangle_bounds(triangles); }
+
+// The bbox of the vertices some face uses, read the slow obvious way from an OFF or OBJ
+// file (EXPECTED.txt's bbox covers every vertex; a few ModelNet files have vertices no
+// face uses, which the reader leaves out). `all_used` says whether every vertex is used.
+vola::Box used_vertex_bounds(const fs::path& path, bool& all_used) {
+  std::vector<Point> vertices;
+  std::vector<long> used;
+  std::ifstream in(path);
+  if (path.extension() == ".off") {
+    std::string magic;
+    long nv = 0, nf = 0, ne = 0;
+    in >> magic >> nv >> nf >> ne;
+    vertices.resize(static_cast<std::size_t>(nv));
+    for (auto& v : vertices) in >> v[0] >> v[1] >> v[2];
+    for (long f = 0; f < nf; ++f) {
+      long n = 0;
+      in >> n;
+      for (long k = 0; k < n; ++k) {
+        long i = 0;
+        in >> i;
+        used.push_back(i);
+      }
+      std::string rest;
+      std::getline(in, rest);  // colours, if any
+    }
+  } else {
+    std::string line;
+    while (std::getline(in, line)) {
+      std::istringstream words(line);
+      std::string tag;
+      words >> tag;
+      if (tag == "v") {
+        Point p;
+        words >> p[0] >> p[1] >> p[2];
+        vertices.push_back(p);
+      } else if (tag == "f") {
+        for (std::string ref; words >> ref;) {
+          const long i = std::stol(ref.substr(0, ref.find('/')));
+          used.push_back(i < 0 ? static_cast<long>(vertices.size()) + i : i - 1);
+        }
+      }
+    }
+  }
+  std::vector<bool> seen(vertices.size(), false);
+  for (long i : used) seen.at(static_cast<std::size_t>(i)) = true;
+  all_used = std::find(seen.begin(), seen.end(), false) == seen.end();
+  std::vector<Triangle> points;
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    if (seen[i]) points.push_back({vertices[i], vertices[i], vertices[i]});
+  return bounds(points);
+}
+
+TEST(MeshAssimp, SharedFilesMatchExpected) {
+  VOLA_REQUIRE_DATA(data);
+  int files = 0, checked = 0, partly_used = 0;
+  for (const char* folder : {"mesh/stl", "mesh/obj", "mesh/off", "modelnet/off"}) {
+    for (const auto& entry : fs::directory_iterator(data / folder)) {
+      const std::string name = entry.path().filename().string();
+      SCOPED_TRACE(name);
+      ++files;
+      const vola::io::Input input = vola::io::read_input(entry.path().string(), "auto", {});
+      EXPECT_EQ(input.format, "mesh");
+      ASSERT_FALSE(input.triangles.empty());
+      const vola::Box got = bounds(input.triangles);
+      bool all_used = true;
+      if (entry.path().extension() != ".stl") {
+        const vola::Box used = used_vertex_bounds(entry.path(), all_used);
+        partly_used += !all_used;
+        for (int a = 0; a < 3; ++a) {  // Assimp keeps 32-bit floats
+          EXPECT_NEAR(got.min[a], used.min[a], 1e-6 * (1 + std::abs(used.min[a]))) << "axis " << a;
+          EXPECT_NEAR(got.max[a], used.max[a], 1e-6 * (1 + std::abs(used.max[a]))) << "axis " << a;
+        }
+      }
+      const auto expected = expected_for(data, name);
+      if (!expected) continue;  // nothing recorded: reading it is the test
+      ++checked;
+      EXPECT_EQ(input.triangles.size(), expected->triangles);
+      for (int a = 0; a < 3; ++a) {
+        // EXPECTED.txt prints 4 decimals of the bbox of every vertex.
+        const double tolerance = 6e-5 + 1e-6 * std::abs(expected->max[a]);
+        if (all_used) {
+          EXPECT_NEAR(got.min[a], expected->min[a], tolerance) << "axis " << a;
+          EXPECT_NEAR(got.max[a], expected->max[a], tolerance) << "axis " << a;
+        } else {
+          EXPECT_GE(got.min[a], expected->min[a] - tolerance) << "axis " << a;
+          EXPECT_LE(got.max[a], expected->max[a] + tolerance) << "axis " << a;
+        }
+      }
+    }
+  }
+  EXPECT_GE(files, 18);
+  EXPECT_GE(checked, 18);
+  EXPECT_GE(partly_used, 1);  // the case above is exercised
+}
+
+void write_file(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// A binary STL: 80-byte header, count, then per triangle normal + 3 vertices + 2 bytes.
+std::string binary_stl(const std::string& header, const std::vector<std::array<float, 9>>& triangles) {
+  std::string out = header;
+  out.resize(80, ' ');
+  const std::uint32_t n = static_cast<std::uint32_t>(triangles.size());
+  out.append(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : triangles) {
+    const float normal[3] = {0, 0, 0};
+    out.append(reinterpret_cast<const char*>(normal), 12);
+    out.append(reinterpret_cast<const char*>(t.data()), 36);
+    out.append(2, '\0');
+  }
+  return out;
+}
+
+const std::vector<std::array<float, 9>> kTetrahedron = {
+    {0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 0, 0, 0, 0, 1, 1, 0, 0}, {0, 0, 0, 0, 1, 0, 0, 0, 1}, {1, 0, 0, 0, 0, 1, 0, 1, 0}};
+
+void expect_tetrahedron(const std::vector<Triangle>& got, const Point& shift = {0, 0, 0}) {
+  ASSERT_EQ(got.size(), kTetrahedron.size());
+  for (std::size_t i = 0; i < got.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) EXPECT_EQ(got[i][k][a], kTetrahedron[i][3 * k + a] + shift[a]) << i << " " << k;
+}
+
+TEST(MeshAssimp, BinaryStlWhoseHeaderSaysSolid) {
+  vola_test::TempDir dir;
+  write_file(dir / "plain.stl", binary_stl("binary", kTetrahedron));
+  write_file(dir / "solid.stl", binary_stl("solid tetrahedron, but binary", kTetrahedron));
+  expect_tetrahedron(vola::io::read_mesh_triangles((dir / "plain.stl").string()));
+  expect_tetrahedron(vola::io::read_mesh_triangles((dir / "solid.stl").string()));
+}
+
+TEST(MeshAssimp, RealBinaryStlWithASolidHeader) {
+  VOLA_REQUIRE_DATA(data);
+  const auto original = vola_test::read_bytes(data / "mesh/stl/trimesh_teapot_bin.stl");
+  std::string bytes(original.begin(), original.end());
+  bytes.replace(0, 11, "solid teapo");
+  vola_test::TempDir dir;
+  write_file(dir / "teapot.stl", bytes);
+  const auto a = vola::io::read_mesh_triangles((data / "mesh/stl/trimesh_teapot_bin.stl").string());
+  const auto b = vola::io::read_mesh_triangles((dir / "teapot.stl").string());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a.size(), 894u);
+}
+
+TEST(MeshAssimp, AsciiStl) {
+  vola_test::TempDir dir;
+  std::string text = "solid tetra\n";
+  for (const auto& t : kTetrahedron) {
+    text += " facet normal 0 0 0\n  outer loop\n";
+    for (int k = 0; k < 3; ++k)
+      text += "   vertex " + std::to_string(t[3 * k]) + " " + std::to_string(t[3 * k + 1]) + " " +
+              std::to_string(t[3 * k + 2]) + "\n";
+    text += "  endloop\n endfacet\n";
+  }
+  text += "endsolid tetra\n";
+  write_file(dir / "tetra.stl", text);
+  expect_tetrahedron(vola::io::read_mesh_triangles((dir / "tetra.stl").string()));
+}
+
+TEST(MeshAssimp, PolygonsAreTriangulatedLinesAndPointsKept) {
+  vola_test::TempDir dir;
+  write_file(dir / "quad.off", "OFF\n5 2 0\n0 0 0\n2 0 0\n2 3 0\n0 3 0\n7 7 7\n4 0 1 2 3\n3 0 1 4\n");
+  EXPECT_EQ(vola::io::read_mesh_triangles((dir / "quad.off").string()).size(), 3u);
+  write_file(dir / "mixed.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 1 2 3 4\nl 1 5\n");
+  const auto mixed = vola::io::read_mesh_triangles((dir / "mixed.obj").string());
+  ASSERT_EQ(mixed.size(), 3u);
+  int segments = 0;
+  for (const Triangle& t : mixed)
+    if (t[1] == t[2] && t[0] != t[1]) {
+      ++segments;
+      EXPECT_TRUE((t[0] == Point{0, 0, 0} && t[1] == Point{5, 5, 5}) || (t[0] == Point{5, 5, 5} && t[1] == Point{0, 0, 0}));
+    }
+  EXPECT_EQ(segments, 1);
+}
+
+// glTF nodes: a parent scaled by 2 and moved by (10, 0, 0), a child moved by (0, 1, 0)
+// in the parent's frame, both placing one triangle (0,0,0) (1,0,0) (0,1,0).
+TEST(MeshAssimp, NodeTransformsAreApplied) {
+  float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::string raw(reinterpret_cast<const char*>(positions), sizeof positions);
+  static const char* kBase64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string encoded;
+  for (std::size_t i = 0; i < raw.size(); i += 3) {
+    const std::uint32_t chunk = (static_cast<std::uint8_t>(raw[i]) << 16) |
+                                (i + 1 < raw.size() ? static_cast<std::uint8_t>(raw[i + 1]) << 8 : 0) |
+                                (i + 2 < raw.size() ? static_cast<std::uint8_t>(raw[i + 2]) : 0);
+    for (int k = 0; k < 4; ++k)
+      encoded += i * 8 + 6 * k < raw.size() * 8 ? kBase64[(chunk >> (18 - 6 * k)) & 63] : '=';
+  }
+  const std::string gltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
+  "nodes":[{"mesh":0,"translation":[10,0,0],"scale":[2,2,2],"children":[1]},{"mesh":0,"translation":[0,1,0]}],
+  "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+  "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+  "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36}],
+  "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)" + encoded + R"("}]})";
+  vola_test::TempDir dir;
+  write_file(dir / "nodes.gltf", gltf);
+  auto triangles = vola::io::read_mesh_triangles((dir / "nodes.gltf").string());
+  ASSERT_EQ(triangles.size(), 2u);
+  std::sort(triangles.begin(), triangles.end());
+  // Parent: 2 * p + (10, 0, 0). Child: 2 * (p + (0, 1, 0)) + (10, 0, 0).
+  EXPECT_EQ(triangles[0], (Triangle{{{10, 0, 0}, {12, 0, 0}, {10, 2, 0}}}));
+  EXPECT_EQ(triangles[1], (Triangle{{{10, 2, 0}, {12, 2, 0}, {10, 4, 0}}}));
+}
+
+TEST(MeshAssimp, BadFilesThrowFormatErrorsNamingTheFile) {
+  vola_test::TempDir dir;
+  const auto expect_error = [&](const std::string& name, const std::string& bytes) {
+    write_file(dir / name, bytes);
+    const std::string path = (dir / name).string();
+    const auto error = vola_test::format_error_of([&] { vola::io::read_mesh_triangles(path); });
+    ASSERT_TRUE(error.has_value()) << name;
+    EXPECT_EQ(error->file(), path);
+    EXPECT_FALSE(error->cause().empty());
+  };
+  expect_error("empty.stl", "");
+  std::string truncated = binary_stl("binary", kTetrahedron);
+  truncated.resize(120);
+  expect_error("truncated.stl", truncated);
+  expect_error("bad_index.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n");
+  expect_error("garbage.off", "OFF\n3 1 0\n0 0\n");
+  expect_error("nothing.obj", "# only a comment\n");
+  const auto missing = vola_test::format_error_of([&] { vola::io::read_mesh_triangles((dir / "missing.stl").string()); });
+  EXPECT_TRUE(missing.has_value());
+}
+
+TEST(MeshAssimp, RegisteredForItsExtensionsButNotPly) {
+  for (const char* ext : {".stl", ".STL", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"})
+    EXPECT_EQ(vola::io::find_input_format(std::string("x") + ext).name, "mesh") << ext;
+  EXPECT_NE(vola::io::find_input_format("x.ply").name, "mesh");
+}
+
+}  // namespace
