@@ -1,7 +1,5 @@
 #include <algorithm>
-#include <algorithm>
 #include <cmath>
-#include <limits>
 #include <limits>
 #include <string>
 
@@ -108,58 +106,6 @@ Frame Quantizer::frame() const noexcept {
     f.origin[a] = std::isfinite(origin) ? origin : 0.0;
   }
   return f;
-}
-
-Box Quantizer::cell_box(const Voxel& v) const noexcept {
-  const std::uint32_t c[3] = {v.x, v.y, v.z};
-  const double inf = std::numeric_limits<double>::infinity();
-  const std::uint32_t last = side_of(depth_) - 1;
-  const double steps = static_cast<double>(last);
-  Box box;
-  for (int a = 0; a < 3; ++a) {
-    if (mode_ == Quantization::grid) {
-      box.min[a] = origin_[a] + static_cast<double>(c[a]) * scale_[a];
-      box.max[a] = origin_[a] + static_cast<double>(c[a] + 1) * scale_[a];
-    } else if (degenerate_) {
-      box.min[a] = c[a] == 0 ? -inf : inf;
-      box.max[a] = c[a] == 0 ? inf : -inf;
-    } else {
-      // Voxel k holds (S-1)(p - min)/scale in [k - 1/2, k + 1/2]: face k - 1/2 is
-      // computed by the same expression for both voxels that share it.
-      const double k = static_cast<double>(c[a]);
-      box.min[a] = c[a] == 0 ? -inf : origin_[a] + (k - 0.5) * scale_[a] / steps;
-      box.max[a] = c[a] >= last ? inf : origin_[a] + ((k + 1.0) - 0.5) * scale_[a] / steps;
-    }
-  }
-  return box;
-}
-
-bool Quantizer::voxel_range(const Box& box, Voxel& first, Voxel& last) const noexcept {
-  const double side = static_cast<double>(side_of(depth_));
-  std::uint32_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    if (!(box.min[a] <= box.max[a])) return false;
-    if (mode_ == Quantization::toolkit && degenerate_) {
-      lo[a] = hi[a] = 0;
-      continue;
-    }
-    // Position in voxel units such that voxel k covers [k, k + 1]; one voxel of slack
-    // on each side absorbs the rounding of this division and of cell_box's faces.
-    const double shift = mode_ == Quantization::toolkit ? 0.5 : 0.0;
-    const double per_unit = mode_ == Quantization::toolkit ? (side - 1.0) / scale_[a] : 1.0 / scale_[a];
-    double from = std::floor((box.min[a] - origin_[a]) * per_unit + shift) - 1.0;
-    double to = std::floor((box.max[a] - origin_[a]) * per_unit + shift) + 1.0;
-    if (std::isnan(from) || std::isnan(to)) return false;
-    if (mode_ == Quantization::grid && (to < 0.0 || from > side - 1.0)) return false;
-    // Toolkit clamps: everything below the bbox lands in voxel 0, above it in S-1.
-    from = std::clamp(from, 0.0, side - 1.0);
-    to = std::clamp(to, 0.0, side - 1.0);
-    lo[a] = static_cast<std::uint32_t>(from);
-    hi[a] = static_cast<std::uint32_t>(to);
-  }
-  first = Voxel{lo[0], lo[1], lo[2]};
-  last = Voxel{hi[0], hi[1], hi[2]};
-  return true;
 }
 
 Box Quantizer::cell_box(const Voxel& v) const noexcept {
