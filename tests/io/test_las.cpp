@@ -1,0 +1,154 @@
+// The LAS reader against every LAS file in the shared data: counts, formats, record
+// lengths, classes and CRS as EXPECTED.txt (an independent reader) records them; LAZ
+// and broken files refused with a clear error.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <regex>
+
+#include "io_test_data.hpp"
+#include "vola/io/las.hpp"
+
+namespace {
+
+using vola_io_test::data_dir;
+using vola_io_test::expected_line;
+namespace fs = vola_io_test::fs;
+
+std::vector<fs::path> las_files(const fs::path& data) {
+  auto files = vola_io_test::files_ending(data / "las", ".las");
+  return files;
+}
+
+// "classes={1: 789, 2: 276}" -> {1: 789, 2: 276}
+std::map<int, std::uint64_t> expected_classes(const std::string& line) {
+  std::map<int, std::uint64_t> out;
+  const auto at = line.find("classes={");
+  if (at == std::string::npos) return out;
+  const std::string body = line.substr(at + 9, line.find('}', at) - at - 9);
+  const std::regex pair(R"((\d+):\s*(\d+))");
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), pair); it != std::sregex_iterator(); ++it)
+    out[std::stoi((*it)[1])] = std::stoull((*it)[2]);
+  return out;
+}
+
+std::optional<std::uint32_t> expected_epsg(const std::string& line) {
+  std::smatch m;
+  if (std::regex_search(line, m, std::regex(R"(ProjCS=(\d+))")) && m[1] != "32767") return std::stoul(m[1]);
+  if (std::regex_search(line, m, std::regex(R"(GeogCS=(\d+))")) && !std::regex_search(line, std::regex("ProjCS=")) &&
+      m[1] != "32767")
+    return std::stoul(m[1]);
+  return std::nullopt;
+}
+
+TEST(Las, EveryFileReadsAsTheIndependentReaderFound) {
+  VOLA_REQUIRE_DATA(data);
+  const auto files = las_files(data);
+  ASSERT_GE(files.size(), 20u) << "expected the shared LAS files under " << data / "las";
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.string());
+    const std::string line = expected_line(data, file.filename().string());
+    vola::io::LasReader reader(file.string());
+    const auto& h = reader.header();
+    EXPECT_EQ(h.point_count, vola_io_test::expected_integer(line, " n=").value());
+    EXPECT_EQ(h.point_format, vola_io_test::expected_integer(line, " pf=").value());
+    EXPECT_EQ(h.record_length, vola_io_test::expected_integer(line, "reclen=").value());
+    std::smatch version;
+    ASSERT_TRUE(std::regex_search(line, version, std::regex(R"(LAS (\d)\.(\d))")));
+    EXPECT_EQ(h.version_minor, std::stoi(version[2]));
+    EXPECT_EQ(h.epsg, expected_epsg(line));
+
+    std::map<int, std::uint64_t> classes;
+    vola::Box box{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+    vola::io::LasChunk chunk;
+    std::uint64_t total = 0, rgb_max = 0;
+    while (const std::size_t n = reader.read(chunk, 777)) {  // an odd chunk size crosses boundaries
+      total += n;
+      for (std::size_t i = 0; i < n; ++i) {
+        ++classes[chunk.classification[i]];
+        for (int a = 0; a < 3; ++a) {
+          box.min[a] = std::min(box.min[a], chunk.xyz[3 * i + a]);
+          box.max[a] = std::max(box.max[a], chunk.xyz[3 * i + a]);
+        }
+        if (!chunk.red.empty()) rgb_max = std::max<std::uint64_t>({rgb_max, chunk.red[i], chunk.green[i], chunk.blue[i]});
+      }
+    }
+    EXPECT_EQ(total, h.point_count);
+    EXPECT_EQ(classes, expected_classes(line));
+    if (const auto expected_rgb = vola_io_test::expected_integer(line, "rgb_max=")) EXPECT_EQ(rgb_max, *expected_rgb);
+    // Where the independent reader found the points inside the header bounds, so do we.
+    if (line.find("decoded_bounds_ok=True") != std::string::npos) {
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_GE(box.min[a], h.min[a] - h.scale[a]);
+        EXPECT_LE(box.max[a], h.max[a] + h.scale[a]);
+      }
+    }
+  }
+}
+
+TEST(Las, WktRecordIsExposed) {
+  VOLA_REQUIRE_DATA(data);
+  vola::io::LasReader reader((data / "las" / "pdal_wontcompress3.las").string());
+  EXPECT_NE(reader.header().wkt.find("AUTHORITY[\"EPSG\",\"26919\"]"), std::string::npos);
+  EXPECT_FALSE(reader.header().epsg.has_value());  // no GeoKeyDirectory in this file
+}
+
+TEST(Las, ExtraBytesBecomeFields) {
+  VOLA_REQUIRE_DATA(data);
+  vola::io::LasReader reader((data / "las" / "pdal_extrabytes.las").string());
+  const auto& fields = reader.header().extra_fields;
+  ASSERT_FALSE(fields.empty());
+  std::uint32_t end = 0;
+  for (const auto& f : fields) end = std::max(end, f.offset + f.size);
+  EXPECT_LE(end, reader.header().record_length);
+  EXPECT_EQ(end, reader.header().record_length);  // this file's extra bytes fill the record
+}
+
+TEST(Las, LazIsRefusedWithAnExplanation) {
+  VOLA_REQUIRE_DATA(data);
+  const auto files = vola_io_test::files_ending(data / "laz", ".laz");
+  ASSERT_FALSE(files.empty());
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.string());
+    try {
+      vola::io::LasReader reader(file.string());
+      ADD_FAILURE() << "a LAZ file was accepted";
+    } catch (const vola::FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("LAZ"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("laszip"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Las, TruncatedAndCorruptFilesAreRefused) {
+  VOLA_REQUIRE_DATA(data);
+  const auto bytes = vola_test::read_bytes(data / "las" / "pdal_autzen_pf1.las");
+  const vola_test::TempDir dir;
+  const auto write = [&](const std::vector<std::uint8_t>& b) {
+    const auto path = dir.path() / "broken.las";
+    vola_test::write_bytes(path, b);
+    return path.string();
+  };
+  auto expect_error = [&](const std::vector<std::uint8_t>& b, const char* why) {
+    SCOPED_TRACE(why);
+    EXPECT_THROW(vola::io::LasReader reader(write(b)), vola::FormatError);
+  };
+  expect_error({bytes.begin(), bytes.begin() + 100}, "cut inside the header");
+  expect_error({bytes.begin(), bytes.end() - 5}, "cut inside the points");
+  auto bad = bytes;
+  bad[0] = 'X';
+  expect_error(bad, "no signature");
+  bad = bytes;
+  bad[104] = 11;
+  expect_error(bad, "unknown point format");
+  bad = bytes;
+  bad[105] = 10;
+  bad[106] = 0;
+  expect_error(bad, "record shorter than the format");
+  bad = bytes;
+  bad[100] = 200;  // 200 VLRs that are not there
+  expect_error(bad, "VLR count past the end");
+}
+
+}  // namespace

@@ -1,0 +1,96 @@
+// StreamBuilder against vola::build over the same points at once: same voxels, same
+// payloads, same attribute values, for random chunkings.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "test_support.hpp"
+#include "vola/vola.hpp"
+
+namespace {
+
+struct Points {
+  vola::PointCloud cloud;
+  std::vector<vola::AttributeSpec> specs;
+};
+
+Points random_points(std::uint64_t seed, std::size_t n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(-5.0, 45.0);
+  std::uniform_int_distribution<int> small(0, 5), byte(0, 255);
+  Points p;
+  p.specs = {{"mean", vola::ValueType::f64, vola::Reduction::mean},
+             {"max", vola::ValueType::u16, vola::Reduction::max},
+             {"min", vola::ValueType::i32, vola::Reduction::min},
+             {"last", vola::ValueType::u8, vola::Reduction::last},
+             {"majority", vola::ValueType::u8, vola::Reduction::majority}};
+  for (const auto& s : p.specs) p.cloud.attributes.push_back({s.name, s.type, s.reduction, {}});
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) p.cloud.xyz.push_back(coordinate(rng));
+    // Few distinct values so that majorities and ties happen.
+    p.cloud.attributes[0].values.push_back(small(rng) * 0.25);
+    p.cloud.attributes[1].values.push_back(byte(rng));
+    p.cloud.attributes[2].values.push_back(small(rng) - 2);
+    p.cloud.attributes[3].values.push_back(byte(rng));
+    p.cloud.attributes[4].values.push_back(small(rng));
+    p.cloud.payload.push_back(static_cast<std::uint64_t>(byte(rng)) * 0x0101010101ull);
+  }
+  return p;
+}
+
+class StreamBuilderEqualsBuild : public ::testing::TestWithParam<int> {};
+
+TEST_P(StreamBuilderEqualsBuild, ForRandomChunks) {
+  const std::uint64_t seed = static_cast<std::uint64_t>(GetParam());
+  const Points p = random_points(seed, 20000);
+  for (const auto mode : {vola::Quantization::toolkit, vola::Quantization::grid}) {
+    vola::BuildOptions options;
+    options.quantization = mode;
+    options.depth = 1 + static_cast<int>(seed % 4);  // coarse grids: many points per voxel
+    options.voxel_size = mode == vola::Quantization::grid ? 2.5 : 0.0;
+    options.payload = true;
+    const vola::Tree expected = vola::build(p.cloud, options);
+
+    vola::BuildOptions resolved = options;
+    const vola::Box box = p.cloud.bounds();
+    const vola::Quantizer quantizer = vola::resolve_quantizer(box, resolved);
+    vola::StreamBuilder builder(quantizer, p.specs, true);
+    std::mt19937_64 rng(seed + 99);
+    for (std::size_t at = 0; at < p.cloud.size();) {
+      const std::size_t n = std::min<std::size_t>(p.cloud.size() - at, 1 + rng() % 3000);
+      std::vector<std::span<const double>> values;
+      for (const auto& a : p.cloud.attributes) values.emplace_back(a.values.data() + at, n);
+      builder.add({p.cloud.xyz.data() + 3 * at, 3 * n}, values, {p.cloud.payload.data() + at, n});
+      at += n;
+    }
+    const vola::Tree got = builder.finish();
+    ASSERT_EQ(got.depth(), expected.depth());
+    ASSERT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+              std::vector<std::uint64_t>(expected.words().begin(), expected.words().end()));
+    ASSERT_EQ(std::vector<std::uint64_t>(got.voxel_payloads().begin(), got.voxel_payloads().end()),
+              std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
+    ASSERT_EQ(got.attributes().size(), expected.attributes().size());
+    for (std::size_t c = 0; c < got.attributes().size(); ++c) {
+      const auto& g = got.attributes().columns()[c];
+      const auto& e = expected.attributes().columns()[c];
+      ASSERT_EQ(g.name(), e.name());
+      for (std::size_t v = 0; v < g.size(); ++v)  // means may differ in the order of summation only
+        ASSERT_NEAR(g.get(v), e.get(v), 1e-9) << g.name() << " voxel " << v;
+    }
+    EXPECT_EQ(builder.points_in(), p.cloud.size());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, StreamBuilderEqualsBuild, ::testing::Range(1, 9));
+
+TEST(StreamBuilder, RefusesMismatchedArrays) {
+  vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {{"a", vola::ValueType::u8, vola::Reduction::max}},
+                              false);
+  const std::vector<double> xyz{1, 1, 1, 2, 2, 2};
+  const std::vector<double> one{1};
+  std::vector<std::span<const double>> values{one};
+  EXPECT_THROW(builder.add(xyz, values, {}), vola::InvalidArgument);
+  EXPECT_THROW(builder.add(xyz, {}, {}), vola::InvalidArgument);
+}
+
+}  // namespace
