@@ -103,4 +103,50 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
   return best;
 }
 
+std::optional<std::string> crs_definition(const Georef& georef) {
+  if (!georef.crs_wkt.empty()) return georef.crs_wkt;
+  if (georef.epsg != kUnsetEpsg) return "EPSG:" + std::to_string(georef.epsg);
+  return std::nullopt;
+}
+
+std::string crs_wkt1(const std::string& definition) {
+  Context ctx = make_context();
+  Pj crs(proj_create(ctx.get(), definition.c_str()));
+  if (!crs) throw Error("CRS " + definition.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
+  // One line: some LAS readers stop a WKT at its first newline.
+  const char* const options[] = {"MULTILINE=NO", nullptr};
+  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT1_GDAL, options);
+  if (!wkt) throw Error("PROJ cannot write " + definition.substr(0, 60) + " as WKT1");
+  return wkt;
+}
+
+struct ToWgs84::State {
+  Context ctx;
+  Pj transform;
+  std::string source;
+};
+
+ToWgs84::ToWgs84(const std::string& definition) : state_(std::make_unique<State>()) {
+  state_->ctx = make_context();
+  state_->source = definition.substr(0, 60);
+  PJ_CONTEXT* ctx = state_->ctx.get();
+  Pj transform(proj_create_crs_to_crs(ctx, definition.c_str(), "EPSG:4326", nullptr));
+  if (!transform) throw Error("CRS " + state_->source + " is not known to PROJ: " + last_error(ctx));
+  // EPSG:4326 is latitude first; normalised, PROJ takes and gives x = easting/longitude.
+  state_->transform.reset(proj_normalize_for_visualization(ctx, transform.get()));
+  if (!state_->transform) throw Error("PROJ cannot normalise the axis order of " + state_->source);
+}
+
+ToWgs84::~ToWgs84() = default;
+ToWgs84::ToWgs84(ToWgs84&&) noexcept = default;
+ToWgs84& ToWgs84::operator=(ToWgs84&&) noexcept = default;
+
+Point ToWgs84::transform(const Point& p) const {
+  const PJ_COORD out = proj_trans(state_->transform.get(), PJ_FWD, proj_coord(p[0], p[1], 0, 0));
+  if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
+    throw Error("PROJ cannot transform (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") from " +
+                state_->source + " to WGS84: " + last_error(state_->ctx.get()));
+  return {out.xy.x, out.xy.y, p[2]};
+}
+
 }  // namespace vola::geo

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -24,5 +25,37 @@ std::string crs_wkt(std::uint32_t epsg);
 // The EPSG code of a CRS given as WKT (the horizontal part of a compound CRS), from
 // its own identifier or, failing that, PROJ's identification with confidence >= 70%.
 std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt);
+
+// The header's EPSG code when nobody said what the CRS is: the reference's default,
+// which names no real CRS of the data.
+inline constexpr std::uint32_t kUnsetEpsg = 2000;
+
+// What the tree says its CRS is, as PROJ takes it: the WKT of our extension if
+// present, else "EPSG:<code>" from the header, else nullopt (header code kUnsetEpsg
+// and no WKT: the file has no CRS, and nothing should invent one).
+std::optional<std::string> crs_definition(const Georef& georef);
+
+// A CRS given as WKT of any version or "EPSG:<code>", written as OGC WKT 1 (the GDAL
+// flavour LAS readers expect). Throws vola::Error when PROJ cannot read or write it.
+std::string crs_wkt1(const std::string& definition);
+
+// Many points from one CRS to WGS84 longitude/latitude through one PROJ
+// transformation, created once.
+class ToWgs84 {
+ public:
+  // Throws vola::Error for a CRS PROJ does not know.
+  explicit ToWgs84(const std::string& definition);
+  ~ToWgs84();
+  ToWgs84(ToWgs84&&) noexcept;
+  ToWgs84& operator=(ToWgs84&&) noexcept;
+
+  // {longitude, latitude, z} with z passed through unchanged. Throws vola::Error for a
+  // point PROJ cannot transform (outside the CRS's domain).
+  Point transform(const Point& p) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace vola::geo
