@@ -1,0 +1,70 @@
+#include "export_columns.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+
+#include "vola/error.hpp"
+
+namespace vola::io {
+
+namespace {
+
+template <class T>
+void append_raw(std::string& out, const std::byte* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  char s[32];
+  const auto r = std::to_chars(s, s + sizeof s, v);
+  out.append(s, r.ptr);
+}
+
+}  // namespace
+
+void require_complete_columns(const Tree& tree) {
+  for (const auto& column : tree.attributes().columns())
+    if (column.size() != tree.voxel_count())
+      throw InvalidArgument("attribute '" + column.name() + "' has " + std::to_string(column.size()) +
+                            " values for " + std::to_string(tree.voxel_count()) + " voxels");
+}
+
+std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken) {
+  std::vector<std::string> names;
+  for (const auto& column : attributes.columns()) {
+    std::string name = column.name();
+    for (char& c : name)
+      if (c <= ' ' || c > '~') c = '_';
+    if (name.empty()) name = "attribute";
+    std::string unique = name;
+    for (int n = 2; std::find(taken.begin(), taken.end(), unique) != taken.end(); ++n)
+      unique = name + "_" + std::to_string(n);
+    taken.push_back(unique);
+    names.push_back(std::move(unique));
+  }
+  return names;
+}
+
+void append_number(std::string& out, double value) {
+  char s[32];
+  const auto r = std::to_chars(s, s + sizeof s, value);
+  out.append(s, r.ptr);
+}
+
+void append_value(std::string& out, const AttributeColumn& column, std::size_t rank) {
+  const std::byte* p = column.bytes().data() + rank * size_of(column.type());
+  switch (column.type()) {
+    case ValueType::u8: return append_raw<std::uint8_t>(out, p);
+    case ValueType::u16: return append_raw<std::uint16_t>(out, p);
+    case ValueType::u32: return append_raw<std::uint32_t>(out, p);
+    case ValueType::u64: return append_raw<std::uint64_t>(out, p);
+    case ValueType::i8: return append_raw<std::int8_t>(out, p);
+    case ValueType::i16: return append_raw<std::int16_t>(out, p);
+    case ValueType::i32: return append_raw<std::int32_t>(out, p);
+    case ValueType::i64: return append_raw<std::int64_t>(out, p);
+    case ValueType::f32: return append_raw<float>(out, p);
+    case ValueType::f64: return append_raw<double>(out, p);
+  }
+}
+
+}  // namespace vola::io

@@ -1,0 +1,26 @@
+// What the text and PLY writers share: attribute values as text, and column names
+// made usable as whitespace-separated tokens.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::io {
+
+// Throws InvalidArgument unless every attribute column holds one value per voxel
+// (writers index columns by voxel rank).
+void require_complete_columns(const Tree& tree);
+
+// One name per column: characters that are not printable ASCII (or are spaces) become
+// '_', and a name equal to one in `taken` or to an earlier column's gets "_2", "_3"...
+std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken);
+
+// The shortest text that reads back as the same double.
+void append_number(std::string& out, double value);
+// A column's value at `rank` as text in the column's own type (64-bit integers exact).
+void append_value(std::string& out, const AttributeColumn& column, std::size_t rank);
+
+}  // namespace vola::io
