@@ -12,5 +12,6 @@ void add_get(CLI::App& app);
 void add_lod(CLI::App& app);
 void add_setops(CLI::App& app);  // union, intersect, diff
 void add_generate(CLI::App& app);
+void add_export(CLI::App& app);
 
 }  // namespace vola::cli

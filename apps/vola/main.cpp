@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   vola::cli::add_lod(app);
   vola::cli::add_setops(app);
   vola::cli::add_generate(app);
+  vola::cli::add_export(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,162 @@
+// vola export: a .vol file back out as PLY, XYZ, LAS, binvox, a dense NPY grid or PNG
+// images.
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "commands.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
+#include "vola/io/binvox.hpp"
+#include "vola/io/export.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct ExportArgs {
+  std::string input, output, format = "auto";
+  bool ascii = false, cubes = false, slices = false, map = false, quiet = false;
+  int depth = 0;
+  int bits = 16;
+  std::uint32_t above = 0;
+  bool above_given = false;
+};
+
+std::string format_from_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".ply") return "ply";
+  if (ext == ".xyz" || ext == ".txt") return "xyz";
+  if (ext == ".las") return "las";
+  if (ext == ".binvox") return "binvox";
+  if (ext == ".npy") return "npy";
+  if (ext == ".png") return "png";
+  throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext +
+                        "'; say --format (ply, xyz, las, binvox, npy, png)");
+}
+
+// The format, after checking that the options given apply to it.
+std::string resolve_format(const ExportArgs& a) {
+  const int images = int{a.slices} + int{a.map} + int{a.above_given};
+  if (images > 1) throw InvalidArgument("--slices, --map and --occupancy-above are different images: give one");
+  std::string format = a.format;
+  if (format == "auto") format = images ? "png" : format_from_extension(a.output);
+  if (images && format != "png") throw InvalidArgument("--slices, --map and --occupancy-above write PNG, not " + format);
+  if (format == "png" && !images)
+    throw InvalidArgument("PNG export needs --slices (OUT is a directory), --map or --occupancy-above Z");
+  if ((a.ascii || a.cubes) && format != "ply") throw InvalidArgument("--ascii and --cubes apply to PLY export");
+  if (a.bits != 16 && !a.map) throw InvalidArgument("--bits applies to --map");
+  return format;
+}
+
+void run_export(const ExportArgs& a) {
+  const std::string format = resolve_format(a);
+  Tree tree = open_mapped(a.input);
+  if (a.depth > tree.depth())
+    throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
+                          std::to_string(tree.depth()));
+  if (a.depth > 0 && a.depth < tree.depth()) tree = tree.level_of_detail(a.depth);
+  const unsigned long long voxels = tree.voxel_count();
+  auto say = [&](const std::string& what) {
+    if (!a.quiet) std::printf("%s -> %s\n", what.c_str(), a.output.c_str());
+  };
+
+  if (format == "ply") {
+    io::PlyOptions options;
+    options.ascii = a.ascii;
+    options.cubes = a.cubes;
+    const io::PlyReport r = write_ply(tree, a.output, options);
+    say("PLY (" + std::string(a.ascii ? "ascii" : "binary") + "): " + std::to_string(r.vertices) + " vertices" +
+        (a.cubes ? ", " + std::to_string(r.faces) + " faces (outer surface of " + std::to_string(voxels) + " voxels)"
+                 : ""));
+  } else if (format == "xyz") {
+    io::write_xyz(tree, a.output);
+    say("XYZ: " + std::to_string(voxels) + " voxel centres");
+  } else if (format == "las") {
+    const io::LasReport r = io::write_las(tree, a.output);
+    std::string what = "LAS 1.4 point format " + std::to_string(r.point_format) + ": " + std::to_string(voxels) +
+                       " points, CRS ";
+    if (r.has_crs) what += "as WKT";
+    else if (geo::crs_definition(tree.georef())) what += "none (PROJ does not know EPSG:" + std::to_string(tree.georef().epsg) + ")";
+    else what += "none (the file has no CRS)";
+    if (!r.extra_bytes.empty()) {
+      what += ", extra bytes:";
+      for (const auto& name : r.extra_bytes) what += " " + name;
+    }
+    say(what);
+  } else if (format == "binvox") {
+    io::write_binvox(tree, a.output);
+    say("binvox: " + std::to_string(voxels) + " voxels");
+  } else if (format == "npy") {
+    io::write_npy_grid(tree, a.output);
+    say("NPY uint8 grid of " + std::to_string(tree.side()) + "^3 cells, " + std::to_string(voxels) + " occupied");
+  } else if (a.slices) {
+    const std::uint32_t images = io::write_png_slices(tree, a.output);
+    say(std::to_string(images) + " PNG slices of " + std::to_string(tree.side()) + "^2 pixels");
+  } else if (a.map) {
+    io::write_png_height_map(tree, a.output, a.bits);
+    say(std::to_string(a.bits) + "-bit PNG height map of " + std::to_string(tree.side()) + "^2 pixels");
+  } else {
+    io::write_png_occupancy_above(tree, a.output, a.above);
+    say("PNG occupancy map of voxels at z >= " + std::to_string(a.above) + ", " + std::to_string(tree.side()) +
+        "^2 pixels");
+  }
+}
+
+}  // namespace
+
+void add_export(CLI::App& app) {
+  auto args = std::make_shared<ExportArgs>();
+  auto* cmd = app.add_subcommand("export", "Write a .vol file as PLY, XYZ, LAS, binvox, a dense NPY grid or PNG images");
+  cmd->footer(
+      "Formats (from OUT's extension unless --format says):\n"
+      "  .ply     voxel centres with every attribute as a vertex property (binary; --ascii),\n"
+      "           or with --cubes the voxels' outer surface as quads (shared faces removed)\n"
+      "  .xyz     \"x y z [attributes]\" text, full double precision\n"
+      "  .las     LAS 1.4 point format 6 (7 with red/green/blue): voxel centres, attributes\n"
+      "           restored, the CRS as WKT\n"
+      "  .binvox  binvox voxel grid\n"
+      "  .npy     uint8 0/1 array of shape (S, S, S), index [x, y, z] (depth <= 5)\n"
+      "  .png     images, with one of:\n"
+      "             --slices               OUT is a directory: one image per z slice, occupied\n"
+      "                                    white, named depth<D>-<z>.png (depth <= 5)\n"
+      "             --map                  height map: highest occupied z + 1 per column, 0 if\n"
+      "                                    empty (16-bit; --bits 8 scales to 1..255)\n"
+      "             --occupancy-above Z    black where a column has a voxel at z >= Z, else\n"
+      "                                    white (the reference reader's --map)\n"
+      "           Images show x to the right and y up (north up); maps stop at depth 7.\n"
+      "Positions are voxel centres in the file's coordinates. --depth K exports the coarser\n"
+      "grid of the first K levels (4^K voxels per axis), e.g. to fit a dense format.\n"
+      "Examples:\n"
+      "  vola export city.vol city.ply\n"
+      "  vola export city.vol city_mesh.ply --cubes --depth 6\n"
+      "  vola export city.vol city.las\n"
+      "  vola export city.vol grid.npy --depth 4\n"
+      "  vola export city.vol slices --slices --depth 4\n"
+      "  vola export city.vol height.png --map\n"
+      "  vola export city.vol obstacles.png --occupancy-above 3");
+  cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
+  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png")
+      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png"}))
+      ->capture_default_str();
+  cmd->add_flag("--ascii", args->ascii, "PLY: ascii instead of binary little-endian");
+  cmd->add_flag("--cubes", args->cubes, "PLY: the voxels' outer surface as a quad mesh instead of centre points");
+  cmd->add_option("--depth", args->depth, "Export the level-of-detail grid of this depth (1..file depth)")
+      ->check(CLI::Range(1, 10));
+  cmd->add_flag("--slices", args->slices, "PNG: one image per z slice into the directory OUT");
+  cmd->add_flag("--map", args->map, "PNG: top-down height map");
+  cmd->add_option("--bits", args->bits, "--map: 16 (exact z + 1) or 8 (scaled)")
+      ->check(CLI::IsMember({8, 16}))
+      ->capture_default_str();
+  cmd->add_option("--occupancy-above", args->above, "PNG: top-down occupancy map of the voxels at z >= Z (voxel units)")
+      ->each([args](const std::string&) { args->above_given = true; });
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->callback([args] { run_export(*args); });
+}
+
+}  // namespace vola::cli
