@@ -1,0 +1,98 @@
+// XYZ export: points -> vol -> XYZ -> the project's text reader -> vol keeps the voxel
+// set, on grid trees of every depth and on a reference (toolkit) file; every number
+// reads back exactly.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "export_test_support.hpp"
+#include "vola/io/export.hpp"
+#include "vola/io/input.hpp"
+
+namespace {
+
+using namespace vola_export_test;
+using vola_test::TempDir;
+
+std::vector<std::string> lines_of(const vola_test::fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+class XyzRoundTrip : public ::testing::TestWithParam<int> {};
+
+TEST_P(XyzRoundTrip, KeepsVoxelsAndEveryValueExactly) {
+  const int depth = GetParam();
+  for (std::uint64_t seed = 0; seed < 6; ++seed) {
+    const Sample s = random_sample(2000 * depth + seed, depth, true);
+    SCOPED_TRACE(s.describe);
+    TempDir dir;
+    const auto file = dir / "out.xyz";
+    vola::io::write_xyz(s.tree, file.string());
+
+    const vola::io::Input in = vola::io::read_input(file.string(), "auto", {});
+    EXPECT_EQ(in.format, "text");
+    EXPECT_EQ(vola_test::voxel_set(rebuild(in, s.grid)), s.voxels);
+
+    const auto lines = lines_of(file);
+    ASSERT_EQ(lines.size(), 1 + s.tree.voxel_count());
+    EXPECT_EQ(lines[0], "# x y z red green blue intensity classification number_of_returns reflectance temperature pulse");
+    const auto sequence = vola_test::voxel_sequence(s.tree);
+    const vola::Quantizer q = s.tree.quantizer();
+    const auto& columns = s.tree.attributes().columns();
+    for (std::size_t i = 0; i < sequence.size(); ++i) {
+      std::istringstream line(lines[i + 1]);
+      const vola::Point c = q.center(vola_test::to_voxel(sequence[i]));
+      for (int a = 0; a < 3; ++a) {
+        std::string token;
+        line >> token;
+        ASSERT_EQ(std::stod(token), c[a]) << "line " << i + 2;
+      }
+      for (const auto& column : columns) {
+        std::string token;
+        line >> token;
+        const double value = column.type() == vola::ValueType::f32 ? std::stof(token) : std::stod(token);
+        ASSERT_EQ(value, column.get(i)) << column.name() << ", line " << i + 2;
+      }
+      std::string rest;
+      EXPECT_FALSE(line >> rest) << "extra column on line " << i + 2;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Depths, XyzRoundTrip, ::testing::Range(1, 7));
+
+TEST(XyzExport, ToolkitFileRoundTripsThroughToolkitQuantization) {
+  VOLA_REQUIRE_GOLDEN(golden);
+  const auto vol = golden / "crs29902_sparse" / "crs29902_sparse.vol";
+  const vola::Tree tree = vola::read(vol.string());
+  ASSERT_FALSE(tree.stored_frame().has_value());  // a reference file: the grid comes from the header bbox
+  TempDir dir;
+  const auto file = dir / "out.xyz";
+  vola::io::write_xyz(tree, file.string());
+  const vola::io::Input in = vola::io::read_input(file.string(), "auto", {});
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::toolkit;
+  options.depth = tree.depth();
+  options.bbox = tree.georef().bbox;
+  EXPECT_EQ(vola_test::voxel_set(vola::build(in.cloud, options)), vola_test::voxel_set(tree));
+  EXPECT_EQ(vola_test::voxel_set(tree), vola_test::read_voxel_list(golden / "crs29902_sparse" / "expected_voxels.txt"));
+}
+
+TEST(XyzExport, EmptyTreeHasOnlyTheHeader) {
+  TempDir dir;
+  vola::io::write_xyz(vola::Tree(), (dir / "e.xyz").string());
+  EXPECT_EQ(lines_of(dir / "e.xyz"), std::vector<std::string>{"# x y z"});
+}
+
+TEST(XyzExport, UnwritablePathIsAnIoErrorAndLeavesNothing) {
+  TempDir dir;
+  const auto file = dir / "missing_dir" / "out.xyz";
+  EXPECT_THROW(vola::io::write_xyz(random_sample(1, 2, false).tree, file.string()), vola::IoError);
+  EXPECT_FALSE(vola_test::fs::exists(file));
+}
+
+}  // namespace
