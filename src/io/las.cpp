@@ -405,7 +405,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
                const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   LasChunk chunk;
-  constexpr std::size_t kChunk = 1 << 20;
+  constexpr std::size_t kChunk = 1 << 22;
   const std::uint64_t passes = options.bbox ? 1 : 2;
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
