@@ -83,6 +83,26 @@ TEST_P(StreamBuilderEqualsBuild, ForRandomChunks) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, StreamBuilderEqualsBuild, ::testing::Range(1, 9));
 
+// Payloads without attribute columns once took a merge path that dropped them.
+TEST(StreamBuilder, PayloadsWithoutAttributes) {
+  Points p = random_points(42, 5000);
+  p.cloud.attributes.clear();
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::toolkit;
+  options.depth = 3;
+  options.payload = true;
+  const vola::Tree expected = vola::build(p.cloud, options);
+  vola::BuildOptions resolved = options;
+  vola::StreamBuilder builder(vola::resolve_quantizer(p.cloud.bounds(), resolved), {}, true);
+  for (std::size_t at = 0; at < p.cloud.size(); at += 1000)
+    builder.add({p.cloud.xyz.data() + 3 * at, 3000}, {}, {p.cloud.payload.data() + at, 1000});
+  const vola::Tree got = builder.finish();
+  EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+            std::vector<std::uint64_t>(expected.words().begin(), expected.words().end()));
+  EXPECT_EQ(std::vector<std::uint64_t>(got.voxel_payloads().begin(), got.voxel_payloads().end()),
+            std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
+}
+
 TEST(StreamBuilder, RefusesMismatchedArrays) {
   vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {{"a", vola::ValueType::u8, vola::Reduction::max}},
                               false);

@@ -41,9 +41,9 @@ struct Run {
 };
 
 // Appends voxel `i` of `from` to `to` (as a new voxel).
-void append(const Run& from, std::size_t i, Run& to, std::span<const AttributeSpec> specs) {
+void append(const Run& from, std::size_t i, Run& to, std::span<const AttributeSpec> specs, bool payload) {
   to.keys.push_back(from.keys[i]);
-  if (!from.payloads.empty()) to.payloads.push_back(from.payloads[i]);
+  if (payload) to.payloads.push_back(from.payloads[i]);
   for (std::size_t a = 0; a < specs.size(); ++a) {
     const Partial& p = from.partials[a];
     Partial& q = to.partials[a];
@@ -62,9 +62,9 @@ void append(const Run& from, std::size_t i, Run& to, std::span<const AttributeSp
 
 // Appends the combination of voxel i of `older` and voxel j of `newer` (same key).
 void append_combined(const Run& older, std::size_t i, const Run& newer, std::size_t j, Run& to,
-                     std::span<const AttributeSpec> specs) {
+                     std::span<const AttributeSpec> specs, bool payload) {
   to.keys.push_back(older.keys[i]);
-  if (!older.payloads.empty()) to.payloads.push_back(newer.payloads[j]);  // the later point wins
+  if (payload) to.payloads.push_back(newer.payloads[j]);  // the later point wins
   for (std::size_t a = 0; a < specs.size(); ++a) {
     const Partial& p = older.partials[a];
     const Partial& r = newer.partials[a];
@@ -134,9 +134,9 @@ Run empty_run(std::span<const AttributeSpec> specs) {
   return run;
 }
 
-Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs) {
+Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload) {
   Run out = empty_run(specs);
-  if (specs.empty() && older.payloads.empty()) {  // occupancy only: a plain sorted union
+  if (specs.empty() && !payload) {  // occupancy only: a plain sorted union
     out.keys.resize(older.keys.size() + newer.keys.size());
     const auto end = std::set_union(older.keys.begin(), older.keys.end(), newer.keys.begin(), newer.keys.end(),
                                     out.keys.begin());
@@ -147,11 +147,11 @@ Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> spe
   std::size_t i = 0, j = 0;
   while (i < older.keys.size() || j < newer.keys.size()) {
     if (j == newer.keys.size() || (i < older.keys.size() && older.keys[i] < newer.keys[j])) {
-      append(older, i++, out, specs);
+      append(older, i++, out, specs, payload);
     } else if (i == older.keys.size() || newer.keys[j] < older.keys[i]) {
-      append(newer, j++, out, specs);
+      append(newer, j++, out, specs, payload);
     } else {
-      append_combined(older, i++, newer, j++, out, specs);
+      append_combined(older, i++, newer, j++, out, specs, payload);
     }
   }
   return out;
@@ -269,7 +269,7 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   s.runs.push_back(std::move(run));
   // Binary-counter merging keeps O(log chunks) runs and merges each record O(log) times.
   while (s.runs.size() >= 2 && s.runs[s.runs.size() - 2].keys.size() <= 2 * s.runs.back().keys.size()) {
-    Run merged = merge(s.runs[s.runs.size() - 2], s.runs.back(), s.specs);
+    Run merged = merge(s.runs[s.runs.size() - 2], s.runs.back(), s.specs, s.payload);
     s.runs.pop_back();
     s.runs.back() = std::move(merged);
   }
@@ -279,7 +279,7 @@ Tree StreamBuilder::finish() {
   State& s = *state_;
   Run all = empty_run(s.specs);
   for (auto& run : s.runs) {
-    all = merge(all, run, s.specs);
+    all = merge(all, run, s.specs, s.payload);
     run = Run{};
   }
   s.runs.clear();
