@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "vola/builder.hpp"
 
@@ -17,34 +18,39 @@ struct Polygon {
   int size = 0;
 };
 
-// The part of `in` on the kept side of the plane p[axis] = bound (p[axis] >= bound when
-// keep_above, else <=). Crossing points get p[axis] = bound exactly.
-Polygon clip(const Polygon& in, int axis, double bound, bool keep_above) {
-  Polygon out;
+// `out` = the part of `in` on the kept side of the plane p[axis] = bound (p[axis] >=
+// bound when keep_above, else <=). Crossing points get p[axis] = bound exactly.
+void clip(const Polygon& in, int axis, double bound, bool keep_above, Polygon& out) {
+  out.size = 0;
   const auto kept = [&](const Point& p) { return keep_above ? p[axis] >= bound : p[axis] <= bound; };
   for (int i = 0; i < in.size; ++i) {
     const Point& from = in.points[i];
-    const Point& to = in.points[(i + 1) % in.size];
+    const Point& to = in.points[i + 1 < in.size ? i + 1 : 0];
     const bool from_kept = kept(from);
     if (from_kept) out.points[out.size++] = from;
     if (from_kept != kept(to)) {
       const double t = (bound - from[axis]) / (to[axis] - from[axis]);
-      Point p;
+      Point& p = out.points[out.size++];
       for (int a = 0; a < 3; ++a) p[a] = from[a] + t * (to[a] - from[a]);
       p[axis] = bound;
-      out.points[out.size++] = p;
     }
   }
-  return out;
 }
 
-// The part of `in` within [low - slack, high + slack] on `axis`; an infinite bound
-// (a toolkit border voxel) clips nothing.
-Polygon clip_slab(const Polygon& in, int axis, double low, double high, double slack) {
-  Polygon out = in;
-  if (std::isfinite(low)) out = clip(out, axis, low - slack, true);
-  if (out.size && std::isfinite(high)) out = clip(out, axis, high + slack, false);
-  return out;
+// `out` = the part of `in` within [low - slack, high + slack] on `axis`; an infinite
+// bound (a toolkit border voxel) clips nothing.
+void clip_slab(const Polygon& in, int axis, double low, double high, double slack, Polygon& out) {
+  if (!std::isfinite(low) && !std::isfinite(high)) {
+    out = in;
+  } else if (!std::isfinite(low)) {
+    clip(in, axis, high + slack, false, out);
+  } else if (!std::isfinite(high)) {
+    clip(in, axis, low - slack, true, out);
+  } else {
+    Polygon above;
+    clip(in, axis, low - slack, true, above);
+    clip(above, axis, high + slack, false, out);
+  }
 }
 
 Box polygon_bounds(const Polygon& polygon) {
@@ -96,51 +102,81 @@ class KeySink {
 // Candidates up to this many are tested directly; larger triangles go slab by slab.
 constexpr std::uint64_t kDirectCandidates = 64;
 
-void voxelize_triangle(const TriangleBoxTest& test, const Triangle& triangle, const Quantizer& quantizer,
-                       double voxel_size, KeySink& sink, VoxelizeReport& report) {
-  // Clipped polygons carry rounding of the order of an ulp of the coordinates; widening
-  // every candidate search by far more than that keeps it a superset of the voxels the
-  // exact test accepts. The exact test decides every voxel.
-  double magnitude = voxel_size;
-  for (const Point& v : triangle)
-    for (double c : v) magnitude = std::max(magnitude, std::abs(c));
-  const double slack = 1e-9 * magnitude;
+// Voxelizes one triangle after another into a KeySink.
+class TriangleVoxelizer {
+ public:
+  TriangleVoxelizer(const Quantizer& quantizer, KeySink& sink, VoxelizeReport& report)
+      : quantizer_(quantizer), voxel_size_(quantizer.frame().voxel_size), sink_(sink), report_(report) {}
 
-  Voxel first, last;
-  if (!quantizer.voxel_range(widened(test.bounds(), slack), first, last)) {
-    ++report.outside;
-    return;
-  }
-  const auto try_voxel = [&](const Voxel& v) {
-    if (test.overlaps(quantizer.cell_box(v))) sink.add(v);
-  };
-  const std::uint64_t candidates = std::uint64_t{last.x - first.x + 1} * (last.y - first.y + 1) * (last.z - first.z + 1);
-  if (candidates <= kDirectCandidates) {
-    for (std::uint32_t z = first.z; z <= last.z; ++z)
-      for (std::uint32_t y = first.y; y <= last.y; ++y)
-        for (std::uint32_t x = first.x; x <= last.x; ++x) try_voxel({x, y, z});
-    return;
-  }
-  Polygon whole;
-  whole.size = 3;
-  for (int i = 0; i < 3; ++i) whole.points[i] = triangle[i];
-  for (std::uint32_t z = first.z; z <= last.z; ++z) {
-    const Box slab_cell = quantizer.cell_box({first.x, first.y, z});
-    const Polygon slab = clip_slab(whole, 2, slab_cell.min[2], slab_cell.max[2], slack);
-    if (!slab.size) continue;
-    Voxel slab_first, slab_last;
-    if (!quantizer.voxel_range(widened(polygon_bounds(slab), slack), slab_first, slab_last)) continue;
-    for (std::uint32_t y = std::max(slab_first.y, first.y); y <= std::min(slab_last.y, last.y); ++y) {
-      const Box row_cell = quantizer.cell_box({first.x, y, z});
-      const Polygon row = clip_slab(slab, 1, row_cell.min[1], row_cell.max[1], slack);
-      if (!row.size) continue;
-      Voxel row_first, row_last;
-      if (!quantizer.voxel_range(widened(polygon_bounds(row), slack), row_first, row_last)) continue;
-      for (std::uint32_t x = std::max(row_first.x, first.x); x <= std::min(row_last.x, last.x); ++x)
-        try_voxel({x, y, z});
+  void add(const TriangleBoxTest& test, const Triangle& triangle) {
+    // Clipped polygons carry rounding of the order of an ulp of the coordinates;
+    // widening every candidate search by far more than that keeps it a superset of
+    // the voxels the exact test accepts. The exact test decides every voxel.
+    double magnitude = voxel_size_;
+    for (const Point& v : triangle)
+      for (double c : v) magnitude = std::max(magnitude, std::abs(c));
+    const double slack = 1e-9 * magnitude;
+
+    if (!quantizer_.voxel_range(widened(test.bounds(), slack), first_, last_)) {
+      ++report_.outside;
+      return;
+    }
+    load_faces();
+    const std::uint64_t candidates =
+        std::uint64_t{last_.x - first_.x + 1} * (last_.y - first_.y + 1) * (last_.z - first_.z + 1);
+    if (candidates <= kDirectCandidates) {
+      for (std::uint32_t z = first_.z; z <= last_.z; ++z)
+        for (std::uint32_t y = first_.y; y <= last_.y; ++y)
+          for (std::uint32_t x = first_.x; x <= last_.x; ++x) try_voxel(test, {x, y, z});
+      return;
+    }
+    Polygon whole, slab, row;
+    whole.size = 3;
+    for (int i = 0; i < 3; ++i) whole.points[i] = triangle[i];
+    for (std::uint32_t z = first_.z; z <= last_.z; ++z) {
+      clip_slab(whole, 2, face(2, z), face(2, z + 1), slack, slab);
+      if (!slab.size) continue;
+      Voxel slab_first, slab_last;
+      if (!quantizer_.voxel_range(widened(polygon_bounds(slab), slack), slab_first, slab_last)) continue;
+      for (std::uint32_t y = std::max(slab_first.y, first_.y); y <= std::min(slab_last.y, last_.y); ++y) {
+        clip_slab(slab, 1, face(1, y), face(1, y + 1), slack, row);
+        if (!row.size) continue;
+        Voxel row_first, row_last;
+        if (!quantizer_.voxel_range(widened(polygon_bounds(row), slack), row_first, row_last)) continue;
+        for (std::uint32_t x = std::max(row_first.x, first_.x); x <= std::min(row_last.x, last_.x); ++x)
+          try_voxel(test, {x, y, z});
+      }
     }
   }
-}
+
+ private:
+  // The cell faces of the candidate range, per axis: faces_[a][i] is the lower face of
+  // voxel first + i and the upper face of voxel first + i - 1 (Quantizer::cell_box
+  // computes shared faces bit for bit, so this is its box, computed once per triangle).
+  void load_faces() {
+    const std::uint32_t from[3] = {first_.x, first_.y, first_.z}, to[3] = {last_.x, last_.y, last_.z};
+    for (int a = 0; a < 3; ++a) {
+      faces_[a].clear();
+      for (std::uint32_t k = from[a]; k <= to[a]; ++k) faces_[a].push_back(quantizer_.cell_box({k, k, k}).min[a]);
+      faces_[a].push_back(quantizer_.cell_box({to[a], to[a], to[a]}).max[a]);
+    }
+  }
+  double face(int axis, std::uint32_t k) const noexcept {
+    const std::uint32_t from = axis == 0 ? first_.x : axis == 1 ? first_.y : first_.z;
+    return faces_[axis][k - from];
+  }
+  void try_voxel(const TriangleBoxTest& test, const Voxel& v) {
+    const Box cell{{face(0, v.x), face(1, v.y), face(2, v.z)}, {face(0, v.x + 1), face(1, v.y + 1), face(2, v.z + 1)}};
+    if (test.overlaps(cell)) sink_.add(v);
+  }
+
+  const Quantizer& quantizer_;
+  double voxel_size_;
+  KeySink& sink_;
+  VoxelizeReport& report_;
+  Voxel first_, last_;
+  std::array<std::vector<double>, 3> faces_;
+};
 
 }  // namespace
 
@@ -165,15 +201,15 @@ std::vector<Key> surface_keys(std::span<const Triangle> triangles, const Quantiz
   VoxelizeReport local;
   VoxelizeReport& r = report ? *report : local;
   r.triangles += triangles.size();
-  const double voxel_size = quantizer.frame().voxel_size;
   KeySink sink(quantizer.depth());
+  TriangleVoxelizer voxelizer(quantizer, sink, r);
   for (const Triangle& t : triangles) {
     const TriangleBoxTest test(t);
     if (!test.usable()) {
       ++r.skipped;
       continue;
     }
-    voxelize_triangle(test, t, quantizer, voxel_size, sink, r);
+    voxelizer.add(test, t);
   }
   std::vector<Key> keys = sink.take();
   r.surface_voxels = keys.size();
@@ -184,16 +220,10 @@ Tree voxelize(std::span<const Triangle> triangles, const Quantizer& quantizer, c
               VoxelizeReport* report) {
   VoxelizeReport local;
   VoxelizeReport& r = report ? *report : local;
-  std::vector<Key> keys = surface_keys(triangles, quantizer, &r);
-  Tree tree;
-  if (options.solid) {
-    std::vector<Key> inside = enclosed_keys(keys, options.max_fill_cells);
-    r.enclosed_voxels = inside.size();
-    keys.insert(keys.end(), inside.begin(), inside.end());
-    tree = build_from_keys(std::move(keys), quantizer.depth());
-  } else {
-    tree = build_from_sorted_keys(keys, quantizer.depth());
-  }
+  const std::vector<Key> keys = surface_keys(triangles, quantizer, &r);
+  Tree tree = options.solid ? solid_tree(keys, quantizer.depth(), options.max_fill_cells)
+                            : build_from_sorted_keys(keys, quantizer.depth());
+  if (options.solid) r.enclosed_voxels = tree.voxel_count() - keys.size();
   tree.set_frame(quantizer.frame());
   return tree;
 }

@@ -66,6 +66,12 @@ XyzSet fast_enclosed(const XyzSet& surface) {
   const auto inside = vola::mesh::enclosed_keys(keys);
   const XyzSet out = vola_mesh_test::key_set(inside);
   EXPECT_EQ(out.size(), inside.size()) << "duplicates";
+  // The tree built straight from the fill holds the surface and the same inside.
+  for (int depth : {4, 5}) {
+    XyzSet solid = out;
+    solid.insert(surface.begin(), surface.end());
+    EXPECT_EQ(vola_test::voxel_set(vola::mesh::solid_tree(keys, depth)), solid) << "depth " << depth;
+  }
   return out;
 }
 
@@ -123,7 +129,12 @@ TEST(SolidFill, RefusesBoxesOverTheLimit) {
   for (const Xyz& v : shell) keys.push_back(vola::encode(vola_test::to_voxel(v)));
   EXPECT_THROW(vola::mesh::enclosed_keys(keys, 999), vola::InvalidArgument);
   EXPECT_EQ(vola::mesh::enclosed_keys(keys, 1000).size(), 512u);
+  EXPECT_THROW(vola::mesh::solid_tree(keys, 2, 999), vola::InvalidArgument);
+  EXPECT_EQ(vola::mesh::solid_tree(keys, 2, 1000).voxel_count(), 1000u);
   EXPECT_TRUE(vola::mesh::enclosed_keys({}).empty());
+  const vola::Tree empty = vola::mesh::solid_tree({}, 3);
+  EXPECT_TRUE(empty.empty());
+  EXPECT_EQ(empty.depth(), 3);
 }
 
 // Inside a convex polyhedron: on the centre's side of every face plane.

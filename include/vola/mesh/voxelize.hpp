@@ -39,7 +39,7 @@ Box triangle_bounds(std::span<const Triangle> triangles) noexcept;
 std::vector<Key> surface_keys(std::span<const Triangle> triangles, const Quantizer& quantizer,
                               VoxelizeReport* report = nullptr);
 
-// The tree of surface_keys (plus, with options.solid, enclosed_keys of them), with the
+// The tree of surface_keys (with options.solid: solid_tree of them), with the
 // quantizer's frame. Its georef bbox is left to the caller (the bbox the quantizer was
 // made from).
 Tree voxelize(std::span<const Triangle> triangles, const Quantizer& quantizer, const VoxelizeOptions& options = {},
