@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <sstream>
 
 #include "vola/error.hpp"
 #include "vola/stream_builder.hpp"
@@ -77,20 +79,32 @@ void LasChunk::clear() {
   for (auto& e : extra) e.clear();
 }
 
-LasReader::LasReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
-  if (!in_) throw IoError(path + ": cannot open");
-  in_.seekg(0, std::ios::end);
-  file_size_ = static_cast<std::uint64_t>(in_.tellg());
-  in_.seekg(0);
+LasReader::LasReader(const std::string& path) : path_(path) {
+  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*file) throw IoError(path + ": cannot open");
+  in_ = std::move(file);
+  read_header();
+}
+
+LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& name) : path_(name) {
+  in_ = std::make_unique<std::istringstream>(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+  read_header();
+}
+
+void LasReader::read_header() {
+  std::istream& in = *in_;
+  in.seekg(0, std::ios::end);
+  file_size_ = static_cast<std::uint64_t>(in.tellg());
+  in.seekg(0);
   auto fail = [&](std::uint64_t offset, const std::string& cause) -> void { throw FormatError(path_, offset, cause); };
   auto read_at = [&](std::uint64_t offset, std::uint64_t size, const char* what) {
     if (offset > file_size_ || size > file_size_ - offset)
       fail(offset, std::string(what) + " of " + std::to_string(size) + " bytes runs past the end of the " +
                        std::to_string(file_size_) + "-byte file");
     std::vector<std::uint8_t> bytes(size);
-    in_.seekg(static_cast<std::streamoff>(offset));
-    in_.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-    if (static_cast<std::uint64_t>(in_.gcount()) != size) fail(offset, std::string("cannot read ") + what);
+    in.seekg(static_cast<std::streamoff>(offset));
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+    if (static_cast<std::uint64_t>(in.gcount()) != size) fail(offset, std::string("cannot read ") + what);
     return bytes;
   };
 
@@ -228,7 +242,7 @@ LasReader::LasReader(const std::string& path) : path_(path), in_(path, std::ios:
                              std::to_string(hd.record_length));
     }
   }
-  in_.seekg(hd.offset_to_points);
+  in.seekg(hd.offset_to_points);
 }
 
 std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_only) {
@@ -239,9 +253,9 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
   if (n == 0) return 0;
   const std::size_t length = hd.record_length;
   buffer_.resize(n * length);
-  in_.seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
-  in_.read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
-  if (static_cast<std::size_t>(in_.gcount()) != buffer_.size())
+  in_->seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
+  in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
+  if (static_cast<std::size_t>(in_->gcount()) != buffer_.size())
     throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
   if (xyz_only) {
     chunk.xyz.resize(3 * n);
@@ -309,8 +323,9 @@ namespace {
 
 // The reference's las2vola payload: int(255 * clip((v - lo) / (hi - lo), 0, 1)).
 std::uint64_t payload_byte(double v, double lo, double hi) {
-  const double n = hi > lo ? std::clamp((v - lo) / (hi - lo), 0.0, 1.0) : 0.0;
-  return static_cast<std::uint64_t>(255.0 * n);
+  const double n = hi > lo ? (v - lo) / (hi - lo) : 0.0;
+  if (!(n > 0.0)) return 0;  // also NaN, from a header max z that is not a number
+  return static_cast<std::uint64_t>(255.0 * std::min(n, 1.0));
 }
 
 }  // namespace
@@ -370,8 +385,8 @@ void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::u
 
 void LasReader::rewind() {
   next_ = 0;
-  in_.clear();
-  in_.seekg(header_.offset_to_points);
+  in_->clear();
+  in_->seekg(header_.offset_to_points);
 }
 
 PointCloud las_points(LasReader& reader, bool attributes, bool payload,

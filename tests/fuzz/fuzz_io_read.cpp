@@ -1,5 +1,5 @@
-// Fuzz entry point of the PLY, PCD, KITTI, NPY and binvox readers: the first byte picks
-// the reader (modulo 5), the rest is the file. Only vola::Error may escape a reader;
+// Fuzz entry point of the PLY, PCD, KITTI, NPY, binvox and LAS readers: the first byte
+// picks the reader (modulo 6), the rest is the file. Only vola::Error may escape a reader;
 // whatever parses must be consistent (counts, sizes, cells inside the grid), and a
 // small binvox grid must survive write -> read unchanged.
 #include <algorithm>
@@ -12,6 +12,7 @@
 #include "fuzz_seeds.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/kitti.hpp"
+#include "vola/io/las.hpp"
 #include "vola/io/npy.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
@@ -55,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   vola::io::InputOptions options;
   options.payload = true;
   try {
-    switch (data[0] % 5) {
+    switch (data[0] % 6) {
       case 0: {
         const vola::io::Input in = vola::io::parse_ply(file, "fuzz.ply", options);
         check_cloud(in.cloud);
@@ -69,7 +70,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (in.grid) check_grid(*in.grid);
         break;
       }
-      default: check_grid(vola::io::parse_binvox(file, "fuzz.binvox")); break;
+      case 4: check_grid(vola::io::parse_binvox(file, "fuzz.binvox")); break;
+      default: {
+        vola::io::LasReader reader(file, "fuzz.las");
+        const auto& header = reader.header();
+        vola::io::LasChunk chunk;
+        std::uint64_t points = 0;
+        while (const std::size_t n = reader.read(chunk, 4096)) {
+          check(chunk.size() == n && chunk.classification.size() == n);
+          points += n;
+        }
+        check(points == header.point_count);
+        reader.rewind();
+        check_cloud(vola::io::las_points(reader, true, true));
+        break;
+      }
     }
   } catch (const vola::Error&) {
     ++vola_fuzz::stats().refused;

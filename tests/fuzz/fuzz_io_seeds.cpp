@@ -1,4 +1,4 @@
-// Seeds for fuzz_io_read: the PLY, PCD, KITTI and binvox files of the shared data folder
+// Seeds for fuzz_io_read: the PLY, PCD, KITTI, binvox and (small) LAS files of the shared data folder
 // (beside golden/) and small files of every variant written here, each prefixed with
 // the byte that picks its reader (see fuzz_io_read.cpp). Linked into fuzz_io_replay in
 // place of fuzz_seeds.cpp, so that replay_main.cpp serves both entry points.
@@ -19,7 +19,7 @@ namespace vola_fuzz {
 
 namespace {
 
-enum Reader : std::uint8_t { kPly = 0, kPcd = 1, kKitti = 2, kNpy = 3, kBinvox = 4 };
+enum Reader : std::uint8_t { kPly = 0, kPcd = 1, kKitti = 2, kNpy = 3, kBinvox = 4, kLas = 5 };
 using Bytes = std::vector<std::uint8_t>;
 
 Seed seed(const std::string& name, Reader reader, const Bytes& file) {
@@ -159,12 +159,16 @@ std::vector<Seed> golden_seeds(const std::filesystem::path& golden) {
   std::vector<Seed> seeds;
   const auto data = golden.parent_path() / "data";
   if (!std::filesystem::is_directory(data)) return seeds;
-  const std::pair<std::string, Reader> kinds[] = {{"ply", kPly}, {"pcd", kPcd}, {"kitti", kKitti}, {"binvox", kBinvox}};
+  const std::pair<std::string, Reader> kinds[] = {
+      {"ply", kPly}, {"pcd", kPcd}, {"kitti", kKitti}, {"binvox", kBinvox}, {"las", kLas}};
   for (const auto& [folder, reader] : kinds) {
     if (!std::filesystem::is_directory(data / folder)) continue;
     for (const auto& entry : std::filesystem::recursive_directory_iterator(data / folder)) {
       const auto extension = entry.path().extension().string();
-      const bool wanted = entry.is_regular_file() && (extension == "." + folder || (reader == kKitti && extension == ".bin"));
+      // LAS seeds stay small so that each mutation parses quickly.
+      const bool wanted = entry.is_regular_file() &&
+                          (extension == "." + folder || (reader == kKitti && extension == ".bin")) &&
+                          (reader != kLas || entry.file_size() <= 128 * 1024);
       if (wanted) seeds.push_back(seed(folder + "_" + entry.path().filename().string(), reader, read_all(entry.path())));
     }
   }

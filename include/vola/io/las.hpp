@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <span>
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,6 +74,8 @@ class LasReader {
   // Reads and checks the header and (E)VLRs. A LAZ file gets an error that says so and
   // what to do. Throws FormatError with file and offset on anything malformed.
   explicit LasReader(const std::string& path);
+  // The same over bytes in memory (copied); `name` labels errors.
+  LasReader(std::span<const std::uint8_t> bytes, const std::string& name);
   const LasHeader& header() const noexcept { return header_; }
   // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end. With
   // `xyz_only`, only the coordinates are decoded.
@@ -82,7 +86,9 @@ class LasReader {
 
  private:
   std::string path_;
-  std::ifstream in_;
+  void read_header();
+
+  std::unique_ptr<std::istream> in_;
   std::uint64_t file_size_ = 0;
   LasHeader header_;
   std::uint64_t next_ = 0;
