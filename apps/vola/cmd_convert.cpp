@@ -299,9 +299,20 @@ void run_convert(const ConvertArgs& a) {
 
 }  // namespace
 
+// "las (.las .laz), text (.xyz ...), ...": every reader this build has, for the help.
+std::string known_formats() {
+  std::string out;
+  for (const auto& f : io::input_formats()) {
+    out += (out.empty() ? "" : ", ") + f.name + " (";
+    for (std::size_t i = 0; i < f.extensions.size(); ++i) out += (i ? " " : "") + f.extensions[i];
+    out += ")";
+  }
+  return out;
+}
+
 void add_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  auto* cmd = app.add_subcommand("convert", "Convert points (XYZ/TXT/CSV text or NPY arrays) into a .vol file");
+  auto* cmd = app.add_subcommand("convert", "Convert points, voxel grids, meshes or elevation rasters into a .vol file");
   cmd->footer(
       "Quantization:\n"
       "  grid     floor((p - origin) / voxel-size): what GIS users expect; grids of one voxel\n"
@@ -315,9 +326,9 @@ void add_convert(CLI::App& app) {
       "  vola convert points.npy points.vol --depth 5 --compress\n"
       "  vola convert part.stl part.vol --quantize toolkit --depth 5 --solid\n"
       "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0");
-  cmd->add_option("input", args->input, "Input points: .las (LAS 1.0-1.4), .xyz .txt .csv .pts .asc (text) or .npy")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file")->required();
-  cmd->add_option("--format", args->format, "Input format: auto (from the extension), las, text, npy")->capture_default_str();
+  cmd->add_option("--format", args->format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
   cmd->add_option("--depth", args->depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size")
       ->check(CLI::Range(1, 10));
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge in input units (grid mode)")->check(CLI::PositiveNumber);
