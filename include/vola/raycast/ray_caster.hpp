@@ -1,0 +1,40 @@
+// Hierarchical DDA over a VOLA tree: Amanatides-Woo at every level, descending only
+// into occupied nodes and stepping over an empty node at the coarsest level that is
+// empty. It finds exactly what reference_cast (reference_dda.hpp) finds: the same voxel,
+// entry time and normal, because it crosses the same planes with the same arithmetic
+// (ray.hpp) and only skips events inside empty nodes.
+//
+// The caster keeps a rank directory per level and, per ray, the path of blocks from the
+// root, so a step re-descends only from the first level whose cell changed.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "vola/raycast/ray.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::raycast {
+
+class RayCaster {
+ public:
+  // The tree must outlive the caster.
+  explicit RayCaster(const Tree& tree);
+
+  std::optional<RayHit> cast(const Ray& ray) const;
+  // hits[i] = cast(rays[i]), on `threads` threads (0 = the hardware's count).
+  void cast(std::span<const Ray> rays, std::span<std::optional<RayHit>> hits, unsigned threads = 0) const;
+
+  const Tree& tree() const noexcept { return *tree_; }
+
+ private:
+  const Tree* tree_;
+  std::vector<RankDirectory> rank_;
+};
+
+// Runs f(begin, end) over [0, count) in chunks on `threads` threads (0 = hardware).
+void parallel_chunks(std::size_t count, unsigned threads, const std::function<void(std::size_t, std::size_t)>& f);
+
+}  // namespace vola::raycast
