@@ -13,5 +13,6 @@ void add_lod(CLI::App& app);
 void add_setops(CLI::App& app);  // union, intersect, diff
 void add_generate(CLI::App& app);
 void add_export(CLI::App& app);
+void add_render(CLI::App& app);
 
 }  // namespace vola::cli

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   vola::cli::add_setops(app);
   vola::cli::add_generate(app);
   vola::cli::add_export(app);
+  vola::cli::add_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -21,8 +21,8 @@ vola::Tree random_tree(std::uint64_t seed, int depth) {
   return vola::build_from_voxels(voxels, depth);
 }
 
-std::optional<vola::Tree> autzen_tree(int depth) {
-  const auto path = vola_io_test::data_dir() / "las" / "pdal_autzen-utm.las";
+std::optional<vola::Tree> autzen_tree(const std::string& file_name, int depth) {
+  const auto path = vola_io_test::data_dir() / "las" / file_name;
   if (!vola_test::fs::exists(path)) return std::nullopt;
   const vola::io::Input input = vola::io::read_input(path.string(), "auto", {});
   vola::BuildOptions options;

@@ -67,7 +67,7 @@ TEST(RayCaster, AgreesWithReferenceOnRandomTrees) {
 }
 
 TEST(RayCaster, AgreesWithReferenceOnARealSurvey) {
-  auto tree = raycast_test::autzen_tree(5);
+  auto tree = raycast_test::autzen_tree("pdal_autzen-utm.las", 5);
   if (!tree) {
     if (std::getenv("CI")) FAIL() << "shared data missing (CI is set)";
     GTEST_SKIP() << "shared data missing; set VOLA_SHARED";

@@ -1,0 +1,23 @@
+// Renders a tree through a pinhole camera (grid coordinates): a depth image and a
+// shaded image. Shading: the hit face's normal against a fixed light, times the voxel's
+// colour from its red/green/blue attributes when the tree has them, else light grey.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vola/raycast/camera.hpp"
+#include "vola/raycast/ray_caster.hpp"
+
+namespace vola::raycast {
+
+struct Rendering {
+  std::uint32_t width = 0, height = 0;
+  std::vector<double> depth;       // entry distance in voxels per pixel, +inf for a miss
+  std::vector<std::uint8_t> rgb;   // 3 bytes per pixel, row 0 at the top; misses black
+  std::uint64_t hits = 0;
+};
+
+Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads = 0);
+
+}  // namespace vola::raycast

@@ -1,0 +1,78 @@
+#include "vola/raycast/render.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace vola::raycast {
+namespace {
+
+// Per-voxel colour from the red/green/blue attribute columns (8- or 16-bit values).
+class VoxelColours {
+ public:
+  explicit VoxelColours(const Tree& tree) : tree_(tree) {
+    const Attributes& a = tree.attributes();
+    channels_ = {a.find("red"), a.find("green"), a.find("blue")};
+    if (!channels_[0] || !channels_[1] || !channels_[2]) return;
+    double top = 0.0;
+    for (const AttributeColumn* c : channels_)
+      for (std::size_t i = 0; i < c->size(); ++i) top = std::max(top, c->get(i));
+    scale_ = top > 255.0 ? 1.0 / 257.0 : 1.0;  // LAS stores colours as 16 bits, most often
+    present_ = true;
+  }
+  std::array<double, 3> at(const Voxel& v) const {
+    if (!present_) return {200, 200, 200};
+    const auto rank = tree_.rank(v);
+    std::array<double, 3> c{};
+    for (int i = 0; i < 3; ++i) c[i] = rank && *rank < channels_[i]->size() ? channels_[i]->get(*rank) * scale_ : 0;
+    return c;
+  }
+
+ private:
+  const Tree& tree_;
+  std::array<const AttributeColumn*, 3> channels_{};
+  double scale_ = 1.0;
+  bool present_ = false;
+};
+
+// Lambert term of an axis normal against a light from above and to the side.
+double lambert(const std::array<int, 3>& normal) {
+  constexpr std::array<double, 3> kLight{0.42426406871192851, 0.56568542494923801, 0.70710678118654757};
+  if (normal == std::array<int, 3>{0, 0, 0}) return 1.0;  // the eye is inside the voxel
+  double d = 0.0;
+  for (int a = 0; a < 3; ++a) d += normal[a] * kLight[a];
+  return 0.3 + 0.7 * std::abs(d);
+}
+
+}  // namespace
+
+Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads) {
+  camera.check();
+  Rendering out;
+  out.width = camera.width;
+  out.height = camera.height;
+  const std::size_t pixels = std::size_t{camera.width} * camera.height;
+  out.depth.assign(pixels, std::numeric_limits<double>::infinity());
+  out.rgb.assign(pixels * 3, 0);
+  const VoxelColours colours(caster.tree());
+  std::atomic<std::uint64_t> hits{0};
+  parallel_chunks(pixels, threads, [&](std::size_t begin, std::size_t end) {
+    std::uint64_t local = 0;
+    for (std::size_t p = begin; p < end; ++p) {
+      const auto hit = caster.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
+                                              static_cast<std::uint32_t>(p / camera.width)));
+      if (!hit) continue;
+      ++local;
+      out.depth[p] = hit->t;
+      const auto colour = colours.at(hit->voxel);
+      const double shade = lambert(hit->normal);
+      for (int i = 0; i < 3; ++i)
+        out.rgb[3 * p + i] = static_cast<std::uint8_t>(std::clamp(colour[i] * shade, 0.0, 255.0));
+    }
+    hits += local;
+  });
+  out.hits = hits;
+  return out;
+}
+
+}  // namespace vola::raycast
