@@ -8,7 +8,7 @@ export VOLA_SHARED=${VOLA_SHARED:-$(cd "$VOLA_ROOT/.." && pwd)/shared}
 
 # Packages every build needs (the core needs none; the CLI, tests and geo do).
 VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-data libgtest-dev libgmock-dev
-  nlohmann-json3-dev python3 python3-numpy gzip libassimp-dev libgdal-dev libpng-dev liblzf-dev)
+  nlohmann-json3-dev python3 python3-numpy python3-scipy gzip libassimp-dev libgdal-dev libpng-dev liblzf-dev)
 
 # install_packages PKG...: apt-get installs the ones that are missing (as root), or
 # says exactly what to install.

@@ -1,0 +1,13 @@
+// Cropping a tree to a box of voxel indices.
+#pragma once
+
+#include "vola/tree.hpp"
+
+namespace vola::analysis {
+
+// The voxels with min <= (x, y, z) <= max per axis (inclusive). Keeps depth, frame and
+// georeferencing; drops payloads and attributes. A box that misses the grid gives an
+// empty tree.
+Tree crop(const Tree& tree, const Voxel& min, const Voxel& max);
+
+}  // namespace vola::analysis

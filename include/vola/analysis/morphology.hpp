@@ -1,0 +1,25 @@
+// Dilation and erosion of a tree's voxels by a radius, on 4x4x4 bricks (64 voxels per
+// word operation) over the occupied region only. Used by planners to inflate
+// obstacles. Results keep the input's depth, frame and georeferencing; payloads and
+// attribute columns are dropped (a grown voxel has no measured value).
+#pragma once
+
+#include "vola/tree.hpp"
+
+namespace vola::analysis {
+
+enum class Element {
+  sphere,  // offsets with dx^2 + dy^2 + dz^2 <= r^2
+  cube,    // offsets with max(|dx|, |dy|, |dz|) <= r
+};
+
+// The voxels within the element of radius r of an occupied voxel, clipped to the grid.
+// r = 0 copies. Throws InvalidArgument for r < 0 or r >= the grid side.
+Tree dilate(const Tree& tree, int radius, Element element);
+// The voxels whose whole element of radius r is occupied; cells outside the grid
+// count as empty (scipy.ndimage.binary_erosion's border_value = 0), so voxels within r
+// of the grid's edge are removed. Computed as the voxels minus the dilation of the
+// empty cells next to them, without complementing the grid.
+Tree erode(const Tree& tree, int radius, Element element);
+
+}  // namespace vola::analysis
