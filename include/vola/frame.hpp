@@ -64,11 +64,14 @@ class Quantizer {
   // The closed box of the world points to_voxel maps to `v` (up to rounding in the last
   // bit); neighbouring voxels share their faces bit for bit. Toolkit mode clamps, so its
   // border voxels reach to infinity outward, and a zero-extent toolkit bbox gives voxel
-  // 0 all of space and every other voxel an empty box (min > max).
+  // 0 all of space and every other voxel an empty box (min > max). (An axis whose
+  // (min + Lmax) - min rounds to 0 collapses the voxels between its border ones onto
+  // the plane at min.)
   Box cell_box(const Voxel& v) const noexcept;
   // The voxels [first, last] (per axis) whose cell boxes may touch `box`: every voxel
-  // whose cell_box intersects it, plus at most the neighbours that rounding could put
-  // there. False when no voxel can (box empty or NaN, or outside a grid-mode grid).
+  // whose cell_box intersects it, plus at most the neighbour on each side that rounding
+  // could put there (the whole axis where the arithmetic overflows). False when no
+  // voxel can (box empty or NaN, or outside a grid-mode grid).
   bool voxel_range(const Box& box, Voxel& first, Voxel& last) const noexcept;
   int depth() const noexcept { return depth_; }
 

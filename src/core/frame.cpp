@@ -141,13 +141,25 @@ bool Quantizer::voxel_range(const Box& box, Voxel& first, Voxel& last) const noe
       lo[a] = hi[a] = 0;
       continue;
     }
-    // Position in voxel units such that voxel k covers [k, k + 1]; one voxel of slack
-    // on each side absorbs the rounding of this division and of cell_box's faces.
+    // Position t in voxel units such that voxel k covers [k, k + 1]: voxels
+    // ceil(t_min) - 1 .. floor(t_max) touch the box. Widened by what the rounding of this
+    // arithmetic and of cell_box's faces can shift (a few ulps of the coordinates, which
+    // exceed a voxel only when the voxel is below the coordinates' resolution). Where
+    // the arithmetic fails (an overflowing or zero scale) the whole axis is the range:
+    // a superset is always correct.
     const double shift = mode_ == Quantization::toolkit ? 0.5 : 0.0;
     const double per_unit = mode_ == Quantization::toolkit ? (side - 1.0) / scale_[a] : 1.0 / scale_[a];
-    double from = std::floor((box.min[a] - origin_[a]) * per_unit + shift) - 1.0;
-    double to = std::floor((box.max[a] - origin_[a]) * per_unit + shift) + 1.0;
-    if (std::isnan(from) || std::isnan(to)) return false;
+    const double t_min = (box.min[a] - origin_[a]) * per_unit + shift;
+    const double t_max = (box.max[a] - origin_[a]) * per_unit + shift;
+    const double eps = 8 * std::numeric_limits<double>::epsilon();
+    const double reach = std::max(std::abs(box.min[a]), std::abs(box.max[a])) + std::abs(origin_[a]);
+    const double rounding = eps * (reach * per_unit + std::max(std::abs(t_min), std::abs(t_max)));
+    double from = std::ceil(t_min - rounding) - 1.0;
+    double to = std::floor(t_max + rounding);
+    if (!std::isfinite(per_unit) || std::isnan(from) || std::isnan(to)) {
+      from = 0.0;
+      to = side - 1.0;
+    }
     if (mode_ == Quantization::grid && (to < 0.0 || from > side - 1.0)) return false;
     // Toolkit clamps: everything below the bbox lands in voxel 0, above it in S-1.
     from = std::clamp(from, 0.0, side - 1.0);

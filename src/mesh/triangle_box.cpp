@@ -37,6 +37,21 @@ TriangleBoxTest::TriangleBoxTest(const Triangle& triangle) noexcept : vertices_(
       if (!(std::abs(v[a]) <= kMaxCoordinate)) usable_ = false;  // also NaN
   }
   edges_ = {minus(triangle[1], triangle[0]), minus(triangle[2], triangle[1]), minus(triangle[0], triangle[2])};
+  // Scale by a power of two (exact) so that the longest edge component is in [0.5, 1):
+  // products of edges and positions then neither underflow for tiny triangles nor
+  // overflow for huge ones, and the answer does not change (separation is scale-free).
+  // Two factors, as 2^-e alone overflows for subnormal edges.
+  double longest = 0.0;
+  for (const Point& e : edges_)
+    for (double c : e) longest = std::max(longest, std::abs(c));
+  if (longest > 0.0 && std::isfinite(longest)) {
+    int exponent = 0;
+    std::frexp(longest, &exponent);
+    scale_[0] = std::ldexp(1.0, -exponent / 2);
+    scale_[1] = std::ldexp(1.0, -(exponent - exponent / 2));
+  }
+  for (Point& e : edges_)
+    for (double& c : e) c = c * scale_[0] * scale_[1];
   normal_ = cross(edges_[0], edges_[1]);
 }
 
@@ -50,9 +65,11 @@ bool TriangleBoxTest::overlaps(const Box& box) const noexcept {
     low[a] = std::max(box.min[a], bounds_.min[a]);
     const double high = std::min(box.max[a], bounds_.max[a]);
     if (!(low[a] <= high)) return false;
-    extent[a] = high - low[a];
+    extent[a] = (high - low[a]) * scale_[0] * scale_[1];
   }
-  const std::array<Point, 3> rel = {minus(vertices_[0], low), minus(vertices_[1], low), minus(vertices_[2], low)};
+  std::array<Point, 3> rel;
+  for (int i = 0; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) rel[i][a] = (vertices_[i][a] - low[a]) * scale_[0] * scale_[1];
   if (separated(normal_, rel, extent)) return false;
   for (const Point& e : edges_) {
     // e x (1,0,0), e x (0,1,0), e x (0,0,1)

@@ -14,11 +14,13 @@ vola_test::fs::path data_dir() { return vola_test::golden_dir().parent_path() / 
 XyzSet brute_force_voxels(std::span<const Triangle> triangles, const vola::Quantizer& quantizer) {
   XyzSet out;
   const std::uint32_t side = vola::side_of(quantizer.depth());
-  for (const Triangle& t : triangles)
+  for (const Triangle& t : triangles) {
+    const vola::mesh::TriangleBoxTest test(t);
     for (std::uint32_t z = 0; z < side; ++z)
       for (std::uint32_t y = 0; y < side; ++y)
         for (std::uint32_t x = 0; x < side; ++x)
-          if (vola::mesh::triangle_box_overlap(t, quantizer.cell_box({x, y, z}))) out.insert({x, y, z});
+          if (test.overlaps(quantizer.cell_box({x, y, z}))) out.insert({x, y, z});
+  }
   return out;
 }
 
@@ -57,8 +59,11 @@ bool clipped_triangle_meets_box(const Triangle& triangle, const Box& box, double
 std::vector<Triangle> random_triangles(std::mt19937_64& rng, const Box& box, const vola::Quantizer& quantizer,
                                        int count) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // A flat axis borrows the box's largest extent (1 for a point).
+  double largest = 0.0;
+  for (int a = 0; a < 3; ++a) largest = std::max(largest, box.max[a] - box.min[a]);
   Point extent;
-  for (int a = 0; a < 3; ++a) extent[a] = std::max(box.max[a] - box.min[a], 1e-3);
+  for (int a = 0; a < 3; ++a) extent[a] = box.max[a] > box.min[a] ? box.max[a] - box.min[a] : (largest > 0 ? largest : 1.0);
   const auto in_box = [&] {  // a point in the box grown by 20% per side
     Point p;
     for (int a = 0; a < 3; ++a) p[a] = box.min[a] + (unit(rng) * 1.4 - 0.2) * extent[a];

@@ -59,6 +59,22 @@ TEST(CellBox, NeighboursShareFacesAndBordersFollowTheMode) {
   EXPECT_EQ(point.cell_box({0, 0, 0}), (Box{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}}));
   const Box other = point.cell_box({1, 0, 0});
   EXPECT_GT(other.min[0], other.max[0]);
+  // An axis whose (min + Lmax) - min rounds to 0: to_voxel puts x <= 1e20 in voxel 0
+  // and x > 1e20 in voxel 3; the voxels between collapse onto the plane x = 1e20.
+  const Quantizer flat = Quantizer::toolkit({{1e20, 0, 0}, {1e20, 1, 1}}, 1);
+  Voxel v;
+  ASSERT_TRUE(flat.to_voxel({1e20, 0.5, 0.5}, v));
+  EXPECT_EQ(v.x, 0u);
+  ASSERT_TRUE(flat.to_voxel({2e20, 0.5, 0.5}, v));
+  EXPECT_EQ(v.x, 3u);
+  EXPECT_EQ(flat.cell_box({0, 0, 0}).max[0], 1e20);
+  EXPECT_EQ(flat.cell_box({3, 0, 0}).min[0], 1e20);
+  EXPECT_EQ(flat.cell_box({1, 0, 0}).min[0], 1e20);
+  EXPECT_EQ(flat.cell_box({1, 0, 0}).max[0], 1e20);
+  Voxel first, last;
+  ASSERT_TRUE(flat.voxel_range({{1e20, 0.2, 0.2}, {1e20, 0.3, 0.3}}, first, last));
+  EXPECT_EQ(first.x, 0u);
+  EXPECT_EQ(last.x, 3u);
 }
 
 TEST(CellBox, PointsLieInTheBoxOfTheirVoxel) {

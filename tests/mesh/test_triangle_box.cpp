@@ -83,13 +83,32 @@ TEST(TriangleBox, InfiniteBoxesAndDegenerateBoxes) {
 
 TEST(TriangleBox, UnusableVerticesNeverOverlap) {
   const Box everything{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
-  for (double bad : {kNaN, kInf, -kInf, 1e200}) {
+  for (double bad : {kNaN, kInf, -kInf, 1e301}) {
     const Triangle t{{{0.5, 0.5, 0.5}, {bad, 0.5, 0.5}, {0.5, 0.6, 0.5}}};
     EXPECT_FALSE(vola::mesh::TriangleBoxTest(t).usable()) << bad;
     EXPECT_FALSE(triangle_box_overlap(t, kUnit)) << bad;
     EXPECT_FALSE(triangle_box_overlap(t, everything)) << bad;
   }
-  EXPECT_TRUE(vola::mesh::TriangleBoxTest({{{1e99, 0, 0}, {0, -1e99, 0}, {0, 0, 1e99}}}).usable());
+  EXPECT_TRUE(vola::mesh::TriangleBoxTest({{{1e299, 0, 0}, {0, -1e299, 0}, {0, 0, 1e299}}}).usable());
+}
+
+// The same shapes at scales from subnormal to 1e290: the answers do not change (the
+// products inside the test would underflow or overflow without rescaling).
+TEST(TriangleBox, AnswersDoNotDependOnScale) {
+  const Triangle apart{{{2.6, -0.5, 0.5}, {-0.5, 2.6, 0.5}, {2.6, 2.6, 0.5}}};  // needs an edge axis
+  const Triangle through{{{-10, -10, 0.5}, {10, -10, 0.7}, {0, 10, 0.5}}};
+  const Triangle above{{{0.2, 0.2, 1.5}, {0.8, 0.2, 1.1}, {0.5, 0.7, 1.01}}};
+  for (double scale : {1e-310, 1e-200, 1e-150, 1.0, 1e150, 1e290}) {
+    const auto scaled = [&](Triangle t) {
+      for (auto& v : t)
+        for (auto& c : v) c *= scale;
+      return t;
+    };
+    const Box box{{0, 0, 0}, {scale, scale, scale}};
+    EXPECT_FALSE(triangle_box_overlap(scaled(apart), box)) << scale;
+    EXPECT_TRUE(triangle_box_overlap(scaled(through), box)) << scale;
+    EXPECT_FALSE(triangle_box_overlap(scaled(above), box)) << scale;
+  }
 }
 
 // Random triangles and boxes: wherever the test says "touch", the triangle clipped to

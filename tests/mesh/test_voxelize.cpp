@@ -23,6 +23,9 @@ struct Scenario {
   Quantizer quantizer;
   Box region;  // where the random triangles go (grown by 20%)
   int triangles;
+  // Voxels larger than the rounding of the coordinates: points computed on a triangle
+  // then lie on it to well within a voxel (the sampling check needs that).
+  bool resolvable = true;
 };
 
 std::vector<Scenario> scenarios() {
@@ -35,6 +38,15 @@ std::vector<Scenario> scenarios() {
       {"grid depth 3, UTM-sized coordinates", Quantizer::grid({500000, 4000000, 100}, 0.5, 3),
        {{500000, 4000000, 100}, {500032, 4000032, 132}}, 44},
       {"toolkit, zero-extent bbox", Quantizer::toolkit({{2, 2, 2}, {2, 2, 2}}, 1), {{1, 1, 1}, {3, 3, 3}}, 110},
+      {"toolkit, an axis below the coordinates' resolution", Quantizer::toolkit({{1e20, 0, 0}, {1e20, 1, 1}}, 2),
+       {{1e20, 0, 0}, {1e20, 1, 1}}, 110},
+      {"grid, voxels below the coordinates' resolution", Quantizer::grid({1e12, 0, 0}, 1e-6, 2),
+       {{1e12, 0, 0}, {1e12 + 1e-5, 1e-5, 1e-5}}, 110, false},
+      // Products of coordinates this small underflow unless the test rescales (a fuzz finding).
+      {"toolkit, a bbox of 1e-300", Quantizer::toolkit({{0, 0, 0}, {1e-300, 1e-300, 2e-300}}, 2),
+       {{0, 0, 0}, {1e-300, 1e-300, 2e-300}}, 110},
+      {"toolkit, a bbox of 1e250", Quantizer::toolkit({{-1e250, 0, 0}, {1e250, 1e250, 1e250}}, 2),
+       {{-1e250, 0, 0}, {1e250, 1e250, 1e250}}, 110},
   };
 }
 
@@ -88,6 +100,7 @@ TEST(Voxelize, EverySampledPointOfATriangleIsInASetVoxel) {
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (const Scenario& s : scenarios()) {
+    if (!s.resolvable) continue;
     const auto triangles = vola_mesh_test::random_triangles(rng, s.region, s.quantizer, s.triangles);
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       const Triangle& t = triangles[i];
@@ -129,7 +142,7 @@ TEST(Voxelize, UnusableTrianglesAreSkipped) {
   const Triangle good{{{0.1, 0.1, 0.1}, {0.9, 0.2, 0.3}, {0.4, 0.8, 0.7}}};
   const std::vector<Triangle> triangles = {
       {{{nan, 0, 0}, {1, 1, 1}, {0, 1, 0}}}, good, {{{0, 0, 0}, {inf, 1, 1}, {0, 1, 0}}},
-      {{{0, 0, 0}, {1, 1, 1}, {0, -inf, 0}}}, {{{0, 0, 1e300}, {1, 1, 1}, {0, 1, 0}}}, {{{nan, nan, nan}, {nan, nan, nan}, {nan, nan, nan}}},
+      {{{0, 0, 0}, {1, 1, 1}, {0, -inf, 0}}}, {{{0, 0, 1e301}, {1, 1, 1}, {0, 1, 0}}}, {{{nan, nan, nan}, {nan, nan, nan}, {nan, nan, nan}}},
   };
   vola::mesh::VoxelizeReport report;
   const auto keys = vola::mesh::surface_keys(triangles, q, &report);
@@ -145,6 +158,17 @@ TEST(Voxelize, UnusableTrianglesAreSkipped) {
   vola::mesh::VoxelizeOptions solid;
   solid.solid = true;
   EXPECT_TRUE(vola::mesh::voxelize(bad, q, solid).empty());
+}
+
+// A NaN bbox minimum gives an axis of NaN faces: nothing touches them (a fuzz finding:
+// the per-triangle face cache once disagreed with cell_box there).
+TEST(Voxelize, NaNFrameAxisSetsNothing) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Quantizer q = Quantizer::toolkit({{nan, 0, 0}, {1, 1, 1}}, 2);
+  std::mt19937_64 rng(14);
+  const auto triangles = vola_mesh_test::random_triangles(rng, {{0, 0, 0}, {1, 1, 1}}, q, 44);
+  const auto keys = vola::mesh::surface_keys(triangles, q);
+  EXPECT_EQ(vola_mesh_test::key_set(keys), vola_mesh_test::brute_force_voxels(triangles, q));
 }
 
 TEST(Voxelize, GridModeCountsTrianglesOutsideTheGrid) {

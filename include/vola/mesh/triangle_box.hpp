@@ -11,9 +11,9 @@ namespace vola::mesh {
 
 using Triangle = std::array<Point, 3>;  // the same type as vola::io::Triangle
 
-// Vertices beyond this magnitude are refused: the test's triple products of
-// coordinates must not overflow a double.
-inline constexpr double kMaxCoordinate = 1e100;
+// Vertices beyond this magnitude are refused: differences of coordinates (edges, a
+// vertex minus a box corner) must stay finite.
+inline constexpr double kMaxCoordinate = 1e300;
 
 // A triangle prepared for many box tests. Degenerate triangles (segments, points) are
 // handled exactly: their zero normal separates nothing and the edge axes still do.
@@ -31,8 +31,9 @@ class TriangleBoxTest {
 
  private:
   Triangle vertices_;
-  std::array<Point, 3> edges_;  // v1 - v0, v2 - v1, v0 - v2
+  std::array<Point, 3> edges_;  // (v1 - v0, v2 - v1, v0 - v2) * scale
   Point normal_;                // edges_[0] x edges_[1]
+  std::array<double, 2> scale_{1.0, 1.0};  // powers of two; their product scales lengths
   Box bounds_;
   bool usable_ = true;
 };
