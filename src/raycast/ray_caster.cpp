@@ -78,6 +78,11 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
     }
   }
 
+  // Crossing time of the plane through which the ray leaves v on each axis.
+  std::array<double, 3> exit_time{kNever, kNever, kNever};
+  for (int a = 0; a < 3; ++a)
+    if (axes.step[a]) exit_time[a] = crossing_time(axes.exit_plane(a, v[a]), ray.origin[a], axes.inverse[a]);
+
   std::array<std::size_t, kMaxDepth> block{};  // block of each level on the current path
   int from = 0;                                // first level whose cell may have changed
   for (;;) {
@@ -99,16 +104,22 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
                          static_cast<std::size_t>(std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
     }
 
-    // Step over the empty node of `level`: to the first event that leaves it.
+    // Step over the empty node of `level`: to the first event that leaves it. An axis
+    // whose own next plane comes later keeps its index; one whose boundary plane is
+    // crossed at that event enters the next node; any other crossed planes inside the
+    // node on the way (only when the node is bigger than a voxel) are counted exactly.
     const int shift = 2 * (depth - 1 - level);
     std::array<std::int64_t, 3> lo{}, hi{};
+    std::array<double, 3> leave{kNever, kNever, kNever};
     double next = kNever;
     for (int a = 0; a < 3; ++a) {
+      if (!axes.step[a]) continue;
       lo[a] = (v[a] >> shift) << shift;
       hi[a] = lo[a] + (std::int64_t{1} << shift) - 1;
-      if (axes.step[a])
-        next = std::min(next, crossing_time(static_cast<double>(axes.step[a] > 0 ? hi[a] + 1 : lo[a]),
-                                            ray.origin[a], axes.inverse[a]));
+      leave[a] = shift == 0 ? exit_time[a]
+                            : crossing_time(static_cast<double>(axes.step[a] > 0 ? hi[a] + 1 : lo[a]), ray.origin[a],
+                                            axes.inverse[a]);
+      next = std::min(next, leave[a]);
     }
     if (next == kNever || !(next <= ray.t_max)) return std::nullopt;
     const std::array<std::int64_t, 3> old = v;
@@ -116,18 +127,15 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
     bool normal_set = false;
     for (int a = 0; a < 3; ++a) {
       const int s = axes.step[a];
-      if (!s) continue;
+      if (!s || exit_time[a] > next) continue;
       const double o = ray.origin[a];
-      const double boundary = static_cast<double>(s > 0 ? hi[a] + 1 : lo[a]);
-      if (crossing_time(boundary, o, axes.inverse[a]) == next)
-        v[a] = s > 0 ? hi[a] + 1 : lo[a] - 1;
-      else
-        v[a] = index_after(axes, ray, a, next, lo[a], hi[a]);
+      v[a] = leave[a] == next ? (s > 0 ? hi[a] + 1 : lo[a] - 1) : index_after(axes, ray, a, next, lo[a], hi[a]);
+      if (v[a] < 0 || v[a] >= side) return std::nullopt;
+      exit_time[a] = crossing_time(axes.exit_plane(a, v[a]), o, axes.inverse[a]);
       if (!normal_set && crossing_time(axes.entry_plane(a, v[a]), o, axes.inverse[a]) == next) {
         hit.normal[a] = -s;
         normal_set = true;
       }
-      if (v[a] < 0 || v[a] >= side) return std::nullopt;
     }
     hit.t = next;
     const auto changed = static_cast<std::uint64_t>((v[0] ^ old[0]) | (v[1] ^ old[1]) | (v[2] ^ old[2]));
