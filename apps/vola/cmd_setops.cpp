@@ -1,8 +1,11 @@
-// vola union | intersect | diff A B OUT: set operations on voxels of one grid.
+// vola union | intersect | diff A B OUT: set operations on voxels of one grid. diff
+// also counts the change between two surveys (A = before, B = after).
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "commands.hpp"
+#include "vola/analysis/change.hpp"
 #include "vola/file.hpp"
 #include "vola/setops.hpp"
 
@@ -12,6 +15,7 @@ namespace {
 
 struct SetArgs {
   std::string a, b, output;
+  std::string outputs_dir;  // diff only
   bool ignore_frame = false;
   bool quiet = false;
 };
@@ -39,14 +43,52 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   });
 }
 
+// diff: OUT (optional) is A - B as always; the counts are printed either way.
+void add_diff(CLI::App& app) {
+  auto args = std::make_shared<SetArgs>();
+  auto* cmd = app.add_subcommand("diff", "Voxels in A but not in B, and the change between two surveys");
+  cmd->footer(
+      "With A the earlier survey and B the later one: added = B - A, removed = A - B,\n"
+      "unchanged = both. OUTPUT (optional) receives A - B, the 'removed' set (swap A and B\n"
+      "to get what was added). --outputs DIR writes added.vol, removed.vol, unchanged.vol.\n"
+      "Both files must have the same depth and grid; payloads and attributes are not carried.\n"
+      "Example: vola diff before.vol after.vol --outputs change/");
+  cmd->add_option("a", args->a, "First .vol (before)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("b", args->b, "Second .vol (after)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("output", args->output, "Output .vol: A - B");
+  cmd->add_option("--outputs", args->outputs_dir, "Write added.vol, removed.vol and unchanged.vol into this folder");
+  cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids differ");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->callback([args] {
+    const Tree a = open_mapped(args->a);
+    const Tree b = open_mapped(args->b);
+    const FrameCheck check = args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal;
+    const Tree removed = subtract(a, b, check);  // also checks depths and frames
+    if (!args->output.empty()) write(removed, args->output);
+    if (!args->outputs_dir.empty()) {
+      std::filesystem::create_directories(args->outputs_dir);
+      const std::filesystem::path dir(args->outputs_dir);
+      write(subtract(b, a, check), (dir / "added.vol").string());
+      write(removed, (dir / "removed.vol").string());
+      write(intersect(a, b, check), (dir / "unchanged.vol").string());
+    }
+    if (args->quiet) return;
+    if (!args->output.empty())
+      std::printf("diff: %llu and %llu voxels -> %llu voxels\n", static_cast<unsigned long long>(a.voxel_count()),
+                  static_cast<unsigned long long>(b.voxel_count()), static_cast<unsigned long long>(removed.voxel_count()));
+    const analysis::ChangeCounts c = analysis::count_changes(a, b);
+    std::printf("added %llu, removed %llu, unchanged %llu voxels\n", static_cast<unsigned long long>(c.added),
+                static_cast<unsigned long long>(c.removed), static_cast<unsigned long long>(c.unchanged));
+  });
+}
+
 }  // namespace
 
 void add_setops(CLI::App& app) {
   add_one(app, "union", "Voxels in A or B", [](const Tree& a, const Tree& b, FrameCheck c) { return unite(a, b, c); });
   add_one(app, "intersect", "Voxels in both A and B",
           [](const Tree& a, const Tree& b, FrameCheck c) { return intersect(a, b, c); });
-  add_one(app, "diff", "Voxels in A but not in B (e.g. what a later survey added)",
-          [](const Tree& a, const Tree& b, FrameCheck c) { return subtract(a, b, c); });
+  add_diff(app);
 }
 
 }  // namespace vola::cli

@@ -13,6 +13,9 @@ void add_lod(CLI::App& app);
 void add_setops(CLI::App& app);  // union, intersect, diff
 void add_generate(CLI::App& app);
 void add_export(CLI::App& app);
+void add_census(CLI::App& app);
+void add_components(CLI::App& app);
+void add_morph(CLI::App& app);  // dilate, erode, fill, crop, downsample
 void add_render(CLI::App& app);
 
 }  // namespace vola::cli

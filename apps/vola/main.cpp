@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   vola::cli::add_setops(app);
   vola::cli::add_generate(app);
   vola::cli::add_export(app);
+  vola::cli::add_census(app);
+  vola::cli::add_components(app);
+  vola::cli::add_morph(app);
   vola::cli::add_render(app);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,163 @@
+// vola census FILE: per level blocks and cells, per attribute histograms (classification
+// counts with ASPRS names), volume and footprint, voxel counts inside boxes or polygons.
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "vola/analysis/census.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct CensusArgs {
+  std::string file;
+  bool json = false;
+  int bins = 16;
+  std::vector<std::string> boxes, polygons;
+};
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::string token;
+  std::istringstream in(text);
+  while (in >> token) {
+    std::size_t start = 0;
+    while (start <= token.size()) {
+      const std::size_t comma = token.find(',', start);
+      const std::string part = token.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (!part.empty()) {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(part, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != part.size()) throw InvalidArgument(what + ": '" + part + "' is not a number");
+        out.push_back(v);
+      }
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  return out;
+}
+
+std::vector<analysis::Region> parse_regions(const CensusArgs& a) {
+  std::vector<analysis::Region> regions;
+  for (const std::string& b : a.boxes) {
+    const auto v = parse_numbers(b, "--box");
+    if (v.size() != 6) throw InvalidArgument("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+    regions.push_back({"box " + b, Box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}}, {}});
+  }
+  for (const std::string& p : a.polygons) {
+    const auto v = parse_numbers(p, "--polygon");
+    if (v.size() < 6 || v.size() % 2) throw InvalidArgument("--polygon needs 3 or more x,y pairs");
+    analysis::Region r{"polygon " + p, std::nullopt, {}};
+    for (std::size_t i = 0; i < v.size(); i += 2) r.polygon.push_back({v[i], v[i + 1]});
+    regions.push_back(std::move(r));
+  }
+  return regions;
+}
+
+nlohmann::json histogram_json(const analysis::Histogram& h) {
+  return {{"min", h.min}, {"max", h.max}, {"counts", h.counts}};
+}
+
+void print_histogram(const analysis::Histogram& h) {
+  const double width = h.counts.empty() ? 0 : (h.max - h.min) / static_cast<double>(h.counts.size());
+  for (std::size_t i = 0; i < h.counts.size(); ++i)
+    std::printf("    [%12.6g, %12.6g%c %12llu\n", h.min + width * static_cast<double>(i),
+                h.min + width * static_cast<double>(i + 1), i + 1 == h.counts.size() ? ']' : ')',
+                static_cast<unsigned long long>(h.counts[i]));
+}
+
+void run_census(const CensusArgs& a) {
+  const Tree tree = open_mapped(a.file);
+  analysis::CensusOptions options;
+  options.bins = a.bins;
+  options.regions = parse_regions(a);
+  const analysis::Census c = analysis::take_census(tree, options);
+
+  if (a.json) {
+    nlohmann::json j;
+    j["file"] = a.file;
+    j["depth"] = c.depth;
+    j["voxels"] = c.voxels;
+    for (std::size_t l = 0; l < c.levels.size(); ++l)
+      j["levels"].push_back({{"level", l}, {"blocks", c.levels[l].blocks}, {"cells", c.levels[l].cells},
+                             {"fill", c.levels[l].fill}});
+    j["voxel_size"] = c.voxel_size ? nlohmann::json(*c.voxel_size) : nlohmann::json(nullptr);
+    j["columns"] = c.columns;
+    j["volume"] = c.voxel_size ? nlohmann::json(c.volume()) : nlohmann::json(nullptr);
+    j["footprint_area"] = c.voxel_size ? nlohmann::json(c.footprint_area()) : nlohmann::json(nullptr);
+    j["heights"] = histogram_json(c.heights);
+    j["attributes"] = nlohmann::json::array();
+    for (const auto& at : c.attributes) {
+      nlohmann::json col{{"name", at.name}, {"count", at.count}, {"mean", at.mean}, {"histogram", histogram_json(at.histogram)}};
+      if (at.name == "classification") {
+        col["classes"] = nlohmann::json::array();
+        for (const auto& k : at.classes)
+          col["classes"].push_back({{"code", k.code}, {"name", analysis::asprs_class_name(k.code)}, {"voxels", k.voxels}});
+      }
+      j["attributes"].push_back(std::move(col));
+    }
+    j["regions"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < options.regions.size(); ++i)
+      j["regions"].push_back({{"region", options.regions[i].label}, {"voxels", c.region_voxels[i]}});
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+
+  std::printf("%s: depth %d, %llu voxels\n", a.file.c_str(), c.depth, static_cast<unsigned long long>(c.voxels));
+  std::printf("  level %12s %14s %8s\n", "blocks", "cells", "fill");
+  for (std::size_t l = 0; l < c.levels.size(); ++l)
+    std::printf("  %5zu %12llu %14llu %8.4f\n", l, static_cast<unsigned long long>(c.levels[l].blocks),
+                static_cast<unsigned long long>(c.levels[l].cells), c.levels[l].fill);
+  std::printf("  occupied columns: %llu\n", static_cast<unsigned long long>(c.columns));
+  if (c.voxel_size)
+    std::printf("  voxel size %.9g: volume %.9g, footprint area %.9g (CRS units)\n", *c.voxel_size, c.volume(),
+                c.footprint_area());
+  else
+    std::printf("  voxel size unknown (no GIS grid recorded): no volume or area\n");
+  std::printf("  voxel centre z:\n");
+  print_histogram(c.heights);
+  for (const auto& at : c.attributes) {
+    std::printf("  attribute %s: %llu values, mean %.6g\n", at.name.c_str(), static_cast<unsigned long long>(at.count),
+                at.mean);
+    if (at.name == "classification")
+      for (const auto& k : at.classes)
+        std::printf("    %3d %-38s %12llu\n", k.code, std::string(analysis::asprs_class_name(k.code)).c_str(),
+                    static_cast<unsigned long long>(k.voxels));
+    else
+      print_histogram(at.histogram);
+  }
+  for (std::size_t i = 0; i < options.regions.size(); ++i)
+    std::printf("  %s: %llu voxels\n", options.regions[i].label.c_str(),
+                static_cast<unsigned long long>(c.region_voxels[i]));
+}
+
+}  // namespace
+
+void add_census(CLI::App& app) {
+  auto args = std::make_shared<CensusArgs>();
+  auto* cmd = app.add_subcommand("census", "Count what a .vol holds: levels, attributes, volume, regions");
+  cmd->footer(
+      "Regions are in world coordinates; a voxel counts when its centre is inside.\n"
+      "Volume and footprint area need a GIS grid (vola convert --voxel-size).\n"
+      "Example: vola census autzen.vol --box 636000,849000,400,637000,850000,500 --json");
+  cmd->add_option("file", args->file, "Input .vol")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--json", args->json, "Print JSON instead of a table");
+  cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 4096));
+  cmd->add_option("--box", args->boxes, "Count voxels in xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
+  cmd->add_option("--polygon", args->polygons, "Count voxels in the x,y polygon 'x1,y1 x2,y2 x3,y3 ...' (repeatable)");
+  cmd->callback([args] { run_census(*args); });
+}
+
+}  // namespace vola::cli

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# vola census | components | dilate | erode | fill | crop | downsample | diff end to end,
+# on the classified Autzen surveys, and components against scipy.ndimage.label.
+# Usage: cli_analysis.sh VOLA SCIPY_DUMP SHARED_DATA_DIR
+set -euo pipefail
+vola=$1 dump=$2 data=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+# Debian's interpreter, where python3-scipy installs (a python3 earlier on PATH may lack it).
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+
+las=$data/las/pdal_autzen_trim.las
+utm=$data/las/pdal_autzen-utm.las
+[ -f "$las" ] && [ -f "$utm" ] || skip "no shared data in $data"
+"$vola" convert "$las" "$tmp/t.vol" --voxel-size 2 > /dev/null
+"$vola" convert "$utm" "$tmp/u.vol" --voxel-size 2 > /dev/null
+
+# Census: valid JSON whose counts add up.
+"$vola" census "$tmp/t.vol" --json --box 636000,849000,0,637000,850000,1000 > "$tmp/census.json"
+"$py" - "$tmp/census.json" <<'PY' || fail "census JSON"
+import json, sys
+d = json.load(open(sys.argv[1]))
+cls = [a for a in d["attributes"] if a["name"] == "classification"][0]["classes"]
+assert sum(c["voxels"] for c in cls) == d["voxels"] > 0
+assert {c["name"] for c in cls} >= {"Ground"}
+assert d["levels"][-1]["cells"] == d["voxels"] and d["volume"] == d["voxels"] * 8
+assert 0 < d["regions"][0]["voxels"] < d["voxels"]
+assert sum(d["heights"]["counts"]) == d["voxels"]
+PY
+"$vola" census "$tmp/u.vol" | grep -q "Ground" || fail "census table has no Ground class"
+
+# Components per class on both surveys: one row per class, voxels summing to the total.
+for f in t u; do
+  "$vola" components "$tmp/$f.vol" --per-class --json > "$tmp/$f.classes.json"
+  total=$("$vola" census "$tmp/$f.vol" --json | "$py" -c 'import json,sys; print(json.load(sys.stdin)["voxels"])')
+  "$py" - "$tmp/$f.classes.json" "$total" <<'PY' || fail "components --per-class on $f"
+import json, sys
+rows = json.load(open(sys.argv[1]))
+assert sum(r["voxels"] for r in rows) == int(sys.argv[2])
+assert all(1 <= r["components"] <= r["voxels"] and r["largest"] <= r["voxels"] for r in rows)
+assert any(r["name"] == "Ground" for r in rows)
+PY
+done
+
+# --split writes one file per kept component; together they hold the kept voxels.
+"$vola" components "$tmp/t.vol" --connectivity 26 --min-voxels 50 --list 1000000 --split "$tmp/parts" --json > "$tmp/comp.json"
+kept=$("$py" -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["kept"], sum(c["voxels"] for c in d["list"]))' "$tmp/comp.json")
+set -- $kept
+[ "$(ls "$tmp/parts" | wc -l)" -eq "$1" ] || fail "--split wrote $(ls "$tmp/parts" | wc -l) files for $1 components"
+sum=0
+for p in "$tmp"/parts/*.vol; do sum=$((sum + $("$vola" voxels "$p" | wc -l))); done
+[ "$sum" -eq "$2" ] || fail "split files hold $sum voxels, listed components $2"
+
+# Morphology keeps the grid; dilate then diff counts what was added.
+"$vola" dilate "$tmp/t.vol" --radius 1 --element cube "$tmp/d.vol" > /dev/null
+"$vola" info "$tmp/d.vol" | grep -q "voxel size 2, origin (636000" || fail "dilate lost the grid"
+out=$("$vola" diff "$tmp/t.vol" "$tmp/d.vol" --outputs "$tmp/change")
+n_t=$("$vola" voxels "$tmp/t.vol" | wc -l)
+n_d=$("$vola" voxels "$tmp/d.vol" | wc -l)
+[ "$out" = "added $((n_d - n_t)), removed 0, unchanged $n_t voxels" ] || fail "diff counts: $out"
+[ "$("$vola" voxels "$tmp/change/added.vol" | wc -l)" -eq $((n_d - n_t)) ] || fail "added.vol"
+# The old form still writes A - B and prints its line.
+"$vola" diff "$tmp/d.vol" "$tmp/t.vol" "$tmp/removed.vol" | head -1 | grep -qx "diff: $n_d and $n_t voxels -> $((n_d - n_t)) voxels" \
+  || fail "diff A B OUT line changed"
+"$vola" erode "$tmp/d.vol" --radius 1 --element cube "$tmp/e.vol" > /dev/null
+"$vola" fill "$tmp/t.vol" "$tmp/f.vol" > /dev/null
+"$vola" crop "$tmp/t.vol" --min 0,0,0 --max 100,100,40 "$tmp/c.vol" > /dev/null
+"$vola" downsample "$tmp/t.vol" --depth 4 "$tmp/s.vol" > /dev/null
+"$vola" lod "$tmp/t.vol" --depth 4 "$tmp/l.vol" > /dev/null
+cmp -s <("$vola" voxels "$tmp/s.vol") <("$vola" voxels "$tmp/l.vol") || fail "downsample --min-voxels 1 differs from lod"
+
+# scipy.ndimage.label on dense copies: random grids and the Autzen survey at depth 4.
+"$py" -c 'import scipy.ndimage, numpy' 2> /dev/null || skip "python3-scipy is not installed"
+"$dump" "$tmp/scipy" "$tmp/s.vol" > /dev/null
+"$py" "$(dirname "$0")/compare_scipy.py" "$tmp/scipy" || fail "components differ from scipy"
+echo "cli_analysis: ok"
