@@ -334,11 +334,12 @@ TEST(FileErrors, CompressedRecordClaimingAHugeSizeIsRefusedBeforeAllocating) {
   if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
   const std::vector<vola::Voxel> voxels = {{1, 2, 3}};
   auto bytes = vola::serialize(vola::build_from_voxels(voxels, 2), {.compress = true});
-  // Levels record: tag, flags, length, then the raw size (u64) of the levels.
-  vola::FileLayout layout;
-  vola::parse(bytes, "ok", &layout);
-  const std::size_t raw_size_at = bytes.size() - ((layout.compressed_level_bytes + 7) / 8) * 8 - 8;
-  ASSERT_EQ(get_le<std::uint64_t>(bytes, raw_size_at), 8 * 2u);  // two level words
+  // Walk the extension's records (from byte 80 + magic, version, count) to the levels
+  // record (tag 4): u32 parts, u32 reserved, then per part u64 raw size, u64 packed size.
+  std::size_t record = 96;
+  while (get_le<std::uint32_t>(bytes, record) != 4) record += 16 + ((get_le<std::uint64_t>(bytes, record + 8) + 7) / 8) * 8;
+  const std::size_t raw_size_at = record + 16 + 8;  // the first part (level 0)
+  ASSERT_EQ(get_le<std::uint64_t>(bytes, raw_size_at), 8u);  // one root word
   put_le<std::uint64_t>(bytes, raw_size_at, std::uint64_t{1} << 40);
   LargestAllocation probe;
   const auto error = format_error_of([&] { (void)vola::parse(bytes, "huge"); });

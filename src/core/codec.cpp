@@ -54,20 +54,28 @@ std::vector<std::uint8_t> zstd_decompress(std::span<const std::uint8_t>, std::ui
 }
 #endif
 
-std::vector<std::uint8_t> shuffle_words(std::span<const std::uint64_t> words) {
+std::vector<std::uint8_t> lanes16_from_words(std::span<const std::uint64_t> words) {
   const std::size_t n = words.size();
   std::vector<std::uint8_t> out(8 * n);
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t b = 0; b < 8; ++b) out[b * n + i] = static_cast<std::uint8_t>(words[i] >> (8 * b));
+    for (std::size_t lane = 0; lane < 4; ++lane) {
+      const std::size_t at = 2 * (lane * n + i);
+      out[at] = static_cast<std::uint8_t>(words[i] >> (16 * lane));
+      out[at + 1] = static_cast<std::uint8_t>(words[i] >> (16 * lane + 8));
+    }
   return out;
 }
 
-std::vector<std::uint64_t> unshuffle_words(std::span<const std::uint8_t> bytes) {
-  const std::size_t n = bytes.size() / 8;
-  std::vector<std::uint64_t> out(n, 0);
-  for (std::size_t b = 0; b < 8; ++b)
-    for (std::size_t i = 0; i < n; ++i) out[i] |= std::uint64_t{bytes[b * n + i]} << (8 * b);
-  return out;
+void words_from_lanes16(std::span<const std::uint8_t> bytes, std::span<std::uint64_t> words) {
+  const std::size_t n = words.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t w = 0;
+    for (std::size_t lane = 0; lane < 4; ++lane) {
+      const std::size_t at = 2 * (lane * n + i);
+      w |= (std::uint64_t{bytes[at]} | std::uint64_t{bytes[at + 1]} << 8) << (16 * lane);
+    }
+    words[i] = w;
+  }
 }
 
 }  // namespace detail

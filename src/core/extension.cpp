@@ -16,7 +16,10 @@ namespace {
 // little), so a lying length cannot make us allocate far beyond the file's size.
 constexpr std::uint64_t kMaxRatio = 8192;
 constexpr std::uint64_t kRatioSlack = 1 << 20;
-constexpr std::uint32_t kShuffled = 1;  // levels record flag
+// Levels record flag: one zstd frame per level part (each level's occupancy words, then
+// its payload words), each in 16-bit lanes. The only layout so far; others would get
+// their own flag.
+constexpr std::uint32_t kLanes16PerPart = 2;
 
 void begin_record(ByteWriter& w, RecordTag tag, std::uint32_t flags, std::uint64_t length) {
   w.put(static_cast<std::uint32_t>(tag));
@@ -89,11 +92,28 @@ void append_extension(const Tree& tree, bool compress_levels, int level, std::ve
   }
 
   if (compress_levels) {
-    const auto shuffled = shuffle_words(tree.words());
-    const auto packed = zstd_compress(shuffled, level);
-    begin_record(w, RecordTag::levels, kShuffled, 8 + packed.size());
-    w.put(static_cast<std::uint64_t>(shuffled.size()));
-    w.put_bytes(packed);
+    // Levels differ in statistics (a leaf level is nothing like its parents), so each
+    // part gets a frame of its own: u32 parts, u32 reserved, per part u64 raw bytes and
+    // u64 compressed bytes, then the frames.
+    std::vector<std::span<const std::uint64_t>> parts;
+    for (int l = 0; l < tree.depth(); ++l) {
+      parts.push_back(tree.occupancy(l));
+      if (tree.has_payload()) parts.push_back(tree.payload(l));
+    }
+    std::vector<std::vector<std::uint8_t>> frames;
+    std::uint64_t length = 8;
+    for (const auto& part : parts) {
+      frames.push_back(zstd_compress(lanes16_from_words(part), level));
+      length += 16 + frames.back().size();
+    }
+    begin_record(w, RecordTag::levels, kLanes16PerPart, length);
+    w.put(static_cast<std::uint32_t>(parts.size()));
+    w.put(std::uint32_t{0});
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      w.put(static_cast<std::uint64_t>(8 * parts[p].size()));
+      w.put(static_cast<std::uint64_t>(frames[p].size()));
+    }
+    for (const auto& frame : frames) w.put_bytes(frame);
     w.pad_to(8);
   }
 }
@@ -175,19 +195,37 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         break;
       }
       case RecordTag::levels: {
-        const auto raw_size = body.get<std::uint64_t>("levels size");
-        if (raw_size % 8 != 0) body.fail_at(record_offset + 16, "levels size is not a whole number of words");
-        const auto data = body.take(body.remaining(), "levels data");
-        check_ratio(body, raw_size, data.size());
-        auto raw = zstd_decompress(data, raw_size, name, record_offset + 24);
-        if (flags & kShuffled) {
-          out.levels = unshuffle_words(raw);
-        } else {
-          out.levels.resize(raw.size() / 8);
-          if (!raw.empty()) std::memcpy(out.levels.data(), raw.data(), raw.size());
+        if (flags != kLanes16PerPart)
+          body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
+        const auto parts = body.get<std::uint32_t>("level part count");
+        body.get<std::uint32_t>("reserved");
+        body.need(16 * std::uint64_t{parts}, "level part sizes");
+        std::vector<std::pair<std::uint64_t, std::uint64_t>> sizes(parts);
+        std::uint64_t raw_total = 0, packed_total = 0;
+        for (auto& [raw, packed] : sizes) {
+          raw = body.get<std::uint64_t>("level part size");
+          packed = body.get<std::uint64_t>("level part compressed size");
+          if (raw % 8 != 0) body.fail("level part size " + std::to_string(raw) + " is not a whole number of words");
+          check_ratio(body, raw, packed);
+          if (raw > (std::uint64_t{1} << 62) || packed > body.remaining())
+            body.fail("level part of " + std::to_string(packed) + " compressed bytes runs past the record");
+          raw_total += raw;
+          packed_total += packed;
+        }
+        if (packed_total != body.remaining())
+          body.fail("level parts take " + std::to_string(packed_total) + " bytes, the record holds " +
+                    std::to_string(body.remaining()));
+        out.levels.resize(raw_total / 8);
+        std::size_t at = 0;
+        for (const auto& [raw, packed] : sizes) {
+          const std::uint64_t frame_offset = body.offset();
+          const auto frame = body.take(packed, "level part");
+          const auto bytes = zstd_decompress(frame, raw, name, frame_offset);
+          words_from_lanes16(bytes, std::span<std::uint64_t>(out.levels).subspan(at, raw / 8));
+          at += raw / 8;
         }
         out.has_levels = true;
-        out.compressed_level_bytes = data.size();
+        out.compressed_level_bytes = packed_total;
         break;
       }
       default:
