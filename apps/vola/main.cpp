@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   vola::cli::add_components(app);
   vola::cli::add_morph(app);
   vola::cli::add_render(app);
+  vola::cli::add_plan(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
