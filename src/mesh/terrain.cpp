@@ -1,6 +1,7 @@
 #include "vola/mesh/terrain.hpp"
 
 #include <algorithm>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,80 @@ std::uint32_t base_row(const Quantizer& quantizer, const Voxel& at, double z) {
   return z < centre[2] ? 0 : side_of(quantizer.depth()) - 1;
 }
 
+// Emits the sparse levels of a set of columns straight from the columns, depth first in
+// key order (like the solid fill), so that memory follows the tree, not the voxels.
+// Columns are sorted by xy key, one per (x, y), and all contain one common row (the
+// base): then the columns under any block of (x, y) together fill exactly the rows
+// [lowest low, highest high], and a cell is occupied iff that run meets its rows.
+class ColumnLevels {
+ public:
+  ColumnLevels(std::span<const Column> columns, int depth)
+      : columns_(columns), depth_(depth), levels_(static_cast<std::size_t>(depth)) {}
+
+  Tree tree() {
+    levels_[0].push_back(block_word(0, {0, 0, 0}, 0, columns_.size()));
+    std::vector<std::uint64_t> words;
+    for (const auto& level : levels_) words.insert(words.end(), level.begin(), level.end());
+    return Tree::from_levels(depth_, false, std::move(words), "terrain columns");
+  }
+
+ private:
+  // The word of the block whose cells at `level` are 4 * parent + (0..3) per axis, for
+  // the columns [begin, end) under the parent; non-empty children's blocks go to the
+  // deeper levels first.
+  std::uint64_t block_word(int level, const Voxel& parent, std::size_t begin, std::size_t end) {
+    const unsigned shift = 2u * static_cast<unsigned>(depth_ - 1 - level);  // cell = 4^shift voxels per axis
+    // The columns of each of the 16 (x, y) children: consecutive, as the xy keys sort by
+    // this level's digit within the parent.
+    std::size_t split[17];
+    split[0] = begin;
+    for (unsigned xy = 0; xy < 16; ++xy) {
+      const auto digit = [&](const Column& c) { return static_cast<unsigned>(c.xy >> (3 * shift)) & 15u; };
+      split[xy + 1] = static_cast<std::size_t>(
+          std::partition_point(columns_.begin() + static_cast<std::ptrdiff_t>(split[xy]),
+                               columns_.begin() + static_cast<std::ptrdiff_t>(end),
+                               [&](const Column& c) { return digit(c) <= xy; }) -
+          columns_.begin());
+    }
+    // The run of rows each (x, y) child's columns fill.
+    std::uint32_t low[16], high[16];
+    for (unsigned xy = 0; xy < 16; ++xy) {
+      if (split[xy] == split[xy + 1]) continue;
+      low[xy] = columns_[split[xy]].low;
+      high[xy] = columns_[split[xy]].high;
+      for (std::size_t i = split[xy] + 1; i < split[xy + 1]; ++i) {
+        low[xy] = std::min(low[xy], columns_[i].low);
+        high[xy] = std::max(high[xy], columns_[i].high);
+      }
+    }
+    // Children in bit order (x + 4y + 16z), as each level stores them.
+    std::uint64_t word = 0;
+    for (unsigned dz = 0; dz < 4; ++dz) {
+      const std::uint32_t cz = 4 * parent.z + dz;
+      const std::uint64_t rows_from = std::uint64_t{cz} << shift, rows_to = ((std::uint64_t{cz} + 1) << shift) - 1;
+      for (unsigned xy = 0; xy < 16; ++xy) {
+        if (split[xy] == split[xy + 1] || high[xy] < rows_from || low[xy] > rows_to) continue;
+        const unsigned bit = xy + 16 * dz;
+        if (level == depth_ - 1) {
+          word |= std::uint64_t{1} << bit;
+          continue;
+        }
+        const Voxel child{4 * parent.x + (xy & 3u), 4 * parent.y + (xy >> 2), cz};
+        const std::uint64_t child_word = block_word(level + 1, child, split[xy], split[xy + 1]);
+        if (child_word) {
+          word |= std::uint64_t{1} << bit;
+          levels_[static_cast<std::size_t>(level + 1)].push_back(child_word);
+        }
+      }
+    }
+    return word;
+  }
+
+  std::span<const Column> columns_;
+  int depth_;
+  std::vector<std::vector<std::uint64_t>> levels_;
+};
+
 }  // namespace
 
 Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, const TerrainOptions& options,
@@ -40,7 +115,14 @@ Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, cons
     const std::uint32_t base = options.surface_only ? v.z : base_row(quantizer, v, options.base);
     columns.push_back({encode(v.x, v.y, 0), std::min(v.z, base), std::max(v.z, base)});
   }
-  if (!options.surface_only) {
+  Tree tree;
+  if (options.surface_only) {
+    // One voxel per point: the points bound the key list.
+    std::vector<Key> keys;
+    keys.reserve(columns.size());
+    for (const Column& c : columns) keys.push_back(c.xy | encode(0, 0, c.low));
+    tree = build_from_keys(std::move(keys), quantizer.depth());
+  } else {
     // Every column of one (x, y) contains the base row, so together they are one run.
     std::sort(columns.begin(), columns.end(), [](const Column& a, const Column& b) { return a.xy < b.xy; });
     std::size_t merged = 0;
@@ -53,17 +135,13 @@ Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, cons
       }
     }
     columns.resize(merged);
+    std::uint64_t voxels = 0;
+    for (const Column& c : columns) voxels += c.high - c.low + 1;
+    if (voxels > options.max_voxels)
+      throw InvalidArgument("terrain: the columns would hold " + std::to_string(voxels) + " voxels, more than " +
+                            std::to_string(options.max_voxels) + "; ask for the surface only or a coarser grid");
+    tree = columns.empty() ? build_from_sorted_keys({}, quantizer.depth()) : ColumnLevels(columns, quantizer.depth()).tree();
   }
-  std::uint64_t voxels = 0;
-  for (const Column& c : columns) voxels += c.high - c.low + 1;
-  if (voxels > options.max_voxels)
-    throw InvalidArgument("terrain: the columns would hold " + std::to_string(voxels) + " voxels, more than " +
-                          std::to_string(options.max_voxels) + "; ask for the surface only or a coarser grid");
-  std::vector<Key> keys;
-  keys.reserve(voxels);
-  for (const Column& c : columns)
-    for (std::uint32_t z = c.low; z <= c.high; ++z) keys.push_back(c.xy | encode(0, 0, z));
-  Tree tree = build_from_keys(std::move(keys), quantizer.depth());
   tree.set_frame(quantizer.frame());
   if (report) {
     report->points_in = n;

@@ -75,6 +75,19 @@ TEST(Terrain, ColumnsMatchTheSlowFill) {
   }
 }
 
+// A bigger field on a deeper grid: many columns under each block of every level.
+TEST(Terrain, DeepGridMatchesTheSlowFill) {
+  std::mt19937_64 rng(32);
+  const vola::PointCloud cloud = height_field(rng, 150, 110, 0.7);
+  for (int depth : {4, 5}) {
+    const Quantizer q = Quantizer::grid({1000.0, 2000.0, 20.0}, 0.35, depth);
+    vola::mesh::TerrainOptions options;
+    options.base = 25.0;
+    const vola::Tree tree = vola::mesh::terrain_columns(cloud, q, options);
+    EXPECT_EQ(vola_test::voxel_set(tree), slow_columns(cloud, q, options.base, false)) << "depth " << depth;
+  }
+}
+
 TEST(Terrain, PointsOutsideTheGridAreCounted) {
   vola::PointCloud cloud;
   cloud.xyz = {0.5, 0.5, 1.5, 10.0, 0.5, 1.0, 0.5, -3.0, 2.0, 0.5, 1.5, 0.2};

@@ -9,9 +9,10 @@
 
 namespace vola::mesh {
 
-// Columns hold at most this many voxels in all (8 bytes each while building); beyond
-// it the caller must ask for the surface only or a coarser grid.
-inline constexpr std::uint64_t kMaxColumnVoxels = std::uint64_t{1} << 31;
+// Columns hold at most this many voxels in all; beyond it the caller must ask for the
+// surface only or a coarser grid. The tree is built straight from the columns (memory:
+// 16 bytes per column plus the tree, about a bit per voxel for columns side by side).
+inline constexpr std::uint64_t kMaxColumnVoxels = std::uint64_t{1} << 34;
 
 struct TerrainOptions {
   double base = 0.0;          // world height the columns start from
