@@ -65,8 +65,11 @@ std::vector<Triangle> read_mesh_triangles(const std::string& path) {
       pending.emplace_back(node->mChildren[i], multiply(matrix, to_matrix(node->mChildren[i]->mTransformation)));
   }
 
+  // Reserve for what the file holds; instances beyond that grow the vector as they come.
+  std::uint64_t stored = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) stored += scene->mMeshes[m]->mNumFaces;
   std::vector<Triangle> triangles;
-  triangles.reserve(faces);
+  triangles.reserve(std::min(faces, stored));
   for (const auto& [node, matrix] : placed) {
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
