@@ -123,10 +123,11 @@ Box Quantizer::cell_box(const Voxel& v) const noexcept {
       box.max[a] = c[a] == 0 ? inf : -inf;
     } else {
       // Voxel k holds (S-1)(p - min)/scale in [k - 1/2, k + 1/2]: face k - 1/2 is
-      // computed by the same expression for both voxels that share it.
-      const double k = static_cast<double>(c[a]);
-      box.min[a] = c[a] == 0 ? -inf : origin_[a] + (k - 0.5) * scale_[a] / steps;
-      box.max[a] = c[a] >= last ? inf : origin_[a] + ((k + 1.0) - 0.5) * scale_[a] / steps;
+      // computed by the same expression for both voxels that share it (the step first,
+      // so that no product overflows where the faces themselves are finite).
+      const double k = static_cast<double>(c[a]), step = scale_[a] / steps;
+      box.min[a] = c[a] == 0 ? -inf : origin_[a] + (k - 0.5) * step;
+      box.max[a] = c[a] >= last ? inf : origin_[a] + ((k + 1.0) - 0.5) * step;
     }
   }
   return box;
@@ -152,8 +153,8 @@ bool Quantizer::voxel_range(const Box& box, Voxel& first, Voxel& last) const noe
     const double t_min = (box.min[a] - origin_[a]) * per_unit + shift;
     const double t_max = (box.max[a] - origin_[a]) * per_unit + shift;
     const double eps = 8 * std::numeric_limits<double>::epsilon();
-    const double reach = std::max(std::abs(box.min[a]), std::abs(box.max[a])) + std::abs(origin_[a]);
-    const double rounding = eps * (reach * per_unit + std::max(std::abs(t_min), std::abs(t_max)));
+    const double reach = std::max(std::abs(box.min[a]), std::abs(box.max[a])) * per_unit + std::abs(origin_[a]) * per_unit;
+    const double rounding = eps * (reach + std::max(std::abs(t_min), std::abs(t_max)));
     double from = std::ceil(t_min - rounding) - 1.0;
     double to = std::floor(t_max + rounding);
     if (!std::isfinite(per_unit) || std::isnan(from) || std::isnan(to)) {

@@ -1,6 +1,7 @@
 #include "vola/mesh/terrain.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 #include <string>
 #include <vector>
@@ -16,12 +17,13 @@ struct Column {
   std::uint32_t low, high;
 };
 
-// The voxel row of height `z` at the column of `at`, clamped to the grid.
-std::uint32_t base_row(const Quantizer& quantizer, const Voxel& at, double z) {
-  const Point centre = quantizer.center(at);
+// The voxel row of height `base` under the point `p` (itself inside the grid), clamped
+// to the grid: when (x, y, base) falls outside, only its height can be out, below the
+// grid if it is below p.
+std::uint32_t base_row(const Quantizer& quantizer, const Point& p, double base) {
   Voxel v;
-  if (quantizer.to_voxel({centre[0], centre[1], z}, v)) return v.z;
-  return z < centre[2] ? 0 : side_of(quantizer.depth()) - 1;
+  if (quantizer.to_voxel({p[0], p[1], base}, v)) return v.z;
+  return base < p[2] ? 0 : side_of(quantizer.depth()) - 1;
 }
 
 // Emits the sparse levels of a set of columns straight from the columns, depth first in
@@ -106,13 +108,16 @@ Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, cons
   std::vector<Column> columns;
   columns.reserve(n);
   std::uint64_t outside = 0;
+  if (!options.surface_only && !std::isfinite(options.base))
+    throw InvalidArgument("terrain: the base height must be a finite number");
   for (std::size_t i = 0; i < n; ++i) {
+    const Point p{surface.xyz[3 * i], surface.xyz[3 * i + 1], surface.xyz[3 * i + 2]};
     Voxel v;
-    if (!quantizer.to_voxel({surface.xyz[3 * i], surface.xyz[3 * i + 1], surface.xyz[3 * i + 2]}, v)) {
+    if (!quantizer.to_voxel(p, v)) {
       ++outside;
       continue;
     }
-    const std::uint32_t base = options.surface_only ? v.z : base_row(quantizer, v, options.base);
+    const std::uint32_t base = options.surface_only ? v.z : base_row(quantizer, p, options.base);
     columns.push_back({encode(v.x, v.y, 0), std::min(v.z, base), std::max(v.z, base)});
   }
   Tree tree;

@@ -79,6 +79,9 @@ std::vector<Bytes> seeds() {
                      {-2.7e154, -2.7e154, -2.7e154, -2.7e154, 7e-251, -2.7e154, 7e-251, 7e-251, -2.7e154}));
   out.push_back(seed(false, true, false, 2, {0, 0, 0, 0, 1.787e-307, 1.787e-307}, 0,
                      {1.77e-307, 1.77e-307, 1.77e-307, 1.77e-307, 0, 1.355e-312, 1.785e-307, 1.785e-307, 1.77e-307}));
+  // A bbox near the largest double: cell faces once overflowed.
+  out.push_back(seed(false, true, false, 2, {2e-314, 0, -2.4e307, 1.4e-309, 2.8e-306, 2.7e-312}, 0,
+                     {6e-311, 0, 1.4e-312, 3.6e-313, 2e-314, 0, 0, 5.3e-315, 0}));
   return out;
 }
 

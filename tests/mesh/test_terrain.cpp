@@ -1,6 +1,7 @@
 // Terrain columns against a set of voxels filled one column at a time.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -97,6 +98,16 @@ TEST(Terrain, PointsOutsideTheGridAreCounted) {
   const vola::Tree tree = vola::mesh::terrain_columns(cloud, Quantizer::grid({0, 0, 0}, 1.0, 1), options, &report);
   EXPECT_EQ(report.points_outside, 2u);
   EXPECT_EQ(vola_test::voxel_set(tree), (XyzSet{{0, 0, 0}, {0, 0, 1}, {0, 1, 0}}));
+}
+
+TEST(Terrain, RefusesANonFiniteBase) {
+  vola::PointCloud cloud;
+  cloud.xyz = {0.5, 0.5, 1.5};
+  vola::mesh::TerrainOptions options;
+  options.base = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(vola::mesh::terrain_columns(cloud, Quantizer::grid({0, 0, 0}, 1.0, 1), options), vola::InvalidArgument);
+  options.surface_only = true;  // no base needed
+  EXPECT_EQ(vola::mesh::terrain_columns(cloud, Quantizer::grid({0, 0, 0}, 1.0, 1), options).voxel_count(), 1u);
 }
 
 TEST(Terrain, RefusesColumnsOverTheLimit) {
