@@ -379,15 +379,19 @@ struct Options {
 };
 
 // Runs f(impl index) `reps` times for each implementation, interleaved; returns the median
-// seconds per implementation.
+// seconds per implementation. `before` runs untimed ahead of each timed call. With `warm`,
+// so does one untimed call of f: a structure's lookups are then timed with its data in the
+// caches, as they would be when run back to back, and not after the previous
+// implementation has evicted it (all four together are ~100-400 MB).
 template <class F>
 std::vector<double> interleaved_medians(std::size_t impls, int reps, const std::string& what,
-                                        const std::vector<std::unique_ptr<Impl>>& all, F&& f,
+                                        const std::vector<std::unique_ptr<Impl>>& all, F&& f, bool warm,
                                         const std::function<void(std::size_t)>& before = {}) {
   std::vector<std::vector<double>> t(impls);
   for (int r = -1; r < reps; ++r)  // r = -1: a warm-up round, not counted
     for (std::size_t i = 0; i < impls; ++i) {
       if (before) before(i);
+      if (warm && r >= 0) f(i);
       const auto t0 = std::chrono::steady_clock::now();
       f(i);
       if (r >= 0) t[i].push_back(seconds_since(t0));
@@ -415,7 +419,7 @@ std::vector<Measure> run_set(const Points& pts, const Points& queries, const Opt
   for (std::size_t i = 0; i < k; ++i) ms[i].name = impls[i]->name();
 
   const auto t_build = interleaved_medians(
-      k, opt.reps, "insert", impls, [&](std::size_t i) { impls[i]->build(pts); },
+      k, opt.reps, "insert", impls, [&](std::size_t i) { impls[i]->build(pts); }, false,
       [&](std::size_t i) { impls[i]->clear(); });
   for (std::size_t i = 0; i < k; ++i) {
     ms[i].insert_mps = static_cast<double>(pts.size()) / t_build[i] / 1e6;
@@ -426,14 +430,14 @@ std::vector<Measure> run_set(const Points& pts, const Points& queries, const Opt
     const std::uint64_t hits = impls[i]->lookup(queries);
     keep(hits);
     ms[i].hits = hits;
-  });
+  }, true);
   const auto t_iter = interleaved_medians(k, opt.reps, "iterate", impls, [&](std::size_t i) {
     std::uint64_t count = 0, sum = 0;
     impls[i]->iterate(count, sum);
     keep(sum);
     ms[i].iterated = count;
     ms[i].coord_sum = sum;
-  });
+  }, true);
   for (std::size_t i = 0; i < k; ++i) {
     ms[i].lookup_mps = static_cast<double>(queries.size()) / t_lookup[i] / 1e6;
     ms[i].iterate_mvps = static_cast<double>(ms[i].iterated) / t_iter[i] / 1e6;
@@ -620,7 +624,8 @@ int main(int argc, char** argv) try {
   fs::create_directories(opt.tmp);
   std::cout << "## vola vs OpenVDB " << openvdb::getLibraryAbiVersionString() << " and OctoMap "
             << VOLA_OCTOMAP_VERSION << "\n\nSingle thread; each figure is the median of " << opt.reps
-            << " repetitions after a warm-up round, the implementations interleaved repetition by repetition; "
+            << " repetitions after a warm-up round, the implementations interleaved repetition by repetition "
+               "(lookups and iteration: each timed pass right after an untimed one on the same structure); "
             << (opt.keep_heap ? "freed memory kept in the process" : "fresh pages (--fresh-pages)") << "; data "
             << opt.data.string() << "; xz " << (have_xz() ? "found" : "not found: no xz column") << "; zstd "
             << (vola::compression_available() ? "built" : "not built") << ".\n";

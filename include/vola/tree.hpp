@@ -25,29 +25,44 @@ namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 // Popcount rank over one level's words: a 64-bit count every 512 words and a 16-bit
-// count (relative to it) every 8 words, 2.1 bits of directory per 64-bit word. The
-// remaining words of a group of 8 are counted with popcount.
+// count (relative to it) every 2^group_shift words; the words between a count and the
+// index asked for are counted with popcount.
+//   group_shift 3 (the default): 2.1 bits of directory per 64-bit word, up to 7 popcounts.
+//   group_shift 4: 1.1 bits per word, up to 15 popcounts; the tree's leaf level, which
+//                  lookups never rank (only rank() and per-voxel payloads do).
+//   group_shift 0: instead, a 32-bit count for every word (32 bits per word), one load
+//                  and no popcount; the tree's small upper levels, which every lookup
+//                  walks. Levels with 2^32 set bits or more fall back to 3.
+// Copies share the (immutable) counts.
 class RankDirectory {
  public:
   RankDirectory() = default;
-  explicit RankDirectory(std::span<const std::uint64_t> words);
+  explicit RankDirectory(std::span<const std::uint64_t> words) : RankDirectory(words, 3) {}
+  // group_shift: 0, 1, 2, 3 or 4.
+  RankDirectory(std::span<const std::uint64_t> words, unsigned group_shift);
 
   // Number of set bits in words[0 .. index).
   std::uint64_t before(std::span<const std::uint64_t> words, std::size_t index) const noexcept {
-    const std::size_t group = index & ~std::size_t{7};
-    std::uint64_t count = super_[index >> 9] + sub_[index >> 3];
-    for (std::size_t i = group; i < index; ++i) count += std::popcount(words[i]);
-    return count;
+    if (dense_) return dense_[index];
+    return before_grouped(words, index);
   }
+  // The count before every word (group_shift 0), or nullptr.
+  const std::uint32_t* counts() const noexcept { return dense_; }
   std::uint64_t total() const noexcept { return total_; }
-  std::size_t memory_bytes() const noexcept {
-    return super_.capacity() * sizeof(std::uint64_t) + sub_.capacity() * sizeof(std::uint16_t);
-  }
+  unsigned group_shift() const noexcept { return shift_; }
+  std::size_t memory_bytes() const noexcept { return bytes_; }
 
  private:
-  std::vector<std::uint64_t> super_;
-  std::vector<std::uint16_t> sub_;
+  // Out of line, so that the one-load path above stays small where it is inlined.
+  std::uint64_t before_grouped(std::span<const std::uint64_t> words, std::size_t index) const noexcept;
+
+  const std::uint64_t* super_ = nullptr;
+  const std::uint16_t* sub_ = nullptr;
+  const std::uint32_t* dense_ = nullptr;  // group_shift 0: the count before every word
+  std::shared_ptr<const void> storage_;   // owns the arrays above
+  std::size_t bytes_ = 0;
   std::uint64_t total_ = 0;
+  unsigned shift_ = 3;
 };
 
 class Tree {
@@ -81,12 +96,14 @@ class Tree {
   std::span<const std::uint64_t> words() const noexcept { return all_words_; }
 
   bool contains(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
-    return inside(Voxel{x, y, z}, depth_ - 1) && locate(encode(x, y, z), depth_ - 1).has_value();
+    // `&`, not `&&`: no branch. occupied() reads only the key's low 6 * depth bits, so it
+    // is safe for any coordinates.
+    return inside(Voxel{x, y, z}, depth_ - 1) & occupied(encode(x, y, z), depth_ - 1);
   }
   bool contains(const Voxel& v) const noexcept { return contains(v.x, v.y, v.z); }
   // Is the level-`level` cell (coordinates on the 4^(level+1) grid) occupied?
   bool contains_node(int level, const Voxel& cell) const noexcept {
-    return inside(cell, level) && locate(encode(cell.x, cell.y, cell.z), level).has_value();
+    return inside(cell, level) & occupied(encode(cell.x, cell.y, cell.z), level);
   }
   // The voxel's index among all voxels in key order, if occupied: the row of its
   // attribute values.
@@ -167,6 +184,40 @@ class Tree {
   static bool inside(const Voxel& cell, int level) noexcept {
     return ((cell.x | cell.y | cell.z) >> (2 * (level + 1))) == 0;
   }
+  // Is the cell of `node_key` (a key of a depth-(level+1) tree) occupied? The walk of
+  // locate() without a branch on the way: a walk that has left the tree goes on at block
+  // 0 of each level (always there, and in cache) and the answer is the AND of the bits
+  // met. Random lookups then cost no branch mispredictions (half of them miss, at
+  // unpredictable levels), so the CPU overlaps the cache misses of several lookups;
+  // that is worth more than stopping early. The first two levels are one table lookup
+  // when the tree has the table, the next ones one load each while their directories
+  // have a count per word (see index()); the loop has no call in it, so the compiler
+  // unrolls it. Any other level is walked out of line.
+  bool occupied(Key node_key, int level) const noexcept {
+    std::size_t block = 0;
+    std::uint64_t present = 1;
+    int l = 0;
+    if (level >= 2 && !jump_.empty()) {
+      const std::uint16_t entry = jump_[static_cast<std::size_t>(node_key >> (6 * (level - 1))) & 4095u];
+      present = entry >> 15;
+      block = entry & 0x7fffu;
+      l = 2;
+    }
+    const int dense_end = level < dense_levels_ ? level : dense_levels_;
+    for (; l < dense_end; ++l) {
+      const std::uint64_t word = steps_[l].words[block];
+      const unsigned bit = static_cast<unsigned>(node_key >> (6 * (level - l))) & 63u;
+      present &= word >> bit;
+      const std::size_t child = steps_[l].counts[block] +
+                                static_cast<std::size_t>(std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
+      block = child & (std::size_t{0} - static_cast<std::size_t>(present & 1u));
+    }
+    if (l < level) return occupied_below(node_key, level, l, block, present);
+    return (present & (steps_[level].words[block] >> (node_key & 63u)) & 1u) != 0;
+  }
+  // occupied() from level `l` on, through the grouped directories.
+  bool occupied_below(Key node_key, int level, int l, std::size_t block, std::uint64_t present) const noexcept;
+
   // Walks from the root to `level` along `key` (a key of a depth-(level+1) tree).
   std::optional<Location> locate(Key node_key, int level) const noexcept {
     std::size_t block = 0;
@@ -198,6 +249,8 @@ class Tree {
   }
 
   void index(const std::string& source, std::uint64_t file_offset);
+  // The rank directory's group size for `level` once the level sizes are known.
+  unsigned rank_group_shift(int level) const noexcept;
 
   int depth_ = 1;
   bool has_payload_ = false;
@@ -208,6 +261,19 @@ class Tree {
   std::array<std::span<const std::uint64_t>, kMaxDepth> occupancy_{};
   std::array<std::span<const std::uint64_t>, kMaxDepth> payload_{};
   std::array<RankDirectory, kMaxDepth> rank_{};
+  // Big trees: the level-2 block of every 2-digit key prefix (4096 entries, bit 15 =
+  // occupied), so that lookups skip the two top levels. Empty otherwise.
+  std::vector<std::uint16_t> jump_;
+  // What occupied() reads per level: the occupancy words (a zero word for the empty
+  // levels of an empty tree, so that block 0 always exists) and, for levels
+  // 0 .. dense_levels_-1, the count before each word. Both outlive copies of the tree:
+  // the words belong to keeper_, the counts are shared by the rank directories.
+  struct Step {
+    const std::uint64_t* words = nullptr;
+    const std::uint32_t* counts = nullptr;
+  };
+  std::array<Step, kMaxDepth> steps_{};
+  int dense_levels_ = 0;
   std::array<std::uint64_t, kMaxDepth> counts_{};
   Georef georef_;
   std::optional<Frame> frame_;
