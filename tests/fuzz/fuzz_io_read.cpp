@@ -1,11 +1,15 @@
-// Fuzz entry point of the PLY, PCD, KITTI, NPY, binvox and LAS readers: the first byte
-// picks the reader (modulo 6), the rest is the file. Only vola::Error may escape a reader;
+// Fuzz entry point of the PLY, PCD, KITTI, NPY, binvox, LAS and text readers: the first
+// byte picks the reader (modulo 7), the rest is the file. Only vola::Error may escape a reader;
 // whatever parses must be consistent (counts, sizes, cells inside the grid), and a
 // small binvox grid must survive write -> read unchanged.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
 #include <span>
 #include <vector>
 
@@ -13,6 +17,7 @@
 #include "vola/io/binvox.hpp"
 #include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/text_points.hpp"
 #include "vola/io/npy.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
@@ -48,6 +53,15 @@ void check_grid(const vola::io::VoxelGrid& grid) {
   check(vola::build_from_voxels(back.voxels, 3).keys() == tree.keys());
 }
 
+// Writes `bytes` to this process's scratch file and returns its path.
+std::string temporary_text_file(std::span<const std::uint8_t> bytes) {
+  static const std::string path = (std::filesystem::temp_directory_path() /
+                                   ("vola_fuzz_text_" + std::to_string(::getpid()) + ".xyz")).string();
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -56,7 +70,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   vola::io::InputOptions options;
   options.payload = true;
   try {
-    switch (data[0] % 6) {
+    switch (data[0] % 7) {
       case 0: {
         const vola::io::Input in = vola::io::parse_ply(file, "fuzz.ply", options);
         check_cloud(in.cloud);
@@ -71,6 +85,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 4: check_grid(vola::io::parse_binvox(file, "fuzz.binvox")); break;
+      case 6: {
+        // The text reader reads files: one temporary file per input, columns chosen so
+        // that payload bytes and an attribute are parsed too.
+        const std::string path = temporary_text_file(file);
+        vola::io::TextColumns columns;
+        columns.payload = {3};
+        columns.attributes.push_back({"a", vola::ValueType::f32, vola::Reduction::mean, {}});
+        columns.attribute_columns = {4};
+        check_cloud(vola::io::read_text_points(path, columns));
+        break;
+      }
       default: {
         vola::io::LasReader reader(file, "fuzz.las");
         const auto& header = reader.header();

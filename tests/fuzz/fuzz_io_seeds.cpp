@@ -19,7 +19,7 @@ namespace vola_fuzz {
 
 namespace {
 
-enum Reader : std::uint8_t { kPly = 0, kPcd = 1, kKitti = 2, kNpy = 3, kBinvox = 4, kLas = 5 };
+enum Reader : std::uint8_t { kPly = 0, kPcd = 1, kKitti = 2, kNpy = 3, kBinvox = 4, kLas = 5, kText = 6 };
 using Bytes = std::vector<std::uint8_t>;
 
 Seed seed(const std::string& name, Reader reader, const Bytes& file) {
@@ -150,6 +150,8 @@ std::vector<Seed> synthetic_seeds() {
   vola::Tree tree = vola::build_from_voxels(voxels, 2);
   tree.set_frame({vola::Quantization::grid, {1, 2, 3}, 0.5});
   seeds.push_back(seed("binvox", kBinvox, vola::io::serialize_binvox(tree)));
+  seeds.push_back(seed("text", kText, text("# x y z payload attribute\n1.5 2 3 7 0.25\n-4e3,5.5;6 255 1e-3\n"
+                                           "\t7 8 9 0 -2\r\n// comment\n\n1 1 1 1 1")));
   return seeds;
 }
 
