@@ -6,6 +6,7 @@
 #include <memory>
 #include <mutex>
 #include <ogr_spatialref.h>
+#include <string>
 #include <vector>
 
 #include "vola/error.hpp"
@@ -85,36 +86,46 @@ DemRaster read_dem(const std::string& path, const std::function<void(std::uint64
   GDALRasterBand* mask = band->GetMaskBand();
   const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
 
-  // Whole rows at a time, about a million cells per read.
-  const std::uint64_t rows_per_read = std::max<std::uint64_t>(1, (std::uint64_t{1} << 20) / std::max<std::uint64_t>(dem.width, 1));
+  // Windows of at most a million cells: whole rows when they are short enough.
+  constexpr std::uint64_t kWindowCells = std::uint64_t{1} << 20;
+  const std::uint64_t window_width = std::min<std::uint64_t>(std::max<std::uint64_t>(dem.width, 1), kWindowCells);
+  const std::uint64_t window_height = std::max<std::uint64_t>(1, kWindowCells / window_width);
   std::vector<double> values;
   std::vector<std::uint8_t> valid;
   double minimum = std::numeric_limits<double>::infinity();
-  for (std::uint64_t row = 0; row < dem.height; row += rows_per_read) {
-    const std::uint64_t rows = std::min(rows_per_read, dem.height - row);
-    values.resize(rows * dem.width);
-    const int x_size = static_cast<int>(dem.width), y_off = static_cast<int>(row), y_size = static_cast<int>(rows);
-    if (band->RasterIO(GF_Read, 0, y_off, x_size, y_size, values.data(), x_size, y_size, GDT_Float64, 0, 0) != CE_None)
-      throw FormatError(path, std::nullopt, gdal_message(("cannot read rows " + std::to_string(row) + "..").c_str()));
-    if (!all_valid) {
-      valid.resize(rows * dem.width);
-      if (mask->RasterIO(GF_Read, 0, y_off, x_size, y_size, valid.data(), x_size, y_size, GDT_Byte, 0, 0) != CE_None)
-        throw FormatError(path, std::nullopt, gdal_message(("cannot read the mask of rows " + std::to_string(row) + "..").c_str()));
-    }
-    for (std::uint64_t r = 0; r < rows; ++r)
-      for (std::uint64_t c = 0; c < dem.width; ++c) {
-        const std::uint64_t i = r * dem.width + c;
-        const double z = values[i] * scale + offset;
-        if ((!all_valid && valid[i] == 0) || !std::isfinite(z)) {
-          ++dem.invalid_cells;
-          continue;
-        }
-        const double px = static_cast<double>(c) + 0.5, py = static_cast<double>(row + r) + 0.5;
-        dem.cells.xyz.push_back(gt[0] + px * gt[1] + py * gt[2]);
-        dem.cells.xyz.push_back(gt[3] + px * gt[4] + py * gt[5]);
-        dem.cells.xyz.push_back(z);
-        minimum = std::min(minimum, z);
+  for (std::uint64_t row = 0; row < dem.height; row += window_height) {
+    const std::uint64_t rows = std::min(window_height, dem.height - row);
+    for (std::uint64_t column = 0; column < dem.width; column += window_width) {
+      const std::uint64_t columns = std::min(window_width, dem.width - column);
+      values.resize(rows * columns);
+      // The sizes fit an int: the raster has at most kMaxDemCells cells.
+      const int x_off = static_cast<int>(column), y_off = static_cast<int>(row);
+      const int x_size = static_cast<int>(columns), y_size = static_cast<int>(rows);
+      const std::string where = "rows " + std::to_string(row) + ".., columns " + std::to_string(column) + "..";
+      if (band->RasterIO(GF_Read, x_off, y_off, x_size, y_size, values.data(), x_size, y_size, GDT_Float64, 0, 0) !=
+          CE_None)
+        throw FormatError(path, std::nullopt, gdal_message(("cannot read " + where).c_str()));
+      if (!all_valid) {
+        valid.resize(rows * columns);
+        if (mask->RasterIO(GF_Read, x_off, y_off, x_size, y_size, valid.data(), x_size, y_size, GDT_Byte, 0, 0) !=
+            CE_None)
+          throw FormatError(path, std::nullopt, gdal_message(("cannot read the mask of " + where).c_str()));
       }
+      for (std::uint64_t r = 0; r < rows; ++r)
+        for (std::uint64_t c = 0; c < columns; ++c) {
+          const std::uint64_t i = r * columns + c;
+          const double z = values[i] * scale + offset;
+          if ((!all_valid && valid[i] == 0) || !std::isfinite(z)) {
+            ++dem.invalid_cells;
+            continue;
+          }
+          const double px = static_cast<double>(column + c) + 0.5, py = static_cast<double>(row + r) + 0.5;
+          dem.cells.xyz.push_back(gt[0] + px * gt[1] + py * gt[2]);
+          dem.cells.xyz.push_back(gt[3] + px * gt[4] + py * gt[5]);
+          dem.cells.xyz.push_back(z);
+          minimum = std::min(minimum, z);
+        }
+    }
     if (progress) progress(row + rows, dem.height);
   }
   dem.minimum = dem.cells.size() ? minimum : 0.0;

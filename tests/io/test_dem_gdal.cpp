@@ -99,6 +99,26 @@ TEST(DemGdal, InputIsATerrainWithItsBase) {
   EXPECT_TRUE(in.terrain_surface_only);
 }
 
+// A raster wider than one read window (2^20 cells) is read in column windows.
+TEST(DemGdal, WideRasterIsReadInWindows) {
+  const int width = (1 << 20) + 7;
+  Raster r{width, 2, GDT_Int16, std::vector<double>(2 * static_cast<std::size_t>(width)), {0, 1, 0, 2, 0, -1}, -1.0, 1.0,
+           0.0, 0};
+  for (int i = 0; i < 2 * width; ++i) r.values[static_cast<std::size_t>(i)] = i % 1000 == 0 ? -1.0 : i % 7;
+  vola_test::TempDir dir;
+  write_geotiff(dir / "wide.tif", r);
+  const vola::io::DemRaster dem = vola::io::read_dem((dir / "wide.tif").string());
+  std::vector<double> expected;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < width; ++i) {
+      const double v = r.values[static_cast<std::size_t>(j) * width + i];
+      if (v == -1.0) continue;
+      expected.insert(expected.end(), {i + 0.5, 2 - (j + 0.5), v});
+    }
+  EXPECT_EQ(dem.invalid_cells, 2u * width - expected.size() / 3);
+  EXPECT_EQ(dem.cells.xyz, expected);
+}
+
 // The raw band as int16 without GDAL's mask: what the reader must agree with.
 std::uint64_t raw_valid_cells(const fs::path& path, std::int16_t nodata, int& width, int& height) {
   GDALAllRegister();
