@@ -25,7 +25,8 @@ struct TerrainOptions {
 // is clamped to it. Columns of points that share a voxel column merge. Points the
 // quantizer refuses are counted in report->points_outside. The tree has the
 // quantizer's frame; the georef bbox is left to the caller. Throws InvalidArgument when
-// the columns would hold more than options.max_voxels voxels.
+// the columns would hold more than options.max_voxels voxels, or when the base is not
+// finite (unless surface_only).
 Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, const TerrainOptions& options,
                      BuildReport* report = nullptr);
 
