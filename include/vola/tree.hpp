@@ -240,6 +240,20 @@ class Tree {
       f(block, word, ox, oy, oz);
       return;
     }
+    if (level + 1 == last_level) {
+      // The children are consecutive blocks of the last level: visit them in this loop
+      // rather than one recursive call each (most blocks of a tree are last-level blocks).
+      const std::uint64_t* child_words = occupancy_[last_level].data();
+      std::size_t child = next[last_level];
+      while (word) {
+        const unsigned b = static_cast<unsigned>(std::countr_zero(word));
+        word &= word - 1;
+        f(child, child_words[child], (ox + (b & 3u)) * 4, (oy + ((b >> 2) & 3u)) * 4, (oz + (b >> 4)) * 4);
+        ++child;
+      }
+      next[last_level] = child;
+      return;
+    }
     while (word) {
       const unsigned b = static_cast<unsigned>(std::countr_zero(word));
       word &= word - 1;
