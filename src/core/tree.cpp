@@ -149,10 +149,15 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
     } else {
       payload_[level] = {};
     }
+    // One pass: the level's bits, and whether any word below the root is zero.
     std::uint64_t count = 0;
-    for (const std::uint64_t w : occupancy_[level]) count += static_cast<std::uint64_t>(std::popcount(w));
+    bool zero = false;
+    for (const std::uint64_t w : occupancy_[level]) {
+      count += static_cast<std::uint64_t>(std::popcount(w));
+      zero |= w == 0;
+    }
     counts_[level] = count;
-    if (level > 0) {
+    if (level > 0 && zero) {
       for (std::size_t i = 0; i < occupancy_[level].size(); ++i) {
         if (occupancy_[level][i] == 0) {
           const std::uint64_t word_offset = (occupancy_[level].data() - all_words_.data()) + i;
