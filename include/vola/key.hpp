@@ -31,17 +31,19 @@ struct Voxel {
 };
 
 namespace detail {
-// spread_table[b]: the 4 bit pairs of byte b moved to bits 6j, 6j+1 (j = 0..3).
-constexpr std::array<std::uint32_t, 256> make_spread_table() {
-  std::array<std::uint32_t, 256> t{};
-  for (std::uint32_t b = 0; b < 256; ++b) {
+// spread_table[c]: the 5 bit pairs of a 10-bit value c moved to bits 6j, 6j+1 (j = 0..4).
+// 4 KiB, so that a coordinate (20 bits at depth 10) spreads with two lookups: encoding
+// is on the path of every lookup and build.
+constexpr std::array<std::uint32_t, 1024> make_spread_table() {
+  std::array<std::uint32_t, 1024> t{};
+  for (std::uint32_t c = 0; c < 1024; ++c) {
     std::uint32_t v = 0;
-    for (int j = 0; j < 4; ++j) v |= ((b >> (2 * j)) & 3u) << (6 * j);
-    t[b] = v;
+    for (int j = 0; j < 5; ++j) v |= ((c >> (2 * j)) & 3u) << (6 * j);
+    t[c] = v;
   }
   return t;
 }
-inline constexpr auto spread_table = make_spread_table();
+alignas(64) inline constexpr auto spread_table = make_spread_table();
 
 // compact_table[d]: inverse of spread for one 12-bit run of two digits
 // (x, y, z bit pairs of two levels) -> 4 bits of x | 4 bits of y << 4 | 4 bits of z << 8.
@@ -61,9 +63,9 @@ constexpr std::array<std::uint16_t, 4096> make_compact_table() {
 }
 inline constexpr auto compact_table = make_compact_table();
 
+// Bits 20 and up of c are ignored.
 constexpr Key spread(std::uint32_t c) noexcept {
-  return Key{spread_table[c & 255u]} | (Key{spread_table[(c >> 8) & 255u]} << 24) |
-         (Key{spread_table[(c >> 16) & 15u]} << 48);
+  return Key{spread_table[c & 1023u]} | (Key{spread_table[(c >> 10) & 1023u]} << 30);
 }
 }  // namespace detail
 

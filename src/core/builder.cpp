@@ -78,18 +78,6 @@ double reduce(const std::vector<double>& values, std::span<const std::uint32_t> 
 // random access into L2/L3-sized arrays replace a 3-pass radix sort, a unique pass and
 // the level emitter; on the 1e6-point benchmark sets this builds 2.5x faster.
 
-// spread() for coordinates below 1024 (depth <= 5): one lookup per coordinate.
-constexpr std::array<std::uint32_t, 1024> make_spread10() {
-  std::array<std::uint32_t, 1024> t{};
-  for (std::uint32_t c = 0; c < 1024; ++c) {
-    std::uint32_t v = 0;
-    for (int j = 0; j < 5; ++j) v |= ((c >> (2 * j)) & 3u) << (6 * j);
-    t[c] = v;
-  }
-  return t;
-}
-alignas(64) constexpr auto kSpread10 = make_spread10();
-
 // Worth it when the bitmap is not much bigger than the keys: its fixed cost (clearing
 // and scanning 64^(D-2) words) then stays below the sort it replaces.
 bool bitmap_build_fits(std::size_t keys, int depth) {
@@ -230,13 +218,14 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
   check_depth(depth);
   const std::uint32_t side = side_of(depth);
   if (bitmap_build_fits(voxels.size(), depth)) {
-    // 32-bit keys (30 bits at most), encoded with one table lookup per coordinate.
+    // 32-bit keys (30 bits at most): one spread-table lookup per coordinate.
     std::unique_ptr<std::uint32_t[]> keys(new std::uint32_t[voxels.size()]);
     std::uint32_t all = 0;  // OR of every coordinate: one branch for the range check
     for (std::size_t i = 0; i < voxels.size(); ++i) {
       const Voxel& v = voxels[i];
       all |= v.x | v.y | v.z;
-      keys[i] = kSpread10[v.x & 1023u] | (kSpread10[v.y & 1023u] << 2) | (kSpread10[v.z & 1023u] << 4);
+      keys[i] = detail::spread_table[v.x & 1023u] | (detail::spread_table[v.y & 1023u] << 2) |
+                (detail::spread_table[v.z & 1023u] << 4);
     }
     if (all >= side) {
       for (const Voxel& v : voxels)

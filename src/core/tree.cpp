@@ -187,9 +187,9 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
   // The jump table over the two top levels: 8 KiB, for trees whose leaf level is at least
   // 32768 words (256 KiB), so it adds at most 3%. Level 2 has at most 64^2 blocks, so a
   // block index fits in 15 bits.
-  jump_.clear();
+  jump_.reset();
   if (depth_ >= 3 && occupancy_[depth_ - 1].size() >= (std::size_t{1} << 15)) {
-    jump_.assign(4096, 0);
+    auto jump = std::make_shared<std::uint16_t[]>(4096);  // zeros: not occupied
     const std::uint64_t root = occupancy_[0][0];
     for (unsigned b0 = 0; b0 < 64; ++b0) {
       if (!((root >> b0) & 1u)) continue;
@@ -199,16 +199,12 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
       for (unsigned b1 = 0; b1 < 64; ++b1) {
         if (!((word >> b1) & 1u)) continue;
         const std::uint64_t c2 = base + static_cast<std::uint64_t>(std::popcount(word & ((std::uint64_t{1} << b1) - 1)));
-        jump_[b0 * 64 + b1] = static_cast<std::uint16_t>(0x8000u | c2);
+        jump[b0 * 64 + b1] = static_cast<std::uint16_t>(0x8000u | c2);
       }
     }
+    jump_ = std::move(jump);
   }
-  for (int level = depth_; level < kMaxDepth; ++level) {
-    occupancy_[level] = {};
-    payload_[level] = {};
-    rank_[level] = RankDirectory();
-    counts_[level] = 0;
-  }
+  fixed_walk_ = jump_ && dense_levels_ >= depth_ - 1 ? depth_ : 0;
 }
 
 // Every lookup ranks one block on each level above the leaf, so those directories decide
@@ -312,7 +308,7 @@ std::size_t Tree::memory_bytes() const noexcept {
   std::size_t bytes = sizeof(Tree);
   if (!mapped_) bytes += all_words_.size() * sizeof(std::uint64_t);
   for (int level = 0; level < depth_; ++level) bytes += rank_[level].memory_bytes();
-  bytes += jump_.capacity() * sizeof(std::uint16_t);
+  if (jump_) bytes += 4096 * sizeof(std::uint16_t);
   for (const auto& column : attributes_.columns()) bytes += column.bytes().size();
   bytes += voxel_payloads_.capacity() * sizeof(std::uint64_t);
   return bytes;
