@@ -13,7 +13,8 @@
 // and print one markdown table per set plus the project's targets with PASS/MISS.
 //
 // Usage: vola_peers [--data DIR] [--reps N] [--tmp DIR] [--sets surface,uniform]
-//   DIR defaults to $VOLA_SHARED/data/bench, else ../shared/data/bench.
+//   DIR defaults to $VOLA_SHARED/data/bench, else ../shared/data/bench, else the shared folder
+//   next to the source tree.
 // Exit status: 0 when every implementation agrees on every count (targets may be missed),
 // 1 on a disagreement or an error.
 
@@ -41,6 +42,7 @@
 #include "vola/builder.hpp"
 #include "vola/file.hpp"
 #include "vola/tree.hpp"
+#include "bench_data.hpp"
 
 namespace fs = std::filesystem;
 
@@ -48,49 +50,8 @@ namespace {
 
 constexpr int kDepth = 5;  // 4^5 = 1024 voxels per axis: the benchmark grid
 
-// ---------------------------------------------------------------------------------------
-// Input: NPY int16 (N, 3), C order, little-endian. Parsed here rather than through vola_io
-// so that this benchmark builds whether or not the CLI's I/O library is configured.
-struct Points {
-  std::vector<std::int16_t> xyz;  // x0 y0 z0 x1 ...
-  std::size_t size() const { return xyz.size() / 3; }
-};
-
-Points read_points(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open " + path.string());
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0)
-    throw std::runtime_error(path.string() + ": not an .npy file");
-  const int major = static_cast<unsigned char>(bytes[6]);
-  std::size_t header_len = 0, at = 0;
-  if (major == 1) {
-    header_len = static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
-    at = 10;
-  } else {
-    if (bytes.size() < 12) throw std::runtime_error(path.string() + ": truncated header");
-    for (int i = 0; i < 4; ++i) header_len |= std::size_t{static_cast<unsigned char>(bytes[8 + i])} << (8 * i);
-    at = 12;
-  }
-  if (at + header_len > bytes.size()) throw std::runtime_error(path.string() + ": truncated header");
-  const std::string header(bytes.data() + at, header_len);
-  if (header.find("'<i2'") == std::string::npos || header.find("'fortran_order': False") == std::string::npos)
-    throw std::runtime_error(path.string() + ": expected little-endian int16 in C order, header " + header);
-  const auto shape_at = header.find("'shape': (");
-  if (shape_at == std::string::npos) throw std::runtime_error(path.string() + ": no shape");
-  std::size_t rows = 0, cols = 0;
-  if (std::sscanf(header.c_str() + shape_at, "'shape': (%zu, %zu)", &rows, &cols) != 2 || cols != 3)
-    throw std::runtime_error(path.string() + ": expected shape (N, 3), header " + header);
-  at += header_len;
-  if (bytes.size() - at != rows * 3 * sizeof(std::int16_t))
-    throw std::runtime_error(path.string() + ": data size does not match the shape");
-  Points p;
-  p.xyz.resize(rows * 3);
-  std::memcpy(p.xyz.data(), bytes.data() + at, rows * 3 * sizeof(std::int16_t));
-  for (const auto c : p.xyz)
-    if (c < 0 || c >= 1024) throw std::runtime_error(path.string() + ": coordinate outside [0, 1024)");
-  return p;
-}
+using vola_bench::Points;
+using vola_bench::read_points;
 
 // ---------------------------------------------------------------------------------------
 // Timing: the median of `reps` runs of f(), which returns nothing; seconds.
@@ -578,8 +539,7 @@ std::vector<Target> targets_for(const std::string& set, const std::vector<Measur
 
 Options parse_args(int argc, char** argv) {
   Options o;
-  if (const char* shared = std::getenv("VOLA_SHARED")) o.data = fs::path(shared) / "data" / "bench";
-  else o.data = fs::path("..") / "shared" / "data" / "bench";
+  o.data = vola_bench::default_data_dir();
   o.tmp = fs::temp_directory_path();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
