@@ -10,6 +10,9 @@ export VOLA_SHARED=${VOLA_SHARED:-$(cd "$VOLA_ROOT/.." && pwd)/shared}
 VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-data libgtest-dev libgmock-dev
   nlohmann-json3-dev python3 python3-numpy python3-scipy gzip libassimp-dev libgdal-dev libpng-dev liblzf-dev)
 
+# The Python module (pybind11, numpy) and its tests (pytest, matplotlib for the example).
+VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib)
+
 # install_packages PKG...: apt-get installs the ones that are missing (as root), or
 # says exactly what to install.
 install_packages() {

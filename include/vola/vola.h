@@ -1,0 +1,157 @@
+/* The VOLA C API: a stable C interface over the C++ library, for FFI users (ctypes,
+ * Rust, Go, Julia) and C programs.
+ *
+ * - Trees are opaque handles (vola_tree *); free each with vola_tree_free.
+ * - Every function that can fail returns a vola_status; VOLA_OK is 0. On failure the
+ *   out-parameters are left untouched and vola_last_error() describes what went wrong
+ *   (for a bad file: "<file>: byte <offset>: <cause>"), in this thread, until the next
+ *   failing call in this thread.
+ * - No C++ exception ever crosses this boundary: every entry point catches.
+ * - A tree may be read from several threads at once (contains, iterate, write); it is
+ *   never modified after it is made.
+ *
+ *     vola_tree *tree = NULL;
+ *     if (vola_open("survey.vol", VOLA_OPEN_MAPPED, &tree) != VOLA_OK) {
+ *       fprintf(stderr, "%s\n", vola_last_error());
+ *       return 1;
+ *     }
+ *     int hit = 0;
+ *     vola_contains(tree, 10, 20, 30, &hit);
+ *     vola_tree_free(tree);
+ *
+ * Link with vola_c (CMake: target vola::vola_c).
+ */
+#ifndef VOLA_VOLA_H
+#define VOLA_VOLA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#  if defined(VOLA_C_BUILDING)
+#    define VOLA_C_API __declspec(dllexport)
+#  else
+#    define VOLA_C_API __declspec(dllimport)
+#  endif
+#else
+#  define VOLA_C_API __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum vola_status {
+  VOLA_OK = 0,
+  VOLA_ERROR_INVALID_ARGUMENT = 1, /* a null pointer, depth out of 1..10, a voxel off the grid ... */
+  VOLA_ERROR_FORMAT = 2,           /* the bytes are not a valid .vol file */
+  VOLA_ERROR_IO = 3,               /* the operating system refused (open, map, write) */
+  VOLA_ERROR_OUT_OF_MEMORY = 4,
+  VOLA_ERROR_INTERNAL = 5          /* anything else; the message says what */
+} vola_status;
+
+typedef struct vola_tree vola_tree;
+
+/* The message of this thread's last failure ("" when there was none). Valid until the
+ * next failing call in this thread. */
+VOLA_C_API const char *vola_last_error(void);
+/* "ok", "invalid argument", "format error", "io error", "out of memory", "internal error". */
+VOLA_C_API const char *vola_status_string(vola_status status);
+/* The library version, e.g. "0.1.0". */
+VOLA_C_API const char *vola_version(void);
+
+/* ---- making trees ---- */
+
+typedef enum vola_open_mode {
+  VOLA_OPEN_READ = 0,  /* read the file into memory */
+  VOLA_OPEN_MAPPED = 1 /* memory-map it: a sparse uncompressed file's levels are used in place */
+} vola_open_mode;
+
+VOLA_C_API vola_status vola_open(const char *path, vola_open_mode mode, vola_tree **out);
+
+typedef enum vola_quantization {
+  VOLA_QUANTIZE_TOOLKIT = 0, /* the reference's rounding against the bbox; needs a depth */
+  VOLA_QUANTIZE_GRID = 1     /* floor((p - origin) / voxel_size); depth and/or voxel size */
+} vola_quantization;
+
+typedef struct vola_build_options {
+  vola_quantization quantization;
+  int depth;          /* 1..10; 0 = grid mode: the smallest depth that covers the points */
+  double voxel_size;  /* grid mode: the voxel edge; 0 = derived from the depth */
+  uint32_t epsg;      /* recorded in the header; 0 = the reference's default (2000) */
+} vola_build_options;
+
+/* Points x0 y0 z0 x1 y1 z1 ... (count points). Non-finite points, and in grid mode points
+ * outside the grid, are dropped; *dropped (may be NULL) receives how many. */
+VOLA_C_API vola_status vola_build_from_points(const double *xyz, size_t count, const vola_build_options *options,
+                                              vola_tree **out, uint64_t *dropped);
+/* Integer voxel coordinates x0 y0 z0 ..., each below 4^depth; duplicates allowed. */
+VOLA_C_API vola_status vola_build_from_voxels(const uint32_t *xyz, size_t count, int depth, vola_tree **out);
+/* The first `depth` levels as a coarser tree (shares no state with `tree` that the caller
+ * must keep: `tree` may be freed first). */
+VOLA_C_API vola_status vola_level_of_detail(const vola_tree *tree, int depth, vola_tree **out);
+/* Frees a tree; NULL is allowed. */
+VOLA_C_API void vola_tree_free(vola_tree *tree);
+
+/* ---- writing ---- */
+
+typedef enum vola_write_flags {
+  VOLA_WRITE_SPARSE = 0,
+  VOLA_WRITE_DENSE = 1,     /* the reference's dense layout (depth <= 5) */
+  VOLA_WRITE_COMPRESS = 2   /* zstd-compressed levels (vola's version-2 files; sparse only) */
+} vola_write_flags;
+
+/* flags: a vola_write_flags value. Writes through a temporary file and a rename. */
+VOLA_C_API vola_status vola_write(const vola_tree *tree, const char *path, int flags);
+
+/* ---- what a tree is ---- */
+
+typedef struct vola_info {
+  int depth;
+  uint32_t side;          /* voxels per axis: 4^depth */
+  uint64_t voxel_count;
+  int mapped;             /* 1 when the levels live in a file mapping */
+  int quantization;       /* a vola_quantization */
+  double origin[3];       /* world position of voxel (0,0,0)'s corner */
+  double voxel_size;      /* world size of a voxel */
+  uint32_t epsg;
+  size_t attribute_count;
+} vola_info;
+
+VOLA_C_API vola_status vola_get_info(const vola_tree *tree, vola_info *out);
+
+/* ---- queries ---- */
+
+/* *out = 1 when voxel (x, y, z) is occupied, else 0 (also for voxels off the grid). */
+VOLA_C_API vola_status vola_contains(const vola_tree *tree, uint32_t x, uint32_t y, uint32_t z, int *out);
+/* out[i] = contains(xyz[3i], xyz[3i+1], xyz[3i+2]) for i < count. */
+VOLA_C_API vola_status vola_contains_many(const vola_tree *tree, const uint32_t *xyz, size_t count, uint8_t *out);
+/* The voxel's index among all voxels in key order (its attribute row). VOLA_ERROR_INVALID_ARGUMENT
+ * when the voxel is not occupied. */
+VOLA_C_API vola_status vola_rank(const vola_tree *tree, uint32_t x, uint32_t y, uint32_t z, uint64_t *out);
+
+/* ---- iteration ---- */
+
+/* Called once per voxel in key order (the order of ranks). Return 0 to go on, anything
+ * else to stop: vola_for_each_voxel then returns VOLA_OK and *visited (may be NULL) says
+ * how many voxels were visited, the stopping one included. */
+typedef int (*vola_voxel_callback)(uint32_t x, uint32_t y, uint32_t z, void *user);
+VOLA_C_API vola_status vola_for_each_voxel(const vola_tree *tree, vola_voxel_callback callback, void *user,
+                                           uint64_t *visited);
+/* Copies up to `capacity` voxels starting at rank `first` into xyz (3 per voxel);
+ * *written receives how many. For paging through a tree without a callback. */
+VOLA_C_API vola_status vola_copy_voxels(const vola_tree *tree, uint64_t first, uint32_t *xyz, size_t capacity,
+                                        size_t *written);
+
+/* ---- attributes ---- */
+
+/* Name of attribute column `index` (< attribute_count), valid while the tree lives. */
+VOLA_C_API vola_status vola_attribute_name(const vola_tree *tree, size_t index, const char **out);
+/* The value of column `name` for the voxel of rank `rank`, as a double. */
+VOLA_C_API vola_status vola_attribute_value(const vola_tree *tree, const char *name, uint64_t rank, double *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VOLA_VOLA_H */

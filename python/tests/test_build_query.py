@@ -1,0 +1,146 @@
+"""Building from points and voxels, queries and arrays, against numpy references."""
+
+import numpy as np
+import pytest
+
+import vola
+from reference import coarsen, dense, grid_voxels, sorted_unique_voxels
+
+
+@pytest.fixture()
+def cloud():
+    rng = np.random.default_rng(7)
+    # Clustered points, so that voxels hold several points each and blocks are sparse.
+    centres = rng.uniform(0, 30, size=(40, 3))
+    return centres[rng.integers(0, 40, 5000)] + rng.normal(0, 0.8, size=(5000, 3))
+
+
+def test_build_grid_matches_floor_reference(cloud):
+    origin = (-5.0, -5.0, -5.0)
+    tree = vola.build(cloud, voxel_size=0.5, origin=origin)
+    expected = sorted_unique_voxels(grid_voxels(cloud, origin, 0.5), tree.depth)
+    assert tree.quantization == "grid" and tree.voxel_size == 0.5 and tuple(tree.origin) == origin
+    assert tree.side >= expected.max() + 1 and tree.side // 4 < expected.max() + 1  # smallest depth that fits
+    np.testing.assert_array_equal(tree.voxels().astype(np.int64), expected)
+    assert len(tree) == tree.voxel_count == len(expected)
+
+
+def test_default_origin_snaps_below_the_points(cloud):
+    tree = vola.build(cloud, voxel_size=0.25)
+    origin = np.asarray(tree.origin)
+    assert np.all(origin <= cloud.min(axis=0))
+    np.testing.assert_allclose(origin / 0.25, np.round(origin / 0.25))
+    expected = sorted_unique_voxels(grid_voxels(cloud, origin, 0.25), tree.depth)
+    np.testing.assert_array_equal(tree.voxels().astype(np.int64), expected)
+
+
+def test_toolkit_needs_depth_and_fits_the_bbox(cloud):
+    tree = vola.build(cloud, depth=4, quantize="toolkit")
+    assert tree.quantization == "toolkit" and tree.depth == 4
+    v = tree.voxels()
+    assert v.max() == 255 and v.min() == 0  # the longest bbox side spans the whole grid
+    with pytest.raises(vola.InvalidArgument, match="depth"):
+        vola.build(cloud, quantize="toolkit")
+
+
+def test_contains_and_rank_against_dense_reference(cloud):
+    tree = vola.build(cloud, voxel_size=1.0, origin=(-5.0, -5.0, -5.0))
+    grid = dense(tree.voxels(), tree.side)
+    rng = np.random.default_rng(1)
+    queries = rng.integers(-3, tree.side + 3, size=(20000, 3))
+    queries = np.vstack([queries, tree.voxels().astype(np.int64), [[2**40, 0, 0], [-(2**40), 1, 1]]])
+    inside = np.all((queries >= 0) & (queries < tree.side), axis=1)
+    expected = np.zeros(len(queries), dtype=bool)
+    q = queries[inside]
+    expected[inside] = grid[q[:, 0], q[:, 1], q[:, 2]]
+    np.testing.assert_array_equal(tree.contains(queries), expected)
+    # Other integer dtypes and a single row.
+    np.testing.assert_array_equal(tree.contains(queries[inside].astype(np.uint16)), expected[inside])
+    v0 = tree.voxels()[0]
+    assert tree.contains(v0) is True and tree.contains([tree.side, 0, 0]) is False
+    # rank: the row in voxels(), -1 when empty.
+    ranks = tree.rank(queries)
+    np.testing.assert_array_equal(ranks >= 0, expected)
+    voxels = tree.voxels()
+    np.testing.assert_array_equal(voxels[ranks[expected]].astype(np.int64), queries[expected])
+    assert tree.rank(voxels[17]) == 17
+
+
+def test_build_from_voxels_and_dense_round_trip():
+    rng = np.random.default_rng(3)
+    voxels = rng.integers(0, 64, size=(3000, 3))
+    tree = vola.build_from_voxels(voxels, depth=3)
+    np.testing.assert_array_equal(tree.voxels().astype(np.int64), sorted_unique_voxels(voxels, 3))
+    grid = dense(voxels, 64)
+    np.testing.assert_array_equal(tree.to_dense(), grid)
+    back = vola.from_dense(grid)
+    assert back.depth == 3
+    np.testing.assert_array_equal(back.voxels(), tree.voxels())
+    # A non-cubic int grid with a world frame: non-zero cells are voxels.
+    small = np.zeros((5, 9, 3), dtype=np.int32)
+    small[4, 8, 2] = 7
+    small[0, 1, 0] = -1
+    framed = vola.from_dense(small, origin=(10.0, 20.0, 30.0), voxel_size=2.0)
+    assert framed.depth == 2 and framed.quantization == "grid" and framed.voxel_size == 2.0
+    np.testing.assert_array_equal(framed.voxels(), [[0, 1, 0], [4, 8, 2]])
+    np.testing.assert_allclose(framed.centers(), [[11.0, 23.0, 31.0], [19.0, 37.0, 35.0]])
+    voxels_back, inside = framed.world_to_voxel(np.array([[19.5, 37.0, 35.9], [9.0, 20.0, 30.0]]))
+    np.testing.assert_array_equal(voxels_back, [[4, 8, 2], [-1, -1, -1]])
+    np.testing.assert_array_equal(inside, [True, False])
+    with pytest.raises(vola.InvalidArgument, match="max_cells"):
+        vola.build_from_voxels([[0, 0, 0]], depth=8).to_dense()
+
+
+def test_level_of_detail_is_any_over_4x4x4():
+    rng = np.random.default_rng(5)
+    voxels = rng.integers(0, 256, size=(5000, 3))
+    tree = vola.build_from_voxels(voxels, depth=4)
+    grid = dense(voxels, 256)
+    for depth in (3, 2, 1):
+        grid = coarsen(grid)
+        coarse = tree.level_of_detail(depth)
+        assert coarse.depth == depth
+        np.testing.assert_array_equal(coarse.to_dense(), grid)
+        np.testing.assert_array_equal(tree.voxels(level=depth - 1), coarse.voxels())
+        np.testing.assert_array_equal(tree.to_dense(level=depth - 1), grid)
+    with pytest.raises(vola.InvalidArgument):
+        tree.level_of_detail(5)
+
+
+def test_attributes_reduce_per_voxel_like_numpy(cloud):
+    n = len(cloud)
+    rng = np.random.default_rng(11)
+    intensity = rng.integers(0, 60000, n).astype(np.uint16)
+    height = cloud[:, 2].astype(np.float64)
+    classification = rng.integers(1, 4, n).astype(np.uint8)
+    tree = vola.build(
+        cloud,
+        voxel_size=2.0,
+        origin=(-5.0, -5.0, -5.0),
+        attributes={"intensity": intensity, "height": height, "classification": classification},
+        reductions={"height": "max", "classification": "majority"},
+    )
+    assert sorted(tree.attribute_names) == ["classification", "height", "intensity"]
+    columns = tree.attributes()
+    assert columns["intensity"].dtype == np.uint16 and columns["height"].dtype == np.float64
+    assert columns["classification"].dtype == np.uint8
+    # Reference: group the points by the voxel they fall in, in rank order.
+    rows = tree.rank(grid_voxels(cloud, (-5.0, -5.0, -5.0), 2.0))
+    assert np.all(rows >= 0)
+    count = np.bincount(rows, minlength=len(tree))
+    mean = np.bincount(rows, weights=intensity, minlength=len(tree)) / count
+    np.testing.assert_array_equal(columns["intensity"], np.clip(np.rint(mean), 0, 65535).astype(np.uint16))
+    highest = np.full(len(tree), -np.inf)
+    np.maximum.at(highest, rows, height)
+    np.testing.assert_array_equal(columns["height"], highest)
+    votes = np.zeros((len(tree), 4), dtype=np.int64)
+    np.add.at(votes, (rows, classification), 1)
+    majority = columns["classification"]
+    assert np.all(votes[np.arange(len(tree)), majority] == votes.max(axis=1))
+    # Views, not copies: read-only, and alive after the tree object is gone.
+    view = tree.attribute("height")
+    assert not view.flags.writeable and not view.flags.owndata
+    del tree, columns
+    np.testing.assert_array_equal(view, highest)
+    with pytest.raises(KeyError, match="colour"):
+        vola.build(cloud, voxel_size=1.0).attribute("colour")

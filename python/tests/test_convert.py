@@ -1,0 +1,71 @@
+"""vola.convert against `vola convert` (the same readers and rules, so the same file)
+and against what the input files are known to hold."""
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import vola
+
+
+def cli_convert(cli, source, out, *args):
+    subprocess.run([cli, "convert", str(source), str(out), "--quiet", *args], check=True)
+    return vola.read(out)
+
+
+def assert_same_tree(ours, theirs):
+    np.testing.assert_array_equal(ours.voxels(), theirs.voxels())
+    assert ours.attribute_names == theirs.attribute_names
+    for name in ours.attribute_names:
+        np.testing.assert_array_equal(ours.attribute(name), theirs.attribute(name))
+    assert (ours.quantization, ours.origin, ours.voxel_size, ours.epsg, ours.bbox) == (
+        theirs.quantization, theirs.origin, theirs.voxel_size, theirs.epsg, theirs.bbox)
+
+
+@pytest.mark.parametrize("args,kwargs", [(["--voxel-size", "5"], {"voxel_size": 5.0}),
+                                         (["--quantize", "toolkit", "--depth", "6"], {"quantize": "toolkit", "depth": 6})])
+def test_las_matches_the_cli(las_file, vola_cli, tmp_path, args, kwargs):
+    ours = vola.convert(las_file, **kwargs)
+    theirs = cli_convert(vola_cli, las_file, tmp_path / "cli.vol", *args)
+    assert_same_tree(ours, theirs)
+    assert ours.to_bytes() == (tmp_path / "cli.vol").read_bytes()
+
+
+def test_las_holds_what_the_survey_holds(las_file):
+    # pdal_autzen-utm.las (EXPECTED.txt): 1065 points, EPSG:26910, classes {1: 789, 2: 276},
+    # bounds [493994.87, 4877429.62, 123.93] .. [494993.68, 4878817.02, 178.73].
+    tree = vola.convert(las_file, voxel_size=0.01)  # small voxels: no two points share one
+    assert len(tree) == 1065 and tree.epsg == 26910 and "26910" in tree.crs_wkt
+    np.testing.assert_allclose(tree.bbox[0], (493994.87, 4877429.62, 123.93), atol=0.006)
+    np.testing.assert_allclose(tree.bbox[1], (494993.68, 4878817.02, 178.73), atol=0.006)
+    codes, counts = np.unique(tree.attribute("classification"), return_counts=True)
+    assert dict(zip(codes.tolist(), counts.tolist())) == {1: 789, 2: 276}
+    centers = tree.centers()
+    assert np.all(centers >= np.asarray(tree.bbox[0]) - 0.01) and np.all(centers <= np.asarray(tree.bbox[1]) + 0.01)
+    lat, lon = tree.lat_lon
+    assert 44.0 < lat < 44.1 and -123.1 < lon < -123.0  # Autzen stadium, Eugene, Oregon
+
+
+def test_voxel_grid_and_mesh_inputs_match_the_cli(shared_data, vola_cli, tmp_path):
+    binvox = shared_data / "binvox" / "trimesh_chair_model.binvox"
+    stl = shared_data / "mesh" / "stl" / "trimesh_featuretype_bin.stl"
+    for path in (binvox, stl):
+        if not path.exists():
+            pytest.fail(f"{path} missing")
+    assert_same_tree(vola.convert(binvox), cli_convert(vola_cli, binvox, tmp_path / "b.vol"))
+    assert_same_tree(vola.convert(stl, voxel_size=1.0, solid=True),
+                     cli_convert(vola_cli, stl, tmp_path / "s.vol", "--voxel-size", "1", "--solid"))
+
+
+def test_convert_errors_name_the_problem(tmp_path, las_file):
+    with pytest.raises(vola.InvalidArgument, match="unknown_ext"):
+        vola.convert(tmp_path / "points.unknown_ext", voxel_size=1.0)
+    with pytest.raises(vola.InvalidArgument, match="toolkit quantization needs a depth"):
+        vola.convert(las_file, quantize="toolkit")
+    bad = tmp_path / "bad.las"
+    bad.write_bytes(b"LASF" + bytes(50))
+    with pytest.raises(vola.FormatError, match="bad.las"):
+        vola.convert(bad, voxel_size=1.0)
+    formats = dict(vola.input_formats())
+    assert ".las" in formats["las"] and ".npy" in formats["npy"]

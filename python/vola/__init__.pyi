@@ -1,0 +1,22 @@
+import os
+from typing import Union
+
+from ._vola import (
+    Error as Error,
+    FormatError as FormatError,
+    InvalidArgument as InvalidArgument,
+    IoError as IoError,
+    Tree as Tree,
+    __version__ as __version__,
+    build as build,
+    build_from_voxels as build_from_voxels,
+    compression_available as compression_available,
+    convert as convert,
+    from_dense as from_dense,
+    input_formats as input_formats,
+    open_mapped as open_mapped,
+    parse as parse,
+    read as read,
+)
+
+def open(path: Union[str, os.PathLike], mapped: bool = True) -> Tree: ...

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# The C API test on a scratch directory, plus a real survey converted by the CLI (a file
+# with attribute columns). Usage: run_capi.sh TEST_CAPI VOLA_CLI DATA_DIR
+set -euo pipefail
+test_capi=$1 vola=$2 data=$3
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+las=$data/las/pdal_1.2-with-color.las
+if [ ! -f "$las" ]; then
+  if [ -n "${CI:-}" ]; then echo "missing $las (CI is set)" >&2; exit 1; fi
+  echo "skipped: $las missing (set VOLA_SHARED)"; exit 77
+fi
+"$vola" convert "$las" "$scratch/survey.vol" --voxel-size 5 --quiet
+"$test_capi" "$scratch" "$scratch/survey.vol"
