@@ -27,6 +27,7 @@ class Collider {
   bool box(const Box& box) const;
 
   const Tree& tree() const noexcept { return caster_.tree(); }
+  const RayCaster& caster() const noexcept { return caster_; }
 
  private:
   template <class Overlaps>
