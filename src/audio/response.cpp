@@ -1,0 +1,341 @@
+#include "vola/audio/response.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <thread>
+
+#include "vola/audio/convolve.hpp"
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/raycast/world.hpp"
+
+namespace vola::audio {
+
+namespace {
+
+// Amplitudes above this (+60 dB re 1 at 1 m: a point a millimetre from a wall) share the top bin.
+constexpr double kMaxGainDb = 60.0;
+
+int bits_for(std::uint64_t values) {
+  int bits = 0;
+  while ((std::uint64_t{1} << bits) < values) ++bits;
+  return bits;
+}
+
+// Everything one voxel's path needs, in grid units (voxels) where possible.
+struct PathModel {
+  Point source{}, listener{};      // grid coordinates
+  double samples_per_voxel = 0.0;  // voxel_size / c * sample_rate
+  double amplitude_scale = 0.0;    // sqrt(A / pi) / voxel_size^2 = 1 / (sqrt(pi) * voxel_size)
+  std::uint32_t max_sample = 0;
+  double floor_amplitude = 0.0;
+  std::vector<double> slot_gain;         // broadband coefficient, 1 for per-band materials
+  std::vector<std::uint16_t> slot_kernel;  // 0 or the per-band kernel number
+  const AcousticScene* scene = nullptr;
+  bool visibility = false;
+  // Bin packing.
+  double inverse_bin_width = 0.0;
+  std::int64_t level_offset = 0, level_count = 0;
+  int level_bits = 0, sample_bits = 0, kernel_bits = 0;
+};
+
+double distance(const Point& a, const Point& b) noexcept {
+  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// Does the segment from `from` to the reflecting point reach the voxel (or a voxel touching
+// it: a ray arriving at a grazing angle may enter the wall one voxel early)?
+bool sees(const raycast::RayCaster& caster, const Point& from, const Point& to, const Voxel& target) {
+  const Point d{to[0] - from[0], to[1] - from[1], to[2] - from[2]};
+  const auto hit = caster.cast(raycast::Ray{from, d, 1.0});
+  if (!hit) return true;
+  auto near = [](std::uint32_t a, std::uint32_t b) { return (a > b ? a - b : b - a) <= 1; };
+  return near(hit->voxel.x, target.x) && near(hit->voxel.y, target.y) && near(hit->voxel.z, target.z);
+}
+
+// The path through one surface voxel, or false when it does not reflect toward both ends,
+// arrives after the window, or is below the floor.
+bool reflect(const PathModel& m, const SurfaceVoxel& s, Reflection& out) {
+  const double lo[3] = {static_cast<double>(s.voxel.x), static_cast<double>(s.voxel.y), static_cast<double>(s.voxel.z)};
+  Point p{lo[0] + 0.5, lo[1] + 0.5, lo[2] + 0.5};
+  bool facing = false;
+  for (int a = 0; a < 3; ++a) {
+    const double hi = lo[a] + 1.0;
+    if ((s.exposed & (1u << (2 * a))) && m.source[a] < lo[a] && m.listener[a] < lo[a]) {
+      p[a] = lo[a];
+      facing = true;
+    } else if ((s.exposed & (2u << (2 * a))) && m.source[a] > hi && m.listener[a] > hi) {
+      p[a] = hi;
+      facing = true;
+    }
+  }
+  if (!facing) return false;
+  const double d1 = distance(m.source, p), d2 = distance(p, m.listener);
+  const double sample = std::nearbyint((d1 + d2) * m.samples_per_voxel);
+  if (!(sample <= static_cast<double>(m.max_sample))) return false;
+  const std::uint16_t slot = m.scene->materials().slot(s.rank, s.leaf_block);
+  const double amplitude = m.slot_gain[slot] * m.amplitude_scale / (d1 * d2);
+  if (!(amplitude >= m.floor_amplitude) || amplitude == 0.0) return false;
+  if (m.visibility && !(sees(m.scene->caster(), m.source, p, s.voxel) && sees(m.scene->caster(), m.listener, p, s.voxel)))
+    return false;
+  const double size = m.scene->frame().voxel_size;
+  out.voxel = s;
+  out.point = raycast::grid_to_world(m.scene->frame(), p);
+  out.path = (d1 + d2) * size;
+  out.amplitude = amplitude;
+  out.sample = static_cast<std::uint32_t>(sample);
+  out.slot = slot;
+  return true;
+}
+
+Key bin_key(const PathModel& m, const Reflection& r) {
+  std::int64_t level = static_cast<std::int64_t>(std::llround(-20.0 * std::log10(r.amplitude) * m.inverse_bin_width));
+  level = std::clamp<std::int64_t>(level + m.level_offset, 0, m.level_count - 1);
+  return (static_cast<Key>(m.slot_kernel[r.slot]) << (m.sample_bits + m.level_bits)) |
+         (static_cast<Key>(r.sample) << m.level_bits) | static_cast<Key>(level);
+}
+
+struct Direct {
+  double distance = 0.0;
+  std::uint32_t sample = 0;
+  double amplitude = 0.0;
+  bool blocked = false;
+};
+
+Direct direct_path(const AcousticScene& scene, const Point& source, const Point& listener, const ResponseOptions& o) {
+  scene.check_point(source, "the source");
+  scene.check_point(listener, "the listener");
+  Direct d;
+  d.distance = distance(source, listener);
+  if (!(d.distance > 0.0)) throw InvalidArgument("the source and the listener are at the same point");
+  const double samples = std::nearbyint(d.distance / o.speed_of_sound * o.sample_rate);
+  if (!(samples < static_cast<double>(1u << 24)))
+    throw InvalidArgument("the source is too far from the listener: the delay exceeds 2^24 samples");
+  d.sample = static_cast<std::uint32_t>(samples);
+  const Point s = raycast::world_to_grid(scene.frame(), source), l = raycast::world_to_grid(scene.frame(), listener);
+  d.blocked = scene.caster().cast(raycast::Ray{s, {l[0] - s[0], l[1] - s[1], l[2] - s[2]}, 1.0}).has_value();
+  d.amplitude = d.blocked ? 0.0 : 1.0 / d.distance;
+  return d;
+}
+
+PathModel path_model(const AcousticScene& scene, const Point& source, const Point& listener, const Direct& direct,
+                     const ResponseOptions& o) {
+  PathModel m;
+  const double size = scene.frame().voxel_size;
+  m.source = raycast::world_to_grid(scene.frame(), source);
+  m.listener = raycast::world_to_grid(scene.frame(), listener);
+  m.samples_per_voxel = size / o.speed_of_sound * o.sample_rate;
+  m.amplitude_scale = 1.0 / (std::sqrt(std::numbers::pi) * size);
+  const double last = std::ceil((direct.distance / o.speed_of_sound + o.reflection_window) * o.sample_rate);
+  if (!(last < static_cast<double>(1u << 24)))
+    throw InvalidArgument("the reflection window ends after 2^24 samples: shorten it");
+  m.max_sample = static_cast<std::uint32_t>(last);
+  m.floor_amplitude = std::pow(10.0, o.floor_db / 20.0);
+  std::uint16_t kernels = 0;
+  for (const Material& mat : scene.materials().slots()) {
+    m.slot_gain.push_back(mat.per_band() ? 1.0 : mat.bands[0]);
+    m.slot_kernel.push_back(mat.per_band() ? ++kernels : 0);
+  }
+  m.scene = &scene;
+  m.visibility = o.visibility;
+  m.inverse_bin_width = 1.0 / o.bin_width_db;
+  m.level_offset = static_cast<std::int64_t>(std::ceil(kMaxGainDb / o.bin_width_db));
+  m.level_count = m.level_offset + static_cast<std::int64_t>(std::ceil(-o.floor_db / o.bin_width_db)) + 2;
+  m.level_bits = bits_for(static_cast<std::uint64_t>(m.level_count));
+  m.sample_bits = bits_for(std::uint64_t{m.max_sample} + 1);
+  m.kernel_bits = bits_for(std::uint64_t{kernels} + 1);
+  if (m.level_bits + m.sample_bits + m.kernel_bits > 64)
+    throw InvalidArgument("too many attenuation bins: widen --bin-width or raise --floor");
+  return m;
+}
+
+// Runs f(range, begin, end) over `ranges` contiguous ranges of [0, count) on `threads`
+// threads. Results stored per range do not depend on the thread count.
+template <class F>
+void for_ranges(std::size_t count, std::size_t ranges, unsigned threads, F&& f) {
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t r; (r = next.fetch_add(1)) < ranges;) f(r, count * r / ranges, count * (r + 1) / ranges);
+  };
+  std::vector<std::jthread> pool;
+  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
+  work();
+}
+
+}  // namespace
+
+void ResponseOptions::check() const {
+  auto fail = [](const std::string& what, double v) {
+    std::ostringstream s;
+    s << what << " (got " << v << ")";
+    throw InvalidArgument(s.str());
+  };
+  if (!(sample_rate >= 1000.0 && sample_rate <= 768000.0)) fail("the sample rate must be in [1000, 768000] Hz", sample_rate);
+  if (!(speed_of_sound > 0.0 && std::isfinite(speed_of_sound))) fail("the speed of sound must be > 0", speed_of_sound);
+  if (!(reflection_window >= 0.0 && reflection_window <= 10.0)) fail("the reflection window must be in [0, 10] s", reflection_window);
+  if (!(bin_width_db > 0.0 && bin_width_db <= 6.0)) fail("the bin width must be in (0, 6] dB", bin_width_db);
+  if (!(floor_db >= -300.0 && floor_db < 0.0)) fail("the floor must be in [-300, 0) dB", floor_db);
+}
+
+AcousticScene::AcousticScene(const Tree& tree, const MaterialTable& materials)
+    : tree_(&tree), frame_(tree.frame()), materials_(materials, tree), blocks_(leaf_blocks(tree)), caster_(tree) {
+  if (!(frame_.voxel_size > 0.0) || !std::isfinite(frame_.voxel_size))
+    throw InvalidArgument("the scene's voxel size is not a positive number");
+}
+
+void AcousticScene::check_point(const Point& p, const std::string& what) const {
+  for (const double c : p)
+    if (!std::isfinite(c)) throw InvalidArgument(what + " has a coordinate that is not a finite number");
+  const Point g = raycast::world_to_grid(frame_, p);
+  const double side = static_cast<double>(tree_->side());
+  if (g[0] >= 0 && g[1] >= 0 && g[2] >= 0 && g[0] < side && g[1] < side && g[2] < side) {
+    const Voxel v{static_cast<std::uint32_t>(g[0]), static_cast<std::uint32_t>(g[1]), static_cast<std::uint32_t>(g[2])};
+    if (tree_->contains(v)) {
+      std::ostringstream s;
+      s << what << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") is inside occupied voxel (" << v.x << ", " << v.y
+        << ", " << v.z << "): sound cannot start or end inside a wall";
+      throw InvalidArgument(s.str());
+    }
+  }
+}
+
+Thresholded threshold(const AcousticScene& scene, const Point& source, const Point& listener, const ResponseOptions& o) {
+  o.check();
+  const Direct direct = direct_path(scene, source, listener, o);
+  const PathModel m = path_model(scene, source, listener, direct, o);
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t count = scene.blocks().size();
+  // A few ranges per thread balance uneven scenes; the ranges (not the threads) fix the result.
+  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(count / 256 + 1, 64));
+  std::vector<std::vector<std::pair<Key, std::uint64_t>>> runs(ranges);
+  const int key_bits = m.kernel_bits + m.sample_bits + m.level_bits;
+  for_ranges(count, ranges, threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
+    std::vector<Key> keys;
+    Reflection reflection;
+    for_each_surface_voxel(scene.tree(), scene.blocks(), begin, end, [&](const SurfaceVoxel& s) {
+      if (reflect(m, s, reflection)) keys.push_back(bin_key(m, reflection));
+    });
+    radix_sort(keys, nullptr, std::max(key_bits, 1));
+    auto& run = runs[r];
+    for (const Key k : keys) {
+      if (!run.empty() && run.back().first == k) ++run.back().second;
+      else run.emplace_back(k, 1);
+    }
+  });
+  std::vector<std::pair<Key, std::uint64_t>> all;
+  for (const auto& run : runs) all.insert(all.end(), run.begin(), run.end());
+  std::sort(all.begin(), all.end());
+  Thresholded t;
+  t.direct_distance = direct.distance;
+  t.direct_sample = direct.sample;
+  t.direct_amplitude = direct.amplitude;
+  t.direct_blocked = direct.blocked;
+  const Key level_mask = (Key{1} << m.level_bits) - 1, sample_mask = (Key{1} << m.sample_bits) - 1;
+  for (const auto& [key, n] : all) {
+    t.reflectors += n;
+    if (!t.bins.empty()) {
+      const Bin& b = t.bins.back();
+      const Key last = (static_cast<Key>(b.kernel) << (m.sample_bits + m.level_bits)) |
+                       (static_cast<Key>(b.sample) << m.level_bits) | static_cast<Key>(b.level + m.level_offset);
+      if (last == key) {
+        t.bins.back().count += n;
+        continue;
+      }
+    }
+    t.bins.push_back(Bin{static_cast<std::uint16_t>(key >> (m.sample_bits + m.level_bits)),
+                         static_cast<std::uint32_t>((key >> m.level_bits) & sample_mask),
+                         static_cast<std::int32_t>(static_cast<std::int64_t>(key & level_mask) - m.level_offset), n});
+  }
+  return t;
+}
+
+std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& t, const ResponseOptions& o) {
+  o.check();
+  std::uint32_t last = t.direct_sample;
+  std::uint16_t kernels = 0;
+  for (const Bin& b : t.bins) {
+    last = std::max(last, b.sample);
+    kernels = std::max(kernels, b.kernel);
+  }
+  const std::size_t length = std::size_t{last} + 1;
+  std::vector<std::vector<double>> per_kernel(std::size_t{kernels} + 1);
+  per_kernel[0].assign(length, 0.0);
+  per_kernel[0][t.direct_sample] += t.direct_amplitude;
+  // Bins are sorted by level within a sample; one pow per distinct level run.
+  const double step_db = o.bin_width_db;
+  std::int32_t cached_level = 0;
+  double cached_amplitude = 1.0;
+  for (const Bin& b : t.bins) {
+    if (b.level != cached_level) {
+      cached_level = b.level;
+      cached_amplitude = std::pow(10.0, -b.level * step_db / 20.0);
+    }
+    auto& h = per_kernel[b.kernel];
+    if (h.empty()) h.assign(length, 0.0);
+    h[b.sample] += static_cast<double>(b.count) * cached_amplitude;
+  }
+  std::vector<double> ir = std::move(per_kernel[0]);
+  if (kernels == 0) return ir;
+  // Per-band materials: their bins through the material's filter, centred on the arrival.
+  std::vector<const Material*> band_materials;
+  for (const Material& mat : scene.materials().slots())
+    if (mat.per_band()) band_materials.push_back(&mat);
+  for (std::uint16_t k = 1; k <= kernels; ++k) {
+    if (per_kernel[k].empty()) continue;
+    const std::vector<double> kernel = band_kernel(*band_materials[k - 1], o.sample_rate);
+    const std::size_t centre = kernel.size() / 2;
+    const std::vector<double> shaped = convolve(per_kernel[k], kernel);
+    if (ir.size() < shaped.size() - centre) ir.resize(shaped.size() - centre, 0.0);
+    for (std::size_t i = centre; i < shaped.size(); ++i) ir[i - centre] += shaped[i];
+  }
+  return ir;
+}
+
+std::vector<Reflection> reflections(const AcousticScene& scene, const Point& source, const Point& listener,
+                                    const ResponseOptions& o) {
+  o.check();
+  const Direct direct = direct_path(scene, source, listener, o);
+  const PathModel m = path_model(scene, source, listener, direct, o);
+  std::vector<Reflection> out;
+  Reflection r;
+  for_each_surface_voxel(scene.tree(), scene.blocks(), 0, scene.blocks().size(), [&](const SurfaceVoxel& s) {
+    if (reflect(m, s, r)) out.push_back(r);
+  });
+  return out;
+}
+
+std::vector<double> band_kernel(const Material& material, double sample_rate) {
+  // About 60 Hz of resolution, enough to tell the 125 Hz band from its neighbours.
+  std::size_t taps = static_cast<std::size_t>(sample_rate / 60.0) | 1u;
+  taps = std::clamp<std::size_t>(taps, 31, 4095);
+  const std::size_t half = taps / 2;
+  auto gain = [&](double f) {
+    const auto& c = material.bands;
+    if (f <= kOctaveBands.front()) return c.front();
+    if (f >= kOctaveBands.back()) return c.back();
+    const double octave = std::log2(f / kOctaveBands.front());
+    const std::size_t i = static_cast<std::size_t>(octave);
+    const double frac = octave - static_cast<double>(i);
+    return c[i] + (c[i + 1] - c[i]) * frac;
+  };
+  // Frequency sampling: a zero-phase cosine sum of the wanted magnitude at taps
+  // equally spaced frequencies, shifted to be causal, then a Hann window.
+  std::vector<double> h(taps);
+  const double n_taps = static_cast<double>(taps);
+  std::vector<double> g(half + 1);
+  for (std::size_t k = 0; k <= half; ++k) g[k] = gain(static_cast<double>(k) * sample_rate / n_taps);
+  for (std::size_t n = 0; n < taps; ++n) {
+    const double t = static_cast<double>(n) - static_cast<double>(half);
+    double sum = g[0];
+    for (std::size_t k = 1; k <= half; ++k) sum += 2.0 * g[k] * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) * t / n_taps);
+    const double window = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(n + 1) / (n_taps + 1.0));
+    h[n] = sum / n_taps * window;
+  }
+  return h;
+}
+
+}  // namespace vola::audio

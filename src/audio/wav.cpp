@@ -1,0 +1,87 @@
+#include "vola/audio/wav.hpp"
+
+#include <sndfile.h>
+
+#include <algorithm>
+#include <memory>
+
+#include "vola/error.hpp"
+
+namespace vola::audio {
+
+namespace {
+
+struct SndfileCloser {
+  void operator()(SNDFILE* f) const noexcept { sf_close(f); }
+};
+using SndfilePtr = std::unique_ptr<SNDFILE, SndfileCloser>;
+
+constexpr sf_count_t kChunkFrames = 65536;
+
+}  // namespace
+
+std::vector<double> Sound::mono() const {
+  std::vector<double> out(frames(), 0.0);
+  if (channels.empty()) return out;
+  for (const auto& c : channels)
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] += c[i];
+  const double scale = 1.0 / static_cast<double>(channels.size());
+  for (double& v : out) v *= scale;
+  return out;
+}
+
+Sound read_sound(const std::string& path) {
+  SF_INFO info{};
+  SndfilePtr file(sf_open(path.c_str(), SFM_READ, &info));
+  if (!file) throw IoError(path + ": cannot read sound: " + sf_strerror(nullptr));
+  if (info.channels <= 0 || info.channels > 256 || info.samplerate <= 0)
+    throw FormatError(path, std::nullopt, "implausible sound header (" + std::to_string(info.channels) + " channels, " +
+                                              std::to_string(info.samplerate) + " Hz)");
+  // Normalised doubles: integer PCM maps to [-1, 1).
+  sf_command(file.get(), SFC_SET_NORM_DOUBLE, nullptr, SF_TRUE);
+  Sound s;
+  s.sample_rate = info.samplerate;
+  const auto channels = static_cast<std::size_t>(info.channels);
+  s.channels.resize(channels);
+  std::vector<double> chunk(static_cast<std::size_t>(kChunkFrames) * channels);
+  for (;;) {
+    const sf_count_t got = sf_readf_double(file.get(), chunk.data(), kChunkFrames);
+    if (got < 0) throw IoError(path + ": " + sf_strerror(file.get()));
+    for (sf_count_t f = 0; f < got; ++f)
+      for (std::size_t c = 0; c < channels; ++c) s.channels[c].push_back(chunk[static_cast<std::size_t>(f) * channels + c]);
+    if (got < kChunkFrames) break;
+  }
+  if (sf_error(file.get()) != SF_ERR_NO_ERROR) throw IoError(path + ": " + sf_strerror(file.get()));
+  return s;
+}
+
+void write_wav(const std::string& path, const Sound& sound, SampleFormat format) {
+  if (sound.channels.empty()) throw InvalidArgument(path + ": nothing to write (no channel)");
+  for (const auto& c : sound.channels)
+    if (c.size() != sound.frames()) throw InvalidArgument(path + ": channels of different lengths");
+  SF_INFO info{};
+  info.samplerate = sound.sample_rate;
+  info.channels = static_cast<int>(sound.channels.size());
+  info.format = SF_FORMAT_WAV | (format == SampleFormat::pcm16   ? SF_FORMAT_PCM_16
+                                 : format == SampleFormat::pcm24 ? SF_FORMAT_PCM_24
+                                                                 : SF_FORMAT_FLOAT);
+  if (!sf_format_check(&info))
+    throw InvalidArgument(path + ": libsndfile cannot write this WAV (" + std::to_string(info.channels) + " channels, " +
+                          std::to_string(info.samplerate) + " Hz)");
+  SndfilePtr file(sf_open(path.c_str(), SFM_WRITE, &info));
+  if (!file) throw IoError(path + ": cannot create: " + sf_strerror(nullptr));
+  // PCM output clips instead of wrapping around.
+  sf_command(file.get(), SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  const std::size_t channels = sound.channels.size();
+  std::vector<double> chunk(static_cast<std::size_t>(kChunkFrames) * channels);
+  for (std::size_t begin = 0; begin < sound.frames(); begin += static_cast<std::size_t>(kChunkFrames)) {
+    const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(kChunkFrames), sound.frames() - begin);
+    for (std::size_t f = 0; f < n; ++f)
+      for (std::size_t c = 0; c < channels; ++c) chunk[f * channels + c] = sound.channels[c][begin + f];
+    if (sf_writef_double(file.get(), chunk.data(), static_cast<sf_count_t>(n)) != static_cast<sf_count_t>(n))
+      throw IoError(path + ": cannot write: " + sf_strerror(file.get()));
+  }
+  if (sf_close(file.release()) != 0) throw IoError(path + ": cannot finish writing");
+}
+
+}  // namespace vola::audio

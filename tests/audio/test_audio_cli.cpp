@@ -1,0 +1,114 @@
+// vola sonify end to end: a shoebox room written as .vol, a real recording in, the wet
+// WAV, the impulse response WAV and the plot out; bad inputs give one clear line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "audio_test_support.hpp"
+#include "vola/audio/wav.hpp"
+#include "vola/file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string output;
+};
+
+CliRun run(const std::string& args, const fs::path& dir) {
+  const fs::path log = dir / "log.txt";
+  const std::string command = std::string(VOLA_CLI) + " sonify " + args + " > " + log.string() + " 2>&1";
+  CliRun r;
+  const int raw = std::system(command.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(log);
+  std::stringstream s;
+  s << in.rdbuf();
+  r.output = s.str();
+  return r;
+}
+
+class SonifyCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("vola_sonify_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    vola::write(vola_audio_test::shoebox_tree({{10, 12, 8}, {200, 150, 100}}, 1.0 / 32.0), (dir_ / "room.vol").string());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(SonifyCli, RealRecordingThroughARoom) {
+  VOLA_REQUIRE_AUDIO(audio);
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  // Source at (2, 1.5, 1.25) m, listener at (4, 3, 2) m: 2.6575 m, 372 samples at 48 kHz.
+  const CliRun r = run(path("room.vol") + " --source 2 1.5 1.25 --listener 4 3 2 --in " + dry + " --out " + path("wet.wav") +
+                        " --ir " + path("ir.wav") + " --plot " + path("ir.png") + " --window 0.03",
+                    dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("source 1: direct"), std::string::npos) << r.output;
+  const vola::audio::Sound ir = vola::audio::read_sound(path("ir.wav"));
+  ASSERT_EQ(ir.channels.size(), 1u);
+  const double d = std::sqrt(2.0 * 2.0 + 1.5 * 1.5 + 0.75 * 0.75);
+  const auto direct = static_cast<std::size_t>(std::lround(d / 343.0 * 48000.0));
+  ASSERT_GT(ir.frames(), direct);
+  EXPECT_NEAR(ir.channels[0][direct], 1.0 / d, 1e-6);  // float WAV
+  for (std::size_t i = 0; i < direct; ++i) ASSERT_EQ(ir.channels[0][i], 0.0) << i;
+  double later = 0.0;
+  for (std::size_t i = direct + 1; i < ir.frames(); ++i) later += std::abs(ir.channels[0][i]);
+  EXPECT_GT(later, 0.0) << "no reflections";
+  const vola::audio::Sound wet = vola::audio::read_sound(path("wet.wav"));
+  EXPECT_EQ(wet.frames(), 68545u + ir.frames() - 1);
+  std::ifstream png(path("ir.png"), std::ios::binary);
+  char magic[8] = {};
+  png.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}
+
+TEST_F(SonifyCli, TwoSourcesOneChannelEach) {
+  VOLA_REQUIRE_AUDIO(audio);
+  const CliRun r = run(path("room.vol") + " --source 2 1.5 1.25 --source 5 3 2 --listener 4 3 2.5 --in " +
+                        (audio / "codec2_speech_orig_16k.wav").string() + " --in " +
+                        (audio / "soundicons_xylofon.wav").string() + " --out " + path("duo.wav") +
+                        " --channels per-source --ir " + path("ir2.wav") + " -q",
+                    dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(r.output.empty()) << r.output;
+  EXPECT_EQ(vola::audio::read_sound(path("duo.wav")).channels.size(), 2u);
+  EXPECT_EQ(vola::audio::read_sound(path("ir2.wav")).channels.size(), 2u);
+}
+
+TEST_F(SonifyCli, BadInputsFailWithOneClearLine) {
+  VOLA_REQUIRE_AUDIO(audio);
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  const std::string base = path("room.vol") + " --listener 4 3 2 --out " + path("o.wav");
+  CliRun r = run(base + " --source 2 1.5 1.25 --in " + path("missing.wav"), dir_);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("missing.wav"), std::string::npos) << r.output;
+  std::ofstream(path("bad.json")) << "{\n  \"attribute\": \"classification\",\n  \"materials\": {\"2\": 0.2,,}\n}\n";
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --materials " + path("bad.json"), dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("line 3"), std::string::npos) << r.output;
+  // x = 10.5 / 32 m is inside the wall at voxel x = 10.
+  r = run(base + " --source 0.328125 1.5 1.25 --in " + dry, dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("the source"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("inside occupied voxel"), std::string::npos) << r.output;
+  std::ofstream(path("ids.json")) << R"({"attribute": "classification", "materials": {"2": 0.2}})";
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --materials " + path("ids.json"), dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("no attribute \"classification\""), std::string::npos) << r.output;
+  r = run(base + " --source 2 1.5 1.25 --source 3 2 2 --in " + dry + " --in " + dry + " --in " + dry, dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("one per --source"), std::string::npos) << r.output;
+}
+
+}  // namespace
