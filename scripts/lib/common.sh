@@ -13,6 +13,11 @@ VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-da
 # The Python module (pybind11, numpy) and its tests (pytest, matplotlib for the example).
 VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib)
 
+# vola view: cpp-httplib, chromium for its browser test, and node/npm to build the page
+# (three.js, esbuild from the npm registry); a machine with its own node keeps it.
+VOLA_BUILD_PACKAGES+=(libcpp-httplib-dev pkg-config chromium)
+command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
+
 # install_packages PKG...: apt-get installs the ones that are missing (as root), or
 # says exactly what to install.
 install_packages() {

@@ -1,0 +1,166 @@
+#include "vola/viewer/server.hpp"
+
+#include <httplib.h>
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "vola/error.hpp"
+#include "web_assets.hpp"
+
+namespace vola::viewer {
+
+namespace {
+
+struct NotFound : Error {
+  using Error::Error;
+};
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+std::string param(const httplib::Request& req, const char* name) {
+  if (!req.has_param(name)) throw InvalidArgument(std::string("missing query parameter '") + name + "'");
+  return req.get_param_value(name);
+}
+
+// The whole text must be the number: "12x", "" and "1e99" for an integer are refused.
+template <class T>
+T integer_param(const httplib::Request& req, const char* name, T min, T max) {
+  const std::string text = param(req, name);
+  T value{};
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc{} || end != text.data() + text.size() || value < min || value > max)
+    throw InvalidArgument(std::string("query parameter '") + name + "' = '" + text + "' is not an integer in " +
+                          std::to_string(min) + ".." + std::to_string(max));
+  return value;
+}
+
+double real_param(const httplib::Request& req, const char* name) {
+  const std::string text = param(req, name);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc{} || end != text.data() + text.size() || !std::isfinite(value))
+    throw InvalidArgument(std::string("query parameter '") + name + "' = '" + text + "' is not a finite number");
+  return value;
+}
+
+}  // namespace
+
+struct Server::Impl {
+  std::vector<std::unique_ptr<ViewedFile>> files;
+  httplib::Server http;
+
+  const ViewedFile& file(const httplib::Request& req) const {
+    const std::string& text = req.matches[1];
+    std::size_t i = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), i);
+    if (ec != std::errc{} || end != text.data() + text.size() || i >= files.size())
+      throw NotFound("no file " + text + " (this viewer serves files 0.." + std::to_string(files.size() - 1) + ")");
+    return *files[i];
+  }
+
+  // Runs a handler, turning vola errors into 400/404 with a JSON message.
+  template <class F>
+  static httplib::Server::Handler guarded(F f) {
+    return [f](const httplib::Request& req, httplib::Response& res) {
+      try {
+        f(req, res);
+      } catch (const NotFound& e) {
+        send_json(res, 404, {{"error", e.what()}});
+      } catch (const Error& e) {
+        send_json(res, 400, {{"error", e.what()}});
+      }
+    };
+  }
+
+  void routes() {
+    http.Get("/", [](const httplib::Request&, httplib::Response& res) {
+      const auto html = index_html();
+      res.set_content(html.data(), html.size(), "text/html; charset=utf-8");
+    });
+    http.Get("/viewer.js", [](const httplib::Request&, httplib::Response& res) {
+      const auto js = viewer_js();
+      res.set_content(js.data(), js.size(), "text/javascript; charset=utf-8");
+    });
+    http.Get("/api/files", [this](const httplib::Request&, httplib::Response& res) {
+      nlohmann::json list = nlohmann::json::array();
+      for (std::size_t i = 0; i < files.size(); ++i) {
+        list.push_back(files[i]->metadata());
+        list.back()["index"] = i;
+      }
+      send_json(res, 200, list);
+    });
+    http.Get(R"(/api/files/(\d+)/cells)", guarded([this](const httplib::Request& req, httplib::Response& res) {
+      const ViewedFile& f = file(req);
+      const int level = integer_param<int>(req, "level", 0, f.tree().depth() - 1);
+      const auto first = integer_param<std::uint64_t>(req, "first", 0, std::numeric_limits<std::uint64_t>::max());
+      const auto count = integer_param<std::uint64_t>(req, "count", 0, kMaxBatchCells);
+      res.set_content(f.cell_batch(level, first, count), "application/octet-stream");
+    }));
+    http.Get(R"(/api/files/(\d+)/cell)", guarded([this](const httplib::Request& req, httplib::Response& res) {
+      const ViewedFile& f = file(req);
+      const int level = integer_param<int>(req, "level", 0, f.tree().depth() - 1);
+      const std::uint32_t max = side_of(level + 1) - 1;
+      const Voxel cell{integer_param<std::uint32_t>(req, "x", 0, max), integer_param<std::uint32_t>(req, "y", 0, max),
+                       integer_param<std::uint32_t>(req, "z", 0, max)};
+      send_json(res, 200, f.cell_info(level, cell));
+    }));
+    http.Get(R"(/api/files/(\d+)/pick)", guarded([this](const httplib::Request& req, httplib::Response& res) {
+      const ViewedFile& f = file(req);
+      const int level = integer_param<int>(req, "level", 0, f.tree().depth() - 1);
+      raycast::Ray ray;
+      ray.origin = {real_param(req, "ox"), real_param(req, "oy"), real_param(req, "oz")};
+      ray.direction = {real_param(req, "dx"), real_param(req, "dy"), real_param(req, "dz")};
+      if (req.has_param("tmax")) ray.t_max = real_param(req, "tmax");
+      send_json(res, 200, f.pick(level, ray));
+    }));
+    http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+      if (res.status == 404 && res.body.empty()) send_json(res, 404, {{"error", "no such path: " + req.path}});
+    });
+    // Anything else a handler throws (bad_alloc, ...): a 500 with its message, never a crash.
+    http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+      std::string what = "internal error";
+      try {
+        std::rethrow_exception(ep);
+      } catch (const std::exception& e) {
+        what = e.what();
+      } catch (...) {
+      }
+      send_json(res, 500, {{"error", what}});
+    });
+  }
+};
+
+Server::Server(std::vector<std::unique_ptr<ViewedFile>> files) : impl_(std::make_unique<Impl>()) {
+  impl_->files = std::move(files);
+  impl_->routes();
+}
+
+Server::~Server() = default;
+
+int Server::bind(int port) {
+  // Loopback only: the page and the files it shows are for this machine's user.
+  const char* host = "127.0.0.1";
+  if (port == 0) {
+    const int bound = impl_->http.bind_to_any_port(host);
+    if (bound <= 0) throw IoError("cannot bind a free port on 127.0.0.1");
+    return bound;
+  }
+  if (port < 0 || port > 65535 || !impl_->http.bind_to_port(host, port))
+    throw IoError("cannot bind 127.0.0.1:" + std::to_string(port) + " (in use or not allowed)");
+  return port;
+}
+
+void Server::listen() {
+  if (!impl_->http.listen_after_bind()) throw IoError("the viewer's HTTP server stopped with an error");
+}
+
+void Server::stop() { impl_->http.stop(); }
+
+}  // namespace vola::viewer

@@ -1,0 +1,92 @@
+// One level of one file on screen: instanced unit cubes whose per-instance data is the
+// cell's grid coordinates and colour, placed by the shader (cell + 0.5) * cellSize +
+// offset, so a batch from the server goes to the GPU without building matrices. The
+// slicing plane hides whole cells in the vertex shader.
+import * as THREE from 'three';
+
+const vertexShader = /* glsl */ `
+attribute vec3 cell;
+attribute vec3 colour;
+uniform float cellSize;
+uniform vec3 offset;
+uniform vec3 sliceAxis;
+uniform float sliceAt;
+uniform float sliceOn;
+varying vec3 vColour;
+void main() {
+  vec3 centre = offset + (cell + 0.5) * cellSize;
+  if (sliceOn > 0.5 && dot(centre, sliceAxis) > sliceAt) {
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);  // outside the clip volume: the cell is not drawn
+    vColour = vec3(0.0);
+    return;
+  }
+  float light = 0.55 + 0.45 * max(dot(normal, normalize(vec3(0.35, 0.25, 0.9))), 0.0);
+  vColour = colour * light;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(centre + position * cellSize, 1.0);
+}`;
+
+const fragmentShader = /* glsl */ `
+varying vec3 vColour;
+void main() { gl_FragColor = vec4(vColour, 1.0); }`;
+
+const unitCube = new THREE.BoxGeometry(1, 1, 1);
+
+export class VoxelLayer {
+  // file: metadata; level: its level; offset: the file's origin minus the scene origin.
+  constructor(file, level, offset, slice) {
+    this.file = file;
+    this.level = level;
+    this.total = file.levels[level].cells;
+    this.loaded = 0;
+    this.cellSize = file.levels[level].cell_size;
+    this.cells = new Float32Array(3 * this.total);
+    this.colours = new Uint8Array(3 * this.total);
+    this.classes = file.has_classes ? new Uint8Array(this.total) : null;
+    this.stored = file.has_colours ? new Uint8Array(3 * this.total) : null;
+    const geometry = new THREE.InstancedBufferGeometry();
+    geometry.index = unitCube.index;
+    geometry.setAttribute('position', unitCube.getAttribute('position'));
+    geometry.setAttribute('normal', unitCube.getAttribute('normal'));
+    this.cellAttribute = new THREE.InstancedBufferAttribute(this.cells, 3);
+    this.colourAttribute = new THREE.InstancedBufferAttribute(this.colours, 3, true);
+    geometry.setAttribute('cell', this.cellAttribute);
+    geometry.setAttribute('colour', this.colourAttribute);
+    geometry.instanceCount = 0;
+    this.material = new THREE.ShaderMaterial({
+      vertexShader,
+      fragmentShader,
+      uniforms: {
+        cellSize: { value: this.cellSize },
+        offset: { value: new THREE.Vector3(...offset) },
+        sliceAxis: slice.axis,
+        sliceAt: slice.at,
+        sliceOn: slice.on,
+      },
+    });
+    this.mesh = new THREE.Mesh(geometry, this.material);
+    this.mesh.frustumCulled = false;  // the geometry's bounds are one unit cube
+  }
+
+  // Appends a batch from fetchCells (batches arrive in order).
+  append(batch, colourOf) {
+    const at = batch.first;
+    for (let i = 0; i < 3 * batch.count; ++i) this.cells[3 * at + i] = batch.coords[i];
+    if (this.classes && batch.classes) this.classes.set(batch.classes, at);
+    if (this.stored && batch.colours) this.stored.set(batch.colours, 3 * at);
+    this.loaded = at + batch.count;
+    this.recolour(colourOf, at, this.loaded);
+    this.cellAttribute.needsUpdate = true;
+    this.mesh.geometry.instanceCount = this.loaded;
+  }
+
+  // colourOf(layer, i) -> [r, g, b] for cells [from, to).
+  recolour(colourOf, from = 0, to = this.loaded) {
+    for (let i = from; i < to; ++i) this.colours.set(colourOf(this, i), 3 * i);
+    this.colourAttribute.needsUpdate = true;
+  }
+
+  // The world z of cell i's centre, relative to the file's origin.
+  height(i) {
+    return (this.cells[3 * i + 2] + 0.5) * this.cellSize;
+  }
+}

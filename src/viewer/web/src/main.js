@@ -1,0 +1,389 @@
+// vola view: the page. Loads every file's metadata, streams levels coarse to fine as
+// binary batches, and answers clicks by casting the click's ray on the server at the
+// level shown. window.volaView exposes the state and a few actions for scripts (the
+// browser test drives the page through it and through real clicks).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { fetchCells, fetchFiles, fetchPick } from './api.js';
+import { VoxelLayer } from './layer.js';
+import { classColour, fileColour, rampColour } from './palette.js';
+
+const BATCH_CELLS = 1 << 20;
+// The default detail is the finest whose levels hold at most this many cells in all:
+// what a laptop's browser draws smoothly. Finer levels load when the slider asks.
+const DEFAULT_CELL_BUDGET = 3_000_000;
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('scene');
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setClearColor(0x15181d);
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(45, 1, 0.1, 1e7);
+camera.up.set(0, 0, 1);
+const controls = new OrbitControls(camera, canvas);
+controls.addEventListener('change', render);
+
+const slice = { on: { value: 0 }, axis: { value: new THREE.Vector3(0, 0, 1) }, at: { value: 0 } };
+const sliceHelper = new THREE.Mesh(new THREE.PlaneGeometry(1, 1),
+  new THREE.MeshBasicMaterial({ color: 0x66aaff, transparent: true, opacity: 0.15, side: THREE.DoubleSide,
+    depthWrite: false }));
+sliceHelper.visible = false;
+scene.add(sliceHelper);
+const highlight = new THREE.LineSegments(new THREE.EdgesGeometry(new THREE.BoxGeometry(1, 1, 1)),
+  new THREE.LineBasicMaterial({ color: 0xffffff }));
+highlight.visible = false;
+scene.add(highlight);
+
+const state = {
+  files: [],
+  sceneOrigin: [0, 0, 0],  // world point at the scene's 0 (float32 on the GPU needs small numbers)
+  bounds: null,            // world box of every file's voxels: { min, max }
+  detail: 1,
+  visible: [],
+  layers: new Map(),       // "file/level" -> VoxelLayer
+  colourMode: 'height',
+  lastPick: null,
+  loading: Promise.resolve(),
+};
+
+function render() {
+  renderer.render(scene, camera);
+}
+
+function resize() {
+  const w = window.innerWidth;
+  const h = window.innerHeight;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / h;
+  camera.updateProjectionMatrix();
+  render();
+}
+
+function levelOf(file) {
+  return Math.min(state.detail, file.depth) - 1;
+}
+
+function fileOffset(file) {
+  return file.origin.map((o, a) => o - state.sceneOrigin[a]);
+}
+
+function colourOf(layer, i) {
+  const file = layer.file;
+  switch (state.colourMode) {
+    case 'classification':
+      return layer.classes ? classColour(layer.classes[i]) : [150, 150, 150];
+    case 'stored':
+      return layer.stored ? [layer.stored[3 * i], layer.stored[3 * i + 1], layer.stored[3 * i + 2]] : [150, 150, 150];
+    case 'file':
+      return fileColour(file.index);
+    default: {
+      const z = file.origin[2] + layer.height(i);
+      return rampColour((z - state.bounds.min[2]) / Math.max(state.bounds.max[2] - state.bounds.min[2], 1e-9));
+    }
+  }
+}
+
+function setStatus(text, isError = false) {
+  $('status').textContent = text;
+  $('status').className = isError ? 'error' : '';
+}
+
+// Streams one level of one file in batches, drawing each as it arrives.
+async function loadLayer(file, level) {
+  const key = `${file.index}/${level}`;
+  let layer = state.layers.get(key);
+  if (layer && layer.loaded === layer.total) return layer;
+  if (!layer) {
+    layer = new VoxelLayer(file, level, fileOffset(file), slice);
+    state.layers.set(key, layer);
+    scene.add(layer.mesh);
+  }
+  updateVisibility();
+  while (layer.loaded < layer.total) {
+    setStatus(`${file.name}: level ${level}, ${layer.loaded.toLocaleString()} of ${layer.total.toLocaleString()} cells`);
+    const batch = await fetchCells(file.index, level, layer.loaded, BATCH_CELLS);
+    if (batch.count === 0) throw new Error(`${file.name}: the server sent no cells at ${layer.loaded}`);
+    layer.append(batch, colourOf);
+    render();
+  }
+  return layer;
+}
+
+function updateVisibility() {
+  for (const layer of state.layers.values())
+    layer.mesh.visible = state.visible[layer.file.index] && layer.level === levelOf(layer.file);
+  render();
+}
+
+// Shows detail d (1 = coarsest), loading every coarser level first so that something
+// is on screen at once; the queue keeps loads in order.
+function setDetail(d) {
+  state.detail = d;
+  $('detail').value = d;
+  $('detail-label').textContent = state.files.map((f) => {
+    const level = levelOf(f);
+    return `${f.name}: level ${level} of ${f.depth - 1}, ${f.levels[level].cells.toLocaleString()} cells` +
+      ` of ${f.levels[level].cell_size} units`;
+  }).join('\n');
+  updateVisibility();
+  state.loading = state.loading.then(async () => {
+    for (let step = 1; step <= d; ++step) {
+      for (const file of state.files) {
+        const level = Math.min(step, file.depth) - 1;
+        // Coarser levels are shown while they stream only when nothing finer is loaded yet.
+        await loadLayer(file, level);
+      }
+    }
+    updateVisibility();
+    setStatus('');
+  }).catch((e) => setStatus(e.message, true));
+  return state.loading;
+}
+
+function recolourAll() {
+  for (const layer of state.layers.values()) layer.recolour(colourOf);
+  renderLegend();
+  render();
+}
+
+function renderLegend() {
+  const legend = $('legend');
+  legend.replaceChildren();
+  const row = (rgb, text) => {
+    const div = document.createElement('div');
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = `rgb(${rgb.join(',')})`;
+    div.append(swatch, text);
+    legend.append(div);
+  };
+  if (state.colourMode === 'classification') {
+    const seen = new Map();
+    for (const f of state.files)
+      for (const c of f.classes) seen.set(c.code, (seen.get(c.code) || 0) + c.voxels);
+    for (const [code, voxels] of [...seen].sort((a, b) => a[0] - b[0])) {
+      const name = state.files.flatMap((f) => f.classes).find((c) => c.code === code).name;
+      row(classColour(code), `${code} ${name} (${voxels.toLocaleString()} voxels)`);
+    }
+    if (!seen.size) legend.append('no file has a classification column');
+  } else if (state.colourMode === 'height') {
+    row(rampColour(0), `${state.bounds.min[2].toFixed(2)} (lowest)`);
+    row(rampColour(1), `${state.bounds.max[2].toFixed(2)} (highest)`);
+  } else if (state.colourMode === 'file') {
+    for (const f of state.files) row(fileColour(f.index), f.name);
+  } else if (!state.files.some((f) => f.has_colours)) {
+    legend.append('no file has red/green/blue columns');
+  }
+}
+
+function updateSlice() {
+  const axis = Number($('slice-axis').value);
+  const { min, max } = state.bounds;
+  const t = Number($('slice-at').value) / 1000;
+  const at = min[axis] + t * (max[axis] - min[axis]);  // world
+  slice.on.value = $('slice-on').checked ? 1 : 0;
+  slice.axis.value.set(axis === 0 ? 1 : 0, axis === 1 ? 1 : 0, axis === 2 ? 1 : 0);
+  slice.at.value = at - state.sceneOrigin[axis];
+  state.sliceWorld = slice.on.value ? { axis, at } : null;
+  // The plane helper, spanning the scene's box on the other two axes.
+  sliceHelper.visible = slice.on.value === 1;
+  const centre = min.map((m, a) => (m + max[a]) / 2 - state.sceneOrigin[a]);
+  centre[axis] = slice.at.value;
+  sliceHelper.position.set(...centre);
+  sliceHelper.rotation.set(axis === 1 ? Math.PI / 2 : 0, axis === 0 ? Math.PI / 2 : 0, 0);
+  const extent = max.map((m, a) => m - min[a]);
+  const others = [0, 1, 2].filter((a) => a !== axis);
+  sliceHelper.scale.set(extent[others[0]] * 1.05 || 1, extent[others[1]] * 1.05 || 1, 1);
+  render();
+}
+
+// Casts the ray through a canvas point at every visible file's shown level and reports
+// the nearest hit. The slicing plane clips the ray as it hides cells.
+async function pickAt(clientX, clientY) {
+  const rect = canvas.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1,
+    -((clientY - rect.top) / rect.height) * 2 + 1);
+  const raycaster = new THREE.Raycaster();
+  raycaster.setFromCamera(ndc, camera);
+  const originWorld = raycaster.ray.origin.toArray().map((v, a) => v + state.sceneOrigin[a]);
+  const direction = raycaster.ray.direction.toArray();
+  let best = null;
+  for (const file of state.files) {
+    if (!state.visible[file.index]) continue;
+    const level = levelOf(file);
+    const size = file.levels[level].cell_size;
+    let o = originWorld.map((v, a) => (v - file.origin[a]) / size);
+    let skipped = 0;  // cell units travelled before the ray enters the kept side
+    let tMax;
+    if (state.sliceWorld) {
+      const a = state.sliceWorld.axis;
+      // Cells whose centre lies above the plane are hidden: keep indices <= k.
+      const k = Math.floor((state.sliceWorld.at - file.origin[a]) / size - 0.5);
+      const plane = k + 1;
+      if (o[a] > plane) {
+        if (direction[a] >= 0) continue;
+        skipped = (plane - o[a]) / direction[a];
+        o = o.map((v, i) => (i === a ? plane : v + skipped * direction[i]));
+      } else if (direction[a] > 0) {
+        tMax = (plane - o[a]) / direction[a];
+      }
+    }
+    const hit = await fetchPick(file.index, level, o, direction, tMax);
+    if (!hit.hit) continue;
+    const distance = (skipped + hit.t) * size;
+    if (!best || distance < best.distance) best = { ...hit, distance, file: file.index, fileName: file.name };
+  }
+  state.lastPick = best;
+  showPick(best);
+  return best;
+}
+
+function showPick(pick) {
+  const box = $('pick');
+  if (!pick) {
+    box.textContent = 'no voxel under the pointer';
+    box.dataset.voxel = '';
+    highlight.visible = false;
+    render();
+    return;
+  }
+  const fmt = (p) => p.map((v) => v.toFixed(3)).join(', ');
+  const lines = [
+    `file     ${pick.fileName}`,
+    `level    ${pick.level}, cell ${pick.cell.join(' ')} (${pick.cell_size} units)`,
+    `voxel    ${pick.voxel.join(' ')}${pick.level === state.files[pick.file].depth - 1 ? '' : ' (first in the cell)'}`,
+    `crs      ${fmt(pick.voxel_centre)}`,
+    `cell crs ${fmt(pick.centre)}`,
+    `rank     ${pick.rank}`,
+  ];
+  if (pick.class_name !== undefined) lines.push(`class    ${pick.attributes.classification} ${pick.class_name}`);
+  for (const [name, value] of Object.entries(pick.attributes))
+    if (name !== 'classification') lines.push(`${name.padEnd(8)} ${Number.isInteger(value) ? value : value.toFixed(3)}`);
+  box.textContent = lines.join('\n');
+  box.dataset.voxel = pick.voxel.join(' ');
+  box.dataset.file = pick.file;
+  highlight.visible = true;
+  highlight.scale.setScalar(pick.cell_size * 1.02);
+  highlight.position.set(...pick.centre.map((v, a) => v - state.sceneOrigin[a]));
+  render();
+}
+
+// Frames the whole scene from above and to the south.
+function frameAll() {
+  const { min, max } = state.bounds;
+  const centre = min.map((m, a) => (m + max[a]) / 2 - state.sceneOrigin[a]);
+  const radius = Math.max(Math.hypot(max[0] - min[0], max[1] - min[1], max[2] - min[2]) / 2, 1);
+  controls.target.set(...centre);
+  camera.position.set(centre[0], centre[1] - 1.15 * radius, centre[2] + 0.9 * radius);
+  camera.near = radius / 1000;
+  camera.far = radius * 100;
+  camera.updateProjectionMatrix();
+  controls.update();
+  render();
+}
+
+// Looks straight down at world point p from `height` above it: the canvas centre's ray
+// then passes through p (whatever the camera's roll).
+function lookDownAt(p, height) {
+  const target = p.map((v, a) => v - state.sceneOrigin[a]);
+  controls.target.set(...target);
+  camera.position.set(target[0], target[1], target[2] + height);
+  controls.update();
+  render();
+}
+
+function buildFileList() {
+  const list = $('files');
+  for (const file of state.files) {
+    const row = document.createElement('div');
+    row.className = 'file';
+    const label = document.createElement('label');
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.checked = true;
+    box.dataset.testid = `visible-${file.index}`;
+    box.addEventListener('change', () => { state.visible[file.index] = box.checked; updateVisibility(); });
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = `rgb(${fileColour(file.index).join(',')})`;
+    label.append(box, swatch, file.name);
+    const count = document.createElement('div');
+    const n = document.createElement('span');
+    n.className = 'count';
+    n.dataset.testid = `voxel-count-${file.index}`;
+    n.dataset.voxels = String(file.voxels);
+    n.textContent = file.voxels.toLocaleString('en-US');
+    count.append(n, ` voxels, depth ${file.depth}, voxel ${file.voxel_size} units` +
+      (file.epsg !== 2000 ? `, EPSG:${file.epsg}` : file.crs_wkt ? ', CRS from WKT' : ''));
+    row.append(label, count);
+    list.append(row);
+  }
+}
+
+async function main() {
+  state.files = await fetchFiles();
+  state.visible = state.files.map(() => true);
+  const nonEmpty = state.files.filter((f) => f.voxels > 0);
+  if (!nonEmpty.length) throw new Error('every file is empty');
+  state.sceneOrigin = [...nonEmpty[0].origin];
+  const min = [Infinity, Infinity, Infinity];
+  const max = [-Infinity, -Infinity, -Infinity];
+  for (const f of nonEmpty)
+    for (let a = 0; a < 3; ++a) {
+      min[a] = Math.min(min[a], f.origin[a] + f.voxels_min[a] * f.voxel_size);
+      max[a] = Math.max(max[a], f.origin[a] + (f.voxels_max[a] + 1) * f.voxel_size);
+    }
+  state.bounds = { min, max };
+  buildFileList();
+  const maxDepth = Math.max(...state.files.map((f) => f.depth));
+  $('detail').max = maxDepth;
+  let d = 1;
+  while (d < maxDepth && state.files.reduce((sum, f) => sum + f.levels[Math.min(d + 1, f.depth) - 1].cells, 0) <=
+    DEFAULT_CELL_BUDGET) ++d;
+  $('detail').addEventListener('input', () => setDetail(Number($('detail').value)));
+  $('colour').addEventListener('change', () => { state.colourMode = $('colour').value; recolourAll(); });
+  for (const id of ['slice-on', 'slice-axis', 'slice-at']) $(id).addEventListener('input', updateSlice);
+  // A click that did not drag the view picks.
+  let down = null;
+  canvas.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
+  canvas.addEventListener('pointerup', (e) => {
+    if (down && Math.hypot(e.clientX - down[0], e.clientY - down[1]) < 4)
+      pickAt(e.clientX, e.clientY).catch((err) => setStatus(err.message, true));
+    down = null;
+  });
+  window.addEventListener('resize', resize);
+  resize();
+  renderLegend();
+  updateSlice();
+  frameAll();
+  await setDetail(d);
+}
+
+// Turns the slicing plane on at world coordinate `at` of `axis` (0 x, 1 y, 2 z), or off.
+function setSlice(on, axis = 2, at = 0) {
+  $('slice-on').checked = on;
+  $('slice-axis').value = String(axis);
+  const { min, max } = state.bounds;
+  $('slice-at').value = String(Math.round(((at - min[axis]) / Math.max(max[axis] - min[axis], 1e-9)) * 1000));
+  updateSlice();
+  if (on) {
+    // Exactly `at`, not the slider's rounding of it.
+    slice.at.value = at - state.sceneOrigin[axis];
+    state.sliceWorld = { axis, at };
+    sliceHelper.position.setComponent(axis, slice.at.value);
+    render();
+  }
+}
+
+window.volaView = {
+  state,
+  setSlice,
+  ready: main().catch((e) => { setStatus(e.message, true); throw e; }),
+  whenIdle: () => state.loading,
+  setDetail,
+  pickAt,
+  lookDownAt,
+  frameAll,
+  render,
+};
