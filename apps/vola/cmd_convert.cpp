@@ -96,19 +96,20 @@ io::TextColumns text_columns(const ConvertArgs& a) {
   return columns;
 }
 
-io::Input load_input(const ConvertArgs& a) {
+// `progress` must outlive the returned Input: streaming readers report through it later.
+io::Input load_input(const ConvertArgs& a, Progress& progress) {
   const io::InputFormat& format = io::find_input_format(a.input, a.format);
   if (format.name != "text" && !a.attributes.empty()) throw InvalidArgument("--attribute applies to text input only");
   io::InputOptions options;
   options.attributes = !a.no_attributes;
   options.payload = a.nbits > 0;
+  options.stream = true;
   if (format.name == "text") options.text = text_columns(a);
   if (format.name != "dem" && (a.dem_base_given || a.dem_surface_only))
     throw InvalidArgument("--dem-base and --dem-surface-only apply to DEM input");
   if (a.dem_base_given) options.dem_base = a.dem_base;
   options.dem_surface_only = a.dem_surface_only;
-  Progress progress("reading " + a.input);
-  options.progress = [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); };
+  options.progress = [&progress](std::uint64_t done, std::uint64_t total) { progress.update(done, total); };
   io::Input input = format.read(a.input, options);
   if (!input.epsg && !input.wkt.empty()) input.epsg = geo::epsg_from_wkt(input.wkt);
   return input;
@@ -195,7 +196,8 @@ void run_convert(const ConvertArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   // Fail on a CRS PROJ does not know before reading gigabytes.
   if (a.crs_given) geo::crs_wkt(a.crs);
-  io::Input loaded = load_input(a);
+  Progress progress("reading " + a.input);
+  io::Input loaded = load_input(a, progress);
   if (a.solid && !loaded.is_mesh()) throw InvalidArgument("--solid applies to mesh input (triangles)");
   const bool one_to_one = maps_one_to_one(loaded, a);
 
@@ -233,6 +235,9 @@ void run_convert(const ConvertArgs& a) {
   Tree tree;
   if (one_to_one) {
     tree = build_from_grid(*loaded.grid, a.depth, report);
+  } else if (loaded.build) {
+    tree = loaded.build(options, &report);
+    if (report.points_in == 0) throw InvalidArgument(a.input + ": no points");
   } else {
     if (loaded.grid) loaded.cloud = grid_centres(*loaded.grid);
     if (loaded.is_mesh()) {
@@ -242,6 +247,7 @@ void run_convert(const ConvertArgs& a) {
       tree = loaded.terrain ? build_from_terrain(loaded, options, report) : build(loaded.cloud, options, &report);
     }
   }
+  progress.finish();
   tree.georef().epsg = options.epsg;
   // lat/lon of the bbox centre through PROJ, from the code or else the input's WKT.
   // A CRS PROJ cannot place leaves them 0 rather than failing the conversion, unless the

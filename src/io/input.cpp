@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <memory>
 
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
@@ -19,12 +20,18 @@ namespace vola::io {
 namespace {
 
 Input read_las_input(const std::string& path, const InputOptions& options) {
-  LasReader reader(path);
+  auto reader = std::make_shared<LasReader>(path);
   Input in;
   in.format = "las";
-  in.epsg = reader.header().epsg;
-  in.wkt = reader.header().wkt;
-  in.cloud = las_points(reader, options.attributes, options.payload, options.progress);
+  in.epsg = reader->header().epsg;
+  in.wkt = reader->header().wkt;
+  if (options.stream) {
+    in.build = [reader, options](BuildOptions& build_options, BuildReport* report) {
+      return build_las(*reader, build_options, options.attributes, options.payload, report, options.progress);
+    };
+  } else {
+    in.cloud = las_points(*reader, options.attributes, options.payload, options.progress);
+  }
   return in;
 }
 

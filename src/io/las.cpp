@@ -417,17 +417,17 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
 }
 
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
-               const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
+  if (chunk_points == 0) throw InvalidArgument("build_las: chunk_points must be positive");
   const LasHeader& hd = reader.header();
   LasChunk chunk;
-  constexpr std::size_t kChunk = 1 << 22;
   const std::uint64_t passes = options.bbox ? 1 : 2;
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
     constexpr double inf = std::numeric_limits<double>::infinity();
     Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
     reader.rewind();
-    while (const std::size_t n = reader.read(chunk, kChunk, true)) {
+    while (const std::size_t n = reader.read(chunk, chunk_points, true)) {
       for (std::size_t i = 0; i < n; ++i)
         for (int a = 0; a < 3; ++a) {
           box.min[a] = std::min(box.min[a], chunk.xyz[3 * i + a]);
@@ -444,7 +444,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
   reader.rewind();
-  while (reader.read(chunk, kChunk, !attributes && !payload) > 0) {
+  while (reader.read(chunk, chunk_points, !attributes && !payload) > 0) {
     if (attributes) las_attribute_values(hd, chunk, values);
     views.assign(values.begin(), values.end());
     if (payload) las_payloads(hd, chunk, payloads);

@@ -19,6 +19,9 @@ struct InputOptions {
   bool attributes = true;  // keep per-point attributes the format carries
   bool payload = false;    // build the reference's payload word per point where the format defines one
   TextColumns text;        // text formats: which columns are what
+  // Formats that can stream (LAS) leave Input::cloud empty and set Input::build, which
+  // reads the file in chunks into a vola::StreamBuilder: memory ~ voxels, not points.
+  bool stream = false;
   std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
@@ -39,6 +42,9 @@ struct Input {
   PointCloud cloud;                    // point formats
   std::optional<VoxelGrid> grid;       // voxel formats
   std::vector<Triangle> triangles;     // mesh formats
+  // Set by streaming readers (InputOptions::stream): builds the tree from the file,
+  // resolving the options like vola::build.
+  std::function<Tree(BuildOptions&, BuildReport*)> build;
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
   // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,

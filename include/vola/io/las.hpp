@@ -111,8 +111,11 @@ void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<st
 
 // The file straight into a tree in memory bounded by the voxels, not the points
 // (vola::StreamBuilder): one pass for the bounds (unless options.bbox is set), one to
-// build. Resolves `options` (depth, voxel size, origin) like vola::build.
+// build. Resolves `options` (depth, voxel size, origin) like vola::build. Memory: the
+// reduced voxels plus a chunk of `chunk_points` points (~100 bytes each).
+constexpr std::size_t kLasChunkPoints = std::size_t{1} << 20;
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
-               const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+               std::size_t chunk_points = kLasChunkPoints);
 
 }  // namespace vola::io

@@ -1,0 +1,166 @@
+// The streaming LAS path (io::build_las: two passes over chunks into a StreamBuilder,
+// what `vola convert` uses) against the obvious one (the whole file as a PointCloud,
+// then vola::build): the same tree for every shared LAS file and for a generated
+// multi-chunk file, in both quantization modes, with and without attribute columns
+// and payloads, and with a given bbox.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "io_test_data.hpp"
+#include "vola/file.hpp"
+#include "vola/io/las.hpp"
+
+namespace {
+
+using vola_io_test::Bytes;
+using vola_io_test::put;
+
+struct Case {
+  const char* name;
+  vola::Quantization quantization;
+  int depth;
+  double voxel_fraction;  // grid mode: voxel edge as a fraction of the largest extent
+  bool attributes;
+  bool payload;
+  bool given_bbox;
+};
+
+const Case kCases[] = {
+    {"toolkit occupancy", vola::Quantization::toolkit, 6, 0, false, false, false},
+    {"toolkit attributes", vola::Quantization::toolkit, 5, 0, true, false, false},
+    {"toolkit payload", vola::Quantization::toolkit, 7, 0, false, true, false},
+    {"grid occupancy", vola::Quantization::grid, 0, 1.0 / 40, false, false, false},
+    {"grid attributes and payload", vola::Quantization::grid, 0, 1.0 / 25, true, true, false},
+    {"grid with a bbox inside the points", vola::Quantization::grid, 0, 1.0 / 30, true, false, true},
+};
+
+vola::BuildOptions options_for(const Case& c, const vola::io::LasHeader& h) {
+  vola::BuildOptions o;
+  o.quantization = c.quantization;
+  o.depth = c.depth;
+  o.payload = c.payload;
+  const double extent = std::max({h.max[0] - h.min[0], h.max[1] - h.min[1], h.max[2] - h.min[2], 1e-3});
+  if (c.quantization == vola::Quantization::grid) o.voxel_size = extent * c.voxel_fraction;
+  if (c.given_bbox) {  // the middle of the header's box: some points fall outside
+    vola::Box b;
+    for (int a = 0; a < 3; ++a) {
+      const double q = (h.max[a] - h.min[a]) / 4;
+      b.min[a] = h.min[a] + q;
+      b.max[a] = h.max[a] - q;
+    }
+    o.bbox = b;
+  }
+  return o;
+}
+
+// Same words, payloads, attribute columns and frame; means may differ in the order of
+// floating-point summation only (per chunk, then across chunks).
+void expect_same_tree(const vola::Tree& got, const vola::Tree& want) {
+  ASSERT_EQ(got.depth(), want.depth());
+  ASSERT_EQ(got.voxel_count(), want.voxel_count());
+  EXPECT_TRUE(std::equal(got.words().begin(), got.words().end(), want.words().begin(), want.words().end()));
+  EXPECT_TRUE(std::equal(got.voxel_payloads().begin(), got.voxel_payloads().end(), want.voxel_payloads().begin(),
+                         want.voxel_payloads().end()));
+  EXPECT_EQ(got.frame().voxel_size, want.frame().voxel_size);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(got.frame().origin[a], want.frame().origin[a]);
+  ASSERT_EQ(got.attributes().size(), want.attributes().size());
+  for (std::size_t c = 0; c < got.attributes().size(); ++c) {
+    const auto& g = got.attributes().columns()[c];
+    const auto& w = want.attributes().columns()[c];
+    ASSERT_EQ(g.name(), w.name());
+    ASSERT_EQ(g.size(), w.size());
+    for (std::size_t v = 0; v < g.size(); ++v)
+      ASSERT_NEAR(g.get(v), w.get(v), 1e-6 * (1 + std::abs(w.get(v)))) << g.name() << " voxel " << v;
+  }
+}
+
+void check_file(const std::function<vola::io::LasReader()>& open, std::size_t chunk_points) {
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(c.name);
+    vola::io::LasReader reader = open();
+    vola::BuildOptions streamed = options_for(c, reader.header());
+    vola::BuildOptions whole = streamed;
+    vola::BuildReport streamed_report, whole_report;
+    const vola::Tree got =
+        vola::io::build_las(reader, streamed, c.attributes, c.payload, &streamed_report, {}, chunk_points);
+    reader.rewind();
+    const vola::PointCloud cloud = vola::io::las_points(reader, c.attributes, c.payload);
+    const vola::Tree want = vola::build(cloud, whole, &whole_report);
+    expect_same_tree(got, want);
+    EXPECT_EQ(streamed_report.points_in, whole_report.points_in);
+    EXPECT_EQ(streamed_report.points_outside, whole_report.points_outside);
+    if (!c.attributes) {
+      EXPECT_EQ(vola::serialize(got), vola::serialize(want));
+    }
+  }
+}
+
+// A LAS 1.2 format 3 file (RGB, GPS time) of `n` points in clusters, so that voxels get
+// several points with differing colours, classes and intensities.
+Bytes generated_las(std::size_t n, std::uint64_t seed) {
+  Bytes b(227, 0);
+  std::memcpy(b.data(), "LASF", 4);
+  b[24] = 1;
+  b[25] = 2;
+  const auto at = [&](std::size_t offset, auto value) { std::memcpy(&b[offset], &value, sizeof value); };
+  at(94, std::uint16_t{227});
+  at(96, std::uint32_t{227});
+  b[104] = 3;
+  at(105, std::uint16_t{34});
+  at(107, static_cast<std::uint32_t>(n));
+  const double scale = 0.01;
+  for (int a = 0; a < 3; ++a) at(131 + 8 * a, scale);
+  at(155, 1000.0);  // x offset
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> spread(0.0, 3.0);
+  std::uniform_int_distribution<int> centre(0, 200), small(0, 4);
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int32_t raw[3];
+    for (int a = 0; a < 3; ++a) {
+      raw[a] = static_cast<std::int32_t>((centre(rng) + spread(rng)) / scale);
+      const double v = raw[a] * scale + (a == 0 ? 1000.0 : 0.0);
+      lo[a] = std::min(lo[a], v);
+      hi[a] = std::max(hi[a], v);
+      put(b, raw[a]);
+    }
+    put(b, static_cast<std::uint16_t>(small(rng) * 100));  // intensity
+    b.push_back(static_cast<std::uint8_t>((1 + small(rng) % 3) | 3 << 3));  // return 1..3 of 3
+    b.push_back(static_cast<std::uint8_t>(small(rng) + 1));               // class
+    b.push_back(0);                                                       // scan angle
+    b.push_back(0);                                                       // user data
+    put(b, std::uint16_t{7});                                             // point source
+    put(b, static_cast<double>(i));                                       // GPS time
+    for (int k = 0; k < 3; ++k) put(b, static_cast<std::uint16_t>(small(rng) * 16000));
+  }
+  for (int a = 0; a < 3; ++a) {
+    at(179 + 16 * a, hi[a]);
+    at(187 + 16 * a, lo[a]);
+  }
+  return b;
+}
+
+TEST(LasStream, SharedFilesBuildAsTheWholeCloudDoes) {
+  VOLA_REQUIRE_DATA(data);
+  const auto files = vola_io_test::files_ending(data / "las", ".las");
+  ASSERT_GE(files.size(), 20u);
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.string());
+    // Chunks of 997 points: every file of more than that takes several chunks and merges.
+    check_file([&] { return vola::io::LasReader(file.string()); }, 997);
+  }
+}
+
+TEST(LasStream, GeneratedFileInManyChunksBuildsAsTheWholeCloudDoes) {
+  const Bytes bytes = generated_las(60000, 11);
+  for (const std::size_t chunk : {std::size_t{61}, std::size_t{4096}, std::size_t{1} << 20}) {
+    SCOPED_TRACE("chunk " + std::to_string(chunk));
+    check_file([&] { return vola::io::LasReader(bytes, "generated.las"); }, chunk);
+  }
+}
+
+}  // namespace
