@@ -3,6 +3,8 @@
 #include <fftw3.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <complex>
 #include <mutex>
 #include <thread>
@@ -119,6 +121,61 @@ std::vector<double> Convolver::apply(std::span<const double> signal, unsigned th
     run(parity, 0, threads);
   }
   return out;
+}
+
+std::vector<double> minimum_phase_fir(std::span<const double> magnitude, std::size_t taps) {
+  const std::size_t n = 2 * (magnitude.size() >= 1 ? magnitude.size() - 1 : 0);
+  if (n < 4 || (n & (n - 1)) != 0 || n > (std::size_t{1} << 24))
+    throw InvalidArgument("minimum_phase_fir: the magnitude needs 2^k + 1 bins (k >= 1)");
+  if (taps == 0 || taps > n) throw InvalidArgument("minimum_phase_fir: taps must be in [1, n]");
+  ComplexBuffer a = complex_buffer(n), b = complex_buffer(n);
+  fftw_plan forward = nullptr, inverse = nullptr;
+  {
+    std::lock_guard lock(planner_mutex());
+    forward = fftw_plan_dft_1d(static_cast<int>(n), a.get(), b.get(), FFTW_FORWARD, FFTW_ESTIMATE);
+    inverse = fftw_plan_dft_1d(static_cast<int>(n), b.get(), a.get(), FFTW_BACKWARD, FFTW_ESTIMATE);
+  }
+  struct Destroy {
+    fftw_plan f, i;
+    ~Destroy() {
+      std::lock_guard lock(planner_mutex());
+      if (f) fftw_destroy_plan(f);
+      if (i) fftw_destroy_plan(i);
+    }
+  } destroy{forward, inverse};
+  if (!forward || !inverse) throw Error("minimum_phase_fir: FFTW could not plan a transform");
+  const std::size_t half = n / 2;
+  // log |H| over the whole circle (even), then its real cepstrum.
+  for (std::size_t k = 0; k < n; ++k) {
+    const double m = magnitude[k <= half ? k : n - k];
+    b[k][0] = std::log(std::max(m, 1e-5));
+    b[k][1] = 0.0;
+  }
+  fftw_execute(inverse);  // a = n * cepstrum
+  // Fold the cepstrum onto positive quefrencies: the minimum-phase log spectrum.
+  for (std::size_t q = 0; q < n; ++q) {
+    const double c = a[q][0] / static_cast<double>(n);
+    const double w = q == 0 || q == half ? 1.0 : q < half ? 2.0 : 0.0;
+    a[q][0] = c * w;
+    a[q][1] = 0.0;
+  }
+  fftw_execute(forward);  // b = log H_min
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::complex<double> h = std::exp(std::complex<double>(b[k][0], b[k][1]));
+    b[k][0] = h.real();
+    b[k][1] = h.imag();
+  }
+  fftw_execute(inverse);  // a = n * h_min
+  std::vector<double> h(taps);
+  // The last eighth fades out with a half Hann window, so truncation does not ring.
+  const std::size_t fade = taps / 8;
+  for (std::size_t i = 0; i < taps; ++i) {
+    double w = 1.0;
+    if (fade > 0 && i >= taps - fade)
+      w = 0.5 + 0.5 * std::cos(std::numbers::pi * static_cast<double>(i - (taps - fade) + 1) / static_cast<double>(fade + 1));
+    h[i] = a[i][0] / static_cast<double>(n) * w;
+  }
+  return h;
 }
 
 std::vector<double> convolve(std::span<const double> signal, std::span<const double> filter) {

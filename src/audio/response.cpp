@@ -280,17 +280,20 @@ std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& t
   }
   std::vector<double> ir = std::move(per_kernel[0]);
   if (kernels == 0) return ir;
-  // Per-band materials: their bins through the material's filter, centred on the arrival.
+  // Per-band materials: their bins through the material's (minimum-phase) filter.
   std::vector<const Material*> band_materials;
   for (const Material& mat : scene.materials().slots())
     if (mat.per_band()) band_materials.push_back(&mat);
   for (std::uint16_t k = 1; k <= kernels; ++k) {
     if (per_kernel[k].empty()) continue;
-    const std::vector<double> kernel = band_kernel(*band_materials[k - 1], o.sample_rate);
-    const std::size_t centre = kernel.size() / 2;
-    const std::vector<double> shaped = convolve(per_kernel[k], kernel);
-    if (ir.size() < shaped.size() - centre) ir.resize(shaped.size() - centre, 0.0);
-    for (std::size_t i = centre; i < shaped.size(); ++i) ir[i - centre] += shaped[i];
+    // From the first arrival on: FFT rounding then cannot put sound before it.
+    const auto& h = per_kernel[k];
+    const std::size_t first = static_cast<std::size_t>(std::find_if(h.begin(), h.end(), [](double v) { return v != 0.0; }) - h.begin());
+    if (first == h.size()) continue;
+    const std::vector<double> shaped =
+        convolve(std::span<const double>(h).subspan(first), band_kernel(*band_materials[k - 1], o.sample_rate));
+    if (ir.size() < first + shaped.size()) ir.resize(first + shaped.size(), 0.0);
+    for (std::size_t i = 0; i < shaped.size(); ++i) ir[first + i] += shaped[i];
   }
   return ir;
 }
@@ -309,33 +312,23 @@ std::vector<Reflection> reflections(const AcousticScene& scene, const Point& sou
 }
 
 std::vector<double> band_kernel(const Material& material, double sample_rate) {
-  // About 60 Hz of resolution, enough to tell the 125 Hz band from its neighbours.
-  std::size_t taps = static_cast<std::size_t>(sample_rate / 60.0) | 1u;
-  taps = std::clamp<std::size_t>(taps, 31, 4095);
-  const std::size_t half = taps / 2;
   auto gain = [&](double f) {
     const auto& c = material.bands;
     if (f <= kOctaveBands.front()) return c.front();
     if (f >= kOctaveBands.back()) return c.back();
     const double octave = std::log2(f / kOctaveBands.front());
-    const std::size_t i = static_cast<std::size_t>(octave);
+    const auto i = std::min(static_cast<std::size_t>(octave), c.size() - 2);
     const double frac = octave - static_cast<double>(i);
     return c[i] + (c[i + 1] - c[i]) * frac;
   };
-  // Frequency sampling: a zero-phase cosine sum of the wanted magnitude at taps
-  // equally spaced frequencies, shifted to be causal, then a Hann window.
-  std::vector<double> h(taps);
-  const double n_taps = static_cast<double>(taps);
-  std::vector<double> g(half + 1);
-  for (std::size_t k = 0; k <= half; ++k) g[k] = gain(static_cast<double>(k) * sample_rate / n_taps);
-  for (std::size_t n = 0; n < taps; ++n) {
-    const double t = static_cast<double>(n) - static_cast<double>(half);
-    double sum = g[0];
-    for (std::size_t k = 1; k <= half; ++k) sum += 2.0 * g[k] * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) * t / n_taps);
-    const double window = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(n + 1) / (n_taps + 1.0));
-    h[n] = sum / n_taps * window;
-  }
-  return h;
+  // A design grid of about 6 Hz, and taps spanning about 1/60 s: enough to tell the 125 Hz
+  // band from its neighbours.
+  std::size_t n = 1024;
+  while (static_cast<double>(n) < sample_rate / 6.0 && n < (std::size_t{1} << 20)) n *= 2;
+  std::vector<double> magnitude(n / 2 + 1);
+  for (std::size_t k = 0; k < magnitude.size(); ++k) magnitude[k] = gain(static_cast<double>(k) * sample_rate / static_cast<double>(n));
+  const auto taps = std::clamp<std::size_t>(static_cast<std::size_t>(sample_rate / 60.0), 32, n);
+  return minimum_phase_fir(magnitude, taps);
 }
 
 }  // namespace vola::audio

@@ -174,19 +174,28 @@ TEST(AudioConvolve, MatchesTheDirectSumForManyLengths) {
   EXPECT_THROW(Convolver(std::vector<double>{}), InvalidArgument);
 }
 
-TEST(AudioConvolve, BandKernelFollowsTheBandCoefficients) {
+TEST(AudioConvolve, BandKernelFollowsTheBandCoefficientsAndStartsAtOnce) {
   const Material m{{0.9, 0.8, 0.6, 0.5, 0.3, 0.2}};
-  const double rate = 48000.0;
-  const std::vector<double> k = band_kernel(m, rate);
-  ASSERT_EQ(k.size() % 2, 1u);
-  const double centre = static_cast<double>(k.size() / 2);
-  for (std::size_t b = 0; b < kOctaveBands.size(); ++b) {
-    std::complex<double> sum = 0;
-    for (std::size_t n = 0; n < k.size(); ++n)
-      sum += k[n] * std::polar(1.0, -2.0 * std::numbers::pi * kOctaveBands[b] / rate * (static_cast<double>(n) - centre));
-    EXPECT_NEAR(std::abs(sum), m.bands[b], 0.03) << kOctaveBands[b] << " Hz";
-    EXPECT_NEAR(sum.imag(), 0.0, 1e-9) << "linear phase";
+  for (const double rate : {16000.0, 48000.0}) {
+    const std::vector<double> k = band_kernel(m, rate);
+    double total = 0.0, early = 0.0;
+    for (std::size_t n = 0; n < k.size(); ++n) {
+      total += k[n] * k[n];
+      if (static_cast<double>(n) < rate * 0.002) early += k[n] * k[n];
+    }
+    EXPECT_GT(early / total, 0.9) << "minimum phase: the energy comes first, at " << rate << " Hz";
+    for (std::size_t b = 0; b < kOctaveBands.size(); ++b) {
+      std::complex<double> sum = 0;
+      for (std::size_t n = 0; n < k.size(); ++n)
+        sum += k[n] * std::polar(1.0, -2.0 * std::numbers::pi * kOctaveBands[b] / rate * static_cast<double>(n));
+      EXPECT_NEAR(std::abs(sum), m.bands[b], 0.03) << kOctaveBands[b] << " Hz at " << rate << " Hz";
+    }
   }
+  // A flat magnitude is a scaled impulse.
+  const std::vector<double> flat = minimum_phase_fir(std::vector<double>(513, 0.25), 64);
+  EXPECT_NEAR(flat[0], 0.25, 1e-12);
+  for (std::size_t n = 1; n < flat.size(); ++n) EXPECT_NEAR(flat[n], 0.0, 1e-12);
+  EXPECT_THROW(minimum_phase_fir(std::vector<double>(100, 1.0), 10), InvalidArgument);
 }
 
 // ---- WAV ----

@@ -237,6 +237,38 @@ TEST(AudioResponse, BinsMatchASlowModelOnRandomClutter) {
   for (std::size_t i = 0; i < ir.size(); ++i) EXPECT_NEAR(ir[i], slow[i], 1e-12 * (1.0 + std::abs(slow[i]))) << i;
 }
 
+TEST(AudioResponse, PerBandMaterialsAddNoPreEcho) {
+  // The floor (z = 8) reflects per band; nothing may sound before the direct sound or
+  // before the floor's image-source arrival.
+  std::vector<Voxel> voxels;
+  for (std::uint32_t y = 0; y < 64; ++y)
+    for (std::uint32_t x = 0; x < 64; ++x) voxels.push_back({x, y, 8});
+  Tree tree = build_from_voxels(voxels, 3);
+  tree.set_frame(Frame{Quantization::grid, {0, 0, 0}, kVoxel});
+  AttributeColumn cls("classification", ValueType::u8, Reduction::majority, voxels.size());
+  for (std::size_t i = 0; i < voxels.size(); ++i) cls.set(i, 5);
+  tree.attributes().add(cls);
+  const MaterialTable table =
+      parse_material_table(R"({"attribute": "classification", "materials": {"5": [0.9, 0.8, 0.7, 0.5, 0.4, 0.3]}})", "m.json");
+  const AcousticScene scene(tree, table);
+  const Point s = world(20, 30, 20), l = world(45, 30, 25);
+  const Thresholded t = threshold(scene, s, l, options());
+  ASSERT_FALSE(t.bins.empty());
+  for (const Bin& b : t.bins) EXPECT_EQ(b.kernel, 1);
+  const std::vector<double> ir = make_filter(scene, t, options());
+  const double floor_arrival = image_source_sample(s, l, 2, 9 * kVoxel);
+  for (std::size_t i = 0; i < ir.size(); ++i) {
+    if (i == t.direct_sample) {
+      EXPECT_DOUBLE_EQ(ir[i], 1.0 / dist(s, l));
+    } else if (static_cast<double>(i) < floor_arrival - 1.0) {
+      EXPECT_EQ(ir[i], 0.0) << "sound at sample " << i << " before the floor's arrival " << floor_arrival;
+    }
+  }
+  double after = 0.0;
+  for (std::size_t i = t.direct_sample + 1; i < ir.size(); ++i) after += std::abs(ir[i]);
+  EXPECT_GT(after, 0.0);
+}
+
 TEST(AudioResponse, BlockedLineOfSightSilencesTheDirectSound) {
   Shoebox box = kRoom;
   const Tree room = shoebox_tree(box, kVoxel);

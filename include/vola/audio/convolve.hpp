@@ -32,6 +32,14 @@ class Convolver {
   std::unique_ptr<Plans> plans_;
 };
 
+// The minimum-phase FIR of `taps` taps whose magnitude response is `magnitude`, sampled
+// at the n/2 + 1 frequencies k * rate / n, k = 0 .. n/2 (n = 2 * (magnitude.size() - 1), a
+// power of two). Minimum phase: its energy comes as early as any causal filter's can, so a
+// reflection through it starts at its arrival (no pre-echo). Real cepstrum method
+// (Oppenheim and Schafer); magnitudes are floored at 1e-5 (-100 dB) for the logarithm.
+// Throws InvalidArgument for a bad size.
+std::vector<double> minimum_phase_fir(std::span<const double> magnitude, std::size_t taps);
+
 // Convolver(filter).apply(signal) on one thread.
 std::vector<double> convolve(std::span<const double> signal, std::span<const double> filter);
 

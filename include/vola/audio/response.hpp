@@ -20,7 +20,8 @@
 //   binning:     delay rounded to the nearest sample, amplitude to the nearest
 //                bin_width_db decibels; each bin adds count * its amplitude to the
 //                filter at its delay. Per-band materials get their own bins, and their
-//                bins pass through a linear-phase FIR shaped by the band coefficients.
+//                bins pass through a minimum-phase FIR shaped by the band coefficients
+//                (it starts at the arrival: no pre-echo).
 // Reflections arriving later than the straight-line travel time plus the reflection
 // window are left out (the late reverberation is not modelled).
 #pragma once
@@ -108,8 +109,9 @@ std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& r
 std::vector<Reflection> reflections(const AcousticScene& scene, const Point& source, const Point& listener,
                                     const ResponseOptions& options);
 
-// The linear-phase FIR (odd length, centre tap = its delay) whose magnitude follows a
-// per-band material's coefficients, interpolated over log frequency.
+// The minimum-phase FIR (about 1/60 s long, starting at tap 0) whose magnitude follows a
+// per-band material's coefficients, interpolated linearly over log frequency and held
+// flat below 125 Hz and above 4 kHz.
 std::vector<double> band_kernel(const Material& material, double sample_rate);
 
 }  // namespace vola::audio
