@@ -1,0 +1,441 @@
+#include "vola/slam/fusion.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tsdf_reader.hpp"
+#include "vola/error.hpp"
+
+namespace vola::slam {
+
+void FusionParams::check() const {
+  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (!positive(voxel_size)) throw InvalidArgument("voxel size must be positive");
+  if (!(truncation >= voxel_size) || !std::isfinite(truncation))
+    throw InvalidArgument("truncation must be at least the voxel size");
+  if (!(max_weight >= 1.0f)) throw InvalidArgument("max weight must be at least 1");
+  if (!(min_depth >= 0.0) || !(max_depth > min_depth) || !std::isfinite(max_depth))
+    throw InvalidArgument("need 0 <= min depth < max depth");
+  if (bilateral_radius < 0 || bilateral_radius > 16 || !positive(bilateral_sigma_space) ||
+      !positive(bilateral_sigma_depth))
+    throw InvalidArgument("bilateral filter: radius 0..16 and positive sigmas");
+  for (int it : icp_iterations)
+    if (it < 0 || it > 100) throw InvalidArgument("ICP iterations must be 0..100 per level");
+  if (!positive(icp_max_distance) || !positive(icp_max_angle_degrees) || !positive(max_step_translation) ||
+      !positive(max_step_rotation_degrees))
+    throw InvalidArgument("ICP thresholds must be positive");
+}
+
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+struct RayHitSample {
+  Eigen::Vector3d position, normal;
+  const TsdfVoxel* voxel = nullptr;
+};
+
+// The zero crossing between t_a (positive nearest-voxel value fa) and t_b (negative
+// fb): with trilinear values, a bracket grown by up to a voxel on each side (nearest
+// values change sign up to half a voxel away from the interpolated ones) and three
+// regula falsi steps; without them, the nearest values' linear interpolation.
+template <class Store, class GridAt>
+double refine_crossing(TsdfReader<Store>& reader, const GridAt& grid_at, double t_a, double fa, double t_b, double fb,
+                       double voxel) {
+  const double fallback = t_a + (t_b - t_a) * fa / (fa - fb);
+  double ia = 0.0, ib = 0.0;
+  if (!reader.trilinear(grid_at(t_a), ia) || !reader.trilinear(grid_at(t_b), ib)) return fallback;
+  if (!(ia > 0.0)) {
+    t_a -= voxel;
+    if (!reader.trilinear(grid_at(t_a), ia) || !(ia > 0.0)) return fallback;
+  }
+  if (!(ib < 0.0)) {
+    t_b += voxel;
+    if (!reader.trilinear(grid_at(t_b), ib) || !(ib < 0.0)) return fallback;
+  }
+  for (int step = 0; step < 3; ++step) {
+    const double t = t_a + (t_b - t_a) * ia / (ia - ib);
+    double f = 0.0;
+    if (!reader.trilinear(grid_at(t), f)) return t;
+    if (f == 0.0) return t;
+    if (f > 0.0) {
+      t_a = t;
+      ia = f;
+    } else {
+      t_b = t;
+      ib = f;
+    }
+  }
+  return t_a + (t_b - t_a) * ia / (ia - ib);
+}
+
+// Marches one ray (world origin o, unit direction d) from t_near to t_far metres: big
+// steps over unallocated bricks, steps of 0.8 of the stored distance (at least a voxel)
+// inside them, and the first positive-to-negative crossing refined by interpolation.
+template <class Store>
+std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometry& geometry, const Eigen::Vector3d& o,
+                                  const Eigen::Vector3d& d, double t_near, double t_far, double truncation) {
+  const double vs = geometry.voxel_size;
+  const Eigen::Vector3d go = (o - geometry.origin) / vs;
+  auto grid_at = [&](double t) -> Eigen::Vector3d { return go + d * (t / vs); };
+  double t = t_near, t_prev = 0.0, f_prev = 0.0;
+  bool prev_valid = false;
+  while (t < t_far) {
+    const Eigen::Vector3d g = grid_at(t);
+    const double fx = std::floor(g.x()), fy = std::floor(g.y()), fz = std::floor(g.z());
+    const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
+    if (!reader.brick_at(x >> 3, y >> 3, z >> 3)) {
+      // Leave the brick: the nearest exit plane over the three axes.
+      double exit = std::numeric_limits<double>::infinity();
+      const std::int64_t cell[3] = {x >> 3, y >> 3, z >> 3};
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.0) continue;
+        const double plane = static_cast<double>((d[a] > 0 ? cell[a] + 1 : cell[a]) * kBrickSide);
+        exit = std::min(exit, (plane - go[a]) / d[a] * vs);
+      }
+      t = std::max(t + vs * 1e-3, exit + vs * 1e-3);
+      prev_valid = false;
+      continue;
+    }
+    const TsdfVoxel* v = reader.voxel(x, y, z);
+    if (!v) {
+      prev_valid = false;
+      t += vs;
+      continue;
+    }
+    const double f = v->tsdf;
+    if (f < 0.0) {
+      if (!prev_valid || f_prev <= 0.0) return std::nullopt;  // entered from behind or from unknown space
+      const double t_hit = refine_crossing(reader, grid_at, t_prev, f_prev, t, f, vs);
+      const Eigen::Vector3d gh = grid_at(t_hit);
+      Eigen::Vector3d gradient;
+      for (int a = 0; a < 3; ++a) {
+        Eigen::Vector3d lo = gh, hi = gh;
+        lo[a] -= 1.0;
+        hi[a] += 1.0;
+        double f_lo = 0.0, f_hi = 0.0;
+        if (!reader.trilinear(lo, f_lo) || !reader.trilinear(hi, f_hi)) return std::nullopt;
+        gradient[a] = f_hi - f_lo;
+      }
+      const double length = gradient.norm();
+      if (!(length > 0.0)) return std::nullopt;
+      const auto hx = static_cast<std::int64_t>(std::floor(gh.x())), hy = static_cast<std::int64_t>(std::floor(gh.y())),
+                 hz = static_cast<std::int64_t>(std::floor(gh.z()));
+      const TsdfVoxel* at = reader.voxel(hx, hy, hz);
+      return RayHitSample{o + d * t_hit, gradient / length, at ? at : v};
+    }
+    t_prev = t;
+    f_prev = f;
+    prev_valid = true;
+    t += std::max(vs, 0.8 * f * truncation);
+  }
+  return std::nullopt;
+}
+
+Eigen::Vector3d pixel_direction(const Intrinsics& k, std::uint32_t u, std::uint32_t v) {
+  return Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+}
+
+Intrinsics level_intrinsics(const Intrinsics& k, int level) {
+  Intrinsics out = k;
+  for (int l = 0; l < level; ++l) out = out.halved();
+  return out;
+}
+
+}  // namespace
+
+template <class Store>
+VertexMap raycast(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height, const Pose& pose,
+                  const FusionParams& params) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::size_t n = std::size_t{width} * height;
+  VertexMap map{width, height, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan)),
+                std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan))};
+  const Eigen::Vector3d o = pose.translation();
+  const Eigen::Matrix3d r = pose.linear();
+  parallel_chunks(height, params.threads, [&](unsigned, std::size_t begin, std::size_t end) {
+    TsdfReader<Store> reader(store);
+    for (std::size_t y = begin; y < end; ++y)
+      for (std::uint32_t x = 0; x < width; ++x) {
+        const Eigen::Vector3d camera_dir = pixel_direction(k, x, static_cast<std::uint32_t>(y));
+        const double scale = camera_dir.norm();  // metres along the ray per metre of depth
+        const Eigen::Vector3d d = r * (camera_dir / scale);
+        const auto hit = march(reader, store.geometry(), o, d, params.min_depth * scale,
+                               params.max_depth * scale + params.truncation, params.truncation);
+        if (!hit) continue;
+        map.vertices[y * width + x] = hit->position.template cast<float>();
+        map.normals[y * width + x] = hit->normal.template cast<float>();
+      }
+  });
+  return map;
+}
+
+template <class Store>
+RgbImage render_view(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height,
+                     const Pose& pose, const FusionParams& params, bool use_colour) {
+  RgbImage image{width, height, std::vector<std::uint8_t>(std::size_t{width} * height * 3, 0)};
+  const Eigen::Vector3d o = pose.translation();
+  const Eigen::Matrix3d r = pose.linear();
+  parallel_chunks(height, params.threads, [&](unsigned, std::size_t begin, std::size_t end) {
+    TsdfReader<Store> reader(store);
+    for (std::size_t y = begin; y < end; ++y)
+      for (std::uint32_t x = 0; x < width; ++x) {
+        const Eigen::Vector3d camera_dir = pixel_direction(k, x, static_cast<std::uint32_t>(y));
+        const double scale = camera_dir.norm();
+        const Eigen::Vector3d d = r * (camera_dir / scale);
+        const auto hit = march(reader, store.geometry(), o, d, params.min_depth * scale,
+                               params.max_depth * scale + params.truncation, params.truncation);
+        if (!hit) continue;
+        const double light = 0.25 + 0.75 * std::max(0.0, -hit->normal.dot(d));
+        const std::uint8_t* colour = nullptr;
+        std::uint8_t grey[3] = {210, 210, 210};
+        colour = (use_colour && hit->voxel) ? &hit->voxel->r : grey;
+        for (int c = 0; c < 3; ++c)
+          image.rgb[(y * width + x) * 3 + c] = static_cast<std::uint8_t>(std::lround(std::min(255.0, colour[c] * light)));
+      }
+  });
+  return image;
+}
+
+std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics& k, const Pose& pose,
+                                       const VolumeGeometry& geometry, double truncation) {
+  const double brick_metres = kBrickSide * geometry.voxel_size;
+  const double side = geometry.bricks_per_side;
+  std::vector<std::uint64_t> keys;
+  std::uint64_t last = ~std::uint64_t{0};
+  for (std::uint32_t y = 0; y < depth.height; ++y)
+    for (std::uint32_t x = 0; x < depth.width; ++x) {
+      const double d = depth.at(x, y);
+      if (!(d > 0.0)) continue;
+      const Eigen::Vector3d dir = pixel_direction(k, x, y);
+      // Depth steps short enough that consecutive samples are at most half a brick apart.
+      const double step = brick_metres / (2 * dir.norm());
+      const int samples = static_cast<int>(std::ceil(2 * truncation / step));
+      for (int s = 0; s <= samples; ++s) {
+        const double z = d - truncation + 2 * truncation * s / samples;
+        if (z <= 0.0) continue;
+        const Eigen::Vector3d g = (pose * (dir * z) - geometry.origin) / brick_metres;
+        const double bx = std::floor(g.x()), by = std::floor(g.y()), bz = std::floor(g.z());
+        if (!(bx >= 0 && by >= 0 && bz >= 0 && bx < side && by < side && bz < side)) continue;
+        const std::uint64_t key = static_cast<std::uint64_t>(bz) << 42 | static_cast<std::uint64_t>(by) << 21 |
+                                  static_cast<std::uint64_t>(bx);
+        if (key != last) keys.push_back(key);
+        last = key;
+      }
+    }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<BrickCoord> bricks;
+  bricks.reserve(keys.size());
+  const std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
+  for (const auto key : keys)
+    bricks.push_back({static_cast<std::uint32_t>(key & mask), static_cast<std::uint32_t>((key >> 21) & mask),
+                      static_cast<std::uint32_t>(key >> 42)});
+  return bricks;
+}
+
+template <class Store>
+Fusion<Store>::Fusion(Store& store, const Intrinsics& intrinsics, std::uint32_t width, std::uint32_t height,
+                      const FusionParams& params)
+    : store_(store), intrinsics_(intrinsics), width_(width), height_(height), params_(params) {
+  params.check();
+  intrinsics.check();
+  if (std::abs(store.geometry().voxel_size - params.voxel_size) > 1e-12 * params.voxel_size)
+    throw InvalidArgument("the store's voxel size differs from the fusion parameters'");
+  if (width < (1u << kPyramidLevels) || height < (1u << kPyramidLevels))
+    throw InvalidArgument("images must be at least 8 x 8 pixels");
+}
+
+template <class Store>
+std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLevels>& frame, int* correspondences) const {
+  Pose estimate = pose_;
+  const Pose previous_inverse = pose_.inverse();
+  const double cos_max = std::cos(params_.icp_max_angle_degrees * M_PI / 180.0);
+  const unsigned chunks = resolve_threads(params_.threads);
+  int last_count = 0;
+  for (int level = kPyramidLevels - 1; level >= 0; --level) {
+    const Intrinsics k = level_intrinsics(intrinsics_, level);
+    const VertexMap& current = frame[level];
+    const VertexMap& model = model_.levels[level];
+    for (int iteration = 0; iteration < params_.icp_iterations[level]; ++iteration) {
+      struct Sums {
+        Mat6 a = Mat6::Zero();
+        Vec6 b = Vec6::Zero();
+        int count = 0;
+      };
+      std::vector<Sums> sums(chunks);
+      const Eigen::Matrix3d rotation = estimate.linear();
+      parallel_chunks(current.height, params_.threads, [&](unsigned chunk, std::size_t begin, std::size_t end) {
+        Sums& s = sums[chunk];
+        for (std::size_t y = begin; y < end; ++y)
+          for (std::uint32_t x = 0; x < current.width; ++x) {
+            const std::size_t i = y * current.width + x;
+            if (!current.valid(i)) continue;
+            const Eigen::Vector3d p = estimate * current.vertices[i].template cast<double>();
+            const Eigen::Vector3d n = rotation * current.normals[i].template cast<double>();
+            const Eigen::Vector3d q = previous_inverse * p;
+            if (q.z() <= 0.0) continue;
+            const double u = std::floor(k.fx * q.x() / q.z() + k.cx + 0.5), v = std::floor(k.fy * q.y() / q.z() + k.cy + 0.5);
+            if (!(u >= 0 && v >= 0 && u < model.width && v < model.height)) continue;
+            const std::size_t j = static_cast<std::size_t>(v) * model.width + static_cast<std::size_t>(u);
+            if (!model.valid(j)) continue;
+            const Eigen::Vector3d vm = model.vertices[j].template cast<double>(), nm = model.normals[j].template cast<double>();
+            const Eigen::Vector3d diff = p - vm;
+            if (diff.squaredNorm() > params_.icp_max_distance * params_.icp_max_distance) continue;
+            if (n.dot(nm) < cos_max) continue;
+            Vec6 jac;
+            jac << p.cross(nm), nm;
+            const double r = nm.dot(diff);
+            s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac);
+            s.b -= jac * r;
+            ++s.count;
+          }
+      });
+      Sums total;
+      for (const auto& s : sums) {  // in chunk order: reproducible
+        total.a += s.a;
+        total.b += s.b;
+        total.count += s.count;
+      }
+      const Mat6 a = total.a.template selfadjointView<Eigen::Upper>();
+      last_count = total.count;
+      if (total.count < 6) return std::nullopt;
+      const Eigen::SelfAdjointEigenSolver<Mat6> eigen(a, Eigen::EigenvaluesOnly);
+      if (!(eigen.eigenvalues()(0) > 1e-6 * eigen.eigenvalues()(5))) return std::nullopt;  // degenerate geometry
+      const Vec6 xi = a.ldlt().solve(total.b);
+      if (!xi.allFinite()) return std::nullopt;
+      const Eigen::Vector3d omega = xi.head<3>();
+      Pose increment = Pose::Identity();
+      const double angle = omega.norm();
+      if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+      increment.translation() = xi.tail<3>();
+      estimate = increment * estimate;
+      if (xi.norm() < 1e-7) break;
+    }
+  }
+  *correspondences = last_count;
+  const Pose step = pose_.inverse() * estimate;
+  const double rotation_degrees = Eigen::AngleAxisd(step.linear()).angle() * 180.0 / M_PI;
+  if (step.translation().norm() > params_.max_step_translation || rotation_degrees > params_.max_step_rotation_degrees)
+    return std::nullopt;
+  const std::size_t pixels = std::size_t{width_} * height_;
+  if (static_cast<std::size_t>(last_count) * 100 < pixels) return std::nullopt;  // under 1% associated
+  return estimate;
+}
+
+template <class Store>
+void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, const Pose& pose) {
+  const VolumeGeometry& geometry = store_.geometry();
+  const std::vector<BrickCoord> bricks = bricks_in_band(depth, intrinsics_, pose, geometry, params_.truncation);
+  std::vector<TsdfVoxel*> data(bricks.size());
+  for (std::size_t i = 0; i < bricks.size(); ++i) data[i] = store_.allocate(bricks[i]);
+  const Pose world_to_camera = pose.inverse();
+  const Eigen::Matrix3d r = world_to_camera.linear();
+  const Eigen::Vector3d t = world_to_camera.translation();
+  const Intrinsics k = intrinsics_;
+  const double vs = geometry.voxel_size, truncation = params_.truncation;
+  const float max_weight = params_.max_weight;
+  parallel_chunks(bricks.size(), params_.threads, [&](unsigned, std::size_t begin, std::size_t end) {
+    for (std::size_t b = begin; b < end; ++b) {
+      const BrickCoord c = bricks[b];
+      for (int i = 0; i < kBrickVoxels; ++i) {
+        const int lx = i & 7, ly = (i >> 3) & 7, lz = i >> 6;
+        const Eigen::Vector3d world =
+            geometry.origin + vs * Eigen::Vector3d(c.x * 8.0 + lx + 0.5, c.y * 8.0 + ly + 0.5, c.z * 8.0 + lz + 0.5);
+        const Eigen::Vector3d p = r * world + t;
+        if (p.z() <= 0.0) continue;
+        const double u = std::floor(k.fx * p.x() / p.z() + k.cx + 0.5), v = std::floor(k.fy * p.y() / p.z() + k.cy + 0.5);
+        if (!(u >= 0 && v >= 0 && u < depth.width && v < depth.height)) continue;
+        const std::size_t pixel = static_cast<std::size_t>(v) * depth.width + static_cast<std::size_t>(u);
+        const double d = depth.metres[pixel];
+        if (!(d > 0.0)) continue;
+        const double sdf = d - p.z();
+        if (sdf < -truncation) continue;
+        const float f = static_cast<float>(std::min(1.0, sdf / truncation));
+        TsdfVoxel& voxel = data[b][i];
+        const float w = voxel.weight;
+        voxel.tsdf = (voxel.tsdf * w + f) / (w + 1.0f);
+        if (rgb && std::abs(sdf) < truncation * 0.5) {
+          const std::uint8_t* c3 = &rgb->rgb[pixel * 3];
+          voxel.r = static_cast<std::uint8_t>(std::lround((voxel.r * w + c3[0]) / (w + 1.0f)));
+          voxel.g = static_cast<std::uint8_t>(std::lround((voxel.g * w + c3[1]) / (w + 1.0f)));
+          voxel.b = static_cast<std::uint8_t>(std::lround((voxel.b * w + c3[2]) / (w + 1.0f)));
+        }
+        voxel.weight = std::min(w + 1.0f, max_weight);
+      }
+    }
+  });
+}
+
+template <class Store>
+DepthImage Fusion<Store>::clipped(const DepthImage& raw, const RgbImage* rgb) const {
+  if (raw.width != width_ || raw.height != height_)
+    throw InvalidArgument("depth frame is " + std::to_string(raw.width) + " x " + std::to_string(raw.height) +
+                          ", the sequence's first was " + std::to_string(width_) + " x " + std::to_string(height_));
+  if (rgb && (rgb->width != width_ || rgb->height != height_))
+    throw InvalidArgument("colour frame size differs from the depth frame's");
+  DepthImage depth = raw;
+  for (float& d : depth.metres)
+    if (!(d >= params_.min_depth && d <= params_.max_depth)) d = 0.0f;
+  return depth;
+}
+
+template <class Store>
+void Fusion<Store>::integrate_and_predict(const DepthImage& depth, const RgbImage* rgb) {
+  integrate(depth, rgb, pose_);
+  model_.levels[0] = raycast(store_, intrinsics_, width_, height_, pose_, params_);
+  for (int l = 1; l < kPyramidLevels; ++l) model_.levels[l] = halve_vertex_map(model_.levels[l - 1]);
+}
+
+template <class Store>
+FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, const Pose& initial_pose) {
+  const DepthImage depth = clipped(raw, rgb);
+  FrameResult result;
+  if (frames_ == 0) {
+    pose_ = initial_pose;
+  } else {
+    std::array<DepthImage, kPyramidLevels> pyramid;
+    pyramid[0] = bilateral_filter(depth, params_.bilateral_radius, params_.bilateral_sigma_space,
+                                  params_.bilateral_sigma_depth, params_.threads);
+    for (int l = 1; l < kPyramidLevels; ++l) pyramid[l] = halve_depth(pyramid[l - 1], params_.bilateral_sigma_depth);
+    std::array<VertexMap, kPyramidLevels> maps;
+    for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
+    int correspondences = 0;
+    const auto tracked = track(maps, &correspondences);
+    result.correspondences = correspondences;
+    result.tracked = tracked.has_value();
+    if (tracked) pose_ = *tracked;
+  }
+  result.pose = pose_;
+  ++frames_;
+  if (result.tracked) integrate_and_predict(depth, rgb);
+  return result;
+}
+
+template <class Store>
+FrameResult Fusion<Store>::process_at_pose(const DepthImage& raw, const RgbImage* rgb, const Pose& pose) {
+  const DepthImage depth = clipped(raw, rgb);
+  pose_ = pose;
+  ++frames_;
+  integrate_and_predict(depth, rgb);
+  FrameResult result;
+  result.pose = pose_;
+  return result;
+}
+
+template class Fusion<SparseTsdfStore>;
+template class Fusion<DenseTsdfStore>;
+template VertexMap raycast(const SparseTsdfStore&, const Intrinsics&, std::uint32_t, std::uint32_t, const Pose&,
+                           const FusionParams&);
+template VertexMap raycast(const DenseTsdfStore&, const Intrinsics&, std::uint32_t, std::uint32_t, const Pose&,
+                           const FusionParams&);
+template RgbImage render_view(const SparseTsdfStore&, const Intrinsics&, std::uint32_t, std::uint32_t, const Pose&,
+                              const FusionParams&, bool);
+template RgbImage render_view(const DenseTsdfStore&, const Intrinsics&, std::uint32_t, std::uint32_t, const Pose&,
+                              const FusionParams&, bool);
+
+}  // namespace vola::slam

@@ -1,0 +1,61 @@
+// Reading voxels of either TSDF store with the last brick remembered (internal).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+
+#include "vola/slam/tsdf_store.hpp"
+
+namespace vola::slam {
+
+// Voxel reads with the last brick remembered (rays and neighbours stay in one brick for
+// many reads). One per thread.
+template <class Store>
+class TsdfReader {
+ public:
+  explicit TsdfReader(const Store& store) : store_(store), side_(store.geometry().bricks_per_side) {}
+  const TsdfVoxel* brick_at(std::int64_t bx, std::int64_t by, std::int64_t bz) {
+    if (bx < 0 || by < 0 || bz < 0 || bx >= side_ || by >= side_ || bz >= side_) return nullptr;
+    const BrickCoord c{static_cast<std::uint32_t>(bx), static_cast<std::uint32_t>(by), static_cast<std::uint32_t>(bz)};
+    if (!(has_last_ && c == last_)) {
+      last_ = c;
+      has_last_ = true;
+      brick_ = store_.brick(c);
+    }
+    return brick_;
+  }
+  // The observed voxel (weight > 0) at integer coordinates, or nullptr.
+  const TsdfVoxel* voxel(std::int64_t x, std::int64_t y, std::int64_t z) {
+    const TsdfVoxel* b = brick_at(x >> 3, y >> 3, z >> 3);
+    if (!b) return nullptr;
+    const TsdfVoxel* v = b + local_index(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                         static_cast<std::uint32_t>(z));
+    return v->weight > 0.0f ? v : nullptr;
+  }
+  // Trilinear TSDF at grid position g (voxel centres at integer + 0.5); false unless all
+  // eight voxels are observed.
+  bool trilinear(const Eigen::Vector3d& g, double& f) {
+    const Eigen::Vector3d s = g - Eigen::Vector3d::Constant(0.5);
+    const double fx = std::floor(s.x()), fy = std::floor(s.y()), fz = std::floor(s.z());
+    const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
+    const double ax = s.x() - fx, ay = s.y() - fy, az = s.z() - fz;
+    double sum = 0.0;
+    for (int c = 0; c < 8; ++c) {
+      const TsdfVoxel* v = voxel(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
+      if (!v) return false;
+      sum += ((c & 1) ? ax : 1 - ax) * ((c & 2) ? ay : 1 - ay) * ((c & 4) ? az : 1 - az) * v->tsdf;
+    }
+    f = sum;
+    return true;
+  }
+
+ private:
+  const Store& store_;
+  std::int64_t side_;
+  BrickCoord last_;
+  bool has_last_ = false;
+  const TsdfVoxel* brick_ = nullptr;
+};
+
+}  // namespace vola::slam
