@@ -56,5 +56,27 @@ class FormatError : public Error {
   std::string cause_;
 };
 
+// Builds without exceptions (-fno-exceptions, e.g. for a microcontroller): every place
+// the library would throw calls the error handler with the error's what() instead. The
+// handler must not return (log and reset, longjmp out, or exit); when it does, or when
+// none is set, the message goes to stderr and the program aborts. Not thread-safe to
+// change while the library runs. With exceptions (the default) the handler is unused:
+// errors are thrown as documented. See docs/EMBEDDED.md.
+using ErrorHandler = void (*)(const char* message);
+// Returns the previous handler (nullptr = the default).
+ErrorHandler set_error_handler(ErrorHandler handler) noexcept;
+
+namespace detail {
+[[noreturn]] void fail(const Error& error) noexcept;
+}  // namespace detail
+
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola
+
+// `VOLA_THROW(FormatError(...))`: throws, or calls the error handler when exceptions
+// are off.
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+#define VOLA_THROW(...) throw __VA_ARGS__
+#else
+#define VOLA_THROW(...) ::vola::detail::fail(__VA_ARGS__)
+#endif

@@ -64,9 +64,9 @@ std::optional<Reduction> parse_reduction(std::string_view name) noexcept {
 AttributeColumn::AttributeColumn(std::string name, ValueType type, Reduction reduction,
                                  std::size_t count)
     : name_(std::move(name)), type_(type), reduction_(reduction), bytes_(count * size_of(type)) {
-  if (static_cast<int>(type) > 9) throw InvalidArgument("attribute " + name_ + ": unknown value type");
+  if (static_cast<int>(type) > 9) VOLA_THROW(InvalidArgument("attribute " + name_ + ": unknown value type"));
   if (static_cast<int>(reduction) > 4)
-    throw InvalidArgument("attribute " + name_ + ": unknown reduction");
+    VOLA_THROW(InvalidArgument("attribute " + name_ + ": unknown reduction"));
 }
 
 double AttributeColumn::get(std::size_t rank) const {
@@ -115,7 +115,7 @@ AttributeColumn* Attributes::find(std::string_view name) noexcept {
 }
 
 AttributeColumn& Attributes::add(AttributeColumn column) {
-  if (find(column.name())) throw InvalidArgument("attribute '" + column.name() + "' exists already");
+  if (find(column.name())) VOLA_THROW(InvalidArgument("attribute '" + column.name() + "' exists already"));
   columns_.push_back(std::move(column));
   return columns_.back();
 }

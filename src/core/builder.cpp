@@ -20,7 +20,7 @@ constexpr std::size_t kBuckets = std::size_t{1} << kRadixBits;
 
 void check_depth(int depth) {
   if (depth < kMinDepth || depth > kMaxDepth)
-    throw InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
+    VOLA_THROW(InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10"));
 }
 
 // Reduces the values of one voxel's points (indices in input order) to one value.
@@ -160,7 +160,7 @@ Box PointCloud::bounds() const noexcept {
 void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int key_bits) {
   const std::size_t n = keys.size();
   const bool with_index = index && !index->empty();
-  if (with_index && index->size() != n) throw InvalidArgument("radix_sort: index size differs");
+  if (with_index && index->size() != n) VOLA_THROW(InvalidArgument("radix_sort: index size differs"));
   if (n < 2) return;
   const int passes = (key_bits + kRadixBits - 1) / kRadixBits;
   std::vector<std::size_t> counts(kBuckets * static_cast<std::size_t>(passes), 0);
@@ -197,8 +197,8 @@ Tree build_from_sorted_keys(std::span<const Key> keys, int depth) {
   check_depth(depth);
   const Key limit = Key{1} << (6 * depth);
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (keys[i] >= limit) throw InvalidArgument("key " + std::to_string(keys[i]) + " is too large for depth " + std::to_string(depth));
-    if (i > 0 && keys[i] <= keys[i - 1]) throw InvalidArgument("keys are not sorted and unique");
+    if (keys[i] >= limit) VOLA_THROW(InvalidArgument("key " + std::to_string(keys[i]) + " is too large for depth " + std::to_string(depth)));
+    if (i > 0 && keys[i] <= keys[i - 1]) VOLA_THROW(InvalidArgument("keys are not sorted and unique"));
   }
   return detail::emit_levels(keys, depth, {}, false);
 }
@@ -207,7 +207,7 @@ Tree build_from_keys(std::vector<Key> keys, int depth) {
   check_depth(depth);
   const Key limit = Key{1} << (6 * depth);
   for (const Key k : keys)
-    if (k >= limit) throw InvalidArgument("key " + std::to_string(k) + " is too large for depth " + std::to_string(depth));
+    if (k >= limit) VOLA_THROW(InvalidArgument("key " + std::to_string(k) + " is too large for depth " + std::to_string(depth)));
   if (bitmap_build_fits(keys.size(), depth)) return build_by_bitmap<Key>(keys, depth);
   radix_sort(keys, nullptr, 6 * depth);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
@@ -230,9 +230,9 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
     if (all >= side) {
       for (const Voxel& v : voxels)
         if (v.x >= side || v.y >= side || v.z >= side)
-          throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
+          VOLA_THROW(InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
                                 std::to_string(v.z) + ") is outside the depth-" + std::to_string(depth) +
-                                " grid of side " + std::to_string(side));
+                                " grid of side " + std::to_string(side)));
     }
     return build_by_bitmap<std::uint32_t>({keys.get(), voxels.size()}, depth);
   }
@@ -240,9 +240,9 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const Voxel& v = voxels[i];
     if (v.x >= side || v.y >= side || v.z >= side)
-      throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
+      VOLA_THROW(InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
                             std::to_string(v.z) + ") is outside the depth-" + std::to_string(depth) +
-                            " grid of side " + std::to_string(side));
+                            " grid of side " + std::to_string(side)));
     keys[i] = encode(v);
   }
   radix_sort(keys, nullptr, 6 * depth);
@@ -252,13 +252,13 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
 
 Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options) {
   if (options.quantization == Quantization::toolkit) {
-    if (options.depth == 0) throw InvalidArgument("toolkit quantization needs a depth");
+    if (options.depth == 0) VOLA_THROW(InvalidArgument("toolkit quantization needs a depth"));
     return Quantizer::toolkit(bbox, options.depth);
   }
   double extent_from_min = 0.0;
   for (int a = 0; a < 3; ++a) extent_from_min = std::max(extent_from_min, bbox.max[a] - bbox.min[a]);
   if (options.voxel_size <= 0.0) {
-    if (options.depth == 0) throw InvalidArgument("grid quantization needs a voxel size or a depth");
+    if (options.depth == 0) VOLA_THROW(InvalidArgument("grid quantization needs a voxel size or a depth"));
     // The largest extent spans all but a sliver of the grid, so the max point lands
     // in the last voxel.
     const double side = static_cast<double>(side_of(options.depth));
@@ -281,16 +281,16 @@ Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options) {
 Tree build(const PointCloud& cloud, const BuildOptions& requested, BuildReport* report) {
   BuildOptions options = requested;
   const std::size_t n = cloud.size();
-  if (cloud.xyz.size() != 3 * n) throw InvalidArgument("point cloud: xyz size is not a multiple of 3");
+  if (cloud.xyz.size() != 3 * n) VOLA_THROW(InvalidArgument("point cloud: xyz size is not a multiple of 3"));
   if (!cloud.payload.empty() && cloud.payload.size() != n)
-    throw InvalidArgument("point cloud: " + std::to_string(cloud.payload.size()) + " payloads for " +
-                          std::to_string(n) + " points");
+    VOLA_THROW(InvalidArgument("point cloud: " + std::to_string(cloud.payload.size()) + " payloads for " +
+                          std::to_string(n) + " points"));
   for (const auto& a : cloud.attributes)
     if (a.values.size() != n)
-      throw InvalidArgument("attribute '" + a.name + "': " + std::to_string(a.values.size()) +
-                            " values for " + std::to_string(n) + " points");
+      VOLA_THROW(InvalidArgument("attribute '" + a.name + "': " + std::to_string(a.values.size()) +
+                            " values for " + std::to_string(n) + " points"));
   if (n > std::numeric_limits<std::uint32_t>::max())
-    throw InvalidArgument("more than 2^32 points in one build: split the input (vola tile)");
+    VOLA_THROW(InvalidArgument("more than 2^32 points in one build: split the input (vola tile)"));
 
   const Box bbox = options.bbox ? *options.bbox : cloud.bounds();
   const Quantizer quantizer = resolve_quantizer(bbox, options);

@@ -59,9 +59,9 @@ class ByteReader {
   }
   void need(std::uint64_t n, const char* what) const {
     if (n > bytes_.size() - at_)
-      throw FormatError(name_, offset(),
+      VOLA_THROW(FormatError(name_, offset(),
                         std::string(what) + " needs " + std::to_string(n) + " bytes but only " +
-                            std::to_string(bytes_.size() - at_) + " remain");
+                            std::to_string(bytes_.size() - at_) + " remain"));
   }
   std::uint64_t offset() const noexcept { return base_ + at_; }
   std::size_t remaining() const noexcept { return bytes_.size() - at_; }
@@ -69,9 +69,9 @@ class ByteReader {
     const std::size_t pad = (alignment - (base_ + at_) % alignment) % alignment;
     at_ += std::min(pad, remaining());
   }
-  [[noreturn]] void fail(const std::string& cause) const { throw FormatError(name_, offset(), cause); }
+  [[noreturn]] void fail(const std::string& cause) const { VOLA_THROW(FormatError(name_, offset(), cause)); }
   [[noreturn]] void fail_at(std::uint64_t offset, const std::string& cause) const {
-    throw FormatError(name_, offset, cause);
+    VOLA_THROW(FormatError(name_, offset, cause));
   }
 
  private:

@@ -18,7 +18,7 @@ bool zstd_available() noexcept { return true; }
 std::vector<std::uint8_t> zstd_compress(std::span<const std::uint8_t> raw, int level) {
   std::vector<std::uint8_t> out(ZSTD_compressBound(raw.size()));
   const std::size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), level);
-  if (ZSTD_isError(n)) throw Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
+  if (ZSTD_isError(n)) VOLA_THROW(Error(std::string("zstd compression failed: ") + ZSTD_getErrorName(n)));
   out.resize(n);
   return out;
 }
@@ -27,30 +27,30 @@ std::vector<std::uint8_t> zstd_decompress(std::span<const std::uint8_t> packed, 
                                           const std::string& name, std::uint64_t offset) {
   const unsigned long long declared = ZSTD_getFrameContentSize(packed.data(), packed.size());
   if (declared == ZSTD_CONTENTSIZE_ERROR)
-    throw FormatError(name, offset, "compressed data is not a zstd frame");
+    VOLA_THROW(FormatError(name, offset, "compressed data is not a zstd frame"));
   if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != raw_size)
-    throw FormatError(name, offset,
+    VOLA_THROW(FormatError(name, offset,
                       "zstd frame holds " + std::to_string(declared) + " bytes, the record promises " +
-                          std::to_string(raw_size));
+                          std::to_string(raw_size)));
   std::vector<std::uint8_t> out(raw_size);
   const std::size_t n = ZSTD_decompress(out.data(), out.size(), packed.data(), packed.size());
-  if (ZSTD_isError(n)) throw FormatError(name, offset, std::string("zstd: ") + ZSTD_getErrorName(n));
+  if (ZSTD_isError(n)) VOLA_THROW(FormatError(name, offset, std::string("zstd: ") + ZSTD_getErrorName(n)));
   if (n != raw_size)
-    throw FormatError(name, offset,
+    VOLA_THROW(FormatError(name, offset,
                       "zstd data decompresses to " + std::to_string(n) + " bytes, expected " +
-                          std::to_string(raw_size));
+                          std::to_string(raw_size)));
   return out;
 }
 #else
 bool zstd_available() noexcept { return false; }
 
 std::vector<std::uint8_t> zstd_compress(std::span<const std::uint8_t>, int) {
-  throw Error("this vola was built without zstd (VOLA_WITH_ZSTD=OFF): cannot compress");
+  VOLA_THROW(Error("this vola was built without zstd (VOLA_WITH_ZSTD=OFF): cannot compress"));
 }
 
 std::vector<std::uint8_t> zstd_decompress(std::span<const std::uint8_t>, std::uint64_t, const std::string& name,
                                           std::uint64_t offset) {
-  throw FormatError(name, offset, "zstd-compressed data, but this vola was built without zstd");
+  VOLA_THROW(FormatError(name, offset, "zstd-compressed data, but this vola was built without zstd"));
 }
 #endif
 

@@ -108,10 +108,10 @@ Tree decode_dense(std::span<const std::uint64_t> words, int depth, bool payload,
       });
     }
     if (!agrees)
-      throw FormatError(name, offset,
+      VOLA_THROW(FormatError(name, offset,
                         "dense level " + std::to_string(level) + " has " + std::to_string(set) +
                             " occupied cells that disagree with the " + std::to_string(tree.node_count(level)) +
-                            " cells the leaf level implies");
+                            " cells the leaf level implies"));
   }
   return tree;
 }

@@ -34,12 +34,12 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
   h.lon = tree.georef().lon;
   h.bbox = tree.georef().bbox;
   if (options.layout == Layout::dense) {
-    if (options.compress) throw InvalidArgument("compression applies to sparse files only");
+    if (options.compress) VOLA_THROW(InvalidArgument("compression applies to sparse files only"));
     if (tree.depth() > options.max_dense_depth)
-      throw InvalidArgument("a dense file of depth " + std::to_string(tree.depth()) + " holds " +
+      VOLA_THROW(InvalidArgument("a dense file of depth " + std::to_string(tree.depth()) + " holds " +
                             std::to_string(detail::dense_level_words(tree.depth() - 1)) +
                             " leaf words; write it sparse (dense is allowed up to depth " +
-                            std::to_string(options.max_dense_depth) + ")");
+                            std::to_string(options.max_dense_depth) + ")"));
     const bool payload = tree.has_payload() || !tree.voxel_payloads().empty();
     h.nbits = payload ? (tree.nbits() ? tree.nbits() : 1) : 0;
     p.owned_body = detail::encode_dense(tree);
@@ -47,7 +47,7 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
   } else {
     h.nbits = tree.has_payload() ? tree.nbits() : 0;
     if (options.compress) {
-      if (!compression_available()) throw Error("this vola was built without zstd: cannot compress");
+      if (!compression_available()) VOLA_THROW(Error("this vola was built without zstd: cannot compress"));
       h.version = kVersionCompressed;
     } else {
       p.body = tree.words();
@@ -69,13 +69,13 @@ std::uint64_t sparse_extent(std::span<const std::uint8_t> bytes, int depth, bool
   for (int level = 0; level < depth; ++level) {
     const std::uint64_t need = blocks * (payload ? 2 : 1);
     if (need > available - at)
-      throw FormatError(name, kHeaderSize + 8 * at,
+      VOLA_THROW(FormatError(name, kHeaderSize + 8 * at,
                         "level " + std::to_string(level) + " needs " + std::to_string(blocks) + " blocks (" +
                             std::to_string(8 * need) + " bytes) but the file ends at byte " +
                             std::to_string(bytes.size()) + " (truncated file" +
                             (payload ? ", or a payload word dropped by the reference writer's zero-payload bug"
                                      : "") +
-                            ")");
+                            ")"));
     std::uint64_t next = 0;
     for (std::uint64_t i = 0; i < blocks; ++i) {
       std::uint64_t word;
@@ -93,9 +93,9 @@ void apply_extension(Tree& tree, detail::ExtensionContents& ext, const std::stri
   tree.georef().crs_wkt = std::move(ext.crs_wkt);
   for (auto& column : ext.attributes) {
     if (column.size() != tree.voxel_count())
-      throw FormatError(name, offset,
+      VOLA_THROW(FormatError(name, offset,
                         "attribute '" + column.name() + "' has " + std::to_string(column.size()) +
-                            " values for " + std::to_string(tree.voxel_count()) + " voxels");
+                            " values for " + std::to_string(tree.voxel_count()) + " voxels"));
     tree.attributes().add(std::move(column));
   }
 }
@@ -111,10 +111,10 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   std::uint64_t extension_at = kHeaderSize;
   if (h.version == kVersionCompressed) {
     if (h.layout == Layout::dense)
-      throw FormatError(name, 6, "a compressed (version 2) file must be sparse");
+      VOLA_THROW(FormatError(name, 6, "a compressed (version 2) file must be sparse"));
     auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize);
     if (!ext.has_levels)
-      throw FormatError(name, kHeaderSize, "a version-2 file must hold its levels in the extension");
+      VOLA_THROW(FormatError(name, kHeaderSize, "a version-2 file must hold its levels in the extension"));
     tree = Tree::from_levels(h.depth, payload, std::move(ext.levels), name + " (compressed levels)");
     info.compressed_levels = true;
     info.compressed_level_bytes = ext.compressed_level_bytes;
@@ -141,10 +141,10 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     const std::uint64_t words = detail::dense_body_words(h.depth, payload);
     const std::uint64_t available = (bytes.size() - kHeaderSize) / 8;
     if (words > available)
-      throw FormatError(name, bytes.size(),
+      VOLA_THROW(FormatError(name, bytes.size(),
                         "a dense file of depth " + std::to_string(h.depth) + (payload ? " with payload" : "") +
                             " needs " + std::to_string(kHeaderSize + 8 * words) + " bytes, the file has " +
-                            std::to_string(bytes.size()) + " (truncated file)");
+                            std::to_string(bytes.size()) + " (truncated file)"));
     std::vector<std::uint64_t> copy(words);
     std::memcpy(copy.data(), bytes.data() + kHeaderSize, 8 * words);
     tree = detail::decode_dense(copy, h.depth, payload, name, kHeaderSize);
@@ -154,12 +154,12 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   if (extension_at < bytes.size()) {
     const auto rest = bytes.subspan(extension_at);
     if (!detail::starts_extension(rest))
-      throw FormatError(name, extension_at,
+      VOLA_THROW(FormatError(name, extension_at,
                         std::to_string(rest.size()) +
-                            " bytes follow the last level and are not a vola extension (trailing garbage)");
+                            " bytes follow the last level and are not a vola extension (trailing garbage)"));
     auto ext = detail::decode_extension(rest, name, extension_at);
     if (ext.has_levels)
-      throw FormatError(name, extension_at, "compressed levels in the extension of a version-1 file");
+      VOLA_THROW(FormatError(name, extension_at, "compressed levels in the extension of a version-1 file"));
     apply_extension(tree, ext, name, extension_at);
     info.extension_offset = extension_at;
     info.extension_bytes = rest.size();
@@ -176,7 +176,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
 
 void write_all(std::FILE* f, const void* data, std::size_t size, const std::string& path) {
   if (size && std::fwrite(data, 1, size, f) != size)
-    throw IoError(path + ": write failed: " + std::strerror(errno));
+    VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
 }
 
 }  // namespace
@@ -201,22 +201,22 @@ void encode_header(const Header& h, std::uint8_t* out) {
 
 Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name) {
   if (bytes.size() < kHeaderSize)
-    throw FormatError(name, bytes.size(),
-                      "the file is " + std::to_string(bytes.size()) + " bytes, shorter than the 80-byte header");
+    VOLA_THROW(FormatError(name, bytes.size(),
+                      "the file is " + std::to_string(bytes.size()) + " bytes, shorter than the 80-byte header"));
   detail::ByteReader r(bytes.first(kHeaderSize), name, 0);
   Header h;
   h.header_size = r.get<std::uint32_t>("header size");
   if (h.header_size != kHeaderSize)
-    throw FormatError(name, 0, "header size " + std::to_string(h.header_size) + " is not the 80 this format knows");
+    VOLA_THROW(FormatError(name, 0, "header size " + std::to_string(h.header_size) + " is not the 80 this format knows"));
   h.version = r.get<std::uint16_t>("version");
   if (h.version != kVersionPlain && h.version != kVersionCompressed)
-    throw FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)");
+    VOLA_THROW(FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)"));
   const auto mode = r.get<std::uint8_t>("mode");
-  if (mode > 1) throw FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)");
+  if (mode > 1) VOLA_THROW(FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)"));
   h.layout = static_cast<Layout>(mode);
   h.depth = r.get<std::uint8_t>("depth");
   if (h.depth < kMinDepth || h.depth > kMaxDepth)
-    throw FormatError(name, 7, "depth " + std::to_string(h.depth) + " is outside 1..10");
+    VOLA_THROW(FormatError(name, 7, "depth " + std::to_string(h.depth) + " is outside 1..10"));
   h.nbits = r.get<std::uint32_t>("nbits");
   h.epsg = r.get<std::uint32_t>("crs");
   h.lat = r.get<double>("lat");
@@ -236,27 +236,37 @@ std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& option
   return out;
 }
 
+namespace {
+// The temporary file of write(): closed and removed unless the write got to the rename,
+// whichever way it fails (an exception unwinding, or nothing to unwind without them).
+struct PartFile {
+  std::string path;
+  std::FILE* file = nullptr;
+  bool keep = false;  // leave the path alone: renamed into place, or never created
+  ~PartFile() {
+    if (file) std::fclose(file);
+    if (!keep) std::remove(path.c_str());
+  }
+};
+}  // namespace
+
 void write(const Tree& tree, const std::string& path, const WriteOptions& options) {
   const Pieces p = assemble(tree, options);
-  const std::string temporary = path + ".part";
-  std::FILE* f = std::fopen(temporary.c_str(), "wb");
-  if (!f) throw IoError(path + ": cannot create: " + std::strerror(errno));
-  try {
-    write_all(f, p.header, kHeaderSize, path);
-    write_all(f, p.body.data(), 8 * p.body.size(), path);
-    write_all(f, p.extension.data(), p.extension.size(), path);
-    if (std::fclose(f) != 0) {
-      f = nullptr;
-      throw IoError(path + ": write failed: " + std::strerror(errno));
-    }
-    f = nullptr;
-    if (std::rename(temporary.c_str(), path.c_str()) != 0)
-      throw IoError(path + ": cannot rename from " + temporary + ": " + std::strerror(errno));
-  } catch (...) {
-    if (f) std::fclose(f);
-    std::remove(temporary.c_str());
-    throw;
+  PartFile part{path + ".part"};
+  part.file = std::fopen(part.path.c_str(), "wb");
+  if (!part.file) {
+    part.keep = true;
+    VOLA_THROW(IoError(path + ": cannot create: " + std::strerror(errno)));
   }
+  write_all(part.file, p.header, kHeaderSize, path);
+  write_all(part.file, p.body.data(), 8 * p.body.size(), path);
+  write_all(part.file, p.extension.data(), p.extension.size(), path);
+  std::FILE* f = part.file;
+  part.file = nullptr;
+  if (std::fclose(f) != 0) VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
+  if (std::rename(part.path.c_str(), path.c_str()) != 0)
+    VOLA_THROW(IoError(path + ": cannot rename from " + part.path + ": " + std::strerror(errno)));
+  part.keep = true;
 }
 
 Tree parse(std::span<const std::uint8_t> bytes, const std::string& name, FileLayout* layout) {

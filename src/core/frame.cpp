@@ -12,7 +12,7 @@ VOLA_INLINE_NAMESPACE_BEGIN
 namespace {
 void check_depth(int depth) {
   if (depth < kMinDepth || depth > kMaxDepth)
-    throw InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
+    VOLA_THROW(InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10"));
 }
 }  // namespace
 
@@ -36,9 +36,9 @@ Quantizer Quantizer::toolkit(const Box& bbox, int depth) {
 Quantizer Quantizer::grid(const Point& origin, double voxel_size, int depth) {
   check_depth(depth);
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
-    throw InvalidArgument("voxel size must be a positive number, got " + std::to_string(voxel_size));
+    VOLA_THROW(InvalidArgument("voxel size must be a positive number, got " + std::to_string(voxel_size)));
   for (double o : origin)
-    if (!std::isfinite(o)) throw InvalidArgument("grid origin must be finite");
+    if (!std::isfinite(o)) VOLA_THROW(InvalidArgument("grid origin must be finite"));
   Quantizer q;
   q.mode_ = Quantization::grid;
   q.depth_ = depth;
@@ -174,11 +174,11 @@ bool Quantizer::voxel_range(const Box& box, Voxel& first, Voxel& last) const noe
 }
 
 int depth_for_extent(double extent, double voxel_size) {
-  if (!(voxel_size > 0.0)) throw InvalidArgument("voxel size must be positive");
+  if (!(voxel_size > 0.0)) VOLA_THROW(InvalidArgument("voxel size must be positive"));
   for (int depth = kMinDepth; depth <= kMaxDepth; ++depth)
     if (extent < static_cast<double>(side_of(depth)) * voxel_size) return depth;
-  throw InvalidArgument("an extent of " + std::to_string(extent) + " at voxel size " +
-                        std::to_string(voxel_size) + " needs more than 4^10 voxels per axis");
+  VOLA_THROW(InvalidArgument("an extent of " + std::to_string(extent) + " at voxel size " +
+                        std::to_string(voxel_size) + " needs more than 4^10 voxels per axis"));
 }
 
 VOLA_INLINE_NAMESPACE_END

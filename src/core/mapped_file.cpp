@@ -16,16 +16,16 @@ namespace detail {
 
 std::shared_ptr<const MappedFile> MappedFile::open(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  if (fd < 0) VOLA_THROW(IoError(path + ": cannot open: " + std::strerror(errno)));
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
     const int e = errno;
     ::close(fd);
-    throw IoError(path + ": cannot stat: " + std::strerror(e));
+    VOLA_THROW(IoError(path + ": cannot stat: " + std::strerror(e)));
   }
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
-    throw IoError(path + ": not a regular file");
+    VOLA_THROW(IoError(path + ": not a regular file"));
   }
   std::shared_ptr<MappedFile> file(new MappedFile());
   file->size_ = static_cast<std::size_t>(st.st_size);
@@ -34,7 +34,7 @@ std::shared_ptr<const MappedFile> MappedFile::open(const std::string& path) {
     if (p == MAP_FAILED) {
       const int e = errno;
       ::close(fd);
-      throw IoError(path + ": cannot map: " + std::strerror(e));
+      VOLA_THROW(IoError(path + ": cannot map: " + std::strerror(e)));
     }
     file->data_ = static_cast<const std::uint8_t*>(p);
   }

@@ -23,13 +23,13 @@ bool same_frame(const Frame& a, const Frame& b) {
 template <class Merge>
 Tree combine(const Tree& a, const Tree& b, FrameCheck check, const char* what, Merge merge) {
   if (a.depth() != b.depth())
-    throw InvalidArgument(std::string(what) + ": depths differ (" + std::to_string(a.depth()) + " and " +
-                          std::to_string(b.depth()) + "); bring them to one depth with a level of detail");
+    VOLA_THROW(InvalidArgument(std::string(what) + ": depths differ (" + std::to_string(a.depth()) + " and " +
+                          std::to_string(b.depth()) + "); bring them to one depth with a level of detail"));
   if (check == FrameCheck::require_equal && !same_frame(a.frame(), b.frame()))
-    throw InvalidArgument(std::string(what) +
+    VOLA_THROW(InvalidArgument(std::string(what) +
                           ": the trees' grids differ (origin or voxel size), so equal voxel indices are "
                           "different places; convert both with the same --quantize grid --voxel-size and "
-                          "--origin");
+                          "--origin"));
   const auto ka = a.keys();
   const auto kb = b.keys();
   std::vector<Key> out;

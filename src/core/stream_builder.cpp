@@ -191,14 +191,14 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
                         std::span<const std::uint64_t> payloads) {
   State& s = *state_;
   const std::size_t n = xyz.size() / 3;
-  if (xyz.size() != 3 * n) throw InvalidArgument("stream builder: xyz size is not a multiple of 3");
+  if (xyz.size() != 3 * n) VOLA_THROW(InvalidArgument("stream builder: xyz size is not a multiple of 3"));
   if (values.size() != s.specs.size())
-    throw InvalidArgument("stream builder: " + std::to_string(values.size()) + " attribute arrays for " +
-                          std::to_string(s.specs.size()) + " attributes");
+    VOLA_THROW(InvalidArgument("stream builder: " + std::to_string(values.size()) + " attribute arrays for " +
+                          std::to_string(s.specs.size()) + " attributes"));
   for (const auto& v : values)
-    if (v.size() != n) throw InvalidArgument("stream builder: an attribute array's length differs from the points'");
-  if (s.payload && payloads.size() != n) throw InvalidArgument("stream builder: one payload per point, please");
-  if (n > std::numeric_limits<std::uint32_t>::max()) throw InvalidArgument("stream builder: chunk too large");
+    if (v.size() != n) VOLA_THROW(InvalidArgument("stream builder: an attribute array's length differs from the points'"));
+  if (s.payload && payloads.size() != n) VOLA_THROW(InvalidArgument("stream builder: one payload per point, please"));
+  if (n > std::numeric_limits<std::uint32_t>::max()) VOLA_THROW(InvalidArgument("stream builder: chunk too large"));
   s.points_in += n;
 
   const bool per_point = s.payload || !s.specs.empty();

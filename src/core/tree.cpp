@@ -20,7 +20,7 @@ RankDirectory::RankDirectory(std::span<const std::uint64_t> words, unsigned grou
   // Counts relative to the 512-word superblock fit in 16 bits (at most 511 * 64) for any
   // group size that divides 512.
   if (group_shift > 4)
-    throw InvalidArgument("rank directory: group shift " + std::to_string(group_shift) + " is above 4");
+    VOLA_THROW(InvalidArgument("rank directory: group shift " + std::to_string(group_shift) + " is above 4"));
   auto storage = std::make_shared<RankStorage>();
   const std::size_t n = words.size();
   if (shift_ == 0) {
@@ -115,7 +115,7 @@ Tree Tree::view_levels(int depth, bool has_payload, std::span<const std::uint64_
                        std::shared_ptr<const void> keeper, const std::string& source,
                        std::uint64_t file_offset) {
   if (depth < kMinDepth || depth > kMaxDepth)
-    throw InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
+    VOLA_THROW(InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10"));
   Tree tree;
   tree.depth_ = depth;
   tree.has_payload_ = has_payload;
@@ -136,10 +136,10 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
   for (int level = 0; level < depth_; ++level) {
     const std::uint64_t available = (all_words_.size() - at) / per_block;
     if (blocks > available) {
-      throw FormatError(source, file_offset + 8 * all_words_.size(),
+      VOLA_THROW(FormatError(source, file_offset + 8 * all_words_.size(),
                         "level " + std::to_string(level) + " needs " + std::to_string(blocks) +
                             " blocks of " + std::to_string(8 * per_block) + " bytes but only " +
-                            std::to_string(available) + " remain (truncated file)");
+                            std::to_string(available) + " remain (truncated file)"));
     }
     occupancy_[level] = all_words_.subspan(at, blocks);
     at += blocks;
@@ -161,18 +161,18 @@ void Tree::index(const std::string& source, std::uint64_t file_offset) {
       for (std::size_t i = 0; i < occupancy_[level].size(); ++i) {
         if (occupancy_[level][i] == 0) {
           const std::uint64_t word_offset = (occupancy_[level].data() - all_words_.data()) + i;
-          throw FormatError(source, file_offset + 8 * word_offset,
+          VOLA_THROW(FormatError(source, file_offset + 8 * word_offset,
                             "level " + std::to_string(level) + " block " + std::to_string(i) +
-                                " is empty although its parent bit is set");
+                                " is empty although its parent bit is set"));
         }
       }
     }
     blocks = counts_[level];
   }
   if (at != all_words_.size()) {
-    throw FormatError(source, file_offset + 8 * at,
+    VOLA_THROW(FormatError(source, file_offset + 8 * at,
                       std::to_string(8 * (all_words_.size() - at)) +
-                          " bytes follow the last level that no level accounts for");
+                          " bytes follow the last level that no level accounts for"));
   }
   // The directories, once every level's size is known (the group sizes depend on them).
   static constexpr std::uint64_t kZeroWord = 0;
@@ -274,8 +274,8 @@ std::optional<std::uint64_t> Tree::voxel_payload(const Voxel& v) const noexcept 
 
 void Tree::set_voxel_payloads(std::vector<std::uint64_t> payloads) {
   if (!payloads.empty() && payloads.size() != voxel_count())
-    throw InvalidArgument("voxel payloads: " + std::to_string(payloads.size()) + " values for " +
-                          std::to_string(voxel_count()) + " voxels");
+    VOLA_THROW(InvalidArgument("voxel payloads: " + std::to_string(payloads.size()) + " values for " +
+                          std::to_string(voxel_count()) + " voxels"));
   voxel_payloads_ = std::move(payloads);
 }
 
@@ -288,8 +288,8 @@ std::vector<Key> Tree::keys() const {
 
 Tree Tree::level_of_detail(int depth) const {
   if (depth < kMinDepth || depth > depth_)
-    throw InvalidArgument("level of detail: depth " + std::to_string(depth) + " is outside 1.." +
-                          std::to_string(depth_));
+    VOLA_THROW(InvalidArgument("level of detail: depth " + std::to_string(depth) + " is outside 1.." +
+                          std::to_string(depth_)));
   if (depth == depth_) return *this;
   const auto& last = has_payload_ ? payload_[depth - 1] : occupancy_[depth - 1];
   const std::size_t end = static_cast<std::size_t>(last.data() + last.size() - all_words_.data());

@@ -1,0 +1,26 @@
+// The error handler of builds without exceptions (error.hpp, docs/EMBEDDED.md).
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+
+#include "vola/error.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+std::atomic<ErrorHandler> handler{nullptr};
+}  // namespace
+
+ErrorHandler set_error_handler(ErrorHandler h) noexcept { return handler.exchange(h); }
+
+namespace detail {
+void fail(const Error& error) noexcept {
+  if (const ErrorHandler h = handler.load()) h(error.what());
+  std::fprintf(stderr, "vola: %s\n", error.what());
+  std::abort();
+}
+}  // namespace detail
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola
