@@ -18,6 +18,7 @@ void add_components(CLI::App& app);
 void add_morph(CLI::App& app);  // dilate, erode, fill, crop, downsample
 void add_render(CLI::App& app);
 void add_plan(CLI::App& app);
+void add_view(CLI::App& app);
 void add_fuse(CLI::App& app);
 void add_rgbd_generate(CLI::App& app);
 void add_rgbd_eval(CLI::App& app);

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   vola::cli::add_morph(app);
   vola::cli::add_render(app);
   vola::cli::add_plan(app);
+  vola::cli::add_view(app);
   vola::cli::add_fuse(app);
   vola::cli::add_rgbd_generate(app);
   vola::cli::add_rgbd_eval(app);

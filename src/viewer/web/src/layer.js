@@ -1,8 +1,12 @@
 // One level of one file on screen: instanced unit cubes whose per-instance data is the
 // cell's grid coordinates and colour, placed by the shader (cell + 0.5) * cellSize +
-// offset, so a batch from the server goes to the GPU without building matrices. The
-// slicing plane hides whole cells in the vertex shader.
+// offset, so a batch from the server goes to the GPU without building matrices. Levels
+// of more than POINTS_ABOVE cells are drawn as one point per cell, sized as the cell
+// would appear: 36 cube vertices per cell would not draw interactively. The slicing
+// plane hides whole cells in the vertex shader.
 import * as THREE from 'three';
+
+const POINTS_ABOVE = 2_000_000;
 
 const vertexShader = /* glsl */ `
 attribute vec3 cell;
@@ -25,6 +29,28 @@ void main() {
   gl_Position = projectionMatrix * modelViewMatrix * vec4(centre + position * cellSize, 1.0);
 }`;
 
+const pointVertexShader = /* glsl */ `
+attribute vec3 colour;
+uniform float cellSize;
+uniform vec3 offset;
+uniform vec3 sliceAxis;
+uniform float sliceAt;
+uniform float sliceOn;
+uniform float pointScale;
+varying vec3 vColour;
+void main() {
+  vec3 centre = offset + (position + 0.5) * cellSize;  // position holds the cell
+  if (sliceOn > 0.5 && dot(centre, sliceAxis) > sliceAt) {
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    vColour = vec3(0.0);
+    return;
+  }
+  vec4 eye = modelViewMatrix * vec4(centre, 1.0);
+  gl_PointSize = clamp(cellSize * pointScale / max(-eye.z, 1e-6), 1.0, 64.0);
+  vColour = colour;
+  gl_Position = projectionMatrix * eye;
+}`;
+
 const fragmentShader = /* glsl */ `
 varying vec3 vColour;
 void main() { gl_FragColor = vec4(vColour, 1.0); }`;
@@ -33,6 +59,7 @@ const unitCube = new THREE.BoxGeometry(1, 1, 1);
 
 export class VoxelLayer {
   // file: metadata; level: its level; offset: the file's origin minus the scene origin.
+  // slice: the shared uniforms of the slicing plane and the point scale.
   constructor(file, level, offset, slice) {
     this.file = file;
     this.level = level;
@@ -43,17 +70,27 @@ export class VoxelLayer {
     this.colours = new Uint8Array(3 * this.total);
     this.classes = file.has_classes ? new Uint8Array(this.total) : null;
     this.stored = file.has_colours ? new Uint8Array(3 * this.total) : null;
-    const geometry = new THREE.InstancedBufferGeometry();
-    geometry.index = unitCube.index;
-    geometry.setAttribute('position', unitCube.getAttribute('position'));
-    geometry.setAttribute('normal', unitCube.getAttribute('normal'));
-    this.cellAttribute = new THREE.InstancedBufferAttribute(this.cells, 3);
-    this.colourAttribute = new THREE.InstancedBufferAttribute(this.colours, 3, true);
-    geometry.setAttribute('cell', this.cellAttribute);
+    this.asPoints = this.total > POINTS_ABOVE;
+    let geometry;
+    if (this.asPoints) {
+      geometry = new THREE.BufferGeometry();
+      this.cellAttribute = new THREE.BufferAttribute(this.cells, 3);
+      this.colourAttribute = new THREE.BufferAttribute(this.colours, 3, true);
+      geometry.setAttribute('position', this.cellAttribute);
+      geometry.setDrawRange(0, 0);
+    } else {
+      geometry = new THREE.InstancedBufferGeometry();
+      geometry.index = unitCube.index;
+      geometry.setAttribute('position', unitCube.getAttribute('position'));
+      geometry.setAttribute('normal', unitCube.getAttribute('normal'));
+      this.cellAttribute = new THREE.InstancedBufferAttribute(this.cells, 3);
+      this.colourAttribute = new THREE.InstancedBufferAttribute(this.colours, 3, true);
+      geometry.setAttribute('cell', this.cellAttribute);
+      geometry.instanceCount = 0;
+    }
     geometry.setAttribute('colour', this.colourAttribute);
-    geometry.instanceCount = 0;
     this.material = new THREE.ShaderMaterial({
-      vertexShader,
+      vertexShader: this.asPoints ? pointVertexShader : vertexShader,
       fragmentShader,
       uniforms: {
         cellSize: { value: this.cellSize },
@@ -61,9 +98,10 @@ export class VoxelLayer {
         sliceAxis: slice.axis,
         sliceAt: slice.at,
         sliceOn: slice.on,
+        pointScale: slice.pointScale,
       },
     });
-    this.mesh = new THREE.Mesh(geometry, this.material);
+    this.mesh = this.asPoints ? new THREE.Points(geometry, this.material) : new THREE.Mesh(geometry, this.material);
     this.mesh.frustumCulled = false;  // the geometry's bounds are one unit cube
   }
 
@@ -76,7 +114,8 @@ export class VoxelLayer {
     this.loaded = at + batch.count;
     this.recolour(colourOf, at, this.loaded);
     this.cellAttribute.needsUpdate = true;
-    this.mesh.geometry.instanceCount = this.loaded;
+    if (this.asPoints) this.mesh.geometry.setDrawRange(0, this.loaded);
+    else this.mesh.geometry.instanceCount = this.loaded;
   }
 
   // colourOf(layer, i) -> [r, g, b] for cells [from, to).

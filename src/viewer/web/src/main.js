@@ -24,7 +24,10 @@ camera.up.set(0, 0, 1);
 const controls = new OrbitControls(camera, canvas);
 controls.addEventListener('change', render);
 
-const slice = { on: { value: 0 }, axis: { value: new THREE.Vector3(0, 0, 1) }, at: { value: 0 } };
+// Uniforms every layer shares: the slicing plane, and pixels per unit of size at unit
+// distance (for layers drawn as points).
+const slice = { on: { value: 0 }, axis: { value: new THREE.Vector3(0, 0, 1) }, at: { value: 0 },
+  pointScale: { value: 1 } };
 const sliceHelper = new THREE.Mesh(new THREE.PlaneGeometry(1, 1),
   new THREE.MeshBasicMaterial({ color: 0x66aaff, transparent: true, opacity: 0.15, side: THREE.DoubleSide,
     depthWrite: false }));
@@ -47,8 +50,15 @@ const state = {
   loading: Promise.resolve(),
 };
 
+// Draws at the next animation frame, once however many changes asked for it.
+let frameRequested = false;
 function render() {
-  renderer.render(scene, camera);
+  if (frameRequested) return;
+  frameRequested = true;
+  requestAnimationFrame(() => {
+    frameRequested = false;
+    renderer.render(scene, camera);
+  });
 }
 
 function resize() {
@@ -57,6 +67,7 @@ function resize() {
   renderer.setSize(w, h, false);
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
+  slice.pointScale.value = (h * renderer.getPixelRatio()) / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2));
   render();
 }
 
