@@ -24,6 +24,9 @@ void add_rgbd_generate(CLI::App& app);
 void add_rgbd_eval(CLI::App& app);
 void add_view(CLI::App& app);
 void add_sonify(CLI::App& app);
+void add_dataset(CLI::App& app);
+void add_train(CLI::App& app);
+void add_classify(CLI::App& app);  // classify and evaluate
 void add_collide(CLI::App& app);
 
 }  // namespace vola::cli

@@ -43,6 +43,9 @@ int main(int argc, char** argv) {
   vola::cli::add_rgbd_eval(app);
   vola::cli::add_view(app);
   vola::cli::add_sonify(app);
+  vola::cli::add_dataset(app);
+  vola::cli::add_train(app);
+  vola::cli::add_classify(app);
   vola::cli::add_collide(app);
   try {
     app.parse(argc, argv);

@@ -18,6 +18,9 @@ VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib
 VOLA_BUILD_PACKAGES+=(libcpp-httplib-dev pkg-config chromium)
 command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
 
+# 3D CNN classification (vola_learn): libtorch (CPU) and libzip for .npz, found through pkg-config.
+VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
+
 # install_packages PKG...: apt-get installs the ones that are missing (as root), or
 # says exactly what to install.
 install_packages() {

@@ -1,0 +1,110 @@
+// 3D CNN classification of VOLA occupancy (libtorch, CPU). This header is free of
+// torch: the networks live in two translation units of vola_learn.
+//
+// Architectures:
+//   paper: the VOLA paper's network on 64^3 x 1 input: conv 8^3 -> 8 channels (57^3),
+//          conv 8^3 -> 16 (50^3), conv 8^3 -> 16 (43^3), ReLU after each, dropout 0.5,
+//          fully connected -> 10, softmax.
+//   small: VoxNet-like on 32^3 (the 64^3 tree read at half resolution): conv 5^3 stride
+//          2 -> 32 (14^3), conv 3^3 -> 32 (12^3), max pool 2 (6^3), fully connected
+//          -> 128 -> 10 with batch norm and dropout; about 0.9 M weights, 3.6 MB.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vola/learn/dataset.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::learn {
+
+enum class Architecture { paper, small };
+std::string_view architecture_name(Architecture architecture) noexcept;
+std::optional<Architecture> parse_architecture(std::string_view name) noexcept;
+// Input grid side: 64 (paper), 32 (small).
+int input_side(Architecture architecture) noexcept;
+
+struct Sample {
+  Tree tree;
+  int label = 0;
+};
+
+// The trees of a dataset folder (DIR/<class>/*.vol, see list_dataset) with their
+// labels. Throws (naming the file) when a file is unreadable or its grid is coarser
+// than `min_side` (the network input; 64 for both networks' datasets).
+std::vector<Sample> load_samples(const std::vector<DatasetEntry>& entries, int min_side = kSceneSide);
+
+struct TrainOptions {
+  Architecture architecture = Architecture::small;
+  int epochs = 30;             // total epochs of the run, counting resumed ones
+  int batch_size = 32;
+  double learning_rate = 1e-3;  // Adam; divided by 10 for the last fifth of the epochs
+  double weight_decay = 1e-4;
+  std::uint64_t seed = 1;        // weights, shuffling, augmentation, dropout
+  double max_rotation_degrees = 15;  // augmentation: uniform angle in [-max, max] about z
+  int threads = 0;                  // torch intra-op threads; 0: all cores
+  std::string model_path;           // the trained weights, written after every epoch
+  std::string checkpoint_path;      // weights + optimizer + epoch, after every epoch
+  bool resume = false;              // continue from checkpoint_path when it exists
+  int max_epochs_this_run = 0;      // stop after this many epochs (0: run to `epochs`)
+};
+
+struct EpochReport {
+  int epoch = 0;  // 1-based
+  double train_loss = 0;
+  double train_accuracy = 0;
+  double validation_accuracy = -1;  // -1 without a validation set
+  double learning_rate = 0;
+  double seconds = 0;
+};
+
+struct TrainCallbacks {
+  std::function<void(int epoch, std::size_t step, std::size_t steps, double loss)> on_step;
+  std::function<void(const EpochReport&)> on_epoch;
+  std::function<void(int first_epoch)> on_resume;  // called when a checkpoint was loaded
+};
+
+// Trains and writes options.model_path (and checkpoint_path). Batches are made from
+// the trees by a producer thread while the network trains on the previous batch.
+// Every epoch's shuffle, rotations and dropout come from (seed, epoch), so a resumed
+// run repeats the epochs an uninterrupted one would have run. Returns this run's epochs.
+std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::vector<Sample>& validation_set,
+                               const TrainOptions& options, const TrainCallbacks& callbacks = {});
+
+// A trained network loaded from a model file (written by train).
+class Classifier {
+ public:
+  // Throws FormatError naming the file when it is not a vola model.
+  explicit Classifier(const std::string& model_path);
+  ~Classifier();
+  Classifier(Classifier&&) noexcept;
+  Classifier& operator=(Classifier&&) noexcept;
+
+  Architecture architecture() const noexcept;
+  // Class probabilities (softmax) of each tree, in one batch.
+  std::vector<std::array<float, kClassCount>> classify(std::span<const Tree* const> trees) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Torch's intra-op thread count (0: leave torch's default of all cores).
+void set_threads(int threads);
+
+// Where the committed small model is looked for, in order: $VOLA_MODEL; next to the
+// executable's prefix, <exe dir>/../share/vola/models/ (install) and <exe dir>/../models/
+// and <exe dir>/../../models/ (a build folder inside the source tree); the source tree
+// the library was built from. Returns the first that exists, or throws IoError listing
+// where it looked.
+std::string default_model_path();
+inline constexpr std::string_view kDefaultModelFile = "modelnet10-small.pt";
+
+}  // namespace vola::learn

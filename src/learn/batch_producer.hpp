@@ -1,0 +1,62 @@
+// Training and evaluation batches made in a thread while the network works on the
+// previous one: each batch is the samples' trees filled straight into float grids
+// (fill_occupancy), turned by a random angle when augmenting.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "vola/learn/classifier.hpp"
+
+namespace vola::learn {
+
+struct Batch {
+  std::vector<float> inputs;          // count * side^3
+  std::vector<std::int64_t> labels;   // count
+  std::vector<std::size_t> indices;   // which samples, in order
+  std::size_t count() const noexcept { return labels.size(); }
+};
+
+class BatchProducer {
+ public:
+  // Batches of `batch_size` (the last may be smaller) over samples[order[...]] at input
+  // grid `side`. Angles are uniform in [-max_rotation, max_rotation] radians, drawn in
+  // order from a generator seeded with `seed` (0 radians when max_rotation is 0). At
+  // most `ahead` batches wait in the queue.
+  BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order, std::size_t batch_size, int side,
+                std::uint64_t seed, double max_rotation, std::size_t ahead = 2);
+  ~BatchProducer();
+  BatchProducer(const BatchProducer&) = delete;
+  BatchProducer& operator=(const BatchProducer&) = delete;
+
+  // The next batch, or nullopt after the last; rethrows what the producer threw.
+  std::optional<Batch> next();
+
+ private:
+  void run();
+
+  const std::vector<Sample>& samples_;
+  std::vector<std::size_t> order_;
+  std::size_t batch_size_;
+  int side_;
+  std::uint64_t seed_;
+  double max_rotation_;
+  std::size_t ahead_;
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Batch> ready_;
+  bool done_ = false;       // the producer made its last batch (or failed)
+  bool stopping_ = false;   // the consumer went away
+  std::exception_ptr failure_;
+  std::thread thread_;
+};
+
+}  // namespace vola::learn

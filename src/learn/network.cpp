@@ -1,0 +1,220 @@
+#include "network.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "vola/error.hpp"
+#include "vola/learn/occupancy.hpp"
+
+#ifndef VOLA_LEARN_SOURCE_MODELS
+#define VOLA_LEARN_SOURCE_MODELS ""
+#endif
+
+namespace vola::learn {
+
+namespace {
+
+constexpr std::int64_t kModelVersion = 1;
+
+struct PaperNet : Network {
+  torch::nn::Conv3d conv1{torch::nn::Conv3dOptions(1, 8, 8)};
+  torch::nn::Conv3d conv2{torch::nn::Conv3dOptions(8, 16, 8)};
+  torch::nn::Conv3d conv3{torch::nn::Conv3dOptions(16, 16, 8)};
+  torch::nn::Dropout dropout{torch::nn::DropoutOptions(0.5)};
+  torch::nn::Linear fc{16 * 43 * 43 * 43, kClassCount};
+
+  PaperNet() {
+    register_module("conv1", conv1);
+    register_module("conv2", conv2);
+    register_module("conv3", conv3);
+    register_module("dropout", dropout);
+    register_module("fc", fc);
+  }
+  torch::Tensor forward(torch::Tensor x) override {
+    x = torch::relu(conv1(x));  // 57^3
+    x = torch::relu(conv2(x));  // 50^3
+    x = torch::relu(conv3(x));  // 43^3
+    return fc(dropout(x.flatten(1)));
+  }
+};
+
+struct SmallNet : Network {
+  torch::nn::Conv3d conv1{torch::nn::Conv3dOptions(1, 32, 5).stride(2)};
+  torch::nn::BatchNorm3d norm1{32};
+  torch::nn::Conv3d conv2{torch::nn::Conv3dOptions(32, 32, 3)};
+  torch::nn::BatchNorm3d norm2{32};
+  torch::nn::Dropout dropout1{torch::nn::DropoutOptions(0.3)};
+  torch::nn::Linear fc1{32 * 6 * 6 * 6, 128};
+  torch::nn::Dropout dropout2{torch::nn::DropoutOptions(0.4)};
+  torch::nn::Linear fc2{128, kClassCount};
+
+  SmallNet() {
+    register_module("conv1", conv1);
+    register_module("norm1", norm1);
+    register_module("conv2", conv2);
+    register_module("norm2", norm2);
+    register_module("dropout1", dropout1);
+    register_module("fc1", fc1);
+    register_module("dropout2", dropout2);
+    register_module("fc2", fc2);
+  }
+  torch::Tensor forward(torch::Tensor x) override {
+    x = torch::leaky_relu(norm1(conv1(x)), 0.1);           // 14^3
+    x = torch::max_pool3d(torch::relu(norm2(conv2(x))), 2);  // 12^3 -> 6^3
+    x = torch::relu(fc1(dropout1(x.flatten(1))));
+    return fc2(dropout2(x));
+  }
+};
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+}  // namespace
+
+std::string_view architecture_name(Architecture architecture) noexcept {
+  return architecture == Architecture::paper ? "paper" : "small";
+}
+
+std::optional<Architecture> parse_architecture(std::string_view name) noexcept {
+  if (name == "paper") return Architecture::paper;
+  if (name == "small") return Architecture::small;
+  return std::nullopt;
+}
+
+int input_side(Architecture architecture) noexcept { return architecture == Architecture::paper ? 64 : 32; }
+
+std::shared_ptr<Network> make_network(Architecture architecture) {
+  if (architecture == Architecture::paper) return std::make_shared<PaperNet>();
+  return std::make_shared<SmallNet>();
+}
+
+void set_threads(int threads) {
+  if (threads > 0) torch::set_num_threads(threads);
+}
+
+void write_architecture(torch::serialize::OutputArchive& archive, Architecture architecture) {
+  archive.write("vola_model_version", torch::tensor(kModelVersion));
+  archive.write("vola_architecture", torch::tensor(static_cast<std::int64_t>(architecture)));
+}
+
+Architecture read_architecture(torch::serialize::InputArchive& archive, const std::string& path) {
+  try {
+    torch::Tensor version, architecture;
+    archive.read("vola_model_version", version);
+    archive.read("vola_architecture", architecture);
+    if (version.numel() != 1 || version.item<std::int64_t>() != kModelVersion)
+      throw FormatError(path, std::nullopt, "vola model version " + std::to_string(version.item<std::int64_t>()) +
+                                                " (this build reads " + std::to_string(kModelVersion) + ")");
+    const std::int64_t value = architecture.numel() == 1 ? architecture.item<std::int64_t>() : -1;
+    if (value != static_cast<std::int64_t>(Architecture::paper) && value != static_cast<std::int64_t>(Architecture::small))
+      throw FormatError(path, std::nullopt, "unknown network architecture " + std::to_string(value));
+    return static_cast<Architecture>(value);
+  } catch (const c10::Error& error) {
+    throw FormatError(path, std::nullopt, "not a vola model (no architecture record): " + first_line(error.what()));
+  }
+}
+
+void load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) throw IoError("cannot open model " + path + ": no such file");
+  try {
+    archive.load_from(path);
+  } catch (const c10::Error& failure) {
+    throw FormatError(path, std::nullopt, "not a torch archive: " + first_line(failure.what()));
+  }
+}
+
+void read_weights(torch::serialize::InputArchive& archive, Network& network, const std::string& path) {
+  try {
+    torch::serialize::InputArchive weights;
+    if (!archive.try_read("model", weights)) throw FormatError(path, std::nullopt, "no network weights ('model')");
+    network.load(weights);
+  } catch (const c10::Error& failure) {
+    throw FormatError(path, std::nullopt, "weights do not fit the network: " + first_line(failure.what()));
+  }
+}
+
+void replace_file(const std::string& path, const std::function<void(const std::string&)>& write) {
+  const std::string temporary = path + ".tmp";
+  write(temporary);
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw IoError("cannot write " + path + ": " + error.message());
+}
+
+void save_model(const Network& network, Architecture architecture, const std::string& path) {
+  torch::serialize::OutputArchive archive, weights;
+  write_architecture(archive, architecture);
+  network.save(weights);
+  archive.write("model", weights);
+  replace_file(path, [&](const std::string& to) { archive.save_to(to); });
+}
+
+torch::Tensor input_tensor(Batch& batch, int side) {
+  return torch::from_blob(batch.inputs.data(), {static_cast<std::int64_t>(batch.count()), 1, side, side, side},
+                          torch::kFloat32);
+}
+
+struct Classifier::Impl {
+  Architecture architecture = Architecture::small;
+  std::shared_ptr<Network> network;
+};
+
+Classifier::Classifier(const std::string& model_path) : impl_(std::make_unique<Impl>()) {
+  torch::serialize::InputArchive archive;
+  load_archive(archive, model_path);
+  impl_->architecture = read_architecture(archive, model_path);
+  impl_->network = make_network(impl_->architecture);
+  read_weights(archive, *impl_->network, model_path);
+  impl_->network->eval();
+}
+
+Classifier::~Classifier() = default;
+Classifier::Classifier(Classifier&&) noexcept = default;
+Classifier& Classifier::operator=(Classifier&&) noexcept = default;
+
+Architecture Classifier::architecture() const noexcept { return impl_->architecture; }
+
+std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const Tree* const> trees) const {
+  std::vector<std::array<float, kClassCount>> result;
+  if (trees.empty()) return result;
+  const int side = input_side(impl_->architecture);
+  const std::size_t cells = std::size_t(side) * side * side;
+  Batch batch;
+  batch.inputs.resize(trees.size() * cells);
+  batch.labels.assign(trees.size(), 0);
+  for (std::size_t i = 0; i < trees.size(); ++i)
+    fill_occupancy(*trees[i], side, 0.0, std::span<float>(batch.inputs.data() + i * cells, cells));
+  torch::NoGradGuard no_grad;
+  const torch::Tensor probabilities = torch::softmax(impl_->network->forward(input_tensor(batch, side)), 1).contiguous();
+  const float* p = probabilities.data_ptr<float>();
+  result.resize(trees.size());
+  for (std::size_t i = 0; i < trees.size(); ++i)
+    for (int k = 0; k < kClassCount; ++k) result[i][std::size_t(k)] = p[i * kClassCount + std::size_t(k)];
+  return result;
+}
+
+std::string default_model_path() {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("VOLA_MODEL"); env && *env) candidates.emplace_back(env);
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const fs::path dir = exe.parent_path();
+    candidates.push_back(dir / ".." / "share" / "vola" / "models" / kDefaultModelFile);
+    candidates.push_back(dir / ".." / "models" / kDefaultModelFile);
+    candidates.push_back(dir / ".." / ".." / "models" / kDefaultModelFile);
+  }
+  if (*VOLA_LEARN_SOURCE_MODELS) candidates.push_back(fs::path(VOLA_LEARN_SOURCE_MODELS) / kDefaultModelFile);
+  std::string looked;
+  for (const auto& candidate : candidates) {
+    if (fs::is_regular_file(candidate, error)) return candidate.lexically_normal().string();
+    looked += "\n  " + candidate.lexically_normal().string();
+  }
+  throw IoError("no model given (--model) and the default " + std::string(kDefaultModelFile) +
+                " is in none of:" + looked);
+}
+
+}  // namespace vola::learn

@@ -1,0 +1,39 @@
+// The torch side of vola_learn (included only by network.cpp and train.cpp, so that
+// torch's slow headers stay in two translation units).
+#pragma once
+
+#include <torch/torch.h>
+
+#include <memory>
+#include <string>
+
+#include "batch_producer.hpp"
+#include "vola/learn/classifier.hpp"
+
+namespace vola::learn {
+
+// A classification network: (N, 1, S, S, S) occupancy -> (N, 10) logits.
+struct Network : torch::nn::Module {
+  virtual torch::Tensor forward(torch::Tensor input) = 0;
+};
+
+std::shared_ptr<Network> make_network(Architecture architecture);
+
+// A model file: an archive holding "vola_model_version", "vola_architecture" and the
+// network's weights under "model". A checkpoint adds "optimizer" and "epochs_done".
+void write_architecture(torch::serialize::OutputArchive& archive, Architecture architecture);
+Architecture read_architecture(torch::serialize::InputArchive& archive, const std::string& path);
+void save_model(const Network& network, Architecture architecture, const std::string& path);
+// Loads the archive at `path`, or throws FormatError naming it.
+void load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+// Reads weights from the "model" member into `network`; FormatError when they do not fit.
+void read_weights(torch::serialize::InputArchive& archive, Network& network, const std::string& path);
+
+// The batch as an (N, 1, S, S, S) tensor viewing batch.inputs (no copy).
+torch::Tensor input_tensor(Batch& batch, int side);
+
+// Writes `write` to path + ".tmp" then renames it over `path`: a reader (or a killed
+// run) never sees half a file.
+void replace_file(const std::string& path, const std::function<void(const std::string&)>& write);
+
+}  // namespace vola::learn

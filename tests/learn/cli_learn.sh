@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# vola dataset / train / classify / evaluate end to end on a small generated npz and the
+# committed model. Usage: cli_learn.sh VOLA_BINARY DATA_DIR
+set -euo pipefail
+vola=$1
+data=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# 20 samples: two per class, cut from the real training split (rows 0, 120, ... spread over classes).
+npz=$data/modelnet/modelnet10_32_train.npz
+if [[ ! -f $npz ]]; then
+  [[ -n ${CI:-} ]] && fail "missing $npz (CI is set)"
+  echo "skip: no $npz"; exit 77
+fi
+/usr/bin/python3 - "$npz" "$work/small.npz" <<'PY'
+import sys, numpy as np
+d = np.load(sys.argv[1]); X, y = d["X_train"], d["y_train"]
+rows = np.concatenate([np.nonzero(y == k)[0][:2] for k in range(10)])
+np.savez_compressed(sys.argv[2], X_test=X[rows].astype(np.int32), y_test=y[rows])
+np.savez_compressed(sys.argv[2] + ".bad.npz", X_test=X[rows][:, :, :, :16], y_test=y[rows])
+PY
+
+# Clean objects: the test split is written whole, ten class folders of two files.
+"$vola" dataset "$work/small.npz" "$work/clean" > "$work/out.txt"
+[[ $(find "$work/clean/test" -name '*.vol' | wc -l) == 20 ]] || fail "expected 20 files"
+[[ -f $work/clean/test/night_stand/night_stand_00012.vol ]] || fail "layout: $(ls "$work/clean/test")"
+"$vola" info "$work/clean/test/chair/chair_00004.vol" | grep -q "depth" || fail "not a VOLA file"
+
+# Objects in rooms: more voxels than the clean ones.
+"$vola" dataset "$work/small.npz" "$work/room" --background > /dev/null
+clean_size=$(stat -c %s "$work/clean/test/sofa/sofa_00014.vol")
+room_size=$(stat -c %s "$work/room/test/sofa/sofa_00014.vol")
+(( room_size > clean_size )) || fail "room file not bigger ($room_size <= $clean_size)"
+
+# Meshes: the class from the file name.
+"$vola" dataset "$data/modelnet/off/bathtub_0001.off" "$work/meshes" > /dev/null
+[[ -f $work/meshes/bathtub/bathtub_0001.vol ]] || fail "mesh not written"
+
+# Evaluate with the committed model: these are training samples, nearly all right.
+"$vola" evaluate "$work/clean/test" --png "$work/confusion.png" --threads 2 > "$work/eval.txt"
+last=$(tail -n 1 "$work/eval.txt")
+[[ $last =~ ^accuracy:\ (0\.[0-9]{4}|1\.0000)$ ]] || fail "last line: $last"
+awk '{ if ($2 < 0.9) exit 1 }' <<< "$last" || fail "accuracy on training samples: $last"
+grep -q "per-class accuracy" "$work/eval.txt" || fail "no per-class accuracy"
+[[ $(head -c 8 "$work/confusion.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] || fail "no PNG"
+
+# Classify one file: the first line names the class.
+"$vola" classify "$work/clean/test/monitor/monitor_00010.vol" > "$work/one.txt"
+[[ $(head -n 1 "$work/one.txt" | cut -d' ' -f1) == monitor ]] || fail "classify: $(cat "$work/one.txt")"
+[[ $(wc -l < "$work/one.txt") == 11 ]] || fail "expected 11 lines"
+
+# Errors: exit 1 and a message naming the file.
+if "$vola" dataset "$work/small.npz.bad.npz" "$work/bad" 2> "$work/err.txt"; then fail "bad npz accepted"; fi
+grep -q "X_test" "$work/err.txt" || fail "bad npz message: $(cat "$work/err.txt")"
+if "$vola" classify --model "$work/eval.txt" "$work/clean/test/chair/chair_00004.vol" 2> "$work/err.txt"; then fail "bad model accepted"; fi
+grep -q "eval.txt" "$work/err.txt" || fail "bad model message: $(cat "$work/err.txt")"
+echo "cli_learn: ok"

@@ -1,0 +1,126 @@
+// The networks: a few training steps lower the loss, a resumed run repeats an
+// uninterrupted one, the committed small model knows training samples, bad model files
+// are refused.
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "learn_test_data.hpp"
+#include "test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/learn/classifier.hpp"
+#include "vola/learn/npz.hpp"
+
+namespace {
+
+using namespace vola::learn;
+using vola_learn_test::shape_grid;
+
+std::vector<Sample> shape_samples(int per_class, std::uint64_t seed) {
+  std::vector<Sample> samples;
+  for (int k = 0; k < kClassCount; ++k)
+    for (int i = 0; i < per_class; ++i) samples.push_back({clean_scene(shape_grid(k, seed + std::uint64_t(i)), 32), k});
+  return samples;
+}
+
+double mean(const std::vector<double>& v, std::size_t first, std::size_t count) {
+  return std::accumulate(v.begin() + long(first), v.begin() + long(first + count), 0.0) / double(count);
+}
+
+TEST(Classifier, SmallModelLossFallsInAFewSteps) {
+  const auto samples = shape_samples(1, 1);
+  TrainOptions options;
+  options.epochs = 12;  // one batch of ten samples per epoch: twelve steps
+  options.batch_size = 10;
+  options.learning_rate = 3e-3;
+  options.max_rotation_degrees = 0;
+  options.threads = 2;
+  std::vector<double> losses;
+  TrainCallbacks callbacks;
+  callbacks.on_step = [&](int, std::size_t, std::size_t, double loss) { losses.push_back(loss); };
+  const auto reports = train(samples, samples, options, callbacks);
+  ASSERT_EQ(losses.size(), 12u);
+  EXPECT_LT(mean(losses, 9, 3), 0.5 * mean(losses, 0, 3)) << "first " << losses.front() << " last " << losses.back();
+  ASSERT_EQ(reports.size(), 12u);
+  EXPECT_GT(reports.back().validation_accuracy, 0.5);
+}
+
+TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
+  vola_test::TempDir dir;
+  const auto samples = shape_samples(1, 5);
+  TrainOptions options;
+  options.epochs = 3;
+  options.batch_size = 5;
+  options.threads = 1;  // one thread: bit-for-bit repeatable sums
+  options.model_path = (dir / "whole.pt").string();
+  options.checkpoint_path = (dir / "whole.ckpt").string();
+  const auto whole = train(samples, samples, options);
+
+  options.model_path = (dir / "parts.pt").string();
+  options.checkpoint_path = (dir / "parts.ckpt").string();
+  options.resume = true;
+  options.max_epochs_this_run = 2;
+  int resumed_at = 0;
+  TrainCallbacks callbacks;
+  callbacks.on_resume = [&](int first) { resumed_at = first; };
+  const auto first = train(samples, samples, options, callbacks);
+  ASSERT_EQ(first.size(), 2u);
+  EXPECT_EQ(resumed_at, 0);
+  const auto second = train(samples, samples, options, callbacks);
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_EQ(resumed_at, 3);
+  EXPECT_EQ(second[0].epoch, 3);
+  EXPECT_DOUBLE_EQ(second[0].train_loss, whole[2].train_loss);
+  EXPECT_DOUBLE_EQ(first[1].train_loss, whole[1].train_loss);
+  // The two model files classify alike.
+  const Classifier a((dir / "whole.pt").string()), b((dir / "parts.pt").string());
+  const vola::Tree* trees[] = {&samples[3].tree};
+  EXPECT_EQ(a.classify(trees), b.classify(trees));
+  // A checkpoint of another architecture is refused.
+  options.architecture = Architecture::paper;
+  EXPECT_THROW(train(samples, samples, options), vola::InvalidArgument);
+}
+
+TEST(Classifier, CommittedModelKnowsTrainingSamples) {
+  VOLA_REQUIRE_DATA(data);
+  const Classifier classifier(vola_learn_test::committed_model_path());
+  EXPECT_EQ(classifier.architecture(), Architecture::small);
+  const auto grids = read_labelled_grids((data / "modelnet" / "modelnet10_32_train.npz").string());
+  // Five samples of each class from the training part of the default split (vola dataset's
+  // --validation-fraction 0.1 --seed 1): the model was trained on exactly these.
+  const Split split = stratified_split(grids.labels, 0.1, 1);
+  std::vector<vola::Tree> trees;
+  std::vector<int> labels;
+  std::vector<int> taken(kClassCount, 0);
+  for (std::size_t i : split.train) {
+    const int label = grids.labels[i];
+    if (taken[std::size_t(label)]++ >= 5) continue;
+    trees.push_back(clean_scene(grids.grid(i), grids.side));
+    labels.push_back(label);
+  }
+  ASSERT_EQ(trees.size(), 50u);
+  std::vector<const vola::Tree*> pointers;
+  for (const auto& tree : trees) pointers.push_back(&tree);
+  const auto probabilities = classifier.classify(pointers);
+  int correct = 0;
+  for (std::size_t i = 0; i < trees.size(); ++i) {
+    const auto& p = probabilities[i];
+    EXPECT_NEAR(std::accumulate(p.begin(), p.end(), 0.0), 1.0, 1e-4);
+    correct += std::max_element(p.begin(), p.end()) - p.begin() == labels[i];
+  }
+  EXPECT_GE(correct, 48) << "of 50 training samples";
+}
+
+TEST(Classifier, RefusesFilesThatAreNotModels) {
+  vola_test::TempDir dir;
+  EXPECT_THROW(Classifier((dir / "missing.pt").string()), vola::IoError);
+  vola_test::write_bytes(dir / "junk.pt", std::vector<std::uint8_t>(300, 'j'));
+  try {
+    Classifier classifier((dir / "junk.pt").string());
+    ADD_FAILURE() << "junk accepted";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("junk.pt"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

@@ -1,0 +1,118 @@
+// .npz reading: the labelled grid layout, dtype conversions and every refusal.
+#include <gtest/gtest.h>
+
+#include "learn_test_data.hpp"
+#include "test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/learn/npz.hpp"
+
+namespace {
+
+using namespace vola_learn_test;
+using vola::learn::read_labelled_grids;
+
+std::vector<std::vector<std::uint8_t>> three_grids() {
+  return {shape_grid(0, 1), shape_grid(3, 2), shape_grid(9, 3)};
+}
+
+// The FormatError message of read_labelled_grids, or "" when it reads.
+std::string read_error(const std::string& path, const std::string& split = {}) {
+  try {
+    read_labelled_grids(path, split);
+  } catch (const vola::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Npz, ReadsGridsAndLabelsInNpyOrder) {
+  vola_test::TempDir dir;
+  const auto grids = three_grids();
+  for (const std::string dtype : {"|u1", "<i4"}) {
+    const std::string path = (dir / ("a" + dtype.substr(1) + ".npz")).string();
+    write_npz(path, {{"X_train", grids_npy(grids, 32, dtype)}, {"y_train", labels_npy({0, 3, 9})}});
+    EXPECT_EQ(vola::learn::npz_array_names(path), (std::vector<std::string>{"X_train", "y_train"}));
+    const auto read = read_labelled_grids(path);
+    EXPECT_EQ(read.split, "train");
+    EXPECT_EQ(read.side, 32);
+    ASSERT_EQ(read.size(), 3u);
+    EXPECT_EQ(read.labels, (std::vector<int>{0, 3, 9}));
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto g = read.grid(i);
+      EXPECT_TRUE(std::equal(g.begin(), g.end(), grids[i].begin(), grids[i].end())) << dtype << " grid " << i;
+    }
+  }
+}
+
+TEST(Npz, NamesTheSplitWhenThereAreSeveral) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "two.npz").string();
+  const auto grids = three_grids();
+  write_npz(path, {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 1, 2})},
+                   {"X_test", grids_npy({grids[0]}, 32)}, {"y_test", labels_npy({7})}});
+  EXPECT_NE(read_error(path).find("several X_<split>"), std::string::npos);
+  const auto test = read_labelled_grids(path, "test");
+  EXPECT_EQ(test.split, "test");
+  EXPECT_EQ(test.labels, std::vector<int>{7});
+  EXPECT_NE(read_error(path, "val").find("no array 'X_val'"), std::string::npos);
+}
+
+TEST(Npz, RefusesBadShapesDtypesValuesAndLabels) {
+  vola_test::TempDir dir;
+  const auto grids = three_grids();
+  const auto check = [&](const std::string& name, const std::vector<std::pair<std::string, Bytes>>& members,
+                         const std::string& expected) {
+    const std::string path = (dir / (name + ".npz")).string();
+    write_npz(path, members);
+    const std::string message = read_error(path);
+    EXPECT_NE(message.find(expected), std::string::npos) << name << ": " << message;
+    EXPECT_NE(message.find(path), std::string::npos) << name << ": " << message;
+  };
+  check("no_x", {{"y_train", labels_npy({1})}}, "no X_<split>");
+  check("no_y", {{"X_train", grids_npy(grids, 32)}}, "no array 'y_train'");
+  check("flat", {{"X_train", vola_io_test::npy_bytes("|u1", {3, 32}, false, Bytes(96, 0))}, {"y_train", labels_npy({0, 1, 2})}},
+        "expected (N, S, S, S)");
+  check("not_cubic", {{"X_train", vola_io_test::npy_bytes("|u1", {1, 8, 8, 4}, false, Bytes(256, 0))}, {"y_train", labels_npy({0})}},
+        "expected (N, S, S, S)");
+  check("count", {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 1})}}, "one label per grid (3)");
+  check("label", {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 12, 1})}}, "label 1 is 12");
+  check("float_labels", {{"X_train", grids_npy(grids, 32)}, {"y_train", vola_io_test::npy_bytes("<f8", {3}, false, Bytes(24, 0))}},
+        "expected integer labels");
+  Bytes two(8 * 8 * 8, 0);
+  two[100] = 2;
+  check("value", {{"X_train", vola_io_test::npy_bytes("|u1", {1, 8, 8, 8}, false, two)}, {"y_train", labels_npy({0})}},
+        "grid 0 holds 2");
+  Bytes truncated = grids_npy(grids, 32);
+  truncated.resize(truncated.size() - 10);
+  check("short", {{"X_train", truncated}, {"y_train", labels_npy({0, 1, 2})}}, "X_train.npy");
+}
+
+TEST(Npz, RefusesFilesThatAreNotArchives) {
+  vola_test::TempDir dir;
+  const std::string text = (dir / "text.npz").string();
+  vola_test::write_bytes(text, Bytes(200, 'x'));
+  EXPECT_NE(read_error(text).find("not a readable .npz"), std::string::npos) << read_error(text);
+  const std::string missing = (dir / "missing.npz").string();
+  EXPECT_NE(read_error(missing).find("cannot open"), std::string::npos) << read_error(missing);
+  // A member that is no .npy.
+  const std::string junk = (dir / "junk.npz").string();
+  write_npz(junk, {{"X_train", Bytes(64, 7)}, {"y_train", labels_npy({0})}});
+  EXPECT_NE(read_error(junk).find("X_train.npy"), std::string::npos) << read_error(junk);
+}
+
+TEST(Npz, ReadsTheModelNetTrainingSplit) {
+  VOLA_REQUIRE_DATA(data);
+  const auto grids = read_labelled_grids((data / "modelnet" / "modelnet10_32_train.npz").string());
+  EXPECT_EQ(grids.split, "train");
+  EXPECT_EQ(grids.side, 32);
+  ASSERT_EQ(grids.size(), 3991u);
+  std::vector<int> counts(10, 0);
+  for (int label : grids.labels) ++counts[std::size_t(label)];
+  // The label histogram an independent reader found (EXPECTED.txt).
+  EXPECT_EQ(counts, (std::vector<int>{106, 515, 889, 200, 200, 465, 200, 680, 392, 344}));
+  std::size_t filled = 0;
+  for (auto c : grids.cells) filled += c;
+  EXPECT_NEAR(double(filled) / double(grids.cells.size()), 0.0954, 0.0005);
+}
+
+}  // namespace
