@@ -30,25 +30,39 @@ std::int64_t index_after(const RayAxes& axes, const Ray& ray, int a, double t, s
   return i;
 }
 
+// The bit of cell c (cell indices of its level) in its block's word.
+unsigned cell_bit(const std::array<std::int64_t, 3>& c) noexcept {
+  return static_cast<unsigned>((c[0] & 3) + 4 * (c[1] & 3) + 16 * (c[2] & 3));
+}
+
 }  // namespace
 
 RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
-  rank_.reserve(static_cast<std::size_t>(tree.depth()));
-  for (int l = 0; l < tree.depth(); ++l) rank_.emplace_back(tree.occupancy(l));
+  nodes_.resize(static_cast<std::size_t>(tree.depth()));
+  for (int l = 0; l < tree.depth(); ++l) {
+    const auto words = tree.occupancy(l);
+    auto& nodes = nodes_[static_cast<std::size_t>(l)];
+    nodes.resize(words.size());
+    std::uint64_t children = 0;
+    for (std::size_t i = 0; i < words.size(); ++i) {
+      nodes[i] = Node{words[i], children};
+      children += static_cast<std::uint64_t>(std::popcount(words[i]));
+    }
+  }
 }
 
 std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
   check_ray(ray);
   if (tree_->empty()) return std::nullopt;
   const RayAxes axes(ray);
-  const int depth = tree_->depth();
+  const int last = tree_->depth() - 1;
   const auto side = static_cast<std::int64_t>(tree_->side());
 
   // Clip to the cube [0, side]^3: the first event that puts the ray inside it.
   std::array<std::int64_t, 3> v = axes.start;
   double t = 0.0;
   if (std::any_of(v.begin(), v.end(), [&](std::int64_t i) { return i < 0 || i >= side; })) {
-    double enter = 0.0, leave = kNever;
+    double enter = 0.0, exit = kNever;
     for (int a = 0; a < 3; ++a) {
       const int s = axes.step[a];
       if (s == 0) {
@@ -59,87 +73,96 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       const double o = ray.origin[a];
       if (v[a] < 0 || v[a] >= side)
         enter = std::max(enter, crossing_time(s > 0 ? 0.0 : static_cast<double>(side), o, axes.inverse[a]));
-      leave = std::min(leave, crossing_time(s > 0 ? static_cast<double>(side) : 0.0, o, axes.inverse[a]));
+      exit = std::min(exit, crossing_time(s > 0 ? static_cast<double>(side) : 0.0, o, axes.inverse[a]));
     }
-    if (!(enter < leave) || !(enter <= ray.t_max)) return std::nullopt;
+    if (!(enter < exit) || !(enter <= ray.t_max)) return std::nullopt;
     t = enter;
     for (int a = 0; a < 3; ++a)
       if (axes.step[a]) v[a] = index_after(axes, ray, a, t, 0, side - 1);
   }
 
-  RayHit hit;
-  hit.t = t;
-  if (t > 0.0) {
+  // Per level: the ray's cell (in cells of that level) and, per axis, the time it
+  // crosses the plane through which it leaves that cell. Stepping a cell costs one
+  // multiplication per axis that moves; the voxel-level index inside a cell is worked
+  // out only when descending into it.
+  std::array<std::array<std::int64_t, 3>, kMaxDepth> cell{};
+  std::array<std::array<double, 3>, kMaxDepth> leave{};
+  std::array<std::size_t, kMaxDepth> block{};  // the cell's block on each level of the path
+  auto exit_time = [&](int a, std::int64_t c, int shift) {
+    return crossing_time(static_cast<double>((axes.step[a] > 0 ? c + 1 : c) << shift), ray.origin[a], axes.inverse[a]);
+  };
+  auto enter_level = [&](int level, const std::array<std::int64_t, 3>& voxel) {
+    const int shift = 2 * (last - level);
     for (int a = 0; a < 3; ++a) {
-      if (axes.step[a] && crossing_time(axes.entry_plane(a, v[a]), ray.origin[a], axes.inverse[a]) == t) {
-        hit.normal[a] = -axes.step[a];
-        break;
-      }
+      cell[level][a] = voxel[a] >> shift;
+      leave[level][a] = axes.step[a] ? exit_time(a, cell[level][a], shift) : kNever;
     }
-  }
-
-  // Crossing time of the plane through which the ray leaves v on each axis.
-  std::array<double, 3> exit_time{kNever, kNever, kNever};
-  for (int a = 0; a < 3; ++a)
-    if (axes.step[a]) exit_time[a] = crossing_time(axes.exit_plane(a, v[a]), ray.origin[a], axes.inverse[a]);
-
-  std::array<std::size_t, kMaxDepth> block{};  // block of each level on the current path
-  int from = 0;                                // first level whose cell may have changed
+  };
+  // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
+  bool moved = t > 0.0;
+  int level = 0;
+  enter_level(0, v);
   for (;;) {
-    // Descend from `from` until a level's cell is empty, or the voxel is occupied.
-    int level = from;
-    for (;; ++level) {
-      const int shift = 2 * (depth - 1 - level);
-      const auto bit = static_cast<unsigned>(((v[0] >> shift) & 3) + 4 * ((v[1] >> shift) & 3) +
-                                             16 * ((v[2] >> shift) & 3));
-      const auto words = tree_->occupancy(level);
-      const std::uint64_t word = words[block[level]];
-      if (!((word >> bit) & 1u)) break;
-      if (level == depth - 1) {
-        hit.voxel = Voxel{static_cast<std::uint32_t>(v[0]), static_cast<std::uint32_t>(v[1]),
-                          static_cast<std::uint32_t>(v[2])};
+    const std::array<std::int64_t, 3>& c = cell[level];
+    const unsigned bit = cell_bit(c);
+    const Node& node = nodes_[static_cast<std::size_t>(level)][block[level]];
+    if ((node.bits >> bit) & 1u) {
+      if (level == last) {
+        RayHit hit;
+        hit.voxel = Voxel{static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
+                          static_cast<std::uint32_t>(c[2])};
+        hit.t = t;
+        // The normal: the lowest axis whose entry plane into the voxel is crossed now.
+        for (int a = 0; a < 3 && moved; ++a) {
+          if (axes.step[a] && crossing_time(axes.entry_plane(a, c[a]), ray.origin[a], axes.inverse[a]) == t) {
+            hit.normal[a] = -axes.step[a];
+            break;
+          }
+        }
         return hit;
       }
-      block[level + 1] = rank_[level].before(words, block[level]) +
-                         static_cast<std::size_t>(std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
+      // Descend: the child cell holding the voxel the ray is in just after t.
+      block[level + 1] = node.first_child + static_cast<std::size_t>(std::popcount(node.bits & ((std::uint64_t{1} << bit) - 1)));
+      const int shift = 2 * (last - level);
+      for (int a = 0; a < 3; ++a) {
+        if (!axes.step[a]) continue;
+        const std::int64_t lo = c[a] << shift;
+        v[a] = index_after(axes, ray, a, t, lo, lo + (std::int64_t{1} << shift) - 1);
+      }
+      enter_level(++level, v);
+      continue;
     }
 
-    // Step over the empty node of `level`: to the first event that leaves it. An axis
-    // whose own next plane comes later keeps its index; one whose boundary plane is
-    // crossed at that event enters the next node; any other crossed planes inside the
-    // node on the way (only when the node is bigger than a voxel) are counted exactly.
-    const int shift = 2 * (depth - 1 - level);
-    std::array<std::int64_t, 3> lo{}, hi{};
-    std::array<double, 3> leave{kNever, kNever, kNever};
-    double next = kNever;
-    for (int a = 0; a < 3; ++a) {
-      if (!axes.step[a]) continue;
-      lo[a] = (v[a] >> shift) << shift;
-      hi[a] = lo[a] + (std::int64_t{1} << shift) - 1;
-      leave[a] = shift == 0 ? exit_time[a]
-                            : crossing_time(static_cast<double>(axes.step[a] > 0 ? hi[a] + 1 : lo[a]), ray.origin[a],
-                                            axes.inverse[a]);
-      next = std::min(next, leave[a]);
-    }
+    // An empty cell: step to the next cell of this level, every axis crossing now together.
+    std::array<double, 3>& out = leave[level];
+    const double next = std::min({out[0], out[1], out[2]});
     if (next == kNever || !(next <= ray.t_max)) return std::nullopt;
-    const std::array<std::int64_t, 3> old = v;
-    hit.normal = {0, 0, 0};
-    bool normal_set = false;
+    const int shift = 2 * (last - level);
+    const std::int64_t cells = side >> shift;
+    std::int64_t changed = 0;
+    std::array<std::int64_t, 3>& here = cell[level];
     for (int a = 0; a < 3; ++a) {
-      const int s = axes.step[a];
-      if (!s || exit_time[a] > next) continue;
-      const double o = ray.origin[a];
-      v[a] = leave[a] == next ? (s > 0 ? hi[a] + 1 : lo[a] - 1) : index_after(axes, ray, a, next, lo[a], hi[a]);
-      if (v[a] < 0 || v[a] >= side) return std::nullopt;
-      exit_time[a] = crossing_time(axes.exit_plane(a, v[a]), o, axes.inverse[a]);
-      if (!normal_set && crossing_time(axes.entry_plane(a, v[a]), o, axes.inverse[a]) == next) {
-        hit.normal[a] = -s;
-        normal_set = true;
+      if (out[a] != next) continue;
+      const std::int64_t i = here[a] + axes.step[a];
+      if (i < 0 || i >= cells) return std::nullopt;
+      changed |= i ^ here[a];
+      here[a] = i;
+      out[a] = exit_time(a, i, shift);
+    }
+    t = next;
+    moved = true;
+    // Left the parent block: climb to the coarsest level whose cell changed (its own
+    // parent's cell did not); the levels below it are entered again by descending.
+    const int up = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(changed)) - 1) / 2;
+    if (up > 0) {
+      level -= up;
+      for (int a = 0; a < 3; ++a) {
+        const std::int64_t moved_to = here[a] >> (2 * up);
+        if (moved_to == cell[level][a]) continue;
+        cell[level][a] = moved_to;
+        leave[level][a] = exit_time(a, moved_to, 2 * (last - level));
       }
     }
-    hit.t = next;
-    const auto changed = static_cast<std::uint64_t>((v[0] ^ old[0]) | (v[1] ^ old[1]) | (v[2] ^ old[2]));
-    from = depth - 1 - static_cast<int>(std::bit_width(changed) - 1) / 2;
   }
 }
 

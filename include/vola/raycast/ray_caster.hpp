@@ -4,10 +4,14 @@
 // entry time and normal, because it crosses the same planes with the same arithmetic
 // (ray.hpp) and only skips events inside empty nodes.
 //
-// The caster keeps a rank directory per level and, per ray, the path of blocks from the
-// root, so a step re-descends only from the first level whose cell changed.
+// The caster keeps, per level, each word next to the index of its first child (so a
+// descent is one load and one popcount per level) and, per ray, the path of blocks from
+// the root, so a step re-descends only from the first level whose cell changed. Inside
+// an occupied 4x4x4 block it steps voxel by voxel testing bits of the block's word,
+// until the ray leaves the block.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <span>
@@ -30,8 +34,12 @@ class RayCaster {
   const Tree& tree() const noexcept { return *tree_; }
 
  private:
+  struct Node {
+    std::uint64_t bits;         // the occupancy word
+    std::uint64_t first_child;  // index of its first child block on the next level
+  };
   const Tree* tree_;
-  std::vector<RankDirectory> rank_;
+  std::vector<std::vector<Node>> nodes_;  // per level
 };
 
 // Runs f(begin, end) over [0, count) in chunks on `threads` threads (0 = hardware).
