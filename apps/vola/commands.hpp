@@ -22,7 +22,6 @@ void add_view(CLI::App& app);
 void add_fuse(CLI::App& app);
 void add_rgbd_generate(CLI::App& app);
 void add_rgbd_eval(CLI::App& app);
-void add_view(CLI::App& app);
 void add_sonify(CLI::App& app);
 void add_dataset(CLI::App& app);
 void add_train(CLI::App& app);

@@ -41,7 +41,6 @@ int main(int argc, char** argv) {
   vola::cli::add_fuse(app);
   vola::cli::add_rgbd_generate(app);
   vola::cli::add_rgbd_eval(app);
-  vola::cli::add_view(app);
   vola::cli::add_sonify(app);
   vola::cli::add_dataset(app);
   vola::cli::add_train(app);
