@@ -265,18 +265,19 @@ std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& t
   std::vector<std::vector<double>> per_kernel(std::size_t{kernels} + 1);
   per_kernel[0].assign(length, 0.0);
   per_kernel[0][t.direct_sample] += t.direct_amplitude;
-  // Bins are sorted by level within a sample; one pow per distinct level run.
-  const double step_db = o.bin_width_db;
-  std::int32_t cached_level = 0;
-  double cached_amplitude = 1.0;
+  // One pow per level the bins use, not one per bin: the levels span a few hundred values.
+  std::int32_t low = t.bins.empty() ? 0 : t.bins.front().level, high = low;
   for (const Bin& b : t.bins) {
-    if (b.level != cached_level) {
-      cached_level = b.level;
-      cached_amplitude = std::pow(10.0, -b.level * step_db / 20.0);
-    }
+    low = std::min(low, b.level);
+    high = std::max(high, b.level);
+  }
+  std::vector<double> amplitude(t.bins.empty() ? 0 : static_cast<std::size_t>(high - low) + 1);
+  for (std::size_t i = 0; i < amplitude.size(); ++i)
+    amplitude[i] = std::pow(10.0, -(low + static_cast<double>(i)) * o.bin_width_db / 20.0);
+  for (const Bin& b : t.bins) {
     auto& h = per_kernel[b.kernel];
     if (h.empty()) h.assign(length, 0.0);
-    h[b.sample] += static_cast<double>(b.count) * cached_amplitude;
+    h[b.sample] += static_cast<double>(b.count) * amplitude[static_cast<std::size_t>(b.level - low)];
   }
   std::vector<double> ir = std::move(per_kernel[0]);
   if (kernels == 0) return ir;
