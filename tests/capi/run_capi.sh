@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The C API test on a scratch directory, plus a real survey converted by the CLI (a file
-# with attribute columns). Usage: run_capi.sh TEST_CAPI VOLA_CLI DATA_DIR
+# with attribute columns). Usage: run_capi.sh TEST_CAPI VOLA_CLI DEFAULT_DATA_DIR
 set -euo pipefail
-test_capi=$1 vola=$2 data=$3
+test_capi=$1 vola=$2 data=${VOLA_SHARED:+$VOLA_SHARED/data}
+data=${data:-$3}  # VOLA_SHARED wins over the configured default
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 las=$data/las/pdal_1.2-with-color.las
