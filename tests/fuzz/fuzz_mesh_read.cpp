@@ -1,0 +1,38 @@
+// Fuzz entry point of the mesh reader through Assimp (io::read_mesh_triangles): the
+// first byte picks the file kind (STL, OBJ, OFF, PLY, glTF: modulo 5), the rest is the
+// file, written to a scratch file with that extension. Only vola::Error may escape;
+// what parses must hold at least one and at most kMaxMeshTriangles triangles.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <span>
+
+#include "fuzz_seeds.hpp"
+#include "scratch_file.hpp"
+#include "vola/error.hpp"
+#include "vola/io/mesh.hpp"
+
+namespace vola_fuzz {
+Stats& stats() {
+  static Stats s;
+  return s;
+}
+// The extension of each selector value (fuzz_mesh_read_seeds.cpp writes seeds with it).
+extern const char* const kMeshExtensions[5];
+const char* const kMeshExtensions[5] = {"stl", "obj", "off", "ply", "gltf"};
+}  // namespace vola_fuzz
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  const std::string path =
+      vola_fuzz::scratch_file("mesh", vola_fuzz::kMeshExtensions[data[0] % 5], std::span(data + 1, size - 1));
+  try {
+    const auto triangles = vola::io::read_mesh_triangles(path);
+    if (triangles.empty() || triangles.size() > vola::io::kMaxMeshTriangles) std::abort();
+  } catch (const vola::Error&) {
+    ++vola_fuzz::stats().refused;
+    return 0;
+  }
+  ++vola_fuzz::stats().parsed;
+  return 0;
+}

@@ -1,0 +1,27 @@
+// The mesh and DEM readers go through third-party libraries that open paths, so their
+// fuzz entry points write each input to a scratch file of this process first.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <string>
+
+namespace vola_fuzz {
+
+// Writes `bytes` to "<tmp>/vola_fuzz_<stem>_<pid>.<extension>" and returns its path (the
+// extension is what the libraries pick their parser by).
+inline std::string scratch_file(const std::string& stem, const std::string& extension,
+                                std::span<const std::uint8_t> bytes) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("vola_fuzz_" + stem + "_" + std::to_string(::getpid()) + "." + extension))
+                               .string();
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+}  // namespace vola_fuzz
