@@ -245,26 +245,36 @@ void LasReader::read_header() {
   in.seekg(hd.offset_to_points);
 }
 
+std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
+  const LasHeader& hd = header_;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  if (n == 0) return {};
+  const std::size_t length = hd.record_length;
+  // resize() only grows the buffer after the first chunk: no zeroing per chunk.
+  if (buffer_.size() < n * length) buffer_.resize(n * length);
+  in_->seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
+  in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
+  if (static_cast<std::size_t>(in_->gcount()) != n * length)
+    throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
+  next_ += n;
+  return {buffer_.data(), n * length};
+}
+
 std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_only) {
   chunk.clear();
   const LasHeader& hd = header_;
   chunk.extra.resize(hd.extra_fields.size());
-  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
-  if (n == 0) return 0;
   const std::size_t length = hd.record_length;
-  buffer_.resize(n * length);
-  in_->seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
-  in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
-  if (static_cast<std::size_t>(in_->gcount()) != buffer_.size())
-    throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
+  const std::span<const std::uint8_t> records = read_records(max_points);
+  const std::size_t n = records.size() / length;
+  if (n == 0) return 0;
   if (xyz_only) {
     chunk.xyz.resize(3 * n);
     double* out = chunk.xyz.data();
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t* r = buffer_.data() + i * length;
+      const std::uint8_t* r = records.data() + i * length;
       for (int a = 0; a < 3; ++a) out[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
     }
-    next_ += n;
     return n;
   }
   const bool extended = hd.extended_format();
@@ -287,7 +297,7 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
   }
   for (auto& e : chunk.extra) e.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t* r = buffer_.data() + i * length;
+    const std::uint8_t* r = records.data() + i * length;
     for (int a = 0; a < 3; ++a)
       chunk.xyz[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
     chunk.intensity[i] = load<std::uint16_t>(r + 12);
@@ -315,7 +325,6 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
       chunk.extra[f][i] = extra_value(r + field.offset, field.data_type) * field.scale + field.add;
     }
   }
-  next_ += n;
   return n;
 }
 
@@ -416,6 +425,71 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
   return cloud;
 }
 
+namespace {
+
+// x y z of each record, resized (not cleared: no zeroing) to 3 per record.
+void decode_xyz(const LasHeader& hd, std::span<const std::uint8_t> records, std::vector<double>& xyz) {
+  const std::size_t length = hd.record_length, n = records.size() / length;
+  xyz.resize(3 * n);
+  double* out = xyz.data();
+  const std::uint8_t* r = records.data();
+  for (std::size_t i = 0; i < n; ++i, r += length, out += 3) {
+    out[0] = static_cast<double>(load<std::int32_t>(r)) * hd.scale[0] + hd.offset[0];
+    out[1] = static_cast<double>(load<std::int32_t>(r + 4)) * hd.scale[1] + hd.offset[1];
+    out[2] = static_cast<double>(load<std::int32_t>(r + 8)) * hd.scale[2] + hd.offset[2];
+  }
+}
+
+// The bounds of the decoded coordinates, from the rest of the file. x * scale + offset
+// is monotonic in the stored integer x (rounding keeps the order; a negative scale
+// reverses it), so the extremes of the integers decode to the extremes of the
+// coordinates: no point is decoded. A scale or offset that is not finite could make
+// NaN, which the comparisons of the decoded path skip: such files take that path.
+Box las_bounds(LasReader& reader, std::size_t chunk_points, const std::function<void(std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
+  bool finite = true;
+  for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(hd.scale[a]) && std::isfinite(hd.offset[a]);
+  std::int32_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<std::int32_t>::max();
+    hi[a] = std::numeric_limits<std::int32_t>::min();
+  }
+  std::vector<double> xyz;
+  const std::size_t length = hd.record_length;
+  while (true) {
+    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
+    if (records.empty()) break;
+    if (finite) {
+      for (const std::uint8_t* r = records.data(); r < records.data() + records.size(); r += length)
+        for (int a = 0; a < 3; ++a) {
+          const std::int32_t v = load<std::int32_t>(r + 4 * a);
+          lo[a] = std::min(lo[a], v);
+          hi[a] = std::max(hi[a], v);
+        }
+    } else {
+      decode_xyz(hd, records, xyz);
+      for (std::size_t i = 0; i < xyz.size(); ++i) {
+        box.min[i % 3] = std::min(box.min[i % 3], xyz[i]);
+        box.max[i % 3] = std::max(box.max[i % 3], xyz[i]);
+      }
+    }
+    progress(reader.points_read());
+  }
+  if (reader.points_read() == 0) return Box{};
+  if (finite)
+    for (int a = 0; a < 3; ++a) {
+      const double from_lo = static_cast<double>(lo[a]) * hd.scale[a] + hd.offset[a];
+      const double from_hi = static_cast<double>(hi[a]) * hd.scale[a] + hd.offset[a];
+      box.min[a] = std::min(from_lo, from_hi);
+      box.max[a] = std::max(from_lo, from_hi);
+    }
+  return box;
+}
+
+}  // namespace
+
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
   if (chunk_points == 0) throw InvalidArgument("build_las: chunk_points must be positive");
@@ -424,18 +498,10 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   const std::uint64_t passes = options.bbox ? 1 : 2;
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
     reader.rewind();
-    while (const std::size_t n = reader.read(chunk, chunk_points, true)) {
-      for (std::size_t i = 0; i < n; ++i)
-        for (int a = 0; a < 3; ++a) {
-          box.min[a] = std::min(box.min[a], chunk.xyz[3 * i + a]);
-          box.max[a] = std::max(box.max[a], chunk.xyz[3 * i + a]);
-        }
-      if (progress) progress(reader.points_read(), passes * hd.point_count);
-    }
-    options.bbox = reader.points_read() > 0 ? box : Box{};
+    options.bbox = las_bounds(reader, chunk_points, [&](std::uint64_t done) {
+      if (progress) progress(done, passes * hd.point_count);
+    });
   }
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
   std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
@@ -443,12 +509,22 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   std::vector<std::vector<double>> values;
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
+  std::vector<double> xyz;  // occupancy only: coordinates decoded straight from the records
   reader.rewind();
-  while (reader.read(chunk, chunk_points, !attributes && !payload) > 0) {
-    if (attributes) las_attribute_values(hd, chunk, values);
-    views.assign(values.begin(), values.end());
-    if (payload) las_payloads(hd, chunk, payloads);
-    builder.add(chunk.xyz, views, payload ? std::span<const std::uint64_t>(payloads) : std::span<const std::uint64_t>{});
+  const bool occupancy_only = !attributes && !payload;
+  while (true) {
+    if (occupancy_only) {
+      const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
+      if (records.empty()) break;
+      decode_xyz(hd, records, xyz);
+      builder.add(xyz, {}, {});
+    } else {
+      if (reader.read(chunk, chunk_points) == 0) break;
+      if (attributes) las_attribute_values(hd, chunk, values);
+      views.assign(values.begin(), values.end());
+      if (payload) las_payloads(hd, chunk, payloads);
+      builder.add(chunk.xyz, views, payload ? std::span<const std::uint64_t>(payloads) : std::span<const std::uint64_t>{});
+    }
     if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
   }
   Tree tree = builder.finish();

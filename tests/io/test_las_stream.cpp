@@ -100,8 +100,9 @@ void check_file(const std::function<vola::io::LasReader()>& open, std::size_t ch
 }
 
 // A LAS 1.2 format 3 file (RGB, GPS time) of `n` points in clusters, so that voxels get
-// several points with differing colours, classes and intensities.
-Bytes generated_las(std::size_t n, std::uint64_t seed) {
+// several points with differing colours, classes and intensities. A negative x scale
+// reverses the order of the stored integers (the bounds pass must cope).
+Bytes generated_las(std::size_t n, std::uint64_t seed, double x_scale = 0.01) {
   Bytes b(227, 0);
   std::memcpy(b.data(), "LASF", 4);
   b[24] = 1;
@@ -112,8 +113,8 @@ Bytes generated_las(std::size_t n, std::uint64_t seed) {
   b[104] = 3;
   at(105, std::uint16_t{34});
   at(107, static_cast<std::uint32_t>(n));
-  const double scale = 0.01;
-  for (int a = 0; a < 3; ++a) at(131 + 8 * a, scale);
+  const double scales[3] = {x_scale, 0.01, 0.01};
+  for (int a = 0; a < 3; ++a) at(131 + 8 * a, scales[a]);
   at(155, 1000.0);  // x offset
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> spread(0.0, 3.0);
@@ -122,8 +123,8 @@ Bytes generated_las(std::size_t n, std::uint64_t seed) {
   for (std::size_t i = 0; i < n; ++i) {
     std::int32_t raw[3];
     for (int a = 0; a < 3; ++a) {
-      raw[a] = static_cast<std::int32_t>((centre(rng) + spread(rng)) / scale);
-      const double v = raw[a] * scale + (a == 0 ? 1000.0 : 0.0);
+      raw[a] = static_cast<std::int32_t>((centre(rng) + spread(rng)) / scales[a]);
+      const double v = raw[a] * scales[a] + (a == 0 ? 1000.0 : 0.0);
       lo[a] = std::min(lo[a], v);
       hi[a] = std::max(hi[a], v);
       put(b, raw[a]);
@@ -161,6 +162,11 @@ TEST(LasStream, GeneratedFileInManyChunksBuildsAsTheWholeCloudDoes) {
     SCOPED_TRACE("chunk " + std::to_string(chunk));
     check_file([&] { return vola::io::LasReader(bytes, "generated.las"); }, chunk);
   }
+}
+
+TEST(LasStream, NegativeScaleBoundsAsDecoded) {
+  const Bytes bytes = generated_las(5000, 12, -0.01);
+  check_file([&] { return vola::io::LasReader(bytes, "negative_scale.las"); }, 333);
 }
 
 }  // namespace

@@ -80,6 +80,9 @@ class LasReader {
   // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end. With
   // `xyz_only`, only the coordinates are decoded.
   std::size_t read(LasChunk& chunk, std::size_t max_points, bool xyz_only = false);
+  // Up to `max_points` undecoded point records, header().record_length bytes each (valid
+  // until the next read); empty at the end.
+  std::span<const std::uint8_t> read_records(std::size_t max_points);
   std::uint64_t points_read() const noexcept { return next_; }
   // Back to the first point (for a second pass).
   void rewind();
