@@ -5,7 +5,7 @@
 // without the slicing plane), that the page needs nothing but the loopback server, that
 // bad API requests get clear errors without stopping the server, and that the
 // screenshot it writes is not blank.
-// Usage: node browser_test.mjs VOLA DATA_DIR NODE_MODULES CHROMIUM OUT.png
+// Usage: node browser_test.mjs VOLA DATA_DIR NODE_MODULES CHROMIUM OUT.png ($VOLA_SHARED/data if set)
 // Exit 77 (skip) when the data is missing and CI is not set.
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
@@ -14,7 +14,9 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { existsSync } from 'node:fs';
 
-const [vola, dataDir, nodeModules, chromiumPath, screenshotPath] = process.argv.slice(2);
+const [vola, defaultDataDir, nodeModules, chromiumPath, screenshotPath] = process.argv.slice(2);
+// VOLA_SHARED in the environment overrides the configured data folder, as for every test.
+const dataDir = process.env.VOLA_SHARED ? path.join(process.env.VOLA_SHARED, 'data') : defaultDataDir;
 const las = path.join(dataDir, 'las', 'pdal_autzen_trim.las');
 if (!existsSync(las)) {
   if (process.env.CI) { console.error(`FAIL: ${las} is missing (CI is set)`); process.exit(1); }

@@ -216,6 +216,8 @@ async function pickAt(clientX, clientY) {
   const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1,
     -((clientY - rect.top) / rect.height) * 2 + 1);
   const raycaster = new THREE.Raycaster();
+  // The camera as the controls left it, even when no frame has drawn it yet.
+  camera.updateMatrixWorld();
   raycaster.setFromCamera(ndc, camera);
   const originWorld = raycaster.ray.origin.toArray().map((v, a) => v + state.sceneOrigin[a]);
   const direction = raycaster.ray.direction.toArray();
