@@ -1,4 +1,6 @@
-// vola plan: a collision-free path between two points (A* over free voxels), as CSV and PLY.
+// vola plan: a collision-free path between two points (A* over free voxels), as CSV and PLY;
+// with --avoid, the trajectory of a reactive agent that only looks along a fan of rays.
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -7,6 +9,7 @@
 #include "commands.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/raycast/avoidance.hpp"
 #include "vola/raycast/path_planner.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -20,7 +23,24 @@ struct PlanArgs {
   double radius = 0.0;
   int level = -1;
   bool hierarchical = false, no_smooth = false, grid = false, quiet = false;
+  bool avoid = false;
+  double speed = 0.0, look_ahead = 0.0;  // 0: one voxel, 24 voxels
+  std::size_t max_steps = 100000;
 };
+
+// The agent's positions (grid coordinates) from `from` towards `to`, step by step; throws
+// when it does not arrive, after the caller had the chance to write what it flew.
+raycast::Flight fly_to(const PlanArgs& a, const Tree& tree, const Point& from, const Point& to, double scale) {
+  const raycast::Collider collider(tree);
+  raycast::AvoidanceOptions options;
+  options.radius = a.radius * scale;
+  options.speed = a.speed > 0.0 ? a.speed * scale : 1.0;
+  options.look_ahead = a.look_ahead > 0.0 ? a.look_ahead * scale : 24.0;
+  if (collider.sphere(from, options.radius))
+    throw InvalidArgument("--from: the agent there touches an occupied voxel (or is closer than --radius to one)");
+  const raycast::ObstacleAvoider avoider(collider, options);
+  return raycast::fly(avoider, from, to, a.max_steps, std::max(0.5, options.speed));
+}
 
 void run_plan(const PlanArgs& a) {
   const Tree tree = open_mapped(a.input);
@@ -35,7 +55,14 @@ void run_plan(const PlanArgs& a) {
     from = raycast::world_to_grid(frame, from);
     to = raycast::world_to_grid(frame, to);
   }
-  const raycast::PlannedPath path = raycast::plan_path(tree, from, to, options);
+  raycast::PlannedPath path;
+  raycast::Flight flight;
+  if (a.avoid) {
+    flight = fly_to(a, tree, from, to, a.grid ? 1.0 : 1.0 / frame.voxel_size);
+    path.points = flight.positions;
+  } else {
+    path = raycast::plan_path(tree, from, to, options);
+  }
   std::vector<Point> points;
   for (const Point& p : path.points) points.push_back(a.grid ? p : raycast::grid_to_world(frame, p));
   std::ofstream csv(a.output);
@@ -55,6 +82,15 @@ void run_plan(const PlanArgs& a) {
     for (std::size_t i = 1; i < points.size(); ++i) ply << i - 1 << ' ' << i << '\n';
     if (!ply.flush()) throw IoError("cannot write " + a.ply);
   }
+  if (a.avoid) {
+    if (!flight.reached)
+      throw InvalidArgument("--avoid: the agent did not reach the goal in " + std::to_string(points.size() - 1) +
+                            " steps (" + (flight.held_steps ? "boxed in" : "out of --max-steps") +
+                            "); its trajectory is in " + a.output);
+    if (!a.quiet)
+      std::printf("%zu steps to the goal, never closer than --radius to a voxel\n", points.size() - 1);
+    return;
+  }
   if (!a.quiet)
     std::printf("%zu waypoints, length %.6g (A* cost %.6g) %s, %llu cells expanded\n", points.size(),
                 a.grid ? path.length : path.length * frame.voxel_size,
@@ -73,9 +109,14 @@ void add_plan(CLI::App& app) {
       "planning grid; smoothing then replaces runs by straight segments the sphere can sweep clear.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
       "Coordinates are world coordinates (the file's frame) unless --grid is given.\n"
+      "--avoid flies a reactive agent instead of planning: each step it casts a fan of rays around\n"
+      "the goal direction (--look-ahead long, as thick as the agent), takes the open direction\n"
+      "closest to the goal and its current heading, and moves --speed only if the swept sphere is\n"
+      "clear, so it never collides; without a map search it can get stuck (then exit status 1).\n"
       "Examples:\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 -o path.csv --ply path.ply\n"
-      "  vola plan site.vol --grid --from 0.5 0.5 0.5 --to 900 900 30 --hierarchical");
+      "  vola plan site.vol --grid --from 0.5 0.5 0.5 --to 900 900 30 --hierarchical\n"
+      "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 --avoid --speed 0.25");
   cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("--from", args->from, "Start X Y Z")->required()->expected(3);
   cmd->add_option("--to", args->to, "Goal X Y Z")->required()->expected(3);
@@ -85,6 +126,12 @@ void add_plan(CLI::App& app) {
   cmd->add_flag("--no-smooth", args->no_smooth, "Keep every cell of the A* path");
   cmd->add_option("-o,--output", args->output, "CSV of waypoints (x,y,z)")->capture_default_str();
   cmd->add_option("--ply", args->ply, "Also write the path as a PLY polyline");
+  cmd->add_flag("--avoid", args->avoid, "Fly a reactive obstacle-avoiding agent instead of A*");
+  cmd->add_option("--speed", args->speed, "--avoid: distance per step (default: one voxel)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--look-ahead", args->look_ahead, "--avoid: length of the fan's rays (default: 24 voxels)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-steps", args->max_steps, "--avoid: give up after this many steps")->capture_default_str();
   cmd->add_flag("--grid", args->grid, "Points and radius are in voxel-grid coordinates");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_plan(*args); });

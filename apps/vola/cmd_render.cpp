@@ -127,8 +127,8 @@ void run_render(const RenderArgs& a) {
                   static_cast<unsigned long long>(image.hits), static_cast<unsigned long long>(width) * height);
   }
   if (!a.quiet)
-    std::printf("%llu rays in %.3f s: %.3f M rays/s\n", static_cast<unsigned long long>(rays), seconds,
-                seconds > 0 ? static_cast<double>(rays) / seconds / 1e6 : 0.0);
+    std::printf("%llu rays in %.3f s: %.3f M rays/s, %.2f frames/s\n", static_cast<unsigned long long>(rays), seconds,
+                seconds > 0 ? static_cast<double>(rays) / seconds / 1e6 : 0.0, seconds > 0 ? frames / seconds : 0.0);
 }
 
 }  // namespace
