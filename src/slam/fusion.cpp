@@ -331,8 +331,18 @@ template <class Store>
 void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, const Pose& pose) {
   const VolumeGeometry& geometry = store_.geometry();
   const std::vector<BrickCoord> bricks = bricks_in_band(depth, intrinsics_, pose, geometry, params_.truncation);
+  // Bricks not yet in the store are integrated into scratch space first and only stored
+  // when at least one voxel was observed: the band test is per pixel ray, so a brick it
+  // names can still have every voxel behind the surface or projecting outside the
+  // image, and such all-unobserved bricks would hold memory without any surface.
   std::vector<TsdfVoxel*> data(bricks.size());
-  for (std::size_t i = 0; i < bricks.size(); ++i) data[i] = store_.allocate(bricks[i]);
+  std::vector<std::size_t> fresh;  // indices into `bricks` of the ones not yet stored
+  for (std::size_t i = 0; i < bricks.size(); ++i) {
+    data[i] = store_.brick(bricks[i]);
+    if (!data[i]) fresh.push_back(i);
+  }
+  std::vector<TsdfVoxel> scratch(fresh.size() * kBrickVoxels);
+  for (std::size_t f = 0; f < fresh.size(); ++f) data[fresh[f]] = scratch.data() + f * kBrickVoxels;
   const Pose world_to_camera = pose.inverse();
   const Eigen::Matrix3d r = world_to_camera.linear();
   const Eigen::Vector3d t = world_to_camera.translation();
@@ -369,6 +379,11 @@ void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, cons
       }
     }
   });
+  for (std::size_t f = 0; f < fresh.size(); ++f) {
+    const TsdfVoxel* brick = scratch.data() + f * kBrickVoxels;
+    if (std::any_of(brick, brick + kBrickVoxels, [](const TsdfVoxel& v) { return v.weight > 0.0f; }))
+      std::copy(brick, brick + kBrickVoxels, store_.allocate(bricks[fresh[f]]));
+  }
 }
 
 template <class Store>
