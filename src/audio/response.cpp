@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <thread>
 
+#include "vola/audio/attenuation_level.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -36,9 +39,10 @@ struct PathModel {
   std::vector<std::uint16_t> slot_kernel;  // 0 or the per-band kernel number
   const AcousticScene* scene = nullptr;
   bool visibility = false;
+  bool single_slot = false;  // one material: every voxel's slot is 0
   // Bin packing.
-  double inverse_bin_width = 0.0;
   std::int64_t level_offset = 0, level_count = 0;
+  std::optional<AttenuationLevels> levels;
   int level_bits = 0, sample_bits = 0, kernel_bits = 0;
 };
 
@@ -57,8 +61,30 @@ bool sees(const raycast::RayCaster& caster, const Point& from, const Point& to, 
   return near(hit->voxel.x, target.x) && near(hit->voxel.y, target.y) && near(hit->voxel.z, target.z);
 }
 
-// The path through one surface voxel, or false when it does not reflect toward both ends,
-// arrives after the window, or is below the floor.
+// What reaches the listener through the reflecting point p of a surface voxel.
+struct Arrival {
+  double d1 = 0.0, d2 = 0.0;  // the two legs (voxels)
+  double sample = 0.0;
+  double amplitude = 0.0;
+  std::uint16_t slot = 0;
+};
+
+// false when the path arrives after the window, is below the floor, or (with visibility)
+// is blocked.
+// Inlined: it is the per-voxel work of threshold().
+[[gnu::always_inline]] inline bool arrives(const PathModel& m, const Point& p, std::uint64_t rank, std::size_t leaf_block, const Voxel& voxel, Arrival& a) {
+  a.d1 = distance(m.source, p);
+  a.d2 = distance(p, m.listener);
+  a.sample = std::nearbyint((a.d1 + a.d2) * m.samples_per_voxel);
+  if (!(a.sample <= static_cast<double>(m.max_sample))) return false;
+  a.slot = m.single_slot ? 0 : m.scene->materials().slot(rank, leaf_block);
+  a.amplitude = m.slot_gain[a.slot] * m.amplitude_scale / (a.d1 * a.d2);
+  if (!(a.amplitude >= m.floor_amplitude) || a.amplitude == 0.0) return false;
+  return !m.visibility || (sees(m.scene->caster(), m.source, p, voxel) && sees(m.scene->caster(), m.listener, p, voxel));
+}
+
+// The path through one surface voxel, or false when it does not reflect toward both ends
+// or does not arrive (above). The obvious per-voxel form of what threshold() does per block.
 bool reflect(const PathModel& m, const SurfaceVoxel& s, Reflection& out) {
   const double lo[3] = {static_cast<double>(s.voxel.x), static_cast<double>(s.voxel.y), static_cast<double>(s.voxel.z)};
   Point p{lo[0] + 0.5, lo[1] + 0.5, lo[2] + 0.5};
@@ -74,29 +100,69 @@ bool reflect(const PathModel& m, const SurfaceVoxel& s, Reflection& out) {
     }
   }
   if (!facing) return false;
-  const double d1 = distance(m.source, p), d2 = distance(p, m.listener);
-  const double sample = std::nearbyint((d1 + d2) * m.samples_per_voxel);
-  if (!(sample <= static_cast<double>(m.max_sample))) return false;
-  const std::uint16_t slot = m.scene->materials().slot(s.rank, s.leaf_block);
-  const double amplitude = m.slot_gain[slot] * m.amplitude_scale / (d1 * d2);
-  if (!(amplitude >= m.floor_amplitude) || amplitude == 0.0) return false;
-  if (m.visibility && !(sees(m.scene->caster(), m.source, p, s.voxel) && sees(m.scene->caster(), m.listener, p, s.voxel)))
-    return false;
-  const double size = m.scene->frame().voxel_size;
+  Arrival a;
+  if (!arrives(m, p, s.rank, s.leaf_block, s.voxel, a)) return false;
   out.voxel = s;
   out.point = raycast::grid_to_world(m.scene->frame(), p);
-  out.path = (d1 + d2) * size;
-  out.amplitude = amplitude;
-  out.sample = static_cast<std::uint32_t>(sample);
-  out.slot = slot;
+  out.path = (a.d1 + a.d2) * m.scene->frame().voxel_size;
+  out.amplitude = a.amplitude;
+  out.sample = static_cast<std::uint32_t>(a.sample);
+  out.slot = a.slot;
   return true;
 }
 
-Key bin_key(const PathModel& m, const Reflection& r) {
-  std::int64_t level = static_cast<std::int64_t>(std::llround(-20.0 * std::log10(r.amplitude) * m.inverse_bin_width));
-  level = std::clamp<std::int64_t>(level + m.level_offset, 0, m.level_count - 1);
-  return (static_cast<Key>(m.slot_kernel[r.slot]) << (m.sample_bits + m.level_bits)) |
-         (static_cast<Key>(r.sample) << m.level_bits) | static_cast<Key>(level);
+Key bin_key(const PathModel& m, std::uint16_t slot, double sample, double amplitude) {
+  const std::int64_t level = m.levels->index(amplitude);
+  return (static_cast<Key>(m.slot_kernel[slot]) << (m.sample_bits + m.level_bits)) |
+         (static_cast<Key>(sample) << m.level_bits) | static_cast<Key>(level);
+}
+
+// Bits of a block word whose cell coordinate along `axis` is c (0..3).
+constexpr std::uint64_t layer(int axis, unsigned c) {
+  constexpr std::uint64_t first[3] = {detail::kX0, detail::kY0, detail::kZ0};
+  return first[axis] << (c << (2 * axis));
+}
+
+// Calls key(Key) for every reflecting voxel of the surface blocks [begin, end): the faces
+// that face both ends are found for the whole block with word masks, then only the
+// reflecting voxels are visited.
+template <class F>
+void block_keys(const PathModel& m, const std::vector<SurfaceBlock>& blocks, std::size_t begin, std::size_t end, F&& key) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const SurfaceBlock& b = blocks[i];
+    const std::uint32_t origin[3] = {b.origin.x, b.origin.y, b.origin.z};
+    std::uint64_t below[3], above[3];  // reflect at the low / high face on each axis
+    std::uint64_t reflecting = 0;
+    for (int a = 0; a < 3; ++a) {
+      std::uint64_t low_ok = 0, high_ok = 0;
+      for (unsigned c = 0; c < 4; ++c) {
+        const double lo = static_cast<double>(origin[a] + c), hi = lo + 1.0;
+        if (m.source[a] < lo && m.listener[a] < lo) low_ok |= layer(a, c);
+        if (m.source[a] > hi && m.listener[a] > hi) high_ok |= layer(a, c);
+      }
+      below[a] = b.exposed[2 * a] & low_ok;
+      above[a] = b.exposed[2 * a + 1] & high_ok & ~below[a];
+      reflecting |= below[a] | above[a];
+    }
+    Arrival arrivals[64];
+    unsigned n = 0;
+    while (reflecting) {
+      const unsigned bit = static_cast<unsigned>(std::countr_zero(reflecting));
+      reflecting &= reflecting - 1;
+      const std::uint32_t cell[3] = {bit & 3u, (bit >> 2) & 3u, bit >> 4};
+      // The low face, the high face or the centre (below and above exclude each other).
+      static constexpr double kOffset[3] = {0.5, 0.0, 1.0};
+      Point p;
+      for (int a = 0; a < 3; ++a)
+        p[a] = static_cast<double>(origin[a] + cell[a]) + kOffset[((below[a] >> bit) & 1) | (((above[a] >> bit) & 1) << 1)];
+      const std::uint64_t mask = std::uint64_t{1} << bit;
+      const std::uint64_t rank = b.first_rank + static_cast<std::uint64_t>(std::popcount(b.word & (mask - 1)));
+      Arrival& arrival = arrivals[n];
+      n += arrives(m, p, rank, b.index, Voxel{origin[0] + cell[0], origin[1] + cell[1], origin[2] + cell[2]}, arrival);
+    }
+    // Binned in a second loop: the bin searches of different voxels then overlap.
+    for (unsigned j = 0; j < n; ++j) key(bin_key(m, arrivals[j].slot, arrivals[j].sample, arrivals[j].amplitude));
+  }
 }
 
 struct Direct {
@@ -141,8 +207,8 @@ PathModel path_model(const AcousticScene& scene, const Point& source, const Poin
     m.slot_kernel.push_back(mat.per_band() ? ++kernels : 0);
   }
   m.scene = &scene;
+  m.single_slot = scene.materials().slots().size() == 1;
   m.visibility = o.visibility;
-  m.inverse_bin_width = 1.0 / o.bin_width_db;
   m.level_offset = static_cast<std::int64_t>(std::ceil(kMaxGainDb / o.bin_width_db));
   m.level_count = m.level_offset + static_cast<std::int64_t>(std::ceil(-o.floor_db / o.bin_width_db)) + 2;
   m.level_bits = bits_for(static_cast<std::uint64_t>(m.level_count));
@@ -150,6 +216,7 @@ PathModel path_model(const AcousticScene& scene, const Point& source, const Poin
   m.kernel_bits = bits_for(std::uint64_t{kernels} + 1);
   if (m.level_bits + m.sample_bits + m.kernel_bits > 64)
     throw InvalidArgument("too many attenuation bins: widen --bin-width or raise --floor");
+  m.levels.emplace(o.bin_width_db, m.level_offset, m.level_count);
   return m;
 }
 
@@ -182,7 +249,8 @@ void ResponseOptions::check() const {
 }
 
 AcousticScene::AcousticScene(const Tree& tree, const MaterialTable& materials)
-    : tree_(&tree), frame_(tree.frame()), materials_(materials, tree), blocks_(leaf_blocks(tree)), caster_(tree) {
+    : tree_(&tree), frame_(tree.frame()), materials_(materials, tree), blocks_(leaf_blocks(tree)),
+      surface_(surface_blocks(tree, blocks_)), caster_(tree) {
   if (!(frame_.voxel_size > 0.0) || !std::isfinite(frame_.voxel_size))
     throw InvalidArgument("the scene's voxel size is not a positive number");
 }
@@ -208,17 +276,15 @@ Thresholded threshold(const AcousticScene& scene, const Point& source, const Poi
   const Direct direct = direct_path(scene, source, listener, o);
   const PathModel m = path_model(scene, source, listener, direct, o);
   const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t count = scene.blocks().size();
-  // A few ranges per thread balance uneven scenes; the ranges (not the threads) fix the result.
-  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(count / 256 + 1, 64));
+  const std::size_t count = scene.surface().size();
+  // A few ranges per thread balance uneven scenes; the counts per key, hence the bins, do not
+  // depend on how the blocks are split.
+  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(count / 256 + 1, 4 * threads));
   std::vector<std::vector<std::pair<Key, std::uint64_t>>> runs(ranges);
   const int key_bits = m.kernel_bits + m.sample_bits + m.level_bits;
   for_ranges(count, ranges, threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
     std::vector<Key> keys;
-    Reflection reflection;
-    for_each_surface_voxel(scene.tree(), scene.blocks(), begin, end, [&](const SurfaceVoxel& s) {
-      if (reflect(m, s, reflection)) keys.push_back(bin_key(m, reflection));
-    });
+    block_keys(m, scene.surface(), begin, end, [&](Key k) { keys.push_back(k); });
     radix_sort(keys, nullptr, std::max(key_bits, 1));
     auto& run = runs[r];
     for (const Key k : keys) {
@@ -226,16 +292,27 @@ Thresholded threshold(const AcousticScene& scene, const Point& source, const Poi
       else run.emplace_back(k, 1);
     }
   });
-  std::vector<std::pair<Key, std::uint64_t>> all;
-  for (const auto& run : runs) all.insert(all.end(), run.begin(), run.end());
-  std::sort(all.begin(), all.end());
+  // The runs sorted by one radix sort of their keys (an index keeps the counts; a scene with
+  // 2^32 runs would take 64 GiB of keys and counts first, so 32-bit indices suffice).
+  std::vector<Key> keys;
+  std::vector<std::uint64_t> counts;
+  for (const auto& run : runs)
+    for (const auto& [k, n] : run) {
+      keys.push_back(k);
+      counts.push_back(n);
+    }
+  std::vector<std::uint32_t> order(keys.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+  radix_sort(keys, &order, std::max(key_bits, 1));
   Thresholded t;
   t.direct_distance = direct.distance;
   t.direct_sample = direct.sample;
   t.direct_amplitude = direct.amplitude;
   t.direct_blocked = direct.blocked;
   const Key level_mask = (Key{1} << m.level_bits) - 1, sample_mask = (Key{1} << m.sample_bits) - 1;
-  for (const auto& [key, n] : all) {
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const Key key = keys[i];
+    const std::uint64_t n = counts[order[i]];
     t.reflectors += n;
     if (!t.bins.empty()) {
       const Bin& b = t.bins.back();

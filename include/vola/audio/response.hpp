@@ -59,6 +59,8 @@ class AcousticScene {
   const Frame& frame() const noexcept { return frame_; }
   const VoxelMaterials& materials() const noexcept { return materials_; }
   const std::vector<LeafBlock>& blocks() const noexcept { return blocks_; }
+  // The blocks holding surface voxels, with their exposed faces (found once, here).
+  const std::vector<SurfaceBlock>& surface() const noexcept { return surface_; }
   const raycast::RayCaster& caster() const noexcept { return caster_; }
   // Throws InvalidArgument when `p` is not finite or lies inside an occupied voxel;
   // `what` names the point ("source 1", "listener").
@@ -69,6 +71,7 @@ class AcousticScene {
   Frame frame_;
   VoxelMaterials materials_;
   std::vector<LeafBlock> blocks_;
+  std::vector<SurfaceBlock> surface_;
   raycast::RayCaster caster_;
 };
 

@@ -32,6 +32,20 @@ struct LeafBlock {
 
 std::vector<LeafBlock> leaf_blocks(const Tree& tree);
 
+// A leaf block with at least one surface voxel, and per face (Face bit order: -x, +x, -y,
+// +y, -z, +z) the block-word bits of its voxels whose neighbour there is empty. Found once
+// per scene, so that each response walks words instead of asking the tree per voxel.
+struct SurfaceBlock {
+  std::uint64_t exposed[6] = {};
+  Voxel origin;
+  std::uint64_t word = 0;
+  std::uint64_t first_rank = 0;
+  std::size_t index = 0;
+};
+
+// The surface blocks of blocks, in key order (for_each_surface_voxel gathered per block).
+std::vector<SurfaceBlock> surface_blocks(const Tree& tree, const std::vector<LeafBlock>& blocks);
+
 // Calls f(const SurfaceVoxel&) for each surface voxel of blocks[begin, end), in key order.
 template <class F>
 void for_each_surface_voxel(const Tree& tree, const std::vector<LeafBlock>& blocks, std::size_t begin, std::size_t end, F&& f);
