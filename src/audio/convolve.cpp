@@ -38,20 +38,40 @@ ComplexBuffer complex_buffer(std::size_t n) {
   return ComplexBuffer(p);
 }
 
+// Plans for one transform size, made once per process and size (under the planner mutex)
+// and kept: planning, above all with FFTW_MEASURE, costs far more than one execution.
+struct SizePlans {
+  fftw_plan forward = nullptr;
+  fftw_plan inverse = nullptr;
+};
+
+SizePlans plans_for(std::size_t n, FftPlanning planning) {
+  static std::vector<std::pair<std::pair<std::size_t, FftPlanning>, SizePlans>> cache;
+  std::lock_guard lock(planner_mutex());
+  for (const auto& [key, plans] : cache)
+    if (key == std::pair{n, planning}) return plans;
+  // Scratch arrays from fftw_malloc: plans then run on any fftw_malloc'ed arrays (same
+  // alignment) through the new-array execute functions.
+  RealBuffer time = real_buffer(n);
+  ComplexBuffer spectrum = complex_buffer(n / 2 + 1);
+  const unsigned flags = planning == FftPlanning::measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+  SizePlans p;
+  p.forward = fftw_plan_dft_r2c_1d(static_cast<int>(n), time.get(), spectrum.get(), flags);
+  p.inverse = fftw_plan_dft_c2r_1d(static_cast<int>(n), spectrum.get(), time.get(), flags);
+  if (!p.forward || !p.inverse) throw Error("convolution: FFTW could not plan a transform");
+  cache.emplace_back(std::pair{n, planning}, p);
+  return p;
+}
+
 }  // namespace
 
 struct Convolver::Plans {
-  fftw_plan forward = nullptr;
-  fftw_plan inverse = nullptr;
+  SizePlans size;
   ComplexBuffer filter_spectrum;
-  ~Plans() {
-    std::lock_guard lock(planner_mutex());
-    if (forward) fftw_destroy_plan(forward);
-    if (inverse) fftw_destroy_plan(inverse);
-  }
 };
 
-Convolver::Convolver(std::span<const double> filter) : filter_size_(filter.size()), plans_(std::make_unique<Plans>()) {
+Convolver::Convolver(std::span<const double> filter, FftPlanning planning)
+    : filter_size_(filter.size()), plans_(std::make_unique<Plans>()) {
   if (filter.empty()) throw InvalidArgument("convolution: the filter is empty");
   // Blocks at least four times the filter keep the FFT work per output sample low; a
   // power of two (>= 2 * filter) also keeps a block's tail shorter than a block, so even
@@ -60,19 +80,12 @@ Convolver::Convolver(std::span<const double> filter) : filter_size_(filter.size(
   while (fft_size_ < 4 * filter.size()) fft_size_ *= 2;
   block_ = fft_size_ - filter.size() + 1;
   const std::size_t bins = fft_size_ / 2 + 1;
+  plans_->size = plans_for(fft_size_, planning);
   RealBuffer time = real_buffer(fft_size_);
   plans_->filter_spectrum = complex_buffer(bins);
-  ComplexBuffer spectrum = complex_buffer(bins);
-  {
-    std::lock_guard lock(planner_mutex());
-    const int n = static_cast<int>(fft_size_);
-    plans_->forward = fftw_plan_dft_r2c_1d(n, time.get(), spectrum.get(), FFTW_ESTIMATE);
-    plans_->inverse = fftw_plan_dft_c2r_1d(n, spectrum.get(), time.get(), FFTW_ESTIMATE);
-  }
-  if (!plans_->forward || !plans_->inverse) throw Error("convolution: FFTW could not plan a transform");
   std::fill(time.get(), time.get() + fft_size_, 0.0);
   std::copy(filter.begin(), filter.end(), time.get());
-  fftw_execute_dft_r2c(plans_->forward, time.get(), plans_->filter_spectrum.get());
+  fftw_execute_dft_r2c(plans_->size.forward, time.get(), plans_->filter_spectrum.get());
 }
 
 Convolver::~Convolver() = default;
@@ -102,15 +115,15 @@ std::vector<double> Convolver::apply(std::span<const double> signal, unsigned th
       const std::size_t n = std::min(block_, signal.size() - begin);
       std::copy_n(signal.data() + begin, n, time);
       std::fill(time + n, time + fft_size_, 0.0);
-      fftw_execute_dft_r2c(plans_->forward, time, spectrum);
-      for (std::size_t k = 0; k < bins; ++k) {
-        const std::complex<double> a(spectrum[k][0], spectrum[k][1]);
-        const std::complex<double> h(plans_->filter_spectrum[k][0], plans_->filter_spectrum[k][1]);
-        const std::complex<double> y = a * h;
-        spectrum[k][0] = y.real();
-        spectrum[k][1] = y.imag();
+      fftw_execute_dft_r2c(plans_->size.forward, time, spectrum);
+      const fftw_complex* h = plans_->filter_spectrum.get();
+      for (std::size_t k = 0; k < bins; ++k) {  // written out: std::complex's * checks for NaN
+        const double re = spectrum[k][0] * h[k][0] - spectrum[k][1] * h[k][1];
+        const double im = spectrum[k][0] * h[k][1] + spectrum[k][1] * h[k][0];
+        spectrum[k][0] = re;
+        spectrum[k][1] = im;
       }
-      fftw_execute_dft_c2r(plans_->inverse, spectrum, time);
+      fftw_execute_dft_c2r(plans_->size.inverse, spectrum, time);
       const std::size_t valid = std::min(fft_size_, out.size() - begin);
       for (std::size_t i = 0; i < valid; ++i) out[begin + i] += time[i] * scale;
     }

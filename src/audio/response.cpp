@@ -4,6 +4,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -21,6 +22,20 @@ namespace {
 
 // Amplitudes above this (+60 dB re 1 at 1 m: a point a millimetre from a wall) share the top bin.
 constexpr double kMaxGainDb = 60.0;
+
+// Attenuation levels run from -offset to count - 1 - offset: +kMaxGainDb down to the floor.
+struct LevelRange {
+  std::int64_t offset = 0, count = 0;
+};
+LevelRange level_range(const ResponseOptions& o) {
+  LevelRange r;
+  r.offset = static_cast<std::int64_t>(std::ceil(kMaxGainDb / o.bin_width_db));
+  r.count = r.offset + static_cast<std::int64_t>(std::ceil(-o.floor_db / o.bin_width_db)) + 2;
+  return r;
+}
+
+// Above this many levels a table of their amplitudes is not worth making.
+constexpr std::int64_t kMaxTabulatedLevels = std::int64_t{1} << 20;
 
 int bits_for(std::uint64_t values) {
   int bits = 0;
@@ -209,8 +224,9 @@ PathModel path_model(const AcousticScene& scene, const Point& source, const Poin
   m.scene = &scene;
   m.single_slot = scene.materials().slots().size() == 1;
   m.visibility = o.visibility;
-  m.level_offset = static_cast<std::int64_t>(std::ceil(kMaxGainDb / o.bin_width_db));
-  m.level_count = m.level_offset + static_cast<std::int64_t>(std::ceil(-o.floor_db / o.bin_width_db)) + 2;
+  const LevelRange levels = level_range(o);
+  m.level_offset = levels.offset;
+  m.level_count = levels.count;
   m.level_bits = bits_for(static_cast<std::uint64_t>(m.level_count));
   m.sample_bits = bits_for(std::uint64_t{m.max_sample} + 1);
   m.kernel_bits = bits_for(std::uint64_t{kernels} + 1);
@@ -248,11 +264,37 @@ void ResponseOptions::check() const {
   if (!(floor_db >= -300.0 && floor_db < 0.0)) fail("the floor must be in [-300, 0) dB", floor_db);
 }
 
+struct AcousticScene::AmplitudeCache {
+  std::mutex mutex;
+  std::vector<std::pair<std::pair<double, double>, std::shared_ptr<const LevelAmplitudes>>> tables;  // (width, floor)
+};
+
 AcousticScene::AcousticScene(const Tree& tree, const MaterialTable& materials)
     : tree_(&tree), frame_(tree.frame()), materials_(materials, tree), blocks_(leaf_blocks(tree)),
-      surface_(surface_blocks(tree, blocks_)), caster_(tree) {
+      surface_(surface_blocks(tree, blocks_)), caster_(tree),
+      amplitude_cache_(std::make_unique<AmplitudeCache>()) {
   if (!(frame_.voxel_size > 0.0) || !std::isfinite(frame_.voxel_size))
     throw InvalidArgument("the scene's voxel size is not a positive number");
+}
+
+AcousticScene::~AcousticScene() = default;
+
+std::shared_ptr<const LevelAmplitudes> AcousticScene::level_amplitudes(const ResponseOptions& o) const {
+  std::lock_guard lock(amplitude_cache_->mutex);
+  auto& tables = amplitude_cache_->tables;
+  const std::pair<double, double> key{o.bin_width_db, o.floor_db};
+  for (const auto& [k, table] : tables)
+    if (k == key) return table;
+  auto table = std::make_shared<LevelAmplitudes>();
+  const LevelRange levels = level_range(o);
+  if (levels.count <= kMaxTabulatedLevels) {
+    table->low = static_cast<std::int32_t>(-levels.offset);
+    table->values.resize(static_cast<std::size_t>(levels.count));
+    for (std::size_t i = 0; i < table->values.size(); ++i)
+      table->values[i] = std::pow(10.0, -(table->low + static_cast<double>(i)) * o.bin_width_db / 20.0);
+  }
+  tables.emplace_back(key, table);
+  return table;
 }
 
 void AcousticScene::check_point(const Point& p, const std::string& what) const {
@@ -330,31 +372,74 @@ Thresholded threshold(const AcousticScene& scene, const Point& source, const Poi
   return t;
 }
 
+namespace {
+
+// Adds count * amplitude of bins [begin, end) (all of one kernel, sorted by sample) into h.
+// Each sample's bins are added in their order, as a plain loop would (the same sums to the
+// bit), but four streams of bins, split where the sample changes, run side by side: one
+// stream's additions to a sample form a chain of dependent adds, four chains overlap.
+void add_bins(const Bin* begin, const Bin* end, std::uint16_t kernel, const LevelAmplitudes& table, double width,
+              std::vector<double>& h) {
+  const double* const values = table.values.data();
+  const std::uint64_t levels = table.values.size();
+  double* const out = h.data();
+  const std::size_t size = h.size();
+  auto add = [&](const Bin& b) {
+    if (b.kernel != kernel || b.sample >= size)
+      throw InvalidArgument("make_filter: the bins are not sorted by kernel and sample as threshold() gives them");
+    const auto level = static_cast<std::uint64_t>(static_cast<std::int64_t>(b.level) - table.low);  // wraps below
+    const double amplitude = level < levels ? values[level] : std::pow(10.0, -static_cast<double>(b.level) * width / 20.0);
+    out[b.sample] += static_cast<double>(b.count) * amplitude;
+  };
+  // Stream boundaries at a quarter, a half and three quarters, moved on to a sample change.
+  const std::size_t n = static_cast<std::size_t>(end - begin);
+  auto cut_after = [&](const Bin* from, std::size_t quarter) {
+    const Bin* cut = std::max(from, begin + n * quarter / 4);
+    while (cut != end && cut != begin && cut[-1].sample == cut->sample) ++cut;  // a sample stays in one stream
+    return cut;
+  };
+  const Bin* const c1 = cut_after(begin, 1);
+  const Bin* const c2 = cut_after(c1, 2);
+  const Bin* const c3 = cut_after(c2, 3);
+  const Bin *a = begin, *b = c1, *c = c2, *d = c3;
+  while (a != c1 && b != c2 && c != c3 && d != end) {
+    add(*a++);
+    add(*b++);
+    add(*c++);
+    add(*d++);
+  }
+  for (; a != c1; ++a) add(*a);
+  for (; b != c2; ++b) add(*b);
+  for (; c != c3; ++c) add(*c);
+  for (; d != end; ++d) add(*d);
+}
+
+}  // namespace
+
 std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& t, const ResponseOptions& o) {
   o.check();
-  std::uint32_t last = t.direct_sample;
+  const std::shared_ptr<const LevelAmplitudes> table = scene.level_amplitudes(o);
+  // The bins come sorted by kernel, then sample: each kernel's last bin has its last sample.
+  const Bin* const bins = t.bins.data();
+  const Bin* const bins_end = bins + t.bins.size();
+  std::vector<std::pair<const Bin*, const Bin*>> runs;  // per kernel present
+  std::size_t length = std::size_t{t.direct_sample} + 1;
   std::uint16_t kernels = 0;
-  for (const Bin& b : t.bins) {
-    last = std::max(last, b.sample);
-    kernels = std::max(kernels, b.kernel);
+  for (const Bin* run = bins; run != bins_end;) {
+    const std::uint16_t k = run->kernel;
+    const Bin* run_end = std::partition_point(run, bins_end, [k](const Bin& b) { return b.kernel == k; });
+    runs.emplace_back(run, run_end);
+    length = std::max(length, std::size_t{run_end[-1].sample} + 1);
+    kernels = std::max(kernels, k);
+    run = run_end;
   }
-  const std::size_t length = std::size_t{last} + 1;
   std::vector<std::vector<double>> per_kernel(std::size_t{kernels} + 1);
   per_kernel[0].assign(length, 0.0);
   per_kernel[0][t.direct_sample] += t.direct_amplitude;
-  // One pow per level the bins use, not one per bin: the levels span a few hundred values.
-  std::int32_t low = t.bins.empty() ? 0 : t.bins.front().level, high = low;
-  for (const Bin& b : t.bins) {
-    low = std::min(low, b.level);
-    high = std::max(high, b.level);
-  }
-  std::vector<double> amplitude(t.bins.empty() ? 0 : static_cast<std::size_t>(high - low) + 1);
-  for (std::size_t i = 0; i < amplitude.size(); ++i)
-    amplitude[i] = std::pow(10.0, -(low + static_cast<double>(i)) * o.bin_width_db / 20.0);
-  for (const Bin& b : t.bins) {
-    auto& h = per_kernel[b.kernel];
+  for (const auto& [begin, end] : runs) {
+    auto& h = per_kernel[begin->kernel];
     if (h.empty()) h.assign(length, 0.0);
-    h[b.sample] += static_cast<double>(b.count) * amplitude[static_cast<std::size_t>(b.level - low)];
+    add_bins(begin, end, begin->kernel, *table, o.bin_width_db, h);
   }
   std::vector<double> ir = std::move(per_kernel[0]);
   if (kernels == 0) return ir;
@@ -362,6 +447,7 @@ std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& t
   std::vector<const Material*> band_materials;
   for (const Material& mat : scene.materials().slots())
     if (mat.per_band()) band_materials.push_back(&mat);
+  if (band_materials.size() < kernels) throw InvalidArgument("make_filter: the bins name a per-band material the scene lacks");
   for (std::uint16_t k = 1; k <= kernels; ++k) {
     if (per_kernel[k].empty()) continue;
     // From the first arrival on: FFT rounding then cannot put sound before it.

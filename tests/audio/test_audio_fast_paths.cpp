@@ -13,6 +13,7 @@
 #include "vola/audio/attenuation_level.hpp"
 #include "vola/audio/response.hpp"
 #include "vola/builder.hpp"
+#include "vola/error.hpp"
 
 namespace {
 
@@ -101,6 +102,24 @@ TEST(AudioThresholdFastPath, BinsEqualTheBinnedPerVoxelReflections) {
     EXPECT_EQ(got, expected) << "visibility " << visibility;
     EXPECT_EQ(t.reflectors, reflectors);
   }
+
+  // make_filter adds each bin in its order into its sample, as the plain loop below: the
+  // same sums to the bit. Broadband materials only, so no band filter follows.
+  const AcousticScene broadband(tree, scene_material(0.6));
+  ResponseOptions o;
+  o.reflection_window = 0.03;
+  const Thresholded t = threshold(broadband, s, l, o);
+  ASSERT_GT(t.bins.size(), 1000u);
+  const std::vector<double> ir = make_filter(broadband, t, o);
+  std::vector<double> plain(std::size_t{std::max(t.direct_sample, t.bins.back().sample)} + 1, 0.0);
+  plain[t.direct_sample] += t.direct_amplitude;
+  for (const Bin& b : t.bins) plain[b.sample] += static_cast<double>(b.count) * std::pow(10.0, -b.level * o.bin_width_db / 20.0);
+  EXPECT_EQ(ir, plain);
+  EXPECT_EQ(make_filter(broadband, t, o), ir) << "the cached level table changed the filter";
+
+  Thresholded shuffled = t;
+  std::swap(shuffled.bins.front(), shuffled.bins.back());
+  EXPECT_THROW(make_filter(broadband, shuffled, o), InvalidArgument);
 }
 
 }  // namespace

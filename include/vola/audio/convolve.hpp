@@ -2,17 +2,24 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
 
 namespace vola::audio {
 
-// A filter ready to apply: its spectrum and the FFT plans are made once.
+// How FFTW plans a transform size: estimate (instant, for a one-off convolution) or
+// measure (times candidate algorithms: a second or so once per size, then faster
+// transforms, for a program that convolves many times). Plans are made once per size and
+// planning per process, and shared.
+enum class FftPlanning : std::uint8_t { estimate, measure };
+
+// A filter ready to apply: its spectrum is made once, the FFT plans once per size.
 class Convolver {
  public:
   // Throws InvalidArgument for an empty filter.
-  explicit Convolver(std::span<const double> filter);
+  explicit Convolver(std::span<const double> filter, FftPlanning planning = FftPlanning::estimate);
   ~Convolver();
   Convolver(const Convolver&) = delete;
   Convolver& operator=(const Convolver&) = delete;

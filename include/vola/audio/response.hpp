@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -50,10 +51,17 @@ struct ResponseOptions {
   void check() const;
 };
 
+// The amplitude of each attenuation level, values[level - low] = 10^(-level * width / 20).
+struct LevelAmplitudes {
+  std::int32_t low = 0;
+  std::vector<double> values;
+};
+
 // A tree with its reflection coefficients, ready for responses. The tree must outlive it.
 class AcousticScene {
  public:
   AcousticScene(const Tree& tree, const MaterialTable& materials);
+  ~AcousticScene();
 
   const Tree& tree() const noexcept { return *tree_; }
   const Frame& frame() const noexcept { return frame_; }
@@ -65,14 +73,20 @@ class AcousticScene {
   // Throws InvalidArgument when `p` is not finite or lies inside an occupied voxel;
   // `what` names the point ("source 1", "listener").
   void check_point(const Point& p, const std::string& what) const;
+  // Every level a response with these options can have (one pow each), made on first use
+  // per (bin width, floor) and kept, so make_filter() costs no pow per call. Empty values
+  // when the levels are too many to tabulate (a bin width far below 0.001 dB). Thread-safe.
+  std::shared_ptr<const LevelAmplitudes> level_amplitudes(const ResponseOptions& options) const;
 
  private:
+  struct AmplitudeCache;
   const Tree* tree_;
   Frame frame_;
   VoxelMaterials materials_;
   std::vector<LeafBlock> blocks_;
   std::vector<SurfaceBlock> surface_;
   raycast::RayCaster caster_;
+  std::unique_ptr<AmplitudeCache> amplitude_cache_;
 };
 
 // One reflecting voxel's path, before binning.
