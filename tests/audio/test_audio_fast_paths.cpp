@@ -120,6 +120,17 @@ TEST(AudioThresholdFastPath, BinsEqualTheBinnedPerVoxelReflections) {
   Thresholded shuffled = t;
   std::swap(shuffled.bins.front(), shuffled.bins.back());
   EXPECT_THROW(make_filter(broadband, shuffled, o), InvalidArgument);
+  ResponseOptions higher_floor = o;
+  higher_floor.floor_db = -20.0;
+  EXPECT_THROW(make_filter(broadband, t, higher_floor), InvalidArgument);
+  // Too fine a bin width to tabulate: a pow per bin, the same sums.
+  ResponseOptions fine = o;
+  fine.bin_width_db = 1e-5;
+  const Thresholded tf = threshold(broadband, s, l, fine);
+  std::vector<double> plain_fine(std::size_t{std::max(tf.direct_sample, tf.bins.back().sample)} + 1, 0.0);
+  plain_fine[tf.direct_sample] += tf.direct_amplitude;
+  for (const Bin& b : tf.bins) plain_fine[b.sample] += static_cast<double>(b.count) * std::pow(10.0, -b.level * fine.bin_width_db / 20.0);
+  EXPECT_EQ(make_filter(broadband, tf, fine), plain_fine);
 }
 
 }  // namespace

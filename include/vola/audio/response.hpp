@@ -120,6 +120,9 @@ struct Thresholded {
 Thresholded threshold(const AcousticScene& scene, const Point& source, const Point& listener,
                       const ResponseOptions& options);
 // Step 2: the impulse response, starting at time 0 (sample n = n / sample_rate seconds).
+// The bins must be sorted as threshold() leaves them, and made with the same bin width and
+// floor: a bin past its kernel's last sample or with a level outside those options throws
+// InvalidArgument; a bin of one kernel among another's is not detected (a wrong filter).
 std::vector<double> make_filter(const AcousticScene& scene, const Thresholded& response,
                                 const ResponseOptions& options);
 // Every reflecting voxel's path in key order, unbinned (what threshold() bins).
