@@ -141,10 +141,20 @@ constexpr std::uint64_t layer(int axis, unsigned c) {
 }
 
 // Calls key(Key) for every reflecting voxel of the surface blocks [begin, end): the faces
-// that face both ends are found for the whole block with word masks, then only the
-// reflecting voxels are visited.
+// that face both ends are found for the whole block with word masks, then the block's
+// reflecting voxels go through the model of arrives() in stages over small arrays: the
+// distances, delays (and with one material the amplitudes) in a branch-free loop the
+// compiler vectorises (the same IEEE operations, so the same values), then the tests and
+// the binning.
 template <class F>
 void block_keys(const PathModel& m, const std::vector<SurfaceBlock>& blocks, std::size_t begin, std::size_t end, F&& key) {
+  alignas(16) double px[64], py[64], pz[64], sample[64], product[64], amplitude[64];
+  std::uint8_t bits[64];
+  const double sx = m.source[0], sy = m.source[1], sz = m.source[2];
+  const double lx = m.listener[0], ly = m.listener[1], lz = m.listener[2];
+  const double spv = m.samples_per_voxel;
+  const double single_gain = m.slot_gain[0] * m.amplitude_scale;
+  const bool plain = m.single_slot && !m.visibility;
   for (std::size_t i = begin; i < end; ++i) {
     const SurfaceBlock& b = blocks[i];
     const std::uint32_t origin[3] = {b.origin.x, b.origin.y, b.origin.z};
@@ -161,24 +171,45 @@ void block_keys(const PathModel& m, const std::vector<SurfaceBlock>& blocks, std
       above[a] = b.exposed[2 * a + 1] & high_ok & ~below[a];
       reflecting |= below[a] | above[a];
     }
-    Arrival arrivals[64];
+    // The reflecting points: the low face, the high face or the centre on each axis (below
+    // and above exclude each other).
+    static constexpr double kOffset[3] = {0.5, 0.0, 1.0};
     unsigned n = 0;
-    while (reflecting) {
+    for (; reflecting; reflecting &= reflecting - 1, ++n) {
       const unsigned bit = static_cast<unsigned>(std::countr_zero(reflecting));
-      reflecting &= reflecting - 1;
-      const std::uint32_t cell[3] = {bit & 3u, (bit >> 2) & 3u, bit >> 4};
-      // The low face, the high face or the centre (below and above exclude each other).
-      static constexpr double kOffset[3] = {0.5, 0.0, 1.0};
-      Point p;
-      for (int a = 0; a < 3; ++a)
-        p[a] = static_cast<double>(origin[a] + cell[a]) + kOffset[((below[a] >> bit) & 1) | (((above[a] >> bit) & 1) << 1)];
-      const std::uint64_t mask = std::uint64_t{1} << bit;
-      const std::uint64_t rank = b.first_rank + static_cast<std::uint64_t>(std::popcount(b.word & (mask - 1)));
-      Arrival& arrival = arrivals[n];
-      n += arrives(m, p, rank, b.index, Voxel{origin[0] + cell[0], origin[1] + cell[1], origin[2] + cell[2]}, arrival);
+      bits[n] = static_cast<std::uint8_t>(bit);
+      px[n] = static_cast<double>(origin[0] + (bit & 3u)) + kOffset[((below[0] >> bit) & 1) | (((above[0] >> bit) & 1) << 1)];
+      py[n] = static_cast<double>(origin[1] + ((bit >> 2) & 3u)) + kOffset[((below[1] >> bit) & 1) | (((above[1] >> bit) & 1) << 1)];
+      pz[n] = static_cast<double>(origin[2] + (bit >> 4)) + kOffset[((below[2] >> bit) & 1) | (((above[2] >> bit) & 1) << 1)];
     }
-    // Binned in a second loop: the bin searches of different voxels then overlap.
-    for (unsigned j = 0; j < n; ++j) key(bin_key(m, arrivals[j].slot, arrivals[j].sample, arrivals[j].amplitude));
+    // As distance() and arrives(): the same operations in the same order.
+    for (unsigned j = 0; j < n; ++j) {
+      const double ax = sx - px[j], ay = sy - py[j], az = sz - pz[j];
+      const double bx = px[j] - lx, by = py[j] - ly, bz = pz[j] - lz;
+      const double d1 = std::sqrt(ax * ax + ay * ay + az * az);
+      const double d2 = std::sqrt(bx * bx + by * by + bz * bz);
+      product[j] = d1 * d2;
+      sample[j] = std::nearbyint((d1 + d2) * spv);
+      amplitude[j] = single_gain / product[j];
+    }
+    for (unsigned j = 0; j < n; ++j) {
+      if (!(sample[j] <= static_cast<double>(m.max_sample))) continue;
+      std::uint16_t slot = 0;
+      double a = amplitude[j];
+      if (!plain) {
+        const unsigned bit = bits[j];
+        const std::uint64_t rank = b.first_rank + static_cast<std::uint64_t>(std::popcount(b.word & ((std::uint64_t{1} << bit) - 1)));
+        slot = m.single_slot ? 0 : m.scene->materials().slot(rank, b.index);
+        a = m.slot_gain[slot] * m.amplitude_scale / product[j];
+        if (m.visibility && (a >= m.floor_amplitude && a != 0.0)) {
+          const Point p{px[j], py[j], pz[j]};
+          const Voxel v{origin[0] + (bit & 3u), origin[1] + ((bit >> 2) & 3u), origin[2] + (bit >> 4)};
+          if (!(sees(m.scene->caster(), m.source, p, v) && sees(m.scene->caster(), m.listener, p, v))) continue;
+        }
+      }
+      if (!(a >= m.floor_amplitude) || a == 0.0) continue;
+      key(bin_key(m, slot, sample[j], a));
+    }
   }
 }
 
