@@ -101,7 +101,7 @@ std::vector<Bin> naive_threshold(const Tree& tree, const Point& s, const Point& 
         if (sample > last) continue;
         const double amplitude = coefficient * (1.0 / (std::sqrt(std::numbers::pi) * kVoxel)) / (d1 * d2);
         keys.emplace_back(static_cast<std::uint32_t>(sample),
-                          static_cast<std::int32_t>(std::llround(-20.0 * std::log10(amplitude) / o.bin_width_db)));
+                          static_cast<std::int32_t>(std::llround(-20.0 * std::log10(amplitude) * (1.0 / o.bin_width_db))));
       }
   std::sort(keys.begin(), keys.end());
   std::vector<Bin> bins;

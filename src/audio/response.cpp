@@ -269,6 +269,31 @@ PathModel path_model(const AcousticScene& scene, const Point& source, const Poin
   return m;
 }
 
+// Sorts bin keys: the usual ones (kernel, sample and level in at most 24 bits) in two
+// counting passes of 12 bits, one pass fewer than radix_sort's 11-bit digits need.
+void sort_keys(std::vector<Key>& keys, int key_bits) {
+  constexpr int kDigit = 12;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigit;
+  if (key_bits > 2 * kDigit) {
+    radix_sort(keys, nullptr, std::max(key_bits, 1));
+    return;
+  }
+  std::vector<std::size_t> count(2 * kBuckets, 0);
+  for (const Key k : keys) {
+    ++count[k & (kBuckets - 1)];
+    ++count[kBuckets + ((k >> kDigit) & (kBuckets - 1))];
+  }
+  std::vector<Key> buffer(keys.size());
+  for (int pass = 0; pass < 2; ++pass) {
+    std::size_t* c = &count[static_cast<std::size_t>(pass) * kBuckets];
+    std::size_t offset = 0;
+    for (std::size_t b = 0; b < kBuckets; ++b) offset += std::exchange(c[b], offset);
+    const int shift = pass * kDigit;
+    for (const Key k : keys) buffer[c[(k >> shift) & (kBuckets - 1)]++] = k;
+    keys.swap(buffer);
+  }
+}
+
 // Runs f(range, begin, end) over `ranges` contiguous ranges of [0, count) on `threads`
 // threads. Results stored per range do not depend on the thread count.
 template <class F>
@@ -360,7 +385,7 @@ Thresholded threshold(const AcousticScene& scene, const Point& source, const Poi
   for_ranges(count, ranges, threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
     std::vector<Key> keys;
     block_keys(m, scene.surface(), begin, end, [&](Key k) { keys.push_back(k); });
-    radix_sort(keys, nullptr, std::max(key_bits, 1));
+    sort_keys(keys, key_bits);
     auto& run = runs[r];
     for (const Key k : keys) {
       if (!run.empty() && run.back().first == k) ++run.back().second;
