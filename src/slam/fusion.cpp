@@ -399,6 +399,17 @@ DepthImage Fusion<Store>::clipped(const DepthImage& raw, const RgbImage* rgb) co
   return depth;
 }
 
+// The map integrates the bilateral-filtered depth, not the raw one: while a region has
+// been seen only once, the model raycast from it carries that frame's noise in its
+// normals, and on large planes those noisy normals add false stiffness in the weakly
+// observed directions (sliding along a wall), which dragged ICP several centimetres off
+// (the generated room's first step: 57 mm error from raw, under 1 mm from filtered).
+template <class Store>
+DepthImage Fusion<Store>::filtered(const DepthImage& depth) const {
+  return bilateral_filter(depth, params_.bilateral_radius, params_.bilateral_sigma_space, params_.bilateral_sigma_depth,
+                          params_.threads);
+}
+
 template <class Store>
 void Fusion<Store>::integrate_and_predict(const DepthImage& depth, const RgbImage* rgb) {
   integrate(depth, rgb, pose_);
@@ -408,14 +419,13 @@ void Fusion<Store>::integrate_and_predict(const DepthImage& depth, const RgbImag
 
 template <class Store>
 FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, const Pose& initial_pose) {
-  const DepthImage depth = clipped(raw, rgb);
+  const DepthImage depth = filtered(clipped(raw, rgb));
   FrameResult result;
   if (frames_ == 0) {
     pose_ = initial_pose;
   } else {
     std::array<DepthImage, kPyramidLevels> pyramid;
-    pyramid[0] = bilateral_filter(depth, params_.bilateral_radius, params_.bilateral_sigma_space,
-                                  params_.bilateral_sigma_depth, params_.threads);
+    pyramid[0] = depth;
     for (int l = 1; l < kPyramidLevels; ++l) pyramid[l] = halve_depth(pyramid[l - 1], params_.bilateral_sigma_depth);
     std::array<VertexMap, kPyramidLevels> maps;
     for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
@@ -433,7 +443,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
 
 template <class Store>
 FrameResult Fusion<Store>::process_at_pose(const DepthImage& raw, const RgbImage* rgb, const Pose& pose) {
-  const DepthImage depth = clipped(raw, rgb);
+  const DepthImage depth = filtered(clipped(raw, rgb));
   pose_ = pose;
   ++frames_;
   integrate_and_predict(depth, rgb);

@@ -1,7 +1,7 @@
 // KinectFusion over a brick TSDF store (tsdf_store.hpp): per frame, bilateral filter and
 // a 3-level vertex/normal pyramid, projective point-to-plane ICP against the model
 // raycast from the map at the previous pose (coarse to fine), TSDF integration of the
-// raw depth at the tracked pose into the bricks the frame's truncation band touches,
+// filtered depth at the tracked pose into the bricks the frame's truncation band touches,
 // and a new model raycast. Fusion<SparseTsdfStore> and Fusion<DenseTsdfStore> are the
 // same code; only where the voxels live differs.
 #pragma once
@@ -68,6 +68,7 @@ class Fusion {
  private:
   std::optional<Pose> track(const std::array<VertexMap, kPyramidLevels>& frame, int* correspondences) const;
   DepthImage clipped(const DepthImage& raw, const RgbImage* rgb) const;
+  DepthImage filtered(const DepthImage& depth) const;
   void integrate_and_predict(const DepthImage& depth, const RgbImage* rgb);
   void integrate(const DepthImage& depth, const RgbImage* rgb, const Pose& pose);
 
