@@ -76,26 +76,31 @@ void BrickSet::add_shifted(const BrickSet& other, int dx, int dy, int dz) {
   });
 }
 
+// The bricks are the tree's leaf words: the levels above them are the tree of depth - 1
+// over the block coordinates, so the set never expands into one key per voxel (8 bytes
+// a voxel, by far the largest allocation of a dilation otherwise).
 Tree BrickSet::to_tree() const {
   std::vector<std::pair<Key, std::uint64_t>> sorted;
   sorted.reserve(bricks_.size());
-  std::size_t voxels = 0;
   for_each([&](std::uint32_t bx, std::uint32_t by, std::uint32_t bz, std::uint64_t word) {
-    if (!word) return;
-    sorted.emplace_back(encode(bx, by, bz), word);
-    voxels += static_cast<std::size_t>(std::popcount(word));
+    if (word) sorted.emplace_back(encode(bx, by, bz), word);
   });
+  if (sorted.empty()) return build_from_sorted_keys({}, depth_);
   std::sort(sorted.begin(), sorted.end());
-  std::vector<Key> keys;
-  keys.reserve(voxels);
-  for (const auto& [block, word] : sorted) {
-    std::uint64_t w = word;
-    while (w) {
-      keys.push_back((block << 6) | static_cast<Key>(std::countr_zero(w)));
-      w &= w - 1;
+  std::vector<std::uint64_t> words;
+  if (depth_ > 1) {
+    std::vector<Key> blocks;
+    blocks.reserve(sorted.size());
+    for (const auto& entry : sorted) blocks.push_back(entry.first);
+    const Tree upper = build_from_sorted_keys(blocks, depth_ - 1);
+    for (int level = 0; level < upper.depth(); ++level) {
+      const auto occupancy = upper.occupancy(level);
+      words.insert(words.end(), occupancy.begin(), occupancy.end());
     }
   }
-  return build_from_sorted_keys(keys, depth_);
+  // Leaf words in key order: the order of the set bits of the level above.
+  for (const auto& entry : sorted) words.push_back(entry.second);
+  return Tree::from_levels(depth_, false, std::move(words));
 }
 
 }  // namespace vola::analysis::detail
