@@ -3,10 +3,10 @@
 #include <fftw3.h>
 
 #include <algorithm>
-#include <barrier>
 #include <cmath>
 #include <numbers>
 #include <complex>
+#include <latch>
 #include <mutex>
 #include <thread>
 
@@ -129,16 +129,19 @@ std::vector<double> Convolver::apply(std::span<const double> signal, unsigned th
       for (std::size_t i = 0; i < valid; ++i) out[begin + i] += time[i] * scale;
     }
   };
-  // Threads start once; a barrier keeps the odd blocks until every even one is added.
-  std::barrier even_done(static_cast<std::ptrdiff_t>(threads));
+  // Threads start once; a latch keeps the odd blocks until every even one is added.
+  std::latch even_done(static_cast<std::ptrdiff_t>(threads));
   auto both = [&](std::size_t first) {
     run(0, first, threads);
     even_done.arrive_and_wait();
     run(1, first, threads);
   };
-  std::vector<std::jthread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(both, t);
-  both(0);
+  {
+    // Joined before the return: returning moves `out` away from the workers.
+    std::vector<std::jthread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(both, t);
+    both(0);
+  }
   return out;
 }
 

@@ -8,8 +8,10 @@
 #include <map>
 #include <random>
 #include <tuple>
+#include <vector>
 
 #include "vola/attributes.hpp"
+#include "vola/audio/convolve.hpp"
 #include "vola/audio/attenuation_level.hpp"
 #include "vola/audio/response.hpp"
 #include "vola/builder.hpp"
@@ -131,6 +133,23 @@ TEST(AudioThresholdFastPath, BinsEqualTheBinnedPerVoxelReflections) {
   plain_fine[tf.direct_sample] += tf.direct_amplitude;
   for (const Bin& b : tf.bins) plain_fine[b.sample] += static_cast<double>(b.count) * std::pow(10.0, -b.level * fine.bin_width_db / 20.0);
   EXPECT_EQ(make_filter(broadband, tf, fine), plain_fine);
+}
+
+}  // namespace
+
+namespace {
+
+// Worker threads must be done with the output before apply() returns it (a race once:
+// the result was moved away while a worker still added its last block).
+TEST(AudioConvolveThreads, EveryCallEqualsTheOneThreadResult) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<double> x(20000), h(700);
+  for (double& v : x) v = noise(rng);
+  for (double& v : h) v = noise(rng);
+  const vola::audio::Convolver c(h);
+  const std::vector<double> one = c.apply(x, 1);
+  for (int i = 0; i < 40; ++i) ASSERT_EQ(c.apply(x, 2), one) << "call " << i;
 }
 
 }  // namespace
