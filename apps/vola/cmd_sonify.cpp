@@ -75,7 +75,7 @@ void run_sonify(SonifyArgs& a) {
     const auto t2 = std::chrono::steady_clock::now();
     if (!a.quiet) {
       const double fs = a.response.sample_rate;
-      std::printf("source %zu: direct %.3f m, %.2f ms (sample %u)%s; %llu reflecting voxels in %zu bins; "
+      std::printf("source %zu: direct %.3f scene units, %.2f ms (sample %u)%s; %llu reflecting voxels in %zu bins; "
                   "response %.2f ms; %.1f ms to build, %.1f ms to filter\n",
                   s + 1, binned.direct_distance, binned.direct_sample / fs * 1000.0, binned.direct_sample,
                   binned.direct_blocked ? ", blocked by the scene" : "",
