@@ -148,13 +148,11 @@ Intrinsics level_intrinsics(const Intrinsics& k, int level) {
 
 }  // namespace
 
-template <class Store>
-VertexMap raycast(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height, const Pose& pose,
-                  const FusionParams& params) {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const std::size_t n = std::size_t{width} * height;
-  VertexMap map{width, height, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan)),
-                std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan))};
+// Marches the ray of every pixel through the TSDF from `pose` and calls
+// on_hit(pixel index, hit, world ray direction) for each surface crossing found.
+template <class Store, class OnHit>
+void march_pixels(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height, const Pose& pose,
+                  const FusionParams& params, const OnHit& on_hit) {
   const Eigen::Vector3d o = pose.translation();
   const Eigen::Matrix3d r = pose.linear();
   parallel_chunks(height, params.threads, [&](unsigned, std::size_t begin, std::size_t end) {
@@ -166,10 +164,21 @@ VertexMap raycast(const Store& store, const Intrinsics& k, std::uint32_t width, 
         const Eigen::Vector3d d = r * (camera_dir / scale);
         const auto hit = march(reader, store.geometry(), o, d, params.min_depth * scale,
                                params.max_depth * scale + params.truncation, params.truncation);
-        if (!hit) continue;
-        map.vertices[y * width + x] = hit->position.template cast<float>();
-        map.normals[y * width + x] = hit->normal.template cast<float>();
+        if (hit) on_hit(y * width + x, *hit, d);
       }
+  });
+}
+
+template <class Store>
+VertexMap raycast(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height, const Pose& pose,
+                  const FusionParams& params) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::size_t n = std::size_t{width} * height;
+  VertexMap map{width, height, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan)),
+                std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan))};
+  march_pixels(store, k, width, height, pose, params, [&](std::size_t i, const auto& hit, const Eigen::Vector3d&) {
+    map.vertices[i] = hit.position.template cast<float>();
+    map.normals[i] = hit.normal.template cast<float>();
   });
   return map;
 }
@@ -178,25 +187,12 @@ template <class Store>
 RgbImage render_view(const Store& store, const Intrinsics& k, std::uint32_t width, std::uint32_t height,
                      const Pose& pose, const FusionParams& params, bool use_colour) {
   RgbImage image{width, height, std::vector<std::uint8_t>(std::size_t{width} * height * 3, 0)};
-  const Eigen::Vector3d o = pose.translation();
-  const Eigen::Matrix3d r = pose.linear();
-  parallel_chunks(height, params.threads, [&](unsigned, std::size_t begin, std::size_t end) {
-    TsdfReader<Store> reader(store);
-    for (std::size_t y = begin; y < end; ++y)
-      for (std::uint32_t x = 0; x < width; ++x) {
-        const Eigen::Vector3d camera_dir = pixel_direction(k, x, static_cast<std::uint32_t>(y));
-        const double scale = camera_dir.norm();
-        const Eigen::Vector3d d = r * (camera_dir / scale);
-        const auto hit = march(reader, store.geometry(), o, d, params.min_depth * scale,
-                               params.max_depth * scale + params.truncation, params.truncation);
-        if (!hit) continue;
-        const double light = 0.25 + 0.75 * std::max(0.0, -hit->normal.dot(d));
-        const std::uint8_t* colour = nullptr;
-        std::uint8_t grey[3] = {210, 210, 210};
-        colour = (use_colour && hit->voxel) ? &hit->voxel->r : grey;
-        for (int c = 0; c < 3; ++c)
-          image.rgb[(y * width + x) * 3 + c] = static_cast<std::uint8_t>(std::lround(std::min(255.0, colour[c] * light)));
-      }
+  const std::uint8_t grey[3] = {210, 210, 210};
+  march_pixels(store, k, width, height, pose, params, [&](std::size_t i, const auto& hit, const Eigen::Vector3d& d) {
+    const double light = 0.25 + 0.75 * std::max(0.0, -hit.normal.dot(d));
+    const std::uint8_t* colour = (use_colour && hit.voxel) ? &hit.voxel->r : grey;
+    for (int c = 0; c < 3; ++c)
+      image.rgb[i * 3 + c] = static_cast<std::uint8_t>(std::lround(std::min(255.0, colour[c] * light)));
   });
   return image;
 }
