@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <string>
 
 #include "analysis_models.hpp"
 #include "vola/analysis/crop.hpp"
@@ -25,6 +26,77 @@ TEST(Morphology, DilateAndErodeMatchTheModel) {
         EXPECT_EQ(vola_test::voxel_set(vola::analysis::dilate(t, r, e)), model_dilate(g.voxels, g.depth, r, e));
         EXPECT_EQ(vola_test::voxel_set(vola::analysis::erode(t, r, e)), model_erode(g.voxels, g.depth, r, e));
       }
+  }
+}
+
+// Solid boxes straddling block edges of every level (the walk gathers each block's
+// neighbours from the level above) and touching the grid's edges, at radii that need
+// one brick of halo, several cube steps (radius > 4) or wider windows (sphere radius
+// > 4: two or more bricks of halo; > 16: two blocks of halo on the level above).
+TEST(Morphology, DilateAndErodeAcrossBlockEdgesAndLargeRadii) {
+  auto box = [](XyzSet& s, std::uint32_t x, std::uint32_t y, std::uint32_t z, std::uint32_t side) {
+    for (std::uint32_t k = 0; k < side; ++k)
+      for (std::uint32_t j = 0; j < side; ++j)
+        for (std::uint32_t i = 0; i < side; ++i) s.insert({x + i, y + j, z + k});
+  };
+  XyzSet edges;  // depth 5: side 1024
+  box(edges, 253, 254, 252, 6);  // across x = y = z = 256, the root's cell edge
+  box(edges, 510, 509, 511, 5);  // across 512
+  box(edges, 62, 63, 61, 4);     // across 64
+  box(edges, 0, 0, 0, 5);        // the grid's low corner
+  box(edges, 1019, 1019, 1018, 5);  // and the high one
+  edges.insert({13, 400, 1023});
+  edges.insert({767, 768, 3});
+  for (Element e : {Element::cube, Element::sphere})
+    for (int r : {1, 2, 3, 4, 5, 6}) {
+      if (e == Element::cube && r == 6) continue;  // the model is slow there
+      SCOPED_TRACE((e == Element::cube ? "edges cube r" : "edges sphere r") + std::to_string(r));
+      const vola::Tree t = tree_of(edges, 5);
+      EXPECT_EQ(vola_test::voxel_set(vola::analysis::dilate(t, r, e)), model_dilate(edges, 5, r, e));
+      EXPECT_EQ(vola_test::voxel_set(vola::analysis::erode(t, r, e)), model_erode(edges, 5, r, e));
+    }
+  std::mt19937_64 rng(11);
+  XyzSet few;  // depth 4: side 256
+  std::uniform_int_distribution<std::uint32_t> any(0, 255);
+  for (int i = 0; i < 30; ++i) few.insert({any(rng), any(rng), any(rng)});
+  box(few, 60, 61, 62, 12);  // 1728 voxels: erosion by up to 5 keeps some
+  XyzSet sparse;             // the same without the box, for the largest radii
+  for (const Xyz& v : few)
+    if (!(v[0] >= 60 && v[0] < 72 && v[1] >= 61 && v[1] < 73 && v[2] >= 62 && v[2] < 74)) sparse.insert(v);
+  for (Element e : {Element::cube, Element::sphere})
+    for (int r : {9, 13, 17}) {
+      SCOPED_TRACE((e == Element::cube ? "sparse cube r" : "sparse sphere r") + std::to_string(r));
+      const vola::Tree t = tree_of(sparse, 4);
+      EXPECT_EQ(vola_test::voxel_set(vola::analysis::dilate(t, r, e)), model_dilate(sparse, 4, r, e));
+      EXPECT_EQ(vola_test::voxel_set(vola::analysis::erode(t, r, e)), model_erode(sparse, 4, r, e));
+    }
+  for (Element e : {Element::cube, Element::sphere})
+    for (int r : {4, 5}) {
+      SCOPED_TRACE((e == Element::cube ? "box cube r" : "box sphere r") + std::to_string(r));
+      const vola::Tree t = tree_of(few, 4);
+      EXPECT_EQ(vola_test::voxel_set(vola::analysis::erode(t, r, e)), model_erode(few, 4, r, e));
+    }
+}
+
+// Small grids at every radius the grid allows: at depth 1 the root is the only brick,
+// at depth 2 the root's window is the only one above the bricks.
+TEST(Morphology, EveryRadiusOnSmallGrids) {
+  std::mt19937_64 rng(12);
+  for (int depth : {1, 2}) {
+    const int side = static_cast<int>(vola::side_of(depth));
+    for (double p : {0.0, 0.01, 0.3, 1.0}) {
+      const XyzSet voxels = bernoulli(rng, depth, p);
+      const vola::Tree t = tree_of(voxels, depth);
+      for (Element e : {Element::cube, Element::sphere})
+        for (int r = 0; r < side; ++r) {
+          if ((p >= 0.3 && r > 3) || (r > 7 && r % 3 != 0)) continue;  // the model is slow there
+          std::string trace = e == Element::cube ? "cube" : "sphere";
+          trace += " d" + std::to_string(depth) + " p" + std::to_string(p) + " r" + std::to_string(r);
+          SCOPED_TRACE(trace);
+          EXPECT_EQ(vola_test::voxel_set(vola::analysis::dilate(t, r, e)), model_dilate(voxels, depth, r, e));
+          EXPECT_EQ(vola_test::voxel_set(vola::analysis::erode(t, r, e)), model_erode(voxels, depth, r, e));
+        }
+    }
   }
 }
 

@@ -1,5 +1,6 @@
 // Dilation and erosion of a tree's voxels by a radius, on 4x4x4 bricks (64 voxels per
-// word operation) over the occupied region only. Used by planners to inflate
+// word operation) over the occupied region only, in one walk over the tree's levels
+// that emits the result's levels as it goes (no hash, no sort). Used by planners to inflate
 // obstacles. Results keep the input's depth, frame and georeferencing; payloads and
 // attribute columns are dropped (a grown voxel has no measured value).
 #pragma once
@@ -18,8 +19,8 @@ enum class Element {
 Tree dilate(const Tree& tree, int radius, Element element);
 // The voxels whose whole element of radius r is occupied; cells outside the grid
 // count as empty (scipy.ndimage.binary_erosion's border_value = 0), so voxels within r
-// of the grid's edge are removed. Computed as the voxels minus the dilation of the
-// empty cells next to them, without complementing the grid.
+// of the grid's edge are removed. Computed on the input's own bricks (AND over the
+// element's offsets), without complementing the grid.
 Tree erode(const Tree& tree, int radius, Element element);
 
 }  // namespace vola::analysis
