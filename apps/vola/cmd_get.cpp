@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/tile/tile_set.hpp"
 
 namespace vola::cli {
 
@@ -16,7 +17,31 @@ struct GetArgs {
   bool world = false;
 };
 
+void print_voxel(const Tree& tree, const Voxel& v) {
+  const auto rank = tree.rank(v);
+  std::printf("voxel %u %u %u: %s\n", v.x, v.y, v.z, rank ? "occupied" : "empty");
+  if (!rank) return;
+  std::printf("rank %llu\n", static_cast<unsigned long long>(*rank));
+  if (const auto p = tree.voxel_payload(v)) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*p));
+  for (const auto& c : tree.attributes().columns()) std::printf("%s %.17g\n", c.name().c_str(), c.get(*rank));
+}
+
+// A tile set: the point is in world coordinates; only its tile is opened.
+void get_from_tiles(const GetArgs& a) {
+  const tile::TileSet tiles(a.file);
+  const Point p{a.position[0], a.position[1], a.position[2]};
+  const tile::TileLookup found = tiles.locate(p);
+  std::printf("tile %d %d %d: %s\n", found.tile.i, found.tile.j, found.tile.k,
+              found.in_tile ? tile::tile_file_name(found.tile).c_str() : "not in the set (no points there)");
+  if (!found.in_tile) {
+    std::printf("voxel %u %u %u: empty\n", found.voxel.x, found.voxel.y, found.voxel.z);
+    return;
+  }
+  print_voxel(*tiles.tree(found.tile), found.voxel);
+}
+
 void run_get(const GetArgs& a) {
+  if (tile::is_tile_index_path(a.file)) return get_from_tiles(a);
   const Tree tree = open_mapped(a.file);
   Voxel v;
   if (a.world) {
@@ -34,12 +59,7 @@ void run_get(const GetArgs& a) {
     }
     v = Voxel{c[0], c[1], c[2]};
   }
-  const auto rank = tree.rank(v);
-  std::printf("voxel %u %u %u: %s\n", v.x, v.y, v.z, rank ? "occupied" : "empty");
-  if (!rank) return;
-  std::printf("rank %llu\n", static_cast<unsigned long long>(*rank));
-  if (const auto p = tree.voxel_payload(v)) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*p));
-  for (const auto& c : tree.attributes().columns()) std::printf("%s %.17g\n", c.name().c_str(), c.get(*rank));
+  print_voxel(tree, v);
 }
 
 }  // namespace
@@ -47,8 +67,12 @@ void run_get(const GetArgs& a) {
 void add_get(CLI::App& app) {
   auto args = std::make_shared<GetArgs>();
   auto* cmd = app.add_subcommand("get", "Is voxel X Y Z occupied? Prints its rank, payload and attributes");
-  cmd->footer("Example: vola get scan.vol 120 455 31      vola get scan.vol 315420.5 234010.2 42.0 --world");
-  cmd->add_option("file", args->file, ".vol file")->required()->check(CLI::ExistingFile);
+  cmd->footer(
+      "FILE may be a tile index (index.geojson from vola tile): X Y Z are then world coordinates and\n"
+      "only the tile holding them is opened.\n"
+      "Example: vola get scan.vol 120 455 31      vola get scan.vol 315420.5 234010.2 42.0 --world\n"
+      "         vola get tiles/index.geojson 315420.5 234010.2 42.0");
+  cmd->add_option("file", args->file, ".vol file or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("position", args->position, "X Y Z: voxel coordinates (or world coordinates with --world)")
       ->required()->expected(3)->allow_extra_args(false);
   cmd->add_flag("--world", args->world, "X Y Z are in the file's CRS units, not voxel indices");

@@ -12,6 +12,7 @@
 #include "vola/raycast/avoidance.hpp"
 #include "vola/raycast/path_planner.hpp"
 #include "vola/raycast/world.hpp"
+#include "vola/tile/tile_set.hpp"
 
 namespace vola::cli {
 
@@ -21,6 +22,7 @@ struct PlanArgs {
   std::string input, output = "path.csv", ply;
   std::vector<double> from, to;
   double radius = 0.0;
+  double margin = 0.0;  // tile sets: around the from-to box; 0 = one tile
   int level = -1;
   bool hierarchical = false, no_smooth = false, grid = false, quiet = false;
   bool avoid = false;
@@ -42,8 +44,27 @@ raycast::Flight fly_to(const PlanArgs& a, const Tree& tree, const Point& from, c
   return raycast::fly(avoider, from, to, a.max_steps, std::max(0.5, options.speed));
 }
 
+// The scene to plan in: the file, or for a tile index one grid over the tiles that meet
+// the from-to box grown by --margin (only those tiles are opened).
+Tree load_scene(const PlanArgs& a) {
+  if (!tile::is_tile_index_path(a.input)) return open_mapped(a.input);
+  if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
+  const tile::TileSet tiles(a.input);
+  const double margin = a.margin > 0.0 ? a.margin : tiles.grid().tile_size;
+  Box box;
+  for (int i = 0; i < 3; ++i) {
+    box.min[i] = std::min(a.from[i], a.to[i]) - margin;
+    box.max[i] = std::max(a.from[i], a.to[i]) + margin;
+  }
+  Tree scene = tiles.mosaic(box);
+  if (!a.quiet)
+    std::printf("planning over %zu of %zu tiles (the from-to box and %.6g around it)\n", tiles.tiles_opened(),
+                tiles.index().tiles.size(), margin);
+  return scene;
+}
+
 void run_plan(const PlanArgs& a) {
-  const Tree tree = open_mapped(a.input);
+  const Tree tree = load_scene(a);
   const Frame frame = tree.frame();
   Point from{a.from[0], a.from[1], a.from[2]}, to{a.to[0], a.to[1], a.to[2]};
   raycast::PlanOptions options;
@@ -109,6 +130,8 @@ void add_plan(CLI::App& app) {
       "planning grid; smoothing then replaces runs by straight segments the sphere can sweep clear.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
       "Coordinates are world coordinates (the file's frame) unless --grid is given.\n"
+      "INPUT may be a tile index (index.geojson from vola tile): the search then runs over the tiles\n"
+      "that meet the box around --from and --to grown by --margin, and opens no others.\n"
       "--avoid flies a reactive agent instead of planning: each step it casts a fan of rays around\n"
       "the goal direction (--look-ahead long, as thick as the agent), takes the open direction\n"
       "closest to the goal and its current heading, and moves --speed only if the swept sphere is\n"
@@ -116,8 +139,9 @@ void add_plan(CLI::App& app) {
       "Examples:\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 -o path.csv --ply path.ply\n"
       "  vola plan site.vol --grid --from 0.5 0.5 0.5 --to 900 900 30 --hierarchical\n"
-      "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 --avoid --speed 0.25");
-  cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
+      "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 --avoid --speed 0.25\n"
+      "  vola plan tiles/index.geojson --from 500100 5000100 105 --to 501900 5001200 110 --radius 1");
+  cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--from", args->from, "Start X Y Z")->required()->expected(3);
   cmd->add_option("--to", args->to, "Goal X Y Z")->required()->expected(3);
   cmd->add_option("--radius", args->radius, "Robot radius (obstacle inflation)")->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -132,6 +156,8 @@ void add_plan(CLI::App& app) {
   cmd->add_option("--look-ahead", args->look_ahead, "--avoid: length of the fan's rays (default: 24 voxels)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-steps", args->max_steps, "--avoid: give up after this many steps")->capture_default_str();
+  cmd->add_option("--margin", args->margin, "Tile index: how far around the from-to box to search (default: one tile)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--grid", args->grid, "Points and radius are in voxel-grid coordinates");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_plan(*args); });

@@ -13,6 +13,7 @@
 #include "vola/file.hpp"
 #include "vola/raycast/render.hpp"
 #include "vola/raycast/world.hpp"
+#include "vola/tile/tile_set.hpp"
 
 namespace vola::cli {
 
@@ -89,9 +90,74 @@ std::vector<std::uint16_t> depth_image(const raycast::Rendering& r) {
   return out;
 }
 
+// The default view of a tile set: the same placement as default_camera, over the
+// points' bounding box of every tile (read from the index, no tile opened).
+raycast::PinholeCamera default_camera(const tile::TileSet& tiles) {
+  Box box = tiles.index().tiles.front().bbox;
+  for (const auto& t : tiles.index().tiles)
+    for (int a = 0; a < 3; ++a) {
+      box.min[a] = std::min(box.min[a], t.bbox.min[a]);
+      box.max[a] = std::max(box.max[a], t.bbox.max[a]);
+    }
+  raycast::PinholeCamera cam;
+  double extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    cam.look_at[a] = 0.5 * (box.min[a] + box.max[a]);
+    extent = std::max(extent, box.max[a] - box.min[a]);
+  }
+  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
+  return cam;
+}
+
+void write_images(const RenderArgs& a, const raycast::Rendering& image, const std::string& shaded, std::uint32_t width,
+                  std::uint32_t height) {
+  const std::string depth = with_suffix(shaded, "_depth");
+  write_png_rgb8(shaded, width, height, image.rgb);
+  write_png_gray16(depth, width, height, depth_image(image));
+  if (!a.quiet)
+    std::printf("%s, %s: %llu of %llu rays hit\n", shaded.c_str(), depth.c_str(),
+                static_cast<unsigned long long>(image.hits), static_cast<unsigned long long>(width) * height);
+}
+
+// A tile set: world coordinates only; each tile is opened when a ray first reaches it.
+void render_tiles(const RenderArgs& a, raycast::PinholeCamera camera, std::uint32_t width, std::uint32_t height) {
+  if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
+  const tile::TileSet tiles(a.input);
+  if (a.camera.empty()) camera = default_camera(tiles);
+  camera.up = {a.up[0], a.up[1], a.up[2]};
+  camera.vertical_fov_degrees = a.fov;
+  camera.width = width;
+  camera.height = height;
+  camera.check();
+  const unsigned frames = a.orbit ? a.orbit : 1;
+  double seconds = 0.0;
+  for (unsigned f = 0; f < frames; ++f) {
+    const auto cam = a.orbit ? raycast::orbit(camera, f, frames) : camera;
+    const auto start = std::chrono::steady_clock::now();
+    const raycast::Rendering image = tile::render(tiles, cam, a.threads);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    char frame_suffix[32];
+    std::snprintf(frame_suffix, sizeof frame_suffix, "_%04u", f);
+    write_images(a, image, a.orbit ? with_suffix(a.output, frame_suffix) : a.output, width, height);
+  }
+  if (a.quiet) return;
+  const double rays = static_cast<double>(width) * height * frames;
+  std::printf("%.0f rays in %.3f s: %.3f M rays/s, %.2f frames/s; %zu of %zu tiles opened\n", rays, seconds,
+              seconds > 0 ? rays / seconds / 1e6 : 0.0, seconds > 0 ? frames / seconds : 0.0, tiles.tiles_opened(),
+              tiles.index().tiles.size());
+}
+
 void run_render(const RenderArgs& a) {
-  const Tree tree = open_mapped(a.input);
   const auto [width, height] = parse_size(a.size);
+  if (tile::is_tile_index_path(a.input)) {
+    raycast::PinholeCamera camera;
+    if (!a.camera.empty()) {
+      camera.eye = {a.camera[0], a.camera[1], a.camera[2]};
+      camera.look_at = {a.camera[3], a.camera[4], a.camera[5]};
+    }
+    return render_tiles(a, camera, width, height);
+  }
+  const Tree tree = open_mapped(a.input);
   raycast::PinholeCamera camera;
   if (a.camera.empty()) {
     camera = default_camera(tree);
@@ -118,13 +184,7 @@ void run_render(const RenderArgs& a) {
     rays += std::uint64_t{width} * height;
     char frame_suffix[32];
     std::snprintf(frame_suffix, sizeof frame_suffix, "_%04u", f);
-    const std::string shaded = a.orbit ? with_suffix(a.output, frame_suffix) : a.output;
-    const std::string depth = with_suffix(shaded, "_depth");
-    write_png_rgb8(shaded, width, height, image.rgb);
-    write_png_gray16(depth, width, height, depth_image(image));
-    if (!a.quiet)
-      std::printf("%s, %s: %llu of %llu rays hit\n", shaded.c_str(), depth.c_str(),
-                  static_cast<unsigned long long>(image.hits), static_cast<unsigned long long>(width) * height);
+    write_images(a, image, a.orbit ? with_suffix(a.output, frame_suffix) : a.output, width, height);
   }
   if (!a.quiet)
     std::printf("%llu rays in %.3f s: %.3f M rays/s, %.2f frames/s\n", static_cast<unsigned long long>(rays), seconds,
@@ -142,11 +202,14 @@ void add_render(CLI::App& app) {
       "attributes when the file has them; the depth image (16-bit grey, OUT_depth.png) is brighter\n"
       "where nearer, black where the ray hit nothing.\n"
       "Coordinates are world coordinates (the file's frame) unless --grid is given.\n"
+      "INPUT may be a tile index (index.geojson from vola tile): rays then cross the tiles in order,\n"
+      "each tile mapped when a ray first reaches it; depths are in world units.\n"
       "Examples:\n"
       "  vola render city.vol -o city.png                         (a default view from above a corner)\n"
       "  vola render city.vol --camera 100 -50 80 512 512 0 --size 1280x720 -o view.png\n"
-      "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o frames/orbit.png");
-  cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
+      "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o frames/orbit.png\n"
+      "  vola render tiles/index.geojson --size 1024x768 -o survey.png");
+  cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--camera", args->camera, "Eye X Y Z then look-at X Y Z (default: a view of the whole scene)")
       ->expected(6);
   cmd->add_option("--up", args->up, "Up vector X Y Z")->expected(3)->capture_default_str();

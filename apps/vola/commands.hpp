@@ -27,5 +27,6 @@ void add_dataset(CLI::App& app);
 void add_train(CLI::App& app);
 void add_classify(CLI::App& app);  // classify and evaluate
 void add_collide(CLI::App& app);
+void add_tile(CLI::App& app);
 
 }  // namespace vola::cli

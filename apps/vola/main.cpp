@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
       "  vola get scan.vol 10 20 3\n"
       "  vola lod scan.vol --depth 4 coarse.vol\n"
       "  vola diff after.vol before.vol added.vol\n"
-      "  vola generate city city.xyz --points 1000000\n"};
+      "  vola generate city city.xyz --points 1000000\n"
+      "  vola tile *.las --tile-size 1000 --depth 6 -o tiles/           # a whole survey as tiles\n"};
   app.require_subcommand(1);
   app.set_version_flag("--version", VOLA_VERSION_STRING);
   app.footer("Run 'vola SUBCOMMAND --help' for the options of one subcommand.");
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   vola::cli::add_train(app);
   vola::cli::add_classify(app);
   vola::cli::add_collide(app);
+  vola::cli::add_tile(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

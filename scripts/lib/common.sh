@@ -21,6 +21,9 @@ command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
 # 3D CNN classification (vola_learn): libtorch (CPU) and libzip for .npz, found through pkg-config.
 VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
 
+# vola tile under mpirun: Open MPI (the tests run 3 ranks on one machine).
+VOLA_BUILD_PACKAGES+=(libopenmpi-dev openmpi-bin)
+
 # install_packages PKG...: apt-get installs the ones that are missing (as root), or
 # says exactly what to install.
 install_packages() {

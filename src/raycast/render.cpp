@@ -35,7 +35,8 @@ class VoxelColours {
   bool present_ = false;
 };
 
-// Lambert term of an axis normal against a light from above and to the side.
+}  // namespace
+
 double lambert(const std::array<int, 3>& normal) {
   constexpr std::array<double, 3> kLight{0.42426406871192851, 0.56568542494923801, 0.70710678118654757};
   if (normal == std::array<int, 3>{0, 0, 0}) return 1.0;  // the eye is inside the voxel
@@ -43,8 +44,6 @@ double lambert(const std::array<int, 3>& normal) {
   for (int a = 0; a < 3; ++a) d += normal[a] * kLight[a];
   return 0.3 + 0.7 * std::abs(d);
 }
-
-}  // namespace
 
 Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads) {
   camera.check();

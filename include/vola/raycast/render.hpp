@@ -3,6 +3,7 @@
 // colour from its red/green/blue attributes when the tree has them, else light grey.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +18,10 @@ struct Rendering {
   std::vector<std::uint8_t> rgb;   // 3 bytes per pixel, row 0 at the top; misses black
   std::uint64_t hits = 0;
 };
+
+// Brightness of a face with axis normal `normal` under a fixed light from above and to
+// the side (0.3 ambient + 0.7 Lambert); 1 for the zero normal (the eye inside a voxel).
+double lambert(const std::array<int, 3>& normal);
 
 Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads = 0);
 

@@ -1,0 +1,214 @@
+// vola tile: many point files (or one huge one, or a generated survey) into a grid of
+// georeferenced .vol tiles with a GeoJSON index and an overview pyramid, in a memory
+// budget, on all cores, and on many processes under mpirun.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
+#include "vola/tile/tiler.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct TileArgs {
+  std::vector<std::string> inputs;
+  std::string output, memory = "2G", spill_dir;
+  double tile_size = 0.0;
+  int depth = 0;
+  std::vector<double> origin;
+  std::optional<std::uint32_t> crs;
+  unsigned threads = 0;
+  bool no_overviews = false, quiet = false;
+  std::uint64_t generate = 0;
+  double density = 10.0;
+  std::uint64_t seed = 1;
+  std::size_t chunk_points = std::size_t{1} << 20;
+};
+
+// "2G", "512M", "1.5G", "300000000" -> bytes.
+std::uint64_t parse_bytes(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = text.substr(used);
+  double scale = 0.0;
+  if (unit.empty() || unit == "B") scale = 1.0;
+  else if (unit == "K" || unit == "KiB") scale = 1024.0;
+  else if (unit == "M" || unit == "MiB") scale = 1024.0 * 1024.0;
+  else if (unit == "G" || unit == "GiB") scale = 1024.0 * 1024.0 * 1024.0;
+  if (used == 0 || scale == 0.0 || !(value > 0.0) || !std::isfinite(value))
+    throw InvalidArgument("--memory '" + text + "': expected a size such as 2G, 512M or 1073741824");
+  return static_cast<std::uint64_t>(value * scale);
+}
+
+std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::size_t chunk_points) {
+  std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".las" || ext == ".laz") return tile::open_las_points(path, chunk_points);
+  return tile::open_file_points(path);
+}
+
+// The CRS every tile carries: --crs, else what the inputs say (they must agree).
+void resolve_crs(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources,
+                 tile::TileOptions& options) {
+  if (a.crs) {
+    options.epsg = *a.crs;
+    options.crs_wkt = geo::crs_wkt(*a.crs);
+    return;
+  }
+  const tile::PointSource* first = nullptr;
+  for (const auto& s : sources) {
+    std::optional<std::uint32_t> epsg = s->epsg;
+    if (!epsg && !s->wkt.empty()) epsg = geo::epsg_from_wkt(s->wkt);
+    const bool known = epsg || !s->wkt.empty();
+    if (!first) {
+      first = s.get();
+      options.epsg = epsg;
+      options.crs_wkt = !s->wkt.empty() ? s->wkt : (epsg ? geo::crs_wkt(*epsg) : std::string());
+      continue;
+    }
+    const bool same = epsg && options.epsg ? *epsg == *options.epsg
+                                           : (!known && !options.epsg && options.crs_wkt.empty()) ||
+                                                 (!epsg && !options.epsg && s->wkt == options.crs_wkt);
+    if (!same)
+      throw InvalidArgument("inputs disagree on the CRS: " + first->name() + " says " +
+                            (options.epsg ? "EPSG:" + std::to_string(*options.epsg)
+                                          : (options.crs_wkt.empty() ? std::string("nothing") : std::string("a WKT CRS"))) +
+                            ", " + s->name() + " says " +
+                            (epsg ? "EPSG:" + std::to_string(*epsg) : (known ? std::string("another WKT CRS") : std::string("nothing"))) +
+                            " (tile them separately, or name one with --crs if they really are the same)");
+  }
+}
+
+void run_tile(const TileArgs& a) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<tile::Communicator> comm = tile::world();
+  const bool talk = comm->rank() == 0 && !a.quiet;
+  try {
+    if (a.inputs.empty() && a.generate == 0) throw InvalidArgument("no input: give point files or --generate-survey N");
+    if (a.chunk_points == 0) throw InvalidArgument("--chunk-points must be positive");
+    if (a.crs) geo::crs_wkt(*a.crs);  // an unknown code fails before any work
+    std::vector<std::unique_ptr<tile::PointSource>> sources;
+    for (const std::string& path : a.inputs) sources.push_back(open_source(path, a.chunk_points));
+    if (a.generate) {
+      tile::SurveyOptions survey;
+      survey.points = a.generate;
+      survey.density = a.density;
+      survey.seed = a.seed;
+      sources.push_back(tile::generated_survey(survey));
+    }
+    tile::TileOptions options;
+    options.grid.tile_size = a.tile_size;
+    options.grid.depth = a.depth;
+    if (!a.origin.empty()) options.grid.origin = {a.origin[0], a.origin[1], a.origin[2]};
+    options.output_dir = a.output;
+    options.spill_dir = a.spill_dir;
+    options.memory_budget = parse_bytes(a.memory);
+    options.threads = a.threads;
+    options.overviews = !a.no_overviews;
+    resolve_crs(a, sources, options);
+    std::unique_ptr<Progress> progress;
+    std::string stage;
+    if (talk)
+      options.progress = [&](const std::string& s, std::uint64_t done, std::uint64_t total) {
+        if (s != stage) {
+          if (progress) progress->finish();
+          stage = s;
+          progress = std::make_unique<Progress>(s);
+        }
+        progress->update(done, total);
+      };
+    std::vector<const tile::PointSource*> views;
+    std::uint64_t points = 0;
+    for (const auto& s : sources) {
+      views.push_back(s.get());
+      points += s->point_count();
+    }
+    const tile::TileSummary summary = tile::make_tiles(views, options, *comm);
+    if (progress) progress->finish();
+    if (!talk) return;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("inputs:         %zu (%llu points)\n", sources.size(), static_cast<unsigned long long>(points));
+    std::printf("crs:            %s\n", options.epsg ? ("EPSG:" + std::to_string(*options.epsg)).c_str()
+                                                     : (options.crs_wkt.empty() ? "none known" : "WKT from the input"));
+    std::printf("grid:           tiles of %.6g at depth %d (%u^3 voxels of %.6g), origin %.6g %.6g %.6g\n",
+                options.grid.tile_size, options.grid.depth, side_of(options.grid.depth), options.grid.voxel_size(),
+                options.grid.origin[0], options.grid.origin[1], options.grid.origin[2]);
+    std::printf("points in:      %llu", static_cast<unsigned long long>(summary.points_in));
+    if (summary.points_outside)
+      std::printf(" (%llu not finite or beyond the tile range, dropped)", static_cast<unsigned long long>(summary.points_outside));
+    std::printf("\ntiles:          %llu, %llu voxels, %llu bytes (%.2f bits per voxel)\n",
+                static_cast<unsigned long long>(summary.tiles), static_cast<unsigned long long>(summary.voxels),
+                static_cast<unsigned long long>(summary.tile_bytes),
+                summary.voxels ? 8.0 * static_cast<double>(summary.tile_bytes) / static_cast<double>(summary.voxels) : 0.0);
+    std::printf("overviews:      %llu files\n", static_cast<unsigned long long>(summary.overview_files));
+    std::printf("spilled:        %llu runs, %llu bytes (rank 0 of %d)\n", static_cast<unsigned long long>(summary.spill_runs),
+                static_cast<unsigned long long>(summary.spill_bytes), comm->size());
+    std::printf("index:          %s\n", summary.index_path.c_str());
+    std::printf("time:           %.2f s, %.2f M points/s\n", seconds,
+                seconds > 0 ? static_cast<double>(summary.points_in) / seconds / 1e6 : 0.0);
+  } catch (const std::exception& e) {
+    if (comm->size() == 1) throw;
+    std::fprintf(stderr, "vola: rank %d: %s\n", comm->rank(), e.what());
+    comm->abort(1);
+  }
+}
+
+}  // namespace
+
+void add_tile(CLI::App& app) {
+  auto args = std::make_shared<TileArgs>();
+  auto* cmd = app.add_subcommand("tile", "Point clouds of any size into a grid of georeferenced .vol tiles");
+  cmd->footer(
+      "Tile (i, j, k) covers ORIGIN + [i, i+1) * TILE-SIZE on each axis and holds 4^DEPTH voxels per\n"
+      "axis (voxel = TILE-SIZE / 4^DEPTH), so tiles of one tile size and depth line up voxel for\n"
+      "voxel, across runs too. OUTDIR gets tile_I_J_K.vol files, index.geojson (footprints, files,\n"
+      "counts, CRS: open it in a GIS, or pass it to vola get / render / plan) and overviews/L1, L2, ...\n"
+      "(each level 4x coarser, covering 4x4x4 tiles of the level below).\n"
+      "Memory: voxel keys are bucketed per tile and spilled to disk as sorted runs whenever the\n"
+      "--memory budget is reached, so inputs far larger than memory tile within it; a single tile's\n"
+      "voxel keys (8 bytes each) must fit the budget. The files are byte-identical whatever\n"
+      "--threads, and under mpirun whatever the number of ranks (each rank reads a share of the\n"
+      "chunks; keys travel to each tile's owner by message; OUTDIR must be visible to every rank).\n"
+      "Examples:\n"
+      "  vola tile flight1.las flight2.las --tile-size 512 --depth 6 -o tiles/    (voxels of 512/4^6 = 0.125 m)\n"
+      "  vola tile survey.las --tile-size 1024 --depth 7 -o tiles/ --memory 1G      (voxels of 6.25 cm)\n"
+      "  vola tile --generate-survey 1000000000 --tile-size 2000 --depth 6 --crs 32633 -o big/ --memory 2G\n"
+      "  mpirun -np 3 vola tile *.las --tile-size 1000 --depth 6 -o tiles/\n"
+      "  vola get tiles/index.geojson 636250 849217 435       vola render tiles/index.geojson -o view.png");
+  cmd->add_option("inputs", args->inputs, "Point files: LAS (streamed from a memory map), or any point format vola convert reads");
+  cmd->add_option("-o,--output", args->output, "Output folder")->required();
+  cmd->add_option("--tile-size", args->tile_size, "Tile edge in the CRS's units (metres, feet, ...)")->required()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--depth", args->depth, "Levels per tile: 4^DEPTH voxels per tile edge (1..10)")->required()
+      ->check(CLI::Range(1, 10));
+  cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
+  cmd->add_option("--crs", args->crs, "EPSG code of the coordinates (default: what the inputs say)");
+  cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
+      ->capture_default_str();
+  cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");
+  cmd->add_option("--threads", args->threads, "Threads per process (0 = all cores)")->capture_default_str();
+  cmd->add_flag("--no-overviews", args->no_overviews, "Write no overview pyramid");
+  cmd->add_option("--generate-survey", args->generate,
+                  "Also tile a generated survey of N points (city blocks of 200 m, streamed, never stored)");
+  cmd->add_option("--survey-density", args->density, "Generated survey: points per square metre")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--seed", args->seed, "Generated survey: seed")->capture_default_str();
+  cmd->add_option("--chunk-points", args->chunk_points, "LAS points per work unit")->capture_default_str();
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->callback([args] { run_tile(*args); });
+}
+
+}  // namespace vola::cli

@@ -1,0 +1,49 @@
+// Where `vola tile` gets its points: lists of chunks that can be read independently,
+// in any order, by any thread or process. Work is shared by handing out chunk numbers,
+// so no reader state is shared between workers (nor memory between MPI ranks).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vola/frame.hpp"
+
+namespace vola::tile {
+
+class PointSource {
+ public:
+  virtual ~PointSource() = default;
+  virtual const std::string& name() const noexcept = 0;
+  virtual std::uint64_t chunk_count() const noexcept = 0;
+  virtual std::uint64_t point_count() const noexcept = 0;
+  // Replaces `xyz` with the chunk's points (x y z per point). Safe to call from many
+  // threads at once. Throws vola::Error (file, offset, cause) on bad input.
+  virtual void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const = 0;
+
+  // What the input says its CRS is (nothing for generated points).
+  std::optional<std::uint32_t> epsg;
+  std::string wkt;
+};
+
+// A LAS file (1.0-1.4, any point format), memory-mapped: chunk c is records
+// [c * chunk_points, (c + 1) * chunk_points), decoded straight from the map.
+std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_t chunk_points = std::size_t{1} << 20);
+// Any other point format `vola convert` reads, read whole (one chunk).
+std::unique_ptr<PointSource> open_file_points(const std::string& path);
+
+// A survey the project generates: square city blocks (vola::synth::generate_city, 200 m)
+// side by side in rows, each block one chunk with its own seed, so that any worker can
+// generate any block and the whole is never stored. `density` points per square metre
+// fixes the area; the points are spread evenly over the blocks.
+struct SurveyOptions {
+  std::uint64_t points = 1'000'000;
+  double density = 10.0;
+  std::uint64_t seed = 1;
+  Point origin{500000.0, 5000000.0, 100.0};
+};
+std::unique_ptr<PointSource> generated_survey(const SurveyOptions& options);
+
+}  // namespace vola::tile

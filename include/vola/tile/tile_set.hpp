@@ -1,0 +1,73 @@
+// A tile set opened through its index (vola tile's index.geojson): queries in world
+// coordinates, each tile memory-mapped only when a query first needs it, so a query
+// touches the tiles it needs and no others.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "vola/raycast/camera.hpp"
+#include "vola/raycast/ray.hpp"
+#include "vola/raycast/render.hpp"
+#include "vola/tile/tile_index.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::tile {
+
+struct TileLookup {
+  bool in_tile = false;   // the point falls in a tile the set has
+  TileIndex tile;
+  Voxel voxel;            // inside that tile
+  std::optional<std::uint64_t> rank;  // set when the voxel is occupied
+};
+
+struct TileHit {
+  TileIndex tile;
+  Voxel voxel;            // inside that tile
+  double t = 0.0;         // world distance along the ray (unit direction) or ray parameter
+  std::array<int, 3> normal{};
+};
+
+class TileSet {
+ public:
+  // Reads the index; opens no tile yet. Throws FormatError / IoError.
+  explicit TileSet(const std::string& index_path);
+  ~TileSet();
+
+  const TileIndexFile& index() const noexcept { return index_; }
+  const TileGrid& grid() const noexcept { return index_.grid; }
+  // The tile's tree, mapped on first use (thread-safe); nullptr when the set has none.
+  const Tree* tree(const TileIndex& tile) const;
+  std::size_t tiles_opened() const;
+  // The world box of every tile together.
+  Box bounds() const noexcept { return bounds_; }
+
+  TileLookup locate(const Point& world) const;
+  // The first occupied voxel along a world ray, tiles visited in the ray's order.
+  std::optional<TileHit> cast(const raycast::Ray& world_ray) const;
+  // One tree over the tiles that meet `world_box` (the grid of the lowest such tile),
+  // for searches that need a single grid. Throws InvalidArgument when the region spans
+  // more tiles per axis than depth 10 can hold.
+  Tree mosaic(const Box& world_box) const;
+
+ private:
+  struct Opened;
+  const Opened* open(const TileIndex& tile) const;
+
+  std::string folder_;
+  TileIndexFile index_;
+  std::map<TileIndex, std::size_t> entries_;  // tile -> position in index_.tiles
+  Box bounds_;
+  mutable std::mutex mutex_;
+  mutable std::map<TileIndex, std::unique_ptr<Opened>> opened_;
+};
+
+// A shaded and a depth image of a tile set through a world-coordinate camera (depth
+// in world units), shaded like raycast::render.
+raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& world_camera, unsigned threads = 0);
+
+}  // namespace vola::tile

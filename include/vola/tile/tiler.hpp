@@ -1,0 +1,64 @@
+// `vola tile`: point clouds of any size into a grid of georeferenced .vol tiles, a
+// GeoJSON tile index and an overview pyramid, in bounded memory, on all cores and,
+// under mpirun, on many processes.
+//
+// 1. Bucket: each worker takes chunks of the input, places every point in its tile
+//    (TileGrid::locate) and appends the voxel key to that tile's buffer; when a
+//    worker's buffers reach its share of the memory budget they are sorted, made
+//    unique and appended to the worker's spill file as one run per tile.
+// 2. Exchange (MPI only): tiles are dealt round-robin to ranks in index order; every
+//    rank sends its merged keys of each tile it does not own to the tile's owner.
+// 3. Build: each tile's runs are merged into sorted unique keys, built into a tree and
+//    written. The keys of a tile do not depend on who read which chunk, so the files
+//    are byte-identical for any thread count and any number of ranks.
+// 4. Overviews: level L has tiles of 4^L x 4^L x 4^L base tiles at the same depth
+//    (voxels 4^L times larger), each built from the level below's coarser cells.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vola/tile/communicator.hpp"
+#include "vola/tile/point_source.hpp"
+#include "vola/tile/tile_grid.hpp"
+
+namespace vola::tile {
+
+struct TileOptions {
+  TileGrid grid;
+  std::string output_dir;
+  // Spill files go to spill_dir/rank-<r> (default: output_dir/.spill); removed at the end.
+  std::string spill_dir;
+  // Per process: key buffers, sort scratch and merge buffers stay within it; a tile's
+  // own voxel keys (8 bytes each) must fit it when the tile is built.
+  std::uint64_t memory_budget = std::uint64_t{2} << 30;
+  unsigned threads = 0;  // 0 = all cores
+  bool overviews = true;
+  // The CRS written into every tile (header code and WKT); the caller resolves it.
+  std::optional<std::uint32_t> epsg;
+  std::string crs_wkt;
+  // (stage, done, total) on rank 0, from one thread at a time.
+  std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
+};
+
+struct TileSummary {
+  std::uint64_t points_in = 0;        // over all ranks
+  std::uint64_t points_outside = 0;   // not finite, or beyond the 32-bit tile index range
+  std::uint64_t tiles = 0;
+  std::uint64_t voxels = 0;           // over all tiles
+  std::uint64_t tile_bytes = 0;       // .vol bytes over all tiles
+  std::uint64_t overview_files = 0;
+  std::uint64_t spill_runs = 0;       // this rank's
+  std::uint64_t spill_bytes = 0;      // this rank's
+  std::string index_path;
+};
+
+// Throws vola::Error on bad input or when the output cannot be written. Every rank of
+// `comm` must call it with the same sources and options.
+TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
+                       Communicator& comm);
+
+}  // namespace vola::tile

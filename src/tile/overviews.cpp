@@ -1,0 +1,128 @@
+#include "overviews.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+
+namespace vola::tile {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Node {  // one file of a level: a tile (level 0) or an overview
+  TileIndex tile;
+  std::string file;
+  Box bbox;
+};
+
+TileIndex parent_of(const TileIndex& t) { return {t.i >> 2, t.j >> 2, t.k >> 2}; }  // floor division by 4
+
+Box unite(const Box& a, const Box& b) {
+  Box u;
+  for (int i = 0; i < 3; ++i) {
+    u.min[i] = std::min(a.min[i], b.min[i]);
+    u.max[i] = std::max(a.max[i], b.max[i]);
+  }
+  return u;
+}
+
+Tree build_parent(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c) {
+  const int depth = c.grid.depth;
+  const std::uint32_t child_span = side_of(depth - 1);  // a child's level depth-2 grid
+  std::vector<Key> keys;
+  for (const Node* child : children) {
+    const Tree tree = open_mapped((fs::path(c.output_dir) / child->file).string());
+    if (tree.depth() != depth)
+      throw FormatError(child->file, 0, "depth " + std::to_string(tree.depth()) + " differs from the tile set's " +
+                                            std::to_string(depth));
+    const std::uint32_t ox = static_cast<std::uint32_t>(child->tile.i - 4 * parent.i) * child_span;
+    const std::uint32_t oy = static_cast<std::uint32_t>(child->tile.j - 4 * parent.j) * child_span;
+    const std::uint32_t oz = static_cast<std::uint32_t>(child->tile.k - 4 * parent.k) * child_span;
+    tree.for_each_node(depth - 2, [&](const Voxel& cell) { keys.push_back(encode(ox + cell.x, oy + cell.y, oz + cell.z)); });
+  }
+  return build_from_keys(std::move(keys), depth);
+}
+
+}  // namespace
+
+std::vector<OverviewEntry> build_overviews(
+    const std::vector<TileEntry>& tiles, const OverviewContext& c, Communicator& comm,
+    const std::function<void(const std::string&, std::uint64_t, std::uint64_t)>& progress) {
+  std::vector<OverviewEntry> out;
+  const int depth = c.grid.depth;
+  std::vector<Node> level;
+  for (const TileEntry& t : tiles) level.push_back({t.tile, t.file, t.bbox});
+  const int rank = comm.rank(), ranks = comm.size();
+  for (int L = 1; level.size() > 1 && L <= depth - 1; ++L) {
+    std::map<TileIndex, std::vector<const Node*>> parents;
+    for (const Node& n : level) parents[parent_of(n.tile)].push_back(&n);
+    std::vector<TileIndex> order;
+    for (const auto& [p, children] : parents) order.push_back(p);
+    const fs::path folder = fs::path("overviews") / ("L" + std::to_string(L));
+    fs::create_directories(fs::path(c.output_dir) / folder);
+    const double scale = static_cast<double>(std::uint64_t{1} << (2 * L));  // 4^L
+    std::vector<std::uint64_t> voxels(order.size(), 0);
+    std::vector<Node> next(order.size());
+    std::atomic<std::size_t> next_parent{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < c.workers; ++w)
+      pool.emplace_back([&] {
+        try {
+          for (std::size_t p; (p = next_parent++) < order.size();) {
+            const auto& children = parents[order[p]];
+            Box bbox = children.front()->bbox;
+            for (const Node* child : children) bbox = unite(bbox, child->bbox);
+            next[p] = {order[p], (folder / tile_file_name(order[p])).string(), bbox};
+            if (static_cast<int>(p % static_cast<std::size_t>(ranks)) != rank) continue;
+            Tree tree = build_parent(order[p], children, c);
+            Frame frame;
+            frame.quantization = Quantization::grid;
+            frame.voxel_size = c.grid.voxel_size() * scale;
+            frame.origin = {c.grid.origin[0] + order[p].i * c.grid.tile_size * scale,
+                            c.grid.origin[1] + order[p].j * c.grid.tile_size * scale,
+                            c.grid.origin[2] + order[p].k * c.grid.tile_size * scale};
+            tree.set_frame(frame);
+            c.georef.apply(tree, bbox);
+            write(tree, (fs::path(c.output_dir) / next[p].file).string());
+            voxels[p] = tree.voxel_count();
+          }
+        } catch (...) {
+          const std::lock_guard lock(error_mutex);
+          if (!error) error = std::current_exception();
+        }
+      });
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    // Gathering the counts is also the barrier: every rank has written this level.
+    std::vector<std::uint8_t> mine;
+    for (std::size_t p = 0; p < order.size(); ++p)
+      if (static_cast<int>(p % static_cast<std::size_t>(ranks)) == rank) {
+        const std::uint64_t pair[2] = {p, voxels[p]};
+        const auto* b = reinterpret_cast<const std::uint8_t*>(pair);
+        mine.insert(mine.end(), b, b + sizeof pair);
+      }
+    for (const auto& message : comm.all_gather(mine))
+      for (std::size_t at = 0; at + 16 <= message.size(); at += 16) {
+        std::uint64_t pair[2];
+        std::memcpy(pair, message.data() + at, sizeof pair);
+        if (pair[0] < voxels.size()) voxels[pair[0]] = pair[1];
+      }
+    for (std::size_t p = 0; p < order.size(); ++p) out.push_back({L, order[p], next[p].file, voxels[p]});
+    if (rank == 0 && progress) progress("overview level " + std::to_string(L), order.size(), order.size());
+    level = std::move(next);
+  }
+  return out;
+}
+
+}  // namespace vola::tile

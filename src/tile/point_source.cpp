@@ -1,0 +1,162 @@
+#include "vola/tile/point_source.hpp"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "vola/error.hpp"
+#include "vola/io/input.hpp"
+#include "vola/io/las.hpp"
+#include "vola/synth/city.hpp"
+
+namespace vola::tile {
+
+namespace {
+
+class LasPoints final : public PointSource {
+ public:
+  LasPoints(const std::string& path, std::size_t chunk_points) : name_(path), chunk_points_(chunk_points) {
+    const io::LasReader reader(path);  // checks the header, the VLRs and that the records fit the file
+    header_ = reader.header();
+    epsg = header_.epsg;
+    wkt = header_.wkt;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw IoError(path + ": cannot open (" + std::strerror(errno) + ")");
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
+      ::close(fd);
+      throw IoError(path + ": cannot stat");
+    }
+    size_ = static_cast<std::size_t>(st.st_size);
+    if (size_ > 0) {
+      void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+      ::close(fd);
+      if (map == MAP_FAILED) throw IoError(path + ": cannot map (" + std::strerror(errno) + ")");
+      data_ = static_cast<const std::uint8_t*>(map);
+      ::madvise(map, size_, MADV_SEQUENTIAL);
+    } else {
+      ::close(fd);
+    }
+    const std::uint64_t end = header_.offset_to_points + header_.point_count * std::uint64_t{header_.record_length};
+    if (end > size_)  // the reader checked this already; kept so that decoding can never read past the map
+      throw FormatError(path, header_.offset_to_points, "point records run past the end of the file");
+  }
+  ~LasPoints() override {
+    if (data_) ::munmap(const_cast<std::uint8_t*>(data_), size_);
+  }
+  LasPoints(const LasPoints&) = delete;
+  LasPoints& operator=(const LasPoints&) = delete;
+
+  const std::string& name() const noexcept override { return name_; }
+  std::uint64_t chunk_count() const noexcept override {
+    return (header_.point_count + chunk_points_ - 1) / chunk_points_;
+  }
+  std::uint64_t point_count() const noexcept override { return header_.point_count; }
+
+  void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
+    const std::uint64_t first = chunk * chunk_points_;
+    const std::uint64_t n = first < header_.point_count ? std::min<std::uint64_t>(chunk_points_, header_.point_count - first) : 0;
+    xyz.resize(3 * n);
+    const std::size_t length = header_.record_length;
+    const std::uint8_t* record = data_ + header_.offset_to_points + first * length;
+    const auto& s = header_.scale;
+    const auto& o = header_.offset;
+    double* out = xyz.data();
+    // Every point format starts with X, Y, Z as little-endian int32 (ASPRS LAS 1.4, 2.6).
+    for (std::uint64_t p = 0; p < n; ++p, record += length, out += 3) {
+      std::int32_t v[3];
+      std::memcpy(v, record, sizeof v);
+      out[0] = v[0] * s[0] + o[0];
+      out[1] = v[1] * s[1] + o[1];
+      out[2] = v[2] * s[2] + o[2];
+    }
+  }
+
+ private:
+  std::string name_;
+  std::size_t chunk_points_;
+  io::LasHeader header_;
+  const std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+class WholeFilePoints final : public PointSource {
+ public:
+  explicit WholeFilePoints(const std::string& path) : name_(path) {
+    io::InputOptions options;
+    options.attributes = false;
+    io::Input input = io::read_input(path, "auto", options);
+    if (input.is_mesh() || input.grid || input.terrain)
+      throw InvalidArgument(path + ": vola tile takes point clouds (LAS, XYZ/TXT/CSV, PLY, PCD, NPY, KITTI); convert " +
+                            input.format + " input with vola convert");
+    xyz_ = std::move(input.cloud.xyz);
+    epsg = input.epsg;
+    wkt = input.wkt;
+  }
+  const std::string& name() const noexcept override { return name_; }
+  std::uint64_t chunk_count() const noexcept override { return 1; }
+  std::uint64_t point_count() const noexcept override { return xyz_.size() / 3; }
+  void read_chunk(std::uint64_t, std::vector<double>& xyz) const override { xyz = xyz_; }
+
+ private:
+  std::string name_;
+  std::vector<double> xyz_;
+};
+
+class GeneratedSurvey final : public PointSource {
+ public:
+  explicit GeneratedSurvey(const SurveyOptions& o) : options_(o) {
+    if (!(o.density > 0.0) || !std::isfinite(o.density)) throw InvalidArgument("survey density must be positive");
+    if (o.points == 0) throw InvalidArgument("a generated survey needs at least one point");
+    const double side = std::sqrt(static_cast<double>(o.points) / o.density);
+    per_side_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(side / kBlock)));
+    name_ = "generated survey (" + std::to_string(o.points) + " points, " + std::to_string(per_side_) + "x" +
+            std::to_string(per_side_) + " blocks of 200 m, seed " + std::to_string(o.seed) + ")";
+  }
+  const std::string& name() const noexcept override { return name_; }
+  std::uint64_t chunk_count() const noexcept override { return per_side_ * per_side_; }
+  std::uint64_t point_count() const noexcept override { return options_.points; }
+
+  void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
+    const std::uint64_t blocks = chunk_count();
+    synth::CityOptions city;
+    city.points = options_.points / blocks + (chunk < options_.points % blocks ? 1 : 0);
+    city.seed = options_.seed * 0x9E3779B97F4A7C15ull + chunk;  // one independent stream per block
+    city.size = kBlock;
+    city.origin = {options_.origin[0] + kBlock * static_cast<double>(chunk % per_side_),
+                   options_.origin[1] + kBlock * static_cast<double>(chunk / per_side_), options_.origin[2]};
+    xyz.clear();
+    xyz.reserve(3 * city.points);
+    synth::generate_city(city, [&](const synth::CityPoint& p) {
+      xyz.push_back(p.x);
+      xyz.push_back(p.y);
+      xyz.push_back(p.z);
+    });
+  }
+
+ private:
+  static constexpr double kBlock = 200.0;
+  SurveyOptions options_;
+  std::uint64_t per_side_ = 1;
+  std::string name_;
+};
+
+}  // namespace
+
+std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_t chunk_points) {
+  if (chunk_points == 0) throw InvalidArgument("chunk size must be positive");
+  return std::make_unique<LasPoints>(path, chunk_points);
+}
+
+std::unique_ptr<PointSource> open_file_points(const std::string& path) { return std::make_unique<WholeFilePoints>(path); }
+
+std::unique_ptr<PointSource> generated_survey(const SurveyOptions& options) {
+  return std::make_unique<GeneratedSurvey>(options);
+}
+
+}  // namespace vola::tile

@@ -1,0 +1,44 @@
+// Internal: runs of sorted unique keys spilled to one file per worker, and read back.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vola/key.hpp"
+
+namespace vola::tile::detail {
+
+struct Run {
+  std::uint32_t file = 0;    // which spill file
+  std::uint64_t offset = 0;  // byte offset of the first key
+  std::uint64_t count = 0;   // keys
+};
+
+// An append-only file of keys; positional reads may run on other threads at once.
+class SpillFile {
+ public:
+  explicit SpillFile(std::string path);
+  ~SpillFile();
+  SpillFile(const SpillFile&) = delete;
+  SpillFile& operator=(const SpillFile&) = delete;
+
+  // Appends keys; returns the byte offset they start at. Throws IoError (file, offset) on failure.
+  std::uint64_t append(std::span<const Key> keys);
+  void read(std::uint64_t offset, std::span<Key> out) const;
+  std::uint64_t size() const noexcept { return end_; }
+  const std::string& path() const noexcept { return path_; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::uint64_t end_ = 0;
+};
+
+// Sorted unique keys of many sorted unique runs (one k-way merge), reading each run
+// through a buffer of `buffer_keys` keys.
+std::vector<Key> merge_runs(std::span<const Run> runs, std::span<const SpillFile* const> files,
+                            std::size_t buffer_keys);
+
+}  // namespace vola::tile::detail

@@ -1,0 +1,185 @@
+#include "vola/tile/tile_index.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "vola/error.hpp"
+
+namespace vola::tile {
+
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+ordered_json tile_array(const TileIndex& t) { return ordered_json::array({t.i, t.j, t.k}); }
+
+ordered_json footprint(const Box& b) {
+  const double x0 = b.min[0], y0 = b.min[1], x1 = b.max[0], y1 = b.max[1];
+  return {{"type", "Polygon"},
+          {"coordinates", ordered_json::array({ordered_json::array(
+                              {ordered_json::array({x0, y0}), ordered_json::array({x1, y0}),
+                               ordered_json::array({x1, y1}), ordered_json::array({x0, y1}),
+                               ordered_json::array({x0, y0})})})}};
+}
+
+ordered_json box_array(const Box& b) {
+  return ordered_json::array({b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
+}
+
+[[noreturn]] void bad(const std::string& path, const std::string& what) {
+  throw FormatError(path, 0, "not a vola tile index: " + what);
+}
+
+TileIndex tile_of(const json& j, const std::string& path, const std::string& where) {
+  if (!j.is_array() || j.size() != 3) bad(path, where + ": \"tile\" must be [i, j, k]");
+  TileIndex t;
+  try {
+    t.i = j[0].get<std::int32_t>();
+    t.j = j[1].get<std::int32_t>();
+    t.k = j[2].get<std::int32_t>();
+  } catch (const json::exception&) {
+    bad(path, where + ": \"tile\" must hold three integers");
+  }
+  return t;
+}
+
+std::string relative_file(const json& j, const std::string& path, const std::string& where) {
+  if (!j.is_string()) bad(path, where + ": \"file\" must be a string");
+  const std::string f = j.get<std::string>();
+  // A file name, never a path out of the index's folder.
+  if (f.empty() || f.front() == '/' || f.find("..") != std::string::npos)
+    bad(path, where + ": \"file\" must be a path inside the index's folder (got '" + f + "')");
+  return f;
+}
+
+}  // namespace
+
+void write_tile_index(const TileIndexFile& index, const std::string& path) {
+  ordered_json root;
+  root["type"] = "FeatureCollection";
+  root["name"] = "vola tiles";
+  if (index.epsg)
+    root["crs"] = {{"type", "name"},
+                   {"properties", {{"name", "urn:ogc:def:crs:EPSG::" + std::to_string(*index.epsg)}}}};
+  ordered_json vola;
+  vola["format"] = "vola-tile-index";
+  vola["version"] = 1;
+  vola["origin"] = ordered_json::array({index.grid.origin[0], index.grid.origin[1], index.grid.origin[2]});
+  vola["tile_size"] = index.grid.tile_size;
+  vola["depth"] = index.grid.depth;
+  vola["voxel_size"] = index.grid.voxel_size();
+  if (index.epsg) vola["epsg"] = *index.epsg;
+  else vola["epsg"] = nullptr;
+  vola["crs_wkt"] = index.crs_wkt;
+  vola["points_in"] = index.points_in;
+  vola["points_outside"] = index.points_outside;
+  std::uint64_t voxels = 0;
+  for (const TileEntry& t : index.tiles) voxels += t.voxels;
+  vola["tiles"] = index.tiles.size();
+  vola["voxels"] = voxels;
+  ordered_json overviews = ordered_json::array();
+  for (const OverviewEntry& o : index.overviews)
+    overviews.push_back({{"level", o.level}, {"tile", tile_array(o.tile)}, {"file", o.file}, {"voxels", o.voxels}});
+  vola["overviews"] = std::move(overviews);
+  root["vola"] = std::move(vola);
+  ordered_json features = ordered_json::array();
+  for (const TileEntry& t : index.tiles) {
+    ordered_json f;
+    f["type"] = "Feature";
+    f["geometry"] = footprint(index.grid.tile_box(t.tile));
+    f["properties"] = {{"file", t.file},     {"tile", tile_array(t.tile)}, {"points", t.points},
+                       {"voxels", t.voxels}, {"bytes", t.bytes},           {"bbox", box_array(t.bbox)}};
+    features.push_back(std::move(f));
+  }
+  root["features"] = std::move(features);
+  const std::string part = path + ".part";
+  {
+    std::ofstream out(part, std::ios::binary);
+    if (!out) throw IoError(part + ": cannot create");
+    out << root.dump(1) << '\n';
+    if (!out.flush()) throw IoError(part + ": cannot write");
+  }
+  if (std::rename(part.c_str(), path.c_str()) != 0) throw IoError(path + ": cannot rename " + part + " to it");
+}
+
+TileIndexFile read_tile_index(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw FormatError(path, e.byte, std::string("not valid JSON: ") + e.what());
+  }
+  if (!root.is_object() || !root.contains("vola") || !root["vola"].is_object())
+    bad(path, "no \"vola\" member (write one with vola tile)");
+  const json& v = root["vola"];
+  if (v.value("format", "") != "vola-tile-index") bad(path, "\"vola\".\"format\" is not \"vola-tile-index\"");
+  if (v.value("version", 0) != 1) bad(path, "unsupported \"vola\".\"version\" (this vola reads version 1)");
+  TileIndexFile index;
+  try {
+    const auto origin = v.at("origin");
+    if (!origin.is_array() || origin.size() != 3) bad(path, "\"origin\" must be [x, y, z]");
+    for (int a = 0; a < 3; ++a) index.grid.origin[a] = origin[a].get<double>();
+    index.grid.tile_size = v.at("tile_size").get<double>();
+    index.grid.depth = v.at("depth").get<int>();
+    if (!v.at("epsg").is_null()) index.epsg = v.at("epsg").get<std::uint32_t>();
+    index.crs_wkt = v.value("crs_wkt", "");
+    index.points_in = v.value("points_in", std::uint64_t{0});
+    index.points_outside = v.value("points_outside", std::uint64_t{0});
+    try {
+      index.grid.check();
+    } catch (const InvalidArgument& e) {
+      bad(path, std::string("bad grid: ") + e.what());
+    }
+    if (!root.contains("features") || !root["features"].is_array()) bad(path, "no \"features\" array");
+    std::size_t n = 0;
+    for (const json& f : root["features"]) {
+      const std::string where = "feature " + std::to_string(n++);
+      if (!f.contains("properties") || !f["properties"].is_object()) bad(path, where + ": no properties");
+      const json& p = f["properties"];
+      TileEntry t;
+      t.tile = tile_of(p.at("tile"), path, where);
+      t.file = relative_file(p.at("file"), path, where);
+      t.points = p.value("points", std::uint64_t{0});
+      t.voxels = p.value("voxels", std::uint64_t{0});
+      t.bytes = p.value("bytes", std::uint64_t{0});
+      if (p.contains("bbox") && p["bbox"].is_array() && p["bbox"].size() == 6)
+        for (int a = 0; a < 3; ++a) {
+          t.bbox.min[a] = p["bbox"][a].get<double>();
+          t.bbox.max[a] = p["bbox"][a + 3].get<double>();
+        }
+      index.tiles.push_back(std::move(t));
+    }
+    if (v.contains("overviews") && v["overviews"].is_array()) {
+      n = 0;
+      for (const json& o : v["overviews"]) {
+        const std::string where = "overview " + std::to_string(n++);
+        OverviewEntry e;
+        e.level = o.at("level").get<int>();
+        e.tile = tile_of(o.at("tile"), path, where);
+        e.file = relative_file(o.at("file"), path, where);
+        e.voxels = o.value("voxels", std::uint64_t{0});
+        index.overviews.push_back(std::move(e));
+      }
+    }
+  } catch (const json::exception& e) {
+    bad(path, std::string("a member is missing or of the wrong type (") + e.what() + ")");
+  }
+  std::sort(index.tiles.begin(), index.tiles.end(), [](const TileEntry& a, const TileEntry& b) { return a.tile < b.tile; });
+  for (std::size_t i = 1; i < index.tiles.size(); ++i)
+    if (index.tiles[i].tile == index.tiles[i - 1].tile) bad(path, "tile " + index.tiles[i].file + " is listed twice");
+  return index;
+}
+
+bool is_tile_index_path(const std::string& path) {
+  const auto dot = path.rfind('.');
+  if (dot == std::string::npos) return false;
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".geojson" || ext == ".json";
+}
+
+}  // namespace vola::tile

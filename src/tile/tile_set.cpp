@@ -1,0 +1,198 @@
+#include "vola/tile/tile_set.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/raycast/ray_caster.hpp"
+#include "vola/raycast/world.hpp"
+
+namespace vola::tile {
+
+namespace fs = std::filesystem;
+
+struct TileSet::Opened {
+  Tree tree;
+  std::unique_ptr<raycast::RayCaster> caster;  // made on the first ray
+  std::once_flag caster_once;
+};
+
+TileSet::TileSet(const std::string& index_path) : index_(read_tile_index(index_path)) {
+  folder_ = fs::path(index_path).parent_path().string();
+  if (index_.tiles.empty()) throw FormatError(index_path, 0, "the tile index lists no tiles");
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  bounds_ = Box{{inf, inf, inf}, {-inf, -inf, -inf}};
+  for (std::size_t p = 0; p < index_.tiles.size(); ++p) {
+    entries_[index_.tiles[p].tile] = p;
+    const Box b = index_.grid.tile_box(index_.tiles[p].tile);
+    for (int a = 0; a < 3; ++a) {
+      bounds_.min[a] = std::min(bounds_.min[a], b.min[a]);
+      bounds_.max[a] = std::max(bounds_.max[a], b.max[a]);
+    }
+  }
+}
+
+TileSet::~TileSet() = default;
+
+const TileSet::Opened* TileSet::open(const TileIndex& tile) const {
+  const auto entry = entries_.find(tile);
+  if (entry == entries_.end()) return nullptr;
+  const std::lock_guard lock(mutex_);
+  auto& slot = opened_[tile];
+  if (!slot) {
+    const TileEntry& e = index_.tiles[entry->second];
+    const std::string path = (fs::path(folder_) / e.file).string();
+    Tree tree = open_mapped(path);
+    if (tree.depth() != index_.grid.depth || tree.frame().quantization != Quantization::grid)
+      throw FormatError(path, 0, "tile does not match its index (depth " + std::to_string(tree.depth()) +
+                                     ", the index says " + std::to_string(index_.grid.depth) + ")");
+    slot = std::make_unique<Opened>();
+    slot->tree = std::move(tree);
+  }
+  return slot.get();
+}
+
+const Tree* TileSet::tree(const TileIndex& tile) const {
+  const Opened* o = open(tile);
+  return o ? &o->tree : nullptr;
+}
+
+std::size_t TileSet::tiles_opened() const {
+  const std::lock_guard lock(mutex_);
+  return opened_.size();
+}
+
+TileLookup TileSet::locate(const Point& world) const {
+  TileLookup out;
+  Key key;
+  if (!index_.grid.locate(world, out.tile, key)) return out;
+  out.voxel = decode(key);
+  const Tree* t = tree(out.tile);
+  if (!t) return out;
+  out.in_tile = true;
+  out.rank = t->rank(out.voxel);
+  return out;
+}
+
+std::optional<TileHit> TileSet::cast(const raycast::Ray& world_ray) const {
+  raycast::check_ray(world_ray);
+  const Point& o = world_ray.origin;
+  const Point& d = world_ray.direction;
+  // Where the ray is inside the box of all tiles (slab test).
+  double t0 = 0.0, t1 = world_ray.t_max;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0.0) {
+      if (o[a] < bounds_.min[a] || o[a] > bounds_.max[a]) return std::nullopt;
+      continue;
+    }
+    double ta = (bounds_.min[a] - o[a]) / d[a], tb = (bounds_.max[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  if (!(t0 <= t1)) return std::nullopt;
+  const TileGrid& g = index_.grid;
+  // A DDA over the tile grid from the entry point; each tile the set has casts the ray
+  // itself, and tiles come in the ray's order, so the first hit is the nearest.
+  std::array<std::int64_t, 3> cell{}, step{}, lo{}, hi{};
+  std::array<double, 3> next{}, delta{};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = static_cast<std::int64_t>(std::llround((bounds_.min[a] - g.origin[a]) / g.tile_size));
+    hi[a] = static_cast<std::int64_t>(std::llround((bounds_.max[a] - g.origin[a]) / g.tile_size)) - 1;
+    const double p = o[a] + t0 * d[a];
+    cell[a] = std::clamp(static_cast<std::int64_t>(std::floor((p - g.origin[a]) / g.tile_size)), lo[a], hi[a]);
+    step[a] = d[a] > 0 ? 1 : (d[a] < 0 ? -1 : 0);
+    if (step[a] == 0) {
+      next[a] = delta[a] = std::numeric_limits<double>::infinity();
+    } else {
+      const double plane = g.origin[a] + static_cast<double>(cell[a] + (step[a] > 0 ? 1 : 0)) * g.tile_size;
+      next[a] = (plane - o[a]) / d[a];
+      delta[a] = g.tile_size / std::abs(d[a]);
+    }
+  }
+  const double voxel = g.voxel_size();
+  for (;;) {
+    const TileIndex t{static_cast<std::int32_t>(cell[0]), static_cast<std::int32_t>(cell[1]),
+                      static_cast<std::int32_t>(cell[2])};
+    if (const Opened* opened = open(t)) {
+      std::call_once(const_cast<Opened*>(opened)->caster_once, [opened] {
+        const_cast<Opened*>(opened)->caster = std::make_unique<raycast::RayCaster>(opened->tree);
+      });
+      raycast::Ray local = raycast::world_ray_to_grid(g.tile_frame(t), world_ray);
+      if (const auto hit = opened->caster->cast(local)) return TileHit{t, hit->voxel, hit->t * voxel, hit->normal};
+    }
+    const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+    if (!(next[a] <= t1)) return std::nullopt;
+    cell[a] += step[a];
+    if (cell[a] < lo[a] || cell[a] > hi[a]) return std::nullopt;
+    next[a] += delta[a];
+  }
+}
+
+Tree TileSet::mosaic(const Box& box) const {
+  const TileGrid& g = index_.grid;
+  std::array<std::int64_t, 3> first{}, last{};
+  for (int a = 0; a < 3; ++a) {
+    first[a] = static_cast<std::int64_t>(std::floor((std::max(box.min[a], bounds_.min[a]) - g.origin[a]) / g.tile_size));
+    last[a] = static_cast<std::int64_t>(std::floor((std::min(box.max[a], bounds_.max[a]) - g.origin[a]) / g.tile_size));
+    last[a] = std::min(last[a], static_cast<std::int64_t>(std::llround((bounds_.max[a] - g.origin[a]) / g.tile_size)) - 1);
+    if (last[a] < first[a]) throw InvalidArgument("the region lies outside every tile of the set");
+  }
+  const std::int64_t span = std::max({last[0] - first[0], last[1] - first[1], last[2] - first[2]}) + 1;
+  int extra = 0;
+  while ((std::int64_t{1} << (2 * extra)) < span) ++extra;
+  if (g.depth + extra > kMaxDepth)
+    throw InvalidArgument("the region spans " + std::to_string(span) + " tiles per axis; one grid of depth-" +
+                          std::to_string(g.depth) + " tiles holds at most " +
+                          std::to_string(std::int64_t{1} << (2 * (kMaxDepth - g.depth))) + " (choose a smaller region)");
+  const std::uint32_t side = side_of(g.depth);
+  std::vector<Key> keys;
+  for (const auto& [t, position] : entries_) {
+    if (t.i < first[0] || t.i > last[0] || t.j < first[1] || t.j > last[1] || t.k < first[2] || t.k > last[2]) continue;
+    const Tree* tree = this->tree(t);
+    const auto ox = static_cast<std::uint32_t>((t.i - first[0]) * side);
+    const auto oy = static_cast<std::uint32_t>((t.j - first[1]) * side);
+    const auto oz = static_cast<std::uint32_t>((t.k - first[2]) * side);
+    tree->for_each_voxel([&](const Voxel& v) { keys.push_back(encode(ox + v.x, oy + v.y, oz + v.z)); });
+  }
+  Tree out = build_from_keys(std::move(keys), g.depth + extra);
+  const TileIndex corner{static_cast<std::int32_t>(first[0]), static_cast<std::int32_t>(first[1]),
+                         static_cast<std::int32_t>(first[2])};
+  out.set_frame(g.tile_frame(corner));
+  out.georef().epsg = index_.epsg.value_or(2000);
+  out.georef().crs_wkt = index_.crs_wkt;
+  return out;
+}
+
+raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& camera, unsigned threads) {
+  camera.check();
+  raycast::Rendering out;
+  out.width = camera.width;
+  out.height = camera.height;
+  const std::size_t pixels = std::size_t{camera.width} * camera.height;
+  out.depth.assign(pixels, std::numeric_limits<double>::infinity());
+  out.rgb.assign(pixels * 3, 0);
+  std::atomic<std::uint64_t> hits{0};
+  raycast::parallel_chunks(pixels, threads, [&](std::size_t begin, std::size_t end) {
+    std::uint64_t local = 0;
+    for (std::size_t p = begin; p < end; ++p) {
+      const auto hit = tiles.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
+                                             static_cast<std::uint32_t>(p / camera.width)));
+      if (!hit) continue;
+      ++local;
+      out.depth[p] = hit->t;
+      const auto grey = static_cast<std::uint8_t>(std::clamp(200.0 * raycast::lambert(hit->normal), 0.0, 255.0));
+      for (int i = 0; i < 3; ++i) out.rgb[3 * p + i] = grey;
+    }
+    hits += local;
+  });
+  out.hits = hits;
+  return out;
+}
+
+}  // namespace vola::tile

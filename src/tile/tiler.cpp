@@ -1,0 +1,383 @@
+#include "vola/tile/tiler.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "overviews.hpp"
+#include "spill.hpp"
+#include "tile_georef.hpp"
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/tile/tile_index.hpp"
+
+namespace vola::tile {
+
+namespace fs = std::filesystem;
+using detail::Run;
+using detail::SpillFile;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct TileStat {
+  std::uint64_t points = 0;
+  Box bbox{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+  void merge(const TileStat& o) {
+    points += o.points;
+    for (int a = 0; a < 3; ++a) {
+      bbox.min[a] = std::min(bbox.min[a], o.bbox.min[a]);
+      bbox.max[a] = std::max(bbox.max[a], o.bbox.max[a]);
+    }
+  }
+};
+
+using StatMap = std::map<TileIndex, TileStat>;
+using RunMap = std::map<TileIndex, std::vector<Run>>;
+
+// Sorts keys and drops repeats, in place.
+void sort_unique(std::vector<Key>& keys, int depth) {
+  radix_sort(keys, nullptr, 6 * depth);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+// One worker of the bucket phase: per-tile key buffers spilled as sorted unique runs.
+class Bucketer {
+ public:
+  Bucketer(const TileGrid& grid, SpillFile& file, std::uint32_t file_id, std::uint64_t limit_keys)
+      : grid_(grid), file_(file), file_id_(file_id), limit_(std::max<std::uint64_t>(limit_keys, 1024)) {}
+
+  void add(const std::vector<double>& xyz) {
+    const std::size_t n = xyz.size() / 3;
+    TileIndex last{};
+    std::vector<Key>* keys = nullptr;
+    TileStat* stat = nullptr;
+    for (std::size_t p = 0; p < n; ++p) {
+      const Point point{xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]};
+      TileIndex t;
+      Key key;
+      if (!grid_.locate(point, t, key)) {
+        ++outside_;
+        continue;
+      }
+      if (!keys || t != last) {  // points of a chunk mostly stay in one tile
+        keys = &buckets_[t];
+        stat = &stats_[t];
+        last = t;
+      }
+      keys->push_back(key);
+      ++stat->points;
+      for (int a = 0; a < 3; ++a) {
+        stat->bbox.min[a] = std::min(stat->bbox.min[a], point[a]);
+        stat->bbox.max[a] = std::max(stat->bbox.max[a], point[a]);
+      }
+      if (++buffered_ >= limit_) {
+        flush();
+        keys = nullptr;
+      }
+    }
+  }
+
+  void flush() {
+    for (auto& [tile, keys] : buckets_) {
+      if (keys.empty()) continue;
+      sort_unique(keys, grid_.depth);
+      runs_[tile].push_back(Run{file_id_, file_.append(keys), keys.size()});
+      ++run_count_;
+      std::vector<Key>().swap(keys);  // give the memory back: the budget counts it
+    }
+    buffered_ = 0;
+  }
+
+  const StatMap& stats() const noexcept { return stats_; }
+  const RunMap& runs() const noexcept { return runs_; }
+  std::uint64_t outside() const noexcept { return outside_; }
+  std::uint64_t run_count() const noexcept { return run_count_; }
+
+ private:
+  const TileGrid& grid_;
+  SpillFile& file_;
+  std::uint32_t file_id_;
+  std::uint64_t limit_;
+  std::uint64_t buffered_ = 0, outside_ = 0, run_count_ = 0;
+  std::map<TileIndex, std::vector<Key>> buckets_;
+  StatMap stats_;
+  RunMap runs_;
+};
+
+// Little-endian-agnostic packing of plain values (all ranks run the same binary).
+template <class T>
+void put(std::vector<std::uint8_t>& out, const T& v) {
+  const auto* b = reinterpret_cast<const std::uint8_t*>(&v);
+  out.insert(out.end(), b, b + sizeof v);
+}
+template <class T>
+T take(const std::vector<std::uint8_t>& in, std::size_t& at) {
+  if (at + sizeof(T) > in.size()) throw Error("tile statistics message is truncated");
+  T v;
+  std::memcpy(&v, in.data() + at, sizeof v);
+  at += sizeof v;
+  return v;
+}
+
+unsigned resolve_threads(unsigned threads) {
+  if (threads) return threads;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw ? hw : 1;
+}
+
+// Runs f(worker) on `workers` threads and rethrows the first error.
+template <class F>
+void on_threads(unsigned workers, F&& f) {
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  std::vector<std::thread> pool;
+  for (unsigned w = 0; w < workers; ++w)
+    pool.emplace_back([&, w] {
+      try {
+        f(w);
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    });
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+struct BuiltTile {
+  std::uint64_t voxels = 0, bytes = 0;
+};
+
+}  // namespace
+
+TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
+                       Communicator& comm) {
+  const TileGrid& grid = options.grid;
+  grid.check();
+  if (options.output_dir.empty()) throw InvalidArgument("no output folder given (-o OUTDIR)");
+  if (options.memory_budget < (std::uint64_t{1} << 20))
+    throw InvalidArgument("--memory must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
+  const unsigned workers = resolve_threads(options.threads);
+  const int rank = comm.rank(), ranks = comm.size();
+  const bool talk = rank == 0 && static_cast<bool>(options.progress);
+
+  fs::create_directories(options.output_dir);
+  const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);
+  const fs::path spill_dir = spill_root / ("rank-" + std::to_string(rank) + "-" + std::to_string(::getpid()));
+  fs::create_directories(spill_dir);
+  struct RemoveDir {
+    fs::path dir;
+    ~RemoveDir() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } remove_spill{spill_dir};
+
+  // Every worker's buffers share 35% of the budget: sorting a buffer needs as much
+  // again, and the chunk being read, the maps and the allocator take the rest.
+  const std::uint64_t limit_keys = options.memory_budget * 35 / 100 / workers / sizeof(Key);
+
+  // --- 1. Bucket: this rank's chunks, on all its threads.
+  std::vector<std::pair<const PointSource*, std::uint64_t>> chunks;  // global chunk g -> rank g % ranks
+  std::uint64_t global = 0;
+  for (const PointSource* s : sources)
+    for (std::uint64_t c = 0; c < s->chunk_count(); ++c, ++global)
+      if (static_cast<int>(global % static_cast<std::uint64_t>(ranks)) == rank) chunks.emplace_back(s, c);
+
+  std::vector<std::unique_ptr<SpillFile>> files;
+  for (unsigned w = 0; w <= workers; ++w)  // the last one takes runs received from other ranks
+    files.push_back(std::make_unique<SpillFile>((spill_dir / ("worker-" + std::to_string(w) + ".keys")).string()));
+  std::vector<std::unique_ptr<Bucketer>> bucketers;
+  for (unsigned w = 0; w < workers; ++w)
+    bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], w, limit_keys));
+
+  std::atomic<std::uint64_t> next_chunk{0}, chunks_done{0}, points_read{0};
+  std::mutex progress_mutex;
+  on_threads(workers, [&](unsigned w) {
+    std::vector<double> xyz;
+    for (std::uint64_t c; (c = next_chunk++) < chunks.size();) {
+      chunks[c].first->read_chunk(chunks[c].second, xyz);
+      points_read += xyz.size() / 3;
+      bucketers[w]->add(xyz);
+      const std::uint64_t done = ++chunks_done;
+      if (talk && w == 0) {
+        const std::lock_guard lock(progress_mutex);
+        options.progress("bucketing points", done, chunks.size());
+      }
+    }
+    bucketers[w]->flush();
+  });
+
+  StatMap stats;
+  RunMap runs;
+  std::uint64_t outside = 0;
+  TileSummary summary;
+  for (const auto& b : bucketers) {
+    for (const auto& [t, s] : b->stats()) stats[t].merge(s);
+    for (const auto& [t, r] : b->runs()) runs[t].insert(runs[t].end(), r.begin(), r.end());
+    outside += b->outside();
+    summary.spill_runs += b->run_count();
+  }
+  bucketers.clear();
+
+  // --- 2. Every rank learns every tile's statistics.
+  std::vector<std::uint8_t> mine;
+  put(mine, points_read.load());
+  put(mine, outside);
+  for (const auto& [t, s] : stats) {
+    put(mine, t);
+    put(mine, s.points);
+    put(mine, s.bbox);
+  }
+  StatMap all_stats;
+  for (const auto& message : comm.all_gather(mine)) {
+    std::size_t at = 0;
+    summary.points_in += take<std::uint64_t>(message, at);
+    summary.points_outside += take<std::uint64_t>(message, at);
+    while (at < message.size()) {
+      const auto t = take<TileIndex>(message, at);
+      TileStat s;
+      s.points = take<std::uint64_t>(message, at);
+      s.bbox = take<Box>(message, at);
+      all_stats[t].merge(s);
+    }
+  }
+  std::vector<TileIndex> tiles;
+  for (const auto& [t, s] : all_stats) tiles.push_back(t);
+  const auto owner = [ranks](std::size_t position) { return static_cast<int>(position % static_cast<std::size_t>(ranks)); };
+  const std::uint64_t per_worker = options.memory_budget / workers;
+  const auto merge_buffer = [&](std::size_t run_count) {
+    return static_cast<std::size_t>(std::clamp<std::uint64_t>(per_worker / 4 / sizeof(Key) / std::max<std::size_t>(run_count, 1),
+                                                              512, std::uint64_t{1} << 16));
+  };
+  std::vector<const SpillFile*> file_views;
+  for (const auto& f : files) file_views.push_back(f.get());
+
+  // --- 3. Exchange: each tile's keys go to its owner (one gather per tile, all ranks in step).
+  if (ranks > 1) {
+    const auto received = static_cast<std::uint32_t>(workers);
+    for (std::size_t p = 0; p < tiles.size(); ++p) {
+      const int root = owner(p);
+      std::vector<Key> keys;
+      if (root != rank) {
+        if (const auto it = runs.find(tiles[p]); it != runs.end()) {
+          keys = detail::merge_runs(it->second, file_views, merge_buffer(it->second.size()));
+          runs.erase(it);
+        }
+      }
+      auto gathered = comm.gather(root, keys);
+      if (root != rank) continue;
+      for (int r = 0; r < ranks; ++r)
+        if (r != rank && !gathered[r].empty())
+          runs[tiles[p]].push_back(Run{received, files[received]->append(gathered[r]), gathered[r].size()});
+      if (talk) options.progress("exchanging tiles", p + 1, tiles.size());
+    }
+  }
+  for (const auto& f : files) summary.spill_bytes += f->size();
+
+  // --- 4. Build and write this rank's tiles.
+  std::vector<std::size_t> owned;
+  for (std::size_t p = 0; p < tiles.size(); ++p)
+    if (owner(p) == rank) owned.push_back(p);
+  const detail::TileGeoref georef(options.epsg, options.crs_wkt);
+  std::vector<BuiltTile> built(tiles.size());
+  std::atomic<std::size_t> next_tile{0}, tiles_done{0};
+  on_threads(workers, [&](unsigned w) {
+    for (std::size_t n; (n = next_tile++) < owned.size();) {
+      const std::size_t p = owned[n];
+      const TileIndex& t = tiles[p];
+      std::vector<Key> keys;
+      if (const auto it = runs.find(t); it != runs.end()) {
+        std::uint64_t total = 0;
+        for (const Run& r : it->second) total += r.count;
+        if (it->second.size() == 1 || 2 * total * sizeof(Key) > per_worker) {
+          keys = detail::merge_runs(it->second, file_views, merge_buffer(it->second.size()));
+        } else {  // fits twice over: one read and a radix sort beat a k-way merge
+          keys.resize(total);
+          std::size_t at = 0;
+          for (const Run& r : it->second) {
+            files[r.file]->read(r.offset, std::span<Key>(keys.data() + at, r.count));
+            at += r.count;
+          }
+          sort_unique(keys, grid.depth);
+        }
+      }
+      Tree tree = build_from_sorted_keys(keys, grid.depth);
+      std::vector<Key>().swap(keys);
+      tree.set_frame(grid.tile_frame(t));
+      georef.apply(tree, all_stats.at(t).bbox);
+      const std::string path = (fs::path(options.output_dir) / tile_file_name(t)).string();
+      write(tree, path);
+      built[p] = {tree.voxel_count(), static_cast<std::uint64_t>(fs::file_size(path))};
+      const std::size_t done = ++tiles_done;
+      if (talk && w == 0) {
+        const std::lock_guard lock(progress_mutex);
+        options.progress("writing tiles", done, owned.size());
+      }
+    }
+  });
+  files.clear();  // the spill files go as soon as the tiles are written
+
+  // Every rank learns every tile's voxel count and size.
+  std::vector<std::uint8_t> results;
+  for (const std::size_t p : owned) {
+    put(results, static_cast<std::uint64_t>(p));
+    put(results, built[p]);
+  }
+  for (const auto& message : comm.all_gather(results)) {
+    std::size_t at = 0;
+    while (at < message.size()) {
+      const auto p = take<std::uint64_t>(message, at);
+      if (p >= built.size()) throw Error("tile result message names an unknown tile");
+      built[p] = take<BuiltTile>(message, at);
+    }
+  }
+
+  TileIndexFile index;
+  index.grid = grid;
+  index.epsg = options.epsg;
+  index.crs_wkt = options.crs_wkt;
+  index.points_in = summary.points_in;
+  index.points_outside = summary.points_outside;
+  for (std::size_t p = 0; p < tiles.size(); ++p) {
+    TileEntry e;
+    e.tile = tiles[p];
+    e.file = tile_file_name(tiles[p]);
+    e.points = all_stats[tiles[p]].points;
+    e.voxels = built[p].voxels;
+    e.bytes = built[p].bytes;
+    e.bbox = all_stats[tiles[p]].bbox;
+    summary.voxels += e.voxels;
+    summary.tile_bytes += e.bytes;
+    index.tiles.push_back(std::move(e));
+  }
+  summary.tiles = tiles.size();
+
+  // --- 5. The overview pyramid, level by level (each level reads the one below).
+  if (options.overviews) {
+    comm.barrier();  // every rank's tiles are on disk
+    const OverviewContext context{grid, options.output_dir, georef, workers};
+    index.overviews = build_overviews(index.tiles, context, comm, options.progress);
+    summary.overview_files = index.overviews.size();
+  }
+
+  if (rank == 0) {
+    summary.index_path = (fs::path(options.output_dir) / kIndexFileName).string();
+    write_tile_index(index, summary.index_path);
+  }
+  comm.barrier();
+  return summary;
+}
+
+}  // namespace vola::tile

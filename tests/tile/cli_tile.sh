@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# vola tile end to end on the Autzen survey: the same bytes for 1 and 2 threads, a tiny
+# memory budget and (with mpirun) 3 ranks; the index; queries through the index (get,
+# render, plan) open only the tiles they need; errors for mixed CRSs and bad options.
+# Usage: cli_tile.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
+set -euo pipefail
+vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
+data=${data:-$2}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+las=$data/las/pdal_autzen_trim.las
+[ -f "$las" ] || skip "no $las (set VOLA_SHARED)"
+
+# Tiles of 256 ft at depth 4: voxels of 1 ft, 5 x 3 tiles over the survey.
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/one" --threads 1 > "$tmp/one.txt"
+grep -q '^tiles: ' "$tmp/one.txt" || fail "no summary: $(cat "$tmp/one.txt")"
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/two" --threads 2 --memory 1M --chunk-points 5000 -q
+diff -r "$tmp/one" "$tmp/two" > /dev/null || fail "2 threads, 1 MiB and small chunks give other bytes than 1 thread"
+
+index=$tmp/one/index.geojson
+python3 - "$index" "$las" <<'PY' || fail "index check"
+import json, sys
+index = json.load(open(sys.argv[1]))
+v = index["vola"]
+assert v["tiles"] == len(index["features"]) > 4, v["tiles"]
+assert v["points_in"] == 110000 and v["points_outside"] == 0, v
+assert sum(f["properties"]["points"] for f in index["features"]) == 110000
+assert v["crs_wkt"], "the survey's WKT travels into the index"
+for f in index["features"]:
+    ring = f["geometry"]["coordinates"][0]
+    assert len(ring) == 5 and ring[0] == ring[4]
+    assert abs(ring[1][0] - ring[0][0] - 256) < 1e-9
+assert len(v["overviews"]) >= 2 and v["overviews"][-1]["level"] >= 1
+PY
+ls "$tmp/one/overviews/L1/"*.vol > /dev/null || fail "no overview files"
+
+# get: the centre of a voxel of one tile, through the index, opens that tile only.
+first_tile=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['features'][0]['properties']['file'])" "$index")
+read -r x y z < <("$vola" coords "$tmp/one/$first_tile" 2> /dev/null | sed -n 2p)
+"$vola" get "$index" "$x" "$y" "$z" > "$tmp/get.txt"
+grep -q "^tile .*: $first_tile" "$tmp/get.txt" || fail "get: $(cat "$tmp/get.txt")"
+grep -q ": occupied$" "$tmp/get.txt" || fail "get: $(cat "$tmp/get.txt")"
+"$vola" get "$index" 0 0 0 | grep -q "not in the set" || fail "get far away"
+
+# render: rays cross the tiles; the image has hits.
+"$vola" render "$index" --size 160x120 -o "$tmp/view.png" > "$tmp/render.txt"
+grep -Eq "^view.png|rays hit" "$tmp/render.txt" || fail "render: $(cat "$tmp/render.txt")"
+hits=$(sed -n 's/.*: \([0-9]*\) of 19200 rays hit/\1/p' "$tmp/render.txt")
+[ "${hits:-0}" -gt 1000 ] || fail "render hit only ${hits:-0} of 19200 rays"
+[ -s "$tmp/view.png" ] && [ -s "$tmp/view_depth.png" ] || fail "render wrote no images"
+
+# plan: 150 ft above the ground, across two tiles; opens only the tiles around the path.
+"$vola" plan "$index" --from 636100 849000 560 --to 636400 849100 560 --radius 2 --margin 20 -o "$tmp/path.csv" \
+  > "$tmp/plan.txt"
+grep -Eq "planning over [0-9]+ of [0-9]+ tiles" "$tmp/plan.txt" || fail "plan: $(cat "$tmp/plan.txt")"
+opened=$(sed -n 's/planning over \([0-9]*\) of \([0-9]*\) tiles.*/\1/p' "$tmp/plan.txt")
+total=$(sed -n 's/planning over \([0-9]*\) of \([0-9]*\) tiles.*/\2/p' "$tmp/plan.txt")
+[ "$opened" -lt "$total" ] || fail "plan opened $opened of $total tiles"
+[ "$(wc -l < "$tmp/path.csv")" -ge 3 ] || fail "plan wrote no path"
+
+# Errors: inputs that disagree on the CRS; a bad budget; no input.
+if "$vola" tile "$las" "$data/las/pdal_autzen-utm.las" --tile-size 256 --depth 4 -o "$tmp/mixed" 2> "$tmp/err.txt"; then
+  fail "mixed CRSs accepted"
+fi
+grep -q "disagree on the CRS" "$tmp/err.txt" || fail "mixed CRS message: $(cat "$tmp/err.txt")"
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/bad" --memory lots 2> "$tmp/err.txt" && fail "--memory lots accepted"
+grep -q -- "--memory 'lots'" "$tmp/err.txt" || fail "--memory message: $(cat "$tmp/err.txt")"
+"$vola" tile --tile-size 256 --depth 4 -o "$tmp/none" 2> "$tmp/err.txt" && fail "no input accepted"
+grep -q "no input" "$tmp/err.txt" || fail "no-input message: $(cat "$tmp/err.txt")"
+
+# Many processes: 3 ranks (2 cores, so oversubscribed) write the same bytes.
+if ! command -v mpirun > /dev/null; then
+  skip "mpirun not installed (apt-get install openmpi-bin libopenmpi-dev)"
+fi
+export OMPI_MCA_btl_vader_single_copy_mechanism=none  # no ptrace between ranks in containers
+mpirun --allow-run-as-root --oversubscribe -np 3 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/mpi" \
+  --threads 1 --chunk-points 7000 -q || fail "mpirun -np 3 vola tile failed"
+diff -r "$tmp/one" "$tmp/mpi" > /dev/null || fail "3 MPI ranks give other bytes than one process"
+echo "cli_tile: OK"
