@@ -27,6 +27,7 @@ from ._vola import (
     FormatError,
     InvalidArgument,
     IoError,
+    TileSet,
     Tree,
     __version__,
     build,
@@ -36,6 +37,7 @@ from ._vola import (
     from_dense,
     input_formats,
     open_mapped,
+    open_tiles,
     parse,
     read,
 )
@@ -45,6 +47,7 @@ __all__ = [
     "FormatError",
     "InvalidArgument",
     "IoError",
+    "TileSet",
     "Tree",
     "__version__",
     "build",
@@ -55,6 +58,7 @@ __all__ = [
     "input_formats",
     "open",
     "open_mapped",
+    "open_tiles",
     "parse",
     "read",
 ]

@@ -6,6 +6,7 @@ from ._vola import (
     FormatError as FormatError,
     InvalidArgument as InvalidArgument,
     IoError as IoError,
+    TileSet as TileSet,
     Tree as Tree,
     __version__ as __version__,
     build as build,
@@ -15,6 +16,7 @@ from ._vola import (
     from_dense as from_dense,
     input_formats as input_formats,
     open_mapped as open_mapped,
+    open_tiles as open_tiles,
     parse as parse,
     read as read,
 )

@@ -75,13 +75,19 @@ class Bucketer {
         stat = &stats_[t];
         last = t;
       }
-      keys->push_back(key);
+      if (keys->size() == keys->capacity()) {  // the budget counts what the buffers hold, growth included
+        const std::size_t before = keys->capacity();
+        keys->push_back(key);
+        held_ += keys->capacity() - before;
+      } else {
+        keys->push_back(key);
+      }
       ++stat->points;
       for (int a = 0; a < 3; ++a) {
         stat->bbox.min[a] = std::min(stat->bbox.min[a], point[a]);
         stat->bbox.max[a] = std::max(stat->bbox.max[a], point[a]);
       }
-      if (++buffered_ >= limit_) {
+      if (held_ >= limit_) {
         flush();
         keys = nullptr;
       }
@@ -96,7 +102,7 @@ class Bucketer {
       ++run_count_;
       std::vector<Key>().swap(keys);  // give the memory back: the budget counts it
     }
-    buffered_ = 0;
+    held_ = 0;
   }
 
   const StatMap& stats() const noexcept { return stats_; }
@@ -109,7 +115,8 @@ class Bucketer {
   SpillFile& file_;
   std::uint32_t file_id_;
   std::uint64_t limit_;
-  std::uint64_t buffered_ = 0, outside_ = 0, run_count_ = 0;
+  std::uint64_t held_ = 0;  // keys the buffers have room for
+  std::uint64_t outside_ = 0, run_count_ = 0;
   std::map<TileIndex, std::vector<Key>> buckets_;
   StatMap stats_;
   RunMap runs_;
