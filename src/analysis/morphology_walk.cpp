@@ -28,8 +28,8 @@ constexpr std::uint64_t coordinate_below(int axis, int n) noexcept {
 }
 template <int Axis>
 constexpr std::array<std::uint64_t, 5> kBelowAlong = {coordinate_below(Axis, 0), coordinate_below(Axis, 1),
-                                                       coordinate_below(Axis, 2), coordinate_below(Axis, 3),
-                                                       coordinate_below(Axis, 4)};
+                                                      coordinate_below(Axis, 2), coordinate_below(Axis, 3),
+                                                      coordinate_below(Axis, 4)};
 constexpr std::array<std::array<std::uint64_t, 5>, 3> kBelow = {kBelowAlong<0>, kBelowAlong<1>, kBelowAlong<2>};
 constexpr unsigned kStride[3] = {1, 4, 16};
 
@@ -51,8 +51,7 @@ inline std::uint64_t pick(std::uint64_t lo, std::uint64_t hi, int axis, int s) n
 // `axis`, seen e voxels further on (e may be negative): voxel u of the result is voxel
 // u + e of the array. Reads a[i + floor(e/4) step] and, unless e is a multiple of 4, the
 // brick after it.
-inline std::uint64_t seen_at(const std::uint64_t* a, std::ptrdiff_t i, std::ptrdiff_t step, int axis,
-                             int e) noexcept {
+inline std::uint64_t seen_at(const std::uint64_t* a, std::ptrdiff_t i, std::ptrdiff_t step, int axis, int e) noexcept {
   const auto [q, s] = split(e);
   const std::uint64_t lo = a[i + q * step];
   return s == 0 ? lo : pick(lo, a[i + (q + 1) * step], axis, s);
@@ -98,19 +97,25 @@ class BrickKernel {
 
   void run(const std::uint64_t* in, std::uint64_t* out) {
     if (cube_) {
-      if (dilate_) cube<true>(in, out);
-      else cube<false>(in, out);
+      if (dilate_)
+        cube<true>(in, out);
+      else
+        cube<false>(in, out);
     } else {
-      if (dilate_) sphere<true>(in, out);
-      else sphere<false>(in, out);
+      if (dilate_)
+        sphere<true>(in, out);
+      else
+        sphere<false>(in, out);
     }
   }
 
  private:
   template <bool Dilate>
   static void combine(std::uint64_t& acc, std::uint64_t v) noexcept {
-    if constexpr (Dilate) acc |= v;
-    else acc &= v;
+    if constexpr (Dilate)
+      acc |= v;
+    else
+      acc &= v;
   }
 
   // The rows along x of the array, dilated or eroded by `reach` voxels, into along_x_
@@ -308,7 +313,8 @@ class Walk {
   static std::array<int, kMaxDepth> halves(int depth, int radius) {
     std::array<int, kMaxDepth> half{};
     half[static_cast<std::size_t>(depth - 1)] = ceil_quarter(radius);
-    for (int l = depth - 2; l >= 0; --l) half[static_cast<std::size_t>(l)] = ceil_quarter(half[static_cast<std::size_t>(l) + 1]);
+    for (int l = depth - 2; l >= 0; --l)
+      half[static_cast<std::size_t>(l)] = ceil_quarter(half[static_cast<std::size_t>(l) + 1]);
     return half;
   }
 
@@ -343,7 +349,8 @@ class Walk {
     const std::uint64_t* words = words_[level + 1].data();
     const std::uint64_t* first = first_child_[level + 1].data();
     const int m = w.side, h = cw.half;
-    const int cx = static_cast<int>(cell & 3u), cy = static_cast<int>((cell >> 2) & 3u), cz = static_cast<int>(cell >> 4);
+    const int cx = static_cast<int>(cell & 3u), cy = static_cast<int>((cell >> 2) & 3u),
+              cz = static_cast<int>(cell >> 4);
     std::size_t j = 0;
     for (int oz = -h; oz <= h; ++oz) {
       const int gz = 4 * w.half + cz + oz;
@@ -355,8 +362,8 @@ class Walk {
           const unsigned bit = static_cast<unsigned>((gx & 3) + 4 * (gy & 3) + 16 * (gz & 3));
           const std::uint64_t pw = w.word[p];
           if ((pw >> bit) & 1u) {
-            const std::uint64_t i = w.child[p] + static_cast<std::uint64_t>(
-                                                     std::popcount(pw & ((std::uint64_t{1} << bit) - 1)));
+            const std::uint64_t i =
+                w.child[p] + static_cast<std::uint64_t>(std::popcount(pw & ((std::uint64_t{1} << bit) - 1)));
             cw.word[j] = words[i];
             cw.child[j] = first[i];
           } else {
@@ -386,8 +393,8 @@ class Walk {
           while (wanted) {
             const auto b = static_cast<unsigned>(std::countr_zero(wanted));
             wanted &= wanted - 1;
-            const std::uint64_t i = w.child[p] + static_cast<std::uint64_t>(
-                                                     std::popcount(full & ((std::uint64_t{1} << b) - 1)));
+            const std::uint64_t i =
+                w.child[p] + static_cast<std::uint64_t>(std::popcount(full & ((std::uint64_t{1} << b) - 1)));
             const int x = ox + static_cast<int>(b & 3u), y = oy + static_cast<int>((b >> 2) & 3u),
                       z = oz + static_cast<int>(b >> 4);
             bricks_[static_cast<std::size_t>(x + n * (y + n * z))] = leaf_words[i];
