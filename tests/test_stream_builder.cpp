@@ -2,6 +2,7 @@
 // payloads, same attribute values, for random chunkings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "test_support.hpp"
@@ -101,6 +102,44 @@ TEST(StreamBuilder, PayloadsWithoutAttributes) {
             std::vector<std::uint64_t>(expected.words().begin(), expected.words().end()));
   EXPECT_EQ(std::vector<std::uint64_t>(got.voxel_payloads().begin(), got.voxel_payloads().end()),
             std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
+}
+
+// add_keys (occupancy from keys: sort of the varying bits only, dedupe, union of runs)
+// against the set of keys, for keys that share high bits, keys that differ in one bit,
+// all-equal chunks, single keys and empty chunks, at every depth.
+TEST(StreamBuilder, KeysEqualTheSetOfKeys) {
+  std::mt19937_64 rng(5);
+  for (int depth = 1; depth <= 10; ++depth) {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    const vola::Key limit = vola::Key{1} << (6 * depth);
+    vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, depth), {}, false);
+    std::vector<vola::Key> all;
+    for (int chunk = 0; chunk < 40; ++chunk) {
+      const std::size_t n = chunk % 7 == 0 ? chunk % 3 : 1 + rng() % 5000;
+      const vola::Key high = rng() % limit;
+      const int varying = static_cast<int>(rng() % (6 * depth + 1));  // bits that vary in this chunk
+      std::vector<vola::Key> keys(n);
+      for (auto& k : keys) {
+        k = varying == 0 ? high : (high & ~((vola::Key{1} << varying) - 1)) | (rng() % (vola::Key{1} << varying));
+        if (rng() % 4 == 0 && !all.empty()) k = all[rng() % all.size()];  // duplicates across chunks
+      }
+      all.insert(all.end(), keys.begin(), keys.end());
+      builder.add_keys(keys, chunk % 5);
+    }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    const vola::Tree got = builder.finish();
+    const vola::Tree want = vola::build_from_sorted_keys(all, depth);
+    EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+              std::vector<std::uint64_t>(want.words().begin(), want.words().end()));
+    EXPECT_EQ(builder.points_outside(), 40u / 5 * (0 + 1 + 2 + 3 + 4));
+  }
+  vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {}, false);
+  std::vector<vola::Key> too_large{vola::Key{1} << 12};
+  EXPECT_THROW(builder.add_keys(too_large), vola::InvalidArgument);
+  vola::StreamBuilder with_payload(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {}, true);
+  std::vector<vola::Key> one{1};
+  EXPECT_THROW(with_payload.add_keys(one), vola::InvalidArgument);
 }
 
 TEST(StreamBuilder, RefusesMismatchedArrays) {

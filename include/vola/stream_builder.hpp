@@ -43,6 +43,15 @@ class StreamBuilder {
   // when building payloads (else empty).
   void add(std::span<const double> xyz, std::span<const std::span<const double>> values,
            std::span<const std::uint64_t> payloads);
+  // Occupancy only (no attributes, no payloads): one chunk as voxel keys already
+  // quantized (any order, duplicates allowed, each below 2^(6 depth)); `outside` counts
+  // the chunk's points that fell outside the grid. The keys are sorted in place (their
+  // order afterwards is unspecified). Cheaper than add(): no coordinates, one sort of
+  // only the key bits that vary within the chunk, no allocation per chunk but the run.
+  void add_keys(std::span<Key> keys, std::uint64_t outside = 0);
+  // A buffer of n keys owned by the builder, reused from chunk to chunk (valid until the
+  // next call), to fill and hand to add_keys.
+  std::span<Key> key_scratch(std::size_t n);
   // All chunks added: the tree (frame set from the quantizer; georef left to the caller).
   Tree finish();
 

@@ -1,9 +1,17 @@
 #include "vola/stream_builder.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <limits>
+#include <memory>
+#include <new>
+#include <utility>
 
 #include "emit.hpp"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 #include "vola/error.hpp"
 
 namespace vola {
@@ -27,9 +35,124 @@ struct Partial {
   }
 };
 
+// Key buffers: resize() leaves new elements uninitialized (the sorts and merges write
+// every element; zeroing tens of megabytes first cost time), and a large buffer is
+// 2 MiB aligned and advised as transparent huge pages: touching fresh memory one 4 KiB
+// page at a time (a page fault each) took half of an occupancy conversion on a
+// virtual machine, and the runs are fresh memory at every merge.
+template <class T>
+struct KeyAllocator {
+  using value_type = T;
+  static constexpr std::size_t kHuge = std::size_t{2} << 20;
+  KeyAllocator() = default;
+  template <class U>
+  KeyAllocator(const KeyAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < 2 * kHuge) return static_cast<T*>(::operator new(bytes));
+    void* p = ::operator new(bytes, std::align_val_t{kHuge});
+#ifdef MADV_HUGEPAGE
+    ::madvise(p, bytes / kHuge * kHuge, MADV_HUGEPAGE);
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t n) noexcept {
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < 2 * kHuge) ::operator delete(p);
+    else ::operator delete(p, std::align_val_t{kHuge});
+  }
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+  friend bool operator==(const KeyAllocator&, const KeyAllocator&) noexcept { return true; }
+};
+using KeyVector = std::vector<Key, KeyAllocator<Key>>;
+
+// Sorts keys[0, n) (LSD radix over only the bits that vary among them, in digits of at
+// most 12 bits, a pass skipped when its digit is the same in every key) and removes
+// duplicates. `buffer` holds n keys; `counts` is scratch. Returns the sorted unique keys,
+// in keys or in buffer.
+std::span<const Key> sort_unique(Key* keys, Key* buffer, std::size_t n, std::vector<std::uint32_t>& counts) {
+  if (n == 0) return {};
+  const Key first = keys[0];
+  Key differ = 0;
+  for (std::size_t i = 0; i < n; ++i) differ |= keys[i] ^ first;
+  if (differ == 0) return {keys, 1};
+  const int low = std::countr_zero(differ), bits = static_cast<int>(std::bit_width(differ)) - low;
+  constexpr int kMaxDigit = 12;
+  const int passes = (bits + kMaxDigit - 1) / kMaxDigit;
+  const int digit = (bits + passes - 1) / passes;
+  const std::size_t buckets = std::size_t{1} << digit;
+  const Key mask = buckets - 1;
+  counts.assign(buckets * static_cast<std::size_t>(passes), 0);
+  std::uint32_t* count = counts.data();
+  if (passes == 1) {
+    for (std::size_t i = 0; i < n; ++i) ++count[(keys[i] >> low) & mask];
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Key k = keys[i] >> low;
+      for (int p = 0; p < passes; ++p) ++count[p * buckets + ((k >> (p * digit)) & mask)];
+    }
+  }
+  Key* from = keys;
+  Key* to = buffer;
+  for (int p = 0; p < passes; ++p) {
+    std::uint32_t* c = count + p * buckets;
+    const int shift = low + p * digit;
+    if (c[(from[0] >> shift) & mask] == n) continue;  // the same digit in every key
+    std::uint32_t offset = 0;
+    for (std::size_t b = 0; b < buckets; ++b) {
+      const std::uint32_t here = c[b];
+      c[b] = offset;
+      offset += here;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const Key k = from[i];
+      to[c[(k >> shift) & mask]++] = k;
+    }
+    std::swap(from, to);
+  }
+  std::size_t unique = 1;
+  for (std::size_t i = 1; i < n; ++i) {
+    const Key k = from[i];
+    from[unique] = k;
+    unique += k != from[unique - 1];
+  }
+  return {from, unique};
+}
+
+// Sorted unique a and b -> their sorted unique union.
+void unite_keys(std::span<const Key> a, std::span<const Key> b, KeyVector& out) {
+  out.resize(a.size() + b.size());
+  Key* o = out.data();
+  // Chunks of a survey often cover their own stretch of the key space: copy the parts
+  // that lie before the other run's first key at once.
+  if (!a.empty() && !b.empty() && b.front() < a.front()) std::swap(a, b);
+  std::size_t i = 0, j = 0;
+  if (!a.empty() && !b.empty()) {
+    i = static_cast<std::size_t>(std::lower_bound(a.begin(), a.end(), b.front()) - a.begin());
+    std::copy(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(i), o);
+    o += i;
+  }
+  while (i < a.size() && j < b.size()) {
+    const Key x = a[i], y = b[j];
+    *o++ = x < y ? x : y;
+    i += x <= y;
+    j += y <= x;
+  }
+  o = std::copy(a.begin() + static_cast<std::ptrdiff_t>(i), a.end(), o);
+  o = std::copy(b.begin() + static_cast<std::ptrdiff_t>(j), b.end(), o);
+  out.resize(static_cast<std::size_t>(o - out.data()));
+}
+
 // Sorted unique voxel keys with their partial reductions.
 struct Run {
-  std::vector<Key> keys;
+  KeyVector keys;
   std::vector<std::uint64_t> payloads;
   std::vector<Partial> partials;
 
@@ -137,10 +260,7 @@ Run empty_run(std::span<const AttributeSpec> specs) {
 Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload) {
   Run out = empty_run(specs);
   if (specs.empty() && !payload) {  // occupancy only: a plain sorted union
-    out.keys.resize(older.keys.size() + newer.keys.size());
-    const auto end = std::set_union(older.keys.begin(), older.keys.end(), newer.keys.begin(), newer.keys.end(),
-                                    out.keys.begin());
-    out.keys.resize(static_cast<std::size_t>(end - out.keys.begin()));
+    unite_keys(older.keys, newer.keys, out.keys);
     return out;
   }
   out.keys.reserve(older.keys.size() + newer.keys.size());
@@ -170,10 +290,82 @@ struct StreamBuilder::State {
   std::vector<Key> keys;
   std::vector<std::uint32_t> index;
   std::vector<std::uint32_t> starts;
+  KeyVector sort_buffer;
+  KeyVector chunk_keys;  // key_scratch()
+  std::vector<std::uint32_t> counts;
+
+  // Key vectors of merged-away runs, reused for new runs and merge outputs: fresh
+  // memory costs a page fault and the kernel's zeroing per page, which dominated the
+  // occupancy merges. At most kSpares are kept (the smallest go first).
+  std::vector<KeyVector> spare;
+  static constexpr std::size_t kSpares = 3;
+  KeyVector take(std::size_t n);
+  void give(KeyVector&& v);
+
+  void push(Run run);
+  void push_keys(std::span<Key> keys);
+  Run unite(Run& older, Run& newer);
 };
 
+KeyVector StreamBuilder::State::take(std::size_t n) {
+  std::size_t best = spare.size();
+  for (std::size_t i = 0; i < spare.size(); ++i)
+    if (spare[i].capacity() >= n && (best == spare.size() || spare[i].capacity() < spare[best].capacity())) best = i;
+  KeyVector v;
+  if (best < spare.size()) {
+    v = std::move(spare[best]);
+    spare.erase(spare.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  v.resize(n);  // uninitialized: KeyAllocator
+  return v;
+}
+
+void StreamBuilder::State::give(KeyVector&& v) {
+  if (v.capacity() == 0) return;
+  v.clear();
+  spare.push_back(std::move(v));
+  if (spare.size() > kSpares)
+    spare.erase(std::min_element(spare.begin(), spare.end(),
+                                 [](const KeyVector& a, const KeyVector& b) { return a.capacity() < b.capacity(); }));
+}
+
+// Occupancy only: the union of two runs, their key vectors given back for reuse.
+Run StreamBuilder::State::unite(Run& older, Run& newer) {
+  Run out;
+  out.keys = take(older.keys.size() + newer.keys.size());
+  unite_keys(older.keys, newer.keys, out.keys);
+  give(std::move(older.keys));
+  give(std::move(newer.keys));
+  return out;
+}
+
+void StreamBuilder::State::push_keys(std::span<Key> chunk) {
+  if (chunk.empty()) return;
+  if (sort_buffer.size() < chunk.size()) sort_buffer.resize(chunk.size());
+  const std::span<const Key> sorted = sort_unique(chunk.data(), sort_buffer.data(), chunk.size(), counts);
+  Run run;
+  run.keys = take(sorted.size());
+  std::copy(sorted.begin(), sorted.end(), run.keys.begin());
+  push(std::move(run));
+}
+
+// Binary-counter merging keeps O(log chunks) runs and merges each record O(log) times.
+void StreamBuilder::State::push(Run run) {
+  runs.push_back(std::move(run));
+  while (runs.size() >= 2 && runs[runs.size() - 2].keys.size() <= 2 * runs.back().keys.size()) {
+    Run merged = specs.empty() && !payload ? unite(runs[runs.size() - 2], runs.back())
+                                           : merge(runs[runs.size() - 2], runs.back(), specs, payload);
+    runs.pop_back();
+    runs.back() = std::move(merged);
+  }
+}
+
 StreamBuilder::StreamBuilder(const Quantizer& quantizer, std::vector<AttributeSpec> attributes, bool payload)
-    : state_(std::make_unique<State>(State{quantizer, std::move(attributes), payload, {}, 0, 0, {}, {}, {}})) {}
+    : state_(std::make_unique<State>()) {
+  state_->quantizer = quantizer;
+  state_->specs = std::move(attributes);
+  state_->payload = payload;
+}
 StreamBuilder::~StreamBuilder() = default;
 StreamBuilder::StreamBuilder(StreamBuilder&&) noexcept = default;
 StreamBuilder& StreamBuilder::operator=(StreamBuilder&&) noexcept = default;
@@ -213,12 +405,14 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
     s.keys.push_back(encode(v));
     if (per_point) s.index.push_back(static_cast<std::uint32_t>(i));
   }
-  radix_sort(s.keys, per_point ? &s.index : nullptr, 6 * s.quantizer.depth());
+  if (!per_point) {
+    s.push_keys(s.keys);
+    return;
+  }
+  radix_sort(s.keys, &s.index, 6 * s.quantizer.depth());
 
   Run run = empty_run(s.specs);
-  if (!per_point) {
-    run.keys.assign(s.keys.begin(), std::unique(s.keys.begin(), s.keys.end()));
-  } else {
+  {
     // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
     std::vector<std::uint32_t>& starts = s.starts;
     starts.clear();
@@ -266,18 +460,46 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
       }
     }
   }
-  s.runs.push_back(std::move(run));
-  // Binary-counter merging keeps O(log chunks) runs and merges each record O(log) times.
-  while (s.runs.size() >= 2 && s.runs[s.runs.size() - 2].keys.size() <= 2 * s.runs.back().keys.size()) {
-    Run merged = merge(s.runs[s.runs.size() - 2], s.runs.back(), s.specs, s.payload);
-    s.runs.pop_back();
-    s.runs.back() = std::move(merged);
-  }
+  s.push(std::move(run));
+}
+
+std::span<Key> StreamBuilder::key_scratch(std::size_t n) {
+  State& s = *state_;
+  if (s.chunk_keys.size() < n) s.chunk_keys.resize(n);
+  return {s.chunk_keys.data(), n};
+}
+
+void StreamBuilder::add_keys(std::span<Key> keys, std::uint64_t outside) {
+  State& s = *state_;
+  if (s.payload || !s.specs.empty())
+    VOLA_THROW(InvalidArgument("stream builder: add_keys is for occupancy only (no attributes, no payloads)"));
+  s.points_in += keys.size() + outside;
+  s.points_outside += outside;
+  if (keys.empty()) return;
+  Key all = 0;
+  for (const Key k : keys) all |= k;
+  if (all >> (6 * s.quantizer.depth()))
+    VOLA_THROW(InvalidArgument("stream builder: a key is too large for depth " + std::to_string(s.quantizer.depth())));
+  s.push_keys(keys);
 }
 
 Tree StreamBuilder::finish() {
   State& s = *state_;
   Run all = empty_run(s.specs);
+  if (s.specs.empty() && !s.payload && !s.runs.empty()) {
+    // Occupancy only: a union is exact in any order, so merge the smallest (newest)
+    // runs first: each key is then copied about twice, not once per run.
+    all = std::move(s.runs.back());
+    s.runs.pop_back();
+    while (!s.runs.empty()) {
+      all = s.unite(s.runs.back(), all);
+      s.runs.pop_back();
+    }
+  }
+  s.spare.clear();
+  s.spare.shrink_to_fit();
+  s.sort_buffer = KeyVector();
+  s.chunk_keys = KeyVector();
   for (auto& run : s.runs) {
     all = merge(all, run, s.specs, s.payload);
     run = Run{};
