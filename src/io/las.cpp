@@ -5,7 +5,13 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "vola/error.hpp"
 #include "vola/stream_builder.hpp"
@@ -80,31 +86,78 @@ void LasChunk::clear() {
 }
 
 LasReader::LasReader(const std::string& path) : path_(path) {
-  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
-  if (!*file) throw IoError(path + ": cannot open");
-  in_ = std::move(file);
+  // Mapped when possible: the point records are then read where the page cache holds
+  // them, with no copy (a read() per chunk cost ~12% of a conversion).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open");
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    const auto size = static_cast<std::size_t>(st.st_size);
+    void* p = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
+    if (p != MAP_FAILED) {
+      ::madvise(p, size, MADV_SEQUENTIAL);
+      mapping_ = std::shared_ptr<const void>(p, [size](const void* q) { ::munmap(const_cast<void*>(q), size); });
+      bytes_ = {static_cast<const std::uint8_t*>(p), size};
+    }
+  }
+  ::close(fd);
+  if (!mapping_) {
+    auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file) throw IoError(path + ": cannot open");
+    in_ = std::move(file);
+  }
   read_header();
 }
 
-LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& name) : path_(name) {
-  in_ = std::make_unique<std::istringstream>(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& name)
+    : path_(name), owned_(bytes.begin(), bytes.end()) {
+  bytes_ = owned_;
   read_header();
+}
+
+// size bytes at offset (checked by the caller to lie inside the file).
+void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) {
+  if (!in_) {
+    if (size) std::memcpy(out, bytes_.data() + offset, size);
+    return;
+  }
+  in_->clear();
+  in_->seekg(static_cast<std::streamoff>(offset));
+  in_->read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(size));
+  if (static_cast<std::uint64_t>(in_->gcount()) != size) throw FormatError(path_, offset, "cannot read");
+}
+
+// Mapped pages of records already handed out leave the resident set (the page cache
+// keeps them): without this a pass over a file larger than memory would count the
+// whole file as the process's memory.
+void LasReader::release_before(std::uint64_t offset, bool all) {
+  if (!mapping_) return;
+  constexpr std::uint64_t kPage = 4096;
+  const std::uint64_t end = all ? (bytes_.size() + kPage - 1) / kPage * kPage : offset / kPage * kPage;
+  if (end <= released_ || (!all && end - released_ < (std::uint64_t{16} << 20))) return;  // steps of >= 16 MiB
+  const auto* base = bytes_.data();
+  ::madvise(const_cast<std::uint8_t*>(base + released_), end - released_, MADV_DONTNEED);
+  released_ = end;
 }
 
 void LasReader::read_header() {
-  std::istream& in = *in_;
-  in.seekg(0, std::ios::end);
-  file_size_ = static_cast<std::uint64_t>(in.tellg());
-  in.seekg(0);
+  file_size_ = in_ ? 0 : bytes_.size();
+  if (in_) {
+    in_->seekg(0, std::ios::end);
+    file_size_ = static_cast<std::uint64_t>(in_->tellg());
+    in_->seekg(0);
+  }
   auto fail = [&](std::uint64_t offset, const std::string& cause) -> void { throw FormatError(path_, offset, cause); };
   auto read_at = [&](std::uint64_t offset, std::uint64_t size, const char* what) {
     if (offset > file_size_ || size > file_size_ - offset)
       fail(offset, std::string(what) + " of " + std::to_string(size) + " bytes runs past the end of the " +
                        std::to_string(file_size_) + "-byte file");
     std::vector<std::uint8_t> bytes(size);
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
-    if (static_cast<std::uint64_t>(in.gcount()) != size) fail(offset, std::string("cannot read ") + what);
+    try {
+      fetch(offset, size, bytes.data());
+    } catch (const FormatError&) {
+      fail(offset, std::string("cannot read ") + what);
+    }
     return bytes;
   };
 
@@ -242,7 +295,7 @@ void LasReader::read_header() {
                              std::to_string(hd.record_length));
     }
   }
-  in.seekg(hd.offset_to_points);
+  if (in_) in_->seekg(hd.offset_to_points);
 }
 
 std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
@@ -250,12 +303,18 @@ std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
   if (n == 0) return {};
   const std::size_t length = hd.record_length;
+  const std::uint64_t at = hd.offset_to_points + next_ * length;
+  if (!in_) {  // the header check guarantees the records lie inside the file
+    release_before(at);
+    next_ += n;
+    return bytes_.subspan(static_cast<std::size_t>(at), n * length);
+  }
   // resize() only grows the buffer after the first chunk: no zeroing per chunk.
   if (buffer_.size() < n * length) buffer_.resize(n * length);
-  in_->seekg(static_cast<std::streamoff>(hd.offset_to_points + next_ * length));
+  in_->seekg(static_cast<std::streamoff>(at));
   in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
   if (static_cast<std::size_t>(in_->gcount()) != n * length)
-    throw FormatError(path_, hd.offset_to_points + next_ * length, "cannot read the point records (truncated file)");
+    throw FormatError(path_, at, "cannot read the point records (truncated file)");
   next_ += n;
   return {buffer_.data(), n * length};
 }
@@ -394,8 +453,14 @@ void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::u
 
 void LasReader::rewind() {
   next_ = 0;
-  in_->clear();
-  in_->seekg(header_.offset_to_points);
+  if (mapping_) {
+    release_before(0, true);
+    released_ = 0;
+  }
+  if (in_) {
+    in_->clear();
+    in_->seekg(header_.offset_to_points);
+  }
 }
 
 PointCloud las_points(LasReader& reader, bool attributes, bool payload,
@@ -445,7 +510,8 @@ void decode_xyz(const LasHeader& hd, std::span<const std::uint8_t> records, std:
 // reverses it), so the extremes of the integers decode to the extremes of the
 // coordinates: no point is decoded. A scale or offset that is not finite could make
 // NaN, which the comparisons of the decoded path skip: such files take that path.
-Box las_bounds(LasReader& reader, std::size_t chunk_points, const std::function<void(std::uint64_t)>& progress) {
+Box las_bounds(LasReader& reader, std::size_t chunk_points, std::int32_t stored_lo[3], std::int32_t stored_hi[3],
+               const std::function<void(std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   constexpr double inf = std::numeric_limits<double>::infinity();
   Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
@@ -462,12 +528,14 @@ Box las_bounds(LasReader& reader, std::size_t chunk_points, const std::function<
     const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
     if (records.empty()) break;
     if (finite) {
-      for (const std::uint8_t* r = records.data(); r < records.data() + records.size(); r += length)
-        for (int a = 0; a < 3; ++a) {
-          const std::int32_t v = load<std::int32_t>(r + 4 * a);
-          lo[a] = std::min(lo[a], v);
-          hi[a] = std::max(hi[a], v);
-        }
+      std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+      for (const std::uint8_t* r = records.data(); r < records.data() + records.size(); r += length) {
+        const std::int32_t x = load<std::int32_t>(r), y = load<std::int32_t>(r + 4), z = load<std::int32_t>(r + 8);
+        l0 = std::min(l0, x), h0 = std::max(h0, x);
+        l1 = std::min(l1, y), h1 = std::max(h1, y);
+        l2 = std::min(l2, z), h2 = std::max(h2, z);
+      }
+      lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
     } else {
       decode_xyz(hd, records, xyz);
       for (std::size_t i = 0; i < xyz.size(); ++i) {
@@ -480,12 +548,253 @@ Box las_bounds(LasReader& reader, std::size_t chunk_points, const std::function<
   if (reader.points_read() == 0) return Box{};
   if (finite)
     for (int a = 0; a < 3; ++a) {
+      stored_lo[a] = lo[a];
+      stored_hi[a] = hi[a];
       const double from_lo = static_cast<double>(lo[a]) * hd.scale[a] + hd.offset[a];
       const double from_hi = static_cast<double>(hi[a]) * hd.scale[a] + hd.offset[a];
       box.min[a] = std::min(from_lo, from_hi);
       box.max[a] = std::max(from_lo, from_hi);
     }
   return box;
+}
+
+// The stored integer of one axis -> its voxel's key bits, exactly as decoding the
+// coordinate (x * scale + offset, as decode_xyz does) and quantizing it
+// (Quantizer::to_voxel) would give, without either per point. Both steps are
+// monotonic in the stored integer x (for a positive scale: rounding keeps the order),
+// so the cells form runs of consecutive integers: `lower[i]` is the smallest stored
+// integer of cell i, found once per cell with the exact decode + to_voxel. Per point,
+// one multiply guesses the cell and one or two comparisons correct the guess.
+class AxisCells {
+ public:
+  static constexpr Key kOutside = Key{1} << 63;
+  // Cells in [lo, hi], the stored integers of this axis that can occur. False (use the
+  // decoded path) when the mapping is not monotonic non-decreasing and finite, or the
+  // range spans too many cells for a table.
+  bool build(const LasHeader& hd, const Quantizer& quantizer, int axis, std::int64_t lo, std::int64_t hi) {
+    const double scale = hd.scale[axis], offset = hd.offset[axis];
+    if (!(scale > 0.0) || !std::isfinite(scale) || !std::isfinite(offset)) return false;
+    axis_ = axis;
+    hd_ = &hd;
+    quantizer_ = &quantizer;
+    // The other axes at a point known to be inside, so to_voxel speaks of this axis only.
+    inside_ = quantizer.center(Voxel{0, 0, 0});
+    Voxel v;
+    if (!quantizer.to_voxel(inside_, v) || v != Voxel{0, 0, 0}) return false;
+    side_ = side_of(quantizer.depth());
+    origin_ = quantizer.frame().origin[axis];
+    if (!std::isfinite(decode(lo)) || !std::isfinite(decode(hi))) return false;
+    const std::int64_t first = cell(lo), last = cell(hi);
+    if (first > last || last - first >= kMaxCells) return false;
+    const std::size_t cells = static_cast<std::size_t>(last - first + 1);
+    lower_.assign(cells + 1, 0);
+    key_.assign(cells, 0);
+    lower_[0] = std::numeric_limits<std::int64_t>::min();
+    lower_[cells] = std::numeric_limits<std::int64_t>::max();
+    std::int64_t from = lo, width = 0;
+    for (std::size_t i = 1; i < cells; ++i) {
+      const std::int64_t at = first_at_least(first + static_cast<std::int64_t>(i), from, hi, from + width);
+      if (i >= 2) width = at - from;
+      lower_[i] = from = at;
+    }
+    for (std::size_t i = 0; i < cells; ++i) {
+      const std::int64_t c = first + static_cast<std::int64_t>(i);
+      key_[i] = c < 0 || c >= side_ ? kOutside : detail::spread(static_cast<std::uint32_t>(c)) << (2 * axis);
+    }
+    // The guess: cell 1 starts at lower_[1], cells are (lower_[last] - lower_[1]) / (cells - 2) wide.
+    base_ = cells >= 2 ? lower_[1] : 0;
+    slope_ = cells >= 3 && lower_[cells - 1] > lower_[1]
+                 ? static_cast<double>(cells - 2) / static_cast<double>(lower_[cells - 1] - lower_[1])
+                 : 0.0;
+    last_ = static_cast<std::int64_t>(cells) - 1;
+    // Check the guess-and-correct lookup against the exact mapping at every border.
+    for (std::size_t i = 1; i < cells; ++i)
+      for (const std::int64_t x : {lower_[i] - 1, lower_[i]})
+        if (x >= lo && x <= hi && key(static_cast<std::int32_t>(x)) != exact_key(x)) return false;
+    return true;
+  }
+
+  // The table by value, for a hot loop (locals that no store can alias).
+  struct Lookup {
+    const std::int64_t* lower;
+    const Key* key;
+    std::int64_t base, last;
+    double slope;
+    Key operator()(std::int32_t x) const noexcept {
+      std::int64_t i = 1 + static_cast<std::int64_t>(static_cast<double>(x - base) * slope);
+      i = std::clamp<std::int64_t>(i, 0, last);
+      while (x < lower[i]) --i;
+      while (x >= lower[i + 1]) ++i;
+      return key[i];
+    }
+  };
+  Lookup lookup() const noexcept { return {lower_.data(), key_.data(), base_, last_, slope_}; }
+  Key key(std::int32_t x) const noexcept { return lookup()(x); }
+
+ private:
+  static constexpr std::int64_t kMaxCells = std::int64_t{1} << 21;
+
+  double decode(std::int64_t x) const noexcept {
+    return static_cast<double>(static_cast<std::int32_t>(x)) * hd_->scale[axis_] + hd_->offset[axis_];
+  }
+  // The cell of stored integer x: -1 below a grid, side above it.
+  std::int64_t cell(std::int64_t x) const noexcept {
+    Point p = inside_;
+    p[axis_] = decode(x);
+    Voxel v;
+    if (quantizer_->to_voxel(p, v)) return axis_ == 0 ? v.x : axis_ == 1 ? v.y : v.z;
+    return p[axis_] < origin_ ? -1 : static_cast<std::int64_t>(side_);
+  }
+  Key exact_key(std::int64_t x) const noexcept {
+    const std::int64_t c = cell(x);
+    return c < 0 || c >= side_ ? kOutside : detail::spread(static_cast<std::uint32_t>(c)) << (2 * axis_);
+  }
+  // The smallest x in [from, to] whose cell is at least c (cell(to) >= c, cell(from - 1) < c).
+  std::int64_t first_at_least(std::int64_t c, std::int64_t from, std::int64_t to, std::int64_t guess) const {
+    std::int64_t below = from - 1, above = to;  // cell(below) < c <= cell(above)
+    guess = std::clamp(guess, from, to);
+    std::int64_t step = 1;
+    if (cell(guess) >= c) {
+      above = guess;
+      while (above - step > below) {
+        if (cell(above - step) < c) {
+          below = above - step;
+          break;
+        }
+        above -= step;
+        step *= 2;
+      }
+    } else {
+      below = guess;
+      while (below + step < above) {
+        if (cell(below + step) >= c) {
+          above = below + step;
+          break;
+        }
+        below += step;
+        step *= 2;
+      }
+    }
+    while (above - below > 1) {
+      const std::int64_t mid = below + (above - below) / 2;
+      (cell(mid) >= c ? above : below) = mid;
+    }
+    return above;
+  }
+
+  int axis_ = 0;
+  const LasHeader* hd_ = nullptr;
+  const Quantizer* quantizer_ = nullptr;
+  Point inside_{};
+  std::int64_t side_ = 0;
+  double origin_ = 0.0;
+  std::vector<std::int64_t> lower_;
+  std::vector<Key> key_;
+  std::int64_t base_ = 0, last_ = 0;
+  double slope_ = 0.0;
+};
+
+// One chunk of records -> voxel keys -> the builder. With kRange, also widens [lo, hi],
+// the range of stored integers per axis.
+template <bool kRange>
+void add_records(StreamBuilder& builder, std::span<const std::uint8_t> records, std::size_t length,
+                 const AxisCells (&cells)[3], std::int32_t lo[3], std::int32_t hi[3]) {
+  const std::size_t n = records.size() / length;
+  const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
+  Key* out = builder.key_scratch(n).data();
+  std::size_t kept = 0;
+  std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+  const std::uint8_t* r = records.data();
+  for (std::size_t i = 0; i < n; ++i, r += length) {
+    const std::int32_t x = load<std::int32_t>(r), y = load<std::int32_t>(r + 4), z = load<std::int32_t>(r + 8);
+    if constexpr (kRange) {
+      l0 = std::min(l0, x), h0 = std::max(h0, x);
+      l1 = std::min(l1, y), h1 = std::max(h1, y);
+      l2 = std::min(l2, z), h2 = std::max(h2, z);
+    }
+    const Key key = kx(x) | ky(y) | kz(z);
+    out[kept] = key;
+    kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+  }
+  if constexpr (kRange) lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
+  builder.add_keys(std::span<Key>(out, kept), n - kept);
+}
+
+// The box of the decoded coordinates from the range of stored integers (as las_bounds).
+Box decoded_box(const LasHeader& hd, const std::int32_t lo[3], const std::int32_t hi[3]) {
+  Box box;
+  for (int a = 0; a < 3; ++a) {
+    const double from_lo = static_cast<double>(lo[a]) * hd.scale[a] + hd.offset[a];
+    const double from_hi = static_cast<double>(hi[a]) * hd.scale[a] + hd.offset[a];
+    box.min[a] = std::min(from_lo, from_hi);
+    box.max[a] = std::max(from_lo, from_hi);
+  }
+  return box;
+}
+
+// Occupancy only, bbox not given: one pass instead of two. The grid is resolved from
+// the header's bounds and the points' bounds are taken on the way; when the grid the
+// points' bounds resolve to is the same grid (the usual case: a toolkit grid needs the
+// same box, a grid-mode one only the same origin, voxel size and depth), the tree is
+// what two passes would build. Otherwise nothing is returned and `bounds`, `lo`, `hi`
+// hold the points' bounds, so the caller needs only its second pass.
+std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& options, BuildReport* report,
+                                          const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                                          std::size_t chunk_points, std::optional<Box>& bounds, std::int32_t lo[3],
+                                          std::int32_t hi[3]) {
+  const LasHeader& hd = reader.header();
+  if (hd.point_count == 0) return std::nullopt;
+  const Box header_box{hd.min, hd.max};
+  for (int a = 0; a < 3; ++a)
+    if (!(std::isfinite(hd.min[a]) && std::isfinite(hd.max[a]) && hd.min[a] <= hd.max[a])) return std::nullopt;
+  BuildOptions guess = options;
+  guess.bbox = header_box;
+  std::optional<Quantizer> quantizer;
+  try {
+    quantizer = resolve_quantizer(header_box, guess);
+  } catch (const Error&) {
+    return std::nullopt;  // a header box no grid fits: the two-pass path says what is wrong
+  }
+  AxisCells cells[3];
+  for (int a = 0; a < 3; ++a)
+    if (!cells[a].build(hd, *quantizer, a, std::numeric_limits<std::int32_t>::min(),
+                        std::numeric_limits<std::int32_t>::max()))
+      return std::nullopt;
+  StreamBuilder builder(*quantizer, {}, false);
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<std::int32_t>::max();
+    hi[a] = std::numeric_limits<std::int32_t>::min();
+  }
+  reader.rewind();
+  while (true) {
+    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
+    if (records.empty()) break;
+    add_records<true>(builder, records, hd.record_length, cells, lo, hi);
+    if (progress) progress(reader.points_read(), hd.point_count);
+  }
+  const Box box = decoded_box(hd, lo, hi);
+  BuildOptions resolved = options;
+  resolved.bbox = box;
+  resolve_quantizer(box, resolved);
+  const bool same =
+      resolved.quantization == guess.quantization && resolved.depth == guess.depth &&
+      (resolved.quantization == Quantization::toolkit
+           ? box == header_box
+           : resolved.voxel_size == guess.voxel_size && *resolved.origin == *guess.origin);
+  if (!same) {
+    bounds = box;
+    return std::nullopt;
+  }
+  options = resolved;
+  Tree tree = builder.finish();
+  tree.georef().bbox = box;
+  tree.georef().epsg = options.epsg;
+  if (report) {
+    report->points_in = builder.points_in();
+    report->points_outside = builder.points_outside();
+    report->voxels = tree.voxel_count();
+  }
+  return tree;
 }
 
 }  // namespace
@@ -495,11 +804,28 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   if (chunk_points == 0) throw InvalidArgument("build_las: chunk_points must be positive");
   const LasHeader& hd = reader.header();
   LasChunk chunk;
+  const bool occupancy_only = !attributes && !payload;
+  std::int32_t stored_lo[3], stored_hi[3];
+  for (int a = 0; a < 3; ++a) {
+    stored_lo[a] = std::numeric_limits<std::int32_t>::min();
+    stored_hi[a] = std::numeric_limits<std::int32_t>::max();
+  }
+  if (occupancy_only && !options.bbox) {
+    std::optional<Box> bounds;
+    std::int32_t lo[3], hi[3];
+    if (std::optional<Tree> tree = occupancy_in_one_pass(reader, options, report, progress, chunk_points, bounds, lo, hi))
+      return std::move(*tree);
+    if (bounds) {  // the pass above took the points' bounds: only the second pass is left
+      options.bbox = bounds;
+      std::copy(lo, lo + 3, stored_lo);
+      std::copy(hi, hi + 3, stored_hi);
+    }
+  }
   const std::uint64_t passes = options.bbox ? 1 : 2;
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
     reader.rewind();
-    options.bbox = las_bounds(reader, chunk_points, [&](std::uint64_t done) {
+    options.bbox = las_bounds(reader, chunk_points, stored_lo, stored_hi, [&](std::uint64_t done) {
       if (progress) progress(done, passes * hd.point_count);
     });
   }
@@ -510,9 +836,20 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
   std::vector<double> xyz;  // occupancy only: coordinates decoded straight from the records
+  // Occupancy only: keys straight from the stored integers (AxisCells), over the range
+  // of stored integers the bounds pass saw (or any int32 when the bbox was given).
+  AxisCells cells[3];
+  bool by_table = occupancy_only && hd.point_count > 0;
+  for (int a = 0; a < 3 && by_table; ++a)
+    by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
   reader.rewind();
-  const bool occupancy_only = !attributes && !payload;
-  while (true) {
+  while (by_table) {
+    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
+    if (records.empty()) break;
+    add_records<false>(builder, records, hd.record_length, cells, stored_lo, stored_hi);
+    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+  }
+  while (!by_table) {
     if (occupancy_only) {
       const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
       if (records.empty()) break;

@@ -169,4 +169,51 @@ TEST(LasStream, NegativeScaleBoundsAsDecoded) {
   check_file([&] { return vola::io::LasReader(bytes, "negative_scale.las"); }, 333);
 }
 
+// x stored in steps of 0.5 while the toolkit grid at depth 6 and 7 has cells far
+// narrower: most cells hold no stored integer at all (the stored-integer -> key tables
+// of the occupancy path must skip them), and a grid voxel holds a few steps.
+TEST(LasStream, CoarseStoredStepsBuildAsTheWholeCloudDoes) {
+  const Bytes bytes = generated_las(20000, 13, 0.5);
+  check_file([&] { return vola::io::LasReader(bytes, "coarse.las"); }, 777);
+}
+
+// A header whose bounds are wider than the points' (stale): the one-pass occupancy
+// build guesses the grid from the header, finds that the points' bounds resolve to
+// another one, and must fall back to building on the points' bounds.
+TEST(LasStream, StaleHeaderBoundsBuildAsTheWholeCloudDoes) {
+  Bytes bytes = generated_las(8000, 14);
+  for (int a = 0; a < 3; ++a) {
+    double lo = 0, hi = 0;
+    std::memcpy(&hi, &bytes[179 + 16 * a], 8);
+    std::memcpy(&lo, &bytes[187 + 16 * a], 8);
+    hi += 7.3;
+    lo -= 11.1;
+    std::memcpy(&bytes[179 + 16 * a], &hi, 8);
+    std::memcpy(&bytes[187 + 16 * a], &lo, 8);
+  }
+  check_file([&] { return vola::io::LasReader(bytes, "stale.las"); }, 1500);
+}
+
+// Occupancy only with the header's bounds right: one pass over the records; stale: the
+// pass is redone on the points' bounds. (Passes counted as progress reports that end one.)
+TEST(LasStream, OccupancyTakesOnePassWhenTheHeaderBoundsAreRight) {
+  Bytes bytes = generated_las(5000, 15);
+  const auto passes = [&] {
+    vola::io::LasReader reader(bytes, "passes.las");
+    vola::BuildOptions options;
+    options.quantization = vola::Quantization::grid;
+    options.voxel_size = 2.0;
+    int ends = 0;
+    vola::io::build_las(reader, options, false, false, nullptr,
+                        [&](std::uint64_t done, std::uint64_t total) { ends += done == total; }, 1000);
+    return ends;
+  };
+  EXPECT_EQ(passes(), 1);
+  double hi = 0;
+  std::memcpy(&hi, &bytes[179], 8);
+  hi += 1000.0;  // another depth
+  std::memcpy(&bytes[179], &hi, 8);
+  EXPECT_EQ(passes(), 2);
+}
+
 }  // namespace

@@ -81,7 +81,9 @@ class LasReader {
   // `xyz_only`, only the coordinates are decoded.
   std::size_t read(LasChunk& chunk, std::size_t max_points, bool xyz_only = false);
   // Up to `max_points` undecoded point records, header().record_length bytes each (valid
-  // until the next read); empty at the end.
+  // until the next read); empty at the end. A file is memory-mapped, so these point into
+  // the page cache: no copy (records already handed out leave the process's resident
+  // set as the reader moves on, so a file larger than memory stays bounded).
   std::span<const std::uint8_t> read_records(std::size_t max_points);
   std::uint64_t points_read() const noexcept { return next_; }
   // Back to the first point (for a second pass).
@@ -90,8 +92,14 @@ class LasReader {
  private:
   std::string path_;
   void read_header();
+  void fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out);
+  void release_before(std::uint64_t offset, bool all = false);
 
-  std::unique_ptr<std::istream> in_;
+  std::unique_ptr<std::istream> in_;         // only for a file that cannot be mapped
+  std::shared_ptr<const void> mapping_;      // owns bytes_ when the file is mapped
+  std::vector<std::uint8_t> owned_;          // owns bytes_ for the in-memory constructor
+  std::span<const std::uint8_t> bytes_;      // the whole file (empty when streamed from in_)
+  std::uint64_t released_ = 0;               // mapped bytes before this were given back
   std::uint64_t file_size_ = 0;
   LasHeader header_;
   std::uint64_t next_ = 0;
