@@ -157,8 +157,10 @@ void run_tile(const TileArgs& a) {
     std::printf("spilled:        %llu runs, %llu bytes (rank 0 of %d)\n", static_cast<unsigned long long>(summary.spill_runs),
                 static_cast<unsigned long long>(summary.spill_bytes), comm->size());
     std::printf("index:          %s\n", summary.index_path.c_str());
-    std::printf("time:           %.2f s, %.2f M points/s\n", seconds,
-                seconds > 0 ? static_cast<double>(summary.points_in) / seconds / 1e6 : 0.0);
+    std::printf("time:           %.2f s, %.2f M points/s (rank 0: bucketing %.2f s, exchange %.2f s, tiles %.2f s, "
+                "overviews %.2f s)\n",
+                seconds, seconds > 0 ? static_cast<double>(summary.points_in) / seconds / 1e6 : 0.0,
+                summary.seconds_bucket, summary.seconds_exchange, summary.seconds_build, summary.seconds_overviews);
   } catch (const std::exception& e) {
     if (comm->size() == 1) throw;
     std::fprintf(stderr, "vola: rank %d: %s\n", comm->rank(), e.what());

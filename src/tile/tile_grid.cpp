@@ -6,22 +6,15 @@
 
 namespace vola::tile {
 
+Locator::Locator(const TileGrid& grid) noexcept
+    : origin_(grid.origin),
+      inverse_(1.0 / grid.voxel_size()),
+      limit_(std::ldexp(1.0, 31 + 2 * grid.depth)),
+      shift_(2 * grid.depth),
+      mask_((std::int64_t{1} << (2 * grid.depth)) - 1) {}
+
 bool TileGrid::locate(const Point& p, TileIndex& tile, Key& key) const noexcept {
-  const double inverse = 1.0 / voxel_size();
-  const int shift = 2 * depth;
-  std::int32_t t[3];
-  std::uint32_t local[3];
-  for (int a = 0; a < 3; ++a) {
-    const double g = std::floor((p[a] - origin[a]) * inverse);
-    // 2^31 tiles of 4^D voxels each way: beyond that the index does not fit.
-    if (!(std::abs(g) < std::ldexp(1.0, 31 + shift))) return false;
-    const auto global = static_cast<std::int64_t>(g);
-    t[a] = static_cast<std::int32_t>(global >> shift);  // arithmetic shift: floor division
-    local[a] = static_cast<std::uint32_t>(global & ((std::int64_t{1} << shift) - 1));
-  }
-  tile = TileIndex{t[0], t[1], t[2]};
-  key = encode(local[0], local[1], local[2]);
-  return true;
+  return Locator(*this).locate(p, tile, key);
 }
 
 Point TileGrid::tile_origin(const TileIndex& t) const noexcept {

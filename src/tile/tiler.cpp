@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -55,26 +57,21 @@ void sort_unique(std::vector<Key>& keys, int depth) {
 class Bucketer {
  public:
   Bucketer(const TileGrid& grid, SpillFile& file, std::uint32_t file_id, std::uint64_t limit_keys)
-      : grid_(grid), file_(file), file_id_(file_id), limit_(std::max<std::uint64_t>(limit_keys, 1024)) {}
+      : grid_(grid), locator_(grid), file_(file), file_id_(file_id), limit_(std::max<std::uint64_t>(limit_keys, 1024)) {}
 
   void add(const std::vector<double>& xyz) {
     const std::size_t n = xyz.size() / 3;
-    TileIndex last{};
-    std::vector<Key>* keys = nullptr;
-    TileStat* stat = nullptr;
     for (std::size_t p = 0; p < n; ++p) {
       const Point point{xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]};
       TileIndex t;
       Key key;
-      if (!grid_.locate(point, t, key)) {
+      if (!locator_.locate(point, t, key)) {
         ++outside_;
         continue;
       }
-      if (!keys || t != last) {  // points of a chunk mostly stay in one tile
-        keys = &buckets_[t];
-        stat = &stats_[t];
-        last = t;
-      }
+      Slot& slot = slot_of(t);
+      std::vector<Key>* keys = slot.keys;
+      TileStat* stat = slot.stat;
       if (keys->size() == keys->capacity()) {  // the budget counts what the buffers hold, growth included
         const std::size_t before = keys->capacity();
         keys->push_back(key);
@@ -87,10 +84,7 @@ class Bucketer {
         stat->bbox.min[a] = std::min(stat->bbox.min[a], point[a]);
         stat->bbox.max[a] = std::max(stat->bbox.max[a], point[a]);
       }
-      if (held_ >= limit_) {
-        flush();
-        keys = nullptr;
-      }
+      if (held_ >= limit_) flush();
     }
   }
 
@@ -111,7 +105,24 @@ class Bucketer {
   std::uint64_t run_count() const noexcept { return run_count_; }
 
  private:
+  // A direct-mapped cache in front of the maps: points come from a few tiles at a time,
+  // often interleaved, and a map lookup per point would cost more than placing it.
+  struct Slot {
+    TileIndex tile;
+    std::vector<Key>* keys = nullptr;
+    TileStat* stat = nullptr;
+  };
+  Slot& slot_of(const TileIndex& t) {
+    const auto h = (static_cast<std::uint32_t>(t.i) * 0x9E3779B1u) ^ (static_cast<std::uint32_t>(t.j) * 0x85EBCA77u) ^
+                   (static_cast<std::uint32_t>(t.k) * 0xC2B2AE3Du);
+    Slot& slot = cache_[(h >> 24) & (cache_.size() - 1)];
+    if (!slot.keys || slot.tile != t) slot = Slot{t, &buckets_[t], &stats_[t]};  // map nodes never move
+    return slot;
+  }
+
+  std::array<Slot, 64> cache_{};
   const TileGrid& grid_;
+  const Locator locator_;
   SpillFile& file_;
   std::uint32_t file_id_;
   std::uint64_t limit_;
@@ -141,6 +152,13 @@ unsigned resolve_threads(unsigned threads) {
   if (threads) return threads;
   const unsigned hw = std::thread::hardware_concurrency();
   return hw ? hw : 1;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point& mark) {
+  const auto now = std::chrono::steady_clock::now();
+  const double s = std::chrono::duration<double>(now - mark).count();
+  mark = now;
+  return s;
 }
 
 // Runs f(worker) on `workers` threads and rethrows the first error.
@@ -209,6 +227,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   for (unsigned w = 0; w < workers; ++w)
     bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], w, limit_keys));
 
+  auto mark = std::chrono::steady_clock::now();
   std::atomic<std::uint64_t> next_chunk{0}, chunks_done{0}, points_read{0};
   std::mutex progress_mutex;
   on_threads(workers, [&](unsigned w) {
@@ -237,6 +256,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     summary.spill_runs += b->run_count();
   }
   bucketers.clear();
+  summary.seconds_bucket = seconds_since(mark);
 
   // --- 2. Every rank learns every tile's statistics.
   std::vector<std::uint8_t> mine;
@@ -292,6 +312,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     }
   }
   for (const auto& f : files) summary.spill_bytes += f->size();
+  summary.seconds_exchange = seconds_since(mark);
 
   // --- 4. Build and write this rank's tiles.
   std::vector<std::size_t> owned;
@@ -308,16 +329,17 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
       if (const auto it = runs.find(t); it != runs.end()) {
         std::uint64_t total = 0;
         for (const Run& r : it->second) total += r.count;
-        if (it->second.size() == 1 || 2 * total * sizeof(Key) > per_worker) {
+        const bool one_run = it->second.size() == 1;  // already sorted and unique
+        if (!one_run && 2 * total * sizeof(Key) > per_worker) {
           keys = detail::merge_runs(it->second, file_views, merge_buffer(it->second.size()));
-        } else {  // fits twice over: one read and a radix sort beat a k-way merge
+        } else {  // one read (and for many runs a radix sort, which beats a k-way merge)
           keys.resize(total);
           std::size_t at = 0;
           for (const Run& r : it->second) {
             files[r.file]->read(r.offset, std::span<Key>(keys.data() + at, r.count));
             at += r.count;
           }
-          sort_unique(keys, grid.depth);
+          if (!one_run) sort_unique(keys, grid.depth);
         }
       }
       Tree tree = build_from_sorted_keys(keys, grid.depth);
@@ -335,6 +357,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     }
   });
   files.clear();  // the spill files go as soon as the tiles are written
+  summary.seconds_build = seconds_since(mark);
 
   // Every rank learns every tile's voxel count and size.
   std::vector<std::uint8_t> results;
@@ -377,6 +400,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     const OverviewContext context{grid, options.output_dir, georef, workers};
     index.overviews = build_overviews(index.tiles, context, comm, options.progress);
     summary.overview_files = index.overviews.size();
+    summary.seconds_overviews = seconds_since(mark);
   }
 
   if (rank == 0) {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <compare>
 #include <cstdint>
 #include <string>
@@ -37,6 +38,33 @@ struct TileGrid {
   Frame tile_frame(const TileIndex& t) const noexcept;
   // Throws InvalidArgument when the tile size, origin or depth cannot make a grid.
   void check() const;
+};
+
+// TileGrid::locate with its constants worked out once, for the per-point loop.
+class Locator {
+ public:
+  explicit Locator(const TileGrid& grid) noexcept;
+  bool locate(const Point& p, TileIndex& tile, Key& key) const noexcept {
+    std::int32_t t[3];
+    std::uint32_t local[3];
+    for (int a = 0; a < 3; ++a) {
+      const double g = std::floor((p[a] - origin_[a]) * inverse_);
+      // 2^31 tiles of 4^D voxels each way: beyond that the index does not fit (NaN fails too).
+      if (!(g > -limit_ && g < limit_)) return false;
+      const auto global = static_cast<std::int64_t>(g);
+      t[a] = static_cast<std::int32_t>(global >> shift_);  // arithmetic shift: floor division
+      local[a] = static_cast<std::uint32_t>(global & mask_);
+    }
+    tile = TileIndex{t[0], t[1], t[2]};
+    key = encode(local[0], local[1], local[2]);
+    return true;
+  }
+
+ private:
+  Point origin_;
+  double inverse_, limit_;
+  int shift_;
+  std::int64_t mask_;
 };
 
 // "tile_3_-2_0.vol"

@@ -54,6 +54,8 @@ struct TileSummary {
   std::uint64_t spill_runs = 0;       // this rank's
   std::uint64_t spill_bytes = 0;      // this rank's
   std::string index_path;
+  // Wall time of each step on this rank.
+  double seconds_bucket = 0, seconds_exchange = 0, seconds_build = 0, seconds_overviews = 0;
 };
 
 // Throws vola::Error on bad input or when the output cannot be written. Every rank of
