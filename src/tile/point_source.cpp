@@ -75,6 +75,13 @@ class LasPoints final : public PointSource {
       out[1] = v[1] * s[1] + o[1];
       out[2] = v[2] * s[2] + o[2];
     }
+    // Done with these pages: drop them from this process (the page cache keeps them), so
+    // that resident memory stays within the budget however large the file. A page shared
+    // with a neighbouring chunk is simply read back in from the cache if still needed.
+    const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto begin = reinterpret_cast<std::uintptr_t>(data_ + header_.offset_to_points + first * length) & ~(page - 1);
+    const auto end = reinterpret_cast<std::uintptr_t>(record) & ~(page - 1);
+    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
   }
 
  private:
