@@ -112,6 +112,8 @@ TileIndexFile read_tile_index(const std::string& path) {
     root = json::parse(in);
   } catch (const json::parse_error& e) {
     throw FormatError(path, e.byte, std::string("not valid JSON: ") + e.what());
+  } catch (const json::exception& e) {  // e.g. a number too large for a double
+    throw FormatError(path, 0, std::string("not valid JSON: ") + e.what());
   }
   if (!root.is_object() || !root.contains("vola") || !root["vola"].is_object())
     bad(path, "no \"vola\" member (write one with vola tile)");

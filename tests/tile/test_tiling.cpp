@@ -357,3 +357,44 @@ TEST(PointSource, LasChunksDecodeLikeTheReader) {
 }
 
 }  // namespace
+
+namespace {
+
+// The index is outside bytes too: random byte flips, cuts and insertions of a real index
+// must give a tile set or a vola::Error, never a crash or another exception.
+TEST(TileIndex, MutatedIndexesFailCleanly) {
+  vola_test::TempDir dir;
+  const PointsInMemory points(3000, 1, 6);
+  const tile::TileOptions o = small_grid(dir / "t");
+  auto comm = tile::single_process();
+  tile::make_tiles({&points}, o, *comm);
+  const std::vector<std::uint8_t> original = bytes_of(dir / "t" / "index.geojson");
+  std::mt19937_64 rng(11);
+  const std::string alphabet = "{}[]\",:0123456789.-eE truefalsnul\\";
+  int parsed = 0;
+  for (int m = 0; m < 3000; ++m) {
+    std::vector<std::uint8_t> bytes = original;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits && !bytes.empty(); ++e) {
+      const std::size_t at = rng() % bytes.size();
+      switch (rng() % 3) {
+        case 0: bytes[at] = static_cast<std::uint8_t>(alphabet[rng() % alphabet.size()]); break;
+        case 1: bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(at)); break;
+        default: bytes.resize(at); break;
+      }
+    }
+    const fs::path path = dir / "t" / "mutated.geojson";
+    vola_test::write_bytes(path, bytes);
+    try {
+      const tile::TileSet tiles(path.string());
+      tiles.locate({5.0, 5.0, 5.0});
+      ++parsed;
+    } catch (const Error&) {
+    } catch (const std::exception& e) {
+      FAIL() << "mutation " << m << ": not a vola::Error: " << e.what();
+    }
+  }
+  EXPECT_GT(parsed, 10) << "some mutations (inside numbers or names) still read";
+}
+
+}  // namespace
