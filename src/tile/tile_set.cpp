@@ -178,11 +178,23 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
   out.depth.assign(pixels, std::numeric_limits<double>::infinity());
   out.rgb.assign(pixels * 3, 0);
   std::atomic<std::uint64_t> hits{0};
+  // A tile that cannot be opened (missing, corrupt) fails the first ray that reaches
+  // it; the error is carried out of the worker threads and thrown here.
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  std::atomic<bool> failed{false};
   raycast::parallel_chunks(pixels, threads, [&](std::size_t begin, std::size_t end) {
     std::uint64_t local = 0;
-    for (std::size_t p = begin; p < end; ++p) {
-      const auto hit = tiles.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
-                                             static_cast<std::uint32_t>(p / camera.width)));
+    for (std::size_t p = begin; p < end && !failed; ++p) {
+      std::optional<TileHit> hit;
+      try {
+        hit = tiles.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
+                                    static_cast<std::uint32_t>(p / camera.width)));
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
       if (!hit) continue;
       ++local;
       out.depth[p] = hit->t;
@@ -191,6 +203,7 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
     }
     hits += local;
   });
+  if (error) std::rethrow_exception(error);
   out.hits = hits;
   return out;
 }

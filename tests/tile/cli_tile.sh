@@ -70,6 +70,16 @@ grep -q -- "--memory 'lots'" "$tmp/err.txt" || fail "--memory message: $(cat "$t
 "$vola" tile --tile-size 256 --depth 4 -o "$tmp/none" 2> "$tmp/err.txt" && fail "no input accepted"
 grep -q "no input" "$tmp/err.txt" || fail "no-input message: $(cat "$tmp/err.txt")"
 
+# A tile gone from the set: queries that need it say which file, and do not crash.
+cp -r "$tmp/one" "$tmp/broken"
+rm "$tmp/broken/$first_tile"
+"$vola" get "$tmp/broken/index.geojson" "$x" "$y" "$z" 2> "$tmp/err.txt" && fail "get on a missing tile succeeded"
+grep -q "$first_tile" "$tmp/err.txt" || fail "missing-tile message: $(cat "$tmp/err.txt")"
+status=0
+"$vola" render "$tmp/broken/index.geojson" --size 160x120 -o "$tmp/b.png" 2> "$tmp/err.txt" || status=$?
+[ "$status" = 1 ] || fail "render with a missing tile: exit $status, expected 1: $(cat "$tmp/err.txt")"
+grep -q "$first_tile" "$tmp/err.txt" || fail "render missing-tile message: $(cat "$tmp/err.txt")"
+
 # Many processes: 3 ranks (2 cores, so oversubscribed) write the same bytes.
 if ! command -v mpirun > /dev/null; then
   skip "mpirun not installed (apt-get install openmpi-bin libopenmpi-dev)"
