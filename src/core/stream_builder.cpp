@@ -296,11 +296,11 @@ struct StreamBuilder::State {
 
   // Key vectors of merged-away runs, reused for new runs and merge outputs: fresh
   // memory costs a page fault and the kernel's zeroing per page, which dominated the
-  // occupancy merges. At most kSpares are kept (the smallest go first).
+  // occupancy merges. The spares hold at most as many keys as the live runs (the
+  // smallest go first), so memory stays within twice the runs.
   std::vector<KeyVector> spare;
-  static constexpr std::size_t kSpares = 3;
   KeyVector take(std::size_t n);
-  void give(KeyVector&& v);
+  void give(KeyVector&& v, std::size_t also_live = 0);
 
   void push(Run run);
   void push_keys(std::span<Key> keys);
@@ -320,13 +320,20 @@ KeyVector StreamBuilder::State::take(std::size_t n) {
   return v;
 }
 
-void StreamBuilder::State::give(KeyVector&& v) {
+// also_live: keys of a run not yet in `runs` (a merge's output).
+void StreamBuilder::State::give(KeyVector&& v, std::size_t also_live) {
   if (v.capacity() == 0) return;
   v.clear();
   spare.push_back(std::move(v));
-  if (spare.size() > kSpares)
-    spare.erase(std::min_element(spare.begin(), spare.end(),
-                                 [](const KeyVector& a, const KeyVector& b) { return a.capacity() < b.capacity(); }));
+  std::size_t live = also_live, kept = 0;
+  for (const Run& run : runs) live += run.keys.capacity();
+  for (const KeyVector& k : spare) kept += k.capacity();
+  while (kept > live && !spare.empty()) {
+    const auto smallest = std::min_element(
+        spare.begin(), spare.end(), [](const KeyVector& a, const KeyVector& b) { return a.capacity() < b.capacity(); });
+    kept -= smallest->capacity();
+    spare.erase(smallest);
+  }
 }
 
 // Occupancy only: the union of two runs, their key vectors given back for reuse.
@@ -334,8 +341,8 @@ Run StreamBuilder::State::unite(Run& older, Run& newer) {
   Run out;
   out.keys = take(older.keys.size() + newer.keys.size());
   unite_keys(older.keys, newer.keys, out.keys);
-  give(std::move(older.keys));
-  give(std::move(newer.keys));
+  give(std::move(older.keys), out.keys.capacity());
+  give(std::move(newer.keys), out.keys.capacity());
   return out;
 }
 
@@ -486,6 +493,11 @@ void StreamBuilder::add_keys(std::span<Key> keys, std::uint64_t outside) {
 Tree StreamBuilder::finish() {
   State& s = *state_;
   Run all = empty_run(s.specs);
+  // The final unions' outputs outgrow every spare: give the memory back first.
+  s.spare.clear();
+  s.spare.shrink_to_fit();
+  s.sort_buffer = KeyVector();
+  s.chunk_keys = KeyVector();
   if (s.specs.empty() && !s.payload && !s.runs.empty()) {
     // Occupancy only: a union is exact in any order, so merge the smallest (newest)
     // runs first: each key is then copied about twice, not once per run.
@@ -494,12 +506,9 @@ Tree StreamBuilder::finish() {
     while (!s.runs.empty()) {
       all = s.unite(s.runs.back(), all);
       s.runs.pop_back();
+      s.spare.clear();
     }
   }
-  s.spare.clear();
-  s.spare.shrink_to_fit();
-  s.sort_buffer = KeyVector();
-  s.chunk_keys = KeyVector();
   for (auto& run : s.runs) {
     all = merge(all, run, s.specs, s.payload);
     run = Run{};

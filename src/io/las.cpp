@@ -771,6 +771,14 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
     if (records.empty()) break;
     add_records<true>(builder, records, hd.record_length, cells, lo, hi);
     if (progress) progress(reader.points_read(), hd.point_count);
+    // A point well outside the header's box: the header is stale, stop guessing at once.
+    // (Writers that round the header's bounds differently from the stored integers put
+    // points a step or so outside it; the grid usually comes out the same.)
+    const Box so_far = decoded_box(hd, lo, hi);
+    for (int a = 0; a < 3; ++a) {
+      const double slack = 2.0 * hd.scale[a];
+      if (so_far.min[a] < header_box.min[a] - slack || so_far.max[a] > header_box.max[a] + slack) return std::nullopt;
+    }
   }
   const Box box = decoded_box(hd, lo, hi);
   BuildOptions resolved = options;
