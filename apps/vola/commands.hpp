@@ -29,4 +29,8 @@ void add_classify(CLI::App& app);  // classify and evaluate
 void add_collide(CLI::App& app);
 void add_tile(CLI::App& app);
 
+// vola-learn holds dataset, train, classify and evaluate (learn_launcher.cpp): vola execs
+// it for them (returns only when argv names none of them) and lists them in its help.
+void exec_learn_if_asked(int argc, char** argv);
+void add_learn_launchers(CLI::App& app);
 }  // namespace vola::cli

@@ -1,14 +1,15 @@
 // vola: the command-line tool. Each subcommand lives in its own file; errors from the
-// library become one line on stderr and exit status 1 (2 for usage errors).
+// library become one line on stderr and exit status 1 (2 for usage errors). The 3D CNN
+// subcommands run in vola-learn beside this binary (learn_launcher.cpp), so that no other
+// command pays for loading libtorch.
 #include <CLI/CLI.hpp>
-#include <cstdio>
-#include <exception>
 
 #include "commands.hpp"
-#include "vola/error.hpp"
+#include "run_app.hpp"
 #include "vola/version.hpp"
 
 int main(int argc, char** argv) {
+  vola::cli::exec_learn_if_asked(argc, argv);
   CLI::App app{
       "vola " VOLA_VERSION_STRING
       " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
@@ -43,24 +44,8 @@ int main(int argc, char** argv) {
   vola::cli::add_rgbd_generate(app);
   vola::cli::add_rgbd_eval(app);
   vola::cli::add_sonify(app);
-  vola::cli::add_dataset(app);
-  vola::cli::add_train(app);
-  vola::cli::add_classify(app);
+  vola::cli::add_learn_launchers(app);
   vola::cli::add_collide(app);
   vola::cli::add_tile(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  } catch (const vola::Error& e) {
-    std::fprintf(stderr, "vola: %s\n", e.what());
-    return 1;
-  } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "vola: out of memory\n");
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vola: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return vola::cli::run_app(app, argc, argv);
 }
