@@ -5,7 +5,7 @@
 # Usage: bench/tile_billion.sh VOLA OUTDIR [POINTS] [MEMORY] [THREADS]
 # Example: flock /tmp/vola-cpu.lock bench/tile_billion.sh build/apps/vola/vola /tmp/billion
 # Prints the tiler's summary, the wall time and the peak resident set size; the
-# baseline RSS of the vola binary alone (libtorch and the other libraries it maps) is
+# baseline RSS of the vola binary alone (the libraries it maps) is
 # printed too, so that what the run itself held can be told apart. Removes OUTDIR's
 # tiles at the end unless KEEP=1.
 set -euo pipefail
