@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -119,11 +120,11 @@ void write_images(const RenderArgs& a, const raycast::Rendering& image, const st
                 static_cast<unsigned long long>(image.hits), static_cast<unsigned long long>(width) * height);
 }
 
-// A tile set: world coordinates only; each tile is opened when a ray first reaches it.
-void render_tiles(const RenderArgs& a, raycast::PinholeCamera camera, std::uint32_t width, std::uint32_t height) {
-  if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
-  const tile::TileSet tiles(a.input);
-  if (a.camera.empty()) camera = default_camera(tiles);
+// Renders one frame, or --orbit N frames around the look-at point, with `draw`; writes the
+// images and prints the rays per second (then `note()`, when given).
+void render_frames(const RenderArgs& a, raycast::PinholeCamera camera, std::uint32_t width, std::uint32_t height,
+                   const std::function<raycast::Rendering(const raycast::PinholeCamera&)>& draw,
+                   const std::function<std::string()>& note = {}) {
   camera.up = {a.up[0], a.up[1], a.up[2]};
   camera.vertical_fov_degrees = a.fov;
   camera.width = width;
@@ -134,61 +135,44 @@ void render_tiles(const RenderArgs& a, raycast::PinholeCamera camera, std::uint3
   for (unsigned f = 0; f < frames; ++f) {
     const auto cam = a.orbit ? raycast::orbit(camera, f, frames) : camera;
     const auto start = std::chrono::steady_clock::now();
-    const raycast::Rendering image = tile::render(tiles, cam, a.threads);
+    const raycast::Rendering image = draw(cam);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     char frame_suffix[32];
     std::snprintf(frame_suffix, sizeof frame_suffix, "_%04u", f);
     write_images(a, image, a.orbit ? with_suffix(a.output, frame_suffix) : a.output, width, height);
   }
   if (a.quiet) return;
-  const double rays = static_cast<double>(width) * height * frames;
-  std::printf("%.0f rays in %.3f s: %.3f M rays/s, %.2f frames/s; %zu of %zu tiles opened\n", rays, seconds,
-              seconds > 0 ? rays / seconds / 1e6 : 0.0, seconds > 0 ? frames / seconds : 0.0, tiles.tiles_opened(),
-              tiles.index().tiles.size());
+  const std::uint64_t rays = std::uint64_t{width} * height * frames;
+  std::printf("%llu rays in %.3f s: %.3f M rays/s, %.2f frames/s%s\n", static_cast<unsigned long long>(rays), seconds,
+              seconds > 0 ? static_cast<double>(rays) / seconds / 1e6 : 0.0, seconds > 0 ? frames / seconds : 0.0,
+              note ? note().c_str() : "");
 }
 
 void run_render(const RenderArgs& a) {
   const auto [width, height] = parse_size(a.size);
-  if (tile::is_tile_index_path(a.input)) {
-    raycast::PinholeCamera camera;
-    if (!a.camera.empty()) {
-      camera.eye = {a.camera[0], a.camera[1], a.camera[2]};
-      camera.look_at = {a.camera[3], a.camera[4], a.camera[5]};
-    }
-    return render_tiles(a, camera, width, height);
-  }
-  const Tree tree = open_mapped(a.input);
   raycast::PinholeCamera camera;
-  if (a.camera.empty()) {
-    camera = default_camera(tree);
-  } else {
+  if (!a.camera.empty()) {
     camera.eye = {a.camera[0], a.camera[1], a.camera[2]};
     camera.look_at = {a.camera[3], a.camera[4], a.camera[5]};
-    if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   }
-  camera.up = {a.up[0], a.up[1], a.up[2]};
-  camera.vertical_fov_degrees = a.fov;
-  camera.width = width;
-  camera.height = height;
-  camera.check();
-
+  if (tile::is_tile_index_path(a.input)) {  // world coordinates; a tile opens when a ray first reaches it
+    if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
+    const tile::TileSet tiles(a.input);
+    if (a.camera.empty()) camera = default_camera(tiles);
+    render_frames(
+        a, camera, width, height, [&](const raycast::PinholeCamera& cam) { return tile::render(tiles, cam, a.threads); },
+        [&] {
+          return "; " + std::to_string(tiles.tiles_opened()) + " of " + std::to_string(tiles.index().tiles.size()) +
+                 " tiles opened";
+        });
+    return;
+  }
+  const Tree tree = open_mapped(a.input);
+  if (a.camera.empty()) camera = default_camera(tree);
+  else if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   const raycast::RayCaster caster(tree);
-  const unsigned frames = a.orbit ? a.orbit : 1;
-  std::uint64_t rays = 0;
-  double seconds = 0.0;
-  for (unsigned f = 0; f < frames; ++f) {
-    const auto cam = a.orbit ? raycast::orbit(camera, f, frames) : camera;
-    const auto start = std::chrono::steady_clock::now();
-    const raycast::Rendering image = raycast::render(caster, cam, a.threads);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    rays += std::uint64_t{width} * height;
-    char frame_suffix[32];
-    std::snprintf(frame_suffix, sizeof frame_suffix, "_%04u", f);
-    write_images(a, image, a.orbit ? with_suffix(a.output, frame_suffix) : a.output, width, height);
-  }
-  if (!a.quiet)
-    std::printf("%llu rays in %.3f s: %.3f M rays/s, %.2f frames/s\n", static_cast<unsigned long long>(rays), seconds,
-                seconds > 0 ? static_cast<double>(rays) / seconds / 1e6 : 0.0, seconds > 0 ? frames / seconds : 0.0);
+  render_frames(a, camera, width, height,
+                [&](const raycast::PinholeCamera& cam) { return raycast::render(caster, cam, a.threads); });
 }
 
 }  // namespace
