@@ -265,6 +265,12 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
       };
       std::vector<Sums> sums(chunks);
       const Eigen::Matrix3d rotation = estimate.linear();
+      // Updates rotate about the estimate's camera centre, then translate. About the
+      // world origin instead, a camera metres away couples every rotation with a large
+      // translation: the 6x6 system's conditioning (and the degeneracy test below) then
+      // depended on where the world frame happens to be, and a run started at a
+      // ground-truth pose 3 m from the origin was refused as degenerate from frame 139 on.
+      const Eigen::Vector3d centre = estimate.translation();
       parallel_chunks(current.height, params_.threads, [&](unsigned chunk, std::size_t begin, std::size_t end) {
         Sums& s = sums[chunk];
         for (std::size_t y = begin; y < end; ++y)
@@ -284,7 +290,7 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
             if (diff.squaredNorm() > params_.icp_max_distance * params_.icp_max_distance) continue;
             if (n.dot(nm) < cos_max) continue;
             Vec6 jac;
-            jac << p.cross(nm), nm;
+            jac << (p - centre).cross(nm), nm;
             const double r = nm.dot(diff);
             s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac);
             s.b -= jac * r;
@@ -308,7 +314,7 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
       Pose increment = Pose::Identity();
       const double angle = omega.norm();
       if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
-      increment.translation() = xi.tail<3>();
+      increment.translation() = centre + xi.tail<3>() - increment.linear() * centre;
       estimate = increment * estimate;
       if (xi.norm() < 1e-7) break;
     }
