@@ -694,6 +694,19 @@ class AxisCells {
   double slope_ = 0.0;
 };
 
+// The streamed tree with its bbox and EPSG code in the header, and what went into it.
+Tree finish_tree(StreamBuilder& builder, const Box& bbox, std::uint32_t epsg, BuildReport* report) {
+  Tree tree = builder.finish();
+  tree.georef().bbox = bbox;
+  tree.georef().epsg = epsg;
+  if (report) {
+    report->points_in = builder.points_in();
+    report->points_outside = builder.points_outside();
+    report->voxels = tree.voxel_count();
+  }
+  return tree;
+}
+
 // One chunk of records -> voxel keys -> the builder. With kRange, also widens [lo, hi],
 // the range of stored integers per axis.
 template <bool kRange>
@@ -794,15 +807,7 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
     return std::nullopt;
   }
   options = resolved;
-  Tree tree = builder.finish();
-  tree.georef().bbox = box;
-  tree.georef().epsg = options.epsg;
-  if (report) {
-    report->points_in = builder.points_in();
-    report->points_outside = builder.points_outside();
-    report->voxels = tree.voxel_count();
-  }
-  return tree;
+  return finish_tree(builder, box, options.epsg, report);
 }
 
 }  // namespace
@@ -872,15 +877,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
     }
     if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
   }
-  Tree tree = builder.finish();
-  tree.georef().bbox = *options.bbox;
-  tree.georef().epsg = options.epsg;
-  if (report) {
-    report->points_in = builder.points_in();
-    report->points_outside = builder.points_outside();
-    report->voxels = tree.voxel_count();
-  }
-  return tree;
+  return finish_tree(builder, *options.bbox, options.epsg, report);
 }
 
 }  // namespace vola::io
