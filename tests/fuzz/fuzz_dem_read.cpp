@@ -1,8 +1,9 @@
-// Fuzz entry point of the DEM reader through GDAL (io::read_dem): the first byte picks
-// the file kind (GeoTIFF or an Esri ASCII grid: modulo 2), the rest is the file, written
-// to a scratch file with that extension. Only vola::Error may escape; what parses must
-// account for every cell (valid + invalid = width x height, at most kMaxDemCells) with
-// finite heights, the lowest of them reported as the minimum.
+// Fuzz entry point of the DEM reader through GDAL (io::read_dem_with_gdal, what the GDAL
+// plugin runs, compiled into this program): the first byte picks the file kind (GeoTIFF
+// or an Esri ASCII grid: modulo 2), the rest is the file, written to a scratch file with
+// that extension. Only vola::Error may escape; what parses must account for every cell
+// (valid + invalid = width x height, at most kMaxDemCells) with finite heights, the
+// lowest of them reported as the minimum.
 //
 // Rasters above 2^20 cells are skipped: a few header bytes may claim up to
 // kMaxDemCells cells (a legitimately compressed raster can), which would make single
@@ -21,7 +22,7 @@
 #include "fuzz_seeds.hpp"
 #include "scratch_file.hpp"
 #include "vola/error.hpp"
-#include "vola/io/dem.hpp"
+#include "readers.hpp"  // src/io/plugins: the reader itself, not its plugin
 
 namespace vola_fuzz {
 Stats& stats() {
@@ -56,7 +57,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       vola_fuzz::scratch_file("dem", vola_fuzz::kDemExtensions[data[0] % 2], std::span(data + 1, size - 1));
   if (!small_enough(path)) return 0;
   try {
-    const vola::io::DemRaster dem = vola::io::read_dem(path);
+    const vola::io::DemRaster dem = vola::io::read_dem_with_gdal(path, {});
     const std::uint64_t cells = dem.cells.size();
     check(dem.width * dem.height <= vola::io::kMaxDemCells);
     check(cells + dem.invalid_cells == dem.width * dem.height);

@@ -1,7 +1,8 @@
-// Fuzz entry point of the mesh reader through Assimp (io::read_mesh_triangles): the
-// first byte picks the file kind (STL, OBJ, OFF, PLY, glTF: modulo 5), the rest is the
-// file, written to a scratch file with that extension. Only vola::Error may escape;
-// what parses must hold at least one and at most kMaxMeshTriangles triangles.
+// Fuzz entry point of the mesh reader through Assimp (io::read_mesh_with_assimp, what the
+// Assimp plugin runs, compiled into this program): the first byte picks the file kind
+// (STL, OBJ, OFF, PLY, glTF: modulo 5), the rest is the file, written to a scratch file
+// with that extension. Only vola::Error may escape; what parses must hold at least one
+// and at most kMaxMeshTriangles triangles.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -10,7 +11,7 @@
 #include "fuzz_seeds.hpp"
 #include "scratch_file.hpp"
 #include "vola/error.hpp"
-#include "vola/io/mesh.hpp"
+#include "readers.hpp"  // src/io/plugins: the reader itself, not its plugin
 
 namespace vola_fuzz {
 Stats& stats() {
@@ -27,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string path =
       vola_fuzz::scratch_file("mesh", vola_fuzz::kMeshExtensions[data[0] % 5], std::span(data + 1, size - 1));
   try {
-    const auto triangles = vola::io::read_mesh_triangles(path);
+    const auto triangles = vola::io::read_mesh_with_assimp(path);
     if (triangles.empty() || triangles.size() > vola::io::kMaxMeshTriangles) std::abort();
   } catch (const vola::Error&) {
     ++vola_fuzz::stats().refused;

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "../reader_plugin.hpp"
+#include "readers.hpp"
 #include "vola/io/dem.hpp"
 
 namespace vola::io {
@@ -58,7 +60,8 @@ void crs_of(const GDALDataset& dataset, DemRaster& dem) {
 
 }  // namespace
 
-DemRaster read_dem(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+DemRaster read_dem_with_gdal(const std::string& path,
+                             const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   static std::once_flag registered;
   std::call_once(registered, [] { GDALAllRegister(); });
   QuietGdalErrors quiet;
@@ -133,3 +136,13 @@ DemRaster read_dem(const std::string& path, const std::function<void(std::uint64
 }
 
 }  // namespace vola::io
+
+// The plugin's entry points (reader_plugin.hpp).
+extern "C" {
+const char* vola_plugin_version() { return vola::io::plugin::kPluginVersion; }
+void vola_plugin_read_dem(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                          vola::io::DemRaster& out, vola::io::plugin::PluginFailure& failure) {
+  vola::io::plugin::capture_failure(failure, [&] { out = vola::io::read_dem_with_gdal(path, progress); });
+}
+}
+static_assert(std::is_same_v<decltype(&vola_plugin_read_dem), vola::io::plugin::ReadDemEntry>);

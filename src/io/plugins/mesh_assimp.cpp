@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "../reader_plugin.hpp"
+#include "readers.hpp"
 #include "vola/io/mesh.hpp"
 
 namespace vola::io {
@@ -39,7 +41,7 @@ Point transform(const Matrix& m, const aiVector3D& v) {
 
 }  // namespace
 
-std::vector<Triangle> read_mesh_triangles(const std::string& path) {
+std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode) throw FormatError(path, std::nullopt, std::string("Assimp: ") + importer.GetErrorString());
@@ -95,3 +97,13 @@ std::vector<Triangle> read_mesh_triangles(const std::string& path) {
 }
 
 }  // namespace vola::io
+
+// The plugin's entry points (reader_plugin.hpp).
+extern "C" {
+const char* vola_plugin_version() { return vola::io::plugin::kPluginVersion; }
+void vola_plugin_read_mesh(const std::string& path, std::vector<vola::io::Triangle>& out,
+                           vola::io::plugin::PluginFailure& failure) {
+  vola::io::plugin::capture_failure(failure, [&] { out = vola::io::read_mesh_with_assimp(path); });
+}
+}
+static_assert(std::is_same_v<decltype(&vola_plugin_read_mesh), vola::io::plugin::ReadMeshEntry>);

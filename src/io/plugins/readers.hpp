@@ -1,0 +1,20 @@
+// The readers inside the plugins, as plain functions: what the plugins' entry points
+// run, and what the fuzz targets call directly (linked with GDAL or Assimp themselves).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vola/io/dem.hpp"
+#include "vola/io/input.hpp"
+
+namespace vola::io {
+
+// As read_dem (vola/io/dem.hpp), through GDAL in this process.
+DemRaster read_dem_with_gdal(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress);
+// As read_mesh_triangles (vola/io/mesh.hpp), through Assimp in this process.
+std::vector<Triangle> read_mesh_with_assimp(const std::string& path);
+
+}  // namespace vola::io
