@@ -140,7 +140,7 @@ constexpr const char* kModelFooter =
 
 void add_classify(CLI::App& app) {
   auto args = std::make_shared<ClassifyArgs>();
-  auto* classify = app.add_subcommand("classify", "Classify .vol objects with a 3D CNN (ModelNet10 classes)");
+  auto* classify = app.add_subcommand("classify", kClassifySummary);
   classify->footer(std::string(kModelFooter) +
                    "Prints the most likely class and its probability, then all ten probabilities.\n"
                    "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
@@ -150,7 +150,7 @@ void add_classify(CLI::App& app) {
   classify->callback([args] { run_classify(*args); });
 
   auto eargs = std::make_shared<ClassifyArgs>();
-  auto* evaluate = app.add_subcommand("evaluate", "Accuracy of a 3D CNN on a labelled dataset folder");
+  auto* evaluate = app.add_subcommand("evaluate", kEvaluateSummary);
   evaluate->footer(std::string(kModelFooter) +
                    "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
                    "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"

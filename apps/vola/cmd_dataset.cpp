@@ -112,7 +112,7 @@ void run_dataset(const DatasetArgs& a) {
 
 void add_dataset(CLI::App& app) {
   auto args = std::make_shared<DatasetArgs>();
-  auto* cmd = app.add_subcommand("dataset", "Make a 3D classification dataset of 64^3 VOLA files (ModelNet10 classes)");
+  auto* cmd = app.add_subcommand("dataset", kDatasetSummary);
   cmd->footer(
       "INPUT is an .npz holding X_<split> (N,S,S,S) 0/1 grids (S = 32, 16, ...) and y_<split> labels 0-9\n"
       "(bathtub bed chair desk dresser monitor night_stand sofa table toilet), or a mesh file (OFF, OBJ,\n"

@@ -134,7 +134,7 @@ void run_sonify(SonifyArgs& a) {
 
 void add_sonify(CLI::App& app) {
   auto args = std::make_shared<SonifyArgs>();
-  auto* cmd = app.add_subcommand("sonify", "Hear a scene: pass a dry recording through the scene's acoustics");
+  auto* cmd = app.add_subcommand("sonify", kSonifySummary);
   cmd->footer(
       "How it works (the VOLA paper's SonifEye): every occupied voxel with an empty 6-neighbour is a\n"
       "reflector. It reflects through each exposed face that both source and listener are in front of,\n"

@@ -116,7 +116,7 @@ void run_train(TrainArgs& a) {
 
 void add_train(CLI::App& app) {
   auto args = std::make_shared<TrainArgs>();
-  auto* cmd = app.add_subcommand("train", "Train a 3D CNN classifier on a `vola dataset` folder");
+  auto* cmd = app.add_subcommand("train", kTrainSummary);
   cmd->footer(
       "TRAIN is a folder of <class>/*.vol files, or a folder holding train/ and val/ (then val/ is the\n"
       "validation set). Architectures: small (VoxNet-like, 32^3 input read at half resolution from the\n"

@@ -37,7 +37,7 @@ void run_view(const ViewArgs& a) {
 
 void add_view(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
-  auto* cmd = app.add_subcommand("view", "Show .vol files in 3D in a web browser (a local page on 127.0.0.1)");
+  auto* cmd = app.add_subcommand("view", kViewSummary);
   cmd->footer(
       "The page streams each file level by level, coarse first, and draws voxels as cubes:\n"
       "orbit (left drag), pan (right drag), zoom (wheel); the detail slider picks the level;\n"

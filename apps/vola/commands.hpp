@@ -29,8 +29,18 @@ void add_classify(CLI::App& app);  // classify and evaluate
 void add_collide(CLI::App& app);
 void add_tile(CLI::App& app);
 
-// vola-learn holds dataset, train, classify and evaluate (learn_launcher.cpp): vola execs
-// it for them (returns only when argv names none of them) and lists them in its help.
-void exec_learn_if_asked(int argc, char** argv);
-void add_learn_launchers(CLI::App& app);
+// One-line summaries of the subcommands that run in companion executables, shared by the
+// companion (its --help) and vola (its list of subcommands).
+inline constexpr const char* kDatasetSummary = "Make a 3D classification dataset of 64^3 VOLA files (ModelNet10 classes)";
+inline constexpr const char* kTrainSummary = "Train a 3D CNN classifier on a `vola dataset` folder";
+inline constexpr const char* kClassifySummary = "Classify .vol objects with a 3D CNN (ModelNet10 classes)";
+inline constexpr const char* kEvaluateSummary = "Accuracy of a 3D CNN on a labelled dataset folder";
+inline constexpr const char* kViewSummary = "Show .vol files in 3D in a web browser (a local page on 127.0.0.1)";
+inline constexpr const char* kSonifySummary = "Hear a scene: pass a dry recording through the scene's acoustics";
+
+// vola-learn, vola-view and vola-sonify hold the subcommands above (companions.cpp): vola
+// execs the right one for them (returns only when argv names none of them) and lists
+// them in its help.
+void exec_companion_if_asked(int argc, char** argv);
+void add_companion_launchers(CLI::App& app);
 }  // namespace vola::cli

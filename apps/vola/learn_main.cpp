@@ -1,5 +1,6 @@
 // vola-learn: the 3D CNN subcommands of vola (libtorch). Users run them as `vola dataset`,
-// `vola train`, `vola classify`, `vola evaluate`; vola hands them over to this binary.
+// `vola train`, `vola classify`, `vola evaluate`; vola hands them over to this binary
+// (companions.cpp).
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"

@@ -1,7 +1,7 @@
 // vola: the command-line tool. Each subcommand lives in its own file; errors from the
 // library become one line on stderr and exit status 1 (2 for usage errors). The 3D CNN
-// subcommands run in vola-learn beside this binary (learn_launcher.cpp), so that no other
-// command pays for loading libtorch.
+// subcommands, view and sonify run in companion executables beside this binary
+// (companions.cpp), so that no other command pays for loading their libraries.
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
@@ -9,7 +9,7 @@
 #include "vola/version.hpp"
 
 int main(int argc, char** argv) {
-  vola::cli::exec_learn_if_asked(argc, argv);
+  vola::cli::exec_companion_if_asked(argc, argv);
   CLI::App app{
       "vola " VOLA_VERSION_STRING
       " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
@@ -39,12 +39,10 @@ int main(int argc, char** argv) {
   vola::cli::add_morph(app);
   vola::cli::add_render(app);
   vola::cli::add_plan(app);
-  vola::cli::add_view(app);
   vola::cli::add_fuse(app);
   vola::cli::add_rgbd_generate(app);
   vola::cli::add_rgbd_eval(app);
-  vola::cli::add_sonify(app);
-  vola::cli::add_learn_launchers(app);
+  vola::cli::add_companion_launchers(app);
   vola::cli::add_collide(app);
   vola::cli::add_tile(app);
   return vola::cli::run_app(app, argc, argv);
