@@ -16,7 +16,7 @@ assert vola.__file__.startswith(sys.argv[1]), vola.__file__
 tree = vola.build(np.array([[0.5, 0.5, 0.5], [7.5, 0.5, 0.5]]), voxel_size=1.0, origin=(0.0, 0.0, 0.0))
 assert tree.contains(np.array([[0, 0, 0], [7, 0, 0], [1, 0, 0]])).tolist() == [True, True, False]
 here = __import__("pathlib").Path(vola.__file__).parent
-for f in ("__init__.pyi", "_vola.pyi", "py.typed", "libvola_assimp.so", "libvola_gdal.so"):
+for f in ("__init__.pyi", "_vola.pyi", "py.typed", "libvola_assimp.so", "libvola_gdal.so", "libvola_proj.so"):
     assert (here / f).exists(), f
 # The mesh reader is a plugin: the installed one loads (VOLA_PLUGIN_DIR, set below, is
 # searched first) and reads an STL written here.

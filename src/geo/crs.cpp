@@ -1,106 +1,53 @@
+// vola/geo/crs.hpp over libvola_proj.so (proj_plugin.hpp), loaded the first time a CRS
+// is needed: a run that never transforms a coordinate never loads PROJ.
 #include "vola/geo/crs.hpp"
 
-#include <proj.h>
-
-#include <cmath>
-#include <memory>
-#include <string>
-
-#include "vola/error.hpp"
+#include "proj_plugin.hpp"
 
 namespace vola::geo {
 
 namespace {
-struct ContextDeleter {
-  void operator()(PJ_CONTEXT* c) const { proj_context_destroy(c); }
-};
-struct PjDeleter {
-  void operator()(PJ* p) const { proj_destroy(p); }
-};
-using Context = std::unique_ptr<PJ_CONTEXT, ContextDeleter>;
-using Pj = std::unique_ptr<PJ, PjDeleter>;
 
-Context make_context() {
-  Context ctx(proj_context_create());
-  if (!ctx) throw Error("PROJ: cannot create a context");
-  proj_log_level(ctx.get(), PJ_LOG_NONE);
-  return ctx;
+const plugin::ProjEntries& proj(const std::string& purpose) {
+  const auto entries = reinterpret_cast<plugin::ProjEntriesEntry>(
+      vola::plugin::plugin_symbol("proj", plugin::kProjEntriesSymbol, purpose));
+  return *entries();
 }
 
-std::string last_error(PJ_CONTEXT* ctx) {
-  const int code = proj_context_errno(ctx);
-  return code ? proj_context_errno_string(ctx, code) : "unknown error";
+// Calls one entry point and throws what it reports.
+template <class Call>
+void run(const std::string& purpose, Call&& call) {
+  plugin::PluginFailure failure;
+  call(proj(purpose), failure);
+  vola::plugin::throw_failure(failure);
 }
+
 }  // namespace
 
 std::pair<double, double> centre_lat_lon(std::uint32_t epsg, const Box& bbox) {
   return centre_lat_lon("EPSG:" + std::to_string(epsg), bbox);
 }
 
-std::pair<double, double> centre_lat_lon(const std::string& source, const Box& bbox) {
-  Context ctx = make_context();
-  Pj transform(proj_create_crs_to_crs(ctx.get(), source.c_str(), "EPSG:4326", nullptr));
-  if (!transform) throw Error("CRS " + source.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
-  Pj normalized(proj_normalize_for_visualization(ctx.get(), transform.get()));
-  if (!normalized) throw Error("PROJ cannot normalise the axis order of " + source);
-  const double cx = (bbox.min[0] + bbox.max[0]) / 2.0;
-  const double cy = (bbox.min[1] + bbox.max[1]) / 2.0;
-  const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, 0, 0));
-  if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
-    throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source.substr(0, 60) +
-                " to WGS84: " + last_error(ctx.get()));  // NOLINT
-  return {out.xy.y, out.xy.x};
+std::pair<double, double> centre_lat_lon(const std::string& crs, const Box& bbox) {
+  std::pair<double, double> lat_lon;
+  run("the latitude and longitude of a bounding box", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) {
+    p.centre_lat_lon(crs, bbox, lat_lon, f);
+  });
+  return lat_lon;
 }
 
 std::string crs_wkt(std::uint32_t epsg) {
-  Context ctx = make_context();
-  const std::string source = "EPSG:" + std::to_string(epsg);
-  Pj crs(proj_create(ctx.get(), source.c_str()));
-  if (!crs) throw Error("CRS " + source + " is not known to PROJ: " + last_error(ctx.get()));
-  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT2_2019, nullptr);
-  if (!wkt) throw Error("PROJ cannot write " + source + " as WKT");
+  std::string wkt;
+  run("the WKT of EPSG:" + std::to_string(epsg),
+      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.crs_wkt(epsg, wkt, f); });
   return wkt;
 }
 
 std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
-  Context ctx = make_context();
-  Pj crs(proj_create(ctx.get(), wkt.c_str()));
-  if (!crs) return std::nullopt;
-  // Down to the horizontal CRS: a TOWGS84 clause makes a bound CRS, a vertical part a
-  // compound one.
-  for (int guard = 0; crs && guard < 4; ++guard) {
-    const PJ_TYPE type = proj_get_type(crs.get());
-    if (type == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx.get(), crs.get()));
-    else if (type == PJ_TYPE_COMPOUND_CRS) crs.reset(proj_crs_get_sub_crs(ctx.get(), crs.get(), 0));
-    else break;
-  }
-  if (!crs) return std::nullopt;
-  auto to_code = [](const char* auth, const char* code) -> std::optional<std::uint32_t> {
-    if (!auth || !code || std::string(auth) != "EPSG") return std::nullopt;
-    try {
-      return static_cast<std::uint32_t>(std::stoul(code));
-    } catch (...) {
-      return std::nullopt;
-    }
-  };
-  if (auto c = to_code(proj_get_id_auth_name(crs.get(), 0), proj_get_id_code(crs.get(), 0))) return c;
-  int* confidence = nullptr;
-  PJ_OBJ_LIST* candidates = proj_identify(ctx.get(), crs.get(), "EPSG", nullptr, &confidence);
-  std::optional<std::uint32_t> best;
-  if (candidates) {
-    int best_confidence = 69;
-    for (int i = 0; i < proj_list_get_count(candidates); ++i) {
-      if (confidence[i] <= best_confidence) continue;
-      Pj candidate(proj_list_get(ctx.get(), candidates, i));
-      if (auto c = to_code(proj_get_id_auth_name(candidate.get(), 0), proj_get_id_code(candidate.get(), 0))) {
-        best = c;
-        best_confidence = confidence[i];
-      }
-    }
-    proj_int_list_destroy(confidence);
-    proj_list_destroy(candidates);
-  }
-  return best;
+  std::optional<std::uint32_t> epsg;
+  run("the EPSG code of a WKT CRS",
+      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.epsg_from_wkt(wkt, epsg, f); });
+  return epsg;
 }
 
 std::optional<std::string> crs_definition(const Georef& georef) {
@@ -110,31 +57,24 @@ std::optional<std::string> crs_definition(const Georef& georef) {
 }
 
 std::string crs_wkt1(const std::string& definition) {
-  Context ctx = make_context();
-  Pj crs(proj_create(ctx.get(), definition.c_str()));
-  if (!crs) throw Error("CRS " + definition.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
-  // One line: some LAS readers stop a WKT at its first newline.
-  const char* const options[] = {"MULTILINE=NO", nullptr};
-  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT1_GDAL, options);
-  if (!wkt) throw Error("PROJ cannot write " + definition.substr(0, 60) + " as WKT1");
+  std::string wkt;
+  run("a CRS as WKT1", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.crs_wkt1(definition, wkt, f); });
   return wkt;
 }
 
 struct ToWgs84::State {
-  Context ctx;
-  Pj transform;
-  std::string source;
+  const plugin::ProjEntries* entries = nullptr;
+  void* transformation = nullptr;
+  ~State() {
+    if (transformation) entries->to_wgs84_close(transformation);
+  }
 };
 
 ToWgs84::ToWgs84(const std::string& definition) : state_(std::make_unique<State>()) {
-  state_->ctx = make_context();
-  state_->source = definition.substr(0, 60);
-  PJ_CONTEXT* ctx = state_->ctx.get();
-  Pj transform(proj_create_crs_to_crs(ctx, definition.c_str(), "EPSG:4326", nullptr));
-  if (!transform) throw Error("CRS " + state_->source + " is not known to PROJ: " + last_error(ctx));
-  // EPSG:4326 is latitude first; normalised, PROJ takes and gives x = easting/longitude.
-  state_->transform.reset(proj_normalize_for_visualization(ctx, transform.get()));
-  if (!state_->transform) throw Error("PROJ cannot normalise the axis order of " + state_->source);
+  state_->entries = &proj("coordinates in longitude and latitude");
+  plugin::PluginFailure failure;
+  state_->entries->to_wgs84_open(definition, state_->transformation, failure);
+  vola::plugin::throw_failure(failure);
 }
 
 ToWgs84::~ToWgs84() = default;
@@ -142,11 +82,11 @@ ToWgs84::ToWgs84(ToWgs84&&) noexcept = default;
 ToWgs84& ToWgs84::operator=(ToWgs84&&) noexcept = default;
 
 Point ToWgs84::transform(const Point& p) const {
-  const PJ_COORD out = proj_trans(state_->transform.get(), PJ_FWD, proj_coord(p[0], p[1], 0, 0));
-  if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
-    throw Error("PROJ cannot transform (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") from " +
-                state_->source + " to WGS84: " + last_error(state_->ctx.get()));
-  return {out.xy.x, out.xy.y, p[2]};
+  Point out{};
+  plugin::PluginFailure failure;
+  state_->entries->to_wgs84_transform(state_->transformation, p, out, failure);
+  vola::plugin::throw_failure(failure);
+  return out;
 }
 
 }  // namespace vola::geo

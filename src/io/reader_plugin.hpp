@@ -1,34 +1,22 @@
-// The contract between vola_io and its reader plugins: libvola_gdal.so (elevation
-// rasters through GDAL) and libvola_assimp.so (meshes through Assimp). Linking GDAL
-// and Assimp into every program cost ~0.1 s of start-up (130 shared libraries to map
-// and relocate) for commands that never read a raster or a mesh; loaded on first use,
-// they cost nothing until then. Internal: built with the same compiler and library as
-// the loader, so C++ types cross the boundary; errors cross as a PluginFailure, not as
-// exceptions.
+// The entry points of the reader plugins libvola_gdal.so (elevation rasters through
+// GDAL) and libvola_assimp.so (meshes through Assimp); see src/plugin/plugin.hpp for why
+// they are plugins.
 #pragma once
 
 #include <cstdint>
 #include <functional>
-#include <new>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "vola/error.hpp"
+#include "../plugin/plugin.hpp"
 #include "vola/io/dem.hpp"
 #include "vola/io/input.hpp"
-#include "vola/version.hpp"
 
-namespace vola::io::plugin {
+namespace vola::io {
 
-// What went wrong inside a plugin, to be thrown again on the loader's side.
-struct PluginFailure {
-  enum class Kind { none, format, invalid_argument, io, out_of_memory, other };
-  Kind kind = Kind::none;
-  std::string file;                     // format errors
-  std::optional<std::uint64_t> offset;  // format errors
-  std::string message;                  // the cause (format errors) or what()
-};
+using vola::plugin::PluginFailure;
+
+namespace plugin {
 
 // Entry points, looked up by these names (extern "C", so unmangled).
 using ReadDemEntry = void (*)(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
@@ -36,56 +24,6 @@ using ReadDemEntry = void (*)(const std::string& path, const std::function<void(
 using ReadMeshEntry = void (*)(const std::string& path, std::vector<Triangle>& out, PluginFailure& failure);
 inline constexpr const char* kReadDemSymbol = "vola_plugin_read_dem";
 inline constexpr const char* kReadMeshSymbol = "vola_plugin_read_mesh";
-// A plugin from another version of vola, or built against another revision of this
-// contract, is refused: the types above may differ. Bump the revision when they change.
-inline constexpr const char* kVersionSymbol = "vola_plugin_version";
-inline constexpr const char* kPluginVersion = VOLA_VERSION_STRING "/plugin-abi-1";
-using VersionEntry = const char* (*)();
 
-// Plugin side: runs `body`, turning what it throws into `failure`.
-template <class Body>
-void capture_failure(PluginFailure& failure, Body&& body) noexcept {
-  using Kind = PluginFailure::Kind;
-  try {
-    body();
-  } catch (const FormatError& e) {
-    failure = {Kind::format, e.file(), e.offset(), e.cause()};
-  } catch (const InvalidArgument& e) {
-    failure = {Kind::invalid_argument, {}, {}, e.what()};
-  } catch (const IoError& e) {
-    failure = {Kind::io, {}, {}, e.what()};
-  } catch (const std::bad_alloc&) {
-    failure = {Kind::out_of_memory, {}, {}, "out of memory"};
-  } catch (const std::exception& e) {
-    failure = {Kind::other, {}, {}, e.what()};
-  } catch (...) {
-    failure = {Kind::other, {}, {}, "unknown error"};
-  }
-}
-
-// Loader side: throws what the plugin caught, as the same kind of error.
-inline void throw_failure(const PluginFailure& failure) {
-  using Kind = PluginFailure::Kind;
-  switch (failure.kind) {
-    case Kind::none:
-      return;
-    case Kind::format:
-      throw FormatError(failure.file, failure.offset, failure.message);
-    case Kind::invalid_argument:
-      throw InvalidArgument(failure.message);
-    case Kind::io:
-      throw IoError(failure.message);
-    case Kind::out_of_memory:
-      throw std::bad_alloc();
-    case Kind::other:
-      throw Error(failure.message);
-  }
-}
-
-// The address of `symbol` in libvola_<name>.so, loading the plugin on first use (thread
-// safe). Searched in $VOLA_PLUGIN_DIR, next to the program or library that holds vola_io
-// (and its ../lib/vola), the build tree, then the install prefix. Throws IoError naming
-// `file` (the input that needs it), the plugin and every folder searched.
-void* plugin_symbol(const char* name, const char* symbol, const std::string& file);
-
-}  // namespace vola::io::plugin
+}  // namespace plugin
+}  // namespace vola::io

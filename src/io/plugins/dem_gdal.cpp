@@ -139,10 +139,10 @@ DemRaster read_dem_with_gdal(const std::string& path,
 
 // The plugin's entry points (reader_plugin.hpp).
 extern "C" {
-const char* vola_plugin_version() { return vola::io::plugin::kPluginVersion; }
+const char* vola_plugin_version() { return vola::plugin::kPluginVersion; }
 void vola_plugin_read_dem(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
-                          vola::io::DemRaster& out, vola::io::plugin::PluginFailure& failure) {
-  vola::io::plugin::capture_failure(failure, [&] { out = vola::io::read_dem_with_gdal(path, progress); });
+                          vola::io::DemRaster& out, vola::plugin::PluginFailure& failure) {
+  vola::plugin::capture_failure(failure, [&] { out = vola::io::read_dem_with_gdal(path, progress); });
 }
 }
 static_assert(std::is_same_v<decltype(&vola_plugin_read_dem), vola::io::plugin::ReadDemEntry>);

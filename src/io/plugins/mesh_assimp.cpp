@@ -100,10 +100,10 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
 
 // The plugin's entry points (reader_plugin.hpp).
 extern "C" {
-const char* vola_plugin_version() { return vola::io::plugin::kPluginVersion; }
+const char* vola_plugin_version() { return vola::plugin::kPluginVersion; }
 void vola_plugin_read_mesh(const std::string& path, std::vector<vola::io::Triangle>& out,
-                           vola::io::plugin::PluginFailure& failure) {
-  vola::io::plugin::capture_failure(failure, [&] { out = vola::io::read_mesh_with_assimp(path); });
+                           vola::plugin::PluginFailure& failure) {
+  vola::plugin::capture_failure(failure, [&] { out = vola::io::read_mesh_with_assimp(path); });
 }
 }
 static_assert(std::is_same_v<decltype(&vola_plugin_read_mesh), vola::io::plugin::ReadMeshEntry>);

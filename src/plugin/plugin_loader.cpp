@@ -1,4 +1,4 @@
-#include "reader_plugin.hpp"
+#include "plugin.hpp"
 
 #include <dlfcn.h>
 
@@ -9,7 +9,7 @@
 #include <mutex>
 #include <vector>
 
-namespace vola::io::plugin {
+namespace vola::plugin {
 
 namespace {
 
@@ -67,18 +67,18 @@ Loaded load(const std::string& name) {
 
 }  // namespace
 
-void* plugin_symbol(const char* name, const char* symbol, const std::string& file) {
+void* plugin_symbol(const char* name, const char* symbol, const std::string& purpose) {
   static std::mutex mutex;
   static std::map<std::string, Loaded> plugins;
   std::lock_guard lock(mutex);
   auto it = plugins.find(name);
   if (it == plugins.end()) it = plugins.emplace(name, load(name)).first;
   const Loaded& plugin = it->second;
-  const std::string needs = file + ": reading it needs vola's " + name + " plugin; ";
+  const std::string needs = purpose + " needs vola's " + name + " plugin; ";
   if (!plugin.handle) throw IoError(needs + plugin.error + " (reinstall vola, or set VOLA_PLUGIN_DIR to its folder)");
   void* address = ::dlsym(plugin.handle, symbol);
   if (!address) throw IoError(needs + "libvola_" + name + ".so has no " + symbol);
   return address;
 }
 
-}  // namespace vola::io::plugin
+}  // namespace vola::plugin

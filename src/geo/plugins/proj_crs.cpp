@@ -1,0 +1,172 @@
+// libvola_proj.so: coordinate reference systems through PROJ, behind the entry points of
+// proj_plugin.hpp (vola/geo/crs.hpp documents what each does).
+#include <proj.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "../proj_plugin.hpp"
+#include "vola/error.hpp"
+
+namespace vola::geo {
+
+namespace {
+
+struct ContextDeleter {
+  void operator()(PJ_CONTEXT* c) const { proj_context_destroy(c); }
+};
+struct PjDeleter {
+  void operator()(PJ* p) const { proj_destroy(p); }
+};
+using Context = std::unique_ptr<PJ_CONTEXT, ContextDeleter>;
+using Pj = std::unique_ptr<PJ, PjDeleter>;
+
+Context make_context() {
+  Context ctx(proj_context_create());
+  if (!ctx) throw Error("PROJ: cannot create a context");
+  proj_log_level(ctx.get(), PJ_LOG_NONE);
+  return ctx;
+}
+
+std::string last_error(PJ_CONTEXT* ctx) {
+  const int code = proj_context_errno(ctx);
+  return code ? proj_context_errno_string(ctx, code) : "unknown error";
+}
+
+std::pair<double, double> centre_lat_lon(const std::string& source, const Box& bbox) {
+  Context ctx = make_context();
+  Pj transform(proj_create_crs_to_crs(ctx.get(), source.c_str(), "EPSG:4326", nullptr));
+  if (!transform) throw Error("CRS " + source.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
+  Pj normalized(proj_normalize_for_visualization(ctx.get(), transform.get()));
+  if (!normalized) throw Error("PROJ cannot normalise the axis order of " + source);
+  const double cx = (bbox.min[0] + bbox.max[0]) / 2.0;
+  const double cy = (bbox.min[1] + bbox.max[1]) / 2.0;
+  const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, 0, 0));
+  if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
+    throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source.substr(0, 60) +
+                " to WGS84: " + last_error(ctx.get()));  // NOLINT
+  return {out.xy.y, out.xy.x};
+}
+
+std::string crs_wkt(std::uint32_t epsg) {
+  Context ctx = make_context();
+  const std::string source = "EPSG:" + std::to_string(epsg);
+  Pj crs(proj_create(ctx.get(), source.c_str()));
+  if (!crs) throw Error("CRS " + source + " is not known to PROJ: " + last_error(ctx.get()));
+  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT2_2019, nullptr);
+  if (!wkt) throw Error("PROJ cannot write " + source + " as WKT");
+  return wkt;
+}
+
+std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
+  Context ctx = make_context();
+  Pj crs(proj_create(ctx.get(), wkt.c_str()));
+  if (!crs) return std::nullopt;
+  // Down to the horizontal CRS: a TOWGS84 clause makes a bound CRS, a vertical part a
+  // compound one.
+  for (int guard = 0; crs && guard < 4; ++guard) {
+    const PJ_TYPE type = proj_get_type(crs.get());
+    if (type == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx.get(), crs.get()));
+    else if (type == PJ_TYPE_COMPOUND_CRS) crs.reset(proj_crs_get_sub_crs(ctx.get(), crs.get(), 0));
+    else break;
+  }
+  if (!crs) return std::nullopt;
+  auto to_code = [](const char* auth, const char* code) -> std::optional<std::uint32_t> {
+    if (!auth || !code || std::string(auth) != "EPSG") return std::nullopt;
+    try {
+      return static_cast<std::uint32_t>(std::stoul(code));
+    } catch (...) {
+      return std::nullopt;
+    }
+  };
+  if (auto c = to_code(proj_get_id_auth_name(crs.get(), 0), proj_get_id_code(crs.get(), 0))) return c;
+  int* confidence = nullptr;
+  PJ_OBJ_LIST* candidates = proj_identify(ctx.get(), crs.get(), "EPSG", nullptr, &confidence);
+  std::optional<std::uint32_t> best;
+  if (candidates) {
+    int best_confidence = 69;
+    for (int i = 0; i < proj_list_get_count(candidates); ++i) {
+      if (confidence[i] <= best_confidence) continue;
+      Pj candidate(proj_list_get(ctx.get(), candidates, i));
+      if (auto c = to_code(proj_get_id_auth_name(candidate.get(), 0), proj_get_id_code(candidate.get(), 0))) {
+        best = c;
+        best_confidence = confidence[i];
+      }
+    }
+    proj_int_list_destroy(confidence);
+    proj_list_destroy(candidates);
+  }
+  return best;
+}
+
+std::string crs_wkt1(const std::string& definition) {
+  Context ctx = make_context();
+  Pj crs(proj_create(ctx.get(), definition.c_str()));
+  if (!crs) throw Error("CRS " + definition.substr(0, 60) + " is not known to PROJ: " + last_error(ctx.get()));
+  // One line: some LAS readers stop a WKT at its first newline.
+  const char* const options[] = {"MULTILINE=NO", nullptr};
+  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT1_GDAL, options);
+  if (!wkt) throw Error("PROJ cannot write " + definition.substr(0, 60) + " as WKT1");
+  return wkt;
+}
+
+// A transformation to WGS84 longitude/latitude (x = easting/longitude in and out).
+class Wgs84Transformation {
+ public:
+  explicit Wgs84Transformation(const std::string& definition) : ctx_(make_context()), source_(definition.substr(0, 60)) {
+    Pj transform(proj_create_crs_to_crs(ctx_.get(), definition.c_str(), "EPSG:4326", nullptr));
+    if (!transform) throw Error("CRS " + source_ + " is not known to PROJ: " + last_error(ctx_.get()));
+    // EPSG:4326 is latitude first; normalised, PROJ takes and gives x = easting/longitude.
+    transform_.reset(proj_normalize_for_visualization(ctx_.get(), transform.get()));
+    if (!transform_) throw Error("PROJ cannot normalise the axis order of " + source_);
+  }
+
+  Point transform(const Point& p) const {
+    const PJ_COORD out = proj_trans(transform_.get(), PJ_FWD, proj_coord(p[0], p[1], 0, 0));
+    if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
+      throw Error("PROJ cannot transform (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") from " +
+                  source_ + " to WGS84: " + last_error(ctx_.get()));
+    return {out.xy.x, out.xy.y, p[2]};
+  }
+
+ private:
+  Context ctx_;
+  Pj transform_;
+  std::string source_;
+};
+
+using plugin::PluginFailure;
+using vola::plugin::capture_failure;
+
+const plugin::ProjEntries kEntries{
+    [](const std::string& crs, const Box& bbox, std::pair<double, double>& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = centre_lat_lon(crs, bbox); });
+    },
+    [](std::uint32_t epsg, std::string& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = crs_wkt(epsg); });
+    },
+    [](const std::string& wkt, std::optional<std::uint32_t>& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = epsg_from_wkt(wkt); });
+    },
+    [](const std::string& definition, std::string& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = crs_wkt1(definition); });
+    },
+    [](const std::string& definition, void*& state, PluginFailure& failure) {
+      capture_failure(failure, [&] { state = new Wgs84Transformation(definition); });
+    },
+    [](const void* state, const Point& in, Point& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = static_cast<const Wgs84Transformation*>(state)->transform(in); });
+    },
+    [](void* state) { delete static_cast<Wgs84Transformation*>(state); },
+};
+
+}  // namespace
+}  // namespace vola::geo
+
+// The plugin's entry points (src/plugin/plugin.hpp, proj_plugin.hpp).
+extern "C" {
+const char* vola_plugin_version() { return vola::plugin::kPluginVersion; }
+const vola::geo::plugin::ProjEntries* vola_plugin_proj_entries() { return &vola::geo::kEntries; }
+}
+static_assert(std::is_same_v<decltype(&vola_plugin_proj_entries), vola::geo::plugin::ProjEntriesEntry>);
