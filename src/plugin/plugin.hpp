@@ -1,7 +1,8 @@
 // Plugins: parts of vola built as shared objects and loaded on first use, because the
 // libraries they link cost every program start-up time (mapping and relocating them)
 // although few runs need them: libvola_gdal.so (elevation rasters), libvola_assimp.so
-// (meshes), libvola_proj.so (coordinate reference systems). Internal: a plugin is built
+// (meshes), libvola_proj.so (coordinate reference systems), libvola_mpi.so (vola tile
+// under mpirun). Internal: a plugin is built
 // with the same compiler and library as its loader, so C++ types cross the boundary;
 // errors cross as a PluginFailure, not as exceptions.
 #pragma once

@@ -12,6 +12,7 @@
 #include "scratch_file.hpp"
 #include "vola/error.hpp"
 #include "readers.hpp"  // src/io/plugins: the reader itself, not its plugin
+#include "vola/io/mesh.hpp"
 
 namespace vola_fuzz {
 Stats& stats() {

@@ -1,10 +1,12 @@
-// MPI_COMM_WORLD behind the Communicator interface (built only with MPI).
+// libvola_mpi.so: MPI_COMM_WORLD behind the entry points of mpi_plugin.hpp.
 #include <mpi.h>
 
+#include <cstdlib>
 #include <limits>
+#include <string>
 
+#include "../mpi_plugin.hpp"
 #include "vola/error.hpp"
-#include "vola/tile/communicator.hpp"
 
 namespace vola::tile {
 
@@ -20,7 +22,7 @@ int count_of(std::size_t n, const char* what) {
   return static_cast<int>(n);
 }
 
-class MpiWorld final : public Communicator {
+class MpiWorld {
  public:
   MpiWorld() {
     int initialised = 0;
@@ -29,15 +31,15 @@ class MpiWorld final : public Communicator {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
   }
-  ~MpiWorld() override {
+  ~MpiWorld() {
     int finalised = 0;
     MPI_Finalized(&finalised);
     if (!finalised) MPI_Finalize();
   }
-  int rank() const noexcept override { return rank_; }
-  int size() const noexcept override { return size_; }
+  int rank() const noexcept { return rank_; }
+  int size() const noexcept { return size_; }
 
-  std::vector<std::vector<std::uint8_t>> all_gather(std::span<const std::uint8_t> mine) override {
+  std::vector<std::vector<std::uint8_t>> all_gather(std::span<const std::uint8_t> mine) {
     const int n = count_of(mine.size(), "all_gather");
     std::vector<int> counts(size_), offsets(size_);
     check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
@@ -55,7 +57,7 @@ class MpiWorld final : public Communicator {
     return out;
   }
 
-  std::vector<std::vector<std::uint64_t>> gather(int root, std::span<const std::uint64_t> mine) override {
+  std::vector<std::vector<std::uint64_t>> gather(int root, std::span<const std::uint64_t> mine) {
     const int n = count_of(mine.size(), "gather");
     std::vector<int> counts(rank_ == root ? size_ : 0), offsets(rank_ == root ? size_ : 0);
     check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, root, MPI_COMM_WORLD), "MPI_Gather");
@@ -78,8 +80,8 @@ class MpiWorld final : public Communicator {
     return out;
   }
 
-  void barrier() override { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
-  [[noreturn]] void abort(int status) override {
+  void barrier() { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
+  [[noreturn]] void abort(int status) {
     MPI_Abort(MPI_COMM_WORLD, status);
     std::exit(status);
   }
@@ -88,8 +90,35 @@ class MpiWorld final : public Communicator {
   int rank_ = 0, size_ = 1;
 };
 
+using plugin::PluginFailure;
+using vola::plugin::capture_failure;
+
+MpiWorld& as_world(void* world) { return *static_cast<MpiWorld*>(world); }
+
+const plugin::MpiEntries kEntries{
+    [](void*& world, int& rank, int& size, PluginFailure& failure) {
+      capture_failure(failure, [&] {
+        auto* opened = new MpiWorld();
+        world = opened;
+        rank = opened->rank();
+        size = opened->size();
+      });
+    },
+    [](void* world) { delete static_cast<MpiWorld*>(world); },
+    [](void* world, std::span<const std::uint8_t> mine, std::vector<std::vector<std::uint8_t>>& out,
+       PluginFailure& failure) { capture_failure(failure, [&] { out = as_world(world).all_gather(mine); }); },
+    [](void* world, int root, std::span<const std::uint64_t> mine, std::vector<std::vector<std::uint64_t>>& out,
+       PluginFailure& failure) { capture_failure(failure, [&] { out = as_world(world).gather(root, mine); }); },
+    [](void* world, PluginFailure& failure) { capture_failure(failure, [&] { as_world(world).barrier(); }); },
+    [](void* world, int status) { as_world(world).abort(status); },
+};
+
 }  // namespace
-
-std::unique_ptr<Communicator> mpi_world() { return std::make_unique<MpiWorld>(); }
-
 }  // namespace vola::tile
+
+// The plugin's entry points (src/plugin/plugin.hpp, mpi_plugin.hpp).
+extern "C" {
+const char* vola_plugin_version() { return vola::plugin::kPluginVersion; }
+const vola::tile::plugin::MpiEntries* vola_plugin_mpi_entries() { return &vola::tile::kEntries; }
+}
+static_assert(std::is_same_v<decltype(&vola_plugin_mpi_entries), vola::tile::plugin::MpiEntriesEntry>);
