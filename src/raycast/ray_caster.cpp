@@ -35,18 +35,45 @@ unsigned cell_bit(const std::array<std::int64_t, 3>& c) noexcept {
   return static_cast<unsigned>((c[0] & 3) + 4 * (c[1] & 3) + 16 * (c[2] & 3));
 }
 
+// kBox.m[a][up][in][out]: the bits of a block's word whose cell index along axis a
+// (0..3 inside the block) lies between the cell the ray enters and the last one it can
+// reach, given as the number of planes between cells crossed at entry (in) and before
+// leaving (out), for a ray moving up (up = 1) or down the axis. The three axes' masks
+// ANDed together are the cells of the ray's bounding box inside the block.
+// kBox.fixed[a][i]: the cells with index i along a (an axis the ray does not move on).
+struct BoxMasks {
+  std::uint64_t m[3][2][4][4];
+  std::uint64_t fixed[3][4];
+};
+constexpr BoxMasks make_box_masks() {
+  BoxMasks r{};
+  for (int a = 0; a < 3; ++a)
+    for (unsigned b = 0; b < 64; ++b) {
+      const int i = static_cast<int>(a == 0 ? b & 3 : a == 1 ? (b >> 2) & 3 : b >> 4);
+      r.fixed[a][i] |= std::uint64_t{1} << b;
+      for (int in = 0; in < 4; ++in)
+        for (int out = in; out < 4; ++out) {
+          if (i >= in && i <= out) r.m[a][1][in][out] |= std::uint64_t{1} << b;
+          if (i >= 3 - out && i <= 3 - in) r.m[a][0][in][out] |= std::uint64_t{1} << b;
+        }
+    }
+  return r;
+}
+constexpr BoxMasks kBox = make_box_masks();
+
 }  // namespace
 
 RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
-  nodes_.resize(static_cast<std::size_t>(tree.depth()));
+  // All levels in one array, level 0 first; first_child indexes this array.
+  std::size_t total = 0;
+  for (int l = 0; l < tree.depth(); ++l) total += tree.occupancy(l).size();
+  nodes_.reserve(total);
   for (int l = 0; l < tree.depth(); ++l) {
     const auto words = tree.occupancy(l);
-    auto& nodes = nodes_[static_cast<std::size_t>(l)];
-    nodes.resize(words.size());
-    std::uint64_t children = 0;
-    for (std::size_t i = 0; i < words.size(); ++i) {
-      nodes[i] = Node{words[i], children};
-      children += static_cast<std::uint64_t>(std::popcount(words[i]));
+    std::uint64_t children = nodes_.size() + words.size();  // where the next level starts
+    for (const std::uint64_t word : words) {
+      nodes_.push_back(Node{word, children});
+      children += static_cast<std::uint64_t>(std::popcount(word));
     }
   }
 }
@@ -81,31 +108,41 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       if (axes.step[a]) v[a] = index_after(axes, ray, a, t, 0, side - 1);
   }
 
-  // Per level: the ray's cell (in cells of that level) and, per axis, the time it
-  // crosses the plane through which it leaves that cell. Stepping a cell costs one
-  // multiplication per axis that moves; the voxel-level index inside a cell is worked
-  // out only when descending into it.
-  std::array<std::array<std::int64_t, 3>, kMaxDepth> cell{};
-  std::array<std::array<double, 3>, kMaxDepth> leave{};
-  std::array<std::size_t, kMaxDepth> block{};  // the cell's block on each level of the path
+  // Per level on the path from the root: the ray's cell (in cells of that level), per
+  // axis the time it crosses the plane through which it leaves that cell, and the
+  // cell's block. Only levels up to the current one are ever read.
+  std::array<std::array<std::int64_t, 3>, kMaxDepth> cell;
+  std::array<std::array<double, 3>, kMaxDepth> leave;
+  std::array<const Node*, kMaxDepth> block;
+  const std::array<double, 3> o = ray.origin;
+  const std::array<double, 3> inv = axes.inverse;
+  const std::array<int, 3> step = axes.step;
+  std::array<std::int64_t, 3> ahead{};  // 1 on an axis moving up: its exit plane is c + 1
+  std::array<const std::uint64_t(*)[4], 3> box_masks{};
+  for (int a = 0; a < 3; ++a) {
+    ahead[a] = step[a] > 0;
+    box_masks[a] = kBox.m[a][step[a] > 0];
+  }
   auto exit_time = [&](int a, std::int64_t c, int shift) {
-    return crossing_time(static_cast<double>((axes.step[a] > 0 ? c + 1 : c) << shift), ray.origin[a], axes.inverse[a]);
+    return crossing_time(static_cast<double>((c + ahead[a]) << shift), o[a], inv[a]);
   };
-  auto enter_level = [&](int level, const std::array<std::int64_t, 3>& voxel) {
-    const int shift = 2 * (last - level);
+  // Events later than this end the ray (an infinite crossing time never happens).
+  const double t_end = std::min(ray.t_max, std::numeric_limits<double>::max());
+  {
+    const int shift = 2 * last;
     for (int a = 0; a < 3; ++a) {
-      cell[level][a] = voxel[a] >> shift;
-      leave[level][a] = axes.step[a] ? exit_time(a, cell[level][a], shift) : kNever;
+      cell[0][a] = v[a] >> shift;
+      leave[0][a] = step[a] ? exit_time(a, cell[0][a], shift) : kNever;
     }
-  };
+    block[0] = nodes_.data();
+  }
   // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
   bool moved = t > 0.0;
   int level = 0;
-  enter_level(0, v);
   for (;;) {
     const std::array<std::int64_t, 3>& c = cell[level];
     const unsigned bit = cell_bit(c);
-    const Node& node = nodes_[static_cast<std::size_t>(level)][block[level]];
+    const Node& node = *block[level];
     if ((node.bits >> bit) & 1u) {
       if (level == last) {
         RayHit hit;
@@ -114,47 +151,81 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
         hit.t = t;
         // The normal: the lowest axis whose entry plane into the voxel is crossed now.
         for (int a = 0; a < 3 && moved; ++a) {
-          if (axes.step[a] && crossing_time(axes.entry_plane(a, c[a]), ray.origin[a], axes.inverse[a]) == t) {
-            hit.normal[a] = -axes.step[a];
+          if (step[a] && crossing_time(axes.entry_plane(a, c[a]), o[a], inv[a]) == t) {
+            hit.normal[a] = -step[a];
             break;
           }
         }
         return hit;
       }
-      // Descend: the child cell holding the voxel the ray is in just after t.
-      block[level + 1] = node.first_child + static_cast<std::size_t>(std::popcount(node.bits & ((std::uint64_t{1} << bit) - 1)));
-      const int shift = 2 * (last - level);
+      // The child block, and per axis the child cells the ray is in from t until it
+      // leaves this cell at t_out: the three planes between the children, in the order
+      // the ray crosses them, counted against t (the child it enters now) and t_out (a
+      // bound on the last child). The box of those children ANDed with the child word
+      // says whether the ray can hit anything below: if not, this cell is stepped over
+      // like an empty one.
+      const Node* child =
+          nodes_.data() + node.first_child + std::popcount(node.bits & ((std::uint64_t{1} << bit) - 1));
+      const std::array<double, 3>& out = leave[level];
+      const double t_out = std::min(out[0], std::min(out[1], out[2]));
+      const int shift = 2 * (last - level - 1);
+      std::array<std::int64_t, 3> child_cell;
+      std::array<double, 3> child_leave;
+      std::uint64_t box = ~std::uint64_t{0};
       for (int a = 0; a < 3; ++a) {
-        if (!axes.step[a]) continue;
-        const std::int64_t lo = c[a] << shift;
-        v[a] = index_after(axes, ray, a, t, lo, lo + (std::int64_t{1} << shift) - 1);
+        if (!step[a]) {
+          const std::int64_t rel = (v[a] >> shift) & 3;
+          child_cell[a] = 4 * c[a] + rel;
+          child_leave[a] = kNever;
+          box &= kBox.fixed[a][rel];
+          continue;
+        }
+        // The planes (in child cells) in crossing order: base + step * k for k = 1, 2, 3,
+        // then at k = 4 the cell's own exit plane.
+        const std::int64_t base = 4 * (c[a] + 1 - ahead[a]);
+        const double t1 = crossing_time(static_cast<double>((base + step[a]) << shift), o[a], inv[a]);
+        const double t2 = crossing_time(static_cast<double>((base + 2 * step[a]) << shift), o[a], inv[a]);
+        const double t3 = crossing_time(static_cast<double>((base + 3 * step[a]) << shift), o[a], inv[a]);
+        const int in = (t1 <= t) + (t2 <= t) + (t3 <= t);
+        const int last_in = (t1 < t_out) + (t2 < t_out) + (t3 < t_out);
+        const double times[4] = {t1, t2, t3, out[a]};
+        child_leave[a] = times[in];
+        child_cell[a] = 4 * c[a] + (ahead[a] ? in : 3 - in);
+        box &= box_masks[a][in][last_in];
       }
-      enter_level(++level, v);
-      continue;
+      if (child->bits & box) {
+        ++level;
+        block[level] = child;
+        cell[level] = child_cell;
+        leave[level] = child_leave;
+        continue;
+      }
     }
 
-    // An empty cell: step to the next cell of this level, every axis crossing now together.
+    // An empty cell (or one the ray cannot hit anything in): step to the next cell of
+    // this level, every axis crossing now together.
     std::array<double, 3>& out = leave[level];
-    const double next = std::min({out[0], out[1], out[2]});
-    if (next == kNever || !(next <= ray.t_max)) return std::nullopt;
-    const int shift = 2 * (last - level);
-    const std::int64_t cells = side >> shift;
-    std::int64_t changed = 0;
     std::array<std::int64_t, 3>& here = cell[level];
+    const double next = std::min(out[0], std::min(out[1], out[2]));
+    if (!(next <= t_end)) return std::nullopt;
+    const int shift = 2 * (last - level);
+    std::uint64_t changed = 0;
     for (int a = 0; a < 3; ++a) {
-      if (out[a] != next) continue;
-      const std::int64_t i = here[a] + axes.step[a];
-      if (i < 0 || i >= cells) return std::nullopt;
-      changed |= i ^ here[a];
+      const bool crosses = out[a] == next;  // never on an axis that does not move
+      const std::int64_t i = here[a] + (crosses ? step[a] : 0);
+      changed |= static_cast<std::uint64_t>(i ^ here[a]);
       here[a] = i;
-      out[a] = exit_time(a, i, shift);
+      const double later = exit_time(a, i, shift);
+      out[a] = crosses ? later : out[a];
     }
     t = next;
     moved = true;
     // Left the parent block: climb to the coarsest level whose cell changed (its own
-    // parent's cell did not); the levels below it are entered again by descending.
-    const int up = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(changed)) - 1) / 2;
+    // parent's cell did not); the levels below it are entered again by descending. A
+    // cell index that left [0, 4^(level+1)) climbs past the root: the ray left the grid.
+    const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
     if (up > 0) {
+      if (up > level) return std::nullopt;
       level -= up;
       for (int a = 0; a < 3; ++a) {
         const std::int64_t moved_to = here[a] >> (2 * up);

@@ -36,10 +36,10 @@ class RayCaster {
  private:
   struct Node {
     std::uint64_t bits;         // the occupancy word
-    std::uint64_t first_child;  // index of its first child block on the next level
+    std::uint64_t first_child;  // index in nodes_ of its first child block
   };
   const Tree* tree_;
-  std::vector<std::vector<Node>> nodes_;  // per level
+  std::vector<Node> nodes_;  // every level's blocks, level 0 first
 };
 
 // Runs f(begin, end) over [0, count) in chunks on `threads` threads (0 = hardware).
