@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include "slam_test_support.hpp"
+#include "vola/error.hpp"
 #include "vola/slam/fuse_sequence.hpp"
 #include "vola/slam/map_export.hpp"
+#include "vola/slam/sequence_generator.hpp"
 #include "vola/slam/trajectory_error.hpp"
 
 namespace {
@@ -37,7 +39,7 @@ class SlamFusionSequence : public ::testing::Test {
 };
 ScratchDir* SlamFusionSequence::dir_ = nullptr;
 
-TEST_F(SlamFusionSequence, TracksTheRoomWithinTwoCentimetresInAFractionOfTheDenseMemory) {
+TEST_F(SlamFusionSequence, TracksTheRoomWithinOneCentimetreInAFractionOfTheDenseMemory) {
   const Sequence s = read_sequence(dir_->path().string());
   ASSERT_EQ(s.frames.size(), kFrames);
   ASSERT_EQ(s.groundtruth.size(), kFrames);
@@ -50,9 +52,9 @@ TEST_F(SlamFusionSequence, TracksTheRoomWithinTwoCentimetresInAFractionOfTheDens
   ASSERT_EQ(r.trajectory.size(), kFrames);
   const AbsoluteError ate = absolute_trajectory_error(s.groundtruth, r.trajectory);
   EXPECT_EQ(ate.pairs, kFrames);
-  EXPECT_LT(ate.rmse, 0.02);
+  EXPECT_LT(ate.rmse, 0.01);  // measured 3.4 mm (the same sequence through vola fuse)
   const RelativeError rpe = relative_pose_error(s.groundtruth, r.trajectory);
-  EXPECT_LT(rpe.translation_rmse, 0.01);
+  EXPECT_LT(rpe.translation_rmse, 0.005);  // measured 1.2 mm
   EXPECT_LT(rpe.rotation_rmse_degrees, 0.5);
   // The camera has turned 48 degrees: the sparse map holds a fraction of the box it spans.
   const MapMemory memory = map_memory(store);
@@ -116,6 +118,50 @@ TEST_F(SlamFusionSequence, GroundTruthPosesMapWithoutTracking) {
     wall += std::abs(x - 4.0) < 0.03;
   }
   EXPECT_GT(wall, 500u);
+}
+
+// Frames 70-95 of the 300-frame room loop: from frame 81 on the camera sees only the
+// wall at y = 5 m and the sofa in front of it, so no depth normal lies along the wall
+// and point-to-plane ICP can hardly observe the slide along it (on the 640 x 480
+// sequence the 6x6 system's smallest eigenvalue falls to ~2e-5 of its largest, and the
+// tracker without the motion prior slid up to 29 mm there). With the prior deciding that
+// direction, these frames track within millimetres. (At this test's 320 x 240 the
+// tracker without the prior also stays within 2 mm here, so the test guards the prior
+// against harm on a near-degenerate view; room300 in docs/BENCHMARKS.md shows the gain.)
+TEST(SlamMotionPrior, WallAndSofaFramesTrackWithinMillimetres) {
+  static const vola::Tree scene = room_scene(0.01);
+  const std::vector<Pose> loop = room_trajectory(300);
+  const std::vector<Pose> poses(loop.begin() + 70, loop.begin() + 96);
+  ScratchDir dir("wall");
+  GeneratorOptions g;
+  g.width = 320;
+  g.height = 240;
+  g.intrinsics = {262.5, 262.5, 159.5, 119.5};
+  g.threads = 2;
+  generate_sequence(scene, poses, g, dir.path().string());
+  const Sequence s = read_sequence(dir.path().string());
+  FuseOptions o;
+  o.intrinsics = *s.intrinsics;
+  o.start_at_groundtruth = true;
+  o.params.voxel_size = 0.01;
+  o.params.threads = 2;
+  ASSERT_GT(o.params.motion_prior, 0.0);  // on by default
+  SparseTsdfStore store(centred_geometry(poses.front().translation(), o.params.voxel_size, 1024));
+  const FuseResult r = fuse_sequence(s, o, store);
+  EXPECT_EQ(r.lost, 0u);
+  EXPECT_LT(absolute_trajectory_error(s.groundtruth, r.trajectory).rmse, 0.006);
+  const RelativeError rpe = relative_pose_error(s.groundtruth, r.trajectory);
+  EXPECT_LT(rpe.translation_rmse, 0.003);
+}
+
+TEST(SlamMotionPrior, OutOfRangeWeightsAreRefused) {
+  FusionParams p;
+  p.motion_prior = -0.1;
+  EXPECT_THROW(p.check(), vola::InvalidArgument);
+  p.motion_prior = 1.0;
+  EXPECT_THROW(p.check(), vola::InvalidArgument);
+  p.motion_prior = 0.0;
+  EXPECT_NO_THROW(p.check());
 }
 
 }  // namespace

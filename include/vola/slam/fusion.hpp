@@ -31,6 +31,16 @@ struct FusionParams {
   std::array<int, kPyramidLevels> icp_iterations{10, 5, 4};  // level 0 (full size) .. 2
   double icp_max_distance = 0.1;       // metres between associated points
   double icp_max_angle_degrees = 20;   // between associated normals
+  // Constant-velocity motion prior where the depth says (almost) nothing. The prediction
+  // is the previous pose moved by the last tracked frame-to-frame motion; in each ICP
+  // solve, every eigen-direction of the 6x6 normal matrix whose eigenvalue is below
+  // motion_prior times the largest is raised to that floor by a prior pulling towards
+  // the prediction. Well-observed directions are left to the data (their eigenvalues are
+  // above the floor); where point-to-plane ICP cannot observe a motion (a flat wall and
+  // a sofa give no normal along the wall, so sliding along it is free) the prediction
+  // decides instead of noise. No prior until a frame-to-frame motion has been tracked
+  // (the second frame, the first after a lost one). 0 disables it (KinectFusion's tracker).
+  double motion_prior = 1e-3;
   // A frame whose ICP update exceeds these (or has too few associations) is "lost":
   // its pose stays the previous one and it is not integrated.
   double max_step_translation = 0.2, max_step_rotation_degrees = 20;
@@ -77,6 +87,7 @@ class Fusion {
   std::uint32_t width_, height_;
   FusionParams params_;
   Pose pose_ = Pose::Identity();
+  std::optional<Pose> motion_;  // the last tracked frame-to-frame motion, previous^-1 * current
   std::size_t frames_ = 0;
   ModelView model_;
 };
