@@ -3,6 +3,8 @@
 # RPE, map memory against a dense TSDF grid, frames per second; the same run on a dense
 # grid for the identical-trajectory check) and the real ICL-NUIM / Kinect frames.
 # Usage: bench/slam_fuse.sh path/to/vola [runs] [work folder]
+# SLAM_SEEDS (default "2 3"): further noise seeds of the same room loop, fused once each
+# for ATE/RPE (the tracker's result on one seed is not a measurement of its accuracy).
 set -euo pipefail
 vola=$1
 runs=${2:-3}
@@ -23,6 +25,15 @@ done
 cat "$work/room300_run1.txt"
 echo "median frames/s: $(for i in $(seq 1 "$runs"); do awk '/frames\/s/ { sub(":", "", $7); print $7 }' "$work/room300_run$i.txt"; done | median)"
 "$vola" rgbd-eval "$work/room300/groundtruth.txt" "$work/room300_est.txt"
+
+for seed in ${SLAM_SEEDS-2 3}; do
+  if [ ! -f "$work/room300s$seed/groundtruth.txt" ]; then
+    "$vola" rgbd-generate "$work/room300s$seed" --frames 300 --seed "$seed" > /dev/null
+  fi
+  echo "== room300 seed $seed, same settings, one run"
+  "$vola" fuse "$work/room300s$seed" --trajectory "$work/room300s${seed}_est.txt" | grep -E 'frames|ATE|RPE|map:'
+  "$vola" rgbd-eval "$work/room300s$seed/groundtruth.txt" "$work/room300s${seed}_est.txt" | grep -E 'rmse'
+done
 
 echo "== room300, 2 cm voxels, sparse vs dense grid of the same 6.4 m extent (40 bricks per side)"
 "$vola" fuse "$work/room300" --trajectory "$work/sparse2.txt" --voxel-size 0.02 --bricks 40 > "$work/sparse2_out.txt"
