@@ -5,6 +5,7 @@
 #include <new>
 
 #include "vola/error.hpp"
+#include "vola/version.hpp"
 
 namespace vola::cli {
 
@@ -24,6 +25,15 @@ int run_app(CLI::App& app, int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+int run_companion(int argc, char** argv, const char* what, void (*const* add)(CLI::App&), std::size_t adds) {
+  CLI::App app{std::string("vola " VOLA_VERSION_STRING " - ") + what};
+  app.name("vola");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", VOLA_VERSION_STRING);
+  for (std::size_t i = 0; i < adds; ++i) add[i](app);
+  return run_app(app, argc, argv);
 }
 
 }  // namespace vola::cli

@@ -4,8 +4,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstddef>
+
 namespace vola::cli {
 
 int run_app(CLI::App& app, int argc, char** argv);
+
+// The main of a companion executable (companions.cpp): an app named vola, described as
+// "vola VERSION - <what>", with the subcommands `add` adds, run by run_app.
+int run_companion(int argc, char** argv, const char* what, void (*const* add)(CLI::App&), std::size_t adds);
+template <std::size_t N>
+int run_companion(int argc, char** argv, const char* what, void (*const (&add)[N])(CLI::App&)) {
+  return run_companion(argc, argv, what, add, N);
+}
 
 }  // namespace vola::cli
