@@ -44,9 +44,12 @@ unsigned cell_bit(const std::array<std::int64_t, 3>& c) noexcept {
 struct BoxMasks {
   std::uint64_t m[3][2][4][4];
   std::uint64_t fixed[3][4];
+  std::uint64_t all[4][4];
 };
 constexpr BoxMasks make_box_masks() {
   BoxMasks r{};
+  for (auto& row : r.all)
+    for (auto& m : row) m = ~std::uint64_t{0};
   for (int a = 0; a < 3; ++a)
     for (unsigned b = 0; b < 64; ++b) {
       const int i = static_cast<int>(a == 0 ? b & 3 : a == 1 ? (b >> 2) & 3 : b >> 4);
@@ -118,11 +121,17 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
   const std::array<double, 3> inv = axes.inverse;
   const std::array<int, 3> step = axes.step;
   std::array<std::int64_t, 3> ahead{};  // 1 on an axis moving up: its exit plane is c + 1
-  std::array<const std::uint64_t(*)[4], 3> box_masks{};
+  std::array<int, 3> flip{};            // cell index inside a block -> planes crossed to reach it
+  std::array<const std::uint64_t(*)[4], 3> box_masks{};  // all ones for an axis that does not move
   for (int a = 0; a < 3; ++a) {
     ahead[a] = step[a] > 0;
-    box_masks[a] = kBox.m[a][step[a] > 0];
+    flip[a] = step[a] > 0 ? 0 : 3;
+    box_masks[a] = step[a] ? kBox.m[a][step[a] > 0] : kBox.all;
   }
+  // Per level: per axis the planes between cells of the block the ray can cross before
+  // leaving the parent cell (3 at the root: the grid's side).
+  std::array<std::array<int, 3>, kMaxDepth> reach;
+  reach[0] = {3, 3, 3};
   auto exit_time = [&](int a, std::int64_t c, int shift) {
     return crossing_time(static_cast<double>((c + ahead[a]) << shift), o[a], inv[a]);
   };
@@ -172,6 +181,7 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       std::array<std::int64_t, 3> child_cell;
       std::array<double, 3> child_leave;
       std::uint64_t box = ~std::uint64_t{0};
+      std::array<int, 3> child_reach{};
       for (int a = 0; a < 3; ++a) {
         if (!step[a]) {
           const std::int64_t rel = (v[a] >> shift) & 3;
@@ -192,47 +202,61 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
         child_leave[a] = times[in];
         child_cell[a] = 4 * c[a] + (ahead[a] ? in : 3 - in);
         box &= box_masks[a][in][last_in];
+        child_reach[a] = last_in;
       }
       if (child->bits & box) {
         ++level;
         block[level] = child;
         cell[level] = child_cell;
         leave[level] = child_leave;
+        reach[level] = child_reach;
         continue;
       }
     }
 
     // An empty cell (or one the ray cannot hit anything in): step to the next cell of
-    // this level, every axis crossing now together.
-    std::array<double, 3>& out = leave[level];
-    std::array<std::int64_t, 3>& here = cell[level];
-    const double next = std::min(out[0], std::min(out[1], out[2]));
-    if (!(next <= t_end)) return std::nullopt;
-    const int shift = 2 * (last - level);
-    std::uint64_t changed = 0;
-    for (int a = 0; a < 3; ++a) {
-      const bool crosses = out[a] == next;  // never on an axis that does not move
-      const std::int64_t i = here[a] + (crosses ? step[a] : 0);
-      changed |= static_cast<std::uint64_t>(i ^ here[a]);
-      here[a] = i;
-      const double later = exit_time(a, i, shift);
-      out[a] = crosses ? later : out[a];
-    }
-    t = next;
-    moved = true;
-    // Left the parent block: climb to the coarsest level whose cell changed (its own
-    // parent's cell did not); the levels below it are entered again by descending. A
-    // cell index that left [0, 4^(level+1)) climbs past the root: the ray left the grid.
-    const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
-    if (up > 0) {
-      if (up > level) return std::nullopt;
-      level -= up;
+    // this level, every axis crossing now together. Then, if nothing the ray can still
+    // reach in the block is occupied (its box from the new cell on), the parent cell is
+    // done too: step on the parent's level instead.
+    for (;;) {
+      std::array<double, 3>& out = leave[level];
+      std::array<std::int64_t, 3>& here = cell[level];
+      const double next = std::min(out[0], std::min(out[1], out[2]));
+      if (!(next <= t_end)) return std::nullopt;
+      const int shift = 2 * (last - level);
+      std::uint64_t changed = 0;
       for (int a = 0; a < 3; ++a) {
-        const std::int64_t moved_to = here[a] >> (2 * up);
-        if (moved_to == cell[level][a]) continue;
-        cell[level][a] = moved_to;
-        leave[level][a] = exit_time(a, moved_to, 2 * (last - level));
+        const bool crosses = out[a] == next;  // never on an axis that does not move
+        const std::int64_t i = here[a] + (crosses ? step[a] : 0);
+        changed |= static_cast<std::uint64_t>(i ^ here[a]);
+        here[a] = i;
+        const double later = exit_time(a, i, shift);
+        out[a] = crosses ? later : out[a];
       }
+      t = next;
+      moved = true;
+      // Left the parent block: climb to the coarsest level whose cell changed (its own
+      // parent's cell did not); the levels below it are entered again by descending. A
+      // cell index that left [0, 4^(level+1)) climbs past the root: the ray left the grid.
+      const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
+      if (up > 0) {
+        if (up > level) return std::nullopt;
+        level -= up;
+        for (int a = 0; a < 3; ++a) {
+          const std::int64_t moved_to = here[a] >> (2 * up);
+          if (moved_to == cell[level][a]) continue;
+          cell[level][a] = moved_to;
+          leave[level][a] = exit_time(a, moved_to, 2 * (last - level));
+        }
+      }
+      const std::array<std::int64_t, 3>& now = cell[level];
+      const std::array<int, 3>& r = reach[level];
+      const std::uint64_t ahead_box = box_masks[0][(now[0] & 3) ^ flip[0]][r[0]] &
+                                      box_masks[1][(now[1] & 3) ^ flip[1]][r[1]] &
+                                      box_masks[2][(now[2] & 3) ^ flip[2]][r[2]];
+      if (block[level]->bits & ahead_box) break;
+      if (level == 0) return std::nullopt;
+      --level;
     }
   }
 }
