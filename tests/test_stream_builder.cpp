@@ -142,6 +142,66 @@ TEST(StreamBuilder, KeysEqualTheSetOfKeys) {
   EXPECT_THROW(with_payload.add_keys(one), vola::InvalidArgument);
 }
 
+// Occupancy runs are leaf blocks with their voxel bits, united in place from the back
+// when the older run has room: chunks that overlap all the others (a survey in random
+// order), chunks above everything so far, below everything so far (every block moves),
+// interleaved ones, and runs of one block, against the set of keys.
+TEST(StreamBuilder, OccupancyUnionsInPlaceEqualTheSetOfKeys) {
+  const int depth = 6;
+  const vola::Key limit = vola::Key{1} << (6 * depth);
+  for (int pattern = 0; pattern < 5; ++pattern) {
+    SCOPED_TRACE("pattern " + std::to_string(pattern));
+    std::mt19937_64 rng(100 + pattern);
+    vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, depth), {}, false);
+    std::vector<vola::Key> all;
+    for (int chunk = 0; chunk < 60; ++chunk) {
+      std::vector<vola::Key> keys(1 + rng() % 4000);
+      for (std::size_t i = 0; i < keys.size(); ++i) {
+        switch (pattern) {
+          case 0: keys[i] = rng() % 20000; break;                                  // all chunks overlap
+          case 1: keys[i] = vola::Key(chunk) * 100000 + rng() % 100000; break;    // ascending
+          case 2: keys[i] = limit - 1 - vola::Key(chunk) * 100000 - rng() % 100000; break;  // descending
+          case 3: keys[i] = (rng() % 500) * 4096 + vola::Key(chunk % 7) * 64 + rng() % 64; break;  // interleaved
+          default: keys[i] = vola::Key(chunk % 3) * 64 + rng() % 8; break;         // one block per chunk
+        }
+      }
+      all.insert(all.end(), keys.begin(), keys.end());
+      builder.add_keys(keys);
+    }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    const vola::Tree got = builder.finish();
+    const vola::Tree want = vola::build_from_sorted_keys(all, depth);
+    EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+              std::vector<std::uint64_t>(want.words().begin(), want.words().end()));
+  }
+}
+
+// Occupancy from coordinates (add() without attributes or payloads) against vola::build.
+TEST(StreamBuilder, OccupancyFromPointsEqualsBuild) {
+  for (int depth = 1; depth <= 7; ++depth) {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    Points p = random_points(static_cast<std::uint64_t>(depth), 30000);
+    p.cloud.attributes.clear();
+    p.cloud.payload.clear();
+    vola::BuildOptions options;
+    options.quantization = vola::Quantization::toolkit;
+    options.depth = depth;
+    const vola::Tree expected = vola::build(p.cloud, options);
+    vola::BuildOptions resolved = options;
+    vola::StreamBuilder builder(vola::resolve_quantizer(p.cloud.bounds(), resolved), {}, false);
+    std::mt19937_64 rng(depth);
+    for (std::size_t at = 0; at < p.cloud.size();) {
+      const std::size_t n = std::min<std::size_t>(p.cloud.size() - at, 1 + rng() % 5000);
+      builder.add({p.cloud.xyz.data() + 3 * at, 3 * n}, {}, {});
+      at += n;
+    }
+    const vola::Tree got = builder.finish();
+    EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+              std::vector<std::uint64_t>(expected.words().begin(), expected.words().end()));
+  }
+}
+
 TEST(StreamBuilder, RefusesMismatchedArrays) {
   vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {{"a", vola::ValueType::u8, vola::Reduction::max}},
                               false);

@@ -71,6 +71,35 @@ Tree emit_levels(std::span<const Key> keys, int depth, std::span<const std::uint
   return Tree::from_levels(depth, with_payload, std::move(words));
 }
 
+Tree emit_block_levels(std::span<const Key> blocks, std::span<const std::uint64_t> bits, int depth) {
+  if (depth == 1) return Tree::from_levels(1, false, {blocks.empty() ? std::uint64_t{0} : bits[0]});
+  // Levels 0 .. depth-2 are those of a depth-1 tree whose voxels are the blocks.
+  const int upper = depth - 1;
+  std::vector<std::vector<std::uint64_t>> occupancy(upper);
+  occupancy[0].push_back(0);
+  if (!blocks.empty()) occupancy[upper - 1].reserve(blocks.size() / 4 + 1);
+  Key previous = 0;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const Key key = blocks[i];
+    int first_changed = 0;
+    if (i > 0) first_changed = upper - 1 - (63 - std::countl_zero(key ^ previous)) / 6;
+    for (int level = first_changed + 1; level < upper; ++level) occupancy[level].push_back(0);
+    for (int level = first_changed; level < upper; ++level)
+      occupancy[level].back() |= std::uint64_t{1} << digit(key, level, upper);
+    previous = key;
+  }
+  std::size_t total = bits.size();
+  for (int level = 0; level < upper; ++level) total += occupancy[level].size();
+  std::vector<std::uint64_t> words;
+  words.reserve(total);
+  for (int level = 0; level < upper; ++level) {
+    words.insert(words.end(), occupancy[level].begin(), occupancy[level].end());
+    std::vector<std::uint64_t>().swap(occupancy[level]);
+  }
+  words.insert(words.end(), bits.begin(), bits.end());
+  return Tree::from_levels(depth, false, std::move(words));
+}
+
 }  // namespace detail
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola

@@ -16,6 +16,11 @@ namespace detail {
 Tree emit_levels(std::span<const Key> keys, int depth, std::span<const std::uint64_t> voxel_payloads,
                  bool with_payload);
 
+// Occupancy only, from the leaf blocks: `blocks` the sorted unique leaf block keys
+// (voxel key >> 6) and `bits` their 64 voxel bits each. The same tree as emit_levels
+// over the voxel keys, with one step per block instead of one per voxel.
+Tree emit_block_levels(std::span<const Key> blocks, std::span<const std::uint64_t> bits, int depth);
+
 }  // namespace detail
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola

@@ -73,91 +73,132 @@ struct KeyAllocator {
 };
 using KeyVector = std::vector<Key, KeyAllocator<Key>>;
 
-// Sorts keys[0, n) (LSD radix over only the bits that vary among them, in digits of at
-// most 12 bits, a pass skipped when its digit is the same in every key) and removes
-// duplicates. `buffer` holds n keys; `counts` is scratch. Returns the sorted unique keys,
-// in keys or in buffer.
-std::span<const Key> sort_unique(Key* keys, Key* buffer, std::size_t n, std::vector<std::uint32_t>& counts) {
-  if (n == 0) return {};
+// Occupancy only: sorts the voxel keys[0, n) by leaf block (key >> 6; LSD radix over
+// only the block bits that vary among them, in digits of at most 12 bits, a pass
+// skipped when its digit is the same in every key) and collapses each block's keys
+// into its 64 voxel bits. `buffer` holds n keys; `counts` is scratch. Returns the
+// number of blocks m: their sorted unique keys in blocks[0, m), their bits in
+// bits[0, m), where (blocks, bits) is (keys, buffer) or (buffer, keys).
+std::size_t sort_blocks(Key* keys, Key* buffer, std::size_t n, std::vector<std::uint32_t>& counts, Key*& blocks,
+                        Key*& bits) {
+  blocks = keys;
+  bits = buffer;
+  if (n == 0) return 0;
   const Key first = keys[0];
   Key differ = 0;
   for (std::size_t i = 0; i < n; ++i) differ |= keys[i] ^ first;
-  if (differ == 0) return {keys, 1};
-  const int low = std::countr_zero(differ), bits = static_cast<int>(std::bit_width(differ)) - low;
-  constexpr int kMaxDigit = 12;
-  const int passes = (bits + kMaxDigit - 1) / kMaxDigit;
-  const int digit = (bits + passes - 1) / passes;
-  const std::size_t buckets = std::size_t{1} << digit;
-  const Key mask = buckets - 1;
-  counts.assign(buckets * static_cast<std::size_t>(passes), 0);
-  std::uint32_t* count = counts.data();
-  if (passes == 1) {
-    for (std::size_t i = 0; i < n; ++i) ++count[(keys[i] >> low) & mask];
-  } else {
-    for (std::size_t i = 0; i < n; ++i) {
-      const Key k = keys[i] >> low;
-      for (int p = 0; p < passes; ++p) ++count[p * buckets + ((k >> (p * digit)) & mask)];
-    }
-  }
+  differ >>= 6;
   Key* from = keys;
   Key* to = buffer;
-  for (int p = 0; p < passes; ++p) {
-    std::uint32_t* c = count + p * buckets;
-    const int shift = low + p * digit;
-    if (c[(from[0] >> shift) & mask] == n) continue;  // the same digit in every key
-    std::uint32_t offset = 0;
-    for (std::size_t b = 0; b < buckets; ++b) {
-      const std::uint32_t here = c[b];
-      c[b] = offset;
-      offset += here;
+  if (differ != 0) {
+    const int low = 6 + std::countr_zero(differ), bits_varying = static_cast<int>(std::bit_width(differ)) + 6 - low;
+    constexpr int kMaxDigit = 12;
+    const int passes = (bits_varying + kMaxDigit - 1) / kMaxDigit;
+    const int digit = (bits_varying + passes - 1) / passes;
+    const std::size_t buckets = std::size_t{1} << digit;
+    const Key mask = buckets - 1;
+    counts.assign(buckets * static_cast<std::size_t>(passes), 0);
+    std::uint32_t* count = counts.data();
+    if (passes == 1) {
+      for (std::size_t i = 0; i < n; ++i) ++count[(keys[i] >> low) & mask];
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        const Key k = keys[i] >> low;
+        for (int p = 0; p < passes; ++p) ++count[p * buckets + ((k >> (p * digit)) & mask)];
+      }
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      const Key k = from[i];
-      to[c[(k >> shift) & mask]++] = k;
+    for (int p = 0; p < passes; ++p) {
+      std::uint32_t* c = count + p * buckets;
+      const int shift = low + p * digit;
+      if (c[(from[0] >> shift) & mask] == n) continue;  // the same digit in every key
+      std::uint32_t offset = 0;
+      for (std::size_t b = 0; b < buckets; ++b) {
+        const std::uint32_t here = c[b];
+        c[b] = offset;
+        offset += here;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const Key k = from[i];
+        to[c[(k >> shift) & mask]++] = k;
+      }
+      std::swap(from, to);
     }
-    std::swap(from, to);
   }
-  std::size_t unique = 1;
-  for (std::size_t i = 1; i < n; ++i) {
-    const Key k = from[i];
-    from[unique] = k;
-    unique += k != from[unique - 1];
+  // Equal blocks are adjacent now: block u's key goes to from[u] (u <= i: already read),
+  // its bits to to[u]; written at every step, so the last write of a block holds all.
+  Key block = from[0] >> 6, acc = 0;
+  std::size_t u = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Key k = from[i], b = k >> 6;
+    const bool same = b == block;
+    u += !same;
+    acc = (same ? acc : 0) | (Key{1} << (k & 63));
+    from[u] = b;
+    to[u] = acc;
+    block = b;
   }
-  return {from, unique};
+  blocks = from;
+  bits = to;
+  return u + 1;
 }
 
-// Sorted unique a and b -> their sorted unique union.
-void unite_keys(std::span<const Key> a, std::span<const Key> b, KeyVector& out) {
-  out.resize(a.size() + b.size());
-  Key* o = out.data();
-  // Chunks of a survey often cover their own stretch of the key space: copy the parts
-  // that lie before the other run's first key at once.
-  if (!a.empty() && !b.empty() && b.front() < a.front()) std::swap(a, b);
-  std::size_t i = 0, j = 0;
-  if (!a.empty() && !b.empty()) {
-    i = static_cast<std::size_t>(std::lower_bound(a.begin(), a.end(), b.front()) - a.begin());
-    std::copy(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(i), o);
-    o += i;
-  }
-  while (i < a.size() && j < b.size()) {
+// Blocks in both of the sorted unique block lists a and b (only where their ranges
+// overlap: chunks of a survey often cover their own stretch of the key space).
+std::size_t common_blocks(std::span<const Key> a, std::span<const Key> b) {
+  if (a.empty() || b.empty()) return 0;
+  const Key lo = std::max(a.front(), b.front()), hi = std::min(a.back(), b.back());
+  if (lo > hi) return 0;
+  std::size_t i = static_cast<std::size_t>(std::lower_bound(a.begin(), a.end(), lo) - a.begin());
+  std::size_t j = static_cast<std::size_t>(std::lower_bound(b.begin(), b.end(), lo) - b.begin());
+  const std::size_t i_end = static_cast<std::size_t>(std::upper_bound(a.begin() + static_cast<std::ptrdiff_t>(i), a.end(), hi) - a.begin());
+  const std::size_t j_end = static_cast<std::size_t>(std::upper_bound(b.begin() + static_cast<std::ptrdiff_t>(j), b.end(), hi) - b.begin());
+  std::size_t common = 0;
+  while (i < i_end && j < j_end) {
     const Key x = a[i], y = b[j];
-    *o++ = x < y ? x : y;
+    common += x == y;
     i += x <= y;
     j += y <= x;
   }
-  o = std::copy(a.begin() + static_cast<std::ptrdiff_t>(i), a.end(), o);
-  o = std::copy(b.begin() + static_cast<std::ptrdiff_t>(j), b.end(), o);
-  out.resize(static_cast<std::size_t>(o - out.data()));
+  return common;
 }
 
-// Sorted unique voxel keys with their partial reductions.
+// The union of the sorted unique blocks a (with bits) and b (with bits) into a itself,
+// from the back, the bits of a block in both OR-ed. a's vectors need room for
+// `united` blocks (a.size() + b.size() - common_blocks(a, b)). A block is written at
+// or after the position it is read from, so nothing is overwritten before it is read,
+// and the blocks of a below b's first stay where they are.
+void unite_in_place(KeyVector& a, KeyVector& a_bits, std::span<const Key> b, std::span<const Key> b_bits,
+                    std::size_t united) {
+  std::size_t i = a.size(), j = b.size(), o = united;
+  a.resize(united);  // uninitialized: KeyAllocator
+  a_bits.resize(united);
+  Key* ak = a.data();
+  Key* ab = a_bits.data();
+  while (i > 0 && j > 0) {
+    const Key x = ak[i - 1], y = b[j - 1];
+    const bool from_a = x >= y, from_b = y >= x;
+    --o;
+    const Key bits = (from_a ? ab[i - 1] : 0) | (from_b ? b_bits[j - 1] : 0);
+    ak[o] = from_a ? x : y;
+    ab[o] = bits;
+    i -= from_a;
+    j -= from_b;
+  }
+  std::copy(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(j), ak);  // b's blocks below all of a's
+  std::copy(b_bits.begin(), b_bits.begin() + static_cast<std::ptrdiff_t>(j), ab);
+}
+
+// Sorted unique voxel keys with their partial reductions; occupancy only (no
+// attributes, no payloads): sorted unique leaf block keys (voxel key >> 6) with their
+// 64 voxel bits each in `bits`, a word per block instead of a key per voxel.
 struct Run {
   KeyVector keys;
+  KeyVector bits;
   std::vector<std::uint64_t> payloads;
   std::vector<Partial> partials;
 
   std::size_t memory_bytes() const noexcept {
-    std::size_t bytes = keys.capacity() * 8 + payloads.capacity() * 8;
+    std::size_t bytes = keys.capacity() * 8 + bits.capacity() * 8 + payloads.capacity() * 8;
     for (const auto& p : partials) bytes += p.memory_bytes();
     return bytes;
   }
@@ -259,10 +300,6 @@ Run empty_run(std::span<const AttributeSpec> specs) {
 
 Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload) {
   Run out = empty_run(specs);
-  if (specs.empty() && !payload) {  // occupancy only: a plain sorted union
-    unite_keys(older.keys, newer.keys, out.keys);
-    return out;
-  }
   out.keys.reserve(older.keys.size() + newer.keys.size());
   std::size_t i = 0, j = 0;
   while (i < older.keys.size() || j < newer.keys.size()) {
@@ -299,15 +336,16 @@ struct StreamBuilder::State {
   // occupancy merges. The spares hold at most as many keys as the live runs (the
   // smallest go first), so memory stays within twice the runs.
   std::vector<KeyVector> spare;
-  KeyVector take(std::size_t n);
+  KeyVector take(std::size_t n, std::size_t room = 0);
   void give(KeyVector&& v, std::size_t also_live = 0);
 
   void push(Run run);
   void push_keys(std::span<Key> keys);
-  Run unite(Run& older, Run& newer);
+  void unite(Run& older, Run& newer);
 };
 
-KeyVector StreamBuilder::State::take(std::size_t n) {
+// n keys (uninitialized); a new vector has capacity for max(n, room).
+KeyVector StreamBuilder::State::take(std::size_t n, std::size_t room) {
   std::size_t best = spare.size();
   for (std::size_t i = 0; i < spare.size(); ++i)
     if (spare[i].capacity() >= n && (best == spare.size() || spare[i].capacity() < spare[best].capacity())) best = i;
@@ -315,6 +353,8 @@ KeyVector StreamBuilder::State::take(std::size_t n) {
   if (best < spare.size()) {
     v = std::move(spare[best]);
     spare.erase(spare.begin() + static_cast<std::ptrdiff_t>(best));
+  } else {
+    v.reserve(std::max(n, room));
   }
   v.resize(n);  // uninitialized: KeyAllocator
   return v;
@@ -326,7 +366,7 @@ void StreamBuilder::State::give(KeyVector&& v, std::size_t also_live) {
   v.clear();
   spare.push_back(std::move(v));
   std::size_t live = also_live, kept = 0;
-  for (const Run& run : runs) live += run.keys.capacity();
+  for (const Run& run : runs) live += run.keys.capacity() + run.bits.capacity();
   for (const KeyVector& k : spare) kept += k.capacity();
   while (kept > live && !spare.empty()) {
     const auto smallest = std::min_element(
@@ -336,23 +376,41 @@ void StreamBuilder::State::give(KeyVector&& v, std::size_t also_live) {
   }
 }
 
-// Occupancy only: the union of two runs, their key vectors given back for reuse.
-Run StreamBuilder::State::unite(Run& older, Run& newer) {
-  Run out;
-  out.keys = take(older.keys.size() + newer.keys.size());
-  unite_keys(older.keys, newer.keys, out.keys);
-  give(std::move(older.keys), out.keys.capacity());
-  give(std::move(newer.keys), out.keys.capacity());
-  return out;
+// Occupancy only: the union of two block runs, left in `older`; newer's vectors given
+// back for reuse. In place when older's vectors have room; else older moves to vectors
+// with room for as much again (address space only: pages are touched when written),
+// so that the next unions into it are in place too. Fresh memory costs a page fault
+// and the kernel's zeroing per page, which dominated these unions.
+void StreamBuilder::State::unite(Run& older, Run& newer) {
+  const std::size_t united = older.keys.size() + newer.keys.size() - common_blocks(older.keys, newer.keys);
+  if (older.keys.capacity() < united || older.bits.capacity() < united) {
+    KeyVector keys = take(united, 2 * united), bits = take(united, 2 * united);
+    keys.resize(older.keys.size());
+    bits.resize(older.keys.size());
+    std::copy(older.keys.begin(), older.keys.end(), keys.begin());
+    std::copy(older.bits.begin(), older.bits.end(), bits.begin());
+    std::swap(keys, older.keys);
+    std::swap(bits, older.bits);
+    const std::size_t live = older.keys.capacity() + older.bits.capacity();
+    give(std::move(keys), live);
+    give(std::move(bits), live);
+  }
+  unite_in_place(older.keys, older.bits, newer.keys, newer.bits, united);
+  give(std::move(newer.keys));
+  give(std::move(newer.bits));
+  newer = Run{};
 }
 
 void StreamBuilder::State::push_keys(std::span<Key> chunk) {
   if (chunk.empty()) return;
   if (sort_buffer.size() < chunk.size()) sort_buffer.resize(chunk.size());
-  const std::span<const Key> sorted = sort_unique(chunk.data(), sort_buffer.data(), chunk.size(), counts);
+  Key *blocks = nullptr, *bits = nullptr;
+  const std::size_t m = sort_blocks(chunk.data(), sort_buffer.data(), chunk.size(), counts, blocks, bits);
   Run run;
-  run.keys = take(sorted.size());
-  std::copy(sorted.begin(), sorted.end(), run.keys.begin());
+  run.keys = take(m);
+  run.bits = take(m);
+  std::copy(blocks, blocks + m, run.keys.begin());
+  std::copy(bits, bits + m, run.bits.begin());
   push(std::move(run));
 }
 
@@ -360,10 +418,12 @@ void StreamBuilder::State::push_keys(std::span<Key> chunk) {
 void StreamBuilder::State::push(Run run) {
   runs.push_back(std::move(run));
   while (runs.size() >= 2 && runs[runs.size() - 2].keys.size() <= 2 * runs.back().keys.size()) {
-    Run merged = specs.empty() && !payload ? unite(runs[runs.size() - 2], runs.back())
-                                           : merge(runs[runs.size() - 2], runs.back(), specs, payload);
+    if (specs.empty() && !payload) {
+      unite(runs[runs.size() - 2], runs.back());
+    } else {
+      runs[runs.size() - 2] = merge(runs[runs.size() - 2], runs.back(), specs, payload);
+    }
     runs.pop_back();
-    runs.back() = std::move(merged);
   }
 }
 
@@ -504,7 +564,8 @@ Tree StreamBuilder::finish() {
     all = std::move(s.runs.back());
     s.runs.pop_back();
     while (!s.runs.empty()) {
-      all = s.unite(s.runs.back(), all);
+      s.unite(s.runs.back(), all);
+      all = std::move(s.runs.back());
       s.runs.pop_back();
       s.spare.clear();
     }
@@ -515,7 +576,8 @@ Tree StreamBuilder::finish() {
   }
   s.runs.clear();
   const int depth = s.quantizer.depth();
-  Tree tree = detail::emit_levels(all.keys, depth, all.payloads, s.payload);
+  Tree tree = s.specs.empty() && !s.payload ? detail::emit_block_levels(all.keys, all.bits, depth)
+                                            : detail::emit_levels(all.keys, depth, all.payloads, s.payload);
   if (s.payload) tree.set_voxel_payloads(std::move(all.payloads));
   const std::size_t voxels = all.keys.size();
   for (std::size_t a = 0; a < s.specs.size(); ++a) {
