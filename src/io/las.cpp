@@ -1,6 +1,7 @@
 #include "vola/io/las.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,7 +10,6 @@
 #include <sstream>
 
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -86,22 +86,20 @@ void LasChunk::clear() {
 }
 
 LasReader::LasReader(const std::string& path) : path_(path) {
-  // Mapped when possible: the point records are then read where the page cache holds
-  // them, with no copy (a read() per chunk cost ~12% of a conversion).
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw IoError(path + ": cannot open");
   struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
-    const auto size = static_cast<std::size_t>(st.st_size);
-    void* p = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
-    if (p != MAP_FAILED) {
-      ::madvise(p, size, MADV_SEQUENTIAL);
-      mapping_ = std::shared_ptr<const void>(p, [size](const void* q) { ::munmap(const_cast<void*>(q), size); });
-      bytes_ = {static_cast<const std::uint8_t*>(p), size};
-    }
-  }
-  ::close(fd);
-  if (!mapping_) {
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+    fd_ = std::shared_ptr<const int>(new int(fd), [](const int* f) {
+      ::close(*f);
+      delete f;
+    });
+    file_size_ = static_cast<std::uint64_t>(st.st_size);
+#ifdef POSIX_FADV_SEQUENTIAL
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+#endif
+  } else {
+    ::close(fd);
     auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
     if (!*file) throw IoError(path + ": cannot open");
     in_ = std::move(file);
@@ -112,11 +110,23 @@ LasReader::LasReader(const std::string& path) : path_(path) {
 LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& name)
     : path_(name), owned_(bytes.begin(), bytes.end()) {
   bytes_ = owned_;
+  file_size_ = bytes_.size();
   read_header();
 }
 
 // size bytes at offset (checked by the caller to lie inside the file).
 void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) {
+  if (fd_) {
+    std::uint64_t done = 0;
+    while (done < size) {
+      const ::ssize_t got = ::pread(*fd_, out + done, static_cast<std::size_t>(size - done),
+                                    static_cast<off_t>(offset + done));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) throw FormatError(path_, offset + done, "cannot read");
+      done += static_cast<std::uint64_t>(got);
+    }
+    return;
+  }
   if (!in_) {
     if (size) std::memcpy(out, bytes_.data() + offset, size);
     return;
@@ -127,21 +137,7 @@ void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* ou
   if (static_cast<std::uint64_t>(in_->gcount()) != size) throw FormatError(path_, offset, "cannot read");
 }
 
-// Mapped pages of records already handed out leave the resident set (the page cache
-// keeps them): without this a pass over a file larger than memory would count the
-// whole file as the process's memory.
-void LasReader::release_before(std::uint64_t offset, bool all) {
-  if (!mapping_) return;
-  constexpr std::uint64_t kPage = 4096;
-  const std::uint64_t end = all ? (bytes_.size() + kPage - 1) / kPage * kPage : offset / kPage * kPage;
-  if (end <= released_ || (!all && end - released_ < (std::uint64_t{16} << 20))) return;  // steps of >= 16 MiB
-  const auto* base = bytes_.data();
-  ::madvise(const_cast<std::uint8_t*>(base + released_), end - released_, MADV_DONTNEED);
-  released_ = end;
-}
-
 void LasReader::read_header() {
-  file_size_ = in_ ? 0 : bytes_.size();
   if (in_) {
     in_->seekg(0, std::ios::end);
     file_size_ = static_cast<std::uint64_t>(in_->tellg());
@@ -304,17 +300,25 @@ std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   if (n == 0) return {};
   const std::size_t length = hd.record_length;
   const std::uint64_t at = hd.offset_to_points + next_ * length;
-  if (!in_) {  // the header check guarantees the records lie inside the file
-    release_before(at);
+  if (!fd_ && !in_) {  // in memory; the header check guarantees the records lie inside
     next_ += n;
     return bytes_.subspan(static_cast<std::size_t>(at), n * length);
   }
   // resize() only grows the buffer after the first chunk: no zeroing per chunk.
   if (buffer_.size() < n * length) buffer_.resize(n * length);
-  in_->seekg(static_cast<std::streamoff>(at));
-  in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
-  if (static_cast<std::size_t>(in_->gcount()) != n * length)
-    throw FormatError(path_, at, "cannot read the point records (truncated file)");
+  if (fd_) {
+    try {
+      fetch(at, n * length, buffer_.data());
+    } catch (const FormatError&) {
+      throw FormatError(path_, at, "cannot read the point records (truncated file)");
+    }
+  } else {
+    in_->clear();
+    in_->seekg(static_cast<std::streamoff>(at));
+    in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
+    if (static_cast<std::size_t>(in_->gcount()) != n * length)
+      throw FormatError(path_, at, "cannot read the point records (truncated file)");
+  }
   next_ += n;
   return {buffer_.data(), n * length};
 }
@@ -324,15 +328,21 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
   const LasHeader& hd = header_;
   chunk.extra.resize(hd.extra_fields.size());
   const std::size_t length = hd.record_length;
-  const std::span<const std::uint8_t> records = read_records(max_points);
-  const std::size_t n = records.size() / length;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
   if (n == 0) return 0;
+  // The records come in batches that stay in cache while their fields are spread out.
+  const std::size_t batch = std::max<std::size_t>(1, kLasRecordBatchBytes / length);
   if (xyz_only) {
     chunk.xyz.resize(3 * n);
     double* out = chunk.xyz.data();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t* r = records.data() + i * length;
-      for (int a = 0; a < 3; ++a) out[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+    for (std::size_t done = 0; done < n;) {
+      const std::span<const std::uint8_t> records = read_records(std::min(batch, n - done));
+      const std::size_t m = records.size() / length;
+      for (std::size_t i = 0; i < m; ++i, out += 3) {
+        const std::uint8_t* r = records.data() + i * length;
+        for (int a = 0; a < 3; ++a) out[a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+      }
+      done += m;
     }
     return n;
   }
@@ -355,34 +365,40 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
     chunk.blue.resize(n);
   }
   for (auto& e : chunk.extra) e.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t* r = records.data() + i * length;
-    for (int a = 0; a < 3; ++a)
-      chunk.xyz[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
-    chunk.intensity[i] = load<std::uint16_t>(r + 12);
-    if (extended) {
-      chunk.return_number[i] = r[14] & 15u;
-      chunk.number_of_returns[i] = r[14] >> 4;
-      chunk.classification[i] = r[16];
-      chunk.user_data[i] = r[17];
-      chunk.point_source_id[i] = load<std::uint16_t>(r + 20);
-    } else {
-      chunk.return_number[i] = r[14] & 7u;
-      chunk.number_of_returns[i] = (r[14] >> 3) & 7u;
-      chunk.classification[i] = r[15] & 31u;  // bits 5-7 are synthetic/key-point/withheld flags
-      chunk.user_data[i] = r[17];
-      chunk.point_source_id[i] = load<std::uint16_t>(r + 18);
+  for (std::size_t done = 0; done < n;) {
+    const std::span<const std::uint8_t> records = read_records(std::min(batch, n - done));
+    const std::size_t m = records.size() / length;
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::uint8_t* r = records.data() + k * length;
+      const std::size_t i = done + k;
+      for (int a = 0; a < 3; ++a)
+        chunk.xyz[3 * i + a] = static_cast<double>(load<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+      chunk.intensity[i] = load<std::uint16_t>(r + 12);
+      if (extended) {
+        chunk.return_number[i] = r[14] & 15u;
+        chunk.number_of_returns[i] = r[14] >> 4;
+        chunk.classification[i] = r[16];
+        chunk.user_data[i] = r[17];
+        chunk.point_source_id[i] = load<std::uint16_t>(r + 20);
+      } else {
+        chunk.return_number[i] = r[14] & 7u;
+        chunk.number_of_returns[i] = (r[14] >> 3) & 7u;
+        chunk.classification[i] = r[15] & 31u;  // bits 5-7 are synthetic/key-point/withheld flags
+        chunk.user_data[i] = r[17];
+        chunk.point_source_id[i] = load<std::uint16_t>(r + 18);
+      }
+      if (gps) chunk.gps_time[i] = load<double>(r + gps_at);
+      if (rgb) {
+        chunk.red[i] = load<std::uint16_t>(r + rgb_at);
+        chunk.green[i] = load<std::uint16_t>(r + rgb_at + 2);
+        chunk.blue[i] = load<std::uint16_t>(r + rgb_at + 4);
+      }
+      for (std::size_t f = 0; f < hd.extra_fields.size(); ++f) {
+        const auto& field = hd.extra_fields[f];
+        chunk.extra[f][i] = extra_value(r + field.offset, field.data_type) * field.scale + field.add;
+      }
     }
-    if (gps) chunk.gps_time[i] = load<double>(r + gps_at);
-    if (rgb) {
-      chunk.red[i] = load<std::uint16_t>(r + rgb_at);
-      chunk.green[i] = load<std::uint16_t>(r + rgb_at + 2);
-      chunk.blue[i] = load<std::uint16_t>(r + rgb_at + 4);
-    }
-    for (std::size_t f = 0; f < hd.extra_fields.size(); ++f) {
-      const auto& field = hd.extra_fields[f];
-      chunk.extra[f][i] = extra_value(r + field.offset, field.data_type) * field.scale + field.add;
-    }
+    done += m;
   }
   return n;
 }
@@ -453,10 +469,6 @@ void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::u
 
 void LasReader::rewind() {
   next_ = 0;
-  if (mapping_) {
-    release_before(0, true);
-    released_ = 0;
-  }
   if (in_) {
     in_->clear();
     in_->seekg(header_.offset_to_points);
@@ -492,17 +504,36 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
 
 namespace {
 
-// x y z of each record, resized (not cleared: no zeroing) to 3 per record.
+// x y z of each record, appended to xyz.
 void decode_xyz(const LasHeader& hd, std::span<const std::uint8_t> records, std::vector<double>& xyz) {
   const std::size_t length = hd.record_length, n = records.size() / length;
-  xyz.resize(3 * n);
-  double* out = xyz.data();
+  const std::size_t at = xyz.size();
+  xyz.resize(at + 3 * n);
+  double* out = xyz.data() + at;
   const std::uint8_t* r = records.data();
   for (std::size_t i = 0; i < n; ++i, r += length, out += 3) {
     out[0] = static_cast<double>(load<std::int32_t>(r)) * hd.scale[0] + hd.offset[0];
     out[1] = static_cast<double>(load<std::int32_t>(r + 4)) * hd.scale[1] + hd.offset[1];
     out[2] = static_cast<double>(load<std::int32_t>(r + 8)) * hd.scale[2] + hd.offset[2];
   }
+}
+
+// Points in a batch of records that stays in cache (LasReader::read_records).
+std::size_t batch_points(const LasHeader& hd) { return std::max<std::size_t>(1, kLasRecordBatchBytes / hd.record_length); }
+
+// The next chunk of up to chunk_points points, decoded into xyz (replaced); the points read.
+std::size_t read_xyz(LasReader& reader, std::size_t chunk_points, std::vector<double>& xyz) {
+  const LasHeader& hd = reader.header();
+  xyz.clear();
+  const std::size_t batch = batch_points(hd);
+  std::size_t done = 0;
+  while (done < chunk_points) {
+    const std::span<const std::uint8_t> records = reader.read_records(std::min(batch, chunk_points - done));
+    if (records.empty()) break;
+    decode_xyz(hd, records, xyz);
+    done += records.size() / hd.record_length;
+  }
+  return done;
 }
 
 // The bounds of the decoded coordinates, from the rest of the file. x * scale + offset
@@ -523,9 +554,10 @@ Box las_bounds(LasReader& reader, std::size_t chunk_points, std::int32_t stored_
     hi[a] = std::numeric_limits<std::int32_t>::min();
   }
   std::vector<double> xyz;
-  const std::size_t length = hd.record_length;
+  const std::size_t length = hd.record_length, batch = batch_points(hd);
+  std::uint64_t reported = 0;
   while (true) {
-    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
+    const std::span<const std::uint8_t> records = reader.read_records(batch);
     if (records.empty()) break;
     if (finite) {
       std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
@@ -537,13 +569,17 @@ Box las_bounds(LasReader& reader, std::size_t chunk_points, std::int32_t stored_
       }
       lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
     } else {
+      xyz.clear();
       decode_xyz(hd, records, xyz);
       for (std::size_t i = 0; i < xyz.size(); ++i) {
         box.min[i % 3] = std::min(box.min[i % 3], xyz[i]);
         box.max[i % 3] = std::max(box.max[i % 3], xyz[i]);
       }
     }
-    progress(reader.points_read());
+    if (reader.points_read() - reported >= chunk_points || reader.points_read() == hd.point_count) {
+      reported = reader.points_read();
+      progress(reported);
+    }
   }
   if (reader.points_read() == 0) return Box{};
   if (finite)
@@ -707,30 +743,43 @@ Tree finish_tree(StreamBuilder& builder, const Box& bbox, std::uint32_t epsg, Bu
   return tree;
 }
 
-// One chunk of records -> voxel keys -> the builder. With kRange, also widens [lo, hi],
-// the range of stored integers per axis.
+// The next chunk of up to chunk_points records -> voxel keys -> the builder, the
+// records read in batches that stay in cache. With kRange, also widens [lo, hi], the
+// range of stored integers per axis. Returns the points read (0 at the end).
 template <bool kRange>
-void add_records(StreamBuilder& builder, std::span<const std::uint8_t> records, std::size_t length,
-                 const AxisCells (&cells)[3], std::int32_t lo[3], std::int32_t hi[3]) {
-  const std::size_t n = records.size() / length;
+std::size_t add_chunk(LasReader& reader, StreamBuilder& builder, std::size_t chunk_points, const AxisCells (&cells)[3],
+                      std::int32_t lo[3], std::int32_t hi[3]) {
+  const LasHeader& hd = reader.header();
+  const std::size_t length = hd.record_length;
+  const std::size_t n =
+      static_cast<std::size_t>(std::min<std::uint64_t>(chunk_points, hd.point_count - reader.points_read()));
+  if (n == 0) return 0;
+  const std::size_t batch = batch_points(hd);
   const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
   Key* out = builder.key_scratch(n).data();
-  std::size_t kept = 0;
+  std::size_t kept = 0, done = 0;
   std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
-  const std::uint8_t* r = records.data();
-  for (std::size_t i = 0; i < n; ++i, r += length) {
-    const std::int32_t x = load<std::int32_t>(r), y = load<std::int32_t>(r + 4), z = load<std::int32_t>(r + 8);
-    if constexpr (kRange) {
-      l0 = std::min(l0, x), h0 = std::max(h0, x);
-      l1 = std::min(l1, y), h1 = std::max(h1, y);
-      l2 = std::min(l2, z), h2 = std::max(h2, z);
+  while (done < n) {
+    const std::span<const std::uint8_t> records = reader.read_records(std::min(batch, n - done));
+    const std::size_t m = records.size() / length;
+    if (m == 0) break;
+    const std::uint8_t* r = records.data();
+    for (std::size_t i = 0; i < m; ++i, r += length) {
+      const std::int32_t x = load<std::int32_t>(r), y = load<std::int32_t>(r + 4), z = load<std::int32_t>(r + 8);
+      if constexpr (kRange) {
+        l0 = std::min(l0, x), h0 = std::max(h0, x);
+        l1 = std::min(l1, y), h1 = std::max(h1, y);
+        l2 = std::min(l2, z), h2 = std::max(h2, z);
+      }
+      const Key key = kx(x) | ky(y) | kz(z);
+      out[kept] = key;
+      kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
     }
-    const Key key = kx(x) | ky(y) | kz(z);
-    out[kept] = key;
-    kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+    done += m;
   }
   if constexpr (kRange) lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
-  builder.add_keys(std::span<Key>(out, kept), n - kept);
+  builder.add_keys(std::span<Key>(out, kept), done - kept);
+  return done;
 }
 
 // The box of the decoded coordinates from the range of stored integers (as las_bounds).
@@ -779,10 +828,7 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
     hi[a] = std::numeric_limits<std::int32_t>::min();
   }
   reader.rewind();
-  while (true) {
-    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
-    if (records.empty()) break;
-    add_records<true>(builder, records, hd.record_length, cells, lo, hi);
+  while (add_chunk<true>(reader, builder, chunk_points, cells, lo, hi) > 0) {
     if (progress) progress(reader.points_read(), hd.point_count);
     // A point well outside the header's box: the header is stale, stop guessing at once.
     // (Writers that round the header's bounds differently from the stored integers put
@@ -856,17 +902,12 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   for (int a = 0; a < 3 && by_table; ++a)
     by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
   reader.rewind();
-  while (by_table) {
-    const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
-    if (records.empty()) break;
-    add_records<false>(builder, records, hd.record_length, cells, stored_lo, stored_hi);
+  while (by_table && add_chunk<false>(reader, builder, chunk_points, cells, stored_lo, stored_hi) > 0) {
     if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
   }
   while (!by_table) {
     if (occupancy_only) {
-      const std::span<const std::uint8_t> records = reader.read_records(chunk_points);
-      if (records.empty()) break;
-      decode_xyz(hd, records, xyz);
+      if (read_xyz(reader, chunk_points, xyz) == 0) break;
       builder.add(xyz, {}, {});
     } else {
       if (reader.read(chunk, chunk_points) == 0) break;

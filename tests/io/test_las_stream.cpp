@@ -164,6 +164,33 @@ TEST(LasStream, GeneratedFileInManyChunksBuildsAsTheWholeCloudDoes) {
   }
 }
 
+// The same from a file on disk (read with pread() in batches of kLasRecordBatchBytes):
+// chunks smaller than a batch, and chunks of many batches.
+TEST(LasStream, GeneratedFileOnDiskBuildsAsTheWholeCloudDoes) {
+  const Bytes bytes = generated_las(60000, 16);
+  const vola_test::TempDir dir;
+  const auto path = dir.path() / "generated.las";
+  vola_test::write_bytes(path, bytes);
+  ASSERT_GT(60000u, 3 * vola::io::kLasRecordBatchBytes / 34);
+  for (const std::size_t chunk : {std::size_t{61}, std::size_t{25000}, std::size_t{1} << 20}) {
+    SCOPED_TRACE("chunk " + std::to_string(chunk));
+    check_file([&] { return vola::io::LasReader(path.string()); }, chunk);
+  }
+  // Chunks of whole records from the file and from memory are the same.
+  vola::io::LasReader from_file(path.string()), from_memory(bytes, "generated.las");
+  vola::io::LasChunk a, b;
+  while (true) {
+    const std::size_t n = from_file.read(a, 20011);
+    ASSERT_EQ(n, from_memory.read(b, 20011));
+    if (n == 0) break;
+    EXPECT_EQ(a.xyz, b.xyz);
+    EXPECT_EQ(a.gps_time, b.gps_time);
+    EXPECT_EQ(a.red, b.red);
+    EXPECT_EQ(a.classification, b.classification);
+  }
+  EXPECT_EQ(from_file.points_read(), 60000u);
+}
+
 TEST(LasStream, NegativeScaleBoundsAsDecoded) {
   const Bytes bytes = generated_las(5000, 12, -0.01);
   check_file([&] { return vola::io::LasReader(bytes, "negative_scale.las"); }, 333);

@@ -81,9 +81,10 @@ class LasReader {
   // `xyz_only`, only the coordinates are decoded.
   std::size_t read(LasChunk& chunk, std::size_t max_points, bool xyz_only = false);
   // Up to `max_points` undecoded point records, header().record_length bytes each (valid
-  // until the next read); empty at the end. A file is memory-mapped, so these point into
-  // the page cache: no copy (records already handed out leave the process's resident
-  // set as the reader moves on, so a file larger than memory stays bounded).
+  // until the next read); empty at the end. A file is read with pread() into a buffer
+  // the reader reuses (as large as the largest request): the file's pages stay in the
+  // page cache, not in the process's memory, so a file larger than memory reads in
+  // bounded memory. Requests of ~kLasRecordBatchBytes keep the records in cache.
   std::span<const std::uint8_t> read_records(std::size_t max_points);
   std::uint64_t points_read() const noexcept { return next_; }
   // Back to the first point (for a second pass).
@@ -93,18 +94,22 @@ class LasReader {
   std::string path_;
   void read_header();
   void fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out);
-  void release_before(std::uint64_t offset, bool all = false);
 
-  std::unique_ptr<std::istream> in_;         // only for a file that cannot be mapped
-  std::shared_ptr<const void> mapping_;      // owns bytes_ when the file is mapped
-  std::vector<std::uint8_t> owned_;          // owns bytes_ for the in-memory constructor
-  std::span<const std::uint8_t> bytes_;      // the whole file (empty when streamed from in_)
-  std::uint64_t released_ = 0;               // mapped bytes before this were given back
+  std::unique_ptr<std::istream> in_;         // only for a file that pread() cannot read (a pipe)
+  std::shared_ptr<const int> fd_;            // a regular file, open for pread()
+  std::vector<std::uint8_t> owned_;          // the in-memory constructor's copy
+  std::span<const std::uint8_t> bytes_;      // owned_ (empty when read from a file)
   std::uint64_t file_size_ = 0;
   LasHeader header_;
   std::uint64_t next_ = 0;
   std::vector<std::uint8_t> buffer_;
 };
+
+// Bytes of records worth reading at once: a batch that stays in L2 while its keys or
+// fields are decoded (a pread() of it from the page cache is a copy through the
+// kernel's huge-page direct map; reading a memory-mapped file instead costs a TLB miss
+// and a page fault every few pages, and was 3x slower).
+constexpr std::size_t kLasRecordBatchBytes = std::size_t{256} << 10;
 
 // The whole file as a point cloud with the attribute columns vola keeps from LAS:
 // red/green/blue (mean), intensity (mean), classification (majority), height (mean z),
