@@ -24,6 +24,7 @@ struct FuseArgs {
   double depth_factor = 5000.0, voxel_size = 0.01, truncation = 0.0, max_depth = 5.0, min_depth = 0.2;
   float max_weight = 64.0f;
   std::vector<int> icp_iterations{10, 5, 4};
+  double motion_prior = slam::FusionParams{}.motion_prior;
   std::size_t frames = 0, render_frame = 1;
   std::uint32_t bricks = 4096;
   unsigned threads = 0;
@@ -117,6 +118,7 @@ void run_fuse(const FuseArgs& a) {
   p.min_depth = a.min_depth;
   p.max_depth = a.max_depth;
   for (int l = 0; l < slam::kPyramidLevels; ++l) p.icp_iterations[l] = a.icp_iterations[l];
+  p.motion_prior = a.motion_prior;
   p.threads = a.threads;
   p.check();
   if ((a.groundtruth_poses || a.start_at_groundtruth) && sequence.groundtruth.empty())
@@ -170,6 +172,10 @@ void add_fuse(CLI::App& app) {
   cmd->add_option("--min-depth", a->min_depth, "Ignore depths nearer than this (m)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-depth", a->max_depth, "Ignore depths farther than this (m)")->check(CLI::PositiveNumber);
   cmd->add_option("--icp-iterations", a->icp_iterations, "ICP iterations at pyramid levels 0 (full size), 1, 2")->expected(3);
+  cmd->add_option("--motion-prior", a->motion_prior,
+                  "Constant-velocity prior in directions the depth barely constrains (ICP eigenvalues below this "
+                  "fraction of the largest; 0 = none, as KinectFusion)")
+      ->capture_default_str();
   cmd->add_option("--frames", a->frames, "Process only the first N frames (0 = all)");
   cmd->add_option("--bricks", a->bricks, "Volume extent in bricks per side, centred on the first camera")->check(CLI::Range(1u, 1u << 17));
   cmd->add_flag("--groundtruth-poses", a->groundtruth_poses, "Map only: integrate every frame at its ground-truth pose");
