@@ -7,7 +7,7 @@ city`, written as LAS 1.2 point format 3 by this script), converts at voxel size
 the same cloud exists as LAZ in the shared data, the LAZ; then times the end-to-end
 conversion of the generated survey (median of several runs) and its peak memory.
 
-usage: bench/las_survey.py VOLA_BINARY OUT_DIR [--points N] [--runs R]
+usage: bench/las_survey.py VOLA_BINARY OUT_DIR [--points N] [--runs R] [--format 1|3]
 """
 import argparse
 import math
@@ -45,8 +45,8 @@ def mean_spacing(path):
     return math.sqrt(area / max(n, 1))
 
 
-def write_survey_las(vola, out_dir, points):
-    """A generated city block survey as LAS 1.2, point format 3 (mm precision)."""
+def write_survey_las(vola, out_dir, points, point_format=3):
+    """A generated city block survey as LAS 1.2, point format 3 or 1 (no RGB; mm precision)."""
     xyz_path = os.path.join(out_dir, "survey.xyz")
     subprocess.run([vola, "generate", "city", xyz_path, "--points", str(points), "--size", "1000"], check=True,
                    stdout=subprocess.DEVNULL)
@@ -62,21 +62,23 @@ def write_survey_las(vola, out_dir, points):
     header[58:58 + 12] = b"vola bench  "
     struct.pack_into("<H", header, 94, 227)
     struct.pack_into("<I", header, 96, 227)
-    header[104] = 3
-    struct.pack_into("<H", header, 105, 34)
+    fields = [("x", "<i4"), ("y", "<i4"), ("z", "<i4"), ("intensity", "<u2"), ("returns", "u1"),
+              ("classification", "u1"), ("angle", "i1"), ("user", "u1"), ("source", "<u2"), ("time", "<f8")]
+    if point_format == 3:
+        fields += [("r", "<u2"), ("g", "<u2"), ("b", "<u2")]
+    header[104] = point_format
+    struct.pack_into("<H", header, 105, np.dtype(fields).itemsize)
     struct.pack_into("<I", header, 107, n)
     struct.pack_into("<3d", header, 131, scale, scale, scale)
     struct.pack_into("<3d", header, 155, *offset)
     struct.pack_into("<6d", header, 179, hi[0], lo[0], hi[1], lo[1], hi[2], lo[2])
-    record = np.zeros(n, dtype=[("x", "<i4"), ("y", "<i4"), ("z", "<i4"), ("intensity", "<u2"), ("returns", "u1"),
-                                ("classification", "u1"), ("angle", "i1"), ("user", "u1"), ("source", "<u2"),
-                                ("time", "<f8"), ("r", "<u2"), ("g", "<u2"), ("b", "<u2")])
+    record = np.zeros(n, dtype=fields)
     for axis, name in enumerate("xyz"):
         record[name] = np.round((data[:, axis] - offset[axis]) / scale).astype("<i4")
     record["intensity"] = data[:, 3]
     record["returns"] = 0x09  # return 1 of 1
     record["classification"] = data[:, 4]
-    path = os.path.join(out_dir, "survey_%d.las" % n)
+    path = os.path.join(out_dir, ("survey_%d.las" if point_format == 3 else "survey_f%d_%%d.las" % point_format) % n)
     with open(path, "wb") as f:
         f.write(header)
         f.write(record.tobytes())
@@ -98,13 +100,14 @@ def main():
     parser.add_argument("out_dir")
     parser.add_argument("--points", type=int, default=10_000_000)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--format", type=int, choices=(1, 3), default=3, help="LAS point data record format")
     args = parser.parse_args()
     shared = os.environ.get("VOLA_SHARED", os.path.join(os.path.dirname(__file__), "..", "..", "shared"))
     os.makedirs(args.out_dir, exist_ok=True)
     las_dir = os.path.join(shared, "data", "las")
     files = [os.path.join(las_dir, f) for f in sorted(os.listdir(las_dir)) if f.endswith(".las")]
     files = [f for f in files if las_header(f)[0] >= 1000]  # one-point files say nothing about size
-    survey = write_survey_las(args.vola, args.out_dir, args.points)
+    survey = write_survey_las(args.vola, args.out_dir, args.points, args.format)
     files.append(survey)
 
     print("| file | points | LAS bytes | LAZ bytes | spacing | voxel | voxels | .vol bytes | bits/voxel | vol/LAS | vol/LAZ | zstd .vol bytes | zstd/LAS | zstd/LAZ |")
