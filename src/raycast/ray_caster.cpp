@@ -215,9 +215,10 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
     }
 
     // An empty cell (or one the ray cannot hit anything in): step to the next cell of
-    // this level, every axis crossing now together. Then, if nothing the ray can still
-    // reach in the block is occupied (its box from the new cell on), the parent cell is
-    // done too: step on the parent's level instead.
+    // this level, every axis crossing now together. An occupied new cell goes back up
+    // to the descent; an empty one is stepped over at once, unless nothing the ray can
+    // still reach in the block is occupied (its box from the new cell on): then the
+    // parent cell is done too, and the step is on the parent's level.
     for (;;) {
       std::array<double, 3>& out = leave[level];
       std::array<std::int64_t, 3>& here = cell[level];
@@ -226,12 +227,11 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       const int shift = 2 * (last - level);
       std::uint64_t changed = 0;
       for (int a = 0; a < 3; ++a) {
-        const bool crosses = out[a] == next;  // never on an axis that does not move
-        const std::int64_t i = here[a] + (crosses ? step[a] : 0);
+        if (out[a] != next) continue;  // never crossing on an axis that does not move
+        const std::int64_t i = here[a] + step[a];
         changed |= static_cast<std::uint64_t>(i ^ here[a]);
         here[a] = i;
-        const double later = exit_time(a, i, shift);
-        out[a] = crosses ? later : out[a];
+        out[a] = exit_time(a, i, shift);
       }
       t = next;
       moved = true;
@@ -250,11 +250,13 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
         }
       }
       const std::array<std::int64_t, 3>& now = cell[level];
+      const std::uint64_t word = block[level]->bits;
+      if ((word >> cell_bit(now)) & 1u) break;  // occupied: descend (or hit) above
       const std::array<int, 3>& r = reach[level];
       const std::uint64_t ahead_box = box_masks[0][(now[0] & 3) ^ flip[0]][r[0]] &
                                       box_masks[1][(now[1] & 3) ^ flip[1]][r[1]] &
                                       box_masks[2][(now[2] & 3) ^ flip[2]][r[2]];
-      if (block[level]->bits & ahead_box) break;
+      if (word & ahead_box) continue;  // empty, but not all the way: the next step
       if (level == 0) return std::nullopt;
       --level;
     }
