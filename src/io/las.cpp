@@ -860,10 +860,12 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
 
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
-  if (chunk_points == 0) throw InvalidArgument("build_las: chunk_points must be positive");
   const LasHeader& hd = reader.header();
   LasChunk chunk;
   const bool occupancy_only = !attributes && !payload;
+  // Keys are 8 bytes a point; decoded coordinates (the path without key tables) 24.
+  const std::size_t decoded_chunk = chunk_points == 0 ? kLasChunkPoints : chunk_points;
+  if (chunk_points == 0) chunk_points = occupancy_only ? kLasKeyChunkPoints : kLasChunkPoints;
   std::int32_t stored_lo[3], stored_hi[3];
   for (int a = 0; a < 3; ++a) {
     stored_lo[a] = std::numeric_limits<std::int32_t>::min();
@@ -907,7 +909,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   }
   while (!by_table) {
     if (occupancy_only) {
-      if (read_xyz(reader, chunk_points, xyz) == 0) break;
+      if (read_xyz(reader, decoded_chunk, xyz) == 0) break;
       builder.add(xyz, {}, {});
     } else {
       if (reader.read(chunk, chunk_points) == 0) break;

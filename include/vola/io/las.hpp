@@ -129,9 +129,14 @@ void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<st
 // (vola::StreamBuilder): one pass for the bounds (unless options.bbox is set), one to
 // build. Resolves `options` (depth, voxel size, origin) like vola::build. Memory: the
 // reduced voxels plus a chunk of `chunk_points` points (~100 bytes each).
+// chunk_points 0 (the default): kLasChunkPoints with attributes or payloads,
+// kLasKeyChunkPoints occupancy only (8 bytes a point: 32 + 32 MB of chunk buffers; a
+// larger chunk's sorted blocks repeat less of the runs already built, so fewer unions:
+// 0.55 -> 0.35 s for a 1e7-point survey in random order).
 constexpr std::size_t kLasChunkPoints = std::size_t{1} << 20;
+constexpr std::size_t kLasKeyChunkPoints = std::size_t{1} << 22;
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
-               std::size_t chunk_points = kLasChunkPoints);
+               std::size_t chunk_points = 0);
 
 }  // namespace vola::io
