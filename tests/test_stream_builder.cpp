@@ -104,6 +104,17 @@ TEST(StreamBuilder, PayloadsWithoutAttributes) {
             std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
 }
 
+// What a builder fed `keys` (in any order, with repeats) must finish as: the tree of
+// their set.
+void expect_tree_of_key_set(vola::StreamBuilder& builder, std::vector<vola::Key> keys, int depth) {
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  const vola::Tree got = builder.finish();
+  const vola::Tree want = vola::build_from_sorted_keys(keys, depth);
+  EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+            std::vector<std::uint64_t>(want.words().begin(), want.words().end()));
+}
+
 // add_keys (occupancy from keys: sort of the varying bits only, dedupe, union of runs)
 // against the set of keys, for keys that share high bits, keys that differ in one bit,
 // all-equal chunks, single keys and empty chunks, at every depth.
@@ -126,12 +137,7 @@ TEST(StreamBuilder, KeysEqualTheSetOfKeys) {
       all.insert(all.end(), keys.begin(), keys.end());
       builder.add_keys(keys, chunk % 5);
     }
-    std::sort(all.begin(), all.end());
-    all.erase(std::unique(all.begin(), all.end()), all.end());
-    const vola::Tree got = builder.finish();
-    const vola::Tree want = vola::build_from_sorted_keys(all, depth);
-    EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
-              std::vector<std::uint64_t>(want.words().begin(), want.words().end()));
+    expect_tree_of_key_set(builder, all, depth);
     EXPECT_EQ(builder.points_outside(), 40u / 5 * (0 + 1 + 2 + 3 + 4));
   }
   vola::StreamBuilder builder(vola::Quantizer::grid({0, 0, 0}, 1.0, 2), {}, false);
@@ -168,12 +174,7 @@ TEST(StreamBuilder, OccupancyUnionsInPlaceEqualTheSetOfKeys) {
       all.insert(all.end(), keys.begin(), keys.end());
       builder.add_keys(keys);
     }
-    std::sort(all.begin(), all.end());
-    all.erase(std::unique(all.begin(), all.end()), all.end());
-    const vola::Tree got = builder.finish();
-    const vola::Tree want = vola::build_from_sorted_keys(all, depth);
-    EXPECT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
-              std::vector<std::uint64_t>(want.words().begin(), want.words().end()));
+    expect_tree_of_key_set(builder, all, depth);
   }
 }
 
