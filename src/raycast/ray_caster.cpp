@@ -31,7 +31,7 @@ std::int64_t index_after(const RayAxes& axes, const Ray& ray, int a, double t, s
 }
 
 // The bit of cell c (cell indices of its level) in its block's word.
-unsigned cell_bit(const std::array<std::int64_t, 3>& c) noexcept {
+unsigned cell_bit(const std::array<std::int32_t, 3>& c) noexcept {
   return static_cast<unsigned>((c[0] & 3) + 4 * (c[1] & 3) + 16 * (c[2] & 3));
 }
 
@@ -64,6 +64,21 @@ constexpr BoxMasks make_box_masks() {
 }
 constexpr BoxMasks kBox = make_box_masks();
 
+// The per-axis constants of a direction whose signs are X, Y, Z (+1, -1, or 0 for an
+// axis that does not move).
+template <int X, int Y, int Z>
+struct Octant {
+  static constexpr std::array<int, 3> step{X, Y, Z};
+  // 1 on an axis moving up: the plane through which it leaves cell c is c + 1.
+  static constexpr std::array<std::int32_t, 3> ahead{X > 0, Y > 0, Z > 0};
+  // Cell index inside a block -> planes crossed to reach it.
+  static constexpr std::array<int, 3> flip{X > 0 ? 0 : 3, Y > 0 ? 0 : 3, Z > 0 ? 0 : 3};
+  // The box masks per axis (all ones for an axis that does not move).
+  static constexpr const std::uint64_t (&masks(int a))[4][4] { return step[a] ? kBox.m[a][step[a] > 0] : kBox.all; }
+};
+
+double min3(const std::array<double, 3>& x) noexcept { return std::min(x[0], std::min(x[1], x[2])); }
+
 }  // namespace
 
 RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
@@ -81,11 +96,22 @@ RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
   }
 }
 
+// The ray at one level, on the path from the root: its cell (in cells of that level),
+// per axis the time it crosses the plane through which it leaves that cell, per axis the
+// planes between cells of the block it can cross before leaving the parent cell (3 at
+// the root: the grid's side), and the cell's block. Cell indices are below 4^kMaxDepth
+// = 2^20, so 32 bits hold them, and a step out of the grid too.
+struct RayCaster::Level {
+  std::array<std::int32_t, 3> cell;
+  std::array<double, 3> leave;
+  std::array<int, 3> reach;
+  Node block;
+};
+
 std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
   check_ray(ray);
   if (tree_->empty()) return std::nullopt;
   const RayAxes axes(ray);
-  const int last = tree_->depth() - 1;
   const auto side = static_cast<std::int64_t>(tree_->side());
 
   // Clip to the cube [0, side]^3: the first event that puts the ray inside it.
@@ -111,48 +137,56 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       if (axes.step[a]) v[a] = index_after(axes, ray, a, t, 0, side - 1);
   }
 
-  // Per level on the path from the root: the ray's cell (in cells of that level), per
-  // axis the time it crosses the plane through which it leaves that cell, and the
-  // cell's block. Only levels up to the current one are ever read.
-  std::array<std::array<std::int64_t, 3>, kMaxDepth> cell;
-  std::array<std::array<double, 3>, kMaxDepth> leave;
-  std::array<const Node*, kMaxDepth> block;
+  using Walk = std::optional<RayHit> (RayCaster::*)(const Ray&, const RayAxes&, const std::array<std::int64_t, 3>&,
+                                                    double) const;
+  // walks[9 * (x + 1) + 3 * (y + 1) + (z + 1)] for the signs x, y, z.
+  static constexpr Walk walks[27] = {
+      &RayCaster::walk<-1, -1, -1>, &RayCaster::walk<-1, -1, 0>, &RayCaster::walk<-1, -1, 1>,
+      &RayCaster::walk<-1, 0, -1>,  &RayCaster::walk<-1, 0, 0>,  &RayCaster::walk<-1, 0, 1>,
+      &RayCaster::walk<-1, 1, -1>,  &RayCaster::walk<-1, 1, 0>,  &RayCaster::walk<-1, 1, 1>,
+      &RayCaster::walk<0, -1, -1>,  &RayCaster::walk<0, -1, 0>,  &RayCaster::walk<0, -1, 1>,
+      &RayCaster::walk<0, 0, -1>,   &RayCaster::walk<0, 0, 0>,   &RayCaster::walk<0, 0, 1>,
+      &RayCaster::walk<0, 1, -1>,   &RayCaster::walk<0, 1, 0>,   &RayCaster::walk<0, 1, 1>,
+      &RayCaster::walk<1, -1, -1>,  &RayCaster::walk<1, -1, 0>,  &RayCaster::walk<1, -1, 1>,
+      &RayCaster::walk<1, 0, -1>,   &RayCaster::walk<1, 0, 0>,   &RayCaster::walk<1, 0, 1>,
+      &RayCaster::walk<1, 1, -1>,   &RayCaster::walk<1, 1, 0>,   &RayCaster::walk<1, 1, 1>,
+  };
+  const int octant = 9 * (axes.step[0] + 1) + 3 * (axes.step[1] + 1) + (axes.step[2] + 1);
+  return (this->*walks[octant])(ray, axes, v, t);
+}
+
+template <int X, int Y, int Z>
+std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const std::array<std::int64_t, 3>& v,
+                                      double t) const {
+  using S = Octant<X, Y, Z>;
+  const int last = tree_->depth() - 1;
   const std::array<double, 3> o = ray.origin;
   const std::array<double, 3> inv = axes.inverse;
-  const std::array<int, 3> step = axes.step;
-  std::array<std::int64_t, 3> ahead{};  // 1 on an axis moving up: its exit plane is c + 1
-  std::array<int, 3> flip{};            // cell index inside a block -> planes crossed to reach it
-  std::array<const std::uint64_t(*)[4], 3> box_masks{};  // all ones for an axis that does not move
-  for (int a = 0; a < 3; ++a) {
-    ahead[a] = step[a] > 0;
-    flip[a] = step[a] > 0 ? 0 : 3;
-    box_masks[a] = step[a] ? kBox.m[a][step[a] > 0] : kBox.all;
-  }
-  // Per level: per axis the planes between cells of the block the ray can cross before
-  // leaving the parent cell (3 at the root: the grid's side).
-  std::array<std::array<int, 3>, kMaxDepth> reach;
-  reach[0] = {3, 3, 3};
-  auto exit_time = [&](int a, std::int64_t c, int shift) {
-    return crossing_time(static_cast<double>((c + ahead[a]) << shift), o[a], inv[a]);
+  auto exit_time = [&](int a, std::int32_t c, int shift) {
+    return crossing_time(static_cast<double>((c + S::ahead[a]) << shift), o[a], inv[a]);
   };
   // Events later than this end the ray (an infinite crossing time never happens).
   const double t_end = std::min(ray.t_max, std::numeric_limits<double>::max());
-  {
-    const int shift = 2 * last;
-    for (int a = 0; a < 3; ++a) {
-      cell[0][a] = v[a] >> shift;
-      leave[0][a] = step[a] ? exit_time(a, cell[0][a], shift) : kNever;
-    }
-    block[0] = nodes_.data();
+
+  // The levels above the current one, root first; the current one is kept apart from
+  // them (`here`) so that the compiler can hold it in registers.
+  std::array<Level, kMaxDepth> path;
+  Level here;
+  for (int a = 0; a < 3; ++a) {
+    here.cell[a] = static_cast<std::int32_t>(v[a] >> (2 * last));
+    here.leave[a] = S::step[a] ? exit_time(a, here.cell[a], 2 * last) : kNever;
   }
+  here.reach = {3, 3, 3};
+  here.block = nodes_[0];
   // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
   bool moved = t > 0.0;
   int level = 0;
+  auto occupied = [](const Level& l) {
+    return ((l.block.bits >> cell_bit(l.cell)) & 1u) != 0;
+  };
   for (;;) {
-    const std::array<std::int64_t, 3>& c = cell[level];
-    const unsigned bit = cell_bit(c);
-    const Node& node = *block[level];
-    if ((node.bits >> bit) & 1u) {
+    if (occupied(here)) {
+      const std::array<std::int32_t, 3>& c = here.cell;
       if (level == last) {
         RayHit hit;
         hit.voxel = Voxel{static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
@@ -160,8 +194,8 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
         hit.t = t;
         // The normal: the lowest axis whose entry plane into the voxel is crossed now.
         for (int a = 0; a < 3 && moved; ++a) {
-          if (step[a] && crossing_time(axes.entry_plane(a, c[a]), o[a], inv[a]) == t) {
-            hit.normal[a] = -step[a];
+          if (S::step[a] && crossing_time(axes.entry_plane(a, c[a]), o[a], inv[a]) == t) {
+            hit.normal[a] = -S::step[a];
             break;
           }
         }
@@ -173,43 +207,41 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       // bound on the last child). The box of those children ANDed with the child word
       // says whether the ray can hit anything below: if not, this cell is stepped over
       // like an empty one.
-      const Node* child =
-          nodes_.data() + node.first_child + std::popcount(node.bits & ((std::uint64_t{1} << bit) - 1));
-      const std::array<double, 3>& out = leave[level];
-      const double t_out = std::min(out[0], std::min(out[1], out[2]));
+      const unsigned bit = cell_bit(c);
+      const Node& child_block = nodes_[here.block.first_child +
+                                       std::popcount(here.block.bits & ((std::uint64_t{1} << bit) - 1))];
+      const double t_out = min3(here.leave);
       const int shift = 2 * (last - level - 1);
-      std::array<std::int64_t, 3> child_cell;
-      std::array<double, 3> child_leave;
+      Level child;
       std::uint64_t box = ~std::uint64_t{0};
-      std::array<int, 3> child_reach{};
       for (int a = 0; a < 3; ++a) {
-        if (!step[a]) {
-          const std::int64_t rel = (v[a] >> shift) & 3;
-          child_cell[a] = 4 * c[a] + rel;
-          child_leave[a] = kNever;
+        if (!S::step[a]) {
+          const auto rel = static_cast<std::int32_t>((v[a] >> shift) & 3);
+          child.cell[a] = 4 * c[a] + rel;
+          child.leave[a] = kNever;
+          child.reach[a] = 0;
           box &= kBox.fixed[a][rel];
           continue;
         }
         // The planes (in child cells) in crossing order: base + step * k for k = 1, 2, 3,
         // then at k = 4 the cell's own exit plane.
-        const std::int64_t base = 4 * (c[a] + 1 - ahead[a]);
-        const double t1 = crossing_time(static_cast<double>((base + step[a]) << shift), o[a], inv[a]);
-        const double t2 = crossing_time(static_cast<double>((base + 2 * step[a]) << shift), o[a], inv[a]);
-        const double t3 = crossing_time(static_cast<double>((base + 3 * step[a]) << shift), o[a], inv[a]);
+        const std::int32_t base = 4 * (c[a] + 1 - S::ahead[a]);
+        const double t1 = crossing_time(static_cast<double>((base + S::step[a]) << shift), o[a], inv[a]);
+        const double t2 = crossing_time(static_cast<double>((base + 2 * S::step[a]) << shift), o[a], inv[a]);
+        const double t3 = crossing_time(static_cast<double>((base + 3 * S::step[a]) << shift), o[a], inv[a]);
         const int in = (t1 <= t) + (t2 <= t) + (t3 <= t);
         const int last_in = (t1 < t_out) + (t2 < t_out) + (t3 < t_out);
-        const double times[4] = {t1, t2, t3, out[a]};
-        child_leave[a] = times[in];
-        child_cell[a] = 4 * c[a] + (ahead[a] ? in : 3 - in);
-        box &= box_masks[a][in][last_in];
-        child_reach[a] = last_in;
+        const double times[4] = {t1, t2, t3, here.leave[a]};
+        child.leave[a] = times[in];
+        child.cell[a] = 4 * c[a] + (S::ahead[a] ? in : 3 - in);
+        child.reach[a] = last_in;
+        box &= S::masks(a)[in][last_in];
       }
-      if (child->bits & box) {
+      if (child_block.bits & box) {
+        child.block = child_block;
+        path[level] = here;
+        here = child;
         ++level;
-        block[level] = child;
-        cell[level] = child_cell;
-        leave[level] = child_leave;
-        reach[level] = child_reach;
         continue;
       }
     }
@@ -220,18 +252,16 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
     // still reach in the block is occupied (its box from the new cell on): then the
     // parent cell is done too, and the step is on the parent's level.
     for (;;) {
-      std::array<double, 3>& out = leave[level];
-      std::array<std::int64_t, 3>& here = cell[level];
-      const double next = std::min(out[0], std::min(out[1], out[2]));
+      const double next = min3(here.leave);
       if (!(next <= t_end)) return std::nullopt;
       const int shift = 2 * (last - level);
-      std::uint64_t changed = 0;
+      std::uint32_t changed = 0;
       for (int a = 0; a < 3; ++a) {
-        if (out[a] != next) continue;  // never crossing on an axis that does not move
-        const std::int64_t i = here[a] + step[a];
-        changed |= static_cast<std::uint64_t>(i ^ here[a]);
-        here[a] = i;
-        out[a] = exit_time(a, i, shift);
+        if (here.leave[a] != next) continue;  // never crossing on an axis that does not move
+        const std::int32_t i = here.cell[a] + S::step[a];
+        changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
+        here.cell[a] = i;
+        here.leave[a] = exit_time(a, i, shift);
       }
       t = next;
       moved = true;
@@ -242,23 +272,25 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
       if (up > 0) {
         if (up > level) return std::nullopt;
         level -= up;
+        const std::array<std::int32_t, 3> below = here.cell;
+        here = path[level];
         for (int a = 0; a < 3; ++a) {
-          const std::int64_t moved_to = here[a] >> (2 * up);
-          if (moved_to == cell[level][a]) continue;
-          cell[level][a] = moved_to;
-          leave[level][a] = exit_time(a, moved_to, 2 * (last - level));
+          const std::int32_t moved_to = below[a] >> (2 * up);
+          if (moved_to == here.cell[a]) continue;
+          here.cell[a] = moved_to;
+          here.leave[a] = exit_time(a, moved_to, 2 * (last - level));
         }
       }
-      const std::array<std::int64_t, 3>& now = cell[level];
-      const std::uint64_t word = block[level]->bits;
-      if ((word >> cell_bit(now)) & 1u) break;  // occupied: descend (or hit) above
-      const std::array<int, 3>& r = reach[level];
-      const std::uint64_t ahead_box = box_masks[0][(now[0] & 3) ^ flip[0]][r[0]] &
-                                      box_masks[1][(now[1] & 3) ^ flip[1]][r[1]] &
-                                      box_masks[2][(now[2] & 3) ^ flip[2]][r[2]];
-      if (word & ahead_box) continue;  // empty, but not all the way: the next step
+      if (occupied(here)) break;  // occupied: descend (or hit) above
+      const std::array<int, 3>& r = here.reach;
+      const std::array<std::int32_t, 3>& now = here.cell;
+      const std::uint64_t ahead_box = S::masks(0)[(now[0] & 3) ^ S::flip[0]][r[0]] &
+                                      S::masks(1)[(now[1] & 3) ^ S::flip[1]][r[1]] &
+                                      S::masks(2)[(now[2] & 3) ^ S::flip[2]][r[2]];
+      if (here.block.bits & ahead_box) continue;  // empty, but not all the way: the next step
       if (level == 0) return std::nullopt;
       --level;
+      here = path[level];
     }
   }
 }

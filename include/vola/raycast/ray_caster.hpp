@@ -11,6 +11,7 @@
 // until the ray leaves the block.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -38,6 +39,13 @@ class RayCaster {
     std::uint64_t bits;         // the occupancy word
     std::uint64_t first_child;  // index in nodes_ of its first child block
   };
+  struct Level;  // the ray's state at one level of the tree (ray_caster.cpp)
+  // The walk after clipping, from voxel v at time t, for a direction whose per-axis
+  // signs (+1, -1, 0) are X, Y, Z: compile-time signs fold the per-axis choices away.
+  template <int X, int Y, int Z>
+  std::optional<RayHit> walk(const Ray& ray, const RayAxes& axes, const std::array<std::int64_t, 3>& v,
+                             double t) const;
+
   const Tree* tree_;
   std::vector<Node> nodes_;  // every level's blocks, level 0 first
 };
