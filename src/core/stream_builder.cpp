@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <new>
@@ -18,22 +19,6 @@ namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 namespace {
-
-// One attribute's partial reduction over the voxels of a run.
-struct Partial {
-  std::vector<double> value;          // mean: sum; max, min, last: the value
-  std::vector<std::uint32_t> count;   // mean: number of points
-  // majority: for voxel i, (histogram_value, histogram_count)[offsets[i] .. offsets[i+1])
-  // sorted by value
-  std::vector<std::uint64_t> offsets;
-  std::vector<double> histogram_value;
-  std::vector<std::uint32_t> histogram_count;
-
-  std::size_t memory_bytes() const noexcept {
-    return value.capacity() * 8 + count.capacity() * 4 + offsets.capacity() * 8 + histogram_value.capacity() * 8 +
-           histogram_count.capacity() * 4;
-  }
-};
 
 // Key buffers: resize() leaves new elements uninitialized (the sorts and merges write
 // every element; zeroing tens of megabytes first cost time), and a large buffer is
@@ -72,6 +57,9 @@ struct KeyAllocator {
   friend bool operator==(const KeyAllocator&, const KeyAllocator&) noexcept { return true; }
 };
 using KeyVector = std::vector<Key, KeyAllocator<Key>>;
+// The same for the per-voxel columns of runs with attributes: every element is written.
+template <class T>
+using Column = std::vector<T, KeyAllocator<T>>;
 
 // Occupancy only: sorts the voxel keys[0, n) by leaf block (key >> 6; LSD radix over
 // only the block bits that vary among them, in digits of at most 12 bits, a pass
@@ -188,130 +176,206 @@ void unite_in_place(KeyVector& a, KeyVector& a_bits, std::span<const Key> b, std
   std::copy(b_bits.begin(), b_bits.begin() + static_cast<std::ptrdiff_t>(j), ab);
 }
 
+// One attribute's partial reduction over the voxels of a run.
+struct Partial {
+  // mean: the sum; max, min, last: the value; one per voxel (majority: unused)
+  Column<double> value;
+  // majority: the run's distinct (voxel key, value) pairs, sorted, with the number of
+  // points of each: flat arrays, so that merging two runs is one linear pass
+  KeyVector pair_key;
+  Column<double> pair_value;
+  Column<std::uint32_t> pair_count;
+
+  std::size_t memory_bytes() const noexcept {
+    return value.capacity() * 8 + pair_key.capacity() * 8 + pair_value.capacity() * 8 + pair_count.capacity() * 4;
+  }
+};
+
 // Sorted unique voxel keys with their partial reductions; occupancy only (no
 // attributes, no payloads): sorted unique leaf block keys (voxel key >> 6) with their
 // 64 voxel bits each in `bits`, a word per block instead of a key per voxel.
 struct Run {
   KeyVector keys;
   KeyVector bits;
-  std::vector<std::uint64_t> payloads;
+  Column<std::uint32_t> points;  // points per voxel, when an attribute is a mean
+  Column<std::uint64_t> payloads;
   std::vector<Partial> partials;
 
   std::size_t memory_bytes() const noexcept {
-    std::size_t bytes = keys.capacity() * 8 + bits.capacity() * 8 + payloads.capacity() * 8;
+    std::size_t bytes = keys.capacity() * 8 + bits.capacity() * 8 + points.capacity() * 4 + payloads.capacity() * 8;
     for (const auto& p : partials) bytes += p.memory_bytes();
     return bytes;
   }
 };
 
-// Appends voxel `i` of `from` to `to` (as a new voxel).
-void append(const Run& from, std::size_t i, Run& to, std::span<const AttributeSpec> specs, bool payload) {
-  to.keys.push_back(from.keys[i]);
-  if (payload) to.payloads.push_back(from.payloads[i]);
-  for (std::size_t a = 0; a < specs.size(); ++a) {
-    const Partial& p = from.partials[a];
-    Partial& q = to.partials[a];
-    if (specs[a].reduction == Reduction::majority) {
-      q.histogram_value.insert(q.histogram_value.end(), p.histogram_value.begin() + p.offsets[i],
-                               p.histogram_value.begin() + p.offsets[i + 1]);
-      q.histogram_count.insert(q.histogram_count.end(), p.histogram_count.begin() + p.offsets[i],
-                               p.histogram_count.begin() + p.offsets[i + 1]);
-      q.offsets.push_back(q.histogram_value.size());
+bool has_mean(std::span<const AttributeSpec> specs) {
+  return std::any_of(specs.begin(), specs.end(), [](const AttributeSpec& s) { return s.reduction == Reduction::mean; });
+}
+
+// Where a voxel of a merge comes from: the older run, the newer, or both (same key).
+enum Source : std::uint8_t { kOlder = 1, kNewer = 2, kBoth = 3 };
+
+// The source of each key of the sorted union of the keys a and b, in order, into
+// `from`; returns the union's size.
+std::size_t plan_merge(std::span<const Key> a, std::span<const Key> b, std::vector<Source>& from) {
+  from.resize(a.size() + b.size());
+  std::size_t i = 0, j = 0, o = 0;
+  while (i < a.size() && j < b.size()) {
+    const Key x = a[i], y = b[j];
+    const bool take_a = x <= y, take_b = y <= x;
+    from[o++] = static_cast<Source>(take_a | take_b << 1);
+    i += take_a;
+    j += take_b;
+  }
+  std::fill(from.begin() + static_cast<std::ptrdiff_t>(o), from.begin() + static_cast<std::ptrdiff_t>(o + a.size() - i), kOlder);
+  o += a.size() - i;
+  std::fill(from.begin() + static_cast<std::ptrdiff_t>(o), from.begin() + static_cast<std::ptrdiff_t>(o + b.size() - j), kNewer);
+  return o + b.size() - j;
+}
+
+// n elements (uninitialized beyond the old size); room for as much again when the
+// vector has to move, so that the next merges into it stay in place.
+template <class T>
+void grow(Column<T>& column, std::size_t n) {
+  if (column.capacity() < n) column.reserve(2 * n);
+  column.resize(n);
+}
+
+// One per-voxel column of a merge, in place in the older run's column a: a voxel in
+// both runs gets both(older's value, newer's value). From the back: output o is at or
+// after every older value not yet read, so nothing is overwritten before it is read.
+// Merging in place instead of into new vectors halves the fresh memory, whose page
+// faults and zeroing by the kernel took half of the conversion.
+template <class T, class Both>
+void merge_column(Column<T>& a, const Column<T>& b, std::span<const Source> plan, Both both) {
+  std::size_t i = a.size(), j = b.size();
+  grow(a, plan.size());
+  T* out = a.data();
+  for (std::size_t o = plan.size(); o-- > 0;) {
+    switch (plan[o]) {
+      case kOlder: out[o] = out[--i]; break;
+      case kNewer: out[o] = b[--j]; break;
+      case kBoth:
+        --i;
+        out[o] = both(out[i], b[--j]);
+        break;
+    }
+  }
+}
+
+// Majority partials: the union of two sorted (key, value) pair lists in place in a,
+// counts of equal pairs added; from the back, as merge_column.
+void merge_pairs(Partial& a, const Partial& b) {
+  const std::size_t na = a.pair_key.size(), nb = b.pair_key.size();
+  auto before = [](Key x, double u, Key y, double w) { return x < y || (x == y && u < w); };
+  std::size_t united = 0, i = 0, j = 0;
+  while (i < na && j < nb) {
+    const bool take_a = !before(b.pair_key[j], b.pair_value[j], a.pair_key[i], a.pair_value[i]);
+    const bool take_b = !before(a.pair_key[i], a.pair_value[i], b.pair_key[j], b.pair_value[j]);
+    i += take_a;
+    j += take_b;
+    ++united;
+  }
+  united += (na - i) + (nb - j);
+  grow(a.pair_key, united);
+  grow(a.pair_value, united);
+  grow(a.pair_count, united);
+  Key* key = a.pair_key.data();
+  double* value = a.pair_value.data();
+  std::uint32_t* count = a.pair_count.data();
+  i = na;
+  j = nb;
+  for (std::size_t o = united; o-- > 0;) {
+    const bool has_a = i > 0, has_b = j > 0;
+    const bool take_a = has_a && (!has_b || !before(key[i - 1], value[i - 1], b.pair_key[j - 1], b.pair_value[j - 1]));
+    const bool take_b = has_b && (!has_a || !before(b.pair_key[j - 1], b.pair_value[j - 1], key[i - 1], value[i - 1]));
+    if (take_a && take_b) {
+      --i;
+      --j;
+      key[o] = key[i];
+      value[o] = value[i];
+      count[o] = count[i] + b.pair_count[j];
+    } else if (take_a) {
+      --i;
+      key[o] = key[i];
+      value[o] = value[i];
+      count[o] = count[i];
     } else {
-      q.value.push_back(p.value[i]);
-      if (specs[a].reduction == Reduction::mean) q.count.push_back(p.count[i]);
+      --j;
+      key[o] = b.pair_key[j];
+      value[o] = b.pair_value[j];
+      count[o] = b.pair_count[j];
     }
   }
 }
 
-// Appends the combination of voxel i of `older` and voxel j of `newer` (same key).
-void append_combined(const Run& older, std::size_t i, const Run& newer, std::size_t j, Run& to,
-                     std::span<const AttributeSpec> specs, bool payload) {
-  to.keys.push_back(older.keys[i]);
-  if (payload) to.payloads.push_back(newer.payloads[j]);  // the later point wins
+// The union of two runs with attributes or payloads, left in `older`; voxels in both
+// combine their partials (the newer's payload wins: it holds the later point). Column
+// by column, so that each pass is a tight loop over arrays.
+void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload,
+                std::vector<Source>& plan_buffer) {
+  const std::size_t voxels = plan_merge(older.keys, newer.keys, plan_buffer);
+  const std::span<const Source> plan(plan_buffer.data(), voxels);
+  merge_column(older.keys, newer.keys, plan, [](Key k, Key) { return k; });
+  if (has_mean(specs)) merge_column(older.points, newer.points, plan, std::plus<>());
+  if (payload) merge_column(older.payloads, newer.payloads, plan, [](std::uint64_t, std::uint64_t n) { return n; });
   for (std::size_t a = 0; a < specs.size(); ++a) {
-    const Partial& p = older.partials[a];
-    const Partial& r = newer.partials[a];
-    Partial& q = to.partials[a];
+    Column<double>& p = older.partials[a].value;
+    const Column<double>& r = newer.partials[a].value;
     switch (specs[a].reduction) {
-      case Reduction::mean:
-        q.value.push_back(p.value[i] + r.value[j]);
-        q.count.push_back(p.count[i] + r.count[j]);
-        break;
-      case Reduction::max: q.value.push_back(std::max(p.value[i], r.value[j])); break;
-      case Reduction::min: q.value.push_back(std::min(p.value[i], r.value[j])); break;
-      case Reduction::last: q.value.push_back(r.value[j]); break;
-      case Reduction::majority: {
-        std::uint64_t x = p.offsets[i], y = r.offsets[j];
-        const std::uint64_t x_end = p.offsets[i + 1], y_end = r.offsets[j + 1];
-        while (x < x_end || y < y_end) {
-          if (y == y_end || (x < x_end && p.histogram_value[x] < r.histogram_value[y])) {
-            q.histogram_value.push_back(p.histogram_value[x]);
-            q.histogram_count.push_back(p.histogram_count[x++]);
-          } else if (x == x_end || r.histogram_value[y] < p.histogram_value[x]) {
-            q.histogram_value.push_back(r.histogram_value[y]);
-            q.histogram_count.push_back(r.histogram_count[y++]);
-          } else {
-            q.histogram_value.push_back(p.histogram_value[x]);
-            q.histogram_count.push_back(p.histogram_count[x++] + r.histogram_count[y++]);
-          }
-        }
-        q.offsets.push_back(q.histogram_value.size());
-        break;
-      }
+      case Reduction::mean: merge_column(p, r, plan, std::plus<>()); break;
+      case Reduction::max: merge_column(p, r, plan, [](double x, double y) { return std::max(x, y); }); break;
+      case Reduction::min: merge_column(p, r, plan, [](double x, double y) { return std::min(x, y); }); break;
+      case Reduction::last: merge_column(p, r, plan, [](double, double y) { return y; }); break;
+      case Reduction::majority: merge_pairs(older.partials[a], newer.partials[a]); break;
     }
   }
 }
 
-// Majority partials of one chunk: per voxel, the sorted distinct values and their counts.
-void reduce_majority(const double* values, const std::uint32_t* index, const std::vector<std::uint32_t>& starts,
-                     Partial& p) {
-  std::vector<double> scratch;
-  const std::size_t voxels = starts.size() - 1;
-  p.offsets.reserve(voxels + 1);
+// Majority partials of one chunk: per voxel (starts: its points' range in index), its
+// sorted distinct values and their counts.
+void reduce_majority(std::span<const Key> voxel_keys, const double* values, const std::uint32_t* index,
+                     const std::vector<std::uint32_t>& starts, Partial& p, std::vector<double>& scratch) {
+  const std::size_t voxels = voxel_keys.size(), points = starts.back();
+  p.pair_key.resize(points);  // at most one pair per point; trimmed below
+  p.pair_value.resize(points);
+  p.pair_count.resize(points);
+  std::size_t o = 0;
   for (std::size_t v = 0; v < voxels; ++v) {
     const std::uint32_t b = starts[v], e = starts[v + 1];
     if (e - b == 1) {  // the common case: one point
-      p.histogram_value.push_back(values[index[b]]);
-      p.histogram_count.push_back(1);
-    } else {
-      scratch.clear();
-      for (std::uint32_t k = b; k < e; ++k) scratch.push_back(values[index[k]]);
-      std::sort(scratch.begin(), scratch.end());
-      for (std::size_t k = 0; k < scratch.size();) {
-        std::size_t l = k;
-        while (l < scratch.size() && scratch[l] == scratch[k]) ++l;
-        p.histogram_value.push_back(scratch[k]);
-        p.histogram_count.push_back(static_cast<std::uint32_t>(l - k));
-        k = l;
-      }
+      p.pair_key[o] = voxel_keys[v];
+      p.pair_value[o] = values[index[b]];
+      p.pair_count[o++] = 1;
+      continue;
     }
-    p.offsets.push_back(p.histogram_value.size());
-  }
-}
-
-Run empty_run(std::span<const AttributeSpec> specs) {
-  Run run;
-  run.partials.resize(specs.size());
-  for (std::size_t a = 0; a < specs.size(); ++a)
-    if (specs[a].reduction == Reduction::majority) run.partials[a].offsets.push_back(0);
-  return run;
-}
-
-Run merge(const Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload) {
-  Run out = empty_run(specs);
-  out.keys.reserve(older.keys.size() + newer.keys.size());
-  std::size_t i = 0, j = 0;
-  while (i < older.keys.size() || j < newer.keys.size()) {
-    if (j == newer.keys.size() || (i < older.keys.size() && older.keys[i] < newer.keys[j])) {
-      append(older, i++, out, specs, payload);
-    } else if (i == older.keys.size() || newer.keys[j] < older.keys[i]) {
-      append(newer, j++, out, specs, payload);
-    } else {
-      append_combined(older, i++, newer, j++, out, specs, payload);
+    scratch.clear();
+    for (std::uint32_t k = b; k < e; ++k) scratch.push_back(values[index[k]]);
+    std::sort(scratch.begin(), scratch.end());
+    for (std::size_t k = 0; k < scratch.size();) {
+      std::size_t l = k;
+      while (l < scratch.size() && scratch[l] == scratch[k]) ++l;
+      p.pair_key[o] = voxel_keys[v];
+      p.pair_value[o] = scratch[k];
+      p.pair_count[o++] = static_cast<std::uint32_t>(l - k);
+      k = l;
     }
   }
-  return out;
+  p.pair_key.resize(o);
+  p.pair_value.resize(o);
+  p.pair_count.resize(o);
+}
+
+// The most frequent value of each voxel (ties to the smallest: values are sorted),
+// stored at the voxel's rank in keys.
+void store_majority(std::span<const Key> keys, const Partial& p, AttributeColumn& column) {
+  std::size_t k = 0;
+  for (std::size_t v = 0; v < keys.size(); ++v) {
+    std::size_t best = k;
+    for (; k < p.pair_key.size() && p.pair_key[k] == keys[v]; ++k)
+      if (p.pair_count[k] > p.pair_count[best]) best = k;
+    column.set(v, p.pair_value[best]);
+  }
 }
 
 }  // namespace
@@ -330,6 +394,8 @@ struct StreamBuilder::State {
   KeyVector sort_buffer;
   KeyVector chunk_keys;  // key_scratch()
   std::vector<std::uint32_t> counts;
+  std::vector<Source> merge_plan;
+  std::vector<double> majority_scratch;
 
   // Key vectors of merged-away runs, reused for new runs and merge outputs: fresh
   // memory costs a page fault and the kernel's zeroing per page, which dominated the
@@ -384,16 +450,16 @@ void StreamBuilder::State::give(KeyVector&& v, std::size_t also_live) {
 void StreamBuilder::State::unite(Run& older, Run& newer) {
   const std::size_t united = older.keys.size() + newer.keys.size() - common_blocks(older.keys, newer.keys);
   if (older.keys.capacity() < united || older.bits.capacity() < united) {
-    KeyVector keys = take(united, 2 * united), bits = take(united, 2 * united);
-    keys.resize(older.keys.size());
-    bits.resize(older.keys.size());
-    std::copy(older.keys.begin(), older.keys.end(), keys.begin());
-    std::copy(older.bits.begin(), older.bits.end(), bits.begin());
-    std::swap(keys, older.keys);
-    std::swap(bits, older.bits);
+    KeyVector roomy_keys = take(united, 2 * united), roomy_bits = take(united, 2 * united);
+    roomy_keys.resize(older.keys.size());
+    roomy_bits.resize(older.keys.size());
+    std::copy(older.keys.begin(), older.keys.end(), roomy_keys.begin());
+    std::copy(older.bits.begin(), older.bits.end(), roomy_bits.begin());
+    std::swap(roomy_keys, older.keys);
+    std::swap(roomy_bits, older.bits);
     const std::size_t live = older.keys.capacity() + older.bits.capacity();
-    give(std::move(keys), live);
-    give(std::move(bits), live);
+    give(std::move(roomy_keys), live);  // the old, smaller vectors
+    give(std::move(roomy_bits), live);
   }
   unite_in_place(older.keys, older.bits, newer.keys, newer.bits, united);
   give(std::move(newer.keys));
@@ -421,7 +487,7 @@ void StreamBuilder::State::push(Run run) {
     if (specs.empty() && !payload) {
       unite(runs[runs.size() - 2], runs.back());
     } else {
-      runs[runs.size() - 2] = merge(runs[runs.size() - 2], runs.back(), specs, payload);
+      merge_into(runs[runs.size() - 2], runs.back(), specs, payload, merge_plan);
     }
     runs.pop_back();
   }
@@ -478,53 +544,56 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   }
   radix_sort(s.keys, &s.index, 6 * s.quantizer.depth());
 
-  Run run = empty_run(s.specs);
-  {
-    // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
-    std::vector<std::uint32_t>& starts = s.starts;
-    starts.clear();
-    for (std::size_t k = 0; k < s.keys.size(); ++k) {
-      if (k == 0 || s.keys[k] != s.keys[k - 1]) {
-        starts.push_back(static_cast<std::uint32_t>(k));
-        run.keys.push_back(s.keys[k]);
-      }
+  // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
+  Run run;
+  std::vector<std::uint32_t>& starts = s.starts;
+  starts.clear();
+  run.keys.resize(s.keys.size());  // uninitialized: KeyAllocator
+  std::size_t voxels = 0;
+  for (std::size_t k = 0; k < s.keys.size(); ++k) {
+    if (k == 0 || s.keys[k] != s.keys[k - 1]) {
+      starts.push_back(static_cast<std::uint32_t>(k));
+      run.keys[voxels++] = s.keys[k];
     }
-    starts.push_back(static_cast<std::uint32_t>(s.keys.size()));
-    const std::size_t voxels = run.keys.size();
-    const std::uint32_t* index = s.index.data();
-    if (s.payload) {
-      run.payloads.resize(voxels);
-      for (std::size_t v = 0; v < voxels; ++v) run.payloads[v] = payloads[index[starts[v + 1] - 1]];
+  }
+  starts.push_back(static_cast<std::uint32_t>(s.keys.size()));
+  run.keys.resize(voxels);
+  const std::uint32_t* index = s.index.data();
+  if (s.payload) {
+    run.payloads.resize(voxels);
+    for (std::size_t v = 0; v < voxels; ++v) run.payloads[v] = payloads[index[starts[v + 1] - 1]];
+  }
+  if (has_mean(s.specs)) {
+    run.points.resize(voxels);
+    for (std::size_t v = 0; v < voxels; ++v) run.points[v] = starts[v + 1] - starts[v];
+  }
+  // Attribute by attribute, each with a tight loop over the voxels.
+  run.partials.resize(s.specs.size());
+  for (std::size_t a = 0; a < s.specs.size(); ++a) {
+    const double* values_of = values[a].data();
+    Partial& p = run.partials[a];
+    const Reduction reduction = s.specs[a].reduction;
+    if (reduction == Reduction::majority) {
+      reduce_majority(run.keys, values_of, index, starts, p, s.majority_scratch);
+      continue;
     }
-    // Attribute by attribute, each with a tight loop over the voxels.
-    for (std::size_t a = 0; a < s.specs.size(); ++a) {
-      const double* values_of = values[a].data();
-      Partial& p = run.partials[a];
-      const Reduction reduction = s.specs[a].reduction;
-      if (reduction == Reduction::majority) {
-        reduce_majority(values_of, index, starts, p);
-        continue;
+    p.value.resize(voxels);
+    for (std::size_t v = 0; v < voxels; ++v) {
+      const std::uint32_t b = starts[v], e = starts[v + 1];
+      double r = values_of[index[reduction == Reduction::last ? e - 1 : b]];
+      switch (reduction) {
+        case Reduction::mean:
+          for (std::uint32_t k = b + 1; k < e; ++k) r += values_of[index[k]];
+          break;
+        case Reduction::max:
+          for (std::uint32_t k = b + 1; k < e; ++k) r = std::max(r, values_of[index[k]]);
+          break;
+        case Reduction::min:
+          for (std::uint32_t k = b + 1; k < e; ++k) r = std::min(r, values_of[index[k]]);
+          break;
+        default: break;
       }
-      p.value.resize(voxels);
-      if (reduction == Reduction::mean) p.count.resize(voxels);
-      for (std::size_t v = 0; v < voxels; ++v) {
-        const std::uint32_t b = starts[v], e = starts[v + 1];
-        double r = values_of[index[reduction == Reduction::last ? e - 1 : b]];
-        switch (reduction) {
-          case Reduction::mean:
-            for (std::uint32_t k = b + 1; k < e; ++k) r += values_of[index[k]];
-            p.count[v] = e - b;
-            break;
-          case Reduction::max:
-            for (std::uint32_t k = b + 1; k < e; ++k) r = std::max(r, values_of[index[k]]);
-            break;
-          case Reduction::min:
-            for (std::uint32_t k = b + 1; k < e; ++k) r = std::min(r, values_of[index[k]]);
-            break;
-          default: break;
-        }
-        p.value[v] = r;
-      }
+      p.value[v] = r;
     }
   }
   s.push(std::move(run));
@@ -552,52 +621,47 @@ void StreamBuilder::add_keys(std::span<Key> keys, std::uint64_t outside) {
 
 Tree StreamBuilder::finish() {
   State& s = *state_;
-  Run all = empty_run(s.specs);
+  Run all;
+  all.partials.resize(s.specs.size());
   // The final unions' outputs outgrow every spare: give the memory back first.
   s.spare.clear();
   s.spare.shrink_to_fit();
   s.sort_buffer = KeyVector();
   s.chunk_keys = KeyVector();
-  if (s.specs.empty() && !s.payload && !s.runs.empty()) {
-    // Occupancy only: a union is exact in any order, so merge the smallest (newest)
-    // runs first: each key is then copied about twice, not once per run.
+  // A union is exact in any order, so merge the smallest (newest) runs first: each
+  // voxel is then copied about twice, not once per run.
+  if (!s.runs.empty()) {
     all = std::move(s.runs.back());
     s.runs.pop_back();
-    while (!s.runs.empty()) {
+  }
+  const bool occupancy_only = s.specs.empty() && !s.payload;
+  while (!s.runs.empty()) {
+    if (occupancy_only) {
       s.unite(s.runs.back(), all);
-      all = std::move(s.runs.back());
-      s.runs.pop_back();
       s.spare.clear();
+    } else {
+      merge_into(s.runs.back(), all, s.specs, s.payload, s.merge_plan);
     }
+    all = std::move(s.runs.back());
+    s.runs.pop_back();
   }
-  for (auto& run : s.runs) {
-    all = merge(all, run, s.specs, s.payload);
-    run = Run{};
-  }
-  s.runs.clear();
+  s.merge_plan = {};
   const int depth = s.quantizer.depth();
-  Tree tree = s.specs.empty() && !s.payload ? detail::emit_block_levels(all.keys, all.bits, depth)
-                                            : detail::emit_levels(all.keys, depth, all.payloads, s.payload);
-  if (s.payload) tree.set_voxel_payloads(std::move(all.payloads));
+  Tree tree = occupancy_only ? detail::emit_block_levels(all.keys, all.bits, depth)
+                             : detail::emit_levels(all.keys, depth, all.payloads, s.payload);
+  if (s.payload) tree.set_voxel_payloads(std::vector<std::uint64_t>(all.payloads.begin(), all.payloads.end()));
   const std::size_t voxels = all.keys.size();
   for (std::size_t a = 0; a < s.specs.size(); ++a) {
     const AttributeSpec& spec = s.specs[a];
-    const Partial& p = all.partials[a];
+    Partial& p = all.partials[a];
     AttributeColumn column(spec.name, spec.type, spec.reduction, voxels);
-    for (std::size_t v = 0; v < voxels; ++v) {
-      switch (spec.reduction) {
-        case Reduction::mean: column.set(v, p.value[v] / p.count[v]); break;
-        case Reduction::majority: {
-          // The most frequent value; ties go to the smallest (the histogram is sorted).
-          std::uint64_t best = p.offsets[v];
-          for (std::uint64_t k = p.offsets[v]; k < p.offsets[v + 1]; ++k)
-            if (p.histogram_count[k] > p.histogram_count[best]) best = k;
-          column.set(v, p.histogram_value[best]);
-          break;
-        }
-        default: column.set(v, p.value[v]); break;
-      }
+    if (spec.reduction == Reduction::majority) {
+      store_majority(all.keys, p, column);
+    } else {
+      for (std::size_t v = 0; v < voxels; ++v)
+        column.set(v, spec.reduction == Reduction::mean ? p.value[v] / all.points[v] : p.value[v]);
     }
+    p = Partial{};  // the column holds it now
     tree.attributes().add(std::move(column));
   }
   tree.set_frame(s.quantizer.frame());
