@@ -473,8 +473,11 @@ void StreamBuilder::State::push_keys(std::span<Key> chunk) {
   Key *blocks = nullptr, *bits = nullptr;
   const std::size_t m = sort_blocks(chunk.data(), sort_buffer.data(), chunk.size(), counts, blocks, bits);
   Run run;
-  run.keys = take(m);
-  run.bits = take(m);
+  // Room for the unions into this run to come (address space only: pages are touched
+  // when written), so that they need no fresh vectors, whose first touch (a page fault
+  // and the kernel's zeroing per page) costs more than the union itself.
+  run.keys = take(m, 4 * m);
+  run.bits = take(m, 4 * m);
   std::copy(blocks, blocks + m, run.keys.begin());
   std::copy(bits, bits + m, run.bits.begin());
   push(std::move(run));
