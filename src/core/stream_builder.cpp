@@ -395,6 +395,7 @@ struct StreamBuilder::State {
   KeyVector chunk_keys;  // key_scratch()
   std::vector<std::uint32_t> counts;
   std::vector<Source> merge_plan;
+  Run recycled;  // attributes or payloads: a merged-away run, its vectors reused by add()
   std::vector<double> majority_scratch;
 
   // Key vectors of merged-away runs, reused for new runs and merge outputs: fresh
@@ -491,6 +492,9 @@ void StreamBuilder::State::push(Run run) {
       unite(runs[runs.size() - 2], runs.back());
     } else {
       merge_into(runs[runs.size() - 2], runs.back(), specs, payload, merge_plan);
+      // The merged-away run's vectors take the next chunk's partials: memory already
+      // touched, where new vectors would cost a page fault and zeroing per page.
+      if (runs.back().keys.capacity() > recycled.keys.capacity()) recycled = std::move(runs.back());
     }
     runs.pop_back();
   }
@@ -548,7 +552,8 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   radix_sort(s.keys, &s.index, 6 * s.quantizer.depth());
 
   // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
-  Run run;
+  Run run = std::move(s.recycled);  // sizes set below; only the capacity matters
+  s.recycled = Run{};
   std::vector<std::uint32_t>& starts = s.starts;
   starts.clear();
   run.keys.resize(s.keys.size());  // uninitialized: KeyAllocator
@@ -631,6 +636,7 @@ Tree StreamBuilder::finish() {
   s.spare.shrink_to_fit();
   s.sort_buffer = KeyVector();
   s.chunk_keys = KeyVector();
+  s.recycled = Run{};
   // A union is exact in any order, so merge the smallest (newest) runs first: each
   // voxel is then copied about twice, not once per run.
   if (!s.runs.empty()) {

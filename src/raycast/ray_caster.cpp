@@ -75,6 +75,8 @@ struct Octant {
   static constexpr std::array<int, 3> flip{X > 0 ? 0 : 3, Y > 0 ? 0 : 3, Z > 0 ? 0 : 3};
   // The box masks per axis (all ones for an axis that does not move).
   static constexpr const std::uint64_t (&masks(int a))[4][4] { return step[a] ? kBox.m[a][step[a] > 0] : kBox.all; }
+  // The cells of a block from cell index i on along axis a, in the ray's direction.
+  static constexpr std::uint64_t onward(int a, std::int32_t i) { return masks(a)[(i & 3) ^ flip[a]][3]; }
 };
 
 double min3(const std::array<double, 3>& x) noexcept { return std::min(x[0], std::min(x[1], x[2])); }
@@ -97,14 +99,15 @@ RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
 }
 
 // The ray at one level, on the path from the root: its cell (in cells of that level),
-// per axis the time it crosses the plane through which it leaves that cell, per axis the
-// planes between cells of the block it can cross before leaving the parent cell (3 at
-// the root: the grid's side), and the cell's block. Cell indices are below 4^kMaxDepth
-// = 2^20, so 32 bits hold them, and a step out of the grid too.
+// per axis the time it crosses the plane through which it leaves that cell, the cell's
+// block, and the cells of that block the ray can still reach: the box from its cell to
+// where it leaves the parent cell (the whole grid at the root), narrowed at every step.
+// Cell indices are below 4^kMaxDepth = 2^20, so 32 bits hold them, and a step out of
+// the grid too.
 struct RayCaster::Level {
   std::array<std::int32_t, 3> cell;
   std::array<double, 3> leave;
-  std::array<int, 3> reach;
+  std::uint64_t ahead;
   Node block;
 };
 
@@ -172,11 +175,12 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
   // them (`here`) so that the compiler can hold it in registers.
   std::array<Level, kMaxDepth> path;
   Level here;
+  here.ahead = ~std::uint64_t{0};
   for (int a = 0; a < 3; ++a) {
     here.cell[a] = static_cast<std::int32_t>(v[a] >> (2 * last));
     here.leave[a] = S::step[a] ? exit_time(a, here.cell[a], 2 * last) : kNever;
+    here.ahead &= S::step[a] ? S::onward(a, here.cell[a]) : kBox.fixed[a][here.cell[a]];
   }
-  here.reach = {3, 3, 3};
   here.block = nodes_[0];
   // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
   bool moved = t > 0.0;
@@ -219,7 +223,6 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
           const auto rel = static_cast<std::int32_t>((v[a] >> shift) & 3);
           child.cell[a] = 4 * c[a] + rel;
           child.leave[a] = kNever;
-          child.reach[a] = 0;
           box &= kBox.fixed[a][rel];
           continue;
         }
@@ -231,13 +234,14 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
         const double t3 = crossing_time(static_cast<double>((base + 3 * S::step[a]) << shift), o[a], inv[a]);
         const int in = (t1 <= t) + (t2 <= t) + (t3 <= t);
         const int last_in = (t1 < t_out) + (t2 < t_out) + (t3 < t_out);
-        const double times[4] = {t1, t2, t3, here.leave[a]};
-        child.leave[a] = times[in];
+        // The child's exit plane: the next one after those crossed (k = 4 gives the same
+        // double as the cell's own exit time).
+        child.leave[a] = crossing_time(static_cast<double>((base + (in + 1) * S::step[a]) << shift), o[a], inv[a]);
         child.cell[a] = 4 * c[a] + (S::ahead[a] ? in : 3 - in);
-        child.reach[a] = last_in;
         box &= S::masks(a)[in][last_in];
       }
       if (child_block.bits & box) {
+        child.ahead = box;
         child.block = child_block;
         path[level] = here;
         here = child;
@@ -249,8 +253,8 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
     // An empty cell (or one the ray cannot hit anything in): step to the next cell of
     // this level, every axis crossing now together. An occupied new cell goes back up
     // to the descent; an empty one is stepped over at once, unless nothing the ray can
-    // still reach in the block is occupied (its box from the new cell on): then the
-    // parent cell is done too, and the step is on the parent's level.
+    // still reach in the block is occupied: then the parent cell is done too, and the
+    // step is on the parent's level.
     for (;;) {
       const double next = min3(here.leave);
       if (!(next <= t_end)) return std::nullopt;
@@ -262,6 +266,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
         changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
         here.cell[a] = i;
         here.leave[a] = exit_time(a, i, shift);
+        here.ahead &= S::onward(a, i);
       }
       t = next;
       moved = true;
@@ -279,15 +284,11 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
           if (moved_to == here.cell[a]) continue;
           here.cell[a] = moved_to;
           here.leave[a] = exit_time(a, moved_to, 2 * (last - level));
+          here.ahead &= S::onward(a, moved_to);
         }
       }
       if (occupied(here)) break;  // occupied: descend (or hit) above
-      const std::array<int, 3>& r = here.reach;
-      const std::array<std::int32_t, 3>& now = here.cell;
-      const std::uint64_t ahead_box = S::masks(0)[(now[0] & 3) ^ S::flip[0]][r[0]] &
-                                      S::masks(1)[(now[1] & 3) ^ S::flip[1]][r[1]] &
-                                      S::masks(2)[(now[2] & 3) ^ S::flip[2]][r[2]];
-      if (here.block.bits & ahead_box) continue;  // empty, but not all the way: the next step
+      if (here.block.bits & here.ahead) continue;  // empty, but not all the way: the next step
       if (level == 0) return std::nullopt;
       --level;
       here = path[level];
