@@ -76,7 +76,9 @@ TEST(Las, EveryFileReadsAsTheIndependentReaderFound) {
     }
     EXPECT_EQ(total, h.point_count);
     EXPECT_EQ(classes, expected_classes(line));
-    if (const auto expected_rgb = vola_io_test::expected_integer(line, "rgb_max=")) EXPECT_EQ(rgb_max, *expected_rgb);
+    if (const auto expected_rgb = vola_io_test::expected_integer(line, "rgb_max=")) {
+      EXPECT_EQ(rgb_max, *expected_rgb);
+    }
     // Where the independent reader found the points inside the header bounds, so do we.
     if (line.find("decoded_bounds_ok=True") != std::string::npos) {
       for (int a = 0; a < 3; ++a) {
