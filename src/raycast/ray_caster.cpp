@@ -31,8 +31,8 @@ std::int64_t index_after(const RayAxes& axes, const Ray& ray, int a, double t, s
 }
 
 // The bit of cell c (cell indices of its level) in its block's word.
-unsigned cell_bit(const std::array<std::int32_t, 3>& c) noexcept {
-  return static_cast<unsigned>((c[0] & 3) + 4 * (c[1] & 3) + 16 * (c[2] & 3));
+std::uint64_t cell_bit(const std::array<std::int32_t, 3>& c) noexcept {
+  return std::uint64_t{1} << ((c[0] & 3) + 4 * (c[1] & 3) + 16 * (c[2] & 3));
 }
 
 // kBox.m[a][up][in][out]: the bits of a block's word whose cell index along axis a
@@ -77,6 +77,11 @@ struct Octant {
   static constexpr const std::uint64_t (&masks(int a))[4][4] { return step[a] ? kBox.m[a][step[a] > 0] : kBox.all; }
   // The cells of a block from cell index i on along axis a, in the ray's direction.
   static constexpr std::uint64_t onward(int a, std::int32_t i) { return masks(a)[(i & 3) ^ flip[a]][3]; }
+  // A cell's bit in its block's word, moved one cell along axis a in the ray's direction.
+  static constexpr std::uint64_t next_bit(int a, std::uint64_t bit) {
+    const int stride = 1 << (2 * a);
+    return step[a] > 0 ? bit << stride : bit >> stride;
+  }
 };
 
 double min3(const std::array<double, 3>& x) noexcept { return std::min(x[0], std::min(x[1], x[2])); }
@@ -107,6 +112,7 @@ RayCaster::RayCaster(const Tree& tree) : tree_(&tree) {
 struct RayCaster::Level {
   std::array<std::int32_t, 3> cell;
   std::array<double, 3> leave;
+  std::uint64_t bit;  // the cell's bit in the block's word, moved along with the cell
   std::uint64_t ahead;
   Node block;
 };
@@ -181,13 +187,12 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
     here.leave[a] = S::step[a] ? exit_time(a, here.cell[a], 2 * last) : kNever;
     here.ahead &= S::step[a] ? S::onward(a, here.cell[a]) : kBox.fixed[a][here.cell[a]];
   }
+  here.bit = cell_bit(here.cell);
   here.block = nodes_[0];
   // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
   bool moved = t > 0.0;
   int level = 0;
-  auto occupied = [](const Level& l) {
-    return ((l.block.bits >> cell_bit(l.cell)) & 1u) != 0;
-  };
+  auto occupied = [](const Level& l) { return (l.block.bits & l.bit) != 0; };
   for (;;) {
     if (occupied(here)) {
       const std::array<std::int32_t, 3>& c = here.cell;
@@ -211,9 +216,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
       // bound on the last child). The box of those children ANDed with the child word
       // says whether the ray can hit anything below: if not, this cell is stepped over
       // like an empty one.
-      const unsigned bit = cell_bit(c);
-      const Node& child_block = nodes_[here.block.first_child +
-                                       std::popcount(here.block.bits & ((std::uint64_t{1} << bit) - 1))];
+      const Node& child_block = nodes_[here.block.first_child + std::popcount(here.block.bits & (here.bit - 1))];
       const double t_out = min3(here.leave);
       const int shift = 2 * (last - level - 1);
       Level child;
@@ -241,6 +244,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
         box &= S::masks(a)[in][last_in];
       }
       if (child_block.bits & box) {
+        child.bit = cell_bit(child.cell);
         child.ahead = box;
         child.block = child_block;
         path[level] = here;
@@ -266,6 +270,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
         changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
         here.cell[a] = i;
         here.leave[a] = exit_time(a, i, shift);
+        here.bit = S::next_bit(a, here.bit);  // meaningless if the cell left the block: then it climbs
         here.ahead &= S::onward(a, i);
       }
       t = next;
@@ -284,6 +289,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
           if (moved_to == here.cell[a]) continue;
           here.cell[a] = moved_to;
           here.leave[a] = exit_time(a, moved_to, 2 * (last - level));
+          here.bit = S::next_bit(a, here.bit);
           here.ahead &= S::onward(a, moved_to);
         }
       }
