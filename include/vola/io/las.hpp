@@ -130,11 +130,13 @@ void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<st
 // build. Resolves `options` (depth, voxel size, origin) like vola::build. Memory: the
 // reduced voxels plus a chunk of `chunk_points` points (~100 bytes each).
 // chunk_points 0 (the default): kLasChunkPoints with attributes or payloads,
-// kLasKeyChunkPoints occupancy only (8 bytes a point: 32 + 32 MB of chunk buffers; a
-// larger chunk's sorted blocks repeat less of the runs already built, so fewer unions:
-// 0.55 -> 0.35 s for a 1e7-point survey in random order).
+// kLasKeyChunkPoints occupancy only (8 bytes a point: 16 + 16 MB of chunk buffers).
+// A larger chunk's sorted blocks repeat less of the runs already built (fewer unions),
+// a smaller one touches less fresh memory, whose page faults and zeroing are costly on
+// a VM: 2M points measured best (1e7 random-order survey 0.46 s, 88 MiB; 2e8 strip
+// survey 3.7 s, 183 MiB; 4M points: 0.47 s, 125 MiB; 4.1 s, 239 MiB).
 constexpr std::size_t kLasChunkPoints = std::size_t{1} << 20;
-constexpr std::size_t kLasKeyChunkPoints = std::size_t{1} << 22;
+constexpr std::size_t kLasKeyChunkPoints = std::size_t{1} << 21;
 Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
                std::size_t chunk_points = 0);
