@@ -1,5 +1,9 @@
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <string_view>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -39,9 +43,51 @@ Point transform(const Matrix& m, const aiVector3D& v) {
   return p;
 }
 
+// The decimal number at text[at...] after blanks and '#' comment lines, saturating at
+// 2^63; nullopt when there is none. `at` moves past it.
+std::optional<std::uint64_t> next_count(std::string_view text, std::size_t& at) {
+  while (at < text.size() && (std::isspace(static_cast<unsigned char>(text[at])) || text[at] == '#')) {
+    if (text[at] == '#')
+      while (at < text.size() && text[at] != '\n') ++at;
+    else
+      ++at;
+  }
+  if (at >= text.size() || !std::isdigit(static_cast<unsigned char>(text[at]))) return std::nullopt;
+  std::uint64_t value = 0;
+  for (; at < text.size() && std::isdigit(static_cast<unsigned char>(text[at])); ++at)
+    value = std::min<std::uint64_t>(value * 10 + static_cast<std::uint64_t>(text[at] - '0'), std::uint64_t{1} << 63);
+  return value;
+}
+
+// Assimp's OFF reader reserves the header's vertex and face counts before reading
+// them: a 143-byte file declaring billions of faces made it allocate gigabytes (found
+// by fuzz_mesh_read). Each vertex or face takes at least two bytes of text, so counts
+// the rest of the file cannot hold are refused before Assimp sees them.
+void check_off_counts(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<char, 1024> head{};
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  const std::string_view text(head.data(), static_cast<std::size_t>(in.gcount()));
+  const std::size_t keyword = text.find("OFF");
+  if (keyword == std::string_view::npos || keyword > 4) return;  // not OFF (or a prefixed ST/C/N/4 OFF)
+  std::size_t at = keyword + 3;
+  const std::size_t vertices_at = at;
+  const std::optional<std::uint64_t> vertices = next_count(text, at);
+  const std::optional<std::uint64_t> faces = vertices ? next_count(text, at) : std::nullopt;
+  if (!faces) return;  // Assimp reports a header it cannot read itself
+  std::error_code error;
+  const std::uint64_t bytes = std::filesystem::file_size(path, error);
+  if (error) return;
+  if (*vertices > bytes / 2 || *faces > bytes / 2 || *vertices + *faces > bytes / 2)
+    throw FormatError(path, vertices_at,
+                      "the OFF header declares " + std::to_string(*vertices) + " vertices and " + std::to_string(*faces) +
+                          " faces, more than the file's " + std::to_string(bytes) + " bytes can hold");
+}
+
 }  // namespace
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
+  check_off_counts(path);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
   if (!scene || !scene->mRootNode) throw FormatError(path, std::nullopt, std::string("Assimp: ") + importer.GetErrorString());
