@@ -110,8 +110,8 @@ def main():
     survey = write_survey_las(args.vola, args.out_dir, args.points, args.format)
     files.append(survey)
 
-    print("| file | points | LAS bytes | LAZ bytes | spacing | voxel | voxels | .vol bytes | bits/voxel | vol/LAS | vol/LAZ | zstd .vol bytes | zstd/LAS | zstd/LAZ |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| file | points | LAS bytes | LAZ bytes | spacing | voxel | voxels | .vol bytes | bits/voxel | vol/LAS | vol/LAZ | zstd .vol bytes | zstd/LAS | zstd/LAZ | convert s | M points/s | peak MiB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     vol = os.path.join(args.out_dir, "out.vol")
     for las in files:
         n = las_header(las)[0]
@@ -121,13 +121,14 @@ def main():
         spacing = mean_spacing(las)
         for k in (1, 2, 4):
             voxel = k * spacing
-            size, voxels, _, _ = convert(args.vola, las, vol, voxel, ["--no-attributes"])
+            # End to end, one run (the process start included: small files measure that).
+            size, voxels, seconds, kib = convert(args.vola, las, vol, voxel, ["--no-attributes"])
             zsize, _, _, _ = convert(args.vola, las, vol, voxel, ["--no-attributes", "--compress"])
             laz = "%d" % laz_bytes if laz_bytes else "-"
-            print("| %s | %d | %d | %s | %.3g | %dx = %.3g | %d | %d | %.2f | %.3f | %s | %d | %.4f | %s |" % (
+            print("| %s | %d | %d | %s | %.3g | %dx = %.3g | %d | %d | %.2f | %.3f | %s | %d | %.4f | %s | %.2f | %.2f | %.0f |" % (
                 os.path.basename(las), n, las_bytes, laz, spacing, k, voxel, voxels, size, 8.0 * size / voxels,
                 size / las_bytes, "%.3f" % (size / laz_bytes) if laz_bytes else "-", zsize, zsize / las_bytes,
-                "%.3f" % (zsize / laz_bytes) if laz_bytes else "-"))
+                "%.3f" % (zsize / laz_bytes) if laz_bytes else "-", seconds, n / max(seconds, 0.01) / 1e6, kib / 1024))
 
     print()
     print("Throughput, %s (%d points, %d bytes), voxel = 1x spacing, median of %d runs, file in page cache:" % (
