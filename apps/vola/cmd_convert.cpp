@@ -208,7 +208,11 @@ void run_convert(const ConvertArgs& a) {
     options.quantization = Quantization::grid;
   } else if (quantize == "toolkit") {
     options.quantization = Quantization::toolkit;
-    if (a.depth == 0) throw InvalidArgument("--quantize toolkit needs --depth (1..10)");
+    if (a.depth == 0)
+      throw InvalidArgument(a.quantize.empty()
+                                ? "how fine should the voxels be? Give --voxel-size S (grid mode, S in the input's units, "
+                                  "e.g. the point spacing) or --depth D (toolkit mode: 4^D voxels along the longest side, 1..10)"
+                                : "--quantize toolkit needs --depth (1..10)");
     if (a.voxel_size > 0.0 || !a.origin.empty())
       throw InvalidArgument("--voxel-size and --origin apply to --quantize grid; toolkit mode derives the grid from the bbox");
   } else if (quantize == "grid") {

@@ -90,6 +90,17 @@ else
   fail "vola convert $chair"
 fi
 
+# A point file with nothing saying how fine the voxels are: refused, and the error says
+# which options to give (not the toolkit mode's internal name for it).
+ply=$(ls "$data"/ply/*.ply | head -1)
+if message=$("$vola" convert "$ply" "$tmp/unsized.vol" 2>&1); then
+  fail "vola convert $ply without --voxel-size or --depth succeeded"
+elif [[ $message != *--voxel-size*--depth* ]]; then
+  fail "vola convert without a voxel size: unhelpful error: $message"
+else
+  echo "ok: no voxel size -> $message"
+fi
+
 if ((failures > 0)); then
   echo "$failures failure(s)" >&2
   exit 1
