@@ -265,7 +265,9 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
       const int shift = 2 * (last - level);
       std::uint32_t changed = 0;
       for (int a = 0; a < 3; ++a) {
-        if (here.leave[a] != next) continue;  // never crossing on an axis that does not move
+        // Not crossing now (never on an axis that does not move). leave >= next, so > is
+        // the same test as != but compiles to one compare and branch (no NaN check).
+        if (here.leave[a] > next) continue;
         const std::int32_t i = here.cell[a] + S::step[a];
         changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
         here.cell[a] = i;
@@ -278,8 +280,9 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
       // Left the parent block: climb to the coarsest level whose cell changed (its own
       // parent's cell did not); the levels below it are entered again by descending. A
       // cell index that left [0, 4^(level+1)) climbs past the root: the ray left the grid.
-      const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
-      if (up > 0) {
+      // Indices that changed in their two low bits only stayed in the block.
+      if (changed > 3) {
+        const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
         if (up > level) return std::nullopt;
         level -= up;
         const std::array<std::int32_t, 3> below = here.cell;
