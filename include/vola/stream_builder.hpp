@@ -52,6 +52,11 @@ class StreamBuilder {
   // A buffer of n keys owned by the builder, reused from chunk to chunk (valid until the
   // next call), to fill and hand to add_keys.
   std::span<Key> key_scratch(std::size_t n);
+  // A hint (a LAS header's point count, say): about `points` points will be added. With
+  // attributes or payloads the first run then reserves room for that many voxels in
+  // each column (address space only: pages are touched as written), so the merges into
+  // it never move its columns to fresh memory. Any count is safe; 0 is no hint.
+  void expect_points(std::uint64_t points) noexcept;
   // All chunks added: the tree (frame set from the quantizer; georef left to the caller).
   Tree finish();
 

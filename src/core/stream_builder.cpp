@@ -332,6 +332,24 @@ void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> spe
   }
 }
 
+// Room for `voxels` in every column the run uses (address space only).
+void reserve_voxels(Run& run, std::span<const AttributeSpec> specs, bool payload, std::uint64_t voxels) {
+  run.keys.reserve(voxels);
+  if (has_mean(specs)) run.points.reserve(voxels);
+  if (payload) run.payloads.reserve(voxels);
+  run.partials.resize(specs.size());
+  for (std::size_t a = 0; a < specs.size(); ++a) {
+    Partial& p = run.partials[a];
+    if (specs[a].reduction != Reduction::majority) {
+      p.value.reserve(voxels);
+    } else {
+      p.pair_key.reserve(voxels);
+      p.pair_value.reserve(voxels);
+      p.pair_count.reserve(voxels);
+    }
+  }
+}
+
 // Majority partials of one chunk: per voxel (starts: its points' range in index), its
 // sorted distinct values and their counts.
 void reduce_majority(std::span<const Key> voxel_keys, const double* values, const std::uint32_t* index,
@@ -396,6 +414,7 @@ struct StreamBuilder::State {
   std::vector<std::uint32_t> counts;
   std::vector<Source> merge_plan;
   Run recycled;  // attributes or payloads: a merged-away run, its vectors reused by add()
+  std::uint64_t expected_points = 0;  // expect_points()
   std::vector<double> majority_scratch;
 
   // Key vectors of merged-away runs, reused for new runs and merge outputs: fresh
@@ -511,6 +530,7 @@ StreamBuilder::StreamBuilder(StreamBuilder&&) noexcept = default;
 StreamBuilder& StreamBuilder::operator=(StreamBuilder&&) noexcept = default;
 
 std::uint64_t StreamBuilder::points_in() const noexcept { return state_->points_in; }
+void StreamBuilder::expect_points(std::uint64_t points) noexcept { state_->expected_points = points; }
 std::uint64_t StreamBuilder::points_outside() const noexcept { return state_->points_outside; }
 
 std::size_t StreamBuilder::memory_bytes() const noexcept {
@@ -554,6 +574,7 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
   Run run = std::move(s.recycled);  // sizes set below; only the capacity matters
   s.recycled = Run{};
+  if (s.runs.empty() && s.expected_points > s.keys.size()) reserve_voxels(run, s.specs, s.payload, s.expected_points);
   std::vector<std::uint32_t>& starts = s.starts;
   starts.clear();
   run.keys.resize(s.keys.size());  // uninitialized: KeyAllocator

@@ -893,6 +893,7 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
   std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
   StreamBuilder builder(quantizer, specs, payload);
+  if (!occupancy_only) builder.expect_points(hd.point_count);
   std::vector<std::vector<double>> values;
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
