@@ -49,14 +49,15 @@ bool starts_extension(std::span<const std::uint8_t> bytes) noexcept {
   return bytes.size() >= 8 && std::memcmp(bytes.data(), kExtensionMagic, 8) == 0;
 }
 
-void append_extension(const Tree& tree, bool compress_levels, int level, std::vector<std::uint8_t>& out) {
-  // Room for everything but compressed levels at once: attribute columns can be
-  // hundreds of megabytes, and each doubling of the vector copied them into fresh pages
-  // (40% of the page faults of a 1e7-point LAS conversion with attributes).
-  std::size_t room = 128 + tree.georef().crs_wkt.size();
-  for (const auto& column : tree.attributes().columns()) room += 48 + column.name().size() + column.bytes().size();
-  out.reserve(out.size() + room);
-  ByteWriter w(out);
+std::uint64_t ExtensionPieces::size() const noexcept {
+  std::uint64_t bytes = own.size();
+  for (const auto& piece : borrowed) bytes += piece.second.size();
+  return bytes;
+}
+
+void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out) {
+  ByteWriter w(out.own);
+  std::uint64_t borrowed_bytes = 0;  // so far: the file offset is own.size() + this
   w.put_bytes(kExtensionMagic);
   w.put(kExtensionVersion);
   const std::uint32_t records = 1 + (tree.georef().crs_wkt.empty() ? 0 : 1) +
@@ -92,9 +93,13 @@ void append_extension(const Tree& tree, bool compress_levels, int level, std::ve
     w.put(static_cast<std::uint32_t>(column.name().size()));
     w.put(static_cast<std::uint64_t>(raw.size()));
     w.put_bytes(as_bytes(column.name()));
-    if (compress) w.put_bytes(packed);
-    else w.put_bytes({reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()});
-    w.pad_to(8);
+    if (compress) {
+      w.put_bytes(packed);
+    } else {
+      out.borrowed.emplace_back(w.size(), std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()));
+      borrowed_bytes += raw.size();
+    }
+    while ((w.size() + borrowed_bytes) % 8) w.put(std::uint8_t{0});  // padding by the file offset
   }
 
   if (compress_levels) {
@@ -120,7 +125,7 @@ void append_extension(const Tree& tree, bool compress_levels, int level, std::ve
       w.put(static_cast<std::uint64_t>(frames[p].size()));
     }
     for (const auto& compressed : frames) w.put_bytes(compressed);
-    w.pad_to(8);
+    while ((w.size() + borrowed_bytes) % 8) w.put(std::uint8_t{0});
   }
 }
 

@@ -33,9 +33,33 @@ struct ExtensionContents {
   std::uint64_t compressed_level_bytes = 0;
 };
 
+// The extension as the writer emits it: the bytes it builds itself, with the attribute
+// columns' raw bytes borrowed from the tree rather than copied (they can be hundreds of
+// megabytes; a copy cost a memcpy and as much fresh memory).
+struct ExtensionPieces {
+  std::vector<std::uint8_t> own;
+  // (at, bytes): `bytes` come before own[at]; in increasing `at`
+  std::vector<std::pair<std::size_t, std::span<const std::uint8_t>>> borrowed;
+
+  std::uint64_t size() const noexcept;
+  bool empty() const noexcept { return size() == 0; }
+  // Calls emit(span) for each piece in file order.
+  template <class Emit>
+  void for_each(Emit&& emit) const {
+    std::size_t from = 0;
+    for (const auto& [at, bytes] : borrowed) {
+      if (at > from) emit(std::span<const std::uint8_t>(own).subspan(from, at - from));
+      emit(bytes);
+      from = at;
+    }
+    if (own.size() > from) emit(std::span<const std::uint8_t>(own).subspan(from));
+  }
+};
+
 bool needs_extension(const Tree& tree) noexcept;
 bool starts_extension(std::span<const std::uint8_t> bytes) noexcept;
-void append_extension(const Tree& tree, bool compress_levels, int level, std::vector<std::uint8_t>& out);
+// The tree's columns must outlive `out` (their bytes are borrowed, not copied).
+void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out);
 // `base` = file offset of bytes[0]. Checks every length against what is there.
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
                                    std::uint64_t base);

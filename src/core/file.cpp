@@ -21,7 +21,7 @@ struct Pieces {
   std::uint8_t header[kHeaderSize];
   std::span<const std::uint64_t> body;
   std::vector<std::uint64_t> owned_body;  // dense bodies are made, sparse ones viewed
-  std::vector<std::uint8_t> extension;
+  detail::ExtensionPieces extension;  // borrows the tree's attribute columns
 };
 
 Pieces assemble(const Tree& tree, const WriteOptions& options) {
@@ -231,8 +231,11 @@ std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& option
   std::vector<std::uint8_t> out(kHeaderSize + 8 * p.body.size() + p.extension.size());
   std::memcpy(out.data(), p.header, kHeaderSize);
   if (!p.body.empty()) std::memcpy(out.data() + kHeaderSize, p.body.data(), 8 * p.body.size());
-  if (!p.extension.empty())
-    std::memcpy(out.data() + kHeaderSize + 8 * p.body.size(), p.extension.data(), p.extension.size());
+  std::size_t at = kHeaderSize + 8 * p.body.size();
+  p.extension.for_each([&](std::span<const std::uint8_t> piece) {
+    if (!piece.empty()) std::memcpy(out.data() + at, piece.data(), piece.size());
+    at += piece.size();
+  });
   return out;
 }
 
@@ -260,7 +263,7 @@ void write(const Tree& tree, const std::string& path, const WriteOptions& option
   }
   write_all(part.file, p.header, kHeaderSize, path);
   write_all(part.file, p.body.data(), 8 * p.body.size(), path);
-  write_all(part.file, p.extension.data(), p.extension.size(), path);
+  p.extension.for_each([&](std::span<const std::uint8_t> piece) { write_all(part.file, piece.data(), piece.size(), path); });
   std::FILE* f = part.file;
   part.file = nullptr;
   if (std::fclose(f) != 0) VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));

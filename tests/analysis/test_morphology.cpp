@@ -191,7 +191,9 @@ TEST(Downsample, MatchesTheModelAndLevelOfDetail) {
         const vola::Tree d = vola::analysis::downsample(t, depth, min_voxels);
         EXPECT_EQ(d.depth(), depth);
         EXPECT_EQ(vola_test::voxel_set(d), model) << g.name << " to depth " << depth;
-        if (min_voxels == 1) EXPECT_EQ(vola_test::voxel_set(d), vola_test::voxel_set(t.level_of_detail(depth)));
+        if (min_voxels == 1) {
+          EXPECT_EQ(vola_test::voxel_set(d), vola_test::voxel_set(t.level_of_detail(depth)));
+        }
       }
   }
   EXPECT_THROW(vola::analysis::downsample(tree_of({}, 2), 3), vola::InvalidArgument);
