@@ -921,6 +921,13 @@ Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool p
     }
     if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
   }
+  // The chunk buffers (~100 bytes a point with attributes) are not needed by the final
+  // merges, which are the peak of the conversion.
+  chunk = LasChunk{};
+  values = {};
+  views = {};
+  payloads = {};
+  xyz = {};
   return finish_tree(builder, *options.bbox, options.epsg, report);
 }
 
