@@ -104,6 +104,37 @@ TEST(StreamBuilder, PayloadsWithoutAttributes) {
             std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
 }
 
+// expect_points is a hint only: too small, right or absurdly large (the reservation is
+// capped), the attribute columns and payloads come out the same as without it.
+TEST(StreamBuilder, ExpectPointsIsOnlyAHint) {
+  const Points p = random_points(7, 6000);
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::toolkit;
+  options.depth = 3;
+  options.payload = true;
+  const vola::Tree expected = vola::build(p.cloud, options);
+  for (const std::uint64_t hint : {std::uint64_t{0}, std::uint64_t{10}, std::uint64_t{6000}, ~std::uint64_t{0}}) {
+    vola::BuildOptions resolved = options;
+    vola::StreamBuilder builder(vola::resolve_quantizer(p.cloud.bounds(), resolved), p.specs, true);
+    builder.expect_points(hint);
+    for (std::size_t at = 0; at < p.cloud.size(); at += 1000) {
+      std::vector<std::span<const double>> values;
+      for (const auto& a : p.cloud.attributes) values.emplace_back(a.values.data() + at, 1000);
+      builder.add({p.cloud.xyz.data() + 3 * at, 3000}, values, {p.cloud.payload.data() + at, 1000});
+    }
+    const vola::Tree got = builder.finish();
+    ASSERT_EQ(std::vector<std::uint64_t>(got.words().begin(), got.words().end()),
+              std::vector<std::uint64_t>(expected.words().begin(), expected.words().end()))
+        << "hint " << hint;
+    ASSERT_EQ(std::vector<std::uint64_t>(got.voxel_payloads().begin(), got.voxel_payloads().end()),
+              std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
+    for (std::size_t c = 0; c < got.attributes().size(); ++c)
+      for (std::size_t v = 0; v < got.attributes().columns()[c].size(); ++v)
+        ASSERT_NEAR(got.attributes().columns()[c].get(v), expected.attributes().columns()[c].get(v), 1e-9)
+            << "hint " << hint << " column " << c << " voxel " << v;
+  }
+}
+
 // What a builder fed `keys` (in any order, with repeats) must finish as: the tree of
 // their set.
 void expect_tree_of_key_set(vola::StreamBuilder& builder, std::vector<vola::Key> keys, int depth) {

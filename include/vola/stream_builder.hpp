@@ -55,7 +55,8 @@ class StreamBuilder {
   // A hint (a LAS header's point count, say): about `points` points will be added. With
   // attributes or payloads the first run then reserves room for that many voxels in
   // each column (address space only: pages are touched as written), so the merges into
-  // it never move its columns to fresh memory. Any count is safe; 0 is no hint.
+  // it never move its columns to fresh memory (up to 2^27 voxels; larger runs grow as
+  // they go). Any count is safe; 0 is no hint.
   void expect_points(std::uint64_t points) noexcept;
   // All chunks added: the tree (frame set from the quantizer; georef left to the caller).
   Tree finish();

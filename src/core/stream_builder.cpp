@@ -332,6 +332,11 @@ void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> spe
   }
 }
 
+// expect_points() reserves at most this many voxels per column (1 GiB of address space
+// for 8-byte values): the kernel refuses single allocations far beyond its memory, and
+// beyond this the columns grow as they go.
+constexpr std::uint64_t kMaxReservedVoxels = std::uint64_t{1} << 27;
+
 // Room for `voxels` in every column the run uses (address space only).
 void reserve_voxels(Run& run, std::span<const AttributeSpec> specs, bool payload, std::uint64_t voxels) {
   run.keys.reserve(voxels);
@@ -574,7 +579,8 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   // Runs of equal keys hold one voxel's points in input order: [starts[v], starts[v+1]).
   Run run = std::move(s.recycled);  // sizes set below; only the capacity matters
   s.recycled = Run{};
-  if (s.runs.empty() && s.expected_points > s.keys.size()) reserve_voxels(run, s.specs, s.payload, s.expected_points);
+  if (s.runs.empty() && s.expected_points > s.keys.size())
+    reserve_voxels(run, s.specs, s.payload, std::min(s.expected_points, kMaxReservedVoxels));
   std::vector<std::uint32_t>& starts = s.starts;
   starts.clear();
   run.keys.resize(s.keys.size());  // uninitialized: KeyAllocator

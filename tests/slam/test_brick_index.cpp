@@ -39,7 +39,9 @@ TEST(SlamBrickIndex, MatchesAMapUnderRandomInsertions) {
       const auto found = index.find(c[0], c[1], c[2]);
       const auto it = reference.find(c);
       ASSERT_EQ(found.has_value(), it != reference.end()) << levels;
-      if (found) EXPECT_EQ(*found, it->second);
+      if (found) {
+        EXPECT_EQ(*found, it->second);
+      }
     }
     for (const auto& [c, v] : reference) ASSERT_EQ(index.find(c[0], c[1], c[2]), v);
     EXPECT_FALSE(index.find(side, 0, 0));
