@@ -9,6 +9,7 @@
 
 #include "vola/error.hpp"
 #include "emit.hpp"
+#include "value_order.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
@@ -47,14 +48,14 @@ double reduce(const std::vector<double>& values, std::span<const std::uint32_t> 
       if (points.size() == 1) return values[points.front()];
       scratch.clear();
       for (auto p : points) scratch.push_back(values[p]);
-      std::sort(scratch.begin(), scratch.end());
+      std::sort(scratch.begin(), scratch.end(), detail::value_before);
       // The most frequent value; ties go to the smallest value, so the result does not
       // depend on input order.
       double best = scratch[0];
       std::size_t best_run = 0;
       for (std::size_t s = 0; s < scratch.size();) {
         std::size_t e = s;
-        while (e < scratch.size() && scratch[e] == scratch[s]) ++e;
+        while (e < scratch.size() && detail::same_value(scratch[e], scratch[s])) ++e;
         if (e - s > best_run) {
           best_run = e - s;
           best = scratch[s];

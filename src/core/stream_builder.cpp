@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "emit.hpp"
+#include "value_order.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -267,7 +268,7 @@ void merge_column(Column<T>& a, const Column<T>& b, std::span<const Source> plan
 // counts of equal pairs added; from the back, as merge_column.
 void merge_pairs(Partial& a, const Partial& b) {
   const std::size_t na = a.pair_key.size(), nb = b.pair_key.size();
-  auto before = [](Key x, double u, Key y, double w) { return x < y || (x == y && u < w); };
+  auto before = [](Key x, double u, Key y, double w) { return x < y || (x == y && detail::value_before(u, w)); };
   std::size_t united = 0, i = 0, j = 0;
   while (i < na && j < nb) {
     const bool take_a = !before(b.pair_key[j], b.pair_value[j], a.pair_key[i], a.pair_value[i]);
@@ -374,10 +375,10 @@ void reduce_majority(std::span<const Key> voxel_keys, const double* values, cons
     }
     scratch.clear();
     for (std::uint32_t k = b; k < e; ++k) scratch.push_back(values[index[k]]);
-    std::sort(scratch.begin(), scratch.end());
+    std::sort(scratch.begin(), scratch.end(), detail::value_before);
     for (std::size_t k = 0; k < scratch.size();) {
       std::size_t l = k;
-      while (l < scratch.size() && scratch[l] == scratch[k]) ++l;
+      while (l < scratch.size() && detail::same_value(scratch[l], scratch[k])) ++l;
       p.pair_key[o] = voxel_keys[v];
       p.pair_value[o] = scratch[k];
       p.pair_count[o++] = static_cast<std::uint32_t>(l - k);
