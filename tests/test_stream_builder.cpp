@@ -107,13 +107,15 @@ TEST(StreamBuilder, PayloadsWithoutAttributes) {
 }
 
 // NaN in a majority column is one value among others, sorting after the numbers (it
-// once made the reduction loop forever: NaN != NaN). Built at once and streamed one
+// once made the reduction loop forever: NaN != NaN); max and min skip NaN unless every
+// value is NaN. Built at once and streamed one
 // point per chunk (so that the merges combine the histograms), the same answers.
 TEST(StreamBuilder, MajorityWithNaNValues) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   vola::PointCloud cloud;
   cloud.xyz = {0.1, 0.1, 0.1, 0.2, 0.2, 0.2, 0.3, 0.3, 0.3, 5.1, 5.1, 5.1, 5.2, 5.2, 5.2, 9.9, 9.9, 9.9};
   cloud.attributes.push_back({"m", vola::ValueType::f64, vola::Reduction::majority, {nan, 1.0, nan, 2.0, nan, nan}});
+  cloud.attributes.push_back({"hi", vola::ValueType::f64, vola::Reduction::max, {nan, 1.0, nan, nan, 2.0, nan}});
   vola::BuildOptions options;
   options.quantization = vola::Quantization::grid;
   options.voxel_size = 1.0;
@@ -121,10 +123,13 @@ TEST(StreamBuilder, MajorityWithNaNValues) {
   const vola::Tree built = vola::build(cloud, options);
   vola::BuildOptions resolved = options;
   vola::StreamBuilder builder(vola::resolve_quantizer(cloud.bounds(), resolved),
-                              {{"m", vola::ValueType::f64, vola::Reduction::majority}}, false);
+                              {{"m", vola::ValueType::f64, vola::Reduction::majority},
+                               {"hi", vola::ValueType::f64, vola::Reduction::max}},
+                              false);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const std::span<const double> value(cloud.attributes[0].values.data() + i, 1);
-    builder.add({cloud.xyz.data() + 3 * i, 3}, std::vector<std::span<const double>>{value}, {});
+    const std::vector<std::span<const double>> values{{cloud.attributes[0].values.data() + i, 1},
+                                                      {cloud.attributes[1].values.data() + i, 1}};
+    builder.add({cloud.xyz.data() + 3 * i, 3}, values, {});
   }
   const vola::Tree streamed = builder.finish();
   for (const vola::Tree* tree : {&built, &streamed}) {
@@ -133,6 +138,11 @@ TEST(StreamBuilder, MajorityWithNaNValues) {
     EXPECT_TRUE(std::isnan(column.get(0)));  // NaN, 1, NaN: NaN twice
     EXPECT_EQ(column.get(1), 2.0);           // 2, NaN: a tie goes to the number
     EXPECT_TRUE(std::isnan(column.get(2)));  // NaN alone
+    // max ignores NaN where a number is there, whatever the order or chunking.
+    const auto& high = tree->attributes().columns()[1];
+    EXPECT_EQ(high.get(0), 1.0);
+    EXPECT_EQ(high.get(1), 2.0);
+    EXPECT_TRUE(std::isnan(high.get(2)));
   }
 }
 

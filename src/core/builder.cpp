@@ -36,12 +36,12 @@ double reduce(const std::vector<double>& values, std::span<const std::uint32_t> 
     }
     case Reduction::max: {
       double m = values[points.front()];
-      for (auto p : points) m = std::max(m, values[p]);
+      for (auto p : points) m = std::fmax(m, values[p]);  // NaN only where every value is
       return m;
     }
     case Reduction::min: {
       double m = values[points.front()];
-      for (auto p : points) m = std::min(m, values[p]);
+      for (auto p : points) m = std::fmin(m, values[p]);
       return m;
     }
     case Reduction::majority: {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -325,8 +326,9 @@ void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> spe
     const Column<double>& r = newer.partials[a].value;
     switch (specs[a].reduction) {
       case Reduction::mean: merge_column(p, r, plan, std::plus<>()); break;
-      case Reduction::max: merge_column(p, r, plan, [](double x, double y) { return std::max(x, y); }); break;
-      case Reduction::min: merge_column(p, r, plan, [](double x, double y) { return std::min(x, y); }); break;
+      // fmax/fmin: a NaN loses to any number, so the result does not depend on chunking.
+      case Reduction::max: merge_column(p, r, plan, [](double x, double y) { return std::fmax(x, y); }); break;
+      case Reduction::min: merge_column(p, r, plan, [](double x, double y) { return std::fmin(x, y); }); break;
       case Reduction::last: merge_column(p, r, plan, [](double, double y) { return y; }); break;
       case Reduction::majority: merge_pairs(older.partials[a], newer.partials[a]); break;
     }
@@ -622,10 +624,10 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
           for (std::uint32_t k = b + 1; k < e; ++k) r += values_of[index[k]];
           break;
         case Reduction::max:
-          for (std::uint32_t k = b + 1; k < e; ++k) r = std::max(r, values_of[index[k]]);
+          for (std::uint32_t k = b + 1; k < e; ++k) r = std::fmax(r, values_of[index[k]]);
           break;
         case Reduction::min:
-          for (std::uint32_t k = b + 1; k < e; ++k) r = std::min(r, values_of[index[k]]);
+          for (std::uint32_t k = b + 1; k < e; ++k) r = std::fmin(r, values_of[index[k]]);
           break;
         default: break;
       }
