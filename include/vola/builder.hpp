@@ -54,6 +54,12 @@ struct BuildOptions {
   // Store one reference payload word per block (header nbits = 1).
   bool payload = false;
   std::uint32_t epsg = 2000;
+
+  // The quantization rules, decided here once for every front end: a depth is 0 or
+  // 1..10; toolkit needs a depth and takes no voxel size or origin; grid needs a voxel
+  // size or a depth; a voxel size is finite and >= 0; a bbox has min <= max on every
+  // axis. Throws OptionError naming the member that is wrong.
+  void check() const;
 };
 
 struct BuildReport {
@@ -76,9 +82,10 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth);
 // permuted along (stable: equal keys keep their input order).
 void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int key_bits);
 
-// The frame BuildOptions resolve to for a cloud with bounds `bbox` (exposed so that a
-// streaming reader can quantize chunk by chunk with the same grid).
-Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options);
+// The grid BuildOptions resolve to for a cloud with bounds `bbox` (exposed so that a
+// streaming reader can quantize chunk by chunk with the same grid): the depth, origin and
+// voxel size the options leave open are derived from the box. Checks the options first.
+Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options);
 
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola

@@ -24,6 +24,21 @@ class InvalidArgument : public Error {
   using Error::Error;
 };
 
+// One option of a library call that makes no sense. option() names the member of the
+// options struct (e.g. "voxel_size"), so that a front end can name its own spelling of it
+// (the CLI's --voxel-size, Python's voxel_size=); what() reads "<option>: <cause>".
+class OptionError : public InvalidArgument {
+ public:
+  OptionError(std::string option, std::string cause)
+      : InvalidArgument(option + ": " + cause), option_(std::move(option)), cause_(std::move(cause)) {}
+  const std::string& option() const noexcept { return option_; }
+  const std::string& cause() const noexcept { return cause_; }
+
+ private:
+  std::string option_;
+  std::string cause_;
+};
+
 // The operating system refused (open, map, write).
 class IoError : public Error {
  public:

@@ -71,7 +71,8 @@ VOLA_C_API vola_status vola_open(const char *path, vola_open_mode mode, vola_tre
 
 typedef enum vola_quantization {
   VOLA_QUANTIZE_TOOLKIT = 0, /* the reference's rounding against the bbox; needs a depth */
-  VOLA_QUANTIZE_GRID = 1     /* floor((p - origin) / voxel_size); depth and/or voxel size */
+  VOLA_QUANTIZE_GRID = 1,    /* floor((p - origin) / voxel_size); depth and/or voxel size */
+  VOLA_QUANTIZE_AUTO = 2     /* vola_convert only: grid when a voxel size or origin is given, else toolkit */
 } vola_quantization;
 
 typedef struct vola_build_options {
@@ -142,6 +143,56 @@ VOLA_C_API vola_status vola_for_each_voxel(const vola_tree *tree, vola_voxel_cal
  * *written receives how many. For paging through a tree without a callback. */
 VOLA_C_API vola_status vola_copy_voxels(const vola_tree *tree, uint64_t first, uint32_t *xyz, size_t capacity,
                                         size_t *written);
+
+/* ---- converting files: the pipeline of `vola convert` (any input its readers know) ---- */
+
+typedef void (*vola_progress_callback)(uint64_t done, uint64_t total, void *user);
+
+/* Every option `vola convert` has. Start from vola_convert_options_init(): its defaults are
+ * the CLI's. Column numbers count from 1. */
+typedef struct vola_convert_options {
+  const char *format;                  /* NULL or "auto": from the extension; else a reader's name */
+  vola_quantization quantization;      /* default VOLA_QUANTIZE_AUTO */
+  int depth;                           /* 1..10; 0 = grid mode: the smallest that covers the input */
+  double voxel_size;                   /* grid mode: the voxel edge in input units; 0 = from the depth */
+  int has_origin;                      /* origin: world position of voxel (0,0,0)'s corner (grid mode) */
+  double origin[3];
+  int has_bbox;                        /* bbox: min x y z, max x y z to quantize against */
+  double bbox[6];
+  int nbits;                           /* payload words per block: 0 or 1 (the reference's) */
+  uint32_t epsg;                       /* the input's CRS as an EPSG code; 0 = what the input says */
+  int attributes;                      /* keep the format's per-point attributes (default 1) */
+  int columns[3];                      /* text: x y z columns (default 1 2 3) */
+  const int *payload_columns;          /* text, nbits 1: payload byte columns (default: all after x y z) */
+  size_t payload_column_count;
+  const char *const *text_attributes;  /* text: "NAME=COLUMN[:TYPE[:REDUCTION]]" each */
+  size_t text_attribute_count;
+  int skip_lines;                      /* text: header lines to skip */
+  int solid;                           /* meshes: fill the inside too */
+  int has_dem_base;                    /* DEM: height the columns start from (default: lowest cell) */
+  double dem_base;
+  int dem_surface_only;                /* DEM: one voxel per cell, no columns */
+  int write_flags;                     /* vola_convert_file: a vola_write_flags value */
+  vola_progress_callback progress;     /* may be NULL; called now and then during long reads */
+  void *progress_user;
+} vola_convert_options;
+
+typedef struct vola_convert_report {
+  uint64_t inputs;   /* points, triangles (meshes) or cells (DEM) read */
+  uint64_t dropped;  /* outside the grid or not finite */
+  uint64_t voxels;   /* occupied voxels out */
+  uint32_t epsg;     /* the CRS's EPSG code when known, else 0 */
+} vola_convert_report;
+
+/* The CLI's defaults. */
+VOLA_C_API void vola_convert_options_init(vola_convert_options *options);
+/* Reads `input` and builds its tree as `vola convert` does (LAS streams: memory follows
+ * voxels, not points). report may be NULL. */
+VOLA_C_API vola_status vola_convert(const char *input, const vola_convert_options *options, vola_tree **out,
+                                    vola_convert_report *report);
+/* vola_convert, then vola_write(output, options->write_flags). */
+VOLA_C_API vola_status vola_convert_file(const char *input, const char *output, const vola_convert_options *options,
+                                         vola_convert_report *report);
 
 /* ---- attributes ---- */
 

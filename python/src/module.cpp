@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "convert_input.hpp"
 #include "vola/tile/tile_set.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/analysis/components.hpp"
 #include "vola/builder.hpp"
+#include "vola/convert.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/io/input.hpp"
@@ -105,6 +105,26 @@ vola::Quantization parse_quantization(const std::string& name) {
 
 vola::Point to_point(const std::array<double, 3>& p) { return vola::Point{p[0], p[1], p[2]}; }
 
+// The library names options as its structs do; Python's keywords are the same names but
+// for quantize. Runs `body`, rethrowing an OptionError in the keywords' words.
+template <class Body>
+auto with_python_names(Body&& body) {
+  const auto keyword = [](const std::string& option) { return option == "quantization" ? std::string("quantize") : option; };
+  try {
+    return body();
+  } catch (const vola::OptionError& e) {
+    std::string cause = e.cause();
+    for (auto open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
+      const auto close = cause.find('`', open + 1);
+      if (close == std::string::npos) break;
+      const std::string name = keyword(cause.substr(open + 1, close - open - 1));
+      cause.replace(open, close - open + 1, name);
+      open += name.size();
+    }
+    throw vola::InvalidArgument(keyword(e.option()) + ": " + cause);
+  }
+}
+
 // ---- building ----
 
 Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
@@ -138,19 +158,11 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
     if (!attributes.contains(key)) throw vola::InvalidArgument("reductions names '" + py::cast<std::string>(key) + "', which is not an attribute");
   vola::BuildOptions options;
   options.quantization = parse_quantization(quantize);
-  if (depth != 0 && (depth < vola::kMinDepth || depth > vola::kMaxDepth))
-    throw vola::InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
-  if (options.quantization == vola::Quantization::toolkit) {
-    if (depth == 0) throw vola::InvalidArgument("toolkit quantization needs a depth (1..10)");
-    if (voxel_size != 0.0 || origin) throw vola::InvalidArgument("voxel_size and origin apply to grid quantization");
-  } else if (depth == 0 && voxel_size <= 0.0) {
-    throw vola::InvalidArgument("grid quantization needs a voxel_size or a depth");
-  }
-  if (voxel_size < 0.0 || !std::isfinite(voxel_size)) throw vola::InvalidArgument("voxel_size must be finite and > 0");
   options.depth = depth;
   options.voxel_size = voxel_size;
   if (origin) options.origin = to_point(*origin);
   options.epsg = epsg;
+  with_python_names([&] { options.check(); });
   py::gil_scoped_release release;
   Tree tree = vola::build(cloud, options);
   tree.georef().epsg = epsg;
@@ -558,21 +570,42 @@ py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 
   return out;
 }
 
-Tree convert(const std::filesystem::path& path, int depth, double voxel_size, const std::string& quantize,
-             const std::string& format, std::optional<std::uint32_t> epsg, bool solid, bool attributes,
-             std::optional<double> dem_base, bool dem_surface_only) {
-  vola::python::ConvertOptions options;
+Tree convert(const std::filesystem::path& path, int depth,
+             double voxel_size, const std::string& quantize, const std::string& format, std::optional<std::uint32_t> epsg,
+             bool solid, bool attributes, std::optional<double> dem_base, bool dem_surface_only,
+             std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
+             std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
+             int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output) {
+  vola::ConvertOptions options;
   options.format = format;
-  options.quantize = quantize;
+  if (!quantize.empty()) options.quantization = parse_quantization(quantize);
   options.depth = depth;
   options.voxel_size = voxel_size;
+  if (origin) options.origin = to_point(*origin);
+  if (bbox) options.bbox = vola::Box{{(*bbox)[0], (*bbox)[1], (*bbox)[2]}, {(*bbox)[3], (*bbox)[4], (*bbox)[5]}};
+  options.nbits = nbits;
   options.epsg = epsg;
-  options.solid = solid;
   options.attributes = attributes;
+  options.columns = columns;
+  options.payload_columns = std::move(payload_columns);
+  options.text_attributes = std::move(text_attributes);
+  options.skip_lines = skip_lines;
+  options.solid = solid;
   options.dem_base = dem_base;
   options.dem_surface_only = dem_surface_only;
+  options.dense = dense;
+  options.compress = compress;
   py::gil_scoped_release release;
-  return vola::python::convert(path.string(), options);
+  return with_python_names([&] {
+    Tree tree = vola::convert(path.string(), options);
+    if (output) {
+      vola::WriteOptions w;
+      w.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
+      w.compress = compress;
+      vola::write(tree, output->string(), w);
+    }
+    return tree;
+  });
 }
 
 std::string repr(const Tree& tree) {
@@ -727,11 +760,21 @@ PYBIND11_MODULE(_vola, m) {
           const std::string bytes = data;
           return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), name);
         }, py::arg("data"), py::arg("name") = "<bytes>", "Parses the bytes of a .vol file.");
-  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0, py::arg("quantize") = "",
-        py::arg("format") = "auto", py::arg("epsg") = py::none(), py::arg("solid") = false, py::arg("attributes") = true,
-        py::arg("dem_base") = py::none(), py::arg("dem_surface_only") = false,
-        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its tree.\n"
-        "quantize: 'grid' (default with voxel_size) or 'toolkit' (needs depth); voxel grids map cell to voxel by default.");
+  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0,
+        py::arg("voxel_size") = 0.0, py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(),
+        py::arg("solid") = false, py::arg("attributes") = true, py::arg("dem_base") = py::none(),
+        py::arg("dem_surface_only") = false, py::arg("origin") = py::none(), py::arg("bbox") = py::none(),
+        py::arg("nbits") = 0, py::arg("columns") = std::array<int, 3>{1, 2, 3},
+        py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
+        py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
+        py::arg("output") = py::none(),
+        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
+        "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
+        "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
+        "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
+        "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
+        "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
+        "dem_base, dem_surface_only (DEM). Voxel grids map cell to voxel unless another grid is asked for.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

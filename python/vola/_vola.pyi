@@ -137,6 +137,16 @@ def convert(
     attributes: bool = True,
     dem_base: Optional[float] = None,
     dem_surface_only: bool = False,
+    origin: Optional[Tuple[float, float, float]] = None,
+    bbox: Optional[Tuple[float, float, float, float, float, float]] = None,
+    nbits: int = 0,
+    columns: Tuple[int, int, int] = (1, 2, 3),
+    payload_columns: Sequence[int] = (),
+    text_attributes: Sequence[str] = (),
+    skip_lines: int = 0,
+    dense: bool = False,
+    compress: bool = False,
+    output: Optional[PathLike] = None,
 ) -> Tree: ...
 def input_formats() -> List[Tuple[str, List[str]]]: ...
 def compression_available() -> bool: ...

@@ -13,47 +13,13 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/tree.hpp"
-
-struct vola_tree {
-  vola::Tree tree;
-};
+#include "capi_guard.hpp"
 
 namespace {
 
-thread_local std::string last_error;
-
-vola_status fail(vola_status status, const std::string& message) noexcept {
-  try {
-    last_error = message;
-  } catch (...) {
-    last_error.clear();  // no memory for the message: the status still says what happened
-  }
-  return status;
-}
-
-template <class Body>
-vola_status guarded(Body&& body) noexcept {
-  try {
-    body();
-    return VOLA_OK;
-  } catch (const vola::FormatError& e) {
-    return fail(VOLA_ERROR_FORMAT, e.what());
-  } catch (const vola::IoError& e) {
-    return fail(VOLA_ERROR_IO, e.what());
-  } catch (const vola::InvalidArgument& e) {
-    return fail(VOLA_ERROR_INVALID_ARGUMENT, e.what());
-  } catch (const std::bad_alloc&) {
-    return fail(VOLA_ERROR_OUT_OF_MEMORY, "out of memory");
-  } catch (const std::exception& e) {
-    return fail(VOLA_ERROR_INTERNAL, e.what());
-  } catch (...) {
-    return fail(VOLA_ERROR_INTERNAL, "unknown error");
-  }
-}
-
-void require(bool condition, const char* message) {
-  if (!condition) throw vola::InvalidArgument(message);
-}
+using vola::capi::fail;
+using vola::capi::guarded;
+using vola::capi::require;
 
 const vola::Tree& tree_of(const vola_tree* handle) {
   require(handle != nullptr, "tree is NULL");
@@ -90,9 +56,14 @@ void visit_from(const vola::Tree& tree, std::uint64_t first, F&& f) {
 
 }  // namespace
 
+std::string& vola::capi::last_error() noexcept {
+  thread_local std::string message;
+  return message;
+}
+
 extern "C" {
 
-const char* vola_last_error(void) { return last_error.c_str(); }
+const char* vola_last_error(void) { return vola::capi::last_error().c_str(); }
 
 const char* vola_status_string(vola_status status) {
   switch (status) {
@@ -122,23 +93,15 @@ vola_status vola_build_from_points(const double* xyz, size_t count, const vola_b
     require(options != nullptr && out != nullptr, "vola_build_from_points: options and out must not be NULL");
     require(xyz != nullptr || count == 0, "vola_build_from_points: xyz is NULL");
     require(count <= SIZE_MAX / 3, "vola_build_from_points: count is too large");
+    require(options->quantization == VOLA_QUANTIZE_TOOLKIT || options->quantization == VOLA_QUANTIZE_GRID,
+            "vola_build_from_points: quantization is neither toolkit nor grid");
     vola::BuildOptions build;
-    if (options->quantization == VOLA_QUANTIZE_TOOLKIT) {
-      build.quantization = vola::Quantization::toolkit;
-      require_depth(options->depth);
-      require(options->voxel_size == 0.0, "vola_build_from_points: toolkit quantization takes a depth, not a voxel size");
-    } else if (options->quantization == VOLA_QUANTIZE_GRID) {
-      build.quantization = vola::Quantization::grid;
-      if (options->depth != 0) require_depth(options->depth);
-      require(options->voxel_size >= 0.0, "vola_build_from_points: voxel_size must be >= 0");
-      require(options->depth != 0 || options->voxel_size > 0.0,
-              "vola_build_from_points: grid quantization needs a depth or a voxel size");
-    } else {
-      throw vola::InvalidArgument("vola_build_from_points: quantization is neither toolkit nor grid");
-    }
+    build.quantization =
+        options->quantization == VOLA_QUANTIZE_TOOLKIT ? vola::Quantization::toolkit : vola::Quantization::grid;
     build.depth = options->depth;
     build.voxel_size = options->voxel_size;
     if (options->epsg) build.epsg = options->epsg;
+    build.check();
     vola::PointCloud cloud;
     cloud.xyz.assign(xyz, xyz + 3 * count);
     vola::BuildReport report;

@@ -251,36 +251,58 @@ Tree build_from_voxels(std::span<const Voxel> voxels, int depth) {
   return detail::emit_levels(keys, depth, {}, false);
 }
 
-Quantizer resolve_quantizer(const Box& bbox, BuildOptions& options) {
-  if (options.quantization == Quantization::toolkit) {
-    if (options.depth == 0) VOLA_THROW(InvalidArgument("toolkit quantization needs a depth"));
-    return Quantizer::toolkit(bbox, options.depth);
+void BuildOptions::check() const {
+  if (depth != 0 && (depth < kMinDepth || depth > kMaxDepth))
+    VOLA_THROW(OptionError("depth", std::to_string(depth) + " is outside 1..10"));
+  if (!(std::isfinite(voxel_size) && voxel_size >= 0.0))
+    VOLA_THROW(OptionError("voxel_size", "must be a finite number > 0 (0 = derived from the depth)"));
+  if (origin)
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite((*origin)[a])) VOLA_THROW(OptionError("origin", "must be finite"));
+  if (bbox)
+    for (int a = 0; a < 3; ++a)
+      if (!(std::isfinite(bbox->min[a]) && std::isfinite(bbox->max[a]) && bbox->min[a] <= bbox->max[a]))
+        VOLA_THROW(OptionError("bbox", "each minimum must be finite and <= its maximum"));
+  if (quantization == Quantization::toolkit) {
+    if (depth == 0)
+      VOLA_THROW(OptionError("depth", "toolkit quantization needs a depth (1..10: 4^D voxels along the longest side)"));
+    if (voxel_size > 0.0 || origin)
+      VOLA_THROW(OptionError(voxel_size > 0.0 ? "voxel_size" : "origin",
+                             "applies to grid quantization; toolkit quantization derives its grid from the bbox"));
+  } else if (depth == 0 && voxel_size <= 0.0) {
+    VOLA_THROW(OptionError("voxel_size", "grid quantization needs a `voxel_size` or a `depth`"));
   }
+}
+
+Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
+  options.check();
+  if (options.quantization == Quantization::toolkit) return Quantizer::toolkit(bbox, options.depth);
   double extent_from_min = 0.0;
   for (int a = 0; a < 3; ++a) extent_from_min = std::max(extent_from_min, bbox.max[a] - bbox.min[a]);
-  if (options.voxel_size <= 0.0) {
-    if (options.depth == 0) VOLA_THROW(InvalidArgument("grid quantization needs a voxel size or a depth"));
+  double voxel_size = options.voxel_size;
+  std::optional<Point> origin = options.origin;
+  if (voxel_size <= 0.0) {
     // The largest extent spans all but a sliver of the grid, so the max point lands
     // in the last voxel.
     const double side = static_cast<double>(side_of(options.depth));
-    options.voxel_size = extent_from_min > 0.0 ? extent_from_min / side * (1.0 + 1e-9) : 1.0;
-    if (!options.origin) options.origin = bbox.min;
+    voxel_size = extent_from_min > 0.0 ? extent_from_min / side * (1.0 + 1e-9) : 1.0;
+    if (!origin) origin = bbox.min;
   }
-  if (!options.origin) {
+  if (!origin) {
     Point o;
-    for (int a = 0; a < 3; ++a) o[a] = std::floor(bbox.min[a] / options.voxel_size) * options.voxel_size;
-    options.origin = o;
+    for (int a = 0; a < 3; ++a) o[a] = std::floor(bbox.min[a] / voxel_size) * voxel_size;
+    origin = o;
   }
-  if (options.depth == 0) {
+  int depth = options.depth;
+  if (depth == 0) {
     double extent = 0.0;
-    for (int a = 0; a < 3; ++a) extent = std::max(extent, bbox.max[a] - (*options.origin)[a]);
-    options.depth = depth_for_extent(extent, options.voxel_size);
+    for (int a = 0; a < 3; ++a) extent = std::max(extent, bbox.max[a] - (*origin)[a]);
+    depth = depth_for_extent(extent, voxel_size);
   }
-  return Quantizer::grid(*options.origin, options.voxel_size, options.depth);
+  return Quantizer::grid(*origin, voxel_size, depth);
 }
 
-Tree build(const PointCloud& cloud, const BuildOptions& requested, BuildReport* report) {
-  BuildOptions options = requested;
+Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* report) {
   const std::size_t n = cloud.size();
   if (cloud.xyz.size() != 3 * n) VOLA_THROW(InvalidArgument("point cloud: xyz size is not a multiple of 3"));
   if (!cloud.payload.empty() && cloud.payload.size() != n)
@@ -295,7 +317,7 @@ Tree build(const PointCloud& cloud, const BuildOptions& requested, BuildReport* 
 
   const Box bbox = options.bbox ? *options.bbox : cloud.bounds();
   const Quantizer quantizer = resolve_quantizer(bbox, options);
-  const int depth = options.depth;
+  const int depth = quantizer.depth();
 
   const bool per_point = options.payload || !cloud.attributes.empty();
   std::vector<Key> keys;

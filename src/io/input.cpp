@@ -26,7 +26,7 @@ Input read_las_input(const std::string& path, const InputOptions& options) {
   in.epsg = reader->header().epsg;
   in.wkt = reader->header().wkt;
   if (options.stream) {
-    in.build = [reader, options](BuildOptions& build_options, BuildReport* report) {
+    in.build = [reader, options](const BuildOptions& build_options, BuildReport* report) {
       return build_las(*reader, build_options, options.attributes, options.payload, report, options.progress);
     };
   } else {

@@ -800,7 +800,7 @@ Box decoded_box(const LasHeader& hd, const std::int32_t lo[3], const std::int32_
 // same box, a grid-mode one only the same origin, voxel size and depth), the tree is
 // what two passes would build. Otherwise nothing is returned and `bounds`, `lo`, `hi`
 // hold the points' bounds, so the caller needs only its second pass.
-std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& options, BuildReport* report,
+std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions& options, BuildReport* report,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                                           std::size_t chunk_points, std::optional<Box>& bounds, std::int32_t lo[3],
                                           std::int32_t hi[3]) {
@@ -809,11 +809,9 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
   const Box header_box{hd.min, hd.max};
   for (int a = 0; a < 3; ++a)
     if (!(std::isfinite(hd.min[a]) && std::isfinite(hd.max[a]) && hd.min[a] <= hd.max[a])) return std::nullopt;
-  BuildOptions guess = options;
-  guess.bbox = header_box;
   std::optional<Quantizer> quantizer;
   try {
-    quantizer = resolve_quantizer(header_box, guess);
+    quantizer = resolve_quantizer(header_box, options);
   } catch (const Error&) {
     return std::nullopt;  // a header box no grid fits: the two-pass path says what is wrong
   }
@@ -840,26 +838,22 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, BuildOptions& optio
     }
   }
   const Box box = decoded_box(hd, lo, hi);
-  BuildOptions resolved = options;
-  resolved.bbox = box;
-  resolve_quantizer(box, resolved);
-  const bool same =
-      resolved.quantization == guess.quantization && resolved.depth == guess.depth &&
-      (resolved.quantization == Quantization::toolkit
-           ? box == header_box
-           : resolved.voxel_size == guess.voxel_size && *resolved.origin == *guess.origin);
+  const Quantizer resolved = resolve_quantizer(box, options);
+  const bool same = resolved.depth() == quantizer->depth() &&
+                    (options.quantization == Quantization::toolkit ? box == header_box
+                                                                   : resolved.frame() == quantizer->frame());
   if (!same) {
     bounds = box;
     return std::nullopt;
   }
-  options = resolved;
   return finish_tree(builder, box, options.epsg, report);
 }
 
 }  // namespace
 
-Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
+Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
+  BuildOptions options = requested;  // the bbox is filled in from the points when not given
   const LasHeader& hd = reader.header();
   LasChunk chunk;
   const bool occupancy_only = !attributes && !payload;

@@ -44,7 +44,7 @@ struct Input {
   std::vector<Triangle> triangles;     // mesh formats
   // Set by streaming readers (InputOptions::stream): builds the tree from the file,
   // resolving the options like vola::build.
-  std::function<Tree(BuildOptions&, BuildReport*)> build;
+  std::function<Tree(const BuildOptions&, BuildReport*)> build;
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
   // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,

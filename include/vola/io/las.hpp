@@ -137,7 +137,7 @@ void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<st
 // survey 3.7 s, 183 MiB; 4M points: 0.47 s, 125 MiB; 4.1 s, 239 MiB).
 constexpr std::size_t kLasChunkPoints = std::size_t{1} << 20;
 constexpr std::size_t kLasKeyChunkPoints = std::size_t{1} << 21;
-Tree build_las(LasReader& reader, BuildOptions& options, bool attributes, bool payload, BuildReport* report,
+Tree build_las(LasReader& reader, const BuildOptions& options, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
                std::size_t chunk_points = 0);
 

@@ -1,0 +1,86 @@
+// The one road from an input file to a tree: reader -> points, voxels or triangles ->
+// builder -> tree (-> writer). `vola convert`, Python's vola.convert and the C API's
+// vola_convert are thin shells over these two calls; every option and every rule about
+// quantization, bounding boxes, CRSs and attributes is decided here, once.
+//
+//   vola::ConvertOptions options;
+//   options.voxel_size = 2.0;                                   // grid mode, input units
+//   vola::convert_file("survey.las", "survey.vol", options);    // streams: memory ~ voxels
+//
+// Errors: OptionError naming the ConvertOptions member that is wrong (so that each front
+// end can name its own spelling of it), FormatError naming the file and byte offset.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vola/builder.hpp"
+#include "vola/tree.hpp"
+
+namespace vola {
+
+struct ConvertOptions {
+  // The reader: "auto" (from the file's extension) or a name from io::input_formats().
+  std::string format = "auto";
+
+  // ---- the grid (BuildOptions::check() holds the rules) ----
+  // Unset: grid when voxel_size or origin is given, else toolkit.
+  std::optional<Quantization> quantization;
+  int depth = 0;            // 1..10; grid mode: 0 = the smallest that covers the input
+  double voxel_size = 0.0;  // grid mode: the voxel edge in input units
+  std::optional<Point> origin;  // grid mode: world position of voxel (0,0,0)'s corner
+  std::optional<Box> bbox;      // quantize against this box instead of the input's bounds
+  int nbits = 0;                // payload words per block: 0 occupancy only, 1 the reference's
+
+  // ---- what the input is ----
+  // The input's CRS as an EPSG code; wins over what the input says.
+  std::optional<std::uint32_t> epsg;
+  bool attributes = true;  // keep the per-point attributes the format carries (LAS, PLY, PCD, ...)
+  // Text input (XYZ/TXT/CSV); column numbers count from 1, as a user reads the file.
+  std::array<int, 3> columns{1, 2, 3};  // x y z
+  std::vector<int> payload_columns;     // nbits 1: payload bytes 0..7 (default: every column after x y z)
+  // Columns kept as attributes: NAME=COLUMN[:TYPE[:REDUCTION]], e.g. "intensity=4:u16:mean";
+  // TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean).
+  std::vector<std::string> text_attributes;
+  int skip_lines = 0;               // header lines before the points
+  bool solid = false;               // meshes: fill the inside of closed surfaces too
+  std::optional<double> dem_base;   // DEM: height the columns start from (default: the lowest cell)
+  bool dem_surface_only = false;    // DEM: one voxel per cell at its height
+
+  // ---- the file convert_file writes ----
+  bool dense = false;     // the reference's dense layout (depth <= 5)
+  bool compress = false;  // zstd levels and attributes (a file only vola reads)
+
+  // Every rule above that needs no input; the rest (e.g. solid on a point file) is
+  // checked once the reader has said what the input is. Throws OptionError.
+  void check() const;
+};
+
+struct ConvertReport {
+  BuildReport build;             // points (or triangles, cells) in and dropped, voxels out
+  std::string unit = "points";   // what build.points_in counts: points, triangles or cells
+  std::string format;            // the reader that read the input
+  // The CRS: its EPSG code when known (given, stated, or found from the input's WKT);
+  // crs_wkt_only when the input gave a WKT with no code for it.
+  std::optional<std::uint32_t> epsg;
+  bool crs_wkt_only = false;
+};
+
+// (done, total) in any unit, now and then during long reads.
+using ConvertProgress = std::function<void(std::uint64_t done, std::uint64_t total)>;
+
+// Reads `input` and builds its tree: voxel grids cell for cell unless another grid is
+// asked for, meshes voxelized (solid on request), DEM cells as columns, points quantized;
+// formats that can stream (LAS) are read in chunks, so memory follows voxels, not points.
+Tree convert(const std::string& input, const ConvertOptions& options, const ConvertProgress& progress = {},
+             ConvertReport* report = nullptr);
+
+// convert(), then write the tree to `output` as the options say (dense, compress).
+void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,
+                  const ConvertProgress& progress = {}, ConvertReport* report = nullptr);
+
+}  // namespace vola

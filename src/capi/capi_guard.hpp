@@ -1,0 +1,55 @@
+// Internal to the C API: the handle type and `guarded`, which runs an entry point's body
+// and turns any exception into a status code and this thread's last-error message, so
+// that no exception crosses into C.
+#pragma once
+
+#include <new>
+#include <string>
+
+#include "vola/error.hpp"
+#include "vola/tree.hpp"
+#include "vola/vola.h"
+
+struct vola_tree {
+  vola::Tree tree;
+};
+
+namespace vola::capi {
+
+// This thread's last error message (vola_last_error).
+std::string& last_error() noexcept;
+
+inline vola_status fail(vola_status status, const std::string& message) noexcept {
+  try {
+    last_error() = message;
+  } catch (...) {
+    last_error().clear();  // no memory for the message: the status still says what happened
+  }
+  return status;
+}
+
+template <class Body>
+vola_status guarded(Body&& body) noexcept {
+  try {
+    body();
+    return VOLA_OK;
+  } catch (const vola::FormatError& e) {
+    return fail(VOLA_ERROR_FORMAT, e.what());
+  } catch (const vola::IoError& e) {
+    return fail(VOLA_ERROR_IO, e.what());
+  } catch (const vola::InvalidArgument& e) {
+    return fail(VOLA_ERROR_INVALID_ARGUMENT, e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(VOLA_ERROR_OUT_OF_MEMORY, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(VOLA_ERROR_INTERNAL, e.what());
+  } catch (...) {
+    return fail(VOLA_ERROR_INTERNAL, "unknown error");
+  }
+}
+
+inline void require(bool condition, const char* message) {
+  if (!condition) throw vola::InvalidArgument(message);
+}
+
+}  // namespace vola::capi

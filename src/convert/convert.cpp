@@ -1,0 +1,106 @@
+// The conversion pipeline: reader -> points, voxels or triangles -> builder -> tree.
+#include "vola/convert.hpp"
+
+#include "georeference.hpp"
+#include "options.hpp"
+#include "shapes.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
+#include "vola/io/input.hpp"
+
+namespace vola {
+
+namespace {
+
+using namespace convert_detail;
+
+io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
+               const ConvertProgress& progress) {
+  if (format.name != "text" && !options.text_attributes.empty())
+    throw OptionError("text_attributes", "apply to text input only (" + path + " is " + format.name + ")");
+  if (format.name != "dem" && (options.dem_base || options.dem_surface_only))
+    throw OptionError(options.dem_base ? "dem_base" : "dem_surface_only",
+                      "applies to DEM input only (" + path + " is " + format.name + ")");
+  io::InputOptions input;
+  input.attributes = options.attributes;
+  input.payload = options.nbits > 0;
+  input.stream = true;
+  if (format.name == "text") input.text = text_columns(path, options);
+  input.dem_base = options.dem_base;
+  input.dem_surface_only = options.dem_surface_only;
+  input.progress = progress;
+  io::Input loaded = format.read(path, input);
+  if (options.solid && !loaded.is_mesh())
+    throw OptionError("solid", "applies to mesh input (triangles); " + path + " holds none");
+  return loaded;
+}
+
+// Voxel-grid inputs map one cell to one voxel unless the options ask for another grid:
+// then their cell centres are quantized like points.
+bool maps_cell_for_cell(const io::Input& input, const ConvertOptions& options) {
+  return input.grid && !options.quantization && options.voxel_size <= 0.0 && !options.origin && !options.bbox;
+}
+
+const char* unit_of(const io::Input& input) {
+  if (input.is_mesh()) return "triangles";
+  return input.terrain ? "cells" : "points";
+}
+
+Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions& options, const BuildOptions& build,
+                BuildReport& report) {
+  if (maps_cell_for_cell(input, options)) return tree_from_grid_cells(*input.grid, options.depth, report);
+  if (!options.quantization && options.depth == 0 && options.voxel_size <= 0.0)
+    throw OptionError("voxel_size",
+                      "how fine should the voxels be? Give `voxel_size` (grid quantization: the voxel edge in the "
+                      "input's units, e.g. the point spacing) or `depth` (toolkit quantization: 4^D voxels along the "
+                      "longest side, 1..10)");
+  build.check();
+  if (input.build) {  // a streaming reader
+    Tree tree = input.build(build, &report);
+    if (report.points_in == 0) throw InvalidArgument(path + ": no points");
+    return tree;
+  }
+  if (input.grid) input.cloud = grid_cell_centres(*input.grid);
+  if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
+  if (input.cloud.size() == 0) throw InvalidArgument(path + ": no points");
+  return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
+}
+
+}  // namespace
+
+Tree convert(const std::string& path, const ConvertOptions& options, const ConvertProgress& progress,
+             ConvertReport* report_out) {
+  options.check();
+  // A CRS PROJ does not know fails before gigabytes are read.
+  if (options.epsg) geo::crs_wkt(*options.epsg);
+  const io::InputFormat& format = io::find_input_format(path, options.format);
+  io::Input input = read(path, format, options, progress);
+  const std::optional<std::uint32_t> epsg = known_epsg(options, input);
+  const BuildOptions build = build_options(options, header_epsg(epsg));
+
+  ConvertReport report;
+  Tree tree = build_tree(path, input, options, build, report.build);
+  georeference(tree, options, input, epsg, tree.frame().quantization);
+  if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
+  if (report_out) {
+    report.unit = unit_of(input);
+    report.format = format.name;
+    report.epsg = epsg;
+    report.crs_wkt_only = !epsg && !input.wkt.empty();
+    *report_out = std::move(report);
+  }
+  return tree;
+}
+
+void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,
+                  const ConvertProgress& progress, ConvertReport* report) {
+  options.check();
+  const Tree tree = convert(input, options, progress, report);
+  WriteOptions write_options;
+  write_options.layout = options.dense ? Layout::dense : Layout::sparse;
+  write_options.compress = options.compress;
+  write(tree, output, write_options);
+}
+
+}  // namespace vola

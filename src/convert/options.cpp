@@ -1,0 +1,120 @@
+// ConvertOptions: the checks that need no input, and the translation into the readers'
+// and the builder's options.
+#include "options.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "vola/attributes.hpp"
+#include "vola/error.hpp"
+#include "vola/tree.hpp"
+
+namespace vola {
+
+namespace convert_detail {
+
+namespace {
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const auto end = text.find(separator, start);
+    parts.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) return parts;
+    start = end + 1;
+  }
+}
+
+}  // namespace
+
+TextAttributeSpec parse_text_attribute(const std::string& spec) {
+  const auto fail = [&spec](const std::string& why) { return OptionError("text_attributes", "'" + spec + "': " + why); };
+  const auto eq = spec.find('=');
+  if (eq == std::string::npos || eq == 0) throw fail("expected NAME=COLUMN[:TYPE[:REDUCTION]]");
+  TextAttributeSpec out;
+  out.attribute.name = spec.substr(0, eq);
+  const std::vector<std::string> parts = split(spec.substr(eq + 1), ':');
+  if (parts.size() > 3) throw fail("expected NAME=COLUMN[:TYPE[:REDUCTION]]");
+  try {
+    std::size_t used = 0;
+    out.column = std::stoi(parts[0], &used);
+    if (used != parts[0].size()) throw std::invalid_argument(parts[0]);
+  } catch (const std::exception&) {
+    throw fail("column '" + parts[0] + "' is not a number");
+  }
+  if (out.column < 1) throw fail("columns count from 1");
+  if (parts.size() > 1) {
+    const auto type = parse_value_type(parts[1]);
+    if (!type) throw fail("type '" + parts[1] + "' is not one of u8 u16 u32 u64 i8 i16 i32 i64 f32 f64");
+    out.attribute.type = *type;
+  }
+  if (parts.size() > 2) {
+    const auto reduction = parse_reduction(parts[2]);
+    if (!reduction) throw fail("reduction '" + parts[2] + "' is not one of last mean max min majority");
+    out.attribute.reduction = *reduction;
+  }
+  return out;
+}
+
+Quantization quantization_of(const ConvertOptions& options) {
+  if (options.quantization) return *options.quantization;
+  return options.voxel_size > 0.0 || options.origin ? Quantization::grid : Quantization::toolkit;
+}
+
+BuildOptions build_options(const ConvertOptions& options, std::uint32_t epsg) {
+  BuildOptions build;
+  build.quantization = quantization_of(options);
+  build.depth = options.depth;
+  build.voxel_size = options.voxel_size;
+  build.origin = options.origin;
+  build.bbox = options.bbox;
+  build.payload = options.nbits > 0;
+  build.epsg = epsg;
+  return build;
+}
+
+io::TextColumns text_columns(const std::string& input, const ConvertOptions& options) {
+  io::TextColumns columns;
+  columns.x = options.columns[0] - 1;
+  columns.y = options.columns[1] - 1;
+  columns.z = options.columns[2] - 1;
+  columns.skip_lines = options.skip_lines;
+  if (options.nbits > 0) {
+    if (!options.payload_columns.empty()) {
+      for (int c : options.payload_columns) columns.payload.push_back(c - 1);
+    } else {
+      // The reference's xyz2vola: every column after x y z is a payload byte.
+      const int n = io::count_text_columns(input, options.skip_lines);
+      const int last_xyz = std::max({columns.x, columns.y, columns.z});
+      for (int c = last_xyz + 1; c < n && columns.payload.size() < 8; ++c) columns.payload.push_back(c);
+    }
+  }
+  for (const auto& spec : options.text_attributes) {
+    TextAttributeSpec parsed = parse_text_attribute(spec);
+    columns.attributes.push_back(std::move(parsed.attribute));
+    columns.attribute_columns.push_back(parsed.column - 1);
+  }
+  return columns;
+}
+
+}  // namespace convert_detail
+
+void ConvertOptions::check() const {
+  if (nbits < 0 || nbits > 64) throw OptionError("nbits", std::to_string(nbits) + " is outside 0..64");
+  if (dense && compress) throw OptionError("compress", "compressed files are sparse (dense and compress together)");
+  for (int c : columns)
+    if (c < 1) throw OptionError("columns", "column numbers count from 1");
+  for (int c : payload_columns)
+    if (c < 1) throw OptionError("payload_columns", "column numbers count from 1");
+  if (payload_columns.size() > 8) throw OptionError("payload_columns", "a payload word holds at most 8 bytes");
+  if (skip_lines < 0) throw OptionError("skip_lines", "must be >= 0");
+  if (dem_base && !std::isfinite(*dem_base)) throw OptionError("dem_base", "must be finite");
+  for (const auto& spec : text_attributes) convert_detail::parse_text_attribute(spec);
+  BuildOptions grid = convert_detail::build_options(*this, 2000);
+  // Whether the voxels are given a size at all is decided once the input is known: a
+  // voxel-grid input maps cell for cell without either.
+  if (grid.depth == 0 && grid.voxel_size <= 0.0) grid.depth = kMaxDepth;
+  grid.check();
+}
+
+}  // namespace vola

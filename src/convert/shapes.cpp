@@ -1,0 +1,74 @@
+#include "shapes.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "vola/error.hpp"
+#include "vola/mesh/terrain.hpp"
+#include "vola/mesh/voxelize.hpp"
+
+namespace vola::convert_detail {
+
+Tree tree_from_grid_cells(const io::VoxelGrid& grid, int requested_depth, BuildReport& report) {
+  const std::uint32_t largest = std::max({grid.dims[0], grid.dims[1], grid.dims[2], 1u});
+  int depth = requested_depth;
+  if (depth == 0)
+    for (depth = 1; depth < kMaxDepth && side_of(depth) < largest; ++depth) {
+    }
+  if (side_of(depth) < largest)
+    throw OptionError("depth", "a " + std::to_string(largest) + "-cell grid does not fit depth " + std::to_string(depth) +
+                                   " (" + std::to_string(side_of(depth)) + " voxels per axis)");
+  Tree tree = build_from_voxels(grid.voxels, depth);
+  tree.set_frame(Frame{Quantization::grid, grid.origin, grid.voxel_size});
+  Box box{grid.origin, grid.origin};
+  for (int i = 0; i < 3; ++i) box.max[i] += grid.voxel_size * grid.dims[i];
+  tree.georef().bbox = box;
+  report.points_in = grid.voxels.size();
+  report.voxels = tree.voxel_count();
+  return tree;
+}
+
+PointCloud grid_cell_centres(const io::VoxelGrid& grid) {
+  PointCloud cloud;
+  cloud.xyz.reserve(3 * grid.voxels.size());
+  for (const Voxel& v : grid.voxels) {
+    cloud.xyz.push_back(grid.origin[0] + (v.x + 0.5) * grid.voxel_size);
+    cloud.xyz.push_back(grid.origin[1] + (v.y + 0.5) * grid.voxel_size);
+    cloud.xyz.push_back(grid.origin[2] + (v.z + 0.5) * grid.voxel_size);
+  }
+  return cloud;
+}
+
+Tree tree_from_mesh(const io::Input& input, const BuildOptions& options, bool solid, BuildReport& report) {
+  if (options.payload) throw OptionError("nbits", "mesh input carries no payload");
+  const Box bbox = options.bbox ? *options.bbox : mesh::triangle_bounds(input.triangles);
+  const Quantizer quantizer = resolve_quantizer(bbox, options);
+  mesh::VoxelizeOptions voxelize;
+  voxelize.solid = solid;
+  mesh::VoxelizeReport voxels;
+  Tree tree = mesh::voxelize(input.triangles, quantizer, voxelize, &voxels);
+  tree.georef().bbox = bbox;
+  report.points_in = voxels.triangles;
+  report.points_outside = voxels.skipped + voxels.outside;
+  report.voxels = tree.voxel_count();
+  return tree;
+}
+
+Tree tree_from_terrain(const io::Input& input, const BuildOptions& options, BuildReport& report) {
+  if (options.payload) throw OptionError("nbits", "DEM input carries no payload");
+  Box bbox = input.cloud.bounds();
+  if (!input.terrain_surface_only) {
+    bbox.min[2] = std::min(bbox.min[2], input.terrain_base);
+    bbox.max[2] = std::max(bbox.max[2], input.terrain_base);
+  }
+  if (options.bbox) bbox = *options.bbox;
+  const Quantizer quantizer = resolve_quantizer(bbox, options);
+  mesh::TerrainOptions columns;
+  columns.base = input.terrain_base;
+  columns.surface_only = input.terrain_surface_only;
+  Tree tree = mesh::terrain_columns(input.cloud, quantizer, columns, &report);
+  tree.georef().bbox = bbox;
+  return tree;
+}
+
+}  // namespace vola::convert_detail

@@ -1,0 +1,20 @@
+// Internal to the conversion pipeline: inputs that are not plain points, to trees.
+#pragma once
+
+#include "vola/builder.hpp"
+#include "vola/io/input.hpp"
+
+namespace vola::convert_detail {
+
+// A voxel-grid input (binvox, NPY occupancy) cell for cell; depth 0 = the smallest that holds it.
+Tree tree_from_grid_cells(const io::VoxelGrid& grid, int depth, BuildReport& report);
+// The cell centres of a voxel-grid input, as points (to quantize on another grid).
+PointCloud grid_cell_centres(const io::VoxelGrid& grid);
+// Triangles -> surface voxels (and the inside when solid). Toolkit mode frames the
+// vertices' bbox, as a point cloud's bbox frames its points.
+Tree tree_from_mesh(const io::Input& input, const BuildOptions& options, bool solid, BuildReport& report);
+// DEM cells -> columns of voxels from the base height up to each cell's height; the
+// frame covers the base too.
+Tree tree_from_terrain(const io::Input& input, const BuildOptions& options, BuildReport& report);
+
+}  // namespace vola::convert_detail
