@@ -9,7 +9,7 @@
 
 #include "vola/error.hpp"
 #include "emit.hpp"
-#include "value_order.hpp"
+#include "reductions.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
@@ -27,45 +27,16 @@ void check_depth(int depth) {
 // Reduces the values of one voxel's points (indices in input order) to one value.
 double reduce(const std::vector<double>& values, std::span<const std::uint32_t> points,
               Reduction reduction, std::vector<double>& scratch) {
-  switch (reduction) {
-    case Reduction::last: return values[points.back()];
-    case Reduction::mean: {
-      double sum = 0.0;
-      for (auto p : points) sum += values[p];
-      return sum / static_cast<double>(points.size());
-    }
-    case Reduction::max: {
-      double m = values[points.front()];
-      for (auto p : points) m = std::fmax(m, values[p]);  // NaN only where every value is
-      return m;
-    }
-    case Reduction::min: {
-      double m = values[points.front()];
-      for (auto p : points) m = std::fmin(m, values[p]);
-      return m;
-    }
-    case Reduction::majority: {
-      if (points.size() == 1) return values[points.front()];
-      scratch.clear();
-      for (auto p : points) scratch.push_back(values[p]);
-      std::sort(scratch.begin(), scratch.end(), detail::value_before);
-      // The most frequent value; ties go to the smallest value, so the result does not
-      // depend on input order.
-      double best = scratch[0];
-      std::size_t best_run = 0;
-      for (std::size_t s = 0; s < scratch.size();) {
-        std::size_t e = s;
-        while (e < scratch.size() && detail::same_value(scratch[e], scratch[s])) ++e;
-        if (e - s > best_run) {
-          best_run = e - s;
-          best = scratch[s];
-        }
-        s = e;
-      }
-      return best;
-    }
+  if (reduction == Reduction::majority) {
+    scratch.clear();
+    for (auto p : points) scratch.push_back(values[p]);
+    return detail::majority_of(scratch);
   }
-  return values[points.back()];
+  const auto n = static_cast<std::uint32_t>(points.size());
+  const double partial = detail::with_reduction(reduction, [&](auto r) {
+    return detail::fold<decltype(r)::value>([&](std::uint32_t k) { return values[points[k]]; }, n);
+  });
+  return detail::finish(reduction, partial, n);
 }
 
 // ---- Depth <= 5, many keys: leaf blocks marked in a dense bitmap instead of sorting ----

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "emit.hpp"
-#include "value_order.hpp"
+#include "reductions.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -324,14 +324,13 @@ void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> spe
   for (std::size_t a = 0; a < specs.size(); ++a) {
     Column<double>& p = older.partials[a].value;
     const Column<double>& r = newer.partials[a].value;
-    switch (specs[a].reduction) {
-      case Reduction::mean: merge_column(p, r, plan, std::plus<>()); break;
-      // fmax/fmin: a NaN loses to any number, so the result does not depend on chunking.
-      case Reduction::max: merge_column(p, r, plan, [](double x, double y) { return std::fmax(x, y); }); break;
-      case Reduction::min: merge_column(p, r, plan, [](double x, double y) { return std::fmin(x, y); }); break;
-      case Reduction::last: merge_column(p, r, plan, [](double, double y) { return y; }); break;
-      case Reduction::majority: merge_pairs(older.partials[a], newer.partials[a]); break;
+    if (specs[a].reduction == Reduction::majority) {
+      merge_pairs(older.partials[a], newer.partials[a]);
+      continue;
     }
+    detail::with_reduction(specs[a].reduction, [&](auto reduction) {
+      merge_column(p, r, plan, [](double x, double y) { return detail::combine<decltype(reduction)::value>(x, y); });
+    });
   }
 }
 
@@ -377,15 +376,11 @@ void reduce_majority(std::span<const Key> voxel_keys, const double* values, cons
     }
     scratch.clear();
     for (std::uint32_t k = b; k < e; ++k) scratch.push_back(values[index[k]]);
-    std::sort(scratch.begin(), scratch.end(), detail::value_before);
-    for (std::size_t k = 0; k < scratch.size();) {
-      std::size_t l = k;
-      while (l < scratch.size() && detail::same_value(scratch[l], scratch[k])) ++l;
+    detail::distinct_counts(scratch, [&](double value, std::uint32_t count) {
       p.pair_key[o] = voxel_keys[v];
-      p.pair_value[o] = scratch[k];
-      p.pair_count[o++] = static_cast<std::uint32_t>(l - k);
-      k = l;
-    }
+      p.pair_value[o] = value;
+      p.pair_count[o++] = count;
+    });
   }
   p.pair_key.resize(o);
   p.pair_value.resize(o);
@@ -616,23 +611,13 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
       continue;
     }
     p.value.resize(voxels);
-    for (std::size_t v = 0; v < voxels; ++v) {
-      const std::uint32_t b = starts[v], e = starts[v + 1];
-      double r = values_of[index[reduction == Reduction::last ? e - 1 : b]];
-      switch (reduction) {
-        case Reduction::mean:
-          for (std::uint32_t k = b + 1; k < e; ++k) r += values_of[index[k]];
-          break;
-        case Reduction::max:
-          for (std::uint32_t k = b + 1; k < e; ++k) r = std::fmax(r, values_of[index[k]]);
-          break;
-        case Reduction::min:
-          for (std::uint32_t k = b + 1; k < e; ++k) r = std::fmin(r, values_of[index[k]]);
-          break;
-        default: break;
+    detail::with_reduction(reduction, [&](auto r) {
+      for (std::size_t v = 0; v < voxels; ++v) {
+        const std::uint32_t* points = index + starts[v];
+        p.value[v] = detail::fold<decltype(r)::value>([&](std::uint32_t k) { return values_of[points[k]]; },
+                                                      starts[v + 1] - starts[v]);
       }
-      p.value[v] = r;
-    }
+    });
   }
   s.push(std::move(run));
 }
@@ -697,8 +682,9 @@ Tree StreamBuilder::finish() {
     if (spec.reduction == Reduction::majority) {
       store_majority(all.keys, p, column);
     } else {
+      const bool counted = spec.reduction == Reduction::mean;  // points per voxel are kept for means only
       for (std::size_t v = 0; v < voxels; ++v)
-        column.set(v, spec.reduction == Reduction::mean ? p.value[v] / all.points[v] : p.value[v]);
+        column.set(v, detail::finish(spec.reduction, p.value[v], counted ? all.points[v] : 1));
     }
     p = Partial{};  // the column holds it now
     tree.attributes().add(std::move(column));
