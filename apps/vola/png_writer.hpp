@@ -1,4 +1,5 @@
-// Whole-image PNG writing through libpng for the render command: 8-bit RGB or 16-bit grey.
+// Whole-image PNGs for the render, plot and evaluation commands: 8-bit RGB or 16-bit grey,
+// through the library's one PNG writer (vola/io/png_image.hpp).
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,7 @@
 #include "vola/attributes.hpp"
 
+#include "vola/little_endian.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,13 +13,6 @@ namespace {
 constexpr std::string_view kTypeNames[] = {"u8", "u16", "u32", "u64", "i8",
                                            "i16", "i32", "i64", "f32", "f64"};
 constexpr std::string_view kReductionNames[] = {"last", "mean", "max", "min", "majority"};
-
-template <class T>
-T load(const std::byte* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
-}
 
 template <class T>
 void store(std::byte* p, double value) {
@@ -72,16 +67,16 @@ AttributeColumn::AttributeColumn(std::string name, ValueType type, Reduction red
 double AttributeColumn::get(std::size_t rank) const {
   const std::byte* p = bytes_.data() + rank * size_of(type_);
   switch (type_) {
-    case ValueType::u8: return load<std::uint8_t>(p);
-    case ValueType::u16: return load<std::uint16_t>(p);
-    case ValueType::u32: return load<std::uint32_t>(p);
-    case ValueType::u64: return static_cast<double>(load<std::uint64_t>(p));
-    case ValueType::i8: return load<std::int8_t>(p);
-    case ValueType::i16: return load<std::int16_t>(p);
-    case ValueType::i32: return load<std::int32_t>(p);
-    case ValueType::i64: return static_cast<double>(load<std::int64_t>(p));
-    case ValueType::f32: return load<float>(p);
-    case ValueType::f64: return load<double>(p);
+    case ValueType::u8: return load_le<std::uint8_t>(p);
+    case ValueType::u16: return load_le<std::uint16_t>(p);
+    case ValueType::u32: return load_le<std::uint32_t>(p);
+    case ValueType::u64: return static_cast<double>(load_le<std::uint64_t>(p));
+    case ValueType::i8: return load_le<std::int8_t>(p);
+    case ValueType::i16: return load_le<std::int16_t>(p);
+    case ValueType::i32: return load_le<std::int32_t>(p);
+    case ValueType::i64: return static_cast<double>(load_le<std::int64_t>(p));
+    case ValueType::f32: return load_le<float>(p);
+    case ValueType::f64: return load_le<double>(p);
   }
   return 0.0;
 }

@@ -9,31 +9,18 @@
 #include <string_view>
 
 #include "file_bytes.hpp"
+#include "header_words.hpp"
 #include "vola/error.hpp"
 
 namespace vola::io {
 
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::vector<std::string_view> split_words(std::string_view line) {
-  std::vector<std::string_view> words;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && is_space(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !is_space(line[i])) ++i;
-    if (i > start) words.push_back(line.substr(start, i - start));
-  }
-  return words;
-}
-
+// binvox writers may put a '+' before numbers.
 template <class T>
-bool parse_number(std::string_view s, T& value) {
+bool parse_signed_number(std::string_view s, T& value) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), value);
-  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+  return parse_number(s, value);
 }
 
 // Shortest text that reads back as the same double.
@@ -84,16 +71,16 @@ VoxelGrid parse_binvox(std::span<const std::uint8_t> bytes, const std::string& n
       std::array<std::uint64_t, 3> d{};
       if (words.size() != 4) fail("expected 'dim A B C'");
       for (std::size_t i = 0; i < 3; ++i)
-        if (!parse_number(words[i + 1], d[i]) || d[i] == 0 || d[i] > std::numeric_limits<std::uint32_t>::max())
+        if (!parse_signed_number(words[i + 1], d[i]) || d[i] == 0 || d[i] > std::numeric_limits<std::uint32_t>::max())
           fail("dim '" + std::string(words[i + 1]) + "' is not an integer 1..4294967295");
       dim = d;
     } else if (words[0] == "translate") {
       if (words.size() != 4) fail("expected 'translate TX TY TZ'");
       for (std::size_t i = 0; i < 3; ++i)
-        if (!parse_number(words[i + 1], translate[i]) || !std::isfinite(translate[i]))
+        if (!parse_signed_number(words[i + 1], translate[i]) || !std::isfinite(translate[i]))
           fail("translate '" + std::string(words[i + 1]) + "' is not a finite number");
     } else if (words[0] == "scale") {
-      if (words.size() != 2 || !parse_number(words[1], scale) || !(scale > 0) || !std::isfinite(scale))
+      if (words.size() != 2 || !parse_signed_number(words[1], scale) || !(scale > 0) || !std::isfinite(scale))
         fail("expected 'scale S' with S a positive number");
     } else if (words[0] == "data") {
       if (words.size() != 1) fail("expected 'data' alone on its line");

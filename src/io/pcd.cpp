@@ -15,7 +15,9 @@
 
 #include "file_bytes.hpp"
 #include "point_colours.hpp"
+#include "header_words.hpp"
 #include "vola/error.hpp"
+#include "vola/little_endian.hpp"
 
 namespace vola::io {
 
@@ -42,30 +44,10 @@ struct Header {
   std::uint64_t body_line = 1;
 };
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// Splits on spaces and tabs into `words` (cleared first).
-void split_words(std::string_view line, std::vector<std::string_view>& words) {
-  words.clear();
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && is_space(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !is_space(line[i])) ++i;
-    if (i > start) words.push_back(line.substr(start, i - start));
-  }
-}
-
 std::string lower(std::string_view s) {
   std::string out(s);
   std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
-}
-
-template <class T>
-bool parse_integer(std::string_view s, T& value) {
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), value);
-  return r.ec == std::errc() && r.ptr == s.data() + s.size();
 }
 
 Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name) {
@@ -95,13 +77,13 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
     auto numbers = [&](auto& out, const char* what) {
       for (std::size_t i = 1; i <= n; ++i) {
         typename std::remove_reference_t<decltype(out)>::value_type v{};
-        if (!parse_integer(words[i], v)) fail(std::string(what) + " '" + std::string(words[i]) + "' is not a number");
+        if (!parse_number(words[i], v)) fail(std::string(what) + " '" + std::string(words[i]) + "' is not a number");
         out.push_back(v);
       }
     };
     auto single = [&](std::optional<std::uint64_t>& out) {
       std::uint64_t v = 0;
-      if (n != 1 || !parse_integer(words[1], v)) fail(std::string(words[0]) + " takes one non-negative integer");
+      if (n != 1 || !parse_number(words[1], v)) fail(std::string(words[0]) + " takes one non-negative integer");
       out = v;
     };
     if (key == "version" || key == "viewpoint") {
@@ -180,10 +162,7 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
 }
 
 double field_value(const std::uint8_t* p, const Field& f) {
-  auto load = [&](auto v) {
-    std::memcpy(&v, p, sizeof v);
-    return static_cast<double>(v);
-  };
+  auto load = [p](auto type) { return static_cast<double>(load_le<decltype(type)>(p)); };
   switch (f.type) {
     case 'F': return f.size == 4 ? load(float{}) : load(double{});
     case 'I':
@@ -337,7 +316,7 @@ void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSi
       std::uint32_t packed = 0;
       // PCL writes a float rgb field as its 32-bit pattern in decimal (a float would
       // print some colours as nan); other writers print the float itself.
-      if (!parse_integer(w, packed)) {
+      if (!parse_number(w, packed)) {
         const double v = number(*l.packed_rgb);
         if (l.packed_rgb->type == 'F') packed = std::bit_cast<std::uint32_t>(static_cast<float>(v));
         else if (v >= std::numeric_limits<std::int32_t>::min() && v < 0) packed = static_cast<std::uint32_t>(static_cast<std::int32_t>(v));

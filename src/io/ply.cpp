@@ -11,7 +11,9 @@
 
 #include "file_bytes.hpp"
 #include "point_colours.hpp"
+#include "header_words.hpp"
 #include "vola/error.hpp"
+#include "vola/little_endian.hpp"
 
 namespace vola::io {
 
@@ -70,20 +72,6 @@ struct Header {
   std::size_t body = 0;        // byte offset of the first element's data
   std::uint64_t body_line = 1;  // line number of that offset (ascii)
 };
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
-
-std::vector<std::string_view> split_words(std::string_view line) {
-  std::vector<std::string_view> words;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && is_space(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !is_space(line[i])) ++i;
-    if (i > start) words.push_back(line.substr(start, i - start));
-  }
-  return words;
-}
 
 Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name) {
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
@@ -168,14 +156,14 @@ class BinaryInput {
     for (std::size_t i = 0; i < n; ++i) raw[i] = bytes_[at_ + (big_endian_ ? n - 1 - i : i)];
     at_ += n;
     switch (t) {
-      case PlyType::i8: return load<std::int8_t>(raw);
-      case PlyType::u8: return load<std::uint8_t>(raw);
-      case PlyType::i16: return load<std::int16_t>(raw);
-      case PlyType::u16: return load<std::uint16_t>(raw);
-      case PlyType::i32: return load<std::int32_t>(raw);
-      case PlyType::u32: return load<std::uint32_t>(raw);
-      case PlyType::f32: return load<float>(raw);
-      case PlyType::f64: return load<double>(raw);
+      case PlyType::i8: return load_le<std::int8_t>(raw);
+      case PlyType::u8: return load_le<std::uint8_t>(raw);
+      case PlyType::i16: return load_le<std::int16_t>(raw);
+      case PlyType::u16: return load_le<std::uint16_t>(raw);
+      case PlyType::i32: return load_le<std::int32_t>(raw);
+      case PlyType::u32: return load_le<std::uint32_t>(raw);
+      case PlyType::f32: return load_le<float>(raw);
+      case PlyType::f64: return load_le<double>(raw);
     }
     return 0.0;
   }
@@ -192,12 +180,6 @@ class BinaryInput {
   [[noreturn]] void fail(const std::string& cause) const { throw FormatError(name_, at_, cause); }
 
  private:
-  template <class T>
-  static T load(const std::uint8_t* p) {
-    T v;
-    std::memcpy(&v, p, sizeof(T));
-    return v;
-  }
   std::span<const std::uint8_t> bytes_;
   std::size_t at_;
   bool big_endian_;
@@ -232,14 +214,14 @@ class AsciiInput {
 
  private:
   std::string_view next() {
-    while (at_ < text_.size() && is_space(text_[at_])) {
+    while (at_ < text_.size() && is_header_space(text_[at_])) {
       if (text_[at_] == '\n') ++line_;
       ++at_;
     }
     token_start_ = at_;
     token_line_ = line_;
     if (at_ == text_.size()) fail("the data ends before every element was read (truncated file)");
-    while (at_ < text_.size() && !is_space(text_[at_])) ++at_;
+    while (at_ < text_.size() && !is_header_space(text_[at_])) ++at_;
     return text_.substr(token_start_, at_ - token_start_);
   }
   std::string_view text_;

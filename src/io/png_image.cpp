@@ -1,4 +1,4 @@
-#include "png_image.hpp"
+#include "vola/io/png_image.hpp"
 
 #include <png.h>
 
@@ -33,7 +33,7 @@ void on_error(png_structp png, png_const_charp message) {
 void on_warning(png_structp, png_const_charp) {}
 }  // namespace
 
-PngImage::PngImage(const std::string& path, std::uint32_t width, std::uint32_t height, int bits)
+PngImage::PngImage(const std::string& path, std::uint32_t width, std::uint32_t height, int bits, PngColour colour)
     : state_(std::make_unique<State>(path)) {
   State& s = *state_;
   s.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &s.message, on_error, on_warning);
@@ -42,10 +42,10 @@ PngImage::PngImage(const std::string& path, std::uint32_t width, std::uint32_t h
   if (!s.info) throw IoError(path + ": PNG: cannot create a libpng info structure");
   if (setjmp(png_jmpbuf(s.png))) s.fail();
   png_init_io(s.png, s.file.stream());
-  png_set_IHDR(s.png, s.info, width, height, bits, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  // Two-level images compress best unfiltered; height maps gain from the filters.
-  if (bits == 8) png_set_filter(s.png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+  png_set_IHDR(s.png, s.info, width, height, bits, colour == PngColour::rgb ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  // Two-level slices compress best unfiltered; height maps and pictures gain from the filters.
+  if (bits == 8 && colour == PngColour::grey) png_set_filter(s.png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
   png_write_info(s.png, s.info);
   // PNG stores 16-bit samples big-endian.
   if (bits == 16) png_set_swap(s.png);
@@ -64,6 +64,14 @@ void PngImage::finish() {
   if (setjmp(png_jmpbuf(s.png))) s.fail();
   png_write_end(s.png, nullptr);
   s.file.commit();
+}
+
+void write_png(const std::string& path, std::uint32_t width, std::uint32_t height, const std::uint8_t* samples,
+               int bits, PngColour colour) {
+  PngImage image(path, width, height, bits, colour);
+  const std::size_t row_bytes = std::size_t{width} * (colour == PngColour::rgb ? 3 : 1) * (bits == 16 ? 2 : 1);
+  for (std::uint32_t y = 0; y < height; ++y) image.write_row(samples + y * row_bytes);
+  image.finish();
 }
 
 }  // namespace vola::io

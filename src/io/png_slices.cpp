@@ -4,7 +4,7 @@
 #include <system_error>
 #include <vector>
 
-#include "png_image.hpp"
+#include "vola/io/png_image.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
 

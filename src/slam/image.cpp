@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "vola/error.hpp"
+#include "vola/io/png_image.hpp"
 
 namespace vola::slam {
 
@@ -166,32 +167,6 @@ DepthImage read_pgm_depth(const std::string& path, const std::vector<std::uint8_
   return image;
 }
 
-void write_png(const std::string& path, std::uint32_t width, std::uint32_t height, int bit_depth, int color_type,
-               const std::uint8_t* data, std::size_t row_bytes) {
-  File file;
-  file.f = std::fopen(path.c_str(), "wb");
-  if (!file.f) throw IoError(path + ": cannot create: " + std::strerror(errno));
-  PngError error;
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error, on_png_warning);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!info) {
-    png_destroy_write_struct(&png, nullptr);
-    throw IoError(path + ": out of memory");
-  }
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    throw IoError(path + ": PNG: " + error.message);
-  }
-  png_init_io(png, file.f);
-  png_set_IHDR(png, info, width, height, bit_depth, color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (std::uint32_t y = 0; y < height; ++y) png_write_row(png, data + y * row_bytes);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fflush(file.f) != 0) throw IoError(path + ": write failed");
-}
-
 }  // namespace
 
 DepthImage read_depth(const std::string& path, double depth_factor) {
@@ -227,15 +202,14 @@ DepthImage read_depth(const std::string& path, double depth_factor) {
 }
 
 void write_depth_png(const std::string& path, const DepthImage& depth, double depth_factor) {
-  std::vector<std::uint8_t> bytes(depth.metres.size() * 2);
+  std::vector<std::uint16_t> samples(depth.metres.size());
   for (std::size_t i = 0; i < depth.metres.size(); ++i) {
     const double m = depth.metres[i];
     const double raw = (m > 0.0 && std::isfinite(m)) ? std::min(65535.0, std::round(m * depth_factor)) : 0.0;
-    const auto r = static_cast<std::uint16_t>(raw);
-    bytes[2 * i] = static_cast<std::uint8_t>(r >> 8);
-    bytes[2 * i + 1] = static_cast<std::uint8_t>(r & 0xff);
+    samples[i] = static_cast<std::uint16_t>(raw);
   }
-  write_png(path, depth.width, depth.height, 16, PNG_COLOR_TYPE_GRAY, bytes.data(), std::size_t{depth.width} * 2);
+  io::write_png(path, depth.width, depth.height, reinterpret_cast<const std::uint8_t*>(samples.data()), 16,
+                io::PngColour::grey);
 }
 
 RgbImage read_rgb_png(const std::string& path) {
@@ -255,7 +229,7 @@ RgbImage read_rgb_png(const std::string& path) {
 }
 
 void write_rgb_png(const std::string& path, const RgbImage& image) {
-  write_png(path, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, image.rgb.data(), std::size_t{image.width} * 3);
+  io::write_png(path, image.width, image.height, image.rgb.data(), 8, io::PngColour::rgb);
 }
 
 }  // namespace vola::slam

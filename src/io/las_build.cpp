@@ -1,0 +1,440 @@
+// The streaming LAS conversion (build_las): chunks of records into a StreamBuilder, keys
+// straight from the stored integers where the grid allows, the points' bounds without
+// decoding a coordinate, and one pass instead of two when the header's box can be trusted.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "vola/error.hpp"
+#include "vola/io/las.hpp"
+#include "vola/little_endian.hpp"
+#include "vola/stream_builder.hpp"
+
+namespace vola::io {
+
+namespace {
+
+// x y z of each record, appended to xyz.
+void decode_xyz(const LasHeader& hd, std::span<const std::uint8_t> records, std::vector<double>& xyz) {
+  const std::size_t length = hd.record_length, n = records.size() / length;
+  const std::size_t at = xyz.size();
+  xyz.resize(at + 3 * n);
+  double* out = xyz.data() + at;
+  const std::uint8_t* r = records.data();
+  for (std::size_t i = 0; i < n; ++i, r += length, out += 3) {
+    out[0] = static_cast<double>(load_le<std::int32_t>(r)) * hd.scale[0] + hd.offset[0];
+    out[1] = static_cast<double>(load_le<std::int32_t>(r + 4)) * hd.scale[1] + hd.offset[1];
+    out[2] = static_cast<double>(load_le<std::int32_t>(r + 8)) * hd.scale[2] + hd.offset[2];
+  }
+}
+
+// Points in a batch of records that stays in cache (LasReader::read_records).
+std::size_t batch_points(const LasHeader& hd) { return std::max<std::size_t>(1, kLasRecordBatchBytes / hd.record_length); }
+
+// The next chunk of up to chunk_points points, decoded into xyz (replaced); the points read.
+std::size_t read_xyz(LasReader& reader, std::size_t chunk_points, std::vector<double>& xyz) {
+  const LasHeader& hd = reader.header();
+  xyz.clear();
+  const std::size_t batch = batch_points(hd);
+  std::size_t done = 0;
+  while (done < chunk_points) {
+    const std::span<const std::uint8_t> records = reader.read_records(std::min(batch, chunk_points - done));
+    if (records.empty()) break;
+    decode_xyz(hd, records, xyz);
+    done += records.size() / hd.record_length;
+  }
+  return done;
+}
+
+// The bounds of the decoded coordinates, from the rest of the file. x * scale + offset
+// is monotonic in the stored integer x (rounding keeps the order; a negative scale
+// reverses it), so the extremes of the integers decode to the extremes of the
+// coordinates: no point is decoded. A scale or offset that is not finite could make
+// NaN, which the comparisons of the decoded path skip: such files take that path.
+Box las_bounds(LasReader& reader, std::size_t chunk_points, std::int32_t stored_lo[3], std::int32_t stored_hi[3],
+               const std::function<void(std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Box box{{inf, inf, inf}, {-inf, -inf, -inf}};
+  bool finite = true;
+  for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(hd.scale[a]) && std::isfinite(hd.offset[a]);
+  std::int32_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<std::int32_t>::max();
+    hi[a] = std::numeric_limits<std::int32_t>::min();
+  }
+  std::vector<double> xyz;
+  const std::size_t length = hd.record_length, batch = batch_points(hd);
+  std::uint64_t reported = 0;
+  while (true) {
+    const std::span<const std::uint8_t> records = reader.read_records(batch);
+    if (records.empty()) break;
+    if (finite) {
+      std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+      for (const std::uint8_t* r = records.data(); r < records.data() + records.size(); r += length) {
+        const std::int32_t x = load_le<std::int32_t>(r), y = load_le<std::int32_t>(r + 4), z = load_le<std::int32_t>(r + 8);
+        l0 = std::min(l0, x), h0 = std::max(h0, x);
+        l1 = std::min(l1, y), h1 = std::max(h1, y);
+        l2 = std::min(l2, z), h2 = std::max(h2, z);
+      }
+      lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
+    } else {
+      xyz.clear();
+      decode_xyz(hd, records, xyz);
+      for (std::size_t i = 0; i < xyz.size(); ++i) {
+        box.min[i % 3] = std::min(box.min[i % 3], xyz[i]);
+        box.max[i % 3] = std::max(box.max[i % 3], xyz[i]);
+      }
+    }
+    if (reader.points_read() - reported >= chunk_points || reader.points_read() == hd.point_count) {
+      reported = reader.points_read();
+      progress(reported);
+    }
+  }
+  if (reader.points_read() == 0) return Box{};
+  if (finite)
+    for (int a = 0; a < 3; ++a) {
+      stored_lo[a] = lo[a];
+      stored_hi[a] = hi[a];
+      const double from_lo = static_cast<double>(lo[a]) * hd.scale[a] + hd.offset[a];
+      const double from_hi = static_cast<double>(hi[a]) * hd.scale[a] + hd.offset[a];
+      box.min[a] = std::min(from_lo, from_hi);
+      box.max[a] = std::max(from_lo, from_hi);
+    }
+  return box;
+}
+
+// The stored integer of one axis -> its voxel's key bits, exactly as decoding the
+// coordinate (x * scale + offset, as decode_xyz does) and quantizing it
+// (Quantizer::to_voxel) would give, without either per point. Both steps are
+// monotonic in the stored integer x (for a positive scale: rounding keeps the order),
+// so the cells form runs of consecutive integers: `lower[i]` is the smallest stored
+// integer of cell i, found once per cell with the exact decode + to_voxel. Per point,
+// one multiply guesses the cell and one or two comparisons correct the guess.
+class AxisCells {
+ public:
+  static constexpr Key kOutside = Key{1} << 63;
+  // Cells in [lo, hi], the stored integers of this axis that can occur. False (use the
+  // decoded path) when the mapping is not monotonic non-decreasing and finite, or the
+  // range spans too many cells for a table.
+  bool build(const LasHeader& hd, const Quantizer& quantizer, int axis, std::int64_t lo, std::int64_t hi) {
+    const double scale = hd.scale[axis], offset = hd.offset[axis];
+    if (!(scale > 0.0) || !std::isfinite(scale) || !std::isfinite(offset)) return false;
+    axis_ = axis;
+    hd_ = &hd;
+    quantizer_ = &quantizer;
+    // The other axes at a point known to be inside, so to_voxel speaks of this axis only.
+    inside_ = quantizer.center(Voxel{0, 0, 0});
+    Voxel v;
+    if (!quantizer.to_voxel(inside_, v) || v != Voxel{0, 0, 0}) return false;
+    side_ = side_of(quantizer.depth());
+    origin_ = quantizer.frame().origin[axis];
+    if (!std::isfinite(decode(lo)) || !std::isfinite(decode(hi))) return false;
+    const std::int64_t first = cell(lo), last = cell(hi);
+    if (first > last || last - first >= kMaxCells) return false;
+    const std::size_t cells = static_cast<std::size_t>(last - first + 1);
+    lower_.assign(cells + 1, 0);
+    key_.assign(cells, 0);
+    lower_[0] = std::numeric_limits<std::int64_t>::min();
+    lower_[cells] = std::numeric_limits<std::int64_t>::max();
+    std::int64_t from = lo, width = 0;
+    for (std::size_t i = 1; i < cells; ++i) {
+      const std::int64_t at = first_at_least(first + static_cast<std::int64_t>(i), from, hi, from + width);
+      if (i >= 2) width = at - from;
+      lower_[i] = from = at;
+    }
+    for (std::size_t i = 0; i < cells; ++i) {
+      const std::int64_t c = first + static_cast<std::int64_t>(i);
+      key_[i] = c < 0 || c >= side_ ? kOutside : detail::spread(static_cast<std::uint32_t>(c)) << (2 * axis);
+    }
+    // The guess: cell 1 starts at lower_[1], cells are (lower_[last] - lower_[1]) / (cells - 2) wide.
+    base_ = cells >= 2 ? lower_[1] : 0;
+    slope_ = cells >= 3 && lower_[cells - 1] > lower_[1]
+                 ? static_cast<double>(cells - 2) / static_cast<double>(lower_[cells - 1] - lower_[1])
+                 : 0.0;
+    last_ = static_cast<std::int64_t>(cells) - 1;
+    // Check the guess-and-correct lookup against the exact mapping at every border.
+    for (std::size_t i = 1; i < cells; ++i)
+      for (const std::int64_t x : {lower_[i] - 1, lower_[i]})
+        if (x >= lo && x <= hi && key(static_cast<std::int32_t>(x)) != exact_key(x)) return false;
+    return true;
+  }
+
+  // The table by value, for a hot loop (locals that no store can alias).
+  struct Lookup {
+    const std::int64_t* lower;
+    const Key* key;
+    std::int64_t base, last;
+    double slope;
+    Key operator()(std::int32_t x) const noexcept {
+      std::int64_t i = 1 + static_cast<std::int64_t>(static_cast<double>(x - base) * slope);
+      i = std::clamp<std::int64_t>(i, 0, last);
+      while (x < lower[i]) --i;
+      while (x >= lower[i + 1]) ++i;
+      return key[i];
+    }
+  };
+  Lookup lookup() const noexcept { return {lower_.data(), key_.data(), base_, last_, slope_}; }
+  Key key(std::int32_t x) const noexcept { return lookup()(x); }
+
+ private:
+  static constexpr std::int64_t kMaxCells = std::int64_t{1} << 21;
+
+  double decode(std::int64_t x) const noexcept {
+    return static_cast<double>(static_cast<std::int32_t>(x)) * hd_->scale[axis_] + hd_->offset[axis_];
+  }
+  // The cell of stored integer x: -1 below a grid, side above it.
+  std::int64_t cell(std::int64_t x) const noexcept {
+    Point p = inside_;
+    p[axis_] = decode(x);
+    Voxel v;
+    if (quantizer_->to_voxel(p, v)) return axis_ == 0 ? v.x : axis_ == 1 ? v.y : v.z;
+    return p[axis_] < origin_ ? -1 : static_cast<std::int64_t>(side_);
+  }
+  Key exact_key(std::int64_t x) const noexcept {
+    const std::int64_t c = cell(x);
+    return c < 0 || c >= side_ ? kOutside : detail::spread(static_cast<std::uint32_t>(c)) << (2 * axis_);
+  }
+  // The smallest x in [from, to] whose cell is at least c (cell(to) >= c, cell(from - 1) < c).
+  std::int64_t first_at_least(std::int64_t c, std::int64_t from, std::int64_t to, std::int64_t guess) const {
+    std::int64_t below = from - 1, above = to;  // cell(below) < c <= cell(above)
+    guess = std::clamp(guess, from, to);
+    std::int64_t step = 1;
+    if (cell(guess) >= c) {
+      above = guess;
+      while (above - step > below) {
+        if (cell(above - step) < c) {
+          below = above - step;
+          break;
+        }
+        above -= step;
+        step *= 2;
+      }
+    } else {
+      below = guess;
+      while (below + step < above) {
+        if (cell(below + step) >= c) {
+          above = below + step;
+          break;
+        }
+        below += step;
+        step *= 2;
+      }
+    }
+    while (above - below > 1) {
+      const std::int64_t mid = below + (above - below) / 2;
+      (cell(mid) >= c ? above : below) = mid;
+    }
+    return above;
+  }
+
+  int axis_ = 0;
+  const LasHeader* hd_ = nullptr;
+  const Quantizer* quantizer_ = nullptr;
+  Point inside_{};
+  std::int64_t side_ = 0;
+  double origin_ = 0.0;
+  std::vector<std::int64_t> lower_;
+  std::vector<Key> key_;
+  std::int64_t base_ = 0, last_ = 0;
+  double slope_ = 0.0;
+};
+
+// The streamed tree with its bbox and EPSG code in the header, and what went into it.
+Tree finish_tree(StreamBuilder& builder, const Box& bbox, std::uint32_t epsg, BuildReport* report) {
+  Tree tree = builder.finish();
+  tree.georef().bbox = bbox;
+  tree.georef().epsg = epsg;
+  if (report) {
+    report->points_in = builder.points_in();
+    report->points_outside = builder.points_outside();
+    report->voxels = tree.voxel_count();
+  }
+  return tree;
+}
+
+// The next chunk of up to chunk_points records -> voxel keys -> the builder, the
+// records read in batches that stay in cache. With kRange, also widens [lo, hi], the
+// range of stored integers per axis. Returns the points read (0 at the end).
+template <bool kRange>
+std::size_t add_chunk(LasReader& reader, StreamBuilder& builder, std::size_t chunk_points, const AxisCells (&cells)[3],
+                      std::int32_t lo[3], std::int32_t hi[3]) {
+  const LasHeader& hd = reader.header();
+  const std::size_t length = hd.record_length;
+  const std::size_t n =
+      static_cast<std::size_t>(std::min<std::uint64_t>(chunk_points, hd.point_count - reader.points_read()));
+  if (n == 0) return 0;
+  const std::size_t batch = batch_points(hd);
+  const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
+  Key* out = builder.key_scratch(n).data();
+  std::size_t kept = 0, done = 0;
+  std::int32_t l0 = lo[0], l1 = lo[1], l2 = lo[2], h0 = hi[0], h1 = hi[1], h2 = hi[2];
+  while (done < n) {
+    const std::span<const std::uint8_t> records = reader.read_records(std::min(batch, n - done));
+    const std::size_t m = records.size() / length;
+    if (m == 0) break;
+    const std::uint8_t* r = records.data();
+    for (std::size_t i = 0; i < m; ++i, r += length) {
+      const std::int32_t x = load_le<std::int32_t>(r), y = load_le<std::int32_t>(r + 4), z = load_le<std::int32_t>(r + 8);
+      if constexpr (kRange) {
+        l0 = std::min(l0, x), h0 = std::max(h0, x);
+        l1 = std::min(l1, y), h1 = std::max(h1, y);
+        l2 = std::min(l2, z), h2 = std::max(h2, z);
+      }
+      const Key key = kx(x) | ky(y) | kz(z);
+      out[kept] = key;
+      kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+    }
+    done += m;
+  }
+  if constexpr (kRange) lo[0] = l0, lo[1] = l1, lo[2] = l2, hi[0] = h0, hi[1] = h1, hi[2] = h2;
+  builder.add_keys(std::span<Key>(out, kept), done - kept);
+  return done;
+}
+
+// The box of the decoded coordinates from the range of stored integers (as las_bounds).
+Box decoded_box(const LasHeader& hd, const std::int32_t lo[3], const std::int32_t hi[3]) {
+  Box box;
+  for (int a = 0; a < 3; ++a) {
+    const double from_lo = static_cast<double>(lo[a]) * hd.scale[a] + hd.offset[a];
+    const double from_hi = static_cast<double>(hi[a]) * hd.scale[a] + hd.offset[a];
+    box.min[a] = std::min(from_lo, from_hi);
+    box.max[a] = std::max(from_lo, from_hi);
+  }
+  return box;
+}
+
+// Occupancy only, bbox not given: one pass instead of two. The grid is resolved from
+// the header's bounds and the points' bounds are taken on the way; when the grid the
+// points' bounds resolve to is the same grid (the usual case: a toolkit grid needs the
+// same box, a grid-mode one only the same origin, voxel size and depth), the tree is
+// what two passes would build. Otherwise nothing is returned and `bounds`, `lo`, `hi`
+// hold the points' bounds, so the caller needs only its second pass.
+std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions& options, BuildReport* report,
+                                          const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                                          std::size_t chunk_points, std::optional<Box>& bounds, std::int32_t lo[3],
+                                          std::int32_t hi[3]) {
+  const LasHeader& hd = reader.header();
+  if (hd.point_count == 0) return std::nullopt;
+  const Box header_box{hd.min, hd.max};
+  for (int a = 0; a < 3; ++a)
+    if (!(std::isfinite(hd.min[a]) && std::isfinite(hd.max[a]) && hd.min[a] <= hd.max[a])) return std::nullopt;
+  std::optional<Quantizer> quantizer;
+  try {
+    quantizer = resolve_quantizer(header_box, options);
+  } catch (const Error&) {
+    return std::nullopt;  // a header box no grid fits: the two-pass path says what is wrong
+  }
+  AxisCells cells[3];
+  for (int a = 0; a < 3; ++a)
+    if (!cells[a].build(hd, *quantizer, a, std::numeric_limits<std::int32_t>::min(),
+                        std::numeric_limits<std::int32_t>::max()))
+      return std::nullopt;
+  StreamBuilder builder(*quantizer, {}, false);
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<std::int32_t>::max();
+    hi[a] = std::numeric_limits<std::int32_t>::min();
+  }
+  reader.rewind();
+  while (add_chunk<true>(reader, builder, chunk_points, cells, lo, hi) > 0) {
+    if (progress) progress(reader.points_read(), hd.point_count);
+    // A point well outside the header's box: the header is stale, stop guessing at once.
+    // (Writers that round the header's bounds differently from the stored integers put
+    // points a step or so outside it; the grid usually comes out the same.)
+    const Box so_far = decoded_box(hd, lo, hi);
+    for (int a = 0; a < 3; ++a) {
+      const double slack = 2.0 * hd.scale[a];
+      if (so_far.min[a] < header_box.min[a] - slack || so_far.max[a] > header_box.max[a] + slack) return std::nullopt;
+    }
+  }
+  const Box box = decoded_box(hd, lo, hi);
+  const Quantizer resolved = resolve_quantizer(box, options);
+  const bool same = resolved.depth() == quantizer->depth() &&
+                    (options.quantization == Quantization::toolkit ? box == header_box
+                                                                   : resolved.frame() == quantizer->frame());
+  if (!same) {
+    bounds = box;
+    return std::nullopt;
+  }
+  return finish_tree(builder, box, options.epsg, report);
+}
+
+}  // namespace
+
+Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload, BuildReport* report,
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
+  BuildOptions options = requested;  // the bbox is filled in from the points when not given
+  const LasHeader& hd = reader.header();
+  LasChunk chunk;
+  const bool occupancy_only = !attributes && !payload;
+  // Keys are 8 bytes a point; decoded coordinates (the path without key tables) 24.
+  const std::size_t decoded_chunk = chunk_points == 0 ? kLasChunkPoints : chunk_points;
+  if (chunk_points == 0) chunk_points = occupancy_only ? kLasKeyChunkPoints : kLasChunkPoints;
+  std::int32_t stored_lo[3], stored_hi[3];
+  for (int a = 0; a < 3; ++a) {
+    stored_lo[a] = std::numeric_limits<std::int32_t>::min();
+    stored_hi[a] = std::numeric_limits<std::int32_t>::max();
+  }
+  if (occupancy_only && !options.bbox) {
+    std::optional<Box> bounds;
+    std::int32_t lo[3], hi[3];
+    if (std::optional<Tree> tree = occupancy_in_one_pass(reader, options, report, progress, chunk_points, bounds, lo, hi))
+      return std::move(*tree);
+    if (bounds) {  // the pass above took the points' bounds: only the second pass is left
+      options.bbox = bounds;
+      std::copy(lo, lo + 3, stored_lo);
+      std::copy(hi, hi + 3, stored_hi);
+    }
+  }
+  const std::uint64_t passes = options.bbox ? 1 : 2;
+  // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
+  if (!options.bbox) {
+    reader.rewind();
+    options.bbox = las_bounds(reader, chunk_points, stored_lo, stored_hi, [&](std::uint64_t done) {
+      if (progress) progress(done, passes * hd.point_count);
+    });
+  }
+  const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
+  std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
+  StreamBuilder builder(quantizer, specs, payload);
+  if (!occupancy_only) builder.expect_points(hd.point_count);
+  std::vector<std::vector<double>> values;
+  std::vector<std::span<const double>> views;
+  std::vector<std::uint64_t> payloads;
+  std::vector<double> xyz;  // occupancy only: coordinates decoded straight from the records
+  // Occupancy only: keys straight from the stored integers (AxisCells), over the range
+  // of stored integers the bounds pass saw (or any int32 when the bbox was given).
+  AxisCells cells[3];
+  bool by_table = occupancy_only && hd.point_count > 0;
+  for (int a = 0; a < 3 && by_table; ++a)
+    by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
+  reader.rewind();
+  while (by_table && add_chunk<false>(reader, builder, chunk_points, cells, stored_lo, stored_hi) > 0) {
+    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+  }
+  while (!by_table) {
+    if (occupancy_only) {
+      if (read_xyz(reader, decoded_chunk, xyz) == 0) break;
+      builder.add(xyz, {}, {});
+    } else {
+      if (reader.read(chunk, chunk_points) == 0) break;
+      if (attributes) las_attribute_values(hd, chunk, values);
+      views.assign(values.begin(), values.end());
+      if (payload) las_payloads(hd, chunk, payloads);
+      builder.add(chunk.xyz, views, payload ? std::span<const std::uint64_t>(payloads) : std::span<const std::uint64_t>{});
+    }
+    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+  }
+  // The chunk buffers (~100 bytes a point with attributes) are not needed by the final
+  // merges, which are the peak of the conversion.
+  chunk = LasChunk{};
+  values = {};
+  views = {};
+  payloads = {};
+  xyz = {};
+  return finish_tree(builder, *options.bbox, options.epsg, report);
+}
+
+}  // namespace vola::io
+

@@ -1,0 +1,224 @@
+// LasReader::read_header: the public header block, the VLRs and EVLRs, the CRS (GeoTIFF
+// keys or WKT) and the extra-bytes fields, each checked against the file's size before
+// anything is allocated for it.
+#include <algorithm>
+#include <cstring>
+#include <functional>
+#include <optional>
+
+#include "las_format.hpp"
+#include "vola/error.hpp"
+#include "vola/io/las.hpp"
+
+namespace vola::io {
+
+namespace {
+
+using las::text;
+
+// The file's bytes as the header parser reads them: bounds-checked, errors with offsets.
+struct HeaderSource {
+  const std::string& path;
+  std::uint64_t file_size;
+  std::function<void(std::uint64_t, std::uint64_t, std::uint8_t*)> fetch;
+
+  [[noreturn]] void fail(std::uint64_t offset, const std::string& cause) const { throw FormatError(path, offset, cause); }
+
+  std::vector<std::uint8_t> read_at(std::uint64_t offset, std::uint64_t size, const char* what) const {
+    if (offset > file_size || size > file_size - offset)
+      fail(offset, std::string(what) + " of " + std::to_string(size) + " bytes runs past the end of the " +
+                       std::to_string(file_size) + "-byte file");
+    std::vector<std::uint8_t> bytes(size);
+    try {
+      fetch(offset, size, bytes.data());
+    } catch (const FormatError&) {
+      fail(offset, std::string("cannot read ") + what);
+    }
+    return bytes;
+  }
+};
+
+// What the public header block says about the records that follow it.
+struct HeaderCounts {
+  std::uint32_t vlr_count = 0;
+  std::uint8_t raw_format = 0;  // with the LAZ bits
+  std::uint64_t evlr_start = 0;
+  std::uint32_t evlr_count = 0;
+};
+
+HeaderCounts parse_public_block(const HeaderSource& src, LasHeader& hd) {
+  if (src.file_size < 227)
+    src.fail(src.file_size, "a LAS file has at least a 227-byte header; this file has " + std::to_string(src.file_size) +
+                                " bytes");
+  const auto h = src.read_at(0, std::min<std::uint64_t>(src.file_size, 375), "header");
+  if (std::memcmp(h.data(), "LASF", 4) != 0) src.fail(0, "not a LAS file (no LASF signature)");
+  hd.global_encoding = load_le<std::uint16_t>(&h[6]);
+  hd.version_major = h[24];
+  hd.version_minor = h[25];
+  if (hd.version_major != 1 || hd.version_minor > 4)
+    src.fail(24, "LAS version " + hd.version() + " is not known (1.0 to 1.4)");
+  hd.system_identifier = text(&h[26], 32);
+  hd.generating_software = text(&h[58], 32);
+  hd.header_size = load_le<std::uint16_t>(&h[94]);
+  hd.offset_to_points = load_le<std::uint32_t>(&h[96]);
+  HeaderCounts counts;
+  counts.vlr_count = load_le<std::uint32_t>(&h[100]);
+  counts.raw_format = h[104];
+  hd.record_length = load_le<std::uint16_t>(&h[105]);
+  for (int a = 0; a < 3; ++a) {
+    hd.scale[a] = load_le<double>(&h[131 + 8 * a]);
+    hd.offset[a] = load_le<double>(&h[155 + 8 * a]);
+    hd.max[a] = load_le<double>(&h[179 + 16 * a]);
+    hd.min[a] = load_le<double>(&h[187 + 16 * a]);
+  }
+  const std::uint16_t min_header = hd.version_minor >= 4 ? 375 : hd.version_minor == 3 ? 235 : 227;
+  if (hd.header_size < min_header || hd.header_size > src.file_size)
+    src.fail(94, "header size " + std::to_string(hd.header_size) + " does not fit LAS " + hd.version() +
+                     " (at least " + std::to_string(min_header) + ") or the file");
+  hd.point_count = load_le<std::uint32_t>(&h[107]);
+  if (hd.version_minor >= 4) {
+    counts.evlr_start = load_le<std::uint64_t>(&h[235]);
+    counts.evlr_count = load_le<std::uint32_t>(&h[243]);
+    const std::uint64_t count64 = load_le<std::uint64_t>(&h[247]);
+    if (count64 != 0) hd.point_count = count64;
+  }
+  return counts;
+}
+
+// The VLRs after the header; returns the offset just past them.
+std::uint64_t read_vlrs(const HeaderSource& src, LasHeader& hd, std::uint32_t count) {
+  std::uint64_t at = hd.header_size;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const auto v = src.read_at(at, 54, "VLR header");
+    LasVlr vlr;
+    vlr.user_id = text(&v[2], 16);
+    vlr.record_id = load_le<std::uint16_t>(&v[18]);
+    vlr.description = text(&v[22], 32);
+    vlr.offset = at + 54;
+    const std::uint16_t length = load_le<std::uint16_t>(&v[20]);
+    vlr.data = src.read_at(at + 54, length, "VLR data");
+    hd.vlrs.push_back(std::move(vlr));
+    at += 54 + length;
+  }
+  return at;
+}
+
+// The point format and record layout, checked against the format and the file.
+void check_point_layout(const HeaderSource& src, LasHeader& hd, std::uint8_t raw_format, std::uint64_t vlrs_end) {
+  const bool laszip = std::any_of(hd.vlrs.begin(), hd.vlrs.end(), [](const LasVlr& v) { return v.user_id == "laszip encoded"; });
+  if (raw_format & 0xC0 || laszip)
+    src.fail(104, "this is a LAZ (compressed LAS) file; no LAZ library is packaged for this system. Decompress it "
+                  "first (e.g. `laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`) and convert the .las");
+  hd.point_format = raw_format;
+  if (hd.point_format > 10)
+    src.fail(104, "point data record format " + std::to_string(hd.point_format) + " is not known (0..10)");
+  if (hd.record_length < las::kMinRecordLength[hd.point_format])
+    src.fail(105, "record length " + std::to_string(hd.record_length) + " is shorter than format " +
+                      std::to_string(hd.point_format) + " needs (" +
+                      std::to_string(las::kMinRecordLength[hd.point_format]) + ")");
+  if (hd.offset_to_points < vlrs_end || hd.offset_to_points > src.file_size)
+    src.fail(96, "offset to point data " + std::to_string(hd.offset_to_points) + " is before the end of the VLRs (" +
+                     std::to_string(vlrs_end) + ") or past the end of the file");
+}
+
+// The EVLRs (LAS 1.4). Waveform data can be huge and is not needed: only the records
+// that describe the points are kept.
+void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::uint32_t count) {
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const auto v = src.read_at(at, 60, "EVLR header");
+    LasVlr vlr;
+    vlr.extended = true;
+    vlr.user_id = text(&v[2], 16);
+    vlr.record_id = load_le<std::uint16_t>(&v[18]);
+    vlr.description = text(&v[28], 32);
+    const std::uint64_t length = load_le<std::uint64_t>(&v[20]);
+    vlr.offset = at + 60;
+    if (vlr.user_id == "LASF_Projection" || vlr.user_id == "LASF_Spec")
+      vlr.data = src.read_at(at + 60, length, "EVLR data");
+    else if (length > src.file_size - std::min(src.file_size, at + 60))
+      src.fail(at + 20, "EVLR length runs past the end of the file");
+    hd.vlrs.push_back(std::move(vlr));
+    at += 60 + length;
+  }
+}
+
+// GeoKeyDirectoryTag: the projected CRS code, else the geographic one (none when
+// user-defined).
+void parse_geokeys(const LasVlr& vlr, LasHeader& hd) {
+  const std::size_t keys = load_le<std::uint16_t>(&vlr.data[6]);
+  std::optional<std::uint32_t> projected, geographic;
+  for (std::size_t k = 0; k < keys && 8 + 8 * k + 8 <= vlr.data.size(); ++k) {
+    const std::uint8_t* e = &vlr.data[8 + 8 * k];
+    const std::uint16_t id = load_le<std::uint16_t>(e), location = load_le<std::uint16_t>(e + 2);
+    const std::uint16_t value = load_le<std::uint16_t>(e + 6);
+    if (location != 0) continue;
+    if (id == 3072) projected = value;
+    if (id == 2048) geographic = value;
+  }
+  if (projected && *projected != las::kUserDefined && *projected != 0) hd.epsg = *projected;
+  else if (geographic && *geographic != las::kUserDefined && *geographic != 0) hd.epsg = *geographic;
+}
+
+// The extra-bytes VLR: one field per value after the point format's own bytes.
+void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd) {
+  std::uint32_t offset = las::kMinRecordLength[hd.point_format];
+  for (std::size_t d = 0; d + 192 <= vlr.data.size(); d += 192) {
+    const std::uint8_t* e = &vlr.data[d];
+    const std::uint8_t type = e[2], options = e[3];
+    const std::string name = text(e + 4, 32);
+    if (type == 0) {  // undocumented bytes: options holds their count
+      offset += options;
+      continue;
+    }
+    // Types 11..30 (LAS 1.4 R13, deprecated since) are arrays of 2 or 3 values of
+    // type ((t - 1) % 10) + 1; each element becomes its own field.
+    if (type > 30)
+      src.fail(vlr.offset + d + 2, "extra bytes field '" + name + "' has unknown data type " + std::to_string(type));
+    const auto base = static_cast<std::uint8_t>((type - 1) % 10 + 1);
+    const int count = (type - 1) / 10 + 1;
+    for (int k = 0; k < count; ++k) {
+      LasExtraField f;
+      f.name = count == 1 ? name : name + "_" + std::to_string(k);
+      f.data_type = base;
+      f.size = static_cast<std::uint32_t>(las::extra_size(base));
+      f.offset = offset;
+      if (options & 8) f.scale = load_le<double>(e + 112 + 8 * k);
+      if (options & 16) f.add = load_le<double>(e + 136 + 8 * k);
+      hd.extra_fields.push_back(f);
+      offset += f.size;
+    }
+  }
+  if (offset > hd.record_length)
+    src.fail(vlr.offset, "extra bytes fields need " + std::to_string(offset) + " bytes per record, records have " +
+                             std::to_string(hd.record_length));
+}
+
+}  // namespace
+
+void LasReader::read_header() {
+  if (in_) {
+    in_->seekg(0, std::ios::end);
+    file_size_ = static_cast<std::uint64_t>(in_->tellg());
+    in_->seekg(0);
+  }
+  const HeaderSource src{path_, file_size_,
+                         [this](std::uint64_t offset, std::uint64_t size, std::uint8_t* out) { fetch(offset, size, out); }};
+  LasHeader& hd = header_;
+  const HeaderCounts counts = parse_public_block(src, hd);
+  const std::uint64_t vlrs_end = read_vlrs(src, hd, counts.vlr_count);
+  check_point_layout(src, hd, counts.raw_format, vlrs_end);
+  read_evlrs(src, hd, counts.evlr_start, counts.evlr_count);
+  const std::uint64_t point_bytes = file_size_ - hd.offset_to_points;
+  if (hd.point_count > point_bytes / hd.record_length)
+    src.fail(hd.offset_to_points, "the header promises " + std::to_string(hd.point_count) + " points of " +
+                                      std::to_string(hd.record_length) + " bytes but only " +
+                                      std::to_string(point_bytes) + " bytes follow the point data offset (truncated file)");
+  for (const auto& vlr : hd.vlrs) {
+    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8) parse_geokeys(vlr, hd);
+    else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
+    else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
+  }
+  if (in_) in_->seekg(hd.offset_to_points);
+}
+
+}  // namespace vola::io

@@ -1,0 +1,103 @@
+// LAS points as vola sees them: the attribute columns a LAS file gives (colour,
+// intensity, classification, height, returns, extra bytes), the reference's payload word,
+// and a whole file as a PointCloud.
+#include <algorithm>
+
+#include "vola/io/las.hpp"
+
+namespace vola::io {
+
+namespace {
+
+// The reference's las2vola payload: int(255 * clip((v - lo) / (hi - lo), 0, 1)).
+std::uint64_t payload_byte(double v, double lo, double hi) {
+  const double n = hi > lo ? (v - lo) / (hi - lo) : 0.0;
+  if (!(n > 0.0)) return 0;  // also NaN, from a header max z that is not a number
+  return static_cast<std::uint64_t>(255.0 * std::min(n, 1.0));
+}
+
+}  // namespace
+
+std::vector<AttributeSpec> las_attributes(const LasHeader& hd) {
+  std::vector<AttributeSpec> specs;
+  if (hd.has_rgb()) {
+    specs.push_back({"red", ValueType::u16, Reduction::mean});
+    specs.push_back({"green", ValueType::u16, Reduction::mean});
+    specs.push_back({"blue", ValueType::u16, Reduction::mean});
+  }
+  specs.push_back({"intensity", ValueType::u16, Reduction::mean});
+  specs.push_back({"classification", ValueType::u8, Reduction::majority});
+  specs.push_back({"height", ValueType::f32, Reduction::mean});
+  specs.push_back({"number_of_returns", ValueType::u8, Reduction::max});
+  for (const auto& f : hd.extra_fields) specs.push_back({f.name, ValueType::f64, Reduction::mean});
+  return specs;
+}
+
+void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vector<std::vector<double>>& values) {
+  const std::size_t n = chunk.size();
+  values.resize(las_attributes(hd).size());
+  std::size_t c = 0;
+  auto column = [&](auto&& value_of) {
+    auto& v = values[c++];
+    v.resize(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = value_of(i);
+  };
+  if (hd.has_rgb()) {
+    column([&](std::size_t i) { return static_cast<double>(chunk.red[i]); });
+    column([&](std::size_t i) { return static_cast<double>(chunk.green[i]); });
+    column([&](std::size_t i) { return static_cast<double>(chunk.blue[i]); });
+  }
+  column([&](std::size_t i) { return static_cast<double>(chunk.intensity[i]); });
+  column([&](std::size_t i) { return static_cast<double>(chunk.classification[i]); });
+  column([&](std::size_t i) { return chunk.xyz[3 * i + 2]; });
+  column([&](std::size_t i) { return static_cast<double>(chunk.number_of_returns[i]); });
+  for (const auto& extra : chunk.extra) column([&](std::size_t i) { return extra[i]; });
+}
+
+void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::uint64_t>& payloads) {
+  const std::size_t n = chunk.size();
+  payloads.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t r = 200, g = 200, b = 200;  // the reference's grey for points without colour
+    if (hd.has_rgb() && (chunk.red[i] | chunk.green[i] | chunk.blue[i])) {
+      r = chunk.red[i] / 256u;
+      g = chunk.green[i] / 256u;
+      b = chunk.blue[i] / 256u;
+    }
+    payloads[i] = r | g << 8 | b << 16 | payload_byte(chunk.xyz[3 * i + 2], 0.0, hd.max[2]) << 24 |
+                  payload_byte(chunk.number_of_returns[i], 1.0, 7.0) << 32 |
+                  payload_byte(chunk.intensity[i], 0.0, 1000.0) << 40 |
+                  payload_byte(chunk.classification[i], 0.0, 31.0) << 48;
+  }
+}
+
+
+PointCloud las_points(LasReader& reader, bool attributes, bool payload,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  PointCloud cloud;
+  const std::uint64_t total = hd.point_count;
+  cloud.xyz.reserve(3 * total);
+  if (attributes)
+    for (const auto& spec : las_attributes(hd)) cloud.attributes.push_back({spec.name, spec.type, spec.reduction, {}});
+  LasChunk chunk;
+  std::vector<std::vector<double>> values;
+  std::vector<std::uint64_t> payloads;
+  while (reader.read(chunk, 1 << 20) > 0) {
+    cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
+    if (attributes) {
+      las_attribute_values(hd, chunk, values);
+      for (std::size_t a = 0; a < values.size(); ++a)
+        cloud.attributes[a].values.insert(cloud.attributes[a].values.end(), values[a].begin(), values[a].end());
+    }
+    if (payload) {
+      las_payloads(hd, chunk, payloads);
+      cloud.payload.insert(cloud.payload.end(), payloads.begin(), payloads.end());
+    }
+    if (progress) progress(reader.points_read(), total);
+  }
+  return cloud;
+}
+
+
+}  // namespace vola::io

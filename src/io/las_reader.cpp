@@ -1,0 +1,213 @@
+// LasReader: opening a LAS file (pread on regular files, a stream otherwise, or bytes in
+// memory) and decoding its point records in chunks. The header is parsed in las_header.cpp.
+#include "vola/io/las.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <memory>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "las_format.hpp"
+#include "vola/error.hpp"
+
+namespace vola::io {
+
+bool LasHeader::has_rgb() const noexcept {
+  return point_format == 2 || point_format == 3 || point_format == 5 || point_format == 7 || point_format == 8 ||
+         point_format == 10;
+}
+
+bool LasHeader::has_gps_time() const noexcept { return point_format != 0 && point_format != 2; }
+
+void LasChunk::clear() {
+  xyz.clear();
+  intensity.clear();
+  return_number.clear();
+  number_of_returns.clear();
+  classification.clear();
+  user_data.clear();
+  point_source_id.clear();
+  gps_time.clear();
+  red.clear();
+  green.clear();
+  blue.clear();
+  for (auto& e : extra) e.clear();
+}
+
+LasReader::LasReader(const std::string& path) : path_(path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open");
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+    fd_ = std::shared_ptr<const int>(new int(fd), [](const int* f) {
+      ::close(*f);
+      delete f;
+    });
+    file_size_ = static_cast<std::uint64_t>(st.st_size);
+#ifdef POSIX_FADV_SEQUENTIAL
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+#endif
+  } else {
+    ::close(fd);
+    auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file) throw IoError(path + ": cannot open");
+    in_ = std::move(file);
+  }
+  read_header();
+}
+
+LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& name)
+    : path_(name), owned_(bytes.begin(), bytes.end()) {
+  bytes_ = owned_;
+  file_size_ = bytes_.size();
+  read_header();
+}
+
+// size bytes at offset (checked by the caller to lie inside the file).
+void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) {
+  if (fd_) {
+    std::uint64_t done = 0;
+    while (done < size) {
+      const ::ssize_t got = ::pread(*fd_, out + done, static_cast<std::size_t>(size - done),
+                                    static_cast<off_t>(offset + done));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) throw FormatError(path_, offset + done, "cannot read");
+      done += static_cast<std::uint64_t>(got);
+    }
+    return;
+  }
+  if (!in_) {
+    if (size) std::memcpy(out, bytes_.data() + offset, size);
+    return;
+  }
+  in_->clear();
+  in_->seekg(static_cast<std::streamoff>(offset));
+  in_->read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(size));
+  if (static_cast<std::uint64_t>(in_->gcount()) != size) throw FormatError(path_, offset, "cannot read");
+}
+
+
+std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
+  const LasHeader& hd = header_;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  if (n == 0) return {};
+  const std::size_t length = hd.record_length;
+  const std::uint64_t at = hd.offset_to_points + next_ * length;
+  if (!fd_ && !in_) {  // in memory; the header check guarantees the records lie inside
+    next_ += n;
+    return bytes_.subspan(static_cast<std::size_t>(at), n * length);
+  }
+  // resize() only grows the buffer after the first chunk: no zeroing per chunk.
+  if (buffer_.size() < n * length) buffer_.resize(n * length);
+  if (fd_) {
+    try {
+      fetch(at, n * length, buffer_.data());
+    } catch (const FormatError&) {
+      throw FormatError(path_, at, "cannot read the point records (truncated file)");
+    }
+  } else {
+    in_->clear();
+    in_->seekg(static_cast<std::streamoff>(at));
+    in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
+    if (static_cast<std::size_t>(in_->gcount()) != n * length)
+      throw FormatError(path_, at, "cannot read the point records (truncated file)");
+  }
+  next_ += n;
+  return {buffer_.data(), n * length};
+}
+
+std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_only) {
+  chunk.clear();
+  const LasHeader& hd = header_;
+  chunk.extra.resize(hd.extra_fields.size());
+  const std::size_t length = hd.record_length;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  if (n == 0) return 0;
+  // The records come in batches that stay in cache while their fields are spread out.
+  const std::size_t batch = std::max<std::size_t>(1, kLasRecordBatchBytes / length);
+  if (xyz_only) {
+    chunk.xyz.resize(3 * n);
+    double* out = chunk.xyz.data();
+    for (std::size_t done = 0; done < n;) {
+      const std::span<const std::uint8_t> records = read_records(std::min(batch, n - done));
+      const std::size_t m = records.size() / length;
+      for (std::size_t i = 0; i < m; ++i, out += 3) {
+        const std::uint8_t* r = records.data() + i * length;
+        for (int a = 0; a < 3; ++a) out[a] = static_cast<double>(load_le<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+      }
+      done += m;
+    }
+    return n;
+  }
+  const bool extended = hd.extended_format();
+  const bool rgb = hd.has_rgb(), gps = hd.has_gps_time();
+  // Byte offsets of the optional fields inside a record.
+  const std::size_t gps_at = extended ? 22 : 20;
+  const std::size_t rgb_at = extended ? 30 : (hd.point_format == 2 ? 20 : 28);
+  chunk.xyz.resize(3 * n);
+  chunk.intensity.resize(n);
+  chunk.return_number.resize(n);
+  chunk.number_of_returns.resize(n);
+  chunk.classification.resize(n);
+  chunk.user_data.resize(n);
+  chunk.point_source_id.resize(n);
+  if (gps) chunk.gps_time.resize(n);
+  if (rgb) {
+    chunk.red.resize(n);
+    chunk.green.resize(n);
+    chunk.blue.resize(n);
+  }
+  for (auto& e : chunk.extra) e.resize(n);
+  for (std::size_t done = 0; done < n;) {
+    const std::span<const std::uint8_t> records = read_records(std::min(batch, n - done));
+    const std::size_t m = records.size() / length;
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::uint8_t* r = records.data() + k * length;
+      const std::size_t i = done + k;
+      for (int a = 0; a < 3; ++a)
+        chunk.xyz[3 * i + a] = static_cast<double>(load_le<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
+      chunk.intensity[i] = load_le<std::uint16_t>(r + 12);
+      if (extended) {
+        chunk.return_number[i] = r[14] & 15u;
+        chunk.number_of_returns[i] = r[14] >> 4;
+        chunk.classification[i] = r[16];
+        chunk.user_data[i] = r[17];
+        chunk.point_source_id[i] = load_le<std::uint16_t>(r + 20);
+      } else {
+        chunk.return_number[i] = r[14] & 7u;
+        chunk.number_of_returns[i] = (r[14] >> 3) & 7u;
+        chunk.classification[i] = r[15] & 31u;  // bits 5-7 are synthetic/key-point/withheld flags
+        chunk.user_data[i] = r[17];
+        chunk.point_source_id[i] = load_le<std::uint16_t>(r + 18);
+      }
+      if (gps) chunk.gps_time[i] = load_le<double>(r + gps_at);
+      if (rgb) {
+        chunk.red[i] = load_le<std::uint16_t>(r + rgb_at);
+        chunk.green[i] = load_le<std::uint16_t>(r + rgb_at + 2);
+        chunk.blue[i] = load_le<std::uint16_t>(r + rgb_at + 4);
+      }
+      for (std::size_t f = 0; f < hd.extra_fields.size(); ++f) {
+        const auto& field = hd.extra_fields[f];
+        chunk.extra[f][i] = las::extra_value(r + field.offset, field.data_type) * field.scale + field.add;
+      }
+    }
+    done += m;
+  }
+  return n;
+}
+
+
+void LasReader::rewind() {
+  next_ = 0;
+  if (in_) {
+    in_->clear();
+    in_->seekg(header_.offset_to_points);
+  }
+}
+
+
+}  // namespace vola::io
