@@ -1,0 +1,211 @@
+// vola.build, build_from_voxels, from_dense, read, open_mapped, parse and convert: making trees.
+#include "python_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "vola/builder.hpp"
+#include "vola/convert.hpp"
+#include "vola/file.hpp"
+#include "vola/io/input.hpp"
+
+namespace vola::python {
+
+namespace {
+
+// ---- building ----
+
+Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
+                  std::optional<std::array<double, 3>> origin, const py::dict& attributes, const py::dict& reductions,
+                  std::uint32_t epsg) {
+  const auto xyz = rows_of_three<double>(points, "points");
+  const auto n = static_cast<std::size_t>(xyz.shape(0));
+  vola::PointCloud cloud;
+  cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
+  for (const auto& [key, value] : attributes) {
+    vola::PointAttribute a;
+    a.name = py::cast<std::string>(key);
+    const py::array raw = py::array::ensure(value);
+    if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
+    a.type = value_type_of(raw.dtype());
+    const auto column = CArray<double>::ensure(raw);
+    if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
+      throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
+                                  "), got shape " + std::string(py::str(raw.attr("shape"))));
+    a.values.assign(column.data(), column.data() + n);
+    a.reduction = vola::Reduction::mean;
+    if (reductions.contains(key)) {
+      const auto name = py::cast<std::string>(reductions[key]);
+      const auto r = vola::parse_reduction(name);
+      if (!r) throw vola::InvalidArgument("attribute '" + a.name + "': reduction '" + name + "' is not one of last mean max min majority");
+      a.reduction = *r;
+    }
+    cloud.attributes.push_back(std::move(a));
+  }
+  for (const auto& [key, value] : reductions)
+    if (!attributes.contains(key)) throw vola::InvalidArgument("reductions names '" + py::cast<std::string>(key) + "', which is not an attribute");
+  vola::BuildOptions options;
+  options.quantization = parse_quantization(quantize);
+  options.depth = depth;
+  options.voxel_size = voxel_size;
+  if (origin) options.origin = to_point(*origin);
+  options.epsg = epsg;
+  with_python_names([&] { options.check(); });
+  py::gil_scoped_release release;
+  Tree tree = vola::build(cloud, options);
+  tree.georef().epsg = epsg;
+  return tree;
+}
+
+std::vector<Voxel> voxels_from(const py::handle& input, int depth) {
+  const auto xyz = rows_of_three<std::int64_t>(input, "voxels");
+  const std::int64_t side = vola::side_of(depth);
+  std::vector<Voxel> voxels(static_cast<std::size_t>(xyz.shape(0)));
+  const std::int64_t* p = xyz.data();
+  for (std::size_t i = 0; i < voxels.size(); ++i, p += 3) {
+    if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= side || p[1] >= side || p[2] >= side)
+      throw vola::InvalidArgument("voxel " + std::to_string(i) + " (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
+                                  ", " + std::to_string(p[2]) + ") is outside the depth-" + std::to_string(depth) +
+                                  " grid 0.." + std::to_string(side - 1));
+    voxels[i] = Voxel{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]), static_cast<std::uint32_t>(p[2])};
+  }
+  return voxels;
+}
+
+void check_depth(int depth) {
+  if (depth < vola::kMinDepth || depth > vola::kMaxDepth)
+    throw vola::InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10");
+}
+
+Tree build_voxels(const py::handle& input, int depth) {
+  check_depth(depth);
+  std::vector<Voxel> voxels = voxels_from(input, depth);
+  py::gil_scoped_release release;
+  return vola::build_from_voxels(voxels, depth);
+}
+
+Tree from_dense(const py::handle& input, std::optional<std::array<double, 3>> origin, std::optional<double> voxel_size,
+                int depth) {
+  const py::array raw = py::array::ensure(input);
+  if (!raw || raw.ndim() != 3) throw py::value_error("from_dense: expected a 3-D array indexed [x, y, z]");
+  const auto grid = CArray<bool>::ensure(raw.attr("astype")(py::dtype::of<bool>(), py::arg("copy") = false));
+  const auto largest = std::max({grid.shape(0), grid.shape(1), grid.shape(2), py::ssize_t{1}});
+  if (depth == 0)
+    for (depth = 1; depth < vola::kMaxDepth && vola::side_of(depth) < largest; ++depth) {
+    }
+  check_depth(depth);
+  if (vola::side_of(depth) < largest)
+    throw vola::InvalidArgument("from_dense: a grid of " + std::to_string(largest) + " cells per axis does not fit depth " +
+                                std::to_string(depth));
+  std::vector<Voxel> voxels;
+  {
+    py::gil_scoped_release release;
+    const bool* cell = grid.data();
+    const auto nx = grid.shape(0), ny = grid.shape(1), nz = grid.shape(2);
+    for (py::ssize_t x = 0; x < nx; ++x)
+      for (py::ssize_t y = 0; y < ny; ++y)
+        for (py::ssize_t z = 0; z < nz; ++z, ++cell)
+          if (*cell) voxels.push_back(Voxel{static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)});
+  }
+  Tree tree = vola::build_from_voxels(voxels, depth);
+  if (origin || voxel_size) {
+    const double size = voxel_size.value_or(1.0);
+    if (!(size > 0.0) || !std::isfinite(size)) throw vola::InvalidArgument("from_dense: voxel_size must be finite and > 0");
+    const vola::Point o = origin ? to_point(*origin) : vola::Point{0, 0, 0};
+    tree.set_frame(vola::Frame{vola::Quantization::grid, o, size});
+    vola::Box box{o, o};
+    for (int i = 0; i < 3; ++i) box.max[i] += size * static_cast<double>(grid.shape(i));
+    tree.georef().bbox = box;
+  }
+  return tree;
+}
+
+
+Tree convert(const std::filesystem::path& path, int depth,
+             double voxel_size, const std::string& quantize, const std::string& format, std::optional<std::uint32_t> epsg,
+             bool solid, bool attributes, std::optional<double> dem_base, bool dem_surface_only,
+             std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
+             std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
+             int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output) {
+  vola::ConvertOptions options;
+  options.format = format;
+  if (!quantize.empty()) options.quantization = parse_quantization(quantize);
+  options.depth = depth;
+  options.voxel_size = voxel_size;
+  if (origin) options.origin = to_point(*origin);
+  if (bbox) options.bbox = vola::Box{{(*bbox)[0], (*bbox)[1], (*bbox)[2]}, {(*bbox)[3], (*bbox)[4], (*bbox)[5]}};
+  options.nbits = nbits;
+  options.epsg = epsg;
+  options.attributes = attributes;
+  options.columns = columns;
+  options.payload_columns = std::move(payload_columns);
+  options.text_attributes = std::move(text_attributes);
+  options.skip_lines = skip_lines;
+  options.solid = solid;
+  options.dem_base = dem_base;
+  options.dem_surface_only = dem_surface_only;
+  options.dense = dense;
+  options.compress = compress;
+  py::gil_scoped_release release;
+  return with_python_names([&] {
+    Tree tree = vola::convert(path.string(), options);
+    if (output) {
+      vola::WriteOptions w;
+      w.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
+      w.compress = compress;
+      vola::write(tree, output->string(), w);
+    }
+    return tree;
+  });
+}
+
+
+}  // namespace
+
+void bind_building(py::module_& m) {
+  m.def("build", &build_points, py::arg("points"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0,
+        py::arg("quantize") = "grid", py::arg("origin") = py::none(), py::arg("attributes") = py::dict(),
+        py::arg("reductions") = py::dict(), py::arg("epsg") = 2000u,
+        "Builds a tree from an (N, 3) array of world points.\n"
+        "quantize='grid': voxel_size and/or depth; origin defaults to the bbox minimum snapped to the voxel size.\n"
+        "quantize='toolkit': the reference's rounding, needs depth.\n"
+        "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: 'mean'|'max'|'min'|'majority'|'last'}.");
+  m.def("build_from_voxels", &build_voxels, py::arg("voxels"), py::arg("depth"),
+        "Builds a tree from an (N, 3) array of integer voxels, each below 4**depth (duplicates allowed).");
+  m.def("from_dense", &from_dense, py::arg("grid"), py::arg("origin") = py::none(), py::arg("voxel_size") = py::none(),
+        py::arg("depth") = 0, "Builds a tree from a dense 3-D array indexed [x, y, z] (non-zero = occupied).");
+  m.def("read", [](const std::filesystem::path& p) { py::gil_scoped_release r; return vola::read(p.string()); }, py::arg("path"),
+        "Reads a .vol file into memory.");
+  m.def("open_mapped", [](const std::filesystem::path& p) { py::gil_scoped_release r; return vola::open_mapped(p.string()); },
+        py::arg("path"), "Memory-maps a .vol file: a sparse uncompressed file's level words are used in place.");
+  m.def("parse", [](py::bytes data, const std::string& name) {
+          const std::string bytes = data;
+          return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), name);
+        }, py::arg("data"), py::arg("name") = "<bytes>", "Parses the bytes of a .vol file.");
+  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0,
+        py::arg("voxel_size") = 0.0, py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(),
+        py::arg("solid") = false, py::arg("attributes") = true, py::arg("dem_base") = py::none(),
+        py::arg("dem_surface_only") = false, py::arg("origin") = py::none(), py::arg("bbox") = py::none(),
+        py::arg("nbits") = 0, py::arg("columns") = std::array<int, 3>{1, 2, 3},
+        py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
+        py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
+        py::arg("output") = py::none(),
+        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
+        "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
+        "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
+        "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
+        "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
+        "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
+        "dem_base, dem_surface_only (DEM). Voxel grids map cell to voxel unless another grid is asked for.");
+  m.def("input_formats", [] {
+        std::vector<std::pair<std::string, std::vector<std::string>>> out;
+        for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);
+        return out;
+      }, "(name, extensions) of every input format this build reads.");
+  m.def("compression_available", &vola::compression_available, "Whether this build writes zstd-compressed files.");
+}
+
+}  // namespace vola::python

@@ -1,0 +1,125 @@
+// Internal to the Python module: numpy arrays in and out, and the library's option
+// names in Python's words. Arrays come in as numpy arrays (converted only when their
+// dtype or layout differs) and go out as numpy arrays; level words and attribute columns
+// go out as read-only views that keep their tree alive (a mapped tree's words are then
+// views of the file mapping).
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/error.hpp"
+#include "vola/frame.hpp"
+#include "vola/tree.hpp"
+
+namespace py = pybind11;
+
+namespace vola::python {
+
+using vola::Tree;
+using vola::Voxel;
+
+template <class T>
+using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+// A numpy array that owns `values` (moved, not copied).
+template <class T>
+inline py::array_t<T> owning_array(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
+  auto* heap = new std::vector<T>(std::move(values));
+  py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, heap->data(), owner);
+}
+
+// A read-only view of `count` items at `data`, kept alive by `owner`.
+inline py::array readonly_view(py::dtype dtype, std::vector<py::ssize_t> shape, const void* data, py::handle owner) {
+  py::array view(dtype, shape, data, owner);
+  py::detail::array_proxy(view.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return view;
+}
+
+// (N, 3) from an array of N rows of three, or a single row of three (N = 1).
+template <class T>
+CArray<T> rows_of_three(const py::handle& input, const char* what) {
+  auto array = CArray<T>::ensure(input);
+  if (!array) throw py::type_error(std::string(what) + ": expected an array of shape (N, 3)");
+  if (array.ndim() == 1 && array.shape(0) == 3) array = array.reshape({py::ssize_t{1}, py::ssize_t{3}});
+  if (array.ndim() != 2 || array.shape(1) != 3)
+    throw py::value_error(std::string(what) + ": expected shape (N, 3), got " +
+                          std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
+                              array.shape(), array.shape() + array.ndim()))))));
+  return array;
+}
+
+inline bool single_row(const py::handle& input) {
+  return py::array::ensure(input) && py::array::ensure(input).ndim() == 1;
+}
+
+inline vola::ValueType value_type_of(const py::dtype& dtype) {
+  const char kind = dtype.kind();
+  const auto size = dtype.itemsize();
+  if (kind == 'u') return size == 1 ? vola::ValueType::u8 : size == 2 ? vola::ValueType::u16 : size == 4 ? vola::ValueType::u32 : vola::ValueType::u64;
+  if (kind == 'i') return size == 1 ? vola::ValueType::i8 : size == 2 ? vola::ValueType::i16 : size == 4 ? vola::ValueType::i32 : vola::ValueType::i64;
+  if (kind == 'b') return vola::ValueType::u8;
+  if (kind == 'f') return size <= 4 ? vola::ValueType::f32 : vola::ValueType::f64;
+  throw py::type_error("attribute dtype " + py::cast<std::string>(dtype.attr("name")) + " is not a number type");
+}
+
+inline py::dtype dtype_of(vola::ValueType type) {
+  switch (type) {
+    case vola::ValueType::u8: return py::dtype::of<std::uint8_t>();
+    case vola::ValueType::u16: return py::dtype::of<std::uint16_t>();
+    case vola::ValueType::u32: return py::dtype::of<std::uint32_t>();
+    case vola::ValueType::u64: return py::dtype::of<std::uint64_t>();
+    case vola::ValueType::i8: return py::dtype::of<std::int8_t>();
+    case vola::ValueType::i16: return py::dtype::of<std::int16_t>();
+    case vola::ValueType::i32: return py::dtype::of<std::int32_t>();
+    case vola::ValueType::i64: return py::dtype::of<std::int64_t>();
+    case vola::ValueType::f32: return py::dtype::of<float>();
+    case vola::ValueType::f64: return py::dtype::of<double>();
+  }
+  throw vola::InvalidArgument("unknown attribute type");
+}
+
+inline vola::Quantization parse_quantization(const std::string& name) {
+  if (name == "grid") return vola::Quantization::grid;
+  if (name == "toolkit") return vola::Quantization::toolkit;
+  throw vola::InvalidArgument("quantize '" + name + "': expected 'grid' or 'toolkit'");
+}
+
+inline vola::Point to_point(const std::array<double, 3>& p) { return vola::Point{p[0], p[1], p[2]}; }
+
+// The library names options as its structs do; Python's keywords are the same names but
+// for quantize. Runs `body`, rethrowing an OptionError in the keywords' words.
+template <class Body>
+auto with_python_names(Body&& body) {
+  const auto keyword = [](const std::string& option) { return option == "quantization" ? std::string("quantize") : option; };
+  try {
+    return body();
+  } catch (const vola::OptionError& e) {
+    std::string cause = e.cause();
+    for (auto open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
+      const auto close = cause.find('`', open + 1);
+      if (close == std::string::npos) break;
+      const std::string name = keyword(cause.substr(open + 1, close - open - 1));
+      cause.replace(open, close - open + 1, name);
+      open += name.size();
+    }
+    throw vola::InvalidArgument(keyword(e.option()) + ": " + cause);
+  }
+}
+
+
+// Each part of the module adds its functions and classes.
+void bind_building(py::module_& m);
+py::class_<Tree> bind_tree(py::module_& m);
+void bind_tree_analysis(py::class_<Tree>& tree);
+void bind_tiles(py::module_& m);
+
+}  // namespace vola::python

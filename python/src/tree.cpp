@@ -1,0 +1,249 @@
+// vola.Tree: its properties, voxels, lookups, views of its words and columns, writing.
+#include "python_support.hpp"
+
+#include <cstdint>
+#include <filesystem>
+
+#include "vola/file.hpp"
+
+namespace vola::python {
+
+namespace {
+
+// ---- reading a tree ----
+
+py::array_t<std::uint32_t> voxels_of(const Tree& tree, int level) {
+  if (level < 0) level = tree.depth() - 1;
+  if (level >= tree.depth()) throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  const auto n = static_cast<py::ssize_t>(tree.node_count(level));
+  py::array_t<std::uint32_t> out({n, py::ssize_t{3}});
+  std::uint32_t* p = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    tree.for_each_node(level, [&](const Voxel& v) {
+      p[0] = v.x;
+      p[1] = v.y;
+      p[2] = v.z;
+      p += 3;
+    });
+  }
+  return out;
+}
+
+py::array_t<double> centers_of(const Tree& tree) {
+  const auto n = static_cast<py::ssize_t>(tree.voxel_count());
+  py::array_t<double> out({n, py::ssize_t{3}});
+  double* p = out.mutable_data();
+  const vola::Quantizer quantizer = tree.quantizer();
+  {
+    py::gil_scoped_release release;
+    tree.for_each_voxel([&](const Voxel& v) {
+      const vola::Point c = quantizer.center(v);
+      p[0] = c[0];
+      p[1] = c[1];
+      p[2] = c[2];
+      p += 3;
+    });
+  }
+  return out;
+}
+
+py::object contains(const Tree& tree, const py::handle& input) {
+  const auto xyz = rows_of_three<std::int64_t>(input, "contains");
+  const auto n = xyz.shape(0);
+  py::array_t<bool> out(n);
+  bool* hit = out.mutable_data();
+  const std::int64_t* p = xyz.data();
+  {
+    py::gil_scoped_release release;
+    constexpr std::int64_t limit = std::numeric_limits<std::uint32_t>::max();
+    for (py::ssize_t i = 0; i < n; ++i, p += 3) {
+      const bool representable = p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] <= limit && p[1] <= limit && p[2] <= limit;
+      hit[i] = representable && tree.contains(static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
+                                              static_cast<std::uint32_t>(p[2]));
+    }
+  }
+  if (single_row(input)) return py::bool_(hit[0]);
+  return std::move(out);
+}
+
+py::object rank_of(const Tree& tree, const py::handle& input) {
+  const auto xyz = rows_of_three<std::int64_t>(input, "rank");
+  const auto n = xyz.shape(0);
+  py::array_t<std::int64_t> out(n);
+  std::int64_t* rank = out.mutable_data();
+  const std::int64_t* p = xyz.data();
+  {
+    py::gil_scoped_release release;
+    constexpr std::int64_t limit = std::numeric_limits<std::uint32_t>::max();
+    for (py::ssize_t i = 0; i < n; ++i, p += 3) {
+      rank[i] = -1;
+      if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] > limit || p[1] > limit || p[2] > limit) continue;
+      const auto r = tree.rank(Voxel{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]), static_cast<std::uint32_t>(p[2])});
+      if (r) rank[i] = static_cast<std::int64_t>(*r);
+    }
+  }
+  if (single_row(input)) return py::int_(rank[0]);
+  return std::move(out);
+}
+
+// World points -> voxel indices, and which of them fall on the grid.
+py::tuple world_to_voxel(const Tree& tree, const py::handle& input) {
+  const auto xyz = rows_of_three<double>(input, "points");
+  const auto n = xyz.shape(0);
+  py::array_t<std::int64_t> voxels({n, py::ssize_t{3}});
+  py::array_t<bool> inside(n);
+  std::int64_t* v = voxels.mutable_data();
+  bool* ok = inside.mutable_data();
+  const double* p = xyz.data();
+  const vola::Quantizer quantizer = tree.quantizer();
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t i = 0; i < n; ++i, p += 3, v += 3) {
+      Voxel cell;
+      ok[i] = quantizer.to_voxel(vola::Point{p[0], p[1], p[2]}, cell);
+      v[0] = ok[i] ? std::int64_t{cell.x} : -1;
+      v[1] = ok[i] ? std::int64_t{cell.y} : -1;
+      v[2] = ok[i] ? std::int64_t{cell.z} : -1;
+    }
+  }
+  return py::make_tuple(voxels, inside);
+}
+
+py::array_t<bool> to_dense(const Tree& tree, int level, std::uint64_t max_cells) {
+  if (level < 0) level = tree.depth() - 1;
+  if (level >= tree.depth()) throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  const std::uint64_t side = vola::side_of(level + 1);
+  if (side > 4096 || side * side * side > max_cells)
+    throw vola::InvalidArgument("to_dense: a " + std::to_string(side) + "^3 grid is more than max_cells=" + std::to_string(max_cells) +
+                                " cells; pass a coarser level or a larger max_cells");
+  const auto s = static_cast<py::ssize_t>(side);
+  py::array_t<bool> out({s, s, s});
+  bool* cells = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    std::fill(cells, cells + side * side * side, false);
+    tree.for_each_node(level, [&](const Voxel& v) { cells[(v.x * side + v.y) * side + v.z] = true; });
+  }
+  return out;
+}
+
+py::array level_words(const py::object& self, int level, bool payload) {
+  const Tree& tree = py::cast<const Tree&>(self);
+  if (level < 0 || level >= tree.depth())
+    throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  const auto words = payload ? tree.payload(level) : tree.occupancy(level);
+  return readonly_view(py::dtype::of<std::uint64_t>(), {static_cast<py::ssize_t>(words.size())}, words.data(), self);
+}
+
+py::array attribute_view(const py::object& self, const std::string& name) {
+  const Tree& tree = py::cast<const Tree&>(self);
+  const vola::AttributeColumn* column = tree.attributes().find(name);
+  if (!column) {
+    std::string known;
+    for (const auto& c : tree.attributes().columns()) known += (known.empty() ? "" : ", ") + c.name();
+    throw py::key_error("no attribute '" + name + "' (the tree has: " + (known.empty() ? "none" : known) + ")");
+  }
+  return readonly_view(dtype_of(column->type()), {static_cast<py::ssize_t>(column->size())}, column->bytes().data(), self);
+}
+
+py::dict attributes_of(const py::object& self) {
+  py::dict out;
+  for (const auto& column : py::cast<const Tree&>(self).attributes().columns())
+    out[py::str(column.name())] = attribute_view(self, column.name());
+  return out;
+}
+
+py::bytes to_bytes(const Tree& tree, bool dense, bool compress) {
+  vola::WriteOptions options;
+  options.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
+  options.compress = compress;
+  const auto bytes = vola::serialize(tree, options);
+  return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
+
+void write_file(const Tree& tree, const std::filesystem::path& path, bool dense, bool compress) {
+  vola::WriteOptions options;
+  options.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
+  options.compress = compress;
+  py::gil_scoped_release release;
+  vola::write(tree, path.string(), options);
+}
+
+Tree level_of_detail(const Tree& tree, int depth) {
+  if (depth < 1 || depth > tree.depth())
+    throw vola::InvalidArgument("level_of_detail: depth " + std::to_string(depth) + " is outside 1.." + std::to_string(tree.depth()));
+  return tree.level_of_detail(depth);
+}
+
+
+std::string repr(const Tree& tree) {
+  const vola::Frame frame = tree.frame();
+  std::string s = "<vola.Tree depth=" + std::to_string(tree.depth()) + " voxels=" + std::to_string(tree.voxel_count()) +
+                  " " + (frame.quantization == vola::Quantization::grid ? "grid" : "toolkit") +
+                  " voxel_size=" + py::cast<std::string>(py::repr(py::float_(frame.voxel_size)));
+  if (!tree.attributes().empty()) {
+    s += " attributes=";
+    for (std::size_t i = 0; i < tree.attributes().size(); ++i)
+      s += (i ? "," : "") + tree.attributes().columns()[i].name();
+  }
+  return s + (tree.is_mapped() ? " mapped>" : ">");
+}
+
+
+}  // namespace
+
+py::class_<Tree> bind_tree(py::module_& m) {
+  return py::class_<Tree>(m, "Tree", "An immutable VOLA tree: levels of 64-bit occupancy words, one per 4x4x4 block.")
+      .def_property_readonly("depth", &Tree::depth, "Number of levels (1..10); the grid has 4**depth voxels per axis.")
+      .def_property_readonly("side", &Tree::side, "Voxels per axis: 4**depth.")
+      .def_property_readonly("voxel_count", &Tree::voxel_count, "Number of occupied voxels.")
+      .def("__len__", [](const Tree& t) { return t.voxel_count(); })
+      .def("__repr__", &repr)
+      .def_property_readonly("is_mapped", &Tree::is_mapped, "True when the level words live in a file mapping.")
+      .def_property_readonly("memory_bytes", &Tree::memory_bytes, "Bytes held in memory (mapped words not counted).")
+      .def("node_count", &Tree::node_count, py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
+      .def_property_readonly("quantization", [](const Tree& t) { return t.frame().quantization == vola::Quantization::grid ? "grid" : "toolkit"; },
+                             "'grid' (floor((p - origin) / voxel_size)) or 'toolkit' (the reference's rounding).")
+      .def_property_readonly("origin", [](const Tree& t) { return t.frame().origin; }, "World position of voxel (0, 0, 0)'s corner.")
+      .def_property_readonly("voxel_size", [](const Tree& t) { return t.frame().voxel_size; }, "World edge of one voxel.")
+      .def_property_readonly("epsg", [](const Tree& t) { return t.georef().epsg; }, "EPSG code in the header (2000 = the reference's default).")
+      .def_property_readonly("crs_wkt", [](const Tree& t) { return t.georef().crs_wkt; }, "The CRS as WKT ('' when unknown).")
+      .def_property_readonly("bbox", [](const Tree& t) { return py::make_tuple(t.georef().bbox.min, t.georef().bbox.max); },
+                             "(min, max) of the input points in world coordinates, as the header records it.")
+      .def_property_readonly("lat_lon", [](const Tree& t) { return py::make_tuple(t.georef().lat, t.georef().lon); },
+                             "WGS84 latitude and longitude of the bbox centre (0, 0 when unknown).")
+      .def_property_readonly("attribute_names", [](const Tree& t) {
+            std::vector<std::string> names;
+            for (const auto& c : t.attributes().columns()) names.push_back(c.name());
+            return names;
+          }, "Names of the per-voxel attribute columns.")
+      .def("contains", &contains, py::arg("voxels"),
+           "Occupancy of integer voxels: an (M, 3) array gives an (M,) bool array, one (3,) row gives a bool.\n"
+           "Voxels off the grid (negative, >= side) are False. Runs in C++ without the GIL.")
+      .def("rank", &rank_of, py::arg("voxels"),
+           "Index of each voxel among all voxels in key order (its attribute row), -1 when empty.")
+      .def("voxels", &voxels_of, py::arg("level") = -1,
+           "Occupied voxels as an (N, 3) uint32 array in key order (rank order); `level` < depth - 1 gives the\n"
+           "occupied cells of that coarser level.")
+      .def("centers", &centers_of, "World coordinates of the voxel centres, (N, 3) float64 in rank order.")
+      .def("world_to_voxel", &world_to_voxel, py::arg("points"),
+           "World points (M, 3) -> (voxels (M, 3) int64, inside (M,) bool); voxels off the grid are -1.")
+      .def("to_dense", &to_dense, py::arg("level") = -1, py::arg("max_cells") = std::uint64_t{1} << 30,
+           "A dense bool grid indexed [x, y, z] of `level` (default: the voxels). Refuses grids above max_cells.")
+      .def("occupancy", [](const py::object& self, int level) { return level_words(self, level, false); }, py::arg("level"),
+           "The occupancy words of `level` as a read-only uint64 view (of the file mapping for a mapped tree).")
+      .def("payload", [](const py::object& self, int level) { return level_words(self, level, true); }, py::arg("level"),
+           "The payload words of `level` (empty without payload) as a read-only uint64 view.")
+      .def("attribute", &attribute_view, py::arg("name"),
+           "Attribute column `name` as a read-only view, one value per voxel in rank order. KeyError if missing.")
+      .def("attributes", &attributes_of, "Every attribute column: {name: read-only array in rank order}.")
+      .def("level_of_detail", &level_of_detail, py::arg("depth"),
+           "The first `depth` levels as a coarser tree (shares the words; voxel size grows 4x per level dropped).")
+      .def("write", &write_file, py::arg("path"), py::arg("dense") = false, py::arg("compress") = false,
+           "Writes a .vol file (through a temporary file and a rename). dense: the reference's dense layout\n"
+           "(depth <= 5); compress: zstd levels (a version-2 file only vola reads).")
+      .def("to_bytes", &to_bytes, py::arg("dense") = false, py::arg("compress") = false, "The .vol file's bytes.");
+}
+
+}  // namespace vola::python
