@@ -79,9 +79,10 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   const std::optional<std::uint32_t> epsg = known_epsg(options, input);
   const BuildOptions build = build_options(options, header_epsg(epsg));
 
+  CentreLatLon centre(epsg, input);  // PROJ gets ready while the tree is built
   ConvertReport report;
   Tree tree = build_tree(path, input, options, build, report.build);
-  georeference(tree, options, input, epsg, tree.frame().quantization);
+  georeference(tree, options, input, epsg, tree.frame().quantization, centre);
   if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
   if (report_out) {
     report.unit = unit_of(input);

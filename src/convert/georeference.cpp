@@ -12,13 +12,24 @@ std::optional<std::uint32_t> known_epsg(const ConvertOptions& options, io::Input
 
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
 
+CentreLatLon::CentreLatLon(const std::optional<std::uint32_t>& known, const io::Input& input) {
+  const std::string definition =
+      known || input.wkt.empty() ? "EPSG:" + std::to_string(header_epsg(known)) : input.wkt;
+  transform_ = std::async(std::launch::async, [definition] { return geo::ToWgs84(definition); });
+}
+
+std::pair<double, double> CentreLatLon::lat_lon(const Box& bbox) {
+  const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0, 0.0};
+  const Point lon_lat = transform_.get().transform(centre);
+  return {lon_lat[1], lon_lat[0]};
+}
+
 void georeference(Tree& tree, const ConvertOptions& options, const io::Input& input,
-                  const std::optional<std::uint32_t>& known, Quantization quantization) {
+                  const std::optional<std::uint32_t>& known, Quantization quantization, CentreLatLon& centre) {
   Georef& georef = tree.georef();
   georef.epsg = header_epsg(known);
   try {
-    const auto [lat, lon] = known || input.wkt.empty() ? geo::centre_lat_lon(georef.epsg, georef.bbox)
-                                                       : geo::centre_lat_lon(input.wkt, georef.bbox);
+    const auto [lat, lon] = centre.lat_lon(georef.bbox);
     georef.lat = lat;
     georef.lon = lon;
   } catch (const Error&) {

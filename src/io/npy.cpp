@@ -5,7 +5,9 @@
 #include <fstream>
 #include <limits>
 
+#include "file_bytes.hpp"
 #include "vola/error.hpp"
+#include "vola/little_endian.hpp"
 
 namespace vola::io {
 
@@ -82,7 +84,10 @@ double NpyArray::value(std::uint64_t index) const noexcept {
   }
 }
 
-NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name) {
+namespace {
+
+// The header of `bytes` into `a` (everything but the data); returns the data's offset.
+std::uint64_t parse_npy_header(std::span<const std::uint8_t> bytes, const std::string& name, NpyArray& a) {
   static const std::uint8_t magic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
   if (bytes.size() < 10 || std::memcmp(bytes.data(), magic, 6) != 0)
     throw FormatError(name, 0, "not a .npy file (no \\x93NUMPY magic)");
@@ -104,7 +109,6 @@ NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name)
     throw FormatError(name, header_start, "npy header of " + std::to_string(header_length) + " bytes runs past the end");
   const std::string_view dict(reinterpret_cast<const char*>(bytes.data() + header_start), header_length);
 
-  NpyArray a;
   std::string_view descr = find_value(dict, "descr", name, header_start);
   if (descr.size() < 5 || (descr[0] != '\'' && descr[0] != '"'))
     throw FormatError(name, header_start, "npy descr is not a simple dtype string");
@@ -158,17 +162,65 @@ NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name)
     throw FormatError(name, bytes.size(),
                       "npy shape promises " + std::to_string(count) + " values of " + std::to_string(a.item_size) +
                           " bytes but only " + std::to_string(available) + " bytes follow the header (truncated)");
-  a.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(data_start),
-                bytes.begin() + static_cast<std::ptrdiff_t>(data_start + count * a.item_size));
+  return data_start;
+}
+
+}  // namespace
+
+NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name) {
+  NpyArray a;
+  const std::uint64_t start = parse_npy_header(bytes, name, a);
+  const auto values = bytes.subspan(start, a.size() * static_cast<std::uint64_t>(a.item_size));
+  auto storage = std::make_shared<const std::vector<std::uint8_t>>(values.begin(), values.end());
+  a.data = *storage;
+  a.storage = std::move(storage);
   return a;
 }
 
-NpyArray read_npy(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open");
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_npy(bytes, path);
+NpyArray parse_npy(std::vector<std::uint8_t>&& bytes, const std::string& name) {
+  NpyArray a;
+  const std::uint64_t start = parse_npy_header(bytes, name, a);
+  auto storage = std::make_shared<const std::vector<std::uint8_t>>(std::move(bytes));
+  a.data = std::span<const std::uint8_t>(*storage).subspan(start, a.size() * static_cast<std::uint64_t>(a.item_size));
+  a.storage = std::move(storage);
+  return a;
 }
+
+NpyArray read_npy(const std::string& path) { return parse_npy(read_file_bytes(path), path); }
+
+namespace {
+
+// f(T{}) for the array's value type, so that loops over values are compiled per type.
+template <class F>
+void with_value_type(const NpyArray& a, F&& f) {
+  switch (a.kind) {
+    case 'f': return a.item_size == 4 ? f(float{}) : f(double{});
+    case 'i':
+      switch (a.item_size) {
+        case 1: return f(std::int8_t{});
+        case 2: return f(std::int16_t{});
+        case 4: return f(std::int32_t{});
+        default: return f(std::int64_t{});
+      }
+    default:  // 'u' and 'b'
+      switch (a.item_size) {
+        case 1: return f(std::uint8_t{});
+        case 2: return f(std::uint16_t{});
+        case 4: return f(std::uint32_t{});
+        default: return f(std::uint64_t{});
+      }
+  }
+}
+
+template <class T>
+T load_value(const std::uint8_t* p, bool swap) noexcept {
+  if (!swap) return load_le<T>(p);
+  std::uint8_t reversed[sizeof(T)];
+  for (std::size_t b = 0; b < sizeof(T); ++b) reversed[b] = p[sizeof(T) - 1 - b];
+  return load_le<T>(reversed);
+}
+
+}  // namespace
 
 PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns) {
   if (array.shape.size() != 2 || array.shape[1] < 3)
@@ -178,9 +230,20 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
   const std::uint64_t n = array.shape[0];
   const std::uint64_t columns = array.shape[1];
   PointCloud cloud;
-  cloud.xyz.resize(3 * n);
-  for (std::uint64_t i = 0; i < n; ++i)
-    for (std::uint64_t c = 0; c < 3; ++c) cloud.xyz[3 * i + c] = array.value(i * columns + c);
+  cloud.xyz.reserve(3 * n);
+  // Element (row i, column c) lies at i * row_step + c * column_step values.
+  const std::uint64_t row_step = array.fortran_order ? 1 : columns;
+  const std::uint64_t column_step = array.fortran_order ? n : 1;
+  with_value_type(array, [&](auto type) {
+    using T = decltype(type);
+    const std::uint8_t* base = array.data.data();
+    const bool boolean = array.kind == 'b';  // a bool byte other than 0 is true, as numpy reads it
+    for (std::uint64_t i = 0; i < n; ++i)
+      for (std::uint64_t c = 0; c < 3; ++c) {
+        const T v = load_value<T>(base + (i * row_step + c * column_step) * sizeof(T), array.big_endian);
+        cloud.xyz.push_back(boolean ? static_cast<double>(v != 0) : static_cast<double>(v));
+      }
+  });
   if (payload_columns && columns > 3) {
     if (columns - 3 > 8) throw FormatError(name, {}, "more than 8 payload columns do not fit a 64-bit payload word");
     cloud.payload.resize(n);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -18,7 +19,9 @@ struct NpyArray {
   bool big_endian = false;
   bool fortran_order = false;
   std::vector<std::uint64_t> shape;
-  std::vector<std::uint8_t> data;
+  // The values as the file lays them out (size() * item_size bytes), viewed in `storage`.
+  std::span<const std::uint8_t> data;
+  std::shared_ptr<const std::vector<std::uint8_t>> storage;
 
   std::uint64_t size() const noexcept;
   // Value at a C-order multi-index flattened to `index` (Fortran-order files are
@@ -28,8 +31,11 @@ struct NpyArray {
 };
 
 // Throws FormatError with the file name and offset on anything malformed; never
-// allocates more than the file holds.
+// allocates more than the file holds. The first copies the values out of `bytes`; the
+// second keeps the buffer and views the values in place.
 NpyArray parse_npy(std::span<const std::uint8_t> bytes, const std::string& name);
+NpyArray parse_npy(std::vector<std::uint8_t>&& bytes, const std::string& name);
+// The file in one read, its values viewed in place.
 NpyArray read_npy(const std::string& path);
 
 // An (N, C>=3) array as points: columns 0..2 are x y z, columns 3.. become payload
