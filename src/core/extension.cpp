@@ -129,6 +129,96 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
   }
 }
 
+namespace {
+
+// The frame record: quantization, origin and voxel size.
+Frame decode_frame(ByteReader& body, std::uint64_t record_offset) {
+    Frame f;
+    const auto mode = body.get<std::uint8_t>("frame quantization");
+    if (mode > 1) body.fail_at(record_offset + 16, "unknown quantization mode " + std::to_string(mode));
+    f.quantization = static_cast<Quantization>(mode);
+    body.take(7, "frame padding");
+    for (double& o : f.origin) o = body.get<double>("frame origin");
+    f.voxel_size = body.get<double>("frame voxel size");
+    if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
+    if (!std::isfinite(f.voxel_size)) body.fail_at(record_offset + 48, "voxel size is not finite");
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(f.origin[a]))
+        body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a), "frame origin is not finite");
+  return f;
+}
+
+// An attribute record: one column, zstd-compressed or plain.
+AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, const std::string& name) {
+    const auto type = body.get<std::uint8_t>("attribute type");
+    const auto reduction = body.get<std::uint8_t>("attribute reduction");
+    const auto encoding = body.get<std::uint8_t>("attribute encoding");
+    body.get<std::uint8_t>("attribute reserved byte");
+    const auto name_length = body.get<std::uint32_t>("attribute name length");
+    const auto raw_size = body.get<std::uint64_t>("attribute size");
+    const auto column_name = body.take(name_length, "attribute name");
+    if (type > 9) body.fail_at(record_offset + 16, "unknown attribute value type " + std::to_string(type));
+    if (reduction > 4) body.fail_at(record_offset + 17, "unknown attribute reduction " + std::to_string(reduction));
+    if (encoding > 1) body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
+    AttributeColumn column(std::string(column_name.begin(), column_name.end()), static_cast<ValueType>(type),
+                           static_cast<Reduction>(reduction));
+    if (raw_size % size_of(column.type()) != 0)
+      body.fail_at(record_offset + 24, "attribute size " + std::to_string(raw_size) +
+                                           " is not a whole number of values");
+    const auto data = body.take(body.remaining(), "attribute data");
+    std::vector<std::uint8_t> raw;
+    if (encoding == 1) {
+      check_ratio(body, raw_size, data.size());
+      raw = zstd_decompress(data, raw_size, name, record_offset + 32 + name_length);
+    } else {
+      if (data.size() != raw_size)
+        body.fail_at(record_offset + 24, "attribute holds " + std::to_string(data.size()) +
+                                             " bytes, its header says " + std::to_string(raw_size));
+      raw.assign(data.begin(), data.end());
+    }
+    column.resize(raw_size / size_of(column.type()));
+    if (!raw.empty()) std::memcpy(column.bytes().data(), raw.data(), raw.size());
+  return column;
+}
+
+// The zstd-compressed levels record: parts of 16-bit lanes, into out.levels.
+void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t flags, const std::string& name,
+                   ExtensionContents& out) {
+    if (flags != kLanes16PerPart)
+      body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
+    const auto parts = body.get<std::uint32_t>("level part count");
+    body.get<std::uint32_t>("reserved");
+    body.need(16 * std::uint64_t{parts}, "level part sizes");
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> sizes(parts);
+    std::uint64_t raw_total = 0, packed_total = 0;
+    for (auto& [raw, packed] : sizes) {
+      raw = body.get<std::uint64_t>("level part size");
+      packed = body.get<std::uint64_t>("level part compressed size");
+      if (raw % 8 != 0) body.fail("level part size " + std::to_string(raw) + " is not a whole number of words");
+      check_ratio(body, raw, packed);
+      if (raw > (std::uint64_t{1} << 62) || packed > body.remaining())
+        body.fail("level part of " + std::to_string(packed) + " compressed bytes runs past the record");
+      raw_total += raw;
+      packed_total += packed;
+    }
+    if (packed_total != body.remaining())
+      body.fail("level parts take " + std::to_string(packed_total) + " bytes, the record holds " +
+                std::to_string(body.remaining()));
+    out.levels.resize(raw_total / 8);
+    std::size_t at = 0;
+    for (const auto& [raw, packed] : sizes) {
+      const std::uint64_t frame_offset = body.offset();
+      const auto frame = body.take(packed, "level part");
+      const auto lanes = zstd_decompress(frame, raw, name, frame_offset);
+      words_from_lanes16(lanes, std::span<std::uint64_t>(out.levels).subspan(at, raw / 8));
+      at += raw / 8;
+    }
+  out.has_levels = true;
+  out.compressed_level_bytes = packed_total;
+}
+
+}  // namespace
+
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
                                    std::uint64_t base) {
   ByteReader r(bytes, name, base);
@@ -149,96 +239,25 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
     ByteReader body(r.take(length, "record body"), name, record_offset + 16);
     r.skip_padding(8);
     switch (static_cast<RecordTag>(tag)) {
-      case RecordTag::frame: {
-        Frame f;
-        const auto mode = body.get<std::uint8_t>("frame quantization");
-        if (mode > 1) body.fail_at(record_offset + 16, "unknown quantization mode " + std::to_string(mode));
-        f.quantization = static_cast<Quantization>(mode);
-        body.take(7, "frame padding");
-        for (double& o : f.origin) o = body.get<double>("frame origin");
-        f.voxel_size = body.get<double>("frame voxel size");
-        if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
-        if (!std::isfinite(f.voxel_size)) body.fail_at(record_offset + 48, "voxel size is not finite");
-        for (int a = 0; a < 3; ++a)
-          if (!std::isfinite(f.origin[a]))
-            body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a), "frame origin is not finite");
-        out.frame = f;
+      case RecordTag::frame:
+        out.frame = decode_frame(body, record_offset);
         break;
-      }
       case RecordTag::crs_wkt: {
         const auto text = body.take(length, "CRS WKT");
         out.crs_wkt.assign(text.begin(), text.end());
         break;
       }
       case RecordTag::attribute: {
-        const auto type = body.get<std::uint8_t>("attribute type");
-        const auto reduction = body.get<std::uint8_t>("attribute reduction");
-        const auto encoding = body.get<std::uint8_t>("attribute encoding");
-        body.get<std::uint8_t>("attribute reserved byte");
-        const auto name_length = body.get<std::uint32_t>("attribute name length");
-        const auto raw_size = body.get<std::uint64_t>("attribute size");
-        const auto column_name = body.take(name_length, "attribute name");
-        if (type > 9) body.fail_at(record_offset + 16, "unknown attribute value type " + std::to_string(type));
-        if (reduction > 4) body.fail_at(record_offset + 17, "unknown attribute reduction " + std::to_string(reduction));
-        if (encoding > 1) body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
-        AttributeColumn column(std::string(column_name.begin(), column_name.end()), static_cast<ValueType>(type),
-                               static_cast<Reduction>(reduction));
-        if (raw_size % size_of(column.type()) != 0)
-          body.fail_at(record_offset + 24, "attribute size " + std::to_string(raw_size) +
-                                               " is not a whole number of values");
-        const auto data = body.take(body.remaining(), "attribute data");
-        std::vector<std::uint8_t> raw;
-        if (encoding == 1) {
-          check_ratio(body, raw_size, data.size());
-          raw = zstd_decompress(data, raw_size, name, record_offset + 32 + name_length);
-        } else {
-          if (data.size() != raw_size)
-            body.fail_at(record_offset + 24, "attribute holds " + std::to_string(data.size()) +
-                                                 " bytes, its header says " + std::to_string(raw_size));
-          raw.assign(data.begin(), data.end());
-        }
-        column.resize(raw_size / size_of(column.type()));
-        if (!raw.empty()) std::memcpy(column.bytes().data(), raw.data(), raw.size());
+        AttributeColumn column = decode_attribute(body, record_offset, name);
         for (const auto& other : out.attributes)
           if (other.name() == column.name())
             body.fail_at(record_offset, "attribute '" + column.name() + "' appears twice");
         out.attributes.push_back(std::move(column));
         break;
       }
-      case RecordTag::levels: {
-        if (flags != kLanes16PerPart)
-          body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
-        const auto parts = body.get<std::uint32_t>("level part count");
-        body.get<std::uint32_t>("reserved");
-        body.need(16 * std::uint64_t{parts}, "level part sizes");
-        std::vector<std::pair<std::uint64_t, std::uint64_t>> sizes(parts);
-        std::uint64_t raw_total = 0, packed_total = 0;
-        for (auto& [raw, packed] : sizes) {
-          raw = body.get<std::uint64_t>("level part size");
-          packed = body.get<std::uint64_t>("level part compressed size");
-          if (raw % 8 != 0) body.fail("level part size " + std::to_string(raw) + " is not a whole number of words");
-          check_ratio(body, raw, packed);
-          if (raw > (std::uint64_t{1} << 62) || packed > body.remaining())
-            body.fail("level part of " + std::to_string(packed) + " compressed bytes runs past the record");
-          raw_total += raw;
-          packed_total += packed;
-        }
-        if (packed_total != body.remaining())
-          body.fail("level parts take " + std::to_string(packed_total) + " bytes, the record holds " +
-                    std::to_string(body.remaining()));
-        out.levels.resize(raw_total / 8);
-        std::size_t at = 0;
-        for (const auto& [raw, packed] : sizes) {
-          const std::uint64_t frame_offset = body.offset();
-          const auto frame = body.take(packed, "level part");
-          const auto lanes = zstd_decompress(frame, raw, name, frame_offset);
-          words_from_lanes16(lanes, std::span<std::uint64_t>(out.levels).subspan(at, raw / 8));
-          at += raw / 8;
-        }
-        out.has_levels = true;
-        out.compressed_level_bytes = packed_total;
+      case RecordTag::levels:
+        decode_levels(body, record_offset, flags, name, out);
         break;
-      }
       default:
         break;  // a record of a later version: skipped
     }

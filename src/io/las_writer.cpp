@@ -158,41 +158,38 @@ std::optional<std::string> las_wkt(const Tree& tree) {
   }
 }
 
-}  // namespace
+// Voxel centres as LAS stores them: integers of `scale` from the grid's origin.
+struct LasCoordinates {
+  Quantizer quantizer;
+  double scale = 1.0;
+  Point offset{};
 
-LasReport write_las(const Tree& tree, const std::string& path) {
-  require_complete_columns(tree);
-  const LasColumns columns = sort_columns(tree);
-  LasReport report;
-  report.point_format = columns.rgb() ? 7 : 6;
-  report.extra_bytes = columns.extra_names;
-  const std::size_t base_length = columns.rgb() ? 36 : 30;
-  std::size_t record_length = base_length;
-  for (const auto* c : columns.extra) record_length += size_of(c->type());
-  if (record_length > std::numeric_limits<std::uint16_t>::max())
-    throw InvalidArgument("the attribute columns make LAS records of " + std::to_string(record_length) +
-                          " bytes, more than 65535");
-
-  const Frame frame = tree.frame();
-  const Quantizer quantizer = tree.quantizer();
-  const double extent = frame.voxel_size * static_cast<double>(tree.side());
-  report.scale = choose_scale(frame.voxel_size, extent);
-  const Point offset = frame.origin;
-  auto to_integer = [&](const Point& p, int axis) {
-    const double v = std::nearbyint((p[axis] - offset[axis]) / report.scale);
+  std::int32_t integer(const Point& p, int axis) const {
+    const double v = std::nearbyint((p[axis] - offset[axis]) / scale);
     if (!(std::abs(v) <= 2147483647.0))
       throw InvalidArgument("voxel centre " + std::to_string(p[axis]) + " does not fit a 32-bit LAS coordinate");
     return static_cast<std::int32_t>(v);
-  };
+  }
+};
 
-  // Bounds of the points as stored: centres are monotonic in the voxel index, so the
-  // extreme voxels give them.
-  Voxel low{tree.side(), tree.side(), tree.side()}, high{0, 0, 0};
-  tree.for_each_voxel([&](const Voxel& v) {
-    low = {std::min(low.x, v.x), std::min(low.y, v.y), std::min(low.z, v.z)};
-    high = {std::max(high.x, v.x), std::max(high.y, v.y), std::max(high.z, v.z)};
-  });
+struct RecordLayout {
+  std::size_t base_length = 30;  // format 6; 36 for format 7 (RGB)
+  std::size_t length = 30;       // with the extra bytes
+};
 
+RecordLayout record_layout(const LasColumns& columns) {
+  RecordLayout layout;
+  layout.base_length = columns.rgb() ? 36 : 30;
+  layout.length = layout.base_length;
+  for (const auto* c : columns.extra) layout.length += size_of(c->type());
+  if (layout.length > std::numeric_limits<std::uint16_t>::max())
+    throw InvalidArgument("the attribute columns make LAS records of " + std::to_string(layout.length) +
+                          " bytes, more than 65535");
+  return layout;
+}
+
+// The VLRs: the CRS as WKT (when known) and the extra-bytes descriptors.
+std::vector<std::vector<std::uint8_t>> header_vlrs(const Tree& tree, const LasColumns& columns, LasReport& report) {
   std::vector<std::vector<std::uint8_t>> vlrs;
   if (const auto wkt = las_wkt(tree)) {
     std::vector<std::uint8_t> data(wkt->begin(), wkt->end());
@@ -201,9 +198,35 @@ LasReport write_las(const Tree& tree, const std::string& path) {
     report.has_crs = true;
   }
   if (!columns.extra.empty()) vlrs.push_back(extra_bytes_vlr(columns));
+  return vlrs;
+}
+
+// Scale, offset and bounds of the header. The bounds are those of the points as stored:
+// centres are monotonic in the voxel index, so the extreme voxels give them.
+void put_scale_and_bounds(std::vector<std::uint8_t>& h, const Tree& tree, const LasCoordinates& coords) {
+  for (int a = 0; a < 3; ++a) {
+    put<double>(h, 131 + 8 * a, coords.scale);
+    put<double>(h, 155 + 8 * a, coords.offset[a]);
+  }
+  if (tree.empty()) return;
+  Voxel low{tree.side(), tree.side(), tree.side()}, high{0, 0, 0};
+  tree.for_each_voxel([&](const Voxel& v) {
+    low = {std::min(low.x, v.x), std::min(low.y, v.y), std::min(low.z, v.z)};
+    high = {std::max(high.x, v.x), std::max(high.y, v.y), std::max(high.z, v.z)};
+  });
+  const Point min = coords.quantizer.center(low), max = coords.quantizer.center(high);
+  for (int a = 0; a < 3; ++a) {
+    put<double>(h, 179 + 16 * a, coords.integer(max, a) * coords.scale + coords.offset[a]);
+    put<double>(h, 187 + 16 * a, coords.integer(min, a) * coords.scale + coords.offset[a]);
+  }
+}
+
+// The LAS 1.4 public header block.
+std::vector<std::uint8_t> public_header(const Tree& tree, const LasColumns& columns, const RecordLayout& layout,
+                                        const LasCoordinates& coords, const std::vector<std::vector<std::uint8_t>>& vlrs,
+                                        const LasReport& report) {
   std::size_t offset_to_points = kHeaderSize;
   for (const auto& v : vlrs) offset_to_points += v.size();
-
   std::vector<std::uint8_t> h(kHeaderSize);
   std::memcpy(h.data(), "LASF", 4);
   put<std::uint16_t>(h, 6, report.has_crs ? kWktBit : 0);
@@ -220,22 +243,9 @@ LasReport write_las(const Tree& tree, const std::string& path) {
   put<std::uint32_t>(h, 96, static_cast<std::uint32_t>(offset_to_points));
   put<std::uint32_t>(h, 100, static_cast<std::uint32_t>(vlrs.size()));
   h[104] = report.point_format;
-  put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(record_length));
+  put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(layout.length));
   // Legacy 32-bit counts stay 0: formats 6-10 use the 64-bit ones.
-  if (!tree.empty()) {
-    const Point min = quantizer.center(low), max = quantizer.center(high);
-    for (int a = 0; a < 3; ++a) {
-      put<double>(h, 131 + 8 * a, report.scale);
-      put<double>(h, 155 + 8 * a, offset[a]);
-      put<double>(h, 179 + 16 * a, to_integer(max, a) * report.scale + offset[a]);
-      put<double>(h, 187 + 16 * a, to_integer(min, a) * report.scale + offset[a]);
-    }
-  } else {
-    for (int a = 0; a < 3; ++a) {
-      put<double>(h, 131 + 8 * a, report.scale);
-      put<double>(h, 155 + 8 * a, offset[a]);
-    }
-  }
+  put_scale_and_bounds(h, tree, coords);
   put<std::uint64_t>(h, 247, tree.voxel_count());
   // Every point is return 1 of its pulse, but for a number_of_returns of 0 (return 0).
   std::uint64_t first_returns = tree.voxel_count();
@@ -243,17 +253,19 @@ LasReport write_las(const Tree& tree, const std::string& path) {
     for (std::size_t r = 0; r < columns.returns->size(); ++r)
       if (field_value(columns.returns, r, 15.0, 1) == 0) --first_returns;
   put<std::uint64_t>(h, 255, first_returns);
+  return h;
+}
 
-  OutputFile out(path);
-  out.write(h.data(), h.size());
-  for (const auto& v : vlrs) out.write(v.data(), v.size());
-  std::vector<std::uint8_t> record(record_length);
+// One point record per voxel, in rank order, written in 64 KiB batches.
+void write_records(OutputFile& out, const Tree& tree, const LasColumns& columns, const RecordLayout& layout,
+                   const LasCoordinates& coords) {
+  std::vector<std::uint8_t> record(layout.length);
   std::string buffer;
   std::size_t rank = 0;
   tree.for_each_voxel([&](const Voxel& v) {
     std::fill(record.begin(), record.end(), 0);
-    const Point p = quantizer.center(v);
-    for (int a = 0; a < 3; ++a) put<std::int32_t>(record, 4 * static_cast<std::size_t>(a), to_integer(p, a));
+    const Point p = coords.quantizer.center(v);
+    for (int a = 0; a < 3; ++a) put<std::int32_t>(record, 4 * static_cast<std::size_t>(a), coords.integer(p, a));
     put<std::uint16_t>(record, 12, static_cast<std::uint16_t>(field_value(columns.intensity, rank, 65535.0, 0)));
     // One pulse per voxel: return 1 of number_of_returns (1 without the column).
     const std::uint32_t returns = field_value(columns.returns, rank, 15.0, 1);
@@ -265,7 +277,7 @@ LasReport write_las(const Tree& tree, const std::string& path) {
       put<std::uint16_t>(record, 32, colour_value(*columns.green, rank));
       put<std::uint16_t>(record, 34, colour_value(*columns.blue, rank));
     }
-    std::size_t at = base_length;
+    std::size_t at = layout.base_length;
     for (const auto* c : columns.extra) {
       const std::size_t size = size_of(c->type());
       std::memcpy(record.data() + at, c->bytes().data() + rank * size, size);
@@ -279,6 +291,28 @@ LasReport write_las(const Tree& tree, const std::string& path) {
     ++rank;
   });
   out.write(buffer);
+}
+
+}  // namespace
+
+LasReport write_las(const Tree& tree, const std::string& path) {
+  require_complete_columns(tree);
+  const LasColumns columns = sort_columns(tree);
+  LasReport report;
+  report.point_format = columns.rgb() ? 7 : 6;
+  report.extra_bytes = columns.extra_names;
+  const RecordLayout layout = record_layout(columns);
+  const Frame frame = tree.frame();
+  const double extent = frame.voxel_size * static_cast<double>(tree.side());
+  report.scale = choose_scale(frame.voxel_size, extent);
+  const LasCoordinates coords{tree.quantizer(), report.scale, frame.origin};
+  const auto vlrs = header_vlrs(tree, columns, report);
+  const std::vector<std::uint8_t> header = public_header(tree, columns, layout, coords, vlrs, report);
+
+  OutputFile out(path);
+  out.write(header.data(), header.size());
+  for (const auto& v : vlrs) out.write(v.data(), v.size());
+  write_records(out, tree, columns, layout, coords);
   out.commit();
   return report;
 }
