@@ -1,10 +1,9 @@
 // vola convert: any input the readers know -> .vol, through vola::convert
-// (include/vola/convert.hpp). This file only parses the flags, maps the library's option
-// names back to them in errors, and prints the summary.
+// (include/vola/convert.hpp). This file only parses the flags and prints the summary
+// (run_app.cpp names the flag of an option the library refuses).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 
 #include "commands.hpp"
 #include "progress.hpp"
@@ -25,36 +24,6 @@ struct ConvertArgs {
   bool crs_given = false, no_attributes = false, quiet = false;
   std::vector<int> columns{1, 2, 3};
 };
-
-// The library names its options as ConvertOptions does; the user typed flags.
-const std::map<std::string, std::string>& flag_of_option() {
-  static const std::map<std::string, std::string> flags = {
-      {"format", "--format"},         {"quantization", "--quantize"},       {"depth", "--depth"},
-      {"voxel_size", "--voxel-size"}, {"origin", "--origin"},               {"bbox", "--bbox"},
-      {"nbits", "--nbits"},           {"epsg", "--crs"},                    {"attributes", "--no-attributes"},
-      {"columns", "--columns"},       {"payload_columns", "--payload-columns"},
-      {"text_attributes", "--attribute"}, {"skip_lines", "--skip-lines"}, {"solid", "--solid"},
-      {"dem_base", "--dem-base"},     {"dem_surface_only", "--dem-surface-only"},
-      {"dense", "--dense"},           {"compress", "--compress"}};
-  return flags;
-}
-
-// "voxel_size: grid quantization needs `voxel_size` or `depth`" ->
-// "--voxel-size: grid quantization needs --voxel-size or --depth"
-std::string in_flags(const OptionError& e) {
-  const auto& flags = flag_of_option();
-  std::string cause = e.cause();
-  for (std::size_t open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
-    const auto close = cause.find('`', open + 1);
-    if (close == std::string::npos) break;
-    const auto flag = flags.find(cause.substr(open + 1, close - open - 1));
-    const std::string name = flag == flags.end() ? cause.substr(open + 1, close - open - 1) : flag->second;
-    cause.replace(open, close - open + 1, name);
-    open += name.size();
-  }
-  const auto flag = flags.find(e.option());
-  return (flag == flags.end() ? e.option() : flag->second) + ": " + cause;
-}
 
 ConvertOptions options_of(ConvertArgs& a) {
   ConvertOptions options = a.options;
@@ -102,13 +71,9 @@ void run_convert(ConvertArgs& a) {
   const ConvertOptions options = options_of(a);
   Progress progress("reading " + a.input);
   ConvertReport report;
-  Tree tree;
-  try {
-    tree = convert(a.input, options, [&progress](std::uint64_t done, std::uint64_t total) { progress.update(done, total); },
-                   &report);
-  } catch (const OptionError& e) {
-    throw InvalidArgument(in_flags(e));
-  }
+  const Tree tree =
+      convert(a.input, options, [&progress](std::uint64_t done, std::uint64_t total) { progress.update(done, total); },
+              &report);
   progress.finish();
   WriteOptions w;
   w.layout = options.dense ? Layout::dense : Layout::sparse;

@@ -4,6 +4,7 @@
 #include <exception>
 #include <new>
 
+#include "option_flags.hpp"
 #include "vola/error.hpp"
 #include "vola/version.hpp"
 
@@ -14,6 +15,9 @@ int run_app(CLI::App& app, int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const vola::OptionError& e) {
+    std::fprintf(stderr, "vola: %s\n", in_flags(e).c_str());
+    return 1;
   } catch (const vola::Error& e) {
     std::fprintf(stderr, "vola: %s\n", e.what());
     return 1;

@@ -264,7 +264,7 @@ PathModel path_model(const AcousticScene& scene, const Point& source, const Poin
   m.sample_bits = bits_for(std::uint64_t{m.max_sample} + 1);
   m.kernel_bits = bits_for(std::uint64_t{kernels} + 1);
   if (m.level_bits + m.sample_bits + m.kernel_bits > 64)
-    throw InvalidArgument("too many attenuation bins: widen --bin-width or raise --floor");
+    throw OptionError("bin_width_db", "too many attenuation bins: widen `bin_width_db` or raise `floor_db`");
   m.levels.emplace(o.bin_width_db, m.level_offset, m.level_count);
   return m;
 }

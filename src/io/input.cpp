@@ -117,13 +117,13 @@ const InputFormat& find_input_format(const std::string& path, const std::string&
   if (name != "auto") {
     for (const auto& f : formats)
       if (f.name == name) return f;
-    throw InvalidArgument("--format " + name + " is not known (" + known + ")");
+    throw OptionError("format", "'" + name + "' is not known (" + known + ")");
   }
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (const auto& f : formats)
     if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) return f;
-  throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext + "'; say --format (" + known + ")");
+  throw OptionError("format", path + ": cannot tell the format from the extension '" + ext + "'; say which (" + known + ")");
 }
 
 Input read_input(const std::string& path, const std::string& format, const InputOptions& options) {

@@ -213,7 +213,7 @@ std::string default_model_path() {
     if (fs::is_regular_file(candidate, error)) return candidate.lexically_normal().string();
     looked += "\n  " + candidate.lexically_normal().string();
   }
-  throw IoError("no model given (--model) and the default " + std::string(kDefaultModelFile) +
+  throw IoError("no model given and the default " + std::string(kDefaultModelFile) +
                 " is in none of:" + looked);
 }
 

@@ -59,8 +59,8 @@ int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectur
   torch::serialize::InputArchive archive;
   load_archive(archive, path);
   if (read_architecture(archive, path) != architecture)
-    throw InvalidArgument(path + ": checkpoint of another architecture than --arch " +
-                          std::string(architecture_name(architecture)));
+    throw OptionError("architecture", path + ": checkpoint of another architecture than " +
+                                          std::string(architecture_name(architecture)));
   read_weights(archive, network, path);
   try {
     torch::serialize::InputArchive optimizer_state;

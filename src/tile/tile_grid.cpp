@@ -36,11 +36,11 @@ Frame TileGrid::tile_frame(const TileIndex& t) const noexcept {
 
 void TileGrid::check() const {
   if (!(tile_size > 0.0) || !std::isfinite(tile_size))
-    throw InvalidArgument("--tile-size must be a positive number (got " + std::to_string(tile_size) + ")");
+    throw OptionError("tile_size", "must be a positive number (got " + std::to_string(tile_size) + ")");
   if (depth < kMinDepth || depth > kMaxDepth)
-    throw InvalidArgument("--depth must be 1..10 (got " + std::to_string(depth) + ")");
+    throw OptionError("depth", "must be 1..10 (got " + std::to_string(depth) + ")");
   for (const double o : origin)
-    if (!std::isfinite(o)) throw InvalidArgument("--origin must be finite");
+    if (!std::isfinite(o)) throw OptionError("origin", "must be finite");
 }
 
 std::string tile_file_name(const TileIndex& t) {

@@ -190,9 +190,9 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
                        Communicator& comm) {
   const TileGrid& grid = options.grid;
   grid.check();
-  if (options.output_dir.empty()) throw InvalidArgument("no output folder given (-o OUTDIR)");
+  if (options.output_dir.empty()) throw OptionError("output_dir", "no output folder given");
   if (options.memory_budget < (std::uint64_t{1} << 20))
-    throw InvalidArgument("--memory must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
+    throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
   const unsigned workers = resolve_threads(options.threads);
   const int rank = comm.rank(), ranks = comm.size();
   const bool talk = rank == 0 && static_cast<bool>(options.progress);

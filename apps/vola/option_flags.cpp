@@ -1,0 +1,32 @@
+#include "option_flags.hpp"
+
+#include <map>
+
+namespace vola::cli {
+
+std::string flag_of(const std::string& option) {
+  // Members whose flag is not simply --member-name.
+  static const std::map<std::string, std::string> renamed = {
+      {"quantization", "--quantize"},     {"epsg", "--crs"},           {"text_attributes", "--attribute"},
+      {"attributes", "--no-attributes"},  {"memory_budget", "--memory"}, {"bin_width_db", "--bin-width"},
+      {"floor_db", "--floor"},            {"architecture", "--arch"},  {"output_dir", "-o"}};
+  if (const auto it = renamed.find(option); it != renamed.end()) return it->second;
+  std::string flag = "--" + option;
+  for (char& c : flag)
+    if (c == '_') c = '-';
+  return flag;
+}
+
+std::string in_flags(const OptionError& error) {
+  std::string cause = error.cause();
+  for (std::size_t open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
+    const std::size_t close = cause.find('`', open + 1);
+    if (close == std::string::npos) break;
+    const std::string flag = flag_of(cause.substr(open + 1, close - open - 1));
+    cause.replace(open, close - open + 1, flag);
+    open += flag.size();
+  }
+  return flag_of(error.option()) + ": " + cause;
+}
+
+}  // namespace vola::cli
