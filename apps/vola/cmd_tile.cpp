@@ -10,8 +10,8 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
+#include "vola/crs_rules.hpp"
 #include "vola/error.hpp"
-#include "vola/geo/crs.hpp"
 #include "vola/tile/tiler.hpp"
 
 namespace vola::cli {
@@ -61,35 +61,13 @@ std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::siz
 }
 
 // The CRS every tile carries: --crs, else what the inputs say (they must agree).
-void resolve_crs(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources,
-                 tile::TileOptions& options) {
-  if (a.crs) {
-    options.epsg = *a.crs;
-    options.crs_wkt = geo::crs_wkt(*a.crs);
-    return;
-  }
-  const tile::PointSource* first = nullptr;
-  for (const auto& s : sources) {
-    std::optional<std::uint32_t> epsg = s->epsg;
-    if (!epsg && !s->wkt.empty()) epsg = geo::epsg_from_wkt(s->wkt);
-    const bool known = epsg || !s->wkt.empty();
-    if (!first) {
-      first = s.get();
-      options.epsg = epsg;
-      options.crs_wkt = !s->wkt.empty() ? s->wkt : (epsg ? geo::crs_wkt(*epsg) : std::string());
-      continue;
-    }
-    const bool same = epsg && options.epsg ? *epsg == *options.epsg
-                                           : (!known && !options.epsg && options.crs_wkt.empty()) ||
-                                                 (!epsg && !options.epsg && s->wkt == options.crs_wkt);
-    if (!same)
-      throw InvalidArgument("inputs disagree on the CRS: " + first->name() + " says " +
-                            (options.epsg ? "EPSG:" + std::to_string(*options.epsg)
-                                          : (options.crs_wkt.empty() ? std::string("nothing") : std::string("a WKT CRS"))) +
-                            ", " + s->name() + " says " +
-                            (epsg ? "EPSG:" + std::to_string(*epsg) : (known ? std::string("another WKT CRS") : std::string("nothing"))) +
-                            " (tile them separately, or name one with --crs if they really are the same)");
-  }
+void resolve_tile_crs(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources,
+                      tile::TileOptions& options) {
+  std::vector<StatedCrs> stated;
+  for (const auto& s : sources) stated.push_back({s->name(), s->epsg, s->wkt});
+  const ResolvedCrs crs = resolve_crs(stated, a.crs);
+  options.epsg = crs.epsg;
+  options.crs_wkt = crs.wkt;
 }
 
 void run_tile(const TileArgs& a) {
@@ -99,7 +77,7 @@ void run_tile(const TileArgs& a) {
   try {
     if (a.inputs.empty() && a.generate == 0) throw InvalidArgument("no input: give point files or --generate-survey N");
     if (a.chunk_points == 0) throw InvalidArgument("--chunk-points must be positive");
-    if (a.crs) geo::crs_wkt(*a.crs);  // an unknown code fails before any work
+    if (a.crs) resolve_crs({}, a.crs);  // an unknown code fails before any work
     std::vector<std::unique_ptr<tile::PointSource>> sources;
     for (const std::string& path : a.inputs) sources.push_back(open_source(path, a.chunk_points));
     if (a.generate) {
@@ -118,7 +96,7 @@ void run_tile(const TileArgs& a) {
     options.memory_budget = parse_bytes(a.memory);
     options.threads = a.threads;
     options.overviews = !a.no_overviews;
-    resolve_crs(a, sources, options);
+    resolve_tile_crs(a, sources, options);
     std::unique_ptr<Progress> progress;
     std::string stage;
     if (talk)

@@ -73,22 +73,22 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
              ConvertReport* report_out) {
   options.check();
   // A CRS PROJ does not know fails before gigabytes are read.
-  if (options.epsg) geo::crs_wkt(*options.epsg);
+  if (options.epsg) resolve_crs({}, options.epsg);
   const io::InputFormat& format = io::find_input_format(path, options.format);
   io::Input input = read(path, format, options, progress);
-  const std::optional<std::uint32_t> epsg = known_epsg(options, input);
-  const BuildOptions build = build_options(options, header_epsg(epsg));
+  const ResolvedCrs crs = input_crs(path, options, input);
+  const BuildOptions build = build_options(options, header_epsg(crs.epsg));
 
-  CentreLatLon centre(epsg, input);  // PROJ gets ready while the tree is built
+  CentreLatLon centre(crs.epsg, input);  // PROJ gets ready while the tree is built
   ConvertReport report;
   Tree tree = build_tree(path, input, options, build, report.build);
-  georeference(tree, options, input, epsg, tree.frame().quantization, centre);
+  georeference(tree, crs, tree.frame().quantization, centre);
   if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
   if (report_out) {
     report.unit = unit_of(input);
     report.format = format.name;
-    report.epsg = epsg;
-    report.crs_wkt_only = !epsg && !input.wkt.empty();
+    report.epsg = crs.epsg;
+    report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
     *report_out = std::move(report);
   }
   return tree;

@@ -5,9 +5,9 @@
 
 namespace vola::convert_detail {
 
-std::optional<std::uint32_t> known_epsg(const ConvertOptions& options, io::Input& input) {
-  if (!input.epsg && !input.wkt.empty()) input.epsg = geo::epsg_from_wkt(input.wkt);
-  return options.epsg ? options.epsg : input.epsg;
+ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, const io::Input& input) {
+  const StatedCrs stated{path, input.epsg, input.wkt};
+  return resolve_crs(std::span(&stated, 1), options.epsg);
 }
 
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
@@ -24,24 +24,19 @@ std::pair<double, double> CentreLatLon::lat_lon(const Box& bbox) {
   return {lon_lat[1], lon_lat[0]};
 }
 
-void georeference(Tree& tree, const ConvertOptions& options, const io::Input& input,
-                  const std::optional<std::uint32_t>& known, Quantization quantization, CentreLatLon& centre) {
+void georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization, CentreLatLon& centre) {
   Georef& georef = tree.georef();
-  georef.epsg = header_epsg(known);
+  georef.epsg = header_epsg(crs.epsg);
   try {
     const auto [lat, lon] = centre.lat_lon(georef.bbox);
     georef.lat = lat;
     georef.lon = lon;
   } catch (const Error&) {
-    if (options.epsg) throw;
+    if (crs.given) throw;
   }
-  const bool input_has_crs = input.epsg || !input.wkt.empty();
-  if (options.epsg && (input_has_crs || quantization == Quantization::grid))
-    georef.crs_wkt = geo::crs_wkt(*options.epsg);
-  else if (!options.epsg && !input.wkt.empty())
-    georef.crs_wkt = input.wkt;
-  else if (!options.epsg && input.epsg)
-    georef.crs_wkt = geo::crs_wkt(*input.epsg);
+  // A code given for input that states no CRS stays out of a toolkit file, which is then
+  // byte-identical to the reference's.
+  if (!crs.given || crs.stated || quantization == Quantization::grid) georef.crs_wkt = crs.wkt;
 }
 
 }  // namespace vola::convert_detail

@@ -8,14 +8,14 @@
 #include <utility>
 
 #include "vola/convert.hpp"
+#include "vola/crs_rules.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::convert_detail {
 
-// The EPSG code the conversion knows: the one the options give, else the input's (stated,
-// or found by PROJ from the input's WKT).
-std::optional<std::uint32_t> known_epsg(const ConvertOptions& options, io::Input& input);
+// The input's CRS under the rules of vola/crs_rules.hpp (the code given wins).
+ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, const io::Input& input);
 
 // The code the VOLA header carries: the known one, else the reference's default (2000).
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known);
@@ -38,7 +38,6 @@ class CentreLatLon {
 // bbox centre (through PROJ; 0, 0 when PROJ cannot place a CRS nobody named), and the CRS
 // as WKT in the extension whenever it is known, except for a toolkit conversion of
 // CRS-less input, which stays byte-identical to the reference's file.
-void georeference(Tree& tree, const ConvertOptions& options, const io::Input& input,
-                  const std::optional<std::uint32_t>& known, Quantization quantization, CentreLatLon& centre);
+void georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization, CentreLatLon& centre);
 
 }  // namespace vola::convert_detail

@@ -1,0 +1,37 @@
+// The CRS rules of every conversion, decided once: what the inputs say, what the user
+// names, and what the output carries. `vola convert` and `vola tile` (and the Python and C
+// front ends through vola::convert) take their CRS from here.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+
+namespace vola {
+
+// What one input says its CRS is.
+struct StatedCrs {
+  std::string source;                  // the input's name, for errors
+  std::optional<std::uint32_t> epsg;   // a code the input states
+  std::string wkt;                     // a WKT the input states
+};
+
+// The CRS of a conversion.
+struct ResolvedCrs {
+  // The EPSG code: the one given, else the inputs' (stated, or found by PROJ from their
+  // WKT with high confidence); none when nobody knows one.
+  std::optional<std::uint32_t> epsg;
+  // The CRS as WKT: the given code's, else the inputs' WKT, else their code's; empty
+  // when the inputs have no CRS.
+  std::string wkt;
+  bool given = false;      // the user named the code
+  bool stated = false;     // the inputs said something
+};
+
+// `given` wins over what the inputs say (and fails for a code PROJ does not know, before
+// any work); without it, the inputs must agree (the same code, or the same WKT, or all
+// nothing), else InvalidArgument names the first two that differ.
+ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::uint32_t> given);
+
+}  // namespace vola

@@ -1,0 +1,161 @@
+// The conversion pipeline's library face: options checked once with errors that name the
+// options member, the CRS rules, and conversions of real files against the plain builder.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "../io/io_test_data.hpp"
+#include "vola/builder.hpp"
+#include "vola/convert.hpp"
+#include "vola/crs_rules.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/io/las.hpp"
+
+namespace {
+
+// The member an OptionError names, or "" when `f` throws no OptionError.
+template <class F>
+std::string refused_option(F&& f) {
+  try {
+    f();
+  } catch (const vola::OptionError& e) {
+    return e.option();
+  }
+  return "";
+}
+
+TEST(ConvertOptions, ErrorsNameTheMemberThatIsWrong) {
+  vola::ConvertOptions o;
+  o.quantization = vola::Quantization::toolkit;
+  o.depth = 4;
+  EXPECT_EQ(refused_option([&] { o.check(); }), "");
+  o.voxel_size = 1.0;
+  EXPECT_EQ(refused_option([&] { o.check(); }), "voxel_size");
+  o.voxel_size = 0.0;
+  o.depth = 11;
+  EXPECT_EQ(refused_option([&] { o.check(); }), "depth");
+  o.depth = 4;
+  o.nbits = 65;
+  EXPECT_EQ(refused_option([&] { o.check(); }), "nbits");
+  o.nbits = 0;
+  o.text_attributes = {"intensity=x"};
+  EXPECT_EQ(refused_option([&] { o.check(); }), "text_attributes");
+  o.text_attributes = {"intensity=4:u16:median"};
+  EXPECT_EQ(refused_option([&] { o.check(); }), "text_attributes");
+  o.text_attributes = {"intensity=4:u16:max"};
+  o.bbox = vola::Box{{1, 1, 1}, {0, 0, 0}};
+  EXPECT_EQ(refused_option([&] { o.check(); }), "bbox");
+  o.bbox.reset();
+  o.dense = o.compress = true;
+  EXPECT_EQ(refused_option([&] { o.check(); }), "compress");
+}
+
+TEST(BuildOptions, CheckOwnsTheQuantizationRules) {
+  vola::BuildOptions b;
+  b.quantization = vola::Quantization::grid;
+  EXPECT_EQ(refused_option([&] { b.check(); }), "voxel_size");  // neither a size nor a depth
+  b.voxel_size = 0.5;
+  EXPECT_EQ(refused_option([&] { b.check(); }), "");
+  b.voxel_size = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(refused_option([&] { b.check(); }), "voxel_size");
+  b.quantization = vola::Quantization::toolkit;
+  b.voxel_size = 0.0;
+  EXPECT_EQ(refused_option([&] { b.check(); }), "depth");
+  b.depth = 3;
+  b.origin = vola::Point{0, 0, 0};
+  EXPECT_EQ(refused_option([&] { b.check(); }), "origin");
+}
+
+TEST(ResolveQuantizer, LeavesItsOptionsAlone) {
+  vola::BuildOptions b;
+  b.quantization = vola::Quantization::grid;
+  b.voxel_size = 2.0;
+  const vola::BuildOptions before = b;
+  const vola::Quantizer q = vola::resolve_quantizer(vola::Box{{1, 1, 1}, {100, 50, 20}}, b);
+  EXPECT_EQ(b.depth, before.depth);
+  EXPECT_FALSE(b.origin.has_value());
+  EXPECT_EQ(q.frame().voxel_size, 2.0);
+  EXPECT_EQ(q.frame().origin, (vola::Point{0, 0, 0}));  // the bbox min snapped to the voxel size
+  EXPECT_EQ(q.depth(), 3);                               // 64 voxels of 2 cover 100
+}
+
+TEST(ResolveCrs, TheGivenCodeWinsAndInputsMustAgree) {
+  const std::vector<vola::StatedCrs> agree{{"a.las", 32610, ""}, {"b.las", 32610, ""}};
+  const vola::ResolvedCrs crs = vola::resolve_crs(agree, std::nullopt);
+  EXPECT_EQ(crs.epsg, 32610u);
+  EXPECT_NE(crs.wkt.find("32610"), std::string::npos);
+  EXPECT_FALSE(crs.given);
+
+  const std::vector<vola::StatedCrs> nothing{{"a.xyz", std::nullopt, ""}, {"b.xyz", std::nullopt, ""}};
+  const vola::ResolvedCrs none = vola::resolve_crs(nothing, std::nullopt);
+  EXPECT_FALSE(none.epsg.has_value());
+  EXPECT_TRUE(none.wkt.empty());
+  EXPECT_FALSE(none.stated);
+
+  const std::vector<vola::StatedCrs> differ{{"a.las", 32610, ""}, {"b.las", std::nullopt, ""}};
+  try {
+    vola::resolve_crs(differ, std::nullopt);
+    FAIL() << "inputs with and without a CRS were accepted";
+  } catch (const vola::InvalidArgument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("a.las says EPSG:32610"), std::string::npos) << what;
+    EXPECT_NE(what.find("b.las says nothing"), std::string::npos) << what;
+  }
+  const vola::ResolvedCrs given = vola::resolve_crs(differ, 4326u);
+  EXPECT_EQ(given.epsg, 4326u);
+  EXPECT_TRUE(given.given);
+  EXPECT_TRUE(given.stated);
+  EXPECT_THROW(vola::resolve_crs({}, 999999u), vola::Error);
+}
+
+TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {
+  VOLA_REQUIRE_DATA(data);
+  const std::string las = (data / "las" / "pdal_autzen_trim.las").string();
+  vola::ConvertOptions o;
+  o.voxel_size = 10.0;
+  vola::ConvertReport report;
+  const vola::Tree converted = vola::convert(las, o, {}, &report);
+  EXPECT_EQ(report.format, "las");
+  EXPECT_EQ(report.unit, "points");
+
+  vola::io::LasReader reader(las);
+  vola::BuildOptions b;
+  b.quantization = vola::Quantization::grid;
+  b.voxel_size = 10.0;
+  b.epsg = converted.georef().epsg;
+  const vola::Tree built = vola::build(vola::io::las_points(reader, true, false), b);
+  EXPECT_EQ(report.build.points_in, reader.header().point_count);
+  ASSERT_EQ(converted.voxel_count(), built.voxel_count());
+  EXPECT_TRUE(std::equal(converted.words().begin(), converted.words().end(), built.words().begin(), built.words().end()));
+  EXPECT_EQ(converted.frame(), built.frame());
+  ASSERT_EQ(converted.attributes().size(), built.attributes().size());
+  for (std::size_t a = 0; a < built.attributes().size(); ++a) {
+    const auto& got = converted.attributes().columns()[a];
+    const auto& want = built.attributes().columns()[a];
+    ASSERT_EQ(got.name(), want.name());
+    // Streamed means add chunk sums: equal up to rounding.
+    for (std::size_t v = 0; v < want.size(); ++v)
+      ASSERT_NEAR(got.get(v), want.get(v), 1e-6 * (1 + std::abs(want.get(v)))) << want.name() << " voxel " << v;
+  }
+}
+
+TEST(Convert, VoxelGridsMapCellForCellAndPointsNeedAGrid) {
+  VOLA_REQUIRE_DATA(data);
+  const vola::Tree chair = vola::convert((data / "binvox" / "trimesh_chair_model.binvox").string(), {});
+  EXPECT_GT(chair.voxel_count(), 0u);
+  EXPECT_EQ(chair.frame().quantization, vola::Quantization::grid);
+  EXPECT_EQ(refused_option([&] { vola::convert((data / "ply" / "pdal_simple_text.ply").string(), {}); }),
+            "voxel_size");
+  vola::ConvertOptions solid;
+  solid.solid = true;
+  solid.voxel_size = 1.0;
+  EXPECT_EQ(refused_option([&] { vola::convert((data / "ply" / "pdal_simple_text.ply").string(), solid); }), "solid");
+}
+
+}  // namespace
