@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "file_bytes.hpp"
@@ -50,17 +51,22 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name) {
-  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  Header h;
-  std::optional<std::uint64_t> width, height, points;
+// What the header's lines say, before it is checked as a whole.
+struct HeaderLines {
+  std::vector<std::string> fields;
   std::vector<int> sizes;
   std::vector<char> types;
   std::vector<std::uint64_t> counts;
+  std::optional<std::uint64_t> width, height, points;
+};
+
+// The header lines up to DATA into `lines`; the data kind and where the body starts into h.
+HeaderLines read_header_lines(std::string_view text, const std::string& name, Header& h) {
+  HeaderLines lines;
   std::vector<std::string_view> words;
   std::size_t at = 0;
   std::uint64_t line_number = 0;
-  for (;;) {
+  for (;; at = text.find('\n', at) + 1) {
     const std::size_t end = text.find('\n', at);
     ++line_number;
     auto fail = [&](const std::string& cause) -> void {
@@ -68,13 +74,11 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
     };
     if (end == std::string_view::npos) fail("the header ends without a DATA line (truncated or not a PCD file)");
     split_words(text.substr(at, end - at), words);
-    if (words.empty() || words[0].front() == '#') {
-      at = end + 1;
-      continue;
-    }
+    if (words.empty() || words[0].front() == '#') continue;
     const std::string key = lower(words[0]);
     const std::size_t n = words.size() - 1;
     auto numbers = [&](auto& out, const char* what) {
+      out.clear();
       for (std::size_t i = 1; i <= n; ++i) {
         typename std::remove_reference_t<decltype(out)>::value_type v{};
         if (!parse_number(words[i], v)) fail(std::string(what) + " '" + std::string(words[i]) + "' is not a number");
@@ -89,26 +93,24 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
     if (key == "version" || key == "viewpoint") {
       // Nothing to check: the layout lines say everything the data needs.
     } else if (key == "fields" || key == "columns") {
-      h.fields.clear();
-      for (std::size_t i = 1; i <= n; ++i) h.fields.push_back({lower(words[i])});
+      lines.fields.clear();
+      for (std::size_t i = 1; i <= n; ++i) lines.fields.push_back(lower(words[i]));
     } else if (key == "size") {
-      sizes.clear();
-      numbers(sizes, "SIZE");
+      numbers(lines.sizes, "SIZE");
     } else if (key == "type") {
-      types.clear();
+      lines.types.clear();
       for (std::size_t i = 1; i <= n; ++i) {
         if (words[i].size() != 1) fail("TYPE '" + std::string(words[i]) + "' is not F, I or U");
-        types.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(words[i][0]))));
+        lines.types.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(words[i][0]))));
       }
     } else if (key == "count") {
-      counts.clear();
-      numbers(counts, "COUNT");
+      numbers(lines.counts, "COUNT");
     } else if (key == "width") {
-      single(width);
+      single(lines.width);
     } else if (key == "height") {
-      single(height);
+      single(lines.height);
     } else if (key == "points") {
-      single(points);
+      single(lines.points);
     } else if (key == "data") {
       if (n != 1) fail("expected 'DATA ascii', 'DATA binary' or 'DATA binary_compressed'");
       const std::string kind = lower(words[1]);
@@ -118,24 +120,26 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
       else fail("DATA '" + std::string(words[1]) + "' is not ascii, binary or binary_compressed");
       h.body = end + 1;
       h.body_line = line_number + 1;
-      break;
+      return lines;
     } else {
       fail("unknown header line '" + std::string(words[0]) + "'");
     }
-    at = end + 1;
   }
+}
 
+Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name) {
+  Header h;
+  const HeaderLines lines = read_header_lines(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                                              name, h);
   auto fail = [&](const std::string& cause) -> void { throw FormatError(name, h.body, "PCD header: " + cause); };
-  if (h.fields.empty()) fail("no FIELDS line");
-  if (sizes.size() != h.fields.size() || types.size() != h.fields.size())
-    fail("FIELDS, SIZE and TYPE must name the same number of fields (" + std::to_string(h.fields.size()) + ", " +
-         std::to_string(sizes.size()) + ", " + std::to_string(types.size()) + ")");
-  if (!counts.empty() && counts.size() != h.fields.size()) fail("COUNT does not name every field");
-  for (std::size_t f = 0; f < h.fields.size(); ++f) {
-    Field& field = h.fields[f];
-    field.size = sizes[f];
-    field.type = types[f];
-    field.count = counts.empty() ? 1 : counts[f];
+  if (lines.fields.empty()) fail("no FIELDS line");
+  const std::size_t fields = lines.fields.size();
+  if (lines.sizes.size() != fields || lines.types.size() != fields)
+    fail("FIELDS, SIZE and TYPE must name the same number of fields (" + std::to_string(fields) + ", " +
+         std::to_string(lines.sizes.size()) + ", " + std::to_string(lines.types.size()) + ")");
+  if (!lines.counts.empty() && lines.counts.size() != fields) fail("COUNT does not name every field");
+  for (std::size_t f = 0; f < fields; ++f) {
+    Field field{lines.fields[f], lines.types[f], lines.sizes[f], lines.counts.empty() ? 1 : lines.counts[f]};
     const bool valid = (field.type == 'F' && (field.size == 4 || field.size == 8)) ||
                        ((field.type == 'I' || field.type == 'U') &&
                         (field.size == 1 || field.size == 2 || field.size == 4 || field.size == 8));
@@ -149,7 +153,9 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
     field.component = h.components;
     h.point_size += field.count * static_cast<std::uint64_t>(field.size);
     h.components += field.count;
+    h.fields.push_back(std::move(field));
   }
+  const auto& [width, height, points] = std::tie(lines.width, lines.height, lines.points);
   std::optional<std::uint64_t> grid_points;  // WIDTH x HEIGHT, when it does not overflow
   if (width && (!height || *height == 0 || *width <= std::numeric_limits<std::uint64_t>::max() / *height))
     grid_points = *width * height.value_or(1);
