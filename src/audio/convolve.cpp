@@ -6,11 +6,10 @@
 #include <cmath>
 #include <numbers>
 #include <complex>
-#include <latch>
 #include <mutex>
-#include <thread>
 
 #include "vola/error.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::audio {
 
@@ -97,50 +96,42 @@ std::vector<double> Convolver::apply(std::span<const double> signal, unsigned th
   const std::size_t blocks = (signal.size() + block_ - 1) / block_;
   const std::size_t bins = fft_size_ / 2 + 1;
   const double scale = 1.0 / static_cast<double>(fft_size_);
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, (blocks + 1) / 2));
+  ParallelOptions parallel;
+  parallel.threads = static_cast<unsigned>(std::min<std::size_t>(resolve_thread_count(threads), (blocks + 1) / 2));
+  parallel.name = "audio.convolve";
   // Block b writes out[b * block_, b * block_ + fft_size_): it overlaps only blocks b - 1
-  // and b + 1. All even blocks are added first, then all odd ones, so every sample gets
-  // its (at most two) contributions in the same order whatever the thread count.
-  std::vector<RealBuffer> times;
+  // and b + 1. All even blocks are added first (one parallel loop), then all odd ones (a
+  // second), so every sample gets its (at most two) contributions in the same order
+  // whatever the thread count.
+  std::vector<RealBuffer> times;  // scratch per worker
   std::vector<ComplexBuffer> spectra;
-  for (unsigned t = 0; t < threads; ++t) {  // allocated here: a thread must not throw
+  for (unsigned t = 0; t < parallel.threads; ++t) {
     times.push_back(real_buffer(fft_size_));
     spectra.push_back(complex_buffer(bins));
   }
-  auto run = [&](std::size_t parity, std::size_t first, std::size_t stride) {
-    double* time = times[first].get();
-    fftw_complex* spectrum = spectra[first].get();
-    for (std::size_t b = parity + 2 * first; b < blocks; b += 2 * stride) {
-      const std::size_t begin = b * block_;
-      const std::size_t n = std::min(block_, signal.size() - begin);
-      std::copy_n(signal.data() + begin, n, time);
-      std::fill(time + n, time + fft_size_, 0.0);
-      fftw_execute_dft_r2c(plans_->size.forward, time, spectrum);
-      const fftw_complex* h = plans_->filter_spectrum.get();
-      for (std::size_t k = 0; k < bins; ++k) {  // written out: std::complex's * checks for NaN
-        const double re = spectrum[k][0] * h[k][0] - spectrum[k][1] * h[k][1];
-        const double im = spectrum[k][0] * h[k][1] + spectrum[k][1] * h[k][0];
-        spectrum[k][0] = re;
-        spectrum[k][1] = im;
+  for (std::size_t parity = 0; parity < 2; ++parity) {
+    const auto add_blocks = [&](const Chunk& chunk) {
+      double* time = times[chunk.worker].get();
+      fftw_complex* spectrum = spectra[chunk.worker].get();
+      for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+        const std::size_t begin = (2 * i + parity) * block_;
+        const std::size_t n = std::min(block_, signal.size() - begin);
+        std::copy_n(signal.data() + begin, n, time);
+        std::fill(time + n, time + fft_size_, 0.0);
+        fftw_execute_dft_r2c(plans_->size.forward, time, spectrum);
+        const fftw_complex* h = plans_->filter_spectrum.get();
+        for (std::size_t k = 0; k < bins; ++k) {  // written out: std::complex's * checks for NaN
+          const double re = spectrum[k][0] * h[k][0] - spectrum[k][1] * h[k][1];
+          const double im = spectrum[k][0] * h[k][1] + spectrum[k][1] * h[k][0];
+          spectrum[k][0] = re;
+          spectrum[k][1] = im;
+        }
+        fftw_execute_dft_c2r(plans_->size.inverse, spectrum, time);
+        const std::size_t valid = std::min(fft_size_, out.size() - begin);
+        for (std::size_t j = 0; j < valid; ++j) out[begin + j] += time[j] * scale;
       }
-      fftw_execute_dft_c2r(plans_->size.inverse, spectrum, time);
-      const std::size_t valid = std::min(fft_size_, out.size() - begin);
-      for (std::size_t i = 0; i < valid; ++i) out[begin + i] += time[i] * scale;
-    }
-  };
-  // Threads start once; a latch keeps the odd blocks until every even one is added.
-  std::latch even_done(static_cast<std::ptrdiff_t>(threads));
-  auto both = [&](std::size_t first) {
-    run(0, first, threads);
-    even_done.arrive_and_wait();
-    run(1, first, threads);
-  };
-  {
-    // Joined before the return: returning moves `out` away from the workers.
-    std::vector<std::jthread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(both, t);
-    both(0);
+    };
+    parallel_for((blocks + 1 - parity) / 2, add_blocks, parallel);
   }
   return out;
 }

@@ -2,20 +2,19 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <mutex>
 #include <numbers>
 #include <optional>
 #include <sstream>
-#include <thread>
 #include <utility>
 
 #include "vola/audio/attenuation_level.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
+#include "vola/parallel.hpp"
 #include "vola/raycast/world.hpp"
 
 namespace vola::audio {
@@ -294,19 +293,6 @@ void sort_keys(std::vector<Key>& keys, int key_bits) {
   }
 }
 
-// Runs f(range, begin, end) over `ranges` contiguous ranges of [0, count) on `threads`
-// threads. Results stored per range do not depend on the thread count.
-template <class F>
-void for_ranges(std::size_t count, std::size_t ranges, unsigned threads, F&& f) {
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t r; (r = next.fetch_add(1)) < ranges;) f(r, count * r / ranges, count * (r + 1) / ranges);
-  };
-  std::vector<std::jthread> pool;
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-}
-
 }  // namespace
 
 void ResponseOptions::check() const {
@@ -375,23 +361,28 @@ Thresholded threshold(const AcousticScene& scene, const Point& source, const Poi
   o.check();
   const Direct direct = direct_path(scene, source, listener, o);
   const PathModel m = path_model(scene, source, listener, direct, o);
-  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = resolve_thread_count(o.threads);
   const std::size_t count = scene.surface().size();
   // A few ranges per thread balance uneven scenes; the counts per key, hence the bins, do not
   // depend on how the blocks are split.
   const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(count / 256 + 1, 4 * threads));
   std::vector<std::vector<std::pair<Key, std::uint64_t>>> runs(ranges);
   const int key_bits = m.kernel_bits + m.sample_bits + m.level_bits;
-  for_ranges(count, ranges, threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = threads;
+  parallel.chunks = ranges;
+  parallel.name = "audio.threshold";
+  const auto bin_range = [&](const Chunk& range) {
     std::vector<Key> keys;
-    block_keys(m, scene.surface(), begin, end, [&](Key k) { keys.push_back(k); });
+    block_keys(m, scene.surface(), range.begin, range.end, [&](Key k) { keys.push_back(k); });
     sort_keys(keys, key_bits);
-    auto& run = runs[r];
+    auto& run = runs[range.index];
     for (const Key k : keys) {
       if (!run.empty() && run.back().first == k) ++run.back().second;
       else run.emplace_back(k, 1);
     }
-  });
+  };
+  parallel_for(count, bin_range, parallel);
   // The runs sorted by one radix sort of their keys (an index keeps the counts; a scene with
   // 2^32 runs would take 64 GiB of keys and counts first, so 32-bit indices suffice).
   std::vector<Key> keys;

@@ -1,11 +1,11 @@
 #include "vola/raycast/ray_caster.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
-#include <thread>
+#include <limits>
 
 #include "vola/error.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::raycast {
 namespace {
@@ -305,32 +305,17 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
   }
 }
 
-void parallel_chunks(std::size_t count, unsigned threads,
-                     const std::function<void(std::size_t, std::size_t)>& f) {
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  constexpr std::size_t kChunk = 256;
-  const std::size_t chunks = (count + kChunk - 1) / kChunk;
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(chunks, 1)));
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;) f(c * kChunk, std::min(count, (c + 1) * kChunk));
-  };
-  if (threads <= 1) {
-    work();
-    return;
-  }
-  std::vector<std::jthread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
-  work();
-}
-
 void RayCaster::cast(std::span<const Ray> rays, std::span<std::optional<RayHit>> hits, unsigned threads) const {
   if (hits.size() != rays.size()) throw InvalidArgument("cast: as many hits as rays are needed");
   for (const Ray& r : rays) check_ray(r);  // fail before any thread starts
-  parallel_chunks(rays.size(), threads, [&](std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = threads;
+  parallel.grain = kRaysPerChunk;
+  parallel.name = "raycast.cast";
+  const auto cast_rays = [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) hits[i] = cast(rays[i]);
-  });
+  };
+  parallel_for(rays.size(), cast_rays, parallel);
 }
 
 }  // namespace vola::raycast

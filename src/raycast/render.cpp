@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 
+#include "vola/parallel.hpp"
+
 namespace vola::raycast {
 namespace {
 
@@ -55,7 +57,11 @@ Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned 
   out.rgb.assign(pixels * 3, 0);
   const VoxelColours colours(caster.tree());
   std::atomic<std::uint64_t> hits{0};
-  parallel_chunks(pixels, threads, [&](std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = threads;
+  parallel.grain = kRaysPerChunk;
+  parallel.name = "raycast.render";
+  const auto render_pixels = [&](std::size_t begin, std::size_t end) {
     std::uint64_t local = 0;
     for (std::size_t p = begin; p < end; ++p) {
       const auto hit = caster.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
@@ -69,7 +75,8 @@ Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned 
         out.rgb[3 * p + i] = static_cast<std::uint8_t>(std::clamp(colour[i] * shade, 0.0, 255.0));
     }
     hits += local;
-  });
+  };
+  parallel_for(pixels, render_pixels, parallel);
   out.hits = hits;
   return out;
 }

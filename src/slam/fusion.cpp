@@ -8,6 +8,7 @@
 
 #include "tsdf_reader.hpp"
 #include "vola/error.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::slam {
 
@@ -31,6 +32,11 @@ void FusionParams::check() const {
 }
 
 namespace {
+
+// Chunks of the parallel loops over pixels (rows) and bricks (512 voxels each): results
+// are written per pixel and per brick, so the chunking does not change them.
+constexpr std::size_t kRowsPerChunk = 4;
+constexpr std::size_t kBricksPerChunk = 16;
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -156,7 +162,11 @@ void march_pixels(const Store& store, const Intrinsics& k, std::uint32_t width, 
                   const FusionParams& params, const OnHit& on_hit) {
   const Eigen::Vector3d o = pose.translation();
   const Eigen::Matrix3d r = pose.linear();
-  parallel_chunks(height, params.threads, [&](unsigned, std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = params.threads;
+  parallel.grain = kRowsPerChunk;
+  parallel.name = "slam.raycast";
+  const auto march_rows = [&](std::size_t begin, std::size_t end) {
     TsdfReader<Store> reader(store);
     for (std::size_t y = begin; y < end; ++y)
       for (std::uint32_t x = 0; x < width; ++x) {
@@ -167,7 +177,8 @@ void march_pixels(const Store& store, const Intrinsics& k, std::uint32_t width, 
                                params.max_depth * scale + params.truncation, params.truncation);
         if (hit) on_hit(y * width + x, *hit, d);
       }
-  });
+  };
+  parallel_for(height, march_rows, parallel);
 }
 
 template <class Store>
@@ -258,7 +269,12 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
   Pose estimate = pose_;
   const Pose previous_inverse = pose_.inverse();
   const double cos_max = std::cos(params_.icp_max_angle_degrees * M_PI / 180.0);
-  const unsigned chunks = resolve_threads(params_.threads);
+  // One partial sum per thread, over equal bands of rows, added in band order: the same
+  // sums for the same thread count (not across thread counts: the bands move).
+  ParallelOptions bands;
+  bands.threads = resolve_thread_count(params_.threads);
+  bands.chunks = bands.threads;
+  bands.name = "slam.track";
   int last_count = 0;
   for (int level = kPyramidLevels - 1; level >= 0; --level) {
     const Intrinsics k = level_intrinsics(intrinsics_, level);
@@ -270,7 +286,7 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
         Vec6 b = Vec6::Zero();
         int count = 0;
       };
-      std::vector<Sums> sums(chunks);
+      std::vector<Sums> sums(bands.chunks);
       const Eigen::Matrix3d rotation = estimate.linear();
       // Updates rotate about the estimate's camera centre, then translate. About the
       // world origin instead, a camera metres away couples every rotation with a large
@@ -278,9 +294,9 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
       // depended on where the world frame happens to be, and a run started at a
       // ground-truth pose 3 m from the origin was refused as degenerate from frame 139 on.
       const Eigen::Vector3d centre = estimate.translation();
-      parallel_chunks(current.height, params_.threads, [&](unsigned chunk, std::size_t begin, std::size_t end) {
-        Sums& s = sums[chunk];
-        for (std::size_t y = begin; y < end; ++y)
+      const auto sum_rows = [&](const Chunk& chunk) {
+        Sums& s = sums[chunk.index];
+        for (std::size_t y = chunk.begin; y < chunk.end; ++y)
           for (std::uint32_t x = 0; x < current.width; ++x) {
             const std::size_t i = y * current.width + x;
             if (!current.valid(i)) continue;
@@ -303,7 +319,8 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
             s.b -= jac * r;
             ++s.count;
           }
-      });
+      };
+      parallel_for(current.height, sum_rows, bands);
       Sums total;
       for (const auto& s : sums) {  // in chunk order: reproducible
         total.a += s.a;
@@ -374,7 +391,11 @@ void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, cons
   const Intrinsics k = intrinsics_;
   const double vs = geometry.voxel_size, truncation = params_.truncation;
   const float max_weight = params_.max_weight;
-  parallel_chunks(bricks.size(), params_.threads, [&](unsigned, std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = params_.threads;
+  parallel.grain = kBricksPerChunk;
+  parallel.name = "slam.integrate";
+  const auto integrate_bricks = [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const BrickCoord c = bricks[b];
       for (int i = 0; i < kBrickVoxels; ++i) {
@@ -403,7 +424,8 @@ void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, cons
         voxel.weight = std::min(w + 1.0f, max_weight);
       }
     }
-  });
+  };
+  parallel_for(bricks.size(), integrate_bricks, parallel);
   for (std::size_t f = 0; f < fresh.size(); ++f) {
     const TsdfVoxel* brick = scratch.data() + f * kBrickVoxels;
     if (std::any_of(brick, brick + kBrickVoxels, [](const TsdfVoxel& v) { return v.weight > 0.0f; }))

@@ -2,29 +2,14 @@
 
 #include <cmath>
 #include <limits>
-#include <thread>
+
+#include "vola/parallel.hpp"
 
 namespace vola::slam {
 
-unsigned resolve_threads(unsigned threads) noexcept {
-  if (threads) return threads;
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw ? hw : 1;
-}
-
-void parallel_chunks(std::size_t count, unsigned threads, const std::function<void(unsigned, std::size_t, std::size_t)>& f) {
-  const unsigned n = resolve_threads(threads);
-  if (n == 1 || count < 2) {
-    f(0, 0, count);
-    for (unsigned c = 1; c < n; ++c) f(c, count, count);
-    return;
-  }
-  std::vector<std::thread> workers;
-  for (unsigned c = 1; c < n; ++c)
-    workers.emplace_back([&, c] { f(c, count * c / n, count * (c + 1) / n); });
-  f(0, 0, count / n);
-  for (auto& w : workers) w.join();
-}
+namespace {
+constexpr std::size_t kRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
+}  // namespace
 
 DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_space, double sigma_depth,
                             unsigned threads) {
@@ -35,7 +20,11 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
     for (int dx = -radius; dx <= radius; ++dx)
       spatial[(dy + radius) * (2 * radius + 1) + dx + radius] = std::exp(-(dx * dx + dy * dy) * space);
   const int w = static_cast<int>(depth.width), h = static_cast<int>(depth.height);
-  parallel_chunks(depth.height, threads, [&](unsigned, std::size_t begin, std::size_t end) {
+  ParallelOptions parallel;
+  parallel.threads = threads;
+  parallel.grain = kRowsPerChunk;
+  parallel.name = "slam.bilateral_filter";
+  const auto filter_rows = [&](std::size_t begin, std::size_t end) {
     for (int y = static_cast<int>(begin); y < static_cast<int>(end); ++y)
       for (int x = 0; x < w; ++x) {
         const float centre = depth.metres[std::size_t(y) * w + x];
@@ -52,7 +41,8 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
           }
         out.metres[std::size_t(y) * w + x] = static_cast<float>(sum / weights);
       }
-  });
+  };
+  parallel_for(depth.height, filter_rows, parallel);
   return out;
 }
 

@@ -1,16 +1,14 @@
 #include "overviews.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <map>
-#include <mutex>
-#include <thread>
 
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::tile {
 
@@ -72,38 +70,30 @@ std::vector<OverviewEntry> build_overviews(
     const double scale = static_cast<double>(std::uint64_t{1} << (2 * L));  // 4^L
     std::vector<std::uint64_t> voxels(order.size(), 0);
     std::vector<Node> next(order.size());
-    std::atomic<std::size_t> next_parent{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    std::vector<std::thread> pool;
-    for (unsigned w = 0; w < c.workers; ++w)
-      pool.emplace_back([&] {
-        try {
-          for (std::size_t p; (p = next_parent++) < order.size();) {
-            const auto& children = parents[order[p]];
-            Box bbox = children.front()->bbox;
-            for (const Node* child : children) bbox = unite(bbox, child->bbox);
-            next[p] = {order[p], (folder / tile_file_name(order[p])).string(), bbox};
-            if (static_cast<int>(p % static_cast<std::size_t>(ranks)) != rank) continue;
-            Tree tree = build_parent(order[p], children, c);
-            Frame frame;
-            frame.quantization = Quantization::grid;
-            frame.voxel_size = c.grid.voxel_size() * scale;
-            frame.origin = {c.grid.origin[0] + order[p].i * c.grid.tile_size * scale,
-                            c.grid.origin[1] + order[p].j * c.grid.tile_size * scale,
-                            c.grid.origin[2] + order[p].k * c.grid.tile_size * scale};
-            tree.set_frame(frame);
-            c.georef.apply(tree, bbox);
-            write(tree, (fs::path(c.output_dir) / next[p].file).string());
-            voxels[p] = tree.voxel_count();
-          }
-        } catch (...) {
-          const std::lock_guard lock(error_mutex);
-          if (!error) error = std::current_exception();
-        }
-      });
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    ParallelOptions parallel;
+    parallel.threads = c.workers;
+    parallel.name = "tile.overviews";
+    const auto build_parents = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t p = begin; p < end; ++p) {
+        const auto& children = parents.at(order[p]);
+        Box bbox = children.front()->bbox;
+        for (const Node* child : children) bbox = unite(bbox, child->bbox);
+        next[p] = {order[p], (folder / tile_file_name(order[p])).string(), bbox};
+        if (static_cast<int>(p % static_cast<std::size_t>(ranks)) != rank) continue;
+        Tree tree = build_parent(order[p], children, c);
+        Frame frame;
+        frame.quantization = Quantization::grid;
+        frame.voxel_size = c.grid.voxel_size() * scale;
+        frame.origin = {c.grid.origin[0] + order[p].i * c.grid.tile_size * scale,
+                        c.grid.origin[1] + order[p].j * c.grid.tile_size * scale,
+                        c.grid.origin[2] + order[p].k * c.grid.tile_size * scale};
+        tree.set_frame(frame);
+        c.georef.apply(tree, bbox);
+        write(tree, (fs::path(c.output_dir) / next[p].file).string());
+        voxels[p] = tree.voxel_count();
+      }
+    };
+    parallel_for(order.size(), build_parents, parallel);
     // Gathering the counts is also the barrier: every rank has written this level.
     std::vector<std::uint8_t> mine;
     for (std::size_t p = 0; p < order.size(); ++p)

@@ -9,6 +9,7 @@
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/parallel.hpp"
 #include "vola/raycast/ray_caster.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -178,23 +179,17 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
   out.depth.assign(pixels, std::numeric_limits<double>::infinity());
   out.rgb.assign(pixels * 3, 0);
   std::atomic<std::uint64_t> hits{0};
-  // A tile that cannot be opened (missing, corrupt) fails the first ray that reaches
-  // it; the error is carried out of the worker threads and thrown here.
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  std::atomic<bool> failed{false};
-  raycast::parallel_chunks(pixels, threads, [&](std::size_t begin, std::size_t end) {
+  // A tile that cannot be opened (missing, corrupt) fails the first ray that reaches it;
+  // parallel_for stops handing out pixels and throws that error here.
+  ParallelOptions parallel;
+  parallel.threads = threads;
+  parallel.grain = raycast::kRaysPerChunk;
+  parallel.name = "tile.render";
+  const auto render_pixels = [&](std::size_t begin, std::size_t end) {
     std::uint64_t local = 0;
-    for (std::size_t p = begin; p < end && !failed; ++p) {
-      std::optional<TileHit> hit;
-      try {
-        hit = tiles.cast(camera.ray(static_cast<std::uint32_t>(p % camera.width),
-                                    static_cast<std::uint32_t>(p / camera.width)));
-      } catch (...) {
-        const std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
-      }
+    for (std::size_t p = begin; p < end; ++p) {
+      const std::optional<TileHit> hit = tiles.cast(
+          camera.ray(static_cast<std::uint32_t>(p % camera.width), static_cast<std::uint32_t>(p / camera.width)));
       if (!hit) continue;
       ++local;
       out.depth[p] = hit->t;
@@ -202,8 +197,8 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
       for (int i = 0; i < 3; ++i) out.rgb[3 * p + i] = grey;
     }
     hits += local;
-  });
-  if (error) std::rethrow_exception(error);
+  };
+  parallel_for(pixels, render_pixels, parallel);
   out.hits = hits;
   return out;
 }

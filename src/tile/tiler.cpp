@@ -11,8 +11,6 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <mutex>
-#include <thread>
 
 #include "overviews.hpp"
 #include "spill.hpp"
@@ -20,6 +18,7 @@
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/parallel.hpp"
 #include "vola/tile/tile_index.hpp"
 
 namespace vola::tile {
@@ -148,36 +147,11 @@ T take(const std::vector<std::uint8_t>& in, std::size_t& at) {
   return v;
 }
 
-unsigned resolve_threads(unsigned threads) {
-  if (threads) return threads;
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw ? hw : 1;
-}
-
 double seconds_since(std::chrono::steady_clock::time_point& mark) {
   const auto now = std::chrono::steady_clock::now();
   const double s = std::chrono::duration<double>(now - mark).count();
   mark = now;
   return s;
-}
-
-// Runs f(worker) on `workers` threads and rethrows the first error.
-template <class F>
-void on_threads(unsigned workers, F&& f) {
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  std::vector<std::thread> pool;
-  for (unsigned w = 0; w < workers; ++w)
-    pool.emplace_back([&, w] {
-      try {
-        f(w);
-      } catch (...) {
-        const std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    });
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
 }
 
 struct BuiltTile {
@@ -193,7 +167,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   if (options.output_dir.empty()) throw OptionError("output_dir", "no output folder given");
   if (options.memory_budget < (std::uint64_t{1} << 20))
     throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
-  const unsigned workers = resolve_threads(options.threads);
+  const unsigned workers = resolve_thread_count(options.threads);
   const int rank = comm.rank(), ranks = comm.size();
   const bool talk = rank == 0 && static_cast<bool>(options.progress);
 
@@ -228,22 +202,29 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], w, limit_keys));
 
   auto mark = std::chrono::steady_clock::now();
-  std::atomic<std::uint64_t> next_chunk{0}, chunks_done{0}, points_read{0};
-  std::mutex progress_mutex;
-  on_threads(workers, [&](unsigned w) {
-    std::vector<double> xyz;
-    for (std::uint64_t c; (c = next_chunk++) < chunks.size();) {
-      chunks[c].first->read_chunk(chunks[c].second, xyz);
-      points_read += xyz.size() / 3;
-      bucketers[w]->add(xyz);
+  std::atomic<std::uint64_t> chunks_done{0}, points_read{0};
+  // Worker w fills bucketers[w]; progress is reported by worker 0, the calling thread.
+  ParallelOptions bucketing;
+  bucketing.threads = workers;
+  bucketing.name = "tile.bucket";
+  std::vector<std::vector<double>> xyz(workers);
+  const auto bucket_chunks = [&](const Chunk& chunk) {
+    for (std::size_t c = chunk.begin; c < chunk.end; ++c) {
+      chunks[c].first->read_chunk(chunks[c].second, xyz[chunk.worker]);
+      points_read += xyz[chunk.worker].size() / 3;
+      bucketers[chunk.worker]->add(xyz[chunk.worker]);
       const std::uint64_t done = ++chunks_done;
-      if (talk && w == 0) {
-        const std::lock_guard lock(progress_mutex);
-        options.progress("bucketing points", done, chunks.size());
-      }
+      if (talk && chunk.worker == 0) options.progress("bucketing points", done, chunks.size());
     }
-    bucketers[w]->flush();
-  });
+  };
+  parallel_for(chunks.size(), bucket_chunks, bucketing);
+  xyz.clear();
+  ParallelOptions flushing;  // every bucketer's last buffer, sorted and spilled
+  flushing.threads = workers;
+  flushing.chunks = workers;
+  flushing.name = "tile.flush";
+  const auto flush_bucketer = [&](const Chunk& chunk) { bucketers[chunk.index]->flush(); };
+  parallel_for(workers, flush_bucketer, flushing);
 
   StatMap stats;
   RunMap runs;
@@ -320,9 +301,12 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     if (owner(p) == rank) owned.push_back(p);
   const detail::TileGeoref georef(options.epsg, options.crs_wkt);
   std::vector<BuiltTile> built(tiles.size());
-  std::atomic<std::size_t> next_tile{0}, tiles_done{0};
-  on_threads(workers, [&](unsigned w) {
-    for (std::size_t n; (n = next_tile++) < owned.size();) {
+  std::atomic<std::size_t> tiles_done{0};
+  ParallelOptions building;
+  building.threads = workers;
+  building.name = "tile.build";
+  const auto build_tiles = [&](const Chunk& chunk) {
+    for (std::size_t n = chunk.begin; n < chunk.end; ++n) {
       const std::size_t p = owned[n];
       const TileIndex& t = tiles[p];
       std::vector<Key> keys;
@@ -350,12 +334,10 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
       write(tree, path);
       built[p] = {tree.voxel_count(), static_cast<std::uint64_t>(fs::file_size(path))};
       const std::size_t done = ++tiles_done;
-      if (talk && w == 0) {
-        const std::lock_guard lock(progress_mutex);
-        options.progress("writing tiles", done, owned.size());
-      }
+      if (talk && chunk.worker == 0) options.progress("writing tiles", done, owned.size());
     }
-  });
+  };
+  parallel_for(owned.size(), build_tiles, building);
   files.clear();  // the spill files go as soon as the tiles are written
   summary.seconds_build = seconds_since(mark);
 

@@ -25,7 +25,7 @@ class Convolver {
   Convolver& operator=(const Convolver&) = delete;
 
   // The full linear convolution (signal.size() + filter size - 1 samples; empty for an
-  // empty signal) on `threads` threads (0 = all). The result does not depend on the
+  // empty signal) on `threads` threads (0 = vola::thread_count()). The result does not depend on the
   // thread count: blocks are added in a fixed order.
   std::vector<double> apply(std::span<const double> signal, unsigned threads = 1) const;
 

@@ -46,7 +46,7 @@ struct ResponseOptions {
   double bin_width_db = 0.1;        // attenuation bin width in dB (max error +-0.05 dB)
   double floor_db = -120.0;         // reflections weaker than this (re 1 at 1 m) are dropped
   bool visibility = false;          // keep only voxels seen from both ends (two rays each)
-  unsigned threads = 0;             // 0 = every hardware thread
+  unsigned threads = 0;             // 0 = vola::thread_count() (every hardware thread unless set)
   // Throws InvalidArgument naming the bad value.
   void check() const;
 };

@@ -29,7 +29,7 @@ class RayCaster {
   explicit RayCaster(const Tree& tree);
 
   std::optional<RayHit> cast(const Ray& ray) const;
-  // hits[i] = cast(rays[i]), on `threads` threads (0 = the hardware's count).
+  // hits[i] = cast(rays[i]), on `threads` threads (0 = vola::thread_count()).
   void cast(std::span<const Ray> rays, std::span<std::optional<RayHit>> hits, unsigned threads = 0) const;
 
   const Tree& tree() const noexcept { return *tree_; }
@@ -50,7 +50,8 @@ class RayCaster {
   std::vector<Node> nodes_;  // every level's blocks, level 0 first
 };
 
-// Runs f(begin, end) over [0, count) in chunks on `threads` threads (0 = hardware).
-void parallel_chunks(std::size_t count, unsigned threads, const std::function<void(std::size_t, std::size_t)>& f);
+// Rays per chunk of the parallel loops over rays and pixels (vola::parallel_for): a chunk
+// takes tens of microseconds or more, so handing it out costs next to nothing.
+inline constexpr std::size_t kRaysPerChunk = 256;
 
 }  // namespace vola::raycast

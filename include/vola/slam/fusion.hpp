@@ -44,7 +44,7 @@ struct FusionParams {
   // A frame whose ICP update exceeds these (or has too few associations) is "lost":
   // its pose stays the previous one and it is not integrated.
   double max_step_translation = 0.2, max_step_rotation_degrees = 20;
-  unsigned threads = 0;  // 0 = the hardware's count
+  unsigned threads = 0;  // 0 = vola::thread_count() (the hardware's count unless set)
   // Throws InvalidArgument for values that make no sense.
   void check() const;
 };

@@ -4,18 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "vola/slam/image.hpp"
 
 namespace vola::slam {
-
-// Runs f(begin, end) over [0, count) split into `threads` equal contiguous chunks
-// (0 = the hardware's count), one per thread. The split depends only on count and
-// threads, so per-chunk sums reduced in chunk order are reproducible.
-unsigned resolve_threads(unsigned threads) noexcept;
-void parallel_chunks(std::size_t count, unsigned threads, const std::function<void(unsigned chunk, std::size_t, std::size_t)>& f);
 
 // Points and unit normals per pixel; a pixel without one holds NaN in x.
 struct VertexMap {
@@ -25,7 +18,8 @@ struct VertexMap {
 };
 
 // Bilateral filter: each valid pixel becomes the average of the valid pixels within
-// `radius`, weighted by exp(-dpixel^2 / 2 sigma_space^2 - ddepth^2 / 2 sigma_depth^2).
+// `radius`, weighted by exp(-dpixel^2 / 2 sigma_space^2 - ddepth^2 / 2 sigma_depth^2);
+// rows in parallel on `threads` threads (0 = vola::thread_count()).
 DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_space, double sigma_depth,
                             unsigned threads);
 // Half-size depth: the mean of the 2x2 block's valid samples within 3 sigma_depth of its

@@ -35,12 +35,12 @@ struct TileOptions {
   // Per process: key buffers, sort scratch and merge buffers stay within it; a tile's
   // own voxel keys (8 bytes each) must fit it when the tile is built.
   std::uint64_t memory_budget = std::uint64_t{2} << 30;
-  unsigned threads = 0;  // 0 = all cores
+  unsigned threads = 0;  // 0 = vola::thread_count() (all cores unless set)
   bool overviews = true;
   // The CRS written into every tile (header code and WKT); the caller resolves it.
   std::optional<std::uint32_t> epsg;
   std::string crs_wkt;
-  // (stage, done, total) on rank 0, from one thread at a time.
+  // (stage, done, total) on rank 0, from the calling thread.
   std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
 };
 

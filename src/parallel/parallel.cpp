@@ -1,0 +1,107 @@
+#include "vola/parallel.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+
+std::atomic<unsigned> g_thread_count{0};
+std::atomic<detail::ParallelHook> g_hook{nullptr};
+
+// Where chunk c starts: c * grain, or for a fixed chunk count the even split
+// floor(count * c / chunks), computed as q * c + r * c / chunks (count = q * chunks + r)
+// so that it cannot overflow for chunks <= 2^32.
+struct Split {
+  std::size_t count, chunks, grain;
+  std::size_t begin(std::size_t c) const noexcept {
+    if (grain) return std::min(count, c * grain);  // c * grain < count + grain
+    const std::size_t q = count / chunks, r = count % chunks;
+    return q * c + r * c / chunks;
+  }
+};
+
+void run(std::size_t count, const std::function<void(const Chunk&)>& body, const ParallelOptions& options) {
+  const std::size_t grain = std::max<std::size_t>(options.grain, 1);
+  const Split split =
+      options.chunks ? Split{count, options.chunks, 0} : Split{count, count / grain + (count % grain != 0), grain};
+  const std::size_t chunks = split.chunks;
+  if (chunks == 0) return;
+  const auto threads = static_cast<unsigned>(std::min<std::size_t>(resolve_thread_count(options.threads), chunks));
+  const detail::ParallelHook hook = g_hook.load(std::memory_order_acquire);
+  const char* name = options.name ? options.name : "";
+  auto call = [&](std::size_t c, unsigned worker) {
+    const Chunk chunk{c, split.begin(c), split.begin(c + 1), worker};
+    if (hook) hook(name, chunk);
+    body(chunk);
+  };
+  if (threads <= 1) {  // on this thread: an exception leaves at once, the later chunks do not run
+    for (std::size_t c = 0; c < chunks; ++c) call(c, 0);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&](unsigned worker) noexcept {
+    try {
+      while (!stop.load(std::memory_order_relaxed)) {
+        const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
+        if (c >= chunks) break;
+        call(c, worker);
+      }
+    } catch (...) {
+      const std::lock_guard lock(error_mutex);
+      if (!error) error = std::current_exception();
+      stop.store(true, std::memory_order_relaxed);
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(threads - 1);
+  for (unsigned w = 1; w < threads; ++w) {
+    try {
+      pool.emplace_back(work, w);
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: the ones running (and this one) do the work
+    }
+  }
+  work(0);
+  for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+void set_thread_count(unsigned threads) noexcept { g_thread_count.store(threads, std::memory_order_relaxed); }
+
+unsigned thread_count() noexcept {
+  if (const unsigned n = g_thread_count.load(std::memory_order_relaxed)) return n;
+  const unsigned hardware = std::thread::hardware_concurrency();
+  return hardware ? hardware : 1;
+}
+
+unsigned resolve_thread_count(unsigned requested) noexcept { return requested ? requested : thread_count(); }
+
+void parallel_for(std::size_t count, const std::function<void(const Chunk&)>& body, const ParallelOptions& options) {
+  run(count, body, options);
+}
+
+void parallel_for(std::size_t count, const std::function<void(std::size_t, std::size_t)>& body,
+                  const ParallelOptions& options) {
+  const auto range = [&](const Chunk& c) { body(c.begin, c.end); };
+  run(count, range, options);
+}
+
+namespace detail {
+void set_parallel_hook(ParallelHook hook) noexcept { g_hook.store(hook, std::memory_order_release); }
+}  // namespace detail
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola
