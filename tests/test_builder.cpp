@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <iterator>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -261,3 +262,40 @@ TEST(RadixSort, SortsAndKeepsEqualKeysInInputOrder) {
 
 }  // namespace
 }  // namespace vola_test
+
+// Quantizer::to_keys is to_voxel + encode over a batch, with the mode's branches hoisted:
+// the same keys, kept indices and drops as the per-point reference, in every mode.
+TEST(QuantizerToKeys, MatchesToVoxelPointByPoint) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> coordinate(-20.0, 120.0);
+  std::vector<double> xyz;
+  for (int i = 0; i < 30000; ++i) xyz.push_back(coordinate(rng));
+  const double specials[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity(), 0.0, -0.0, 100.0, 1e300};
+  for (std::size_t i = 0; i < std::size(specials); ++i) xyz[7 * i + i % 3] = specials[i];
+  const vola::Box box{{0, 0, 0}, {100, 100, 100}};
+  const vola::Quantizer quantizers[] = {
+      vola::Quantizer::toolkit(box, 4), vola::Quantizer::toolkit(vola::Box{{5, 5, 5}, {5, 5, 5}}, 3),
+      vola::Quantizer::grid({0, 0, 0}, 1.0, 4), vola::Quantizer::grid({-3.5, 2.25, 0}, 0.7, 6)};
+  for (const vola::Quantizer& q : quantizers) {
+    std::vector<vola::Key> keys, want_keys;
+    std::vector<std::uint32_t> kept, want_kept;
+    const std::uint64_t dropped = q.to_keys(xyz, keys, &kept);
+    std::uint64_t want_dropped = 0;
+    for (std::size_t i = 0; i < xyz.size() / 3; ++i) {
+      vola::Voxel v;
+      if (!q.to_voxel({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}, v)) {
+        ++want_dropped;
+        continue;
+      }
+      want_keys.push_back(vola::encode(v));
+      want_kept.push_back(static_cast<std::uint32_t>(i));
+    }
+    EXPECT_EQ(keys, want_keys);
+    EXPECT_EQ(kept, want_kept);
+    EXPECT_EQ(dropped, want_dropped);
+    std::vector<vola::Key> keys_only;
+    EXPECT_EQ(q.to_keys(xyz, keys_only, nullptr), want_dropped);
+    EXPECT_EQ(keys_only, want_keys);
+  }
+}

@@ -3,7 +3,9 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "vola/key.hpp"
 #include "vola/version.hpp"
@@ -57,6 +59,11 @@ class Quantizer {
   // False when the point falls outside the grid (grid mode only; toolkit clamps)
   // or is not finite.
   bool to_voxel(const Point& p, Voxel& out) const noexcept;
+  // The keys of the points xyz (x y z per point) that to_voxel places, appended to `keys`
+  // in input order; `kept`, when not null, gets each placed point's index. The same
+  // arithmetic as to_voxel with the mode's branches out of the loop. Returns how many
+  // points were dropped.
+  std::uint64_t to_keys(std::span<const double> xyz, std::vector<Key>& keys, std::vector<std::uint32_t>* kept) const;
   // Centre of a voxel in world coordinates.
   Point center(const Voxel& v) const noexcept;
   // The grid as origin + voxel size (toolkit: origin = min - step/2, step = Lmax/(S-1)).

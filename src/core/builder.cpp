@@ -292,19 +292,8 @@ Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* re
 
   const bool per_point = options.payload || !cloud.attributes.empty();
   std::vector<Key> keys;
-  keys.reserve(n);
   std::vector<std::uint32_t> index;
-  if (per_point) index.reserve(n);
-  std::uint64_t outside = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    Voxel v;
-    if (!quantizer.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v)) {
-      ++outside;
-      continue;
-    }
-    keys.push_back(encode(v));
-    if (per_point) index.push_back(static_cast<std::uint32_t>(i));
-  }
+  const std::uint64_t outside = quantizer.to_keys(cloud.xyz, keys, per_point ? &index : nullptr);
   radix_sort(keys, per_point ? &index : nullptr, 6 * depth);
 
   Tree tree;

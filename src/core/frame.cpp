@@ -73,6 +73,59 @@ bool Quantizer::to_voxel(const Point& p, Voxel& out) const noexcept {
   return true;
 }
 
+namespace {
+
+// Quantizer::to_keys for one mode; place(point, v) gives the voxel like to_voxel.
+template <class Place>
+std::uint64_t keys_of(std::span<const double> xyz, std::vector<Key>& keys, std::vector<std::uint32_t>* kept,
+                      Place place) {
+  const std::size_t n = xyz.size() / 3;
+  keys.reserve(keys.size() + n);
+  if (kept) kept->reserve(kept->size() + n);
+  std::uint64_t dropped = 0;
+  const double* p = xyz.data();
+  for (std::size_t i = 0; i < n; ++i, p += 3) {
+    std::uint32_t v[3];
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) && place(p, v))) {
+      ++dropped;
+      continue;
+    }
+    keys.push_back(encode(v[0], v[1], v[2]));
+    if (kept) kept->push_back(static_cast<std::uint32_t>(i));
+  }
+  return dropped;
+}
+
+}  // namespace
+
+std::uint64_t Quantizer::to_keys(std::span<const double> xyz, std::vector<Key>& keys,
+                                 std::vector<std::uint32_t>* kept) const {
+  const double side = static_cast<double>(side_of(depth_));
+  const Point origin = origin_, scale = scale_;
+  if (mode_ == Quantization::toolkit && degenerate_)
+    return keys_of(xyz, keys, kept, [](const double*, std::uint32_t* v) {
+      v[0] = v[1] = v[2] = 0;
+      return true;
+    });
+  if (mode_ == Quantization::toolkit)
+    return keys_of(xyz, keys, kept, [&](const double* p, std::uint32_t* v) {
+      for (int a = 0; a < 3; ++a) {
+        double n = (p[a] - origin[a]) / scale[a];
+        n = n > 0.0 ? (n > 1.0 ? 1.0 : n) : 0.0;  // NaN (0/0) to 0, as to_voxel
+        v[a] = static_cast<std::uint32_t>(std::nearbyint((side - 1.0) * n));
+      }
+      return true;
+    });
+  return keys_of(xyz, keys, kept, [&](const double* p, std::uint32_t* v) {
+    for (int a = 0; a < 3; ++a) {
+      const double c = std::floor((p[a] - origin[a]) / scale[a]);
+      if (!(c >= 0.0 && c < side)) return false;
+      v[a] = static_cast<std::uint32_t>(c);
+    }
+    return true;
+  });
+}
+
 Point Quantizer::center(const Voxel& v) const noexcept {
   const std::uint32_t c[3] = {v.x, v.y, v.z};
   Point p{};

@@ -176,15 +176,7 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
   const bool per_point = s.payload || !s.specs.empty();
   s.keys.clear();
   s.index.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    Voxel v;
-    if (!s.quantizer.to_voxel({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}, v)) {
-      ++s.points_outside;
-      continue;
-    }
-    s.keys.push_back(encode(v));
-    if (per_point) s.index.push_back(static_cast<std::uint32_t>(i));
-  }
+  s.points_outside += s.quantizer.to_keys(xyz.subspan(0, 3 * n), s.keys, per_point ? &s.index : nullptr);
   if (!per_point) {
     s.push_keys(s.keys);
     return;

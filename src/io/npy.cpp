@@ -230,7 +230,7 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
   const std::uint64_t n = array.shape[0];
   const std::uint64_t columns = array.shape[1];
   PointCloud cloud;
-  cloud.xyz.reserve(3 * n);
+  cloud.xyz.resize(3 * n);
   // Element (row i, column c) lies at i * row_step + c * column_step values.
   const std::uint64_t row_step = array.fortran_order ? 1 : columns;
   const std::uint64_t column_step = array.fortran_order ? n : 1;
@@ -238,10 +238,11 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
     using T = decltype(type);
     const std::uint8_t* base = array.data.data();
     const bool boolean = array.kind == 'b';  // a bool byte other than 0 is true, as numpy reads it
+    double* out = cloud.xyz.data();
     for (std::uint64_t i = 0; i < n; ++i)
       for (std::uint64_t c = 0; c < 3; ++c) {
         const T v = load_value<T>(base + (i * row_step + c * column_step) * sizeof(T), array.big_endian);
-        cloud.xyz.push_back(boolean ? static_cast<double>(v != 0) : static_cast<double>(v));
+        *out++ = boolean ? static_cast<double>(v != 0) : static_cast<double>(v);
       }
   });
   if (payload_columns && columns > 3) {
