@@ -66,6 +66,11 @@ struct BuildReport {
   std::uint64_t points_in = 0;
   std::uint64_t points_outside = 0;  // grid mode: outside the grid; any mode: not finite
   std::uint64_t voxels = 0;
+
+  // Fills in the counts of a finished build (null: nothing to report).
+  static void of(BuildReport* report, std::uint64_t points_in, std::uint64_t points_outside, const Tree& tree) {
+    if (report) *report = BuildReport{points_in, points_outside, tree.voxel_count()};
+  }
 };
 
 // Points -> tree, with the reference's payload rules and our attribute reductions.

@@ -333,11 +333,7 @@ Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* re
   tree.georef().bbox = bbox;
   tree.georef().epsg = options.epsg;
   tree.set_frame(quantizer.frame());
-  if (report) {
-    report->points_in = n;
-    report->points_outside = outside;
-    report->voxels = tree.voxel_count();
-  }
+  BuildReport::of(report, n, outside, tree);
   return tree;
 }
 

@@ -246,11 +246,7 @@ Tree finish_tree(StreamBuilder& builder, const Box& bbox, std::uint32_t epsg, Bu
   Tree tree = builder.finish();
   tree.georef().bbox = bbox;
   tree.georef().epsg = epsg;
-  if (report) {
-    report->points_in = builder.points_in();
-    report->points_outside = builder.points_outside();
-    report->voxels = tree.voxel_count();
-  }
+  BuildReport::of(report, builder.points_in(), builder.points_outside(), tree);
   return tree;
 }
 

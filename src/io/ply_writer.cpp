@@ -113,6 +113,18 @@ void append_text(std::string& out, const PlyField& f, std::size_t rank) {
   }
 }
 
+// The attribute fields of the voxel of `rank`, after its coordinates.
+void append_fields(std::string& out, const std::vector<PlyField>& fields, std::size_t rank, bool ascii) {
+  for (const auto& f : fields) {
+    if (ascii) {
+      out += ' ';
+      append_text(out, f, rank);
+    } else {
+      append_binary(out, f, rank);
+    }
+  }
+}
+
 void append_point(std::string& out, const Point& p, bool ascii) {
   for (int a = 0; a < 3; ++a) {
     if (ascii) {
@@ -167,14 +179,7 @@ PlyReport write_centres(const Tree& tree, OutputFile& out, const PlyOptions& opt
   std::size_t rank = 0;
   tree.for_each_voxel([&](const Voxel& v) {
     append_point(b, quantizer.center(v), options.ascii);
-    for (const auto& f : fields) {
-      if (options.ascii) {
-        b += ' ';
-        append_text(b, f, rank);
-      } else {
-        append_binary(b, f, rank);
-      }
-    }
+    append_fields(b, fields, rank, options.ascii);
     if (options.ascii) b += '\n';
     ++rank;
     buffer.maybe_flush();
@@ -275,14 +280,7 @@ PlyReport write_cubes(const Tree& tree, OutputFile& out, const PlyOptions& optio
         b.append(reinterpret_cast<const char*>(&index), sizeof index);
       }
     }
-    for (const auto& f : fields) {
-      if (options.ascii) {
-        b += ' ';
-        append_text(b, f, rank);
-      } else {
-        append_binary(b, f, rank);
-      }
-    }
+    append_fields(b, fields, rank, options.ascii);
     if (options.ascii) b += '\n';
     buffer.maybe_flush();
   });

@@ -148,11 +148,7 @@ Tree terrain_columns(const PointCloud& surface, const Quantizer& quantizer, cons
     tree = columns.empty() ? build_from_sorted_keys({}, quantizer.depth()) : ColumnLevels(columns, quantizer.depth()).tree();
   }
   tree.set_frame(quantizer.frame());
-  if (report) {
-    report->points_in = n;
-    report->points_outside = outside;
-    report->voxels = tree.voxel_count();
-  }
+  BuildReport::of(report, n, outside, tree);
   return tree;
 }
 
