@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "overviews.hpp"
 #include "spill.hpp"
@@ -158,50 +159,58 @@ struct BuiltTile {
   std::uint64_t voxels = 0, bytes = 0;
 };
 
-}  // namespace
+// One run of make_tiles on this rank: what its stages share.
+struct Tiling {
+  Tiling(const TileOptions& o, Communicator& c, unsigned w)
+      : options(o), comm(c), workers(w), rank(c.rank()), ranks(c.size()), talk(rank == 0 && static_cast<bool>(o.progress)) {}
 
-TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
-                       Communicator& comm) {
+  const TileOptions& options;
+  Communicator& comm;
+  unsigned workers;
+  int rank, ranks;
+  bool talk;  // this rank reports progress
+  std::vector<std::unique_ptr<SpillFile>> files;  // one per worker, the last for runs from other ranks
+  std::vector<const SpillFile*> file_views;
+  RunMap runs;             // this rank's sorted runs per tile
+  StatMap all_stats;       // every rank's points and bbox per tile
+  std::vector<TileIndex> tiles;  // every tile, in order; tile p belongs to rank p % ranks
+  TileSummary summary;
+  std::chrono::steady_clock::time_point mark = std::chrono::steady_clock::now();
+  std::optional<detail::TileGeoref> georef;  // the tiles' and overviews' CRS and lat/lon
+
+  int owner(std::size_t position) const { return static_cast<int>(position % static_cast<std::size_t>(ranks)); }
+  std::uint64_t per_worker() const { return options.memory_budget / workers; }
+  // Keys a k-way merge buffers per run: a quarter of a worker's budget over the runs.
+  std::size_t merge_buffer(std::size_t run_count) const {
+    return static_cast<std::size_t>(std::clamp<std::uint64_t>(
+        per_worker() / 4 / sizeof(Key) / std::max<std::size_t>(run_count, 1), 512, std::uint64_t{1} << 16));
+  }
+  std::vector<Key> merged(const std::vector<Run>& tile_runs) const {
+    return detail::merge_runs(tile_runs, file_views, merge_buffer(tile_runs.size()));
+  }
+
+  void bucket(const std::vector<const PointSource*>& sources);
+  void share_statistics(const StatMap& stats, std::uint64_t points_read, std::uint64_t outside);
+  void exchange();
+  std::vector<BuiltTile> build();
+  TileIndexFile index(const std::vector<BuiltTile>& built);
+};
+
+// 1. Bucket this rank's chunks on all its threads: keys per tile, sorted runs spilled.
+void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   const TileGrid& grid = options.grid;
-  grid.check();
-  if (options.output_dir.empty()) throw OptionError("output_dir", "no output folder given");
-  if (options.memory_budget < (std::uint64_t{1} << 20))
-    throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
-  const unsigned workers = resolve_thread_count(options.threads);
-  const int rank = comm.rank(), ranks = comm.size();
-  const bool talk = rank == 0 && static_cast<bool>(options.progress);
-
-  fs::create_directories(options.output_dir);
-  const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);
-  const fs::path spill_dir = spill_root / ("rank-" + std::to_string(rank) + "-" + std::to_string(::getpid()));
-  fs::create_directories(spill_dir);
-  struct RemoveDir {
-    fs::path dir;
-    ~RemoveDir() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } remove_spill{spill_dir};
-
   // Every worker's buffers share 35% of the budget: sorting a buffer needs as much
   // again, and the chunk being read, the maps and the allocator take the rest.
   const std::uint64_t limit_keys = options.memory_budget * 35 / 100 / workers / sizeof(Key);
-
-  // --- 1. Bucket: this rank's chunks, on all its threads.
   std::vector<std::pair<const PointSource*, std::uint64_t>> chunks;  // global chunk g -> rank g % ranks
   std::uint64_t global = 0;
   for (const PointSource* s : sources)
     for (std::uint64_t c = 0; c < s->chunk_count(); ++c, ++global)
-      if (static_cast<int>(global % static_cast<std::uint64_t>(ranks)) == rank) chunks.emplace_back(s, c);
+      if (owner(global) == rank) chunks.emplace_back(s, c);
 
-  std::vector<std::unique_ptr<SpillFile>> files;
-  for (unsigned w = 0; w <= workers; ++w)  // the last one takes runs received from other ranks
-    files.push_back(std::make_unique<SpillFile>((spill_dir / ("worker-" + std::to_string(w) + ".keys")).string()));
   std::vector<std::unique_ptr<Bucketer>> bucketers;
   for (unsigned w = 0; w < workers; ++w)
     bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], w, limit_keys));
-
-  auto mark = std::chrono::steady_clock::now();
   std::atomic<std::uint64_t> chunks_done{0}, points_read{0};
   // Worker w fills bucketers[w]; progress is reported by worker 0, the calling thread.
   ParallelOptions bucketing;
@@ -227,52 +236,45 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   parallel_for(workers, flush_bucketer, flushing);
 
   StatMap stats;
-  RunMap runs;
   std::uint64_t outside = 0;
-  TileSummary summary;
   for (const auto& b : bucketers) {
-    for (const auto& [t, s] : b->stats()) stats[t].merge(s);
+    for (const auto& [t, st] : b->stats()) stats[t].merge(st);
     for (const auto& [t, r] : b->runs()) runs[t].insert(runs[t].end(), r.begin(), r.end());
     outside += b->outside();
     summary.spill_runs += b->run_count();
   }
   bucketers.clear();
   summary.seconds_bucket = seconds_since(mark);
+  share_statistics(stats, points_read.load(), outside);
+}
 
-  // --- 2. Every rank learns every tile's statistics.
+// 2. Every rank learns every tile's statistics (and so the list of tiles).
+void Tiling::share_statistics(const StatMap& stats, std::uint64_t points_read, std::uint64_t outside) {
   std::vector<std::uint8_t> mine;
-  put(mine, points_read.load());
+  put(mine, points_read);
   put(mine, outside);
-  for (const auto& [t, s] : stats) {
+  for (const auto& [t, st] : stats) {
     put(mine, t);
-    put(mine, s.points);
-    put(mine, s.bbox);
+    put(mine, st.points);
+    put(mine, st.bbox);
   }
-  StatMap all_stats;
   for (const auto& message : comm.all_gather(mine)) {
     std::size_t at = 0;
     summary.points_in += take<std::uint64_t>(message, at);
     summary.points_outside += take<std::uint64_t>(message, at);
     while (at < message.size()) {
       const auto t = take<TileIndex>(message, at);
-      TileStat s;
-      s.points = take<std::uint64_t>(message, at);
-      s.bbox = take<Box>(message, at);
-      all_stats[t].merge(s);
+      TileStat st;
+      st.points = take<std::uint64_t>(message, at);
+      st.bbox = take<Box>(message, at);
+      all_stats[t].merge(st);
     }
   }
-  std::vector<TileIndex> tiles;
-  for (const auto& [t, s] : all_stats) tiles.push_back(t);
-  const auto owner = [ranks](std::size_t position) { return static_cast<int>(position % static_cast<std::size_t>(ranks)); };
-  const std::uint64_t per_worker = options.memory_budget / workers;
-  const auto merge_buffer = [&](std::size_t run_count) {
-    return static_cast<std::size_t>(std::clamp<std::uint64_t>(per_worker / 4 / sizeof(Key) / std::max<std::size_t>(run_count, 1),
-                                                              512, std::uint64_t{1} << 16));
-  };
-  std::vector<const SpillFile*> file_views;
-  for (const auto& f : files) file_views.push_back(f.get());
+  for (const auto& [t, st] : all_stats) tiles.push_back(t);
+}
 
-  // --- 3. Exchange: each tile's keys go to its owner (one gather per tile, all ranks in step).
+// 3. Each tile's keys go to its owner (one gather per tile, all ranks in step).
+void Tiling::exchange() {
   if (ranks > 1) {
     const auto received = static_cast<std::uint32_t>(workers);
     for (std::size_t p = 0; p < tiles.size(); ++p) {
@@ -280,7 +282,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
       std::vector<Key> keys;
       if (root != rank) {
         if (const auto it = runs.find(tiles[p]); it != runs.end()) {
-          keys = detail::merge_runs(it->second, file_views, merge_buffer(it->second.size()));
+          keys = merged(it->second);
           runs.erase(it);
         }
       }
@@ -294,12 +296,14 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   }
   for (const auto& f : files) summary.spill_bytes += f->size();
   summary.seconds_exchange = seconds_since(mark);
+}
 
-  // --- 4. Build and write this rank's tiles.
+// 4. Build and write this rank's tiles; every rank learns every tile's voxels and bytes.
+std::vector<BuiltTile> Tiling::build() {
+  const TileGrid& grid = options.grid;
   std::vector<std::size_t> owned;
   for (std::size_t p = 0; p < tiles.size(); ++p)
     if (owner(p) == rank) owned.push_back(p);
-  const detail::TileGeoref georef(options.epsg, options.crs_wkt);
   std::vector<BuiltTile> built(tiles.size());
   std::atomic<std::size_t> tiles_done{0};
   ParallelOptions building;
@@ -314,8 +318,8 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
         std::uint64_t total = 0;
         for (const Run& r : it->second) total += r.count;
         const bool one_run = it->second.size() == 1;  // already sorted and unique
-        if (!one_run && 2 * total * sizeof(Key) > per_worker) {
-          keys = detail::merge_runs(it->second, file_views, merge_buffer(it->second.size()));
+        if (!one_run && 2 * total * sizeof(Key) > per_worker()) {
+          keys = merged(it->second);
         } else {  // one read (and for many runs a radix sort, which beats a k-way merge)
           keys.resize(total);
           std::size_t at = 0;
@@ -329,7 +333,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
       Tree tree = build_from_sorted_keys(keys, grid.depth);
       std::vector<Key>().swap(keys);
       tree.set_frame(grid.tile_frame(t));
-      georef.apply(tree, all_stats.at(t).bbox);
+      georef->apply(tree, all_stats.at(t).bbox);
       const std::string path = (fs::path(options.output_dir) / tile_file_name(t)).string();
       write(tree, path);
       built[p] = {tree.voxel_count(), static_cast<std::uint64_t>(fs::file_size(path))};
@@ -339,9 +343,9 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   };
   parallel_for(owned.size(), build_tiles, building);
   files.clear();  // the spill files go as soon as the tiles are written
+  file_views.clear();
   summary.seconds_build = seconds_since(mark);
 
-  // Every rank learns every tile's voxel count and size.
   std::vector<std::uint8_t> results;
   for (const std::size_t p : owned) {
     put(results, static_cast<std::uint64_t>(p));
@@ -355,9 +359,13 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
       built[p] = take<BuiltTile>(message, at);
     }
   }
+  return built;
+}
 
+// The tile index (without overviews) and the summary's totals.
+TileIndexFile Tiling::index(const std::vector<BuiltTile>& built) {
   TileIndexFile index;
-  index.grid = grid;
+  index.grid = options.grid;
   index.epsg = options.epsg;
   index.crs_wkt = options.crs_wkt;
   index.points_in = summary.points_in;
@@ -375,17 +383,54 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     index.tiles.push_back(std::move(e));
   }
   summary.tiles = tiles.size();
+  return index;
+}
 
-  // --- 5. The overview pyramid, level by level (each level reads the one below).
+// A folder that is removed with everything in it when this goes out of scope.
+struct RemovedFolder {
+  fs::path dir;
+  ~RemovedFolder() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
+}  // namespace
+
+TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
+                       Communicator& comm) {
+  const TileGrid& grid = options.grid;
+  grid.check();
+  if (options.output_dir.empty()) throw OptionError("output_dir", "no output folder given");
+  if (options.memory_budget < (std::uint64_t{1} << 20))
+    throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
+  const unsigned workers = resolve_thread_count(options.threads);
+  fs::create_directories(options.output_dir);
+  const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);
+  // Declared before the run, so that the spill files close before their folder goes.
+  const RemovedFolder spill{spill_root / ("rank-" + std::to_string(comm.rank()) + "-" + std::to_string(::getpid()))};
+  fs::create_directories(spill.dir);
+  Tiling run(options, comm, workers);
+  for (unsigned w = 0; w <= workers; ++w)
+    run.files.push_back(std::make_unique<SpillFile>((spill.dir / ("worker-" + std::to_string(w) + ".keys")).string()));
+  for (const auto& f : run.files) run.file_views.push_back(f.get());
+  run.georef.emplace(options.epsg, options.crs_wkt);
+
+  run.bucket(sources);
+  run.exchange();
+  const std::vector<BuiltTile> built = run.build();
+  TileIndexFile index = run.index(built);
+  TileSummary& summary = run.summary;
+
+  // 5. The overview pyramid, level by level (each level reads the one below).
   if (options.overviews) {
     comm.barrier();  // every rank's tiles are on disk
-    const OverviewContext context{grid, options.output_dir, georef, workers};
+    const OverviewContext context{grid, options.output_dir, *run.georef, workers};
     index.overviews = build_overviews(index.tiles, context, comm, options.progress);
     summary.overview_files = index.overviews.size();
-    summary.seconds_overviews = seconds_since(mark);
+    summary.seconds_overviews = seconds_since(run.mark);
   }
-
-  if (rank == 0) {
+  if (run.rank == 0) {
     summary.index_path = (fs::path(options.output_dir) / kIndexFileName).string();
     write_tile_index(index, summary.index_path);
   }
