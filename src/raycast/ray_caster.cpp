@@ -164,6 +164,119 @@ std::optional<RayHit> RayCaster::cast(const Ray& ray) const {
   return (this->*walks[octant])(ray, axes, v, t);
 }
 
+namespace {
+
+// The hit in voxel c at time t. Its normal: the lowest axis whose entry plane into the
+// voxel is crossed now (none for a ray that starts inside it, `moved` false).
+template <class S>
+[[gnu::always_inline]] inline RayHit hit_in(const std::array<std::int32_t, 3>& c, double t, bool moved,
+                                            const RayAxes& axes, const std::array<double, 3>& o,
+                                            const std::array<double, 3>& inv) {
+  RayHit hit;
+  hit.voxel = Voxel{static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]), static_cast<std::uint32_t>(c[2])};
+  hit.t = t;
+  for (int a = 0; a < 3 && moved; ++a) {
+    if (S::step[a] && crossing_time(axes.entry_plane(a, c[a]), o[a], inv[a]) == t) {
+      hit.normal[a] = -S::step[a];
+      break;
+    }
+  }
+  return hit;
+}
+
+// Per axis, the child cells of `here` the ray is in from t until it leaves `here`
+// (children `shift` bits below): the three planes between the children, in the order the
+// ray crosses them, counted against t (the child it enters now, into `child`) and the
+// time it leaves `here` (a bound on the last child). Returns the box of those children;
+// ANDed with the child word it says whether the ray can hit anything below.
+template <class S, class LevelT>
+[[gnu::always_inline]] inline std::uint64_t enter_child(const LevelT& here, LevelT& child,
+                                                        const std::array<std::int64_t, 3>& v,
+                                                        const std::array<double, 3>& o,
+                                                        const std::array<double, 3>& inv, double t, int shift) {
+  const std::array<std::int32_t, 3>& c = here.cell;
+  const double t_out = min3(here.leave);
+  std::uint64_t box = ~std::uint64_t{0};
+  for (int a = 0; a < 3; ++a) {
+    if (!S::step[a]) {
+      const auto rel = static_cast<std::int32_t>((v[a] >> shift) & 3);
+      child.cell[a] = 4 * c[a] + rel;
+      child.leave[a] = kNever;
+      box &= kBox.fixed[a][rel];
+      continue;
+    }
+    // The planes (in child cells) in crossing order: base + step * k for k = 1, 2, 3,
+    // then at k = 4 the cell's own exit plane.
+    const std::int32_t base = 4 * (c[a] + 1 - S::ahead[a]);
+    const double t1 = crossing_time(static_cast<double>((base + S::step[a]) << shift), o[a], inv[a]);
+    const double t2 = crossing_time(static_cast<double>((base + 2 * S::step[a]) << shift), o[a], inv[a]);
+    const double t3 = crossing_time(static_cast<double>((base + 3 * S::step[a]) << shift), o[a], inv[a]);
+    const int in = (t1 <= t) + (t2 <= t) + (t3 <= t);
+    const int last_in = (t1 < t_out) + (t2 < t_out) + (t3 < t_out);
+    // The child's exit plane: the next one after those crossed (k = 4 gives the same
+    // double as the cell's own exit time).
+    child.leave[a] = crossing_time(static_cast<double>((base + (in + 1) * S::step[a]) << shift), o[a], inv[a]);
+    child.cell[a] = 4 * c[a] + (S::ahead[a] ? in : 3 - in);
+    box &= S::masks(a)[in][last_in];
+  }
+  return box;
+}
+
+// From an empty cell (or one the ray cannot hit anything in), steps to the next cell of
+// this level, every axis crossing now together, until a cell is occupied (true: descend
+// or hit there) or the ray ends (false). An empty new cell is stepped over at once,
+// unless nothing the ray can still reach in the block is occupied: then the parent cell
+// is done too, and the step is on the parent's level. A step out of the parent block
+// climbs to the coarsest level whose cell changed (its own parent's cell did not); the
+// levels below it are entered again by descending.
+template <class S, class LevelT, class ExitTime>
+[[gnu::always_inline]] inline bool step_to_occupied(LevelT& here, LevelT* path, int& level, double& t, bool& moved,
+                                                    double t_end, int last, ExitTime&& exit_time) {
+  for (;;) {
+    const double next = min3(here.leave);
+    if (!(next <= t_end)) return false;
+    const int shift = 2 * (last - level);
+    std::uint32_t changed = 0;
+    for (int a = 0; a < 3; ++a) {
+      // Not crossing now (never on an axis that does not move). leave >= next, so > is
+      // the same test as != but compiles to one compare and branch (no NaN check).
+      if (here.leave[a] > next) continue;
+      const std::int32_t i = here.cell[a] + S::step[a];
+      changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
+      here.cell[a] = i;
+      here.leave[a] = exit_time(a, i, shift);
+      here.bit = S::next_bit(a, here.bit);  // meaningless if the cell left the block: then it climbs
+      here.ahead &= S::onward(a, i);
+    }
+    t = next;
+    moved = true;
+    // A cell index that left [0, 4^(level+1)) climbs past the root: the ray left the
+    // grid. Indices that changed in their two low bits only stayed in the block.
+    if (changed > 3) {
+      const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
+      if (up > level) return false;
+      level -= up;
+      const std::array<std::int32_t, 3> below = here.cell;
+      here = path[level];
+      for (int a = 0; a < 3; ++a) {
+        const std::int32_t moved_to = below[a] >> (2 * up);
+        if (moved_to == here.cell[a]) continue;
+        here.cell[a] = moved_to;
+        here.leave[a] = exit_time(a, moved_to, 2 * (last - level));
+        here.bit = S::next_bit(a, here.bit);
+        here.ahead &= S::onward(a, moved_to);
+      }
+    }
+    if ((here.block.bits & here.bit) != 0) return true;
+    if (here.block.bits & here.ahead) continue;  // empty, but not all the way: the next step
+    if (level == 0) return false;
+    --level;
+    here = path[level];
+  }
+}
+
+}  // namespace
+
 template <int X, int Y, int Z>
 std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const std::array<std::int64_t, 3>& v,
                                       double t) const {
@@ -192,57 +305,14 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
   // Has the ray crossed a plane yet (clipping counts)? The start voxel has no entry event.
   bool moved = t > 0.0;
   int level = 0;
-  auto occupied = [](const Level& l) { return (l.block.bits & l.bit) != 0; };
   for (;;) {
-    if (occupied(here)) {
-      const std::array<std::int32_t, 3>& c = here.cell;
-      if (level == last) {
-        RayHit hit;
-        hit.voxel = Voxel{static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
-                          static_cast<std::uint32_t>(c[2])};
-        hit.t = t;
-        // The normal: the lowest axis whose entry plane into the voxel is crossed now.
-        for (int a = 0; a < 3 && moved; ++a) {
-          if (S::step[a] && crossing_time(axes.entry_plane(a, c[a]), o[a], inv[a]) == t) {
-            hit.normal[a] = -S::step[a];
-            break;
-          }
-        }
-        return hit;
-      }
-      // The child block, and per axis the child cells the ray is in from t until it
-      // leaves this cell at t_out: the three planes between the children, in the order
-      // the ray crosses them, counted against t (the child it enters now) and t_out (a
-      // bound on the last child). The box of those children ANDed with the child word
-      // says whether the ray can hit anything below: if not, this cell is stepped over
-      // like an empty one.
+    if ((here.block.bits & here.bit) != 0) {
+      if (level == last) return hit_in<S>(here.cell, t, moved, axes, o, inv);
+      // The child block; if the ray can reach none of its voxels, this cell is stepped
+      // over like an empty one.
       const Node& child_block = nodes_[here.block.first_child + std::popcount(here.block.bits & (here.bit - 1))];
-      const double t_out = min3(here.leave);
-      const int shift = 2 * (last - level - 1);
       Level child;
-      std::uint64_t box = ~std::uint64_t{0};
-      for (int a = 0; a < 3; ++a) {
-        if (!S::step[a]) {
-          const auto rel = static_cast<std::int32_t>((v[a] >> shift) & 3);
-          child.cell[a] = 4 * c[a] + rel;
-          child.leave[a] = kNever;
-          box &= kBox.fixed[a][rel];
-          continue;
-        }
-        // The planes (in child cells) in crossing order: base + step * k for k = 1, 2, 3,
-        // then at k = 4 the cell's own exit plane.
-        const std::int32_t base = 4 * (c[a] + 1 - S::ahead[a]);
-        const double t1 = crossing_time(static_cast<double>((base + S::step[a]) << shift), o[a], inv[a]);
-        const double t2 = crossing_time(static_cast<double>((base + 2 * S::step[a]) << shift), o[a], inv[a]);
-        const double t3 = crossing_time(static_cast<double>((base + 3 * S::step[a]) << shift), o[a], inv[a]);
-        const int in = (t1 <= t) + (t2 <= t) + (t3 <= t);
-        const int last_in = (t1 < t_out) + (t2 < t_out) + (t3 < t_out);
-        // The child's exit plane: the next one after those crossed (k = 4 gives the same
-        // double as the cell's own exit time).
-        child.leave[a] = crossing_time(static_cast<double>((base + (in + 1) * S::step[a]) << shift), o[a], inv[a]);
-        child.cell[a] = 4 * c[a] + (S::ahead[a] ? in : 3 - in);
-        box &= S::masks(a)[in][last_in];
-      }
+      const std::uint64_t box = enter_child<S>(here, child, v, o, inv, t, 2 * (last - level - 1));
       if (child_block.bits & box) {
         child.bit = cell_bit(child.cell);
         child.ahead = box;
@@ -253,55 +323,7 @@ std::optional<RayHit> RayCaster::walk(const Ray& ray, const RayAxes& axes, const
         continue;
       }
     }
-
-    // An empty cell (or one the ray cannot hit anything in): step to the next cell of
-    // this level, every axis crossing now together. An occupied new cell goes back up
-    // to the descent; an empty one is stepped over at once, unless nothing the ray can
-    // still reach in the block is occupied: then the parent cell is done too, and the
-    // step is on the parent's level.
-    for (;;) {
-      const double next = min3(here.leave);
-      if (!(next <= t_end)) return std::nullopt;
-      const int shift = 2 * (last - level);
-      std::uint32_t changed = 0;
-      for (int a = 0; a < 3; ++a) {
-        // Not crossing now (never on an axis that does not move). leave >= next, so > is
-        // the same test as != but compiles to one compare and branch (no NaN check).
-        if (here.leave[a] > next) continue;
-        const std::int32_t i = here.cell[a] + S::step[a];
-        changed |= static_cast<std::uint32_t>(i ^ here.cell[a]);
-        here.cell[a] = i;
-        here.leave[a] = exit_time(a, i, shift);
-        here.bit = S::next_bit(a, here.bit);  // meaningless if the cell left the block: then it climbs
-        here.ahead &= S::onward(a, i);
-      }
-      t = next;
-      moved = true;
-      // Left the parent block: climb to the coarsest level whose cell changed (its own
-      // parent's cell did not); the levels below it are entered again by descending. A
-      // cell index that left [0, 4^(level+1)) climbs past the root: the ray left the grid.
-      // Indices that changed in their two low bits only stayed in the block.
-      if (changed > 3) {
-        const int up = static_cast<int>(std::bit_width(changed) - 1) / 2;
-        if (up > level) return std::nullopt;
-        level -= up;
-        const std::array<std::int32_t, 3> below = here.cell;
-        here = path[level];
-        for (int a = 0; a < 3; ++a) {
-          const std::int32_t moved_to = below[a] >> (2 * up);
-          if (moved_to == here.cell[a]) continue;
-          here.cell[a] = moved_to;
-          here.leave[a] = exit_time(a, moved_to, 2 * (last - level));
-          here.bit = S::next_bit(a, here.bit);
-          here.ahead &= S::onward(a, moved_to);
-        }
-      }
-      if (occupied(here)) break;  // occupied: descend (or hit) above
-      if (here.block.bits & here.ahead) continue;  // empty, but not all the way: the next step
-      if (level == 0) return std::nullopt;
-      --level;
-      here = path[level];
-    }
+    if (!step_to_occupied<S>(here, path.data(), level, t, moved, t_end, last, exit_time)) return std::nullopt;
   }
 }
 
