@@ -68,20 +68,9 @@ class UnionFind {
   std::vector<std::uint32_t> parent_;
 };
 
-}  // namespace
-
-ComponentLabels label_components(const Tree& tree, Connectivity connectivity) {
-  ComponentLabels out;
-  const std::uint64_t n = tree.voxel_count();
-  if (n > std::numeric_limits<std::uint32_t>::max())
-    throw InvalidArgument("connected components: more than 2^32 - 1 voxels");
-  if (n == 0) return out;
-
-  const detail::LeafBlocks leaves(tree);
+// Joins every voxel with its occupied backward neighbours (the offsets), block by block.
+void join_neighbours(const detail::LeafBlocks& leaves, const std::vector<Offset>& offsets, UnionFind& sets) {
   const auto& blocks = leaves.blocks();
-  const std::vector<Offset> offsets = backward_offsets(connectivity);
-  UnionFind sets(static_cast<std::size_t>(n));
-
   for (const detail::LeafBlock& block : blocks) {
     // Neighbouring block indices by (dx+1) + 3(dy+1) + 9(dz+1); resolved on first use.
     std::array<std::int64_t, 27> near;
@@ -112,15 +101,17 @@ ComponentLabels label_components(const Tree& tree, Connectivity connectivity) {
       }
     }
   }
+}
 
-  // Roots are first voxels. Walking ranks upward, every parent (a smaller rank) has
-  // already been overwritten with its component's number in order of discovery, so
-  // one lookup gives a voxel's number; gather sizes, boxes and coordinate sums.
-  std::vector<std::uint32_t>& label = sets.parents();
+// The components in order of their first voxel, with sizes, boxes and coordinate sums;
+// `label` (the union-find parents) becomes each voxel's index into them. Roots are first
+// voxels: walking ranks upward, every parent (a smaller rank) has already been
+// overwritten with its component's number, so one lookup gives a voxel's number.
+std::vector<Component> number_components(const detail::LeafBlocks& leaves, std::vector<std::uint32_t>& label,
+                                         std::vector<std::array<double, 3>>& sums) {
   std::vector<Component> found;
-  std::vector<std::array<double, 3>> sums;
   std::uint64_t rank = 0;
-  for (const detail::LeafBlock& block : blocks) {
+  for (const detail::LeafBlock& block : leaves.blocks()) {
     std::uint64_t word = block.word;
     while (word) {
       const unsigned bit = static_cast<unsigned>(std::countr_zero(word));
@@ -145,6 +136,24 @@ ComponentLabels label_components(const Tree& tree, Connectivity connectivity) {
       ++rank;
     }
   }
+  return found;
+}
+
+}  // namespace
+
+ComponentLabels label_components(const Tree& tree, Connectivity connectivity) {
+  ComponentLabels out;
+  const std::uint64_t n = tree.voxel_count();
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument("connected components: more than 2^32 - 1 voxels");
+  if (n == 0) return out;
+
+  const detail::LeafBlocks leaves(tree);
+  UnionFind sets(static_cast<std::size_t>(n));
+  join_neighbours(leaves, backward_offsets(connectivity), sets);
+  std::vector<std::uint32_t>& label = sets.parents();
+  std::vector<std::array<double, 3>> sums;
+  const std::vector<Component> found = number_components(leaves, label, sums);
 
   // Order: largest first, ties by first voxel (found is already in first-voxel order).
   std::vector<std::uint32_t> order(found.size());
