@@ -37,13 +37,12 @@ audio::SampleFormat sample_format(const std::string& name) {
   return audio::SampleFormat::float32;
 }
 
-void run_sonify(SonifyArgs& a) {
+// The dry recordings, checked before any work on the scene: one for all sources or one
+// per source, each with samples, all at one rate.
+std::vector<audio::Sound> read_dry(const SonifyArgs& a) {
   if (!a.inputs.empty() && a.inputs.size() != 1 && a.inputs.size() != a.sources.size())
     throw InvalidArgument("give one --in for all sources or one per --source (" + std::to_string(a.sources.size()) +
                           " sources, " + std::to_string(a.inputs.size()) + " inputs)");
-  if (a.payload_coefficients && !a.materials.empty())
-    throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
-  // Inputs first: a bad recording fails before any work on the scene.
   std::vector<audio::Sound> dry;
   for (const auto& path : a.inputs) dry.push_back(audio::read_sound(path));
   for (std::size_t i = 0; i < dry.size(); ++i) {
@@ -52,6 +51,56 @@ void run_sonify(SonifyArgs& a) {
       throw InvalidArgument(a.inputs[i] + " is at " + std::to_string(dry[i].sample_rate) + " Hz but " + a.inputs[0] +
                             " at " + std::to_string(dry[0].sample_rate) + " Hz: resample them to one rate");
   }
+  return dry;
+}
+
+// The sources' wet signals into one sound: mixed to one channel or one channel each,
+// normalised to -1 dBFS unless asked not to.
+audio::Sound output_sound(const SonifyArgs& a, std::vector<std::vector<double>>& wet, int sample_rate) {
+  audio::Sound out;
+  out.sample_rate = sample_rate;
+  std::size_t frames = 0;
+  for (const auto& w : wet) frames = std::max(frames, w.size());
+  if (a.channels == "mix") {
+    out.channels.assign(1, std::vector<double>(frames, 0.0));
+    for (const auto& w : wet)
+      for (std::size_t i = 0; i < w.size(); ++i) out.channels[0][i] += w[i];
+  } else {
+    for (auto& w : wet) {
+      w.resize(frames, 0.0);
+      out.channels.push_back(std::move(w));
+    }
+  }
+  if (!a.no_normalize) {
+    double peak = 0.0;
+    for (const auto& c : out.channels)
+      for (const double v : c) peak = std::max(peak, std::abs(v));
+    // -1 dBFS: loud enough to hear, with room for resampling overshoot downstream.
+    const double gain = peak > 0.0 ? std::pow(10.0, -1.0 / 20.0) / peak : 1.0;
+    for (auto& c : out.channels)
+      for (double& v : c) v *= gain;
+    if (!a.quiet) std::printf("output scaled by %+.1f dB to peak at -1 dBFS\n", 20.0 * std::log10(gain));
+  }
+  return out;
+}
+
+// The impulse responses, one channel per source, as a float WAV.
+void write_responses(const std::string& path, const std::vector<std::vector<double>>& responses, int sample_rate) {
+  audio::Sound irs;
+  irs.sample_rate = sample_rate;
+  std::size_t n = 0;
+  for (const auto& r : responses) n = std::max(n, r.size());
+  for (auto r : responses) {
+    r.resize(n, 0.0);
+    irs.channels.push_back(std::move(r));
+  }
+  audio::write_wav(path, irs, audio::SampleFormat::float32);
+}
+
+void run_sonify(SonifyArgs& a) {
+  if (a.payload_coefficients && !a.materials.empty())
+    throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
+  const std::vector<audio::Sound> dry = read_dry(a);
   a.response.sample_rate = dry[0].sample_rate;
   a.response.check();
 
@@ -87,47 +136,14 @@ void run_sonify(SonifyArgs& a) {
     responses.push_back(std::move(ir));
   }
 
-  audio::Sound out;
-  out.sample_rate = dry[0].sample_rate;
-  std::size_t frames = 0;
-  for (const auto& w : wet) frames = std::max(frames, w.size());
-  if (a.channels == "mix") {
-    out.channels.assign(1, std::vector<double>(frames, 0.0));
-    for (const auto& w : wet)
-      for (std::size_t i = 0; i < w.size(); ++i) out.channels[0][i] += w[i];
-  } else {
-    for (auto& w : wet) {
-      w.resize(frames, 0.0);
-      out.channels.push_back(std::move(w));
-    }
-  }
-  if (!a.no_normalize) {
-    double peak = 0.0;
-    for (const auto& c : out.channels)
-      for (const double v : c) peak = std::max(peak, std::abs(v));
-    // -1 dBFS: loud enough to hear, with room for resampling overshoot downstream.
-    const double gain = peak > 0.0 ? std::pow(10.0, -1.0 / 20.0) / peak : 1.0;
-    for (auto& c : out.channels)
-      for (double& v : c) v *= gain;
-    if (!a.quiet) std::printf("output scaled by %+.1f dB to peak at -1 dBFS\n", 20.0 * std::log10(gain));
-  }
+  const audio::Sound out = output_sound(a, wet, dry[0].sample_rate);
   audio::write_wav(a.output, out, sample_format(a.format));
-  if (!a.ir.empty()) {
-    audio::Sound irs;
-    irs.sample_rate = out.sample_rate;
-    std::size_t n = 0;
-    for (const auto& r : responses) n = std::max(n, r.size());
-    for (auto r : responses) {
-      r.resize(n, 0.0);
-      irs.channels.push_back(std::move(r));
-    }
-    audio::write_wav(a.ir, irs, audio::SampleFormat::float32);
-  }
+  if (!a.ir.empty()) write_responses(a.ir, responses, out.sample_rate);
   if (!a.plot.empty()) write_response_plot(a.plot, panels, a.response.sample_rate);
   if (!a.quiet)
     std::printf("wrote %s (%zu channel%s, %.3f s at %d Hz)%s%s%s%s\n", a.output.c_str(), out.channels.size(),
-                out.channels.size() == 1 ? "" : "s", static_cast<double>(frames) / out.sample_rate, out.sample_rate,
-                a.ir.empty() ? "" : ", ", a.ir.c_str(), a.plot.empty() ? "" : ", ", a.plot.c_str());
+                out.channels.size() == 1 ? "" : "s", static_cast<double>(out.frames()) / out.sample_rate,
+                out.sample_rate, a.ir.empty() ? "" : ", ", a.ir.c_str(), a.plot.empty() ? "" : ", ", a.plot.c_str());
 }
 
 }  // namespace
