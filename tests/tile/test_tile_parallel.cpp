@@ -54,6 +54,16 @@ tile::TileOptions options(const fs::path& out) {
   return o;
 }
 
+// A small view of the test survey's tiles.
+raycast::PinholeCamera small_camera() {
+  raycast::PinholeCamera camera;
+  camera.eye = {-60.0, -50.0, 90.0};
+  camera.look_at = {15.0, 15.0, 15.0};
+  camera.width = 48;
+  camera.height = 32;
+  return camera;
+}
+
 TEST(TileParallel, AWorkerErrorInEveryStageReachesTheCaller) {
   const ChunkedPoints points(8, 5000);
   for (const char* stage : {"tile.bucket", "tile.flush", "tile.build", "tile.overviews"}) {
@@ -70,11 +80,7 @@ TEST(TileParallel, AWorkerErrorInEveryStageReachesTheCaller) {
   EXPECT_GT(s.overview_files, 1u);
 
   const tile::TileSet tiles((dir / "t" / "index.geojson").string());
-  raycast::PinholeCamera camera;
-  camera.eye = {-60.0, -50.0, 90.0};
-  camera.look_at = {15.0, 15.0, 15.0};
-  camera.width = 48;
-  camera.height = 32;
+  const raycast::PinholeCamera camera = small_camera();
   vola_test::expect_worker_error_reaches_caller("tile.render", [&] { tile::render(tiles, camera, 2); });
   EXPECT_GT(tile::render(tiles, camera, 2).hits, 100u);
 }
@@ -107,11 +113,7 @@ TEST(TileParallel, AMissingTileFailsTheRenderWithItsError) {
   const tile::TileIndexFile index = tile::read_tile_index((dir / "t" / "index.geojson").string());
   for (const tile::TileEntry& e : index.tiles) fs::remove(dir / "t" / e.file);  // every tile gone
   const tile::TileSet tiles((dir / "t" / "index.geojson").string());
-  raycast::PinholeCamera camera;
-  camera.eye = {-60.0, -50.0, 90.0};
-  camera.look_at = {15.0, 15.0, 15.0};
-  camera.width = 48;
-  camera.height = 32;
+  const raycast::PinholeCamera camera = small_camera();
   try {
     tile::render(tiles, camera, 2);
     ADD_FAILURE() << "no exception";
