@@ -11,3 +11,5 @@ cmake --build "$work/build" >/dev/null
 "$work/build/consumer" "$work/points.vol"
 "$work/build/consumer_convert" "$work"
 "$work/build/consumer_modules"
+"$work/build/consumer_tile" "$work"
+for component in viewer slam audio learn; do "$work/build/consumer_$component"; done
