@@ -258,6 +258,114 @@ Fusion<Store>::Fusion(Store& store, const Intrinsics& intrinsics, std::uint32_t 
     throw InvalidArgument("images must be at least 8 x 8 pixels");
 }
 
+namespace {
+
+// The point-to-plane normal equations of one ICP iteration, summed over the frame's
+// valid pixels: A (upper triangle) and b of A xi = b, and how many pixels took part.
+struct IcpSums {
+  Mat6 a = Mat6::Zero();
+  Vec6 b = Vec6::Zero();
+  int count = 0;
+};
+
+struct IcpFrame {
+  const VertexMap& current;       // the frame's vertices and normals, camera frame
+  const VertexMap& model;         // the model's, raycast from the previous pose
+  Intrinsics k;                   // of this pyramid level
+  Pose previous_inverse;          // world to the previous camera (projective association)
+  double max_distance, cos_max;   // association limits: distance, normal angle
+};
+
+// One partial sum per thread, over equal bands of rows, added in band order: the same
+// sums for the same thread count (not across thread counts: the bands move).
+// Updates rotate about the estimate's camera centre, then translate. About the world
+// origin instead, a camera metres away couples every rotation with a large translation:
+// the 6x6 system's conditioning (and the degeneracy test) then depended on where the
+// world frame happens to be, and a run started at a ground-truth pose 3 m from the
+// origin was refused as degenerate from frame 139 on.
+IcpSums icp_sums(const IcpFrame& f, const Pose& estimate, const ParallelOptions& bands) {
+  std::vector<IcpSums> sums(bands.chunks);
+  const Eigen::Matrix3d rotation = estimate.linear();
+  const Eigen::Vector3d centre = estimate.translation();
+  const VertexMap& current = f.current;
+  const VertexMap& model = f.model;
+  const auto sum_rows = [&](const Chunk& chunk) {
+    IcpSums& s = sums[chunk.index];
+    for (std::size_t y = chunk.begin; y < chunk.end; ++y)
+      for (std::uint32_t x = 0; x < current.width; ++x) {
+        const std::size_t i = y * current.width + x;
+        if (!current.valid(i)) continue;
+        const Eigen::Vector3d p = estimate * current.vertices[i].template cast<double>();
+        const Eigen::Vector3d n = rotation * current.normals[i].template cast<double>();
+        const Eigen::Vector3d q = f.previous_inverse * p;
+        if (q.z() <= 0.0) continue;
+        const double u = std::floor(f.k.fx * q.x() / q.z() + f.k.cx + 0.5),
+                     v = std::floor(f.k.fy * q.y() / q.z() + f.k.cy + 0.5);
+        if (!(u >= 0 && v >= 0 && u < model.width && v < model.height)) continue;
+        const std::size_t j = static_cast<std::size_t>(v) * model.width + static_cast<std::size_t>(u);
+        if (!model.valid(j)) continue;
+        const Eigen::Vector3d vm = model.vertices[j].template cast<double>(), nm = model.normals[j].template cast<double>();
+        const Eigen::Vector3d diff = p - vm;
+        if (diff.squaredNorm() > f.max_distance * f.max_distance) continue;
+        if (n.dot(nm) < f.cos_max) continue;
+        Vec6 jac;
+        jac << (p - centre).cross(nm), nm;
+        const double r = nm.dot(diff);
+        s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac);
+        s.b -= jac * r;
+        ++s.count;
+      }
+  };
+  parallel_for(current.height, sum_rows, bands);
+  IcpSums total;
+  for (const auto& s : sums) {  // in chunk order: reproducible
+    total.a += s.a;
+    total.b += s.b;
+    total.count += s.count;
+  }
+  return total;
+}
+
+// The increment that solves the normal equations, applied to `estimate`; nothing when the
+// geometry is degenerate. The motion prior: directions observed less than
+// motion_prior * the best one are raised to that floor, pulling towards `prediction`
+// (delta: the update that would reach it, in the same parameters as xi). No prediction:
+// no prior.
+struct IcpStep {
+  Pose pose;                 // the estimate moved by the increment
+  double twist_norm = 0.0;   // |xi|: the increment's size, for the stopping rule
+};
+std::optional<IcpStep> icp_step(const IcpSums& total, const Pose& estimate, const std::optional<Pose>& prediction,
+                                double motion_prior) {
+  const Mat6 a = total.a.template selfadjointView<Eigen::Upper>();
+  const Eigen::SelfAdjointEigenSolver<Mat6> eigen(a);
+  const Vec6& lambda = eigen.eigenvalues();  // ascending
+  if (!(lambda(0) > 1e-6 * lambda(5))) return std::nullopt;  // degenerate geometry
+  const Eigen::Vector3d centre = estimate.translation();
+  Mat6 prior = Mat6::Zero();
+  const double prior_floor = prediction ? motion_prior * lambda(5) : 0.0;
+  for (int e = 0; e < 6 && lambda(e) < prior_floor; ++e)
+    prior += (prior_floor - lambda(e)) * eigen.eigenvectors().col(e) * eigen.eigenvectors().col(e).transpose();
+  Vec6 rhs = total.b;
+  if (lambda(0) < prior_floor) {
+    const Pose towards = *prediction * estimate.inverse();
+    const Eigen::AngleAxisd turn(towards.linear());
+    Vec6 delta;
+    delta << turn.angle() * turn.axis(), towards.translation() - centre + towards.linear() * centre;
+    rhs += prior * delta;
+  }
+  const Vec6 xi = (a + prior).ldlt().solve(rhs);
+  if (!xi.allFinite()) return std::nullopt;
+  const Eigen::Vector3d omega = xi.head<3>();
+  Pose increment = Pose::Identity();
+  const double angle = omega.norm();
+  if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  increment.translation() = centre + xi.tail<3>() - increment.linear() * centre;
+  return IcpStep{increment * estimate, xi.norm()};
+}
+
+}  // namespace
+
 template <class Store>
 std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLevels>& frame, int* correspondences) const {
   // ICP starts at the previous pose, as KinectFusion's does; the constant-velocity
@@ -265,98 +373,28 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
   // only once a motion has been tracked (not on the second frame, not after a loss).
   // (Starting at the prediction instead was unstable on room300: from frame 31 the
   // error grew 2.3 times per frame until tracking was lost at frame 39.)
-  const Pose prediction = motion_ ? Pose(pose_ * *motion_) : pose_;
+  const std::optional<Pose> prediction = motion_ ? std::optional<Pose>(pose_ * *motion_) : std::nullopt;
   Pose estimate = pose_;
-  const Pose previous_inverse = pose_.inverse();
-  const double cos_max = std::cos(params_.icp_max_angle_degrees * M_PI / 180.0);
-  // One partial sum per thread, over equal bands of rows, added in band order: the same
-  // sums for the same thread count (not across thread counts: the bands move).
   ParallelOptions bands;
   bands.threads = resolve_thread_count(params_.threads);
   bands.chunks = bands.threads;
   bands.name = "slam.track";
   int last_count = 0;
   for (int level = kPyramidLevels - 1; level >= 0; --level) {
-    const Intrinsics k = level_intrinsics(intrinsics_, level);
-    const VertexMap& current = frame[level];
-    const VertexMap& model = model_.levels[level];
+    const IcpFrame icp{frame[level],
+                       model_.levels[level],
+                       level_intrinsics(intrinsics_, level),
+                       pose_.inverse(),
+                       params_.icp_max_distance,
+                       std::cos(params_.icp_max_angle_degrees * M_PI / 180.0)};
     for (int iteration = 0; iteration < params_.icp_iterations[level]; ++iteration) {
-      struct Sums {
-        Mat6 a = Mat6::Zero();
-        Vec6 b = Vec6::Zero();
-        int count = 0;
-      };
-      std::vector<Sums> sums(bands.chunks);
-      const Eigen::Matrix3d rotation = estimate.linear();
-      // Updates rotate about the estimate's camera centre, then translate. About the
-      // world origin instead, a camera metres away couples every rotation with a large
-      // translation: the 6x6 system's conditioning (and the degeneracy test below) then
-      // depended on where the world frame happens to be, and a run started at a
-      // ground-truth pose 3 m from the origin was refused as degenerate from frame 139 on.
-      const Eigen::Vector3d centre = estimate.translation();
-      const auto sum_rows = [&](const Chunk& chunk) {
-        Sums& s = sums[chunk.index];
-        for (std::size_t y = chunk.begin; y < chunk.end; ++y)
-          for (std::uint32_t x = 0; x < current.width; ++x) {
-            const std::size_t i = y * current.width + x;
-            if (!current.valid(i)) continue;
-            const Eigen::Vector3d p = estimate * current.vertices[i].template cast<double>();
-            const Eigen::Vector3d n = rotation * current.normals[i].template cast<double>();
-            const Eigen::Vector3d q = previous_inverse * p;
-            if (q.z() <= 0.0) continue;
-            const double u = std::floor(k.fx * q.x() / q.z() + k.cx + 0.5), v = std::floor(k.fy * q.y() / q.z() + k.cy + 0.5);
-            if (!(u >= 0 && v >= 0 && u < model.width && v < model.height)) continue;
-            const std::size_t j = static_cast<std::size_t>(v) * model.width + static_cast<std::size_t>(u);
-            if (!model.valid(j)) continue;
-            const Eigen::Vector3d vm = model.vertices[j].template cast<double>(), nm = model.normals[j].template cast<double>();
-            const Eigen::Vector3d diff = p - vm;
-            if (diff.squaredNorm() > params_.icp_max_distance * params_.icp_max_distance) continue;
-            if (n.dot(nm) < cos_max) continue;
-            Vec6 jac;
-            jac << (p - centre).cross(nm), nm;
-            const double r = nm.dot(diff);
-            s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac);
-            s.b -= jac * r;
-            ++s.count;
-          }
-      };
-      parallel_for(current.height, sum_rows, bands);
-      Sums total;
-      for (const auto& s : sums) {  // in chunk order: reproducible
-        total.a += s.a;
-        total.b += s.b;
-        total.count += s.count;
-      }
-      const Mat6 a = total.a.template selfadjointView<Eigen::Upper>();
+      const IcpSums total = icp_sums(icp, estimate, bands);
       last_count = total.count;
       if (total.count < 6) return std::nullopt;
-      const Eigen::SelfAdjointEigenSolver<Mat6> eigen(a);
-      const Vec6& lambda = eigen.eigenvalues();  // ascending
-      if (!(lambda(0) > 1e-6 * lambda(5))) return std::nullopt;  // degenerate geometry
-      // The motion prior: directions observed less than motion_prior * the best one are
-      // raised to that floor, pulling towards the prediction (delta: the update that
-      // would reach it, in the same parameters as xi).
-      Mat6 prior = Mat6::Zero();
-      const double prior_floor = motion_ ? params_.motion_prior * lambda(5) : 0.0;
-      for (int e = 0; e < 6 && lambda(e) < prior_floor; ++e)
-        prior += (prior_floor - lambda(e)) * eigen.eigenvectors().col(e) * eigen.eigenvectors().col(e).transpose();
-      Vec6 rhs = total.b;
-      if (lambda(0) < prior_floor) {
-        const Pose towards = prediction * estimate.inverse();
-        const Eigen::AngleAxisd turn(towards.linear());
-        Vec6 delta;
-        delta << turn.angle() * turn.axis(), towards.translation() - centre + towards.linear() * centre;
-        rhs += prior * delta;
-      }
-      const Vec6 xi = (a + prior).ldlt().solve(rhs);
-      if (!xi.allFinite()) return std::nullopt;
-      const Eigen::Vector3d omega = xi.head<3>();
-      Pose increment = Pose::Identity();
-      const double angle = omega.norm();
-      if (angle > 0.0) increment.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
-      increment.translation() = centre + xi.tail<3>() - increment.linear() * centre;
-      estimate = increment * estimate;
-      if (xi.norm() < 1e-7) break;
+      const std::optional<IcpStep> step = icp_step(total, estimate, prediction, params_.motion_prior);
+      if (!step) return std::nullopt;
+      estimate = step->pose;
+      if (step->twist_norm < 1e-7) break;
     }
   }
   *correspondences = last_count;
