@@ -1,9 +1,12 @@
 // vola info: what a .vol file holds, level by level.
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
+#include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
 
 namespace vola::cli {
 
@@ -24,6 +27,40 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
+// The CRS as PROJ names it, from the file's WKT or its header code; nothing for a file
+// with neither (header code 2000 is the reference's placeholder, not Anguilla's grid).
+struct NamedCrs {
+  std::optional<geo::CrsDescription> description;
+  std::string problem;  // why PROJ could not name a CRS the file states
+};
+
+NamedCrs name_crs(const Tree& tree) {
+  NamedCrs out;
+  const auto definition = geo::crs_definition(tree.georef());
+  if (!definition) return out;
+  try {
+    out.description = geo::describe_crs(*definition);
+  } catch (const Error& e) {
+    out.problem = e.what();
+  }
+  return out;
+}
+
+std::string crs_line(const NamedCrs& crs, std::uint32_t header_code) {
+  if (crs.description) return geo::crs_summary(*crs.description);
+  if (!crs.problem.empty()) return "not readable by PROJ (" + crs.problem + ")";
+  return "none stated (header code " + std::to_string(header_code) + ", the reference's placeholder)";
+}
+
+std::string json_crs(const NamedCrs& crs) {
+  if (!crs.description) return "null";
+  const auto& d = *crs.description;
+  return "{\"name\": " + quoted(d.name) + ", \"kind\": " + quoted(d.kind) +
+         ", \"epsg\": " + (d.epsg ? std::to_string(*d.epsg) : "null") + ", \"unit\": " + quoted(d.horizontal_unit) +
+         ", \"vertical\": " + (d.vertical_name.empty() ? "null" : quoted(d.vertical_name)) +
+         ", \"vertical_unit\": " + (d.vertical_unit.empty() ? "null" : quoted(d.vertical_unit)) + "}";
+}
+
 void run_info(const InfoArgs& a) {
   FileLayout layout;
   const Tree tree = open_mapped(a.file, &layout);
@@ -32,6 +69,7 @@ void run_info(const InfoArgs& a) {
   const double voxels = static_cast<double>(tree.voxel_count());
   const double bits = voxels > 0 ? 8.0 * static_cast<double>(layout.file_size) / voxels : 0.0;
   const char* mode = h.layout == Layout::dense ? "dense" : "sparse";
+  const NamedCrs crs = name_crs(tree);
   if (a.json) {
     std::printf("{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
                 "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %.17g,\n"
@@ -53,15 +91,17 @@ void run_info(const InfoArgs& a) {
       std::printf("%s\n    {\"name\": %s, \"type\": \"%s\", \"reduction\": \"%s\"}", i ? "," : "",
                   quoted(columns[i].name()).c_str(), std::string(name_of(columns[i].type())).c_str(),
                   std::string(name_of(columns[i].reduction())).c_str());
-    std::printf("\n  ],\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s\n}\n",
+    std::printf("\n  ],\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
+                "  \"crs_named\": %s\n}\n",
                 layout.compressed_levels ? "true" : "false", static_cast<unsigned long long>(layout.extension_bytes),
-                quoted(tree.georef().crs_wkt).c_str());
+                quoted(tree.georef().crs_wkt).c_str(), json_crs(crs).c_str());
     return;
   }
   std::printf("file:        %s (%llu bytes)\n", a.file.c_str(), static_cast<unsigned long long>(layout.file_size));
   std::printf("header:      version %u, %s, depth %d (%u^3 voxels), nbits %u\n", h.version, mode, tree.depth(),
               tree.side(), h.nbits);
-  std::printf("crs:         EPSG:%u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
+  std::printf("crs:         %s\n", crs_line(crs, h.epsg).c_str());
+  std::printf("header:      EPSG code %u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
   std::printf("bbox:        min (%.17g, %.17g, %.17g)\n             max (%.17g, %.17g, %.17g)\n", h.bbox.min[0],
               h.bbox.min[1], h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2]);
   std::printf("grid:        %s quantization, voxel size %.9g, origin (%.9g, %.9g, %.9g)%s\n",

@@ -30,7 +30,8 @@ struct ResolvedCrs {
 };
 
 // `given` wins over what the inputs say (and fails for a code PROJ does not know, before
-// any work); without it, the inputs must agree (the same code, or the same WKT, or all
+// any work); without it, the inputs must agree by meaning (the same code, or WKTs PROJ
+// finds equivalent however they are spelled, or all
 // nothing), else InvalidArgument names the first two that differ.
 ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::uint32_t> given);
 

@@ -7,9 +7,35 @@ namespace vola {
 
 namespace {
 
-std::string described(const std::optional<std::uint32_t>& epsg, const std::string& wkt) {
+// How an error names what an input says: its code, else PROJ's name for its WKT.
+std::string described(const StatedCrs& s, const std::optional<std::uint32_t>& epsg) {
   if (epsg) return "EPSG:" + std::to_string(*epsg);
-  return wkt.empty() ? "nothing" : "a WKT CRS";
+  if (s.wkt.empty()) return "nothing";
+  try {
+    return "\"" + geo::describe_crs(s.wkt).name + "\" (a WKT CRS with no EPSG code)";
+  } catch (const Error&) {
+    return "a WKT CRS that PROJ cannot read";
+  }
+}
+
+// What PROJ reads: the stated WKT (the input's own words), else the code.
+std::string definition(const StatedCrs& s, const std::optional<std::uint32_t>& epsg) {
+  return !s.wkt.empty() ? s.wkt : "EPSG:" + std::to_string(*epsg);
+}
+
+// Two inputs name the same CRS: the same code (no PROJ needed), both nothing, or PROJ
+// finds their definitions equivalent (two tools spell the same WKT differently).
+bool same_meaning(const StatedCrs& a, const std::optional<std::uint32_t>& a_epsg, const StatedCrs& b,
+                  const std::optional<std::uint32_t>& b_epsg) {
+  const bool a_none = !a_epsg && a.wkt.empty(), b_none = !b_epsg && b.wkt.empty();
+  if (a_none || b_none) return a_none == b_none;
+  if (a_epsg && b_epsg && *a_epsg == *b_epsg) return true;
+  if (a.wkt == b.wkt && !a.wkt.empty()) return true;
+  try {
+    return geo::same_crs(definition(a, a_epsg), definition(b, b_epsg));
+  } catch (const Error&) {
+    return false;  // PROJ cannot read one of them: not provably the same
+  }
 }
 
 }  // namespace
@@ -33,11 +59,9 @@ ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::ui
       first_epsg = epsg;
       continue;
     }
-    const bool same = epsg && first_epsg ? *epsg == *first_epsg : !epsg && !first_epsg && s.wkt == first->wkt;
-    if (!same)
-      throw InvalidArgument("inputs disagree on the CRS: " + first->source + " says " +
-                            described(first_epsg, first->wkt) + ", " + s.source + " says " +
-                            (epsg ? described(epsg, s.wkt) : s.wkt.empty() ? "nothing" : "another WKT CRS") +
+    if (!same_meaning(*first, first_epsg, s, epsg))
+      throw InvalidArgument("inputs disagree on the CRS: " + first->source + " says " + described(*first, first_epsg) +
+                            ", " + s.source + " says " + described(s, epsg) +
                             " (convert them separately, or name one CRS if they really are the same)");
   }
   if (!first) return out;

@@ -62,6 +62,29 @@ std::string crs_wkt1(const std::string& definition) {
   return wkt;
 }
 
+bool same_crs(const std::string& a, const std::string& b) {
+  bool same = false;
+  run("whether two CRSs are the same", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.same_crs(a, b, same, f); });
+  return same;
+}
+
+CrsDescription describe_crs(const std::string& definition) {
+  CrsDescription out;
+  run("a description of a CRS", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.describe_crs(definition, out, f); });
+  return out;
+}
+
+std::string crs_summary(const CrsDescription& crs) {
+  std::string line = crs.name.empty() ? "unnamed CRS" : crs.name;
+  const std::string which = crs.vertical_name.empty() ? "EPSG:" : "horizontal EPSG:";
+  line += crs.epsg ? " (" + which + std::to_string(*crs.epsg) + ")" : " (no EPSG code)";
+  if (!crs.kind.empty()) line += ", " + crs.kind;
+  if (!crs.horizontal_unit.empty()) line += ", " + crs.horizontal_unit;
+  if (!crs.vertical_name.empty())
+    line += "; vertical " + crs.vertical_name + (crs.vertical_unit.empty() ? "" : " (" + crs.vertical_unit + ")");
+  return line;
+}
+
 struct ToWgs84::State {
   const plugin::ProjEntries* entries = nullptr;
   void* transformation = nullptr;

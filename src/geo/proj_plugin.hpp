@@ -10,6 +10,7 @@
 
 #include "../plugin/plugin.hpp"
 #include "vola/frame.hpp"
+#include "vola/geo/crs.hpp"
 
 namespace vola::geo::plugin {
 
@@ -25,6 +26,8 @@ struct ProjEntries {
   void (*to_wgs84_open)(const std::string& definition, void*& state, PluginFailure& failure);
   void (*to_wgs84_transform)(const void* state, const Point& in, Point& out, PluginFailure& failure);
   void (*to_wgs84_close)(void* state);
+  void (*same_crs)(const std::string& a, const std::string& b, bool& out, PluginFailure& failure);
+  void (*describe_crs)(const std::string& definition, CrsDescription& out, PluginFailure& failure);
 };
 
 using ProjEntriesEntry = const ProjEntries* (*)();

@@ -15,6 +15,7 @@
 #include "vola/crs_rules.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/io/las.hpp"
 
 namespace {
@@ -112,6 +113,71 @@ TEST(ResolveCrs, TheGivenCodeWinsAndInputsMustAgree) {
   EXPECT_TRUE(given.given);
   EXPECT_TRUE(given.stated);
   EXPECT_THROW(vola::resolve_crs({}, 999999u), vola::Error);
+}
+
+// What a LAS file says its CRS is, as convert and tile state it.
+vola::StatedCrs stated_crs_of(const std::filesystem::path& las) {
+  const vola::io::LasReader reader(las.string());
+  return {las.filename().string(), reader.header().epsg, reader.header().wkt};
+}
+
+// Two writers' spellings of the Autzen survey's CRS (PDAL's ESRI-style WKT with no code,
+// and EPSG:2994 in GeoKeys): the same CRS by meaning; a metre CRS of the same place is not.
+TEST(ResolveCrs, InputsAgreeByMeaningNotBySpelling) {
+  VOLA_REQUIRE_DATA(data);
+  const auto trim = stated_crs_of(data / "las" / "pdal_autzen_trim.las");
+  const auto pf1 = stated_crs_of(data / "las" / "pdal_autzen_pf1.las");
+  const auto bmx = stated_crs_of(data / "las" / "pdal_autzen-bmx-2010.las");
+  ASSERT_FALSE(trim.epsg.has_value());  // a WKT with no code: only PROJ can say what it is
+  ASSERT_EQ(pf1.epsg, 2994u);
+  EXPECT_NE(trim.wkt, vola::geo::crs_wkt(2994));
+  const std::vector<vola::StatedCrs> same{trim, pf1};
+  EXPECT_NO_THROW(vola::resolve_crs(same, std::nullopt));
+
+  const std::vector<vola::StatedCrs> differ{trim, bmx};
+  try {
+    vola::resolve_crs(differ, std::nullopt);
+    FAIL() << "a foot CRS and a metre CRS were taken as one";
+  } catch (const vola::InvalidArgument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("pdal_autzen_trim.las says \"NAD_1983_HARN_Lambert_Conformal_Conic\""), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("pdal_autzen-bmx-2010.las says EPSG:2991"), std::string::npos) << what;
+  }
+
+  // The same WKT respelled as another tool writes it: names with underscores.
+  std::string respelled = bmx.wkt;
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"GRS 1980", "GRS_1980"}, {"North_American_Datum_1983", "North American Datum 1983"}}) {
+    const auto at = respelled.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    respelled.replace(at, from.size(), to);
+  }
+  const std::vector<vola::StatedCrs> spelled{bmx, {"respelled.las", std::nullopt, respelled}};
+  EXPECT_NO_THROW(vola::resolve_crs(spelled, std::nullopt));
+}
+
+// vola info's naming of a CRS: PROJ's name, a code only when PROJ identifies one, the units.
+TEST(DescribeCrs, NamesWhatProjFindsAndInventsNoCode) {
+  VOLA_REQUIRE_DATA(data);
+  const auto trim = vola::geo::describe_crs(stated_crs_of(data / "las" / "pdal_autzen_trim.las").wkt);
+  EXPECT_EQ(trim.name, "NAD_1983_HARN_Lambert_Conformal_Conic");
+  EXPECT_FALSE(trim.epsg.has_value());
+  EXPECT_EQ(trim.horizontal_unit, "foot");
+  EXPECT_NE(vola::geo::crs_summary(trim).find("(no EPSG code)"), std::string::npos);
+
+  const auto bmx = vola::geo::describe_crs(stated_crs_of(data / "las" / "pdal_autzen-bmx-2010.las").wkt);
+  EXPECT_EQ(bmx.kind, "compound");
+  EXPECT_EQ(bmx.epsg, 2991u);
+  EXPECT_EQ(bmx.horizontal_unit, "metre");
+  EXPECT_EQ(bmx.vertical_unit, "US survey foot");
+
+  const auto utm = vola::geo::describe_crs("EPSG:32610");
+  EXPECT_EQ(utm.name, "WGS 84 / UTM zone 10N");
+  EXPECT_EQ(utm.epsg, 32610u);
+  EXPECT_TRUE(vola::geo::same_crs("EPSG:4326", "EPSG:4326"));
+  EXPECT_FALSE(vola::geo::same_crs("EPSG:32610", "EPSG:32611"));
+  EXPECT_THROW(vola::geo::describe_crs("not a crs"), vola::Error);
 }
 
 TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {

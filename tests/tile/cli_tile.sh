@@ -65,6 +65,9 @@ if "$vola" tile "$las" "$data/las/pdal_autzen-utm.las" --tile-size 256 --depth 4
   fail "mixed CRSs accepted"
 fi
 grep -q "disagree on the CRS" "$tmp/err.txt" || fail "mixed CRS message: $(cat "$tmp/err.txt")"
+# The same CRS spelled by two writers (PDAL's WKT with no code, GeoKeys EPSG:2994) tiles together.
+"$vola" tile "$las" "$data/las/pdal_autzen_pf1.las" --tile-size 256 --depth 4 -o "$tmp/spelled" -q 2> "$tmp/err.txt" ||
+  fail "one CRS in two spellings refused: $(cat "$tmp/err.txt")"
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/bad" --memory lots 2> "$tmp/err.txt" && fail "--memory lots accepted"
 grep -q -- "--memory 'lots'" "$tmp/err.txt" || fail "--memory message: $(cat "$tmp/err.txt")"
 "$vola" tile --tile-size 256 --depth 4 -o "$tmp/none" 2> "$tmp/err.txt" && fail "no input accepted"

@@ -26,6 +26,29 @@ std::string crs_wkt(std::uint32_t epsg);
 // its own identifier or, failing that, PROJ's identification with confidence >= 70%.
 std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt);
 
+// Whether two CRS definitions (WKT of any version, PROJ strings, "EPSG:<code>") name the
+// same CRS by meaning, as PROJ judges it (proj_is_equivalent_to), whatever the
+// spelling of names ("GRS 1980" or "GRS_1980") and axis order of geographic CRSs aside.
+// Throws vola::Error when PROJ cannot read either.
+bool same_crs(const std::string& a, const std::string& b);
+
+// What PROJ says a CRS is, for people.
+struct CrsDescription {
+  std::string name;                   // the CRS's own name
+  std::string kind;                   // "projected", "geographic 2D", "compound", ...
+  // The horizontal part's EPSG id, or PROJ's identification of it at >= 70% (equivalent);
+  // none rather than a guess.
+  std::optional<std::uint32_t> epsg;
+  std::string horizontal_unit;        // "metre", "US survey foot", "degree", ...
+  std::string vertical_name;          // the vertical CRS of a compound one (else empty)
+  std::string vertical_unit;
+};
+// Throws vola::Error when PROJ cannot read the definition.
+CrsDescription describe_crs(const std::string& definition);
+// One line: "NAD83(HARN) / Oregon GIC Lambert (ft) (EPSG:2994), projected, foot" or, with
+// no code, "... (no EPSG code), ..."; a compound CRS adds "; vertical NAME (UNIT)".
+std::string crs_summary(const CrsDescription& crs);
+
 // The header's EPSG code when nobody said what the CRS is: the reference's default,
 // which names no real CRS of the data.
 inline constexpr std::uint32_t kUnsetEpsg = 2000;

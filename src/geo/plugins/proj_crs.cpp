@@ -59,37 +59,46 @@ std::string crs_wkt(std::uint32_t epsg) {
   return wkt;
 }
 
-std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
-  Context ctx = make_context();
-  Pj crs(proj_create(ctx.get(), wkt.c_str()));
-  if (!crs) return std::nullopt;
-  // Down to the horizontal CRS: a TOWGS84 clause makes a bound CRS, a vertical part a
-  // compound one.
+// A bound CRS (a WKT1 TOWGS84 clause) is the CRS it binds, for naming and comparing.
+Pj unbound(PJ_CONTEXT* ctx, Pj crs) {
+  if (crs && proj_get_type(crs.get()) == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx, crs.get()));
+  return crs;
+}
+
+// The horizontal part: a bound CRS's source, a compound CRS's first component.
+Pj horizontal_part(PJ_CONTEXT* ctx, Pj crs) {
   for (int guard = 0; crs && guard < 4; ++guard) {
     const PJ_TYPE type = proj_get_type(crs.get());
-    if (type == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx.get(), crs.get()));
-    else if (type == PJ_TYPE_COMPOUND_CRS) crs.reset(proj_crs_get_sub_crs(ctx.get(), crs.get(), 0));
+    if (type == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(ctx, crs.get()));
+    else if (type == PJ_TYPE_COMPOUND_CRS) crs.reset(proj_crs_get_sub_crs(ctx, crs.get(), 0));
     else break;
   }
-  if (!crs) return std::nullopt;
-  auto to_code = [](const char* auth, const char* code) -> std::optional<std::uint32_t> {
-    if (!auth || !code || std::string(auth) != "EPSG") return std::nullopt;
-    try {
-      return static_cast<std::uint32_t>(std::stoul(code));
-    } catch (...) {
-      return std::nullopt;
-    }
-  };
-  if (auto c = to_code(proj_get_id_auth_name(crs.get(), 0), proj_get_id_code(crs.get(), 0))) return c;
+  return crs;
+}
+
+std::optional<std::uint32_t> epsg_code(const char* auth, const char* code) {
+  if (!auth || !code || std::string(auth) != "EPSG") return std::nullopt;
+  try {
+    return static_cast<std::uint32_t>(std::stoul(code));
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
+// The CRS's own EPSG id, else PROJ's identification at 70% or more: 70 is PROJ's
+// "equivalent, names differ"; below that the candidates are not the same CRS, and no
+// code is better than an invented one.
+std::optional<std::uint32_t> identify_epsg(PJ_CONTEXT* ctx, const PJ* crs) {
+  if (auto c = epsg_code(proj_get_id_auth_name(crs, 0), proj_get_id_code(crs, 0))) return c;
   int* confidence = nullptr;
-  PJ_OBJ_LIST* candidates = proj_identify(ctx.get(), crs.get(), "EPSG", nullptr, &confidence);
+  PJ_OBJ_LIST* candidates = proj_identify(ctx, crs, "EPSG", nullptr, &confidence);
   std::optional<std::uint32_t> best;
   if (candidates) {
     int best_confidence = 69;
     for (int i = 0; i < proj_list_get_count(candidates); ++i) {
       if (confidence[i] <= best_confidence) continue;
-      Pj candidate(proj_list_get(ctx.get(), candidates, i));
-      if (auto c = to_code(proj_get_id_auth_name(candidate.get(), 0), proj_get_id_code(candidate.get(), 0))) {
+      Pj candidate(proj_list_get(ctx, candidates, i));
+      if (auto c = epsg_code(proj_get_id_auth_name(candidate.get(), 0), proj_get_id_code(candidate.get(), 0))) {
         best = c;
         best_confidence = confidence[i];
       }
@@ -98,6 +107,73 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
     proj_list_destroy(candidates);
   }
   return best;
+}
+
+std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
+  Context ctx = make_context();
+  Pj crs = horizontal_part(ctx.get(), Pj(proj_create(ctx.get(), wkt.c_str())));
+  if (!crs) return std::nullopt;
+  return identify_epsg(ctx.get(), crs.get());
+}
+
+Pj create_crs(PJ_CONTEXT* ctx, const std::string& definition) {
+  Pj crs(proj_create(ctx, definition.c_str()));
+  if (!crs) throw Error("CRS " + definition.substr(0, 60) + " is not known to PROJ: " + last_error(ctx));
+  return crs;
+}
+
+bool same_crs(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  Context ctx = make_context();
+  const Pj first = unbound(ctx.get(), create_crs(ctx.get(), a));
+  const Pj second = unbound(ctx.get(), create_crs(ctx.get(), b));
+  return proj_is_equivalent_to_with_ctx(ctx.get(), first.get(), second.get(),
+                                        PJ_COMP_EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS) != 0;
+}
+
+const char* kind_of(PJ_TYPE type) {
+  switch (type) {
+    case PJ_TYPE_PROJECTED_CRS: return "projected";
+    case PJ_TYPE_GEOGRAPHIC_2D_CRS: return "geographic 2D";
+    case PJ_TYPE_GEOGRAPHIC_3D_CRS: return "geographic 3D";
+    case PJ_TYPE_GEOCENTRIC_CRS: return "geocentric";
+    case PJ_TYPE_VERTICAL_CRS: return "vertical";
+    case PJ_TYPE_COMPOUND_CRS: return "compound";
+    case PJ_TYPE_ENGINEERING_CRS: return "engineering";
+    default: return "other";
+  }
+}
+
+// The unit of a CRS's first axis ("metre", "US survey foot", "degree").
+std::string axis_unit(PJ_CONTEXT* ctx, const PJ* crs) {
+  const Pj cs(proj_crs_get_coordinate_system(ctx, crs));
+  const char* unit = nullptr;
+  if (!cs || !proj_cs_get_axis_info(ctx, cs.get(), 0, nullptr, nullptr, nullptr, nullptr, &unit, nullptr, nullptr))
+    return {};
+  return unit ? unit : "";
+}
+
+CrsDescription describe_crs(const std::string& definition) {
+  Context ctx = make_context();
+  const Pj crs = unbound(ctx.get(), create_crs(ctx.get(), definition));
+  CrsDescription out;
+  const char* name = proj_get_name(crs.get());
+  out.name = name ? name : "";
+  out.kind = kind_of(proj_get_type(crs.get()));
+  const Pj horizontal = horizontal_part(ctx.get(), Pj(proj_clone(ctx.get(), crs.get())));
+  if (horizontal) {
+    out.epsg = identify_epsg(ctx.get(), horizontal.get());
+    out.horizontal_unit = axis_unit(ctx.get(), horizontal.get());
+  }
+  if (proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
+    const Pj vertical = unbound(ctx.get(), Pj(proj_crs_get_sub_crs(ctx.get(), crs.get(), 1)));
+    if (vertical) {
+      const char* vname = proj_get_name(vertical.get());
+      out.vertical_name = vname ? vname : "";
+      out.vertical_unit = axis_unit(ctx.get(), vertical.get());
+    }
+  }
+  return out;
 }
 
 std::string crs_wkt1(const std::string& definition) {
@@ -159,6 +235,12 @@ const plugin::ProjEntries kEntries{
       capture_failure(failure, [&] { out = static_cast<const Wgs84Transformation*>(state)->transform(in); });
     },
     [](void* state) { delete static_cast<Wgs84Transformation*>(state); },
+    [](const std::string& a, const std::string& b, bool& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = same_crs(a, b); });
+    },
+    [](const std::string& definition, CrsDescription& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = describe_crs(definition); });
+    },
 };
 
 }  // namespace
