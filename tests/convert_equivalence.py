@@ -49,6 +49,8 @@ SPECIFIC_CASES = [
      {"quantize": "toolkit", "depth": 6, "bbox": [636500.0, 849000.0, 400.0, 638000.0, 851000.0, 600.0]}),
     ("data/las/pdal_1.2-with-color.las", {"voxel_size": 50.0, "epsg": 32615}),
     ("data/las/pdal_epsg_4326.las", {"voxel_size": 0.001}),
+    ("data/las/pdal_autzen_trim.las", {"voxel_size": 5.0, "target_crs": "EPSG:32610"}),
+    ("data/las/pdal_epsg_4326.las", {"voxel_size": 1.0, "target_crs": "32615", "attributes": False}),
     ("data/las/pdal_extrabytes.las", {"voxel_size": 1.0}),
     ("data/las/laspy_test1_4.las", {"voxel_size": 5.0}),
     ("data/pcd/pcl_milk_color.pcd", {"voxel_size": 0.01}),

@@ -110,6 +110,7 @@ void add_convert(CLI::App& app) {
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
       "  vola convert scan.csv scan.vol --voxel-size 0.1 --attribute intensity=4:u16:mean\n"
       "  vola convert points.npy points.vol --depth 5 --compress\n"
+      "  vola convert autzen.las autzen_utm.vol --target-crs EPSG:32610 --voxel-size 1\n"
       "  vola convert part.stl part.vol --quantize toolkit --depth 5 --solid\n"
       "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0");
   cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
@@ -127,6 +128,9 @@ void add_convert(CLI::App& app) {
   cmd->add_flag("--dense", args->options.dense, "Write the reference's dense layout (depth <= 5)");
   cmd->add_option("--crs", args->crs, "EPSG code of the input coordinates (header lat/lon from it)")
       ->each([args](const std::string&) { args->crs_given = true; })->capture_default_str();
+  cmd->add_option("--target-crs", args->options.target_crs,
+                  "Reproject the points into this CRS (EPSG code, WKT or PROJ string) before voxelising; "
+                  "--voxel-size, --origin and --bbox are then in its units");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1")->expected(3)->capture_default_str();

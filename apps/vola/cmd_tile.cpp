@@ -25,6 +25,7 @@ struct TileArgs {
   int depth = 0;
   std::vector<double> origin;
   std::optional<std::uint32_t> crs;
+  std::string target_crs;
   unsigned threads = 0;
   bool no_overviews = false, quiet = false;
   std::uint64_t generate = 0;
@@ -58,6 +59,21 @@ std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::siz
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".las" || ext == ".laz") return tile::open_las_points(path, chunk_points);
   return tile::open_file_points(path);
+}
+
+// With --target-crs, every input moved from its own CRS (--crs, else what it says) into
+// the target as it is read: inputs in different CRSs then tile together.
+void reproject_sources(const TileArgs& a, std::vector<std::unique_ptr<tile::PointSource>>& sources) {
+  if (a.target_crs.empty()) return;
+  const bool digits = a.target_crs.find_first_not_of("0123456789") == std::string::npos;
+  const std::string to = digits ? "EPSG:" + a.target_crs : a.target_crs;
+  for (auto& s : sources) {
+    std::string from = a.crs ? "EPSG:" + std::to_string(*a.crs) : !s->wkt.empty() ? s->wkt : "";
+    if (from.empty() && s->epsg) from = "EPSG:" + std::to_string(*s->epsg);
+    if (from.empty())
+      throw InvalidArgument(s->name() + " states no CRS to reproject from; name it with --crs");
+    s = tile::reprojected(std::move(s), from, to);
+  }
 }
 
 // The CRS every tile carries: --crs, else what the inputs say (they must agree).
@@ -96,7 +112,9 @@ void run_tile(const TileArgs& a) {
     options.memory_budget = parse_bytes(a.memory);
     options.threads = a.threads;
     options.overviews = !a.no_overviews;
-    resolve_tile_crs(a, sources, options);
+    reproject_sources(a, sources);
+    if (a.target_crs.empty()) resolve_tile_crs(a, sources, options);
+    else resolve_tile_crs(TileArgs{}, sources, options);  // every source now states the target
     std::unique_ptr<Progress> progress;
     std::string stage;
     if (talk)
@@ -176,6 +194,9 @@ void add_tile(CLI::App& app) {
       ->check(CLI::Range(1, 10));
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
   cmd->add_option("--crs", args->crs, "EPSG code of the coordinates (default: what the inputs say)");
+  cmd->add_option("--target-crs", args->target_crs,
+                  "Reproject every input into this CRS (EPSG code, WKT or PROJ string) as it is read; inputs in "
+                  "different CRSs then tile together. --tile-size and --origin are in its units");
   cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
       ->capture_default_str();
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");

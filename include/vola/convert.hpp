@@ -39,6 +39,11 @@ struct ConvertOptions {
   // ---- what the input is ----
   // The input's CRS as an EPSG code; wins over what the input says.
   std::optional<std::uint32_t> epsg;
+  // Reproject the points into this CRS before voxelising ("EPSG:32610", "32610", WKT or
+  // a PROJ string); the grid options (voxel_size, origin, bbox) are then in its units.
+  // Point input only; the input's CRS (stated, or `epsg`) is the source. The points are
+  // read whole for it (not streamed).
+  std::string target_crs;
   bool attributes = true;  // keep the per-point attributes the format carries (LAS, PLY, PCD, ...)
   // Text input (XYZ/TXT/CSV); column numbers count from 1, as a user reads the file.
   std::array<int, 3> columns{1, 2, 3};  // x y z

@@ -129,7 +129,8 @@ Tree convert(const std::filesystem::path& path, int depth,
              bool solid, bool attributes, std::optional<double> dem_base, bool dem_surface_only,
              std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
-             int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output) {
+             int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
+             const std::string& target_crs) {
   vola::ConvertOptions options;
   options.format = format;
   if (!quantize.empty()) options.quantization = parse_quantization(quantize);
@@ -139,6 +140,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   if (bbox) options.bbox = vola::Box{{(*bbox)[0], (*bbox)[1], (*bbox)[2]}, {(*bbox)[3], (*bbox)[4], (*bbox)[5]}};
   options.nbits = nbits;
   options.epsg = epsg;
+  options.target_crs = target_crs;
   options.attributes = attributes;
   options.columns = columns;
   options.payload_columns = std::move(payload_columns);
@@ -192,14 +194,15 @@ void bind_building(py::module_& m) {
         py::arg("nbits") = 0, py::arg("columns") = std::array<int, 3>{1, 2, 3},
         py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
-        py::arg("output") = py::none(),
+        py::arg("output") = py::none(), py::arg("target_crs") = "",
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
         "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
         "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
         "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
-        "dem_base, dem_surface_only (DEM). Voxel grids map cell to voxel unless another grid is asked for.");
+        "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
+        "first (grid options then in its units). Voxel grids map cell to voxel unless another grid is asked for.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

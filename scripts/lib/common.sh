@@ -11,7 +11,7 @@ VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-da
   nlohmann-json3-dev python3 python3-numpy python3-scipy gzip libassimp-dev libgdal-dev libpng-dev liblzf-dev libeigen3-dev libsndfile1-dev libfftw3-dev pkg-config)
 
 # The Python module (pybind11, numpy) and its tests (pytest, matplotlib for the example).
-VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib)
+VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib python3-pyproj)
 
 # vola view: cpp-httplib, chromium for its browser test, and node/npm to build the page
 # (three.js, esbuild from the npm registry); a machine with its own node keeps it.

@@ -25,7 +25,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   io::InputOptions input;
   input.attributes = options.attributes;
   input.payload = options.nbits > 0;
-  input.stream = true;
+  input.stream = options.target_crs.empty();  // reprojection moves the points read whole
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
@@ -40,6 +40,14 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
 // then their cell centres are quantized like points.
 bool maps_cell_for_cell(const io::Input& input, const ConvertOptions& options) {
   return input.grid && !options.quantization && options.voxel_size <= 0.0 && !options.origin && !options.bbox;
+}
+
+void check_target_crs(const std::string& target) {
+  try {
+    geo::crs_wkt(crs_definition_of(target));
+  } catch (const Error& e) {
+    throw OptionError("target_crs", "'" + target.substr(0, 60) + "' is not a CRS PROJ knows: " + e.what());
+  }
 }
 
 const char* unit_of(const io::Input& input) {
@@ -74,12 +82,14 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   options.check();
   // A CRS PROJ does not know fails before gigabytes are read.
   if (options.epsg) resolve_crs({}, options.epsg);
+  if (!options.target_crs.empty()) check_target_crs(options.target_crs);
   const io::InputFormat& format = io::find_input_format(path, options.format);
   io::Input input = read(path, format, options, progress);
-  const ResolvedCrs crs = input_crs(path, options, input);
+  const ResolvedCrs crs =
+      options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));
 
-  CentreLatLon centre(crs.epsg, input);  // PROJ gets ready while the tree is built
+  CentreLatLon centre(crs.epsg, crs.wkt.empty() ? input.wkt : crs.wkt);  // PROJ gets ready while the tree is built
   ConvertReport report;
   Tree tree = build_tree(path, input, options, build, report.build);
   georeference(tree, crs, tree.frame().quantization, centre);

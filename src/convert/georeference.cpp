@@ -12,9 +12,30 @@ ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, co
 
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
 
-CentreLatLon::CentreLatLon(const std::optional<std::uint32_t>& known, const io::Input& input) {
-  const std::string definition =
-      known || input.wkt.empty() ? "EPSG:" + std::to_string(header_epsg(known)) : input.wkt;
+std::string crs_definition_of(const std::string& given) {
+  const bool digits = !given.empty() && given.find_first_not_of("0123456789") == std::string::npos;
+  return digits ? "EPSG:" + given : given;
+}
+
+ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io::Input& input) {
+  if (input.is_mesh() || input.grid || input.terrain)
+    throw OptionError("target_crs", "reprojects points; " + path + " is " + input.format + " input");
+  const ResolvedCrs source = input_crs(path, options, input);
+  if (!source.epsg && source.wkt.empty())
+    throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `epsg`");
+  const std::string from = source.wkt.empty() ? "EPSG:" + std::to_string(*source.epsg) : source.wkt;
+  const std::string to = crs_definition_of(options.target_crs);
+  geo::Reprojection(from, to).transform(input.cloud.xyz);
+  ResolvedCrs target;
+  target.wkt = geo::crs_wkt(to);
+  target.epsg = geo::epsg_from_wkt(target.wkt);
+  target.given = true;
+  target.stated = true;
+  return target;
+}
+
+CentreLatLon::CentreLatLon(const std::optional<std::uint32_t>& known, const std::string& wkt) {
+  const std::string definition = known || wkt.empty() ? "EPSG:" + std::to_string(header_epsg(known)) : wkt;
   transform_ = std::async(std::launch::async, [definition] { return geo::ToWgs84(definition); });
 }
 

@@ -17,6 +17,14 @@ namespace vola::convert_detail {
 // The input's CRS under the rules of vola/crs_rules.hpp (the code given wins).
 ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, const io::Input& input);
 
+// The points of `input` moved into options.target_crs from the input's CRS; the CRS
+// of the result (the target, as given). Throws OptionError("target_crs") for input that
+// is not points or states no CRS, and for a target PROJ cannot read.
+ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io::Input& input);
+
+// A CRS as the user may give it: "32610" means "EPSG:32610"; anything else as it is.
+std::string crs_definition_of(const std::string& given);
+
 // The code the VOLA header carries: the known one, else the reference's default (2000).
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known);
 
@@ -26,8 +34,8 @@ std::uint32_t header_epsg(const std::optional<std::uint32_t>& known);
 class CentreLatLon {
  public:
   // The CRS the header's lat/lon are computed from: the known code (or the reference's
-  // default), else the input's WKT.
-  CentreLatLon(const std::optional<std::uint32_t>& known, const io::Input& input);
+  // default), else the WKT.
+  CentreLatLon(const std::optional<std::uint32_t>& known, const std::string& wkt);
   std::pair<double, double> lat_lon(const Box& bbox);
 
  private:

@@ -2,7 +2,10 @@
 // is needed: a run that never transforms a coordinate never loads PROJ.
 #include "vola/geo/crs.hpp"
 
+#include <vector>
+
 #include "proj_plugin.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::geo {
 
@@ -83,6 +86,66 @@ std::string crs_summary(const CrsDescription& crs) {
   if (!crs.vertical_name.empty())
     line += "; vertical " + crs.vertical_name + (crs.vertical_unit.empty() ? "" : " (" + crs.vertical_unit + ")");
   return line;
+}
+
+std::string crs_wkt(const std::string& definition) {
+  std::string wkt;
+  run("a CRS as WKT", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.crs_wkt_of(definition, wkt, f); });
+  return wkt;
+}
+
+// One PROJ transformation per worker (PROJ objects are not shared between threads),
+// each made the first time its worker needs one.
+struct Reprojection::State {
+  const plugin::ProjEntries* entries = nullptr;
+  std::string from, to;
+  std::vector<void*> per_worker;
+  ~State() {
+    for (void* t : per_worker)
+      if (t) entries->reprojection_close(t);
+  }
+  void* worker(unsigned w) {
+    if (!per_worker[w]) {
+      plugin::PluginFailure failure;
+      entries->reprojection_open(from, to, per_worker[w], failure);
+      vola::plugin::throw_failure(failure);
+    }
+    return per_worker[w];
+  }
+};
+
+Reprojection::Reprojection(const std::string& from, const std::string& to, unsigned threads)
+    : state_(std::make_unique<State>()) {
+  state_->entries = &proj("reprojecting points");
+  state_->from = from;
+  state_->to = to;
+  state_->per_worker.assign(resolve_thread_count(threads), nullptr);
+  state_->worker(0);  // fails here, before any point, for a CRS or pair PROJ cannot do
+}
+
+Reprojection::~Reprojection() = default;
+Reprojection::Reprojection(Reprojection&&) noexcept = default;
+Reprojection& Reprojection::operator=(Reprojection&&) noexcept = default;
+
+void Reprojection::transform(std::span<double> xyz) const {
+  // Batches of 64K points: large enough to pay for a thread, small enough to share out.
+  constexpr std::size_t kBatch = std::size_t{1} << 16;
+  ParallelOptions options;
+  options.threads = static_cast<unsigned>(state_->per_worker.size());
+  options.grain = kBatch;
+  options.name = "geo.reproject";
+  State& state = *state_;
+  parallel_for(
+      xyz.size() / 3,
+      [&state, xyz](const Chunk& chunk) {
+        plugin::PluginFailure failure;
+        state.entries->reprojection_transform(state.worker(chunk.worker), xyz.data() + 3 * chunk.begin,
+                                              chunk.end - chunk.begin, failure);
+        if (failure.kind != plugin::PluginFailure::Kind::none)  // the plugin counts within the batch
+          failure.message += " (the batch of points from " + std::to_string(chunk.begin) + ")";
+        vola::plugin::throw_failure(failure);
+      },
+      options);
 }
 
 struct ToWgs84::State {

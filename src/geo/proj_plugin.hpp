@@ -3,6 +3,7 @@
 // them. Each reports errors through its PluginFailure.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,6 +29,12 @@ struct ProjEntries {
   void (*to_wgs84_close)(void* state);
   void (*same_crs)(const std::string& a, const std::string& b, bool& out, PluginFailure& failure);
   void (*describe_crs)(const std::string& definition, CrsDescription& out, PluginFailure& failure);
+  // A transformation between two CRSs (x = easting/longitude in and out), for one thread
+  // at a time: opened, used for many batches of x y z triples in place, closed.
+  void (*reprojection_open)(const std::string& from, const std::string& to, void*& state, PluginFailure& failure);
+  void (*reprojection_transform)(void* state, double* xyz, std::size_t points, PluginFailure& failure);
+  void (*reprojection_close)(void* state);
+  void (*crs_wkt_of)(const std::string& definition, std::string& out, PluginFailure& failure);
 };
 
 using ProjEntriesEntry = const ProjEntries* (*)();

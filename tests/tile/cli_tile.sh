@@ -65,6 +65,18 @@ if "$vola" tile "$las" "$data/las/pdal_autzen-utm.las" --tile-size 256 --depth 4
   fail "mixed CRSs accepted"
 fi
 grep -q "disagree on the CRS" "$tmp/err.txt" || fail "mixed CRS message: $(cat "$tmp/err.txt")"
+# Different CRSs (feet WKT, EPSG:2991 metres) tile together when reprojected into one, the
+# same bytes for 1 and 2 threads; an input with no CRS cannot be reprojected.
+for t in 1 2; do
+  "$vola" tile "$las" "$data/las/pdal_autzen-bmx-2010.las" --target-crs EPSG:32610 --tile-size 200 --depth 4 \
+    -o "$tmp/utm$t" --threads $t -q 2> "$tmp/err.txt" || fail "--target-crs refused: $(cat "$tmp/err.txt")"
+done
+diff -r "$tmp/utm1" "$tmp/utm2" > /dev/null || fail "--target-crs: 2 threads give other bytes than 1"
+python3 -c "import json, sys; v = json.load(open(sys.argv[1]))['vola']; assert v['epsg'] == 32610, v['epsg']" \
+  "$tmp/utm1/index.geojson" || fail "the reprojected index does not state EPSG:32610"
+"$vola" tile "$data/las/pdal_1.2-with-color.las" --target-crs 32610 --tile-size 200 --depth 4 -o "$tmp/nocrs" \
+  2> "$tmp/err.txt" && fail "an input with no CRS was reprojected"
+grep -q "states no CRS to reproject from" "$tmp/err.txt" || fail "no-CRS message: $(cat "$tmp/err.txt")"
 # The same CRS spelled by two writers (PDAL's WKT with no code, GeoKeys EPSG:2994) tiles together.
 "$vola" tile "$las" "$data/las/pdal_autzen_pf1.las" --tile-size 256 --depth 4 -o "$tmp/spelled" -q 2> "$tmp/err.txt" ||
   fail "one CRS in two spellings refused: $(cat "$tmp/err.txt")"

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -48,6 +49,32 @@ CrsDescription describe_crs(const std::string& definition);
 // One line: "NAD83(HARN) / Oregon GIC Lambert (ft) (EPSG:2994), projected, foot" or, with
 // no code, "... (no EPSG code), ..."; a compound CRS adds "; vertical NAME (UNIT)".
 std::string crs_summary(const CrsDescription& crs);
+
+// A CRS definition of any kind PROJ reads ("EPSG:32610", WKT 1 or 2, a PROJ string) as
+// WKT2 (2019). Throws vola::Error when PROJ cannot read it.
+std::string crs_wkt(const std::string& definition);
+
+// Points from one CRS to another through PROJ (proj_create_crs_to_crs, the best
+// transformation PROJ knows for the pair, axes in x = easting/longitude order, z
+// converted when both CRSs have a vertical part), in batches of x y z triples in place,
+// on all cores (vola::parallel_for, one PROJ object per worker). One transform() at a
+// time per object.
+class Reprojection {
+ public:
+  // Throws vola::Error when PROJ cannot read either CRS or has no transformation.
+  // `threads`: at most this many for one transform() (0: vola::thread_count()); 1 for
+  // callers that are themselves parallel workers.
+  Reprojection(const std::string& from, const std::string& to, unsigned threads = 0);
+  ~Reprojection();
+  Reprojection(Reprojection&&) noexcept;
+  Reprojection& operator=(Reprojection&&) noexcept;
+  // Throws vola::Error naming the first point PROJ cannot transform.
+  void transform(std::span<double> xyz) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // The header's EPSG code when nobody said what the CRS is: the reference's default,
 // which names no real CRS of the data.

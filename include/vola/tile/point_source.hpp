@@ -34,6 +34,12 @@ std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_
 // Any other point format `vola convert` reads, read whole (one chunk).
 std::unique_ptr<PointSource> open_file_points(const std::string& path);
 
+// `source`'s points moved from CRS `from` into CRS `to` (any definition PROJ reads) as
+// each chunk is read; the result states `to` as its CRS. Throws vola::Error when PROJ
+// cannot read either CRS.
+std::unique_ptr<PointSource> reprojected(std::unique_ptr<PointSource> source, const std::string& from,
+                                         const std::string& to);
+
 // A survey the project generates: square city blocks (vola::synth::generate_city, 200 m)
 // side by side in rows, each block one chunk with its own seed, so that any worker can
 // generate any block and the whole is never stored. `density` points per square metre

@@ -212,6 +212,45 @@ class Wgs84Transformation {
   std::string source_;
 };
 
+// Points from one CRS to another, in place, one batch at a time (proj_trans_generic over
+// strided x y z). Own context: one object per thread.
+class Reprojection {
+ public:
+  Reprojection(const std::string& from, const std::string& to)
+      : ctx_(make_context()), names_(from.substr(0, 60) + " to " + to.substr(0, 60)) {
+    Pj transform(proj_create_crs_to_crs(ctx_.get(), from.c_str(), to.c_str(), nullptr));
+    if (!transform) throw Error("PROJ has no transformation from " + names_ + ": " + last_error(ctx_.get()));
+    transform_.reset(proj_normalize_for_visualization(ctx_.get(), transform.get()));
+    if (!transform_) throw Error("PROJ cannot normalise the axis order of " + names_);
+  }
+
+  void transform(double* xyz, std::size_t points) {
+    constexpr std::size_t stride = 3 * sizeof(double);
+    proj_errno_reset(transform_.get());
+    proj_trans_generic(transform_.get(), PJ_FWD, xyz, stride, points, xyz + 1, stride, points, xyz + 2, stride, points,
+                       nullptr, 0, 0);
+    for (std::size_t i = 0; i < points; ++i)
+      if (!std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
+        throw Error("PROJ cannot transform point " + std::to_string(i) + " of a batch from " + names_ +
+                    " (outside the CRSs' domain?)");
+  }
+
+ private:
+  Context ctx_;
+  Pj transform_;
+  std::string names_;
+};
+
+// A CRS definition (code, WKT of any version, PROJ string) as WKT: WKT2 2019 as
+// crs_wkt writes a code.
+std::string crs_wkt_of(const std::string& definition) {
+  Context ctx = make_context();
+  const Pj crs = create_crs(ctx.get(), definition);
+  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT2_2019, nullptr);
+  if (!wkt) throw Error("PROJ cannot write " + definition.substr(0, 60) + " as WKT");
+  return wkt;
+}
+
 using plugin::PluginFailure;
 using vola::plugin::capture_failure;
 
@@ -240,6 +279,16 @@ const plugin::ProjEntries kEntries{
     },
     [](const std::string& definition, CrsDescription& out, PluginFailure& failure) {
       capture_failure(failure, [&] { out = describe_crs(definition); });
+    },
+    [](const std::string& from, const std::string& to, void*& state, PluginFailure& failure) {
+      capture_failure(failure, [&] { state = new Reprojection(from, to); });
+    },
+    [](void* state, double* xyz, std::size_t points, PluginFailure& failure) {
+      capture_failure(failure, [&] { static_cast<Reprojection*>(state)->transform(xyz, points); });
+    },
+    [](void* state) { delete static_cast<Reprojection*>(state); },
+    [](const std::string& definition, std::string& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = crs_wkt_of(definition); });
     },
 };
 
