@@ -71,8 +71,10 @@ Bytes las_records(const LasFile& file) {
   return Bytes(file.bytes.begin() + file.offset_to_points, file.bytes.begin() + static_cast<std::ptrdiff_t>(file.offset_to_points + n));
 }
 
-LasFile make_laz(const vola::io::laz::LaszipInfo& info, std::span<const std::uint8_t> records, std::uint64_t chunk_points) {
+LasFile make_laz(vola::io::laz::LaszipInfo info, std::span<const std::uint8_t> records, std::uint64_t chunk_points) {
   namespace laz = vola::io::laz;
+  if (info.compressor != 1 && info.chunk_size != laz::kVariableChunkSize)
+    info.chunk_size = static_cast<std::uint32_t>(chunk_points);
   LasFile f;
   f.name = "made.laz";
   f.record_length = static_cast<std::uint16_t>(info.record_length());
@@ -82,6 +84,10 @@ LasFile make_laz(const vola::io::laz::LaszipInfo& info, std::span<const std::uin
   f.bytes.assign(227, 0);
   f.bytes.insert(f.bytes.end(), f.laszip.begin(), f.laszip.end());
   f.offset_to_points = static_cast<std::uint32_t>(f.bytes.size());
+  if (info.compressor == 1) {  // one stream, no chunk table
+    if (f.point_count) laz::encode_chunk(info, records, f.record_length, f.bytes);
+    return f;
+  }
   f.bytes.resize(f.bytes.size() + 8);
   std::vector<laz::ChunkEntry> chunks;
   for (std::uint64_t first = 0; first < f.point_count; first += chunk_points) {

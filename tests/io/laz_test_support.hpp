@@ -36,8 +36,10 @@ Bytes las_records(const LasFile& file);
 // A LAZ file image as the tests need it: a 227-byte LAS 1.2 header stand-in holding
 // only the offsets the codec reads, the laszip VLR payload at `laszip_offset`, the
 // chunk table offset, the chunks (of `chunk_points` records, the last one shorter) and
-// the table. For variable-size chunks the counts follow `chunk_points` too.
-LasFile make_laz(const vola::io::laz::LaszipInfo& info, std::span<const std::uint8_t> records,
+// the table. The record's chunk size becomes `chunk_points`, unless the chunks are of
+// variable size (then their counts in the table follow `chunk_points`). Compressor
+// 1: one stream of every record right at the point data, no table.
+LasFile make_laz(vola::io::laz::LaszipInfo info, std::span<const std::uint8_t> records,
                  std::uint64_t chunk_points);
 
 }  // namespace vola_laz_test

@@ -258,11 +258,12 @@ class ArithmeticEncoder {
   }
 
   void encode_symbol(SymbolModel& m, std::uint32_t sym) {
-    length_ >>= kSymbolShift;
-    const std::uint32_t x = m.distribution[sym] * length_;
+    const std::uint32_t unit = length_ >> kSymbolShift;
+    const std::uint32_t x = m.distribution[sym] * unit;
     add_to_base(x);
+    // The last symbol takes the whole rest of the interval (the decoder's y = length).
     if (sym == m.last_symbol()) length_ -= x;
-    else length_ = m.distribution[sym + 1] * length_ - x;
+    else length_ = m.distribution[sym + 1] * unit - x;
     if (length_ < kMinLength) renormalise();
     ++m.counts[sym];
     if (--m.until_update == 0) m.update();
