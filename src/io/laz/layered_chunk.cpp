@@ -43,12 +43,12 @@ std::vector<std::span<const std::uint8_t>> split_layers(const RecordLayout& layo
   const std::size_t head = layout.length + 4 + 4 * layers;
   if (chunk.size() < head)
     VOLA_THROW(FormatError(source, chunk_offset + chunk.size(),
-                           where + " of " + std::to_string(chunk.size()) + " bytes is too short for its header of " +
+                           "LAZ " + where + " of " + std::to_string(chunk.size()) + " bytes is too short for its header of " +
                                std::to_string(head)));
   const auto stated = load_le<std::uint32_t>(chunk.data() + layout.length);
   if (stated != count)
     VOLA_THROW(FormatError(source, chunk_offset + layout.length,
-                           where + " says it holds " + std::to_string(stated) + " points, the chunk table " +
+                           "LAZ " + where + " says it holds " + std::to_string(stated) + " points, the chunk table " +
                                std::to_string(count)));
   std::vector<std::span<const std::uint8_t>> spans(layers);
   std::uint64_t at = head;
@@ -56,7 +56,7 @@ std::vector<std::span<const std::uint8_t>> split_layers(const RecordLayout& layo
     const std::uint64_t size = load_le<std::uint32_t>(chunk.data() + layout.length + 4 + 4 * i);
     if (size > chunk.size() - at)
       VOLA_THROW(FormatError(source, chunk_offset + layout.length + 4 + 4 * i,
-                             where + ": layer " + std::to_string(i) + " of " + std::to_string(size) +
+                             "LAZ " + where + ": layer " + std::to_string(i) + " of " + std::to_string(size) +
                                  " bytes runs past the chunk's end"));
     spans[i] = chunk.subspan(static_cast<std::size_t>(at), static_cast<std::size_t>(size));
     at += size;
