@@ -1,0 +1,178 @@
+// The LAZ encoder: whatever it writes, the decoder must give back byte for byte. Records
+// come from every shared LAS file of a supported format, from every shared LAZ file
+// (decoded), and from generated point streams that reach the coders' rare paths
+// (scanner channel switches, interleaved and jumping GPS times, odd return numbers,
+// arbitrary bytes).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "io_test_data.hpp"
+#include "laz_test_support.hpp"
+#include "vola/error.hpp"
+
+namespace {
+
+namespace fs = vola_io_test::fs;
+namespace laz = vola::io::laz;
+using vola_laz_test::Bytes;
+using vola_laz_test::LasFile;
+
+void expect_round_trip(const laz::LaszipInfo& info, const Bytes& records, std::uint64_t chunk_points) {
+  const LasFile made = vola_laz_test::make_laz(info, records, chunk_points);
+  Bytes back;
+  ASSERT_NO_THROW(back = vola_laz_test::decode_all(made));
+  ASSERT_EQ(back.size(), records.size());
+  const std::size_t n = info.record_length();
+  for (std::size_t i = 0; i < records.size(); i += n)
+    ASSERT_EQ(0, std::memcmp(back.data() + i, records.data() + i, n)) << "record " << i / n;
+}
+
+// Point streams that look like scans: drifting coordinates, pulses of 1-5 returns, GPS
+// times on up to 3 interleaved sequences with regular steps, rare jumps and repeats.
+// `noise` in [0, 1] replaces that share of the fields with arbitrary bytes.
+Bytes generated_records(std::uint8_t format, std::uint16_t record_length, std::size_t count, std::uint64_t seed,
+                        double noise) {
+  std::mt19937_64 rng(seed);
+  auto chance = [&rng](double p) { return std::uniform_real_distribution<double>(0, 1)(rng) < p; };
+  auto any = [&rng]() { return static_cast<std::uint32_t>(rng()); };
+  const bool layered = format >= 6;
+  Bytes out(count * record_length);
+  std::int32_t x = 1000, y = -5000, z = 300;
+  double times[3] = {1e5, 2e5 + 0.25, 3.5e8};
+  int sequence = 0, r = 1, n = 1, channel = 0;
+  std::uint16_t rgb[4] = {100, 200, 300, 400};
+  for (std::size_t i = 0; i < count; ++i) {
+    std::uint8_t* p = out.data() + i * record_length;
+    x += static_cast<std::int32_t>(any() % 200) - 100;
+    y += chance(0.05) ? static_cast<std::int32_t>(any()) : static_cast<std::int32_t>(any() % 50) - 25;
+    z += static_cast<std::int32_t>(any() % 21) - 10;
+    if (++r > n) {
+      r = 1;
+      n = 1 + static_cast<int>(any() % (layered ? 15 : 5));
+      if (chance(0.1)) sequence = static_cast<int>(any() % 3);
+      times[sequence] += chance(0.02) ? 1e7 * (any() % 7) : (chance(0.05) ? 0.0 : 1e-5 * (1 + any() % 3));
+      if (layered && chance(0.05)) channel = static_cast<int>(any() % 4);
+    }
+    if (chance(0.02)) r = static_cast<int>(any() % 16);  // writers that number returns oddly
+    const std::uint16_t intensity = static_cast<std::uint16_t>(chance(0.3) ? any() : 1000);
+    std::memcpy(p, &x, 4), std::memcpy(p + 4, &y, 4), std::memcpy(p + 8, &z, 4), std::memcpy(p + 12, &intensity, 2);
+    std::size_t at;
+    if (!layered) {
+      p[14] = static_cast<std::uint8_t>((r & 7) | ((n & 7) << 3) | (chance(0.1) ? 0x40 : 0) | (chance(0.01) ? 0x80 : 0));
+      p[15] = static_cast<std::uint8_t>(chance(0.9) ? 2 : any() % 32);
+      p[16] = static_cast<std::uint8_t>(chance(0.8) ? 0 : any());
+      p[17] = static_cast<std::uint8_t>(chance(0.95) ? 7 : any());
+      const auto source = static_cast<std::uint16_t>(chance(0.01) ? any() : 17);
+      std::memcpy(p + 18, &source, 2);
+      at = 20;
+      if (format == 1 || format == 3) std::memcpy(p + at, &times[sequence], 8), at += 8;
+    } else {
+      p[14] = static_cast<std::uint8_t>((r & 15) | ((n & 15) << 4));
+      p[15] = static_cast<std::uint8_t>((chance(0.05) ? any() % 16 : 0) | (channel << 4) | (chance(0.1) ? 0x40 : 0));
+      p[16] = static_cast<std::uint8_t>(chance(0.9) ? 2 : any());
+      p[17] = static_cast<std::uint8_t>(chance(0.9) ? 0 : any());
+      const auto angle = static_cast<std::int16_t>(chance(0.2) ? any() : -300);
+      const auto source = static_cast<std::uint16_t>(chance(0.01) ? any() : 17);
+      std::memcpy(p + 18, &angle, 2), std::memcpy(p + 20, &source, 2), std::memcpy(p + 22, &times[sequence], 8);
+      at = 30;
+    }
+    const std::size_t colours = format == 2 || format == 3 || format == 7 ? 3 : (format == 8 ? 4 : 0);
+    if (colours) {
+      if (chance(0.3)) rgb[0] = rgb[1] = rgb[2] = static_cast<std::uint16_t>(any());  // grey
+      else if (chance(0.5)) for (auto& c : rgb) c = static_cast<std::uint16_t>(c + any() % 512 - 256);
+      std::memcpy(p + at, rgb, 2 * colours);
+      at += 2 * colours;
+    }
+    for (; at < record_length; ++at) p[at] = static_cast<std::uint8_t>(chance(0.5) ? i : any());
+    for (std::size_t b = 0; b < record_length; ++b)
+      if (chance(noise)) p[b] = static_cast<std::uint8_t>(any());
+  }
+  return out;
+}
+
+TEST(LazEncode, SharedLasFilesRoundTrip) {
+  VOLA_REQUIRE_DATA(data);
+  auto files = vola_io_test::files_ending(data / "las", ".las");
+  ASSERT_FALSE(files.empty());
+  int tested = 0;
+  for (const fs::path& path : files) {
+    SCOPED_TRACE(path.filename().string());
+    const LasFile las = vola_laz_test::read_las_file(path);
+    laz::LaszipInfo info;
+    try {
+      info = laz::laszip_info_for(las.point_format, las.record_length);
+    } catch (const vola::InvalidArgument&) {
+      EXPECT_TRUE(las.point_format == 4 || las.point_format == 5 || las.point_format >= 9);  // wave packets
+      continue;
+    }
+    EXPECT_EQ(info.compressor, las.point_format <= 3 ? 2 : 3);
+    const Bytes records = vola_laz_test::las_records(las);
+    expect_round_trip(info, records, 50000);
+    expect_round_trip(info, records, 333);  // many chunks, the last one short
+    ++tested;
+  }
+  EXPECT_GE(tested, 20);
+}
+
+TEST(LazEncode, SharedLazFilesRoundTripWithTheirOwnItems) {
+  VOLA_REQUIRE_DATA(data);
+  for (const fs::path& path : vola_io_test::files_ending(data / "laz", ".laz")) {
+    SCOPED_TRACE(path.filename().string());
+    const LasFile file = vola_laz_test::read_las_file(path);
+    const laz::LaszipInfo info = laz::parse_laszip_vlr(file.laszip);
+    expect_round_trip(info, vola_laz_test::decode_all(file), info.chunk_size == laz::kVariableChunkSize ? 100 : info.chunk_size);
+  }
+}
+
+TEST(LazEncode, GeneratedStreamsRoundTripInEveryFormat) {
+  for (const std::uint8_t format : {std::uint8_t{0}, std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}, std::uint8_t{6}, std::uint8_t{7}, std::uint8_t{8}}) {
+    for (const std::uint16_t extra : {std::uint16_t{0}, std::uint16_t{1}, std::uint16_t{13}}) {
+      for (double noise : {0.0, 0.05, 1.0}) {
+        SCOPED_TRACE("format " + std::to_string(format) + " extra " + std::to_string(extra) + " noise " +
+                     std::to_string(noise));
+        static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 0, 0, 30, 36, 38};
+        const auto length = static_cast<std::uint16_t>(kBase[format] + extra);
+        const Bytes records = generated_records(format, length, 3000, format * 100u + extra, noise);
+        laz::LaszipInfo info = laz::laszip_info_for(format, length);
+        expect_round_trip(info, records, 1000);
+        if (format >= 6) {  // version 4 items, and COPC-style variable chunks
+          for (auto& item : info.items) item.version = 4;
+          expect_round_trip(info, records, 700);
+          info.chunk_size = laz::kVariableChunkSize;
+          expect_round_trip(info, records, 450);
+        }
+      }
+    }
+  }
+}
+
+TEST(LazEncode, UnchunkedCompressorOneRoundTrips) {
+  const Bytes records = generated_records(3, 34, 2000, 7, 0.01);
+  laz::LaszipInfo info = laz::laszip_info_for(3, 34);
+  info.compressor = 1;
+  expect_round_trip(info, records, 0);
+}
+
+TEST(LazEncode, OnePointChunksAndTinyFiles) {
+  for (const std::uint8_t format : {std::uint8_t{1}, std::uint8_t{7}}) {
+    const std::uint16_t length = format == 1 ? std::uint16_t{28} : std::uint16_t{36};
+    const Bytes records = generated_records(format, length, 5, 3, 0.5);
+    const laz::LaszipInfo info = laz::laszip_info_for(format, length);
+    expect_round_trip(info, records, 1);
+    expect_round_trip(info, Bytes(records.begin(), records.begin() + length), 50000);
+  }
+}
+
+TEST(LazEncode, VlrPayloadRoundTrips) {
+  for (const std::uint8_t format : {std::uint8_t{0}, std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}, std::uint8_t{6}, std::uint8_t{7}, std::uint8_t{8}}) {
+    laz::LaszipInfo info = laz::laszip_info_for(format, 60);
+    EXPECT_EQ(info.record_length(), 60u);
+    EXPECT_EQ(laz::parse_laszip_vlr(laz::laszip_vlr_payload(info)), info);
+  }
+  EXPECT_THROW(laz::laszip_info_for(4, 57), vola::InvalidArgument);
+  EXPECT_THROW(laz::laszip_info_for(3, 30), vola::InvalidArgument);
+}
+
+}  // namespace
