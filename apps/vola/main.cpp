@@ -45,5 +45,6 @@ int main(int argc, char** argv) {
   vola::cli::add_companion_launchers(app);
   vola::cli::add_collide(app);
   vola::cli::add_tile(app);
+  vola::cli::add_translate(app);
   return vola::cli::run_app(app, argc, argv);
 }

@@ -89,7 +89,7 @@ Input read_dem_input(const std::string& path, const InputOptions& options) {
 
 std::vector<InputFormat> make_formats() {
   return {
-      {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10 (LAZ: a clear error)", read_las_input},
+      {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10, and LAZ (compressed LAS, COPC)", read_las_input},
       {"text", {".xyz", ".txt", ".csv", ".pts", ".asc"}, "points as text columns (x y z ...)", read_text_input},
       {"npy", {".npy"}, "NumPy (N,3+) point arrays or (X,Y,Z) occupancy grids", read_npy_input},
       {"ply", {".ply"}, "PLY ascii/binary points, vertex colours, faces as a mesh", read_ply},

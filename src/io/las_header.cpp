@@ -96,6 +96,7 @@ std::uint64_t read_vlrs(const HeaderSource& src, LasHeader& hd, std::uint32_t co
     vlr.description = text(&v[22], 32);
     vlr.offset = at + 54;
     const std::uint16_t length = load_le<std::uint16_t>(&v[20]);
+    vlr.length = length;
     vlr.data = src.read_at(at + 54, length, "VLR data");
     hd.vlrs.push_back(std::move(vlr));
     at += 54 + length;
@@ -105,11 +106,18 @@ std::uint64_t read_vlrs(const HeaderSource& src, LasHeader& hd, std::uint32_t co
 
 // The point format and record layout, checked against the format and the file.
 void check_point_layout(const HeaderSource& src, LasHeader& hd, std::uint8_t raw_format, std::uint64_t vlrs_end) {
-  const bool laszip = std::any_of(hd.vlrs.begin(), hd.vlrs.end(), [](const LasVlr& v) { return v.user_id == "laszip encoded"; });
-  if (raw_format & 0xC0 || laszip)
-    src.fail(104, "this is a LAZ (compressed LAS) file; no LAZ library is packaged for this system. Decompress it "
-                  "first (e.g. `laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`) and convert the .las");
-  hd.point_format = raw_format;
+  const auto laszip = std::find_if(hd.vlrs.begin(), hd.vlrs.end(),
+                                   [](const LasVlr& v) { return v.user_id == "laszip encoded" && v.record_id == 22204; });
+  if (raw_format & 0xC0 || laszip != hd.vlrs.end()) {  // LAZ: bit 7 (6 in LAZ 1.x) marks compressed records
+    if (laszip == hd.vlrs.end())
+      src.fail(104, "the point format says the records are compressed (LAZ) but there is no laszip VLR "
+                    "(user \"laszip encoded\", record 22204)");
+    hd.laszip = laz::parse_laszip_vlr(laszip->data, src.path, laszip->offset);
+    if (hd.laszip->record_length() != hd.record_length)
+      src.fail(105, "record length " + std::to_string(hd.record_length) + " differs from the " +
+                        std::to_string(hd.laszip->record_length()) + " bytes of the laszip VLR's items");
+  }
+  hd.point_format = raw_format & 0x3F;
   if (hd.point_format > 10)
     src.fail(104, "point data record format " + std::to_string(hd.point_format) + " is not known (0..10)");
   if (hd.record_length < las::kMinRecordLength[hd.point_format])
@@ -133,6 +141,7 @@ void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::u
     vlr.description = text(&v[28], 32);
     const std::uint64_t length = load_le<std::uint64_t>(&v[20]);
     vlr.offset = at + 60;
+    vlr.length = length;
     if (vlr.user_id == "LASF_Projection" || vlr.user_id == "LASF_Spec")
       vlr.data = src.read_at(at + 60, length, "EVLR data");
     else if (length > src.file_size - std::min(src.file_size, at + 60))
@@ -193,6 +202,15 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
                              std::to_string(hd.record_length));
 }
 
+// The CRS (GeoKeys, WKT) and the extra-bytes fields, from the (E)VLRs read.
+void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
+  for (const auto& vlr : hd.vlrs) {
+    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8) parse_geokeys(vlr, hd);
+    else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
+    else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
+  }
+}
+
 }  // namespace
 
 void LasReader::read_header() {
@@ -208,16 +226,19 @@ void LasReader::read_header() {
   const std::uint64_t vlrs_end = read_vlrs(src, hd, counts.vlr_count);
   check_point_layout(src, hd, counts.raw_format, vlrs_end);
   read_evlrs(src, hd, counts.evlr_start, counts.evlr_count);
+  if (hd.compressed()) {
+    hd.laz_chunks = laz::read_chunk_table(
+        *hd.laszip, [this](std::uint64_t offset, std::uint64_t size, std::uint8_t* out) { fetch(offset, size, out); },
+        file_size_, hd.offset_to_points, hd.point_count, path_);
+    parse_crs_and_fields(src, hd);
+    return;
+  }
   const std::uint64_t point_bytes = file_size_ - hd.offset_to_points;
   if (hd.point_count > point_bytes / hd.record_length)
     src.fail(hd.offset_to_points, "the header promises " + std::to_string(hd.point_count) + " points of " +
                                       std::to_string(hd.record_length) + " bytes but only " +
                                       std::to_string(point_bytes) + " bytes follow the point data offset (truncated file)");
-  for (const auto& vlr : hd.vlrs) {
-    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8) parse_geokeys(vlr, hd);
-    else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
-    else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
-  }
+  parse_crs_and_fields(src, hd);
   if (in_) in_->seekg(hd.offset_to_points);
 }
 

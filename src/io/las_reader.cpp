@@ -68,7 +68,7 @@ LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& nam
 }
 
 // size bytes at offset (checked by the caller to lie inside the file).
-void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) {
+void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) const {
   if (fd_) {
     std::uint64_t done = 0;
     while (done < size) {
@@ -95,6 +95,7 @@ std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   const LasHeader& hd = header_;
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
   if (n == 0) return {};
+  if (hd.compressed()) return read_laz_records(n);
   const std::size_t length = hd.record_length;
   const std::uint64_t at = hd.offset_to_points + next_ * length;
   if (!fd_ && !in_) {  // in memory; the header check guarantees the records lie inside
@@ -203,6 +204,8 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
 
 void LasReader::rewind() {
   next_ = 0;
+  next_chunk_ = 0;
+  decoded_first_ = decoded_points_ = 0;
   if (in_) {
     in_->clear();
     in_->seekg(header_.offset_to_points);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/io/laz.hpp"
 #include "vola/stream_builder.hpp"
 
 namespace vola::io {
@@ -24,7 +25,8 @@ struct LasVlr {
   std::string description;
   bool extended = false;  // an EVLR (LAS 1.4)
   std::uint64_t offset = 0;  // file offset of the record's data
-  std::vector<std::uint8_t> data;
+  std::uint64_t length = 0;  // bytes of data in the file
+  std::vector<std::uint8_t> data;  // the data (of an EVLR only when it describes the points)
 };
 
 // One "extra bytes" field (LASF_Spec record 4) of each point record.
@@ -50,6 +52,11 @@ struct LasHeader {
   std::vector<LasExtraField> extra_fields;
   std::optional<std::uint32_t> epsg;  // from the GeoKeyDirectory (not user-defined 32767)
   std::string wkt;                    // OGC WKT record (LASF_Projection 2112), if any
+  // LAZ: the laszip VLR (the point records are compressed; point_format is without the
+  // compression bits) and where each chunk of points lies.
+  std::optional<laz::LaszipInfo> laszip;
+  std::vector<laz::ChunkEntry> laz_chunks;
+  bool compressed() const noexcept { return laszip.has_value(); }
   bool has_rgb() const noexcept;
   bool has_gps_time() const noexcept;
   bool extended_format() const noexcept { return point_format >= 6; }
@@ -71,8 +78,8 @@ struct LasChunk {
 
 class LasReader {
  public:
-  // Reads and checks the header and (E)VLRs. A LAZ file gets an error that says so and
-  // what to do. Throws FormatError with file and offset on anything malformed.
+  // Reads and checks the header and (E)VLRs, and for LAZ the laszip VLR and the chunk
+  // table. Throws FormatError with file and offset on anything malformed.
   explicit LasReader(const std::string& path);
   // The same over bytes in memory (copied); `name` labels errors.
   LasReader(std::span<const std::uint8_t> bytes, const std::string& name);
@@ -90,10 +97,17 @@ class LasReader {
   // Back to the first point (for a second pass).
   void rewind();
 
+  // LAZ: chunk `chunk` of header().laz_chunks decoded into `records` (resized to its
+  // point count x record_length). Safe to call from many threads at once on a file
+  // opened by path; throws FormatError naming the chunk and its byte offset.
+  void decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records) const;
+
  private:
   std::string path_;
   void read_header();
-  void fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out);
+  void fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) const;
+  std::span<const std::uint8_t> read_laz_records(std::size_t max_points);
+  void decode_laz_batch();
 
   std::unique_ptr<std::istream> in_;         // only for a file that pread() cannot read (a pipe)
   std::shared_ptr<const int> fd_;            // a regular file, open for pread()
@@ -103,7 +117,22 @@ class LasReader {
   LasHeader header_;
   std::uint64_t next_ = 0;
   std::vector<std::uint8_t> buffer_;
+  // LAZ: records of the chunks decoded last (a batch decoded on all cores), the first
+  // one's point number, and the next chunk to decode.
+  std::vector<std::uint8_t> decoded_;
+  std::uint64_t decoded_first_ = 0, decoded_points_ = 0;
+  std::size_t next_chunk_ = 0;
+  std::vector<std::uint64_t> chunk_first_point_;
 };
+
+// Point records from a LAS or LAZ file into a LAS (.las) or LAZ (.laz, LASzip compressor 2
+// for point formats 0-3, 3 for 6-8) file, record for record and in order: the header,
+// every VLR and EVLR but those of the input's compression (laszip, COPC), so the CRS,
+// extra bytes, GPS times and returns all carry over. The output's kind follows its
+// extension; it is written under a temporary name and renamed when complete.
+// progress(done, total) counts points.
+void translate_las(const std::string& input, const std::string& output,
+                   const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
 // Bytes of records worth reading at once: a batch that stays in L2 while its keys or
 // fields are decoded (a pread() of it from the page cache is a copy through the

@@ -1,0 +1,73 @@
+// vola translate: point files to point files, point by point, no voxels (PDAL's
+// translate): LAS and LAZ in, LAS and LAZ out, every record as it was.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "progress.hpp"
+#include "vola/error.hpp"
+#include "vola/io/las.hpp"
+
+namespace vola::cli {
+
+namespace {
+
+struct TranslateArgs {
+  std::string input, output;
+  bool quiet = false;
+};
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+void run_translate(const TranslateArgs& a) {
+  for (const std::string* path : {&a.input, &a.output}) {
+    const std::string ext = lower_extension(*path);
+    if (ext != ".las" && ext != ".laz")
+      throw InvalidArgument(*path + ": vola translate reads and writes .las and .laz (LAS 1.0-1.4, LAZ, COPC)");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<Progress> progress;
+  if (!a.quiet) progress = std::make_unique<Progress>("translating points");
+  io::translate_las(a.input, a.output, [&](std::uint64_t done, std::uint64_t total) {
+    if (progress) progress->update(done, total);
+  });
+  if (!progress) return;
+  progress->finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const io::LasReader written(a.output);
+  std::printf("points:  %llu, point format %u, %u bytes a record\n",
+              static_cast<unsigned long long>(written.header().point_count), written.header().point_format,
+              written.header().record_length);
+  std::printf("file:    %llu bytes (%s), input %llu bytes\n",
+              static_cast<unsigned long long>(std::filesystem::file_size(a.output)), a.output.c_str(),
+              static_cast<unsigned long long>(std::filesystem::file_size(a.input)));
+  std::printf("time:    %.3f s\n", seconds);
+}
+
+}  // namespace
+
+void add_translate(CLI::App& app) {
+  auto args = std::make_shared<TranslateArgs>();
+  auto* cmd = app.add_subcommand("translate", "Point files to point files, record for record (LAS <-> LAZ), no voxels");
+  cmd->footer(
+      "Every point record is copied as it is, in order: coordinates, returns, classes, GPS time,\n"
+      "colour, NIR, extra bytes; the header, the CRS and the other (E)VLRs too. A .laz output is\n"
+      "LASzip-compressed (compressor 2 for point formats 0-3, 3 for 6-8) in chunks of 50000 points.\n"
+      "Examples:\n"
+      "  vola translate survey.laz survey.las     # decompress\n"
+      "  vola translate survey.las survey.laz     # compress\n"
+      "  vola translate cloud.copc.laz cloud.las  # a COPC file's points, in its chunk order");
+  cmd->add_option("input", args->input, "Input .las or .laz (COPC too)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("output", args->output, "Output .las or .laz")->required();
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->callback([args] { run_translate(*args); });
+}
+
+}  // namespace vola::cli

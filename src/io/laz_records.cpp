@@ -1,0 +1,92 @@
+// LasReader over LAZ: the point records of a compressed file, decoded chunk by chunk
+// with vola's own codec (vola/io/laz.hpp). Chunks are independent, so a batch of them
+// (one per core) is read and decoded at once, and read_records() hands the records out
+// in file order, exactly as from an uncompressed file: every reader of records (the
+// attribute columns, the streaming builder, export) works on LAZ unchanged.
+#include <algorithm>
+
+#include "vola/error.hpp"
+#include "vola/io/las.hpp"
+#include "vola/parallel.hpp"
+
+namespace vola::io {
+
+namespace {
+
+// The decoded bytes of one chunk a file can justify: a chunk's records may not exceed
+// 1 GiB unless its compressed bytes are at least 1/4096 of them (LASzip compresses
+// a record to a few bytes; only a lying chunk table claims more), so that a small file
+// never makes the reader allocate gigabytes.
+void check_chunk_size(const std::string& path, const LasHeader& hd, std::size_t chunk) {
+  const laz::ChunkEntry& c = hd.laz_chunks[chunk];
+  const std::uint64_t bytes = c.point_count * hd.record_length;
+  if (bytes > (std::uint64_t{1} << 30) && bytes / 4096 > c.byte_size)
+    throw FormatError(path, c.byte_offset,
+                      "LAZ chunk " + std::to_string(chunk) + " claims " + std::to_string(c.point_count) +
+                          " points from " + std::to_string(c.byte_size) + " compressed bytes: more than the file can hold");
+}
+
+}  // namespace
+
+void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records) const {
+  const LasHeader& hd = header_;
+  if (chunk >= hd.laz_chunks.size()) throw InvalidArgument(path_ + ": no LAZ chunk " + std::to_string(chunk));
+  check_chunk_size(path_, hd, chunk);
+  const laz::ChunkEntry& c = hd.laz_chunks[chunk];
+  std::vector<std::uint8_t> compressed(static_cast<std::size_t>(c.byte_size));
+  try {
+    fetch(c.byte_offset, c.byte_size, compressed.data());
+  } catch (const FormatError&) {
+    throw FormatError(path_, c.byte_offset, "cannot read LAZ chunk " + std::to_string(chunk) + " (truncated file)");
+  }
+  records.resize(static_cast<std::size_t>(c.point_count) * hd.record_length);
+  laz::decode_chunk(*hd.laszip, compressed, c.point_count, records.data(), hd.record_length, chunk, c.byte_offset,
+                    path_);
+}
+
+// The next chunks (as many as there are threads, the first one at least) decoded into
+// decoded_, in parallel when the file is read with pread (a stream is read serially).
+void LasReader::decode_laz_batch() {
+  const LasHeader& hd = header_;
+  if (chunk_first_point_.empty()) {
+    std::uint64_t first = 0;
+    for (const auto& c : hd.laz_chunks) {
+      chunk_first_point_.push_back(first);
+      first += c.point_count;
+    }
+  }
+  const std::size_t threads = in_ ? 1 : thread_count();
+  const std::size_t begin = next_chunk_, end = std::min(hd.laz_chunks.size(), begin + threads);
+  std::vector<std::vector<std::uint8_t>> records(end - begin);
+  ParallelOptions options;
+  options.threads = static_cast<unsigned>(threads);
+  options.name = "las.decode_laz";
+  parallel_for(
+      end - begin, [&](const Chunk& chunk) { decode_laz_chunk(begin + chunk.index, records[chunk.index]); }, options);
+  std::size_t bytes = 0;
+  for (const auto& r : records) bytes += r.size();
+  decoded_.resize(bytes);
+  std::size_t at = 0;
+  for (const auto& r : records) {
+    std::copy(r.begin(), r.end(), decoded_.begin() + static_cast<std::ptrdiff_t>(at));
+    at += r.size();
+  }
+  decoded_first_ = chunk_first_point_[begin];
+  decoded_points_ = bytes / hd.record_length;
+  next_chunk_ = end;
+}
+
+std::span<const std::uint8_t> LasReader::read_laz_records(std::size_t max_points) {
+  const LasHeader& hd = header_;
+  if (next_ >= decoded_first_ + decoded_points_) {
+    if (next_chunk_ >= hd.laz_chunks.size()) return {};
+    decode_laz_batch();
+  }
+  const std::uint64_t skip = next_ - decoded_first_;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, decoded_points_ - skip));
+  const std::size_t length = hd.record_length;
+  next_ += n;
+  return {decoded_.data() + skip * length, n * length};
+}
+
+}  // namespace vola::io
