@@ -12,6 +12,7 @@
 #include "vola/error.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
+#include "laz_points.hpp"
 #include "vola/synth/city.hpp"
 
 namespace vola::tile {
@@ -157,6 +158,8 @@ class GeneratedSurvey final : public PointSource {
 
 std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_t chunk_points) {
   if (chunk_points == 0) throw InvalidArgument("chunk size must be positive");
+  auto reader = std::make_unique<io::LasReader>(path);  // checks the header, the VLRs and the records' extent
+  if (reader->header().compressed()) return open_laz_points(std::move(reader));
   return std::make_unique<LasPoints>(path, chunk_points);
 }
 

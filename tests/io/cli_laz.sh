@@ -53,6 +53,13 @@ for las in "$data"/las/*.las "$data"/las/permutations/*.las; do
   [ "$(records_sha "$las")" == "$(records_sha "$tmp/round.las")" ] || fail "$(basename "$las"): LAZ round trip changed records"
 done
 
+# vola tile takes LAZ as it takes LAS: the same tiles and index, whatever the threads.
+"$vola" tile "$data/laz/pdal_autzen_trim.laz" --tile-size 256 --depth 4 -o "$tmp/tiles_laz" -q --threads 2
+"$vola" tile "$data/laz/pdal_autzen_trim.laz" --tile-size 256 --depth 4 -o "$tmp/tiles_laz1" -q --threads 1
+"$vola" tile "$data/las/pdal_autzen_trim.las" --tile-size 256 --depth 4 -o "$tmp/tiles_las" -q
+diff -r "$tmp/tiles_laz" "$tmp/tiles_las" > /dev/null || fail "tiles of the LAZ differ from the LAS's"
+diff -r "$tmp/tiles_laz" "$tmp/tiles_laz1" > /dev/null || fail "LAZ tiles differ between 1 and 2 threads"
+
 # A wave-packet format is refused with the reason, not written wrongly.
 if "$vola" translate "$data/las/laspy_simple1_3.las" "$tmp/w.laz" -q 2> "$tmp/err.txt"; then
   fail "a wave-packet LAS was written as LAZ"

@@ -84,6 +84,7 @@ class LasReader {
   // The same over bytes in memory (copied); `name` labels errors.
   LasReader(std::span<const std::uint8_t> bytes, const std::string& name);
   const LasHeader& header() const noexcept { return header_; }
+  const std::string& path() const noexcept { return path_; }
   // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end. With
   // `xyz_only`, only the coordinates are decoded.
   std::size_t read(LasChunk& chunk, std::size_t max_points, bool xyz_only = false);
