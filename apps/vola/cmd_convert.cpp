@@ -60,6 +60,9 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
   std::printf("file:           %llu bytes (%s), input %llu bytes: %.1fx smaller\n",
               static_cast<unsigned long long>(out_bytes), a.output.c_str(), static_cast<unsigned long long>(in_bytes),
               out_bytes ? static_cast<double>(in_bytes) / static_cast<double>(out_bytes) : 0.0);
+  if (report.bytes_read && *report.bytes_read < in_bytes)
+    std::printf("input read:     %llu of its %llu bytes (COPC nodes outside the level or grid skipped)\n",
+                static_cast<unsigned long long>(*report.bytes_read), static_cast<unsigned long long>(in_bytes));
   if (build.voxels)
     std::printf("bits per voxel: %.2f (occupied voxels)\n",
                 8.0 * static_cast<double>(out_bytes) / static_cast<double>(build.voxels));
@@ -131,6 +134,8 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--target-crs", args->options.target_crs,
                   "Reproject the points into this CRS (EPSG code, WKT or PROJ string) before voxelising; "
                   "--voxel-size, --origin and --bbox are then in its units");
+  cmd->add_option("--level", args->options.level,
+                  "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1")->expected(3)->capture_default_str();

@@ -44,6 +44,10 @@ struct ConvertOptions {
   // Point input only; the input's CRS (stated, or `epsg`) is the source. The points are
   // read whole for it (not streamed).
   std::string target_crs;
+  // COPC input: read only the octree's levels 0..level (0 = the root's points), a
+  // coarser sample of the cloud from a small part of the file. With a grid bbox, nodes
+  // outside the grid are skipped whatever the level.
+  std::optional<int> level;
   bool attributes = true;  // keep the per-point attributes the format carries (LAS, PLY, PCD, ...)
   // Text input (XYZ/TXT/CSV); column numbers count from 1, as a user reads the file.
   std::array<int, 3> columns{1, 2, 3};  // x y z
@@ -73,6 +77,9 @@ struct ConvertReport {
   // crs_wkt_only when the input gave a WKT with no code for it.
   std::optional<std::uint32_t> epsg;
   bool crs_wkt_only = false;
+  // Bytes of the input read, when the reader counts them (LAS, LAZ, COPC): with a COPC
+  // file's --level or a grid bbox, less than the file.
+  std::optional<std::uint64_t> bytes_read;
 };
 
 // (done, total) in any unit, now and then during long reads.

@@ -130,7 +130,7 @@ Tree convert(const std::filesystem::path& path, int depth,
              std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
              int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
-             const std::string& target_crs) {
+             const std::string& target_crs, std::optional<int> level) {
   vola::ConvertOptions options;
   options.format = format;
   if (!quantize.empty()) options.quantization = parse_quantization(quantize);
@@ -141,6 +141,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   options.nbits = nbits;
   options.epsg = epsg;
   options.target_crs = target_crs;
+  options.level = level;
   options.attributes = attributes;
   options.columns = columns;
   options.payload_columns = std::move(payload_columns);
@@ -194,7 +195,7 @@ void bind_building(py::module_& m) {
         py::arg("nbits") = 0, py::arg("columns") = std::array<int, 3>{1, 2, 3},
         py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
-        py::arg("output") = py::none(), py::arg("target_crs") = "",
+        py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
         "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
@@ -202,7 +203,7 @@ void bind_building(py::module_& m) {
         "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
         "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
-        "first (grid options then in its units). Voxel grids map cell to voxel unless another grid is asked for.");
+        "first (grid options then in its units); level=L reads a COPC file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

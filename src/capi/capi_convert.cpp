@@ -26,6 +26,7 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   o.nbits = c.nbits;
   if (c.epsg) o.epsg = c.epsg;
   if (c.target_crs) o.target_crs = c.target_crs;
+  if (c.level >= 0) o.level = c.level;
   o.attributes = c.attributes != 0;
   for (int i = 0; i < 3; ++i) o.columns[static_cast<std::size_t>(i)] = c.columns[i];
   o.payload_columns.assign(c.payload_columns, c.payload_columns + c.payload_column_count);
@@ -68,6 +69,7 @@ void vola_convert_options_init(vola_convert_options* options) {
   *options = vola_convert_options{};
   options->quantization = VOLA_QUANTIZE_AUTO;
   options->attributes = 1;
+  options->level = -1;
   options->columns[0] = 1;
   options->columns[1] = 2;
   options->columns[2] = 3;

@@ -29,6 +29,9 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
+  if (options.level && format.name != "las")
+    throw OptionError("level", "applies to COPC input only (" + path + " is " + format.name + ")");
+  input.copc_level = options.level;
   input.progress = progress;
   io::Input loaded = format.read(path, input);
   if (options.solid && !loaded.is_mesh())
@@ -99,6 +102,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.format = format.name;
     report.epsg = crs.epsg;
     report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
+    if (input.bytes_read) report.bytes_read = input.bytes_read();
     *report_out = std::move(report);
   }
   return tree;

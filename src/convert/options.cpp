@@ -108,6 +108,7 @@ void ConvertOptions::check() const {
     if (c < 1) throw OptionError("payload_columns", "column numbers count from 1");
   if (payload_columns.size() > 8) throw OptionError("payload_columns", "a payload word holds at most 8 bytes");
   if (skip_lines < 0) throw OptionError("skip_lines", "must be >= 0");
+  if (level && (*level < 0 || *level > 30)) throw OptionError("level", std::to_string(*level) + " is outside 0..30");
   if (dem_base && !std::isfinite(*dem_base)) throw OptionError("dem_base", "must be finite");
   for (const auto& spec : text_attributes) convert_detail::parse_text_attribute(spec);
   BuildOptions grid = convert_detail::build_options(*this, 2000);

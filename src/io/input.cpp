@@ -21,8 +21,10 @@ namespace {
 
 Input read_las_input(const std::string& path, const InputOptions& options) {
   auto reader = std::make_shared<LasReader>(path);
+  if (options.copc_level) reader->select_copc_nodes(std::nullopt, options.copc_level);
   Input in;
   in.format = "las";
+  in.bytes_read = [reader] { return reader->bytes_read(); };
   in.epsg = reader->header().epsg;
   in.wkt = reader->header().wkt;
   if (options.stream) {

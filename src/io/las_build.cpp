@@ -87,7 +87,7 @@ Box las_bounds(LasReader& reader, std::size_t chunk_points, std::int32_t stored_
         box.max[i % 3] = std::max(box.max[i % 3], xyz[i]);
       }
     }
-    if (reader.points_read() - reported >= chunk_points || reader.points_read() == hd.point_count) {
+    if (reader.points_read() - reported >= chunk_points || reader.points_read() == reader.points_total()) {
       reported = reader.points_read();
       progress(reported);
     }
@@ -259,7 +259,7 @@ std::size_t add_chunk(LasReader& reader, StreamBuilder& builder, std::size_t chu
   const LasHeader& hd = reader.header();
   const std::size_t length = hd.record_length;
   const std::size_t n =
-      static_cast<std::size_t>(std::min<std::uint64_t>(chunk_points, hd.point_count - reader.points_read()));
+      static_cast<std::size_t>(std::min<std::uint64_t>(chunk_points, reader.points_total() - reader.points_read()));
   if (n == 0) return 0;
   const std::size_t batch = batch_points(hd);
   const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
@@ -312,7 +312,7 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions&
                                           std::size_t chunk_points, std::optional<Box>& bounds, std::int32_t lo[3],
                                           std::int32_t hi[3]) {
   const LasHeader& hd = reader.header();
-  if (hd.point_count == 0) return std::nullopt;
+  if (reader.points_total() == 0) return std::nullopt;
   const Box header_box{hd.min, hd.max};
   for (int a = 0; a < 3; ++a)
     if (!(std::isfinite(hd.min[a]) && std::isfinite(hd.max[a]) && hd.min[a] <= hd.max[a])) return std::nullopt;
@@ -334,7 +334,7 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions&
   }
   reader.rewind();
   while (add_chunk<true>(reader, builder, chunk_points, cells, lo, hi) > 0) {
-    if (progress) progress(reader.points_read(), hd.point_count);
+    if (progress) progress(reader.points_read(), reader.points_total());
     // A point well outside the header's box: the header is stale, stop guessing at once.
     // (Writers that round the header's bounds differently from the stored integers put
     // points a step or so outside it; the grid usually comes out the same.)
@@ -358,10 +358,31 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions&
 
 }  // namespace
 
+namespace {
+
+// COPC in grid mode with a given bbox: the grid is known before any point is read, and a
+// node whose cube misses it holds only points the grid drops, so it is never read. (The
+// toolkit's rule clamps outside points onto the border voxels: nothing can be skipped.)
+void skip_copc_nodes_outside_the_grid(LasReader& reader, const BuildOptions& requested) {
+  if (!reader.header().copc || !requested.bbox || requested.quantization != Quantization::grid) return;
+  const Quantizer quantizer = resolve_quantizer(*requested.bbox, requested);
+  const Frame frame = quantizer.frame();
+  const double extent = frame.voxel_size * side_of(quantizer.depth());
+  Box grid;
+  for (int a = 0; a < 3; ++a) {
+    grid.min[a] = frame.origin[a] - frame.voxel_size;  // a voxel of margin for rounding at the faces
+    grid.max[a] = frame.origin[a] + extent + frame.voxel_size;
+  }
+  reader.select_copc_nodes(grid, reader.copc_level());
+}
+
+}  // namespace
+
 Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload, BuildReport* report,
                const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
   BuildOptions options = requested;  // the bbox is filled in from the points when not given
   const LasHeader& hd = reader.header();
+  skip_copc_nodes_outside_the_grid(reader, requested);
   LasChunk chunk;
   const bool occupancy_only = !attributes && !payload;
   // Keys are 8 bytes a point; decoded coordinates (the path without key tables) 24.
@@ -388,13 +409,13 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   if (!options.bbox) {
     reader.rewind();
     options.bbox = las_bounds(reader, chunk_points, stored_lo, stored_hi, [&](std::uint64_t done) {
-      if (progress) progress(done, passes * hd.point_count);
+      if (progress) progress(done, passes * reader.points_total());
     });
   }
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
   std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
   StreamBuilder builder(quantizer, specs, payload);
-  if (!occupancy_only) builder.expect_points(hd.point_count);
+  if (!occupancy_only) builder.expect_points(reader.points_total());
   std::vector<std::vector<double>> values;
   std::vector<std::span<const double>> views;
   std::vector<std::uint64_t> payloads;
@@ -402,12 +423,12 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   // Occupancy only: keys straight from the stored integers (AxisCells), over the range
   // of stored integers the bounds pass saw (or any int32 when the bbox was given).
   AxisCells cells[3];
-  bool by_table = occupancy_only && hd.point_count > 0;
+  bool by_table = occupancy_only && reader.points_total() > 0;
   for (int a = 0; a < 3 && by_table; ++a)
     by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
   reader.rewind();
   while (by_table && add_chunk<false>(reader, builder, chunk_points, cells, stored_lo, stored_hi) > 0) {
-    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+    if (progress) progress((passes - 1) * reader.points_total() + reader.points_read(), passes * reader.points_total());
   }
   while (!by_table) {
     if (occupancy_only) {
@@ -420,7 +441,7 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
       if (payload) las_payloads(hd, chunk, payloads);
       builder.add(chunk.xyz, views, payload ? std::span<const std::uint64_t>(payloads) : std::span<const std::uint64_t>{});
     }
-    if (progress) progress((passes - 1) * hd.point_count + reader.points_read(), passes * hd.point_count);
+    if (progress) progress((passes - 1) * reader.points_total() + reader.points_read(), passes * reader.points_total());
   }
   // The chunk buffers (~100 bytes a point with attributes) are not needed by the final
   // merges, which are the peak of the conversion.

@@ -230,7 +230,11 @@ void LasReader::read_header() {
     hd.laz_chunks = laz::read_chunk_table(
         *hd.laszip, [this](std::uint64_t offset, std::uint64_t size, std::uint8_t* out) { fetch(offset, size, out); },
         file_size_, hd.offset_to_points, hd.point_count, path_);
+    hd.copc = read_copc_hierarchy(
+        hd, [this](std::uint64_t offset, std::uint64_t size, std::uint8_t* out) { fetch(offset, size, out); },
+        file_size_, path_);
     parse_crs_and_fields(src, hd);
+    select_copc_nodes(std::nullopt, std::nullopt);
     return;
   }
   const std::uint64_t point_bytes = file_size_ - hd.offset_to_points;
@@ -239,6 +243,7 @@ void LasReader::read_header() {
                                       std::to_string(hd.record_length) + " bytes but only " +
                                       std::to_string(point_bytes) + " bytes follow the point data offset (truncated file)");
   parse_crs_and_fields(src, hd);
+  points_total_ = hd.point_count;
   if (in_) in_->seekg(hd.offset_to_points);
 }
 

@@ -76,8 +76,10 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   PointCloud cloud;
-  const std::uint64_t total = hd.point_count;
-  cloud.xyz.reserve(3 * total);
+  const std::uint64_t total = reader.points_total();
+  // An uncompressed file's count was checked against its size; a LAZ chunk table's
+  // counts only bound what decoding may find, so its columns grow as points arrive.
+  cloud.xyz.reserve(3 * (hd.compressed() ? std::min<std::uint64_t>(total, std::uint64_t{1} << 22) : total));
   if (attributes)
     for (const auto& spec : las_attributes(hd)) cloud.attributes.push_back({spec.name, spec.type, spec.reduction, {}});
   LasChunk chunk;

@@ -69,6 +69,7 @@ LasReader::LasReader(std::span<const std::uint8_t> bytes, const std::string& nam
 
 // size bytes at offset (checked by the caller to lie inside the file).
 void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) const {
+  bytes_read_ += size;
   if (fd_) {
     std::uint64_t done = 0;
     while (done < size) {
@@ -93,7 +94,7 @@ void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* ou
 
 std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   const LasHeader& hd = header_;
-  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, points_total_ - next_));
   if (n == 0) return {};
   if (hd.compressed()) return read_laz_records(n);
   const std::size_t length = hd.record_length;
@@ -126,7 +127,7 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
   const LasHeader& hd = header_;
   chunk.extra.resize(hd.extra_fields.size());
   const std::size_t length = hd.record_length;
-  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, hd.point_count - next_));
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, points_total_ - next_));
   if (n == 0) return 0;
   // The records come in batches that stay in cache while their fields are spread out.
   const std::size_t batch = std::max<std::size_t>(1, kLasRecordBatchBytes / length);

@@ -44,25 +44,48 @@ void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& r
                     path_);
 }
 
+void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optional<int> max_level) {
+  const LasHeader& hd = header_;
+  if (max_level && !hd.copc)
+    throw InvalidArgument(path_ + ": a level of detail needs a COPC file (an octree of chunks); this one is not");
+  chunk_order_.clear();
+  chunk_first_point_.clear();
+  points_total_ = 0;
+  copc_level_ = max_level;
+  std::vector<std::uint64_t> wanted;  // byte offsets of the selected nodes' chunks
+  if (hd.copc)
+    for (const CopcNode& node : hd.copc->nodes) {
+      if (max_level && node.level > *max_level) continue;
+      if (region) {
+        const Box cube = hd.copc->bounds(node);
+        bool meets = true;
+        for (int a = 0; a < 3; ++a) meets = meets && cube.min[a] <= region->max[a] && cube.max[a] >= region->min[a];
+        if (!meets) continue;
+      }
+      wanted.push_back(node.offset);
+    }
+  std::sort(wanted.begin(), wanted.end());
+  for (std::size_t c = 0; c < hd.laz_chunks.size(); ++c) {
+    if (hd.copc && !std::binary_search(wanted.begin(), wanted.end(), hd.laz_chunks[c].byte_offset)) continue;
+    chunk_order_.push_back(c);
+    chunk_first_point_.push_back(points_total_);
+    points_total_ += hd.laz_chunks[c].point_count;
+  }
+  rewind();
+}
+
 // The next chunks (as many as there are threads, the first one at least) decoded into
 // decoded_, in parallel when the file is read with pread (a stream is read serially).
 void LasReader::decode_laz_batch() {
-  const LasHeader& hd = header_;
-  if (chunk_first_point_.empty()) {
-    std::uint64_t first = 0;
-    for (const auto& c : hd.laz_chunks) {
-      chunk_first_point_.push_back(first);
-      first += c.point_count;
-    }
-  }
   const std::size_t threads = in_ ? 1 : thread_count();
-  const std::size_t begin = next_chunk_, end = std::min(hd.laz_chunks.size(), begin + threads);
+  const std::size_t begin = next_chunk_, end = std::min(chunk_order_.size(), begin + threads);
   std::vector<std::vector<std::uint8_t>> records(end - begin);
   ParallelOptions options;
   options.threads = static_cast<unsigned>(threads);
   options.name = "las.decode_laz";
   parallel_for(
-      end - begin, [&](const Chunk& chunk) { decode_laz_chunk(begin + chunk.index, records[chunk.index]); }, options);
+      end - begin, [&](const Chunk& chunk) { decode_laz_chunk(chunk_order_[begin + chunk.index], records[chunk.index]); },
+      options);
   std::size_t bytes = 0;
   for (const auto& r : records) bytes += r.size();
   decoded_.resize(bytes);
@@ -72,14 +95,14 @@ void LasReader::decode_laz_batch() {
     at += r.size();
   }
   decoded_first_ = chunk_first_point_[begin];
-  decoded_points_ = bytes / hd.record_length;
+  decoded_points_ = bytes / header_.record_length;
   next_chunk_ = end;
 }
 
 std::span<const std::uint8_t> LasReader::read_laz_records(std::size_t max_points) {
   const LasHeader& hd = header_;
   if (next_ >= decoded_first_ + decoded_points_) {
-    if (next_chunk_ >= hd.laz_chunks.size()) return {};
+    if (next_chunk_ >= chunk_order_.size()) return {};
     decode_laz_batch();
   }
   const std::uint64_t skip = next_ - decoded_first_;

@@ -63,6 +63,8 @@ int main(int argc, char **argv) {
       options.epsg = (uint32_t)strtoul(value, NULL, 10);
     } else if (strcmp(key, "target_crs") == 0) {
       options.target_crs = value;
+    } else if (strcmp(key, "level") == 0) {
+      options.level = atoi(value);
     } else if (strcmp(key, "attributes") == 0) {
       options.attributes = atoi(value);
     } else if (strcmp(key, "columns") == 0) {

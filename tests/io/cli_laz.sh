@@ -60,6 +60,31 @@ done
 diff -r "$tmp/tiles_laz" "$tmp/tiles_las" > /dev/null || fail "tiles of the LAZ differ from the LAS's"
 diff -r "$tmp/tiles_laz" "$tmp/tiles_laz1" > /dev/null || fail "LAZ tiles differ between 1 and 2 threads"
 
+# COPC: a window of the grid reads only the nodes that meet it (fewer bytes) and writes
+# the bytes of converting every point; --level reads the octree down to a level.
+copc=$data/laz/laspy_simple_with_page.copc.laz  # its hierarchy has a second page
+window="--voxel-size 5 --bbox 635619.85 848899.70 406.59 636500 849800 600"
+# shellcheck disable=SC2086
+"$vola" convert "$copc" "$tmp/window.vol" $window > "$tmp/window.txt"
+"$vola" translate "$copc" "$tmp/copc.las" -q
+# shellcheck disable=SC2086
+"$vola" convert "$tmp/copc.las" "$tmp/window_all.vol" $window -q
+cmp -s "$tmp/window.vol" "$tmp/window_all.vol" || fail "a COPC window differs from converting all its points"
+read_bytes=$(sed -n 's/^input read: *\([0-9]*\) of its \([0-9]*\) bytes.*/\1 \2/p' "$tmp/window.txt")
+[ -n "$read_bytes" ] || fail "no bytes-read line: $(cat "$tmp/window.txt")"
+set -- $read_bytes
+[ "$1" -lt $(($2 / 2)) ] || fail "the COPC window read $1 of $2 bytes"
+previous=0
+for level in 0 1 2 3; do
+  points=$("$vola" convert "$copc" "$tmp/level.vol" --voxel-size 10 --level $level | sed -n 's/^points in: *\([0-9]*\).*/\1/p')
+  [ "$points" -gt "$previous" ] || fail "--level $level read $points points, not more than level $((level - 1))"
+  previous=$points
+done
+[ "$previous" -eq 1065 ] || fail "the deepest level read $previous of 1065 points"
+"$vola" convert "$data/laz/laspy_simple.laz" "$tmp/x.vol" --voxel-size 10 --level 1 2> "$tmp/err.txt" &&
+  fail "--level accepted for a LAZ that is not COPC"
+grep -q "needs a COPC file" "$tmp/err.txt" || fail "--level message: $(cat "$tmp/err.txt")"
+
 # A wave-packet format is refused with the reason, not written wrongly.
 if "$vola" translate "$data/las/laspy_simple1_3.las" "$tmp/w.laz" -q 2> "$tmp/err.txt"; then
   fail "a wave-packet LAS was written as LAZ"

@@ -25,6 +25,7 @@ struct InputOptions {
   std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
+  std::optional<int> copc_level;   // COPC: only the octree's levels 0..copc_level
 };
 
 // Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).
@@ -47,6 +48,8 @@ struct Input {
   std::function<Tree(const BuildOptions&, BuildReport*)> build;
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
+  // Readers that can skip parts of a file (COPC) say how many bytes they read so far.
+  std::function<std::uint64_t()> bytes_read;
   // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,
   // each to become a column of voxels down (or up) to terrain_base, or only the voxel
   // of its height when terrain_surface_only.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/io/copc.hpp"
 #include "vola/io/laz.hpp"
 #include "vola/stream_builder.hpp"
 
@@ -56,6 +58,7 @@ struct LasHeader {
   // compression bits) and where each chunk of points lies.
   std::optional<laz::LaszipInfo> laszip;
   std::vector<laz::ChunkEntry> laz_chunks;
+  std::optional<CopcHierarchy> copc;  // a COPC file's octree of chunks
   bool compressed() const noexcept { return laszip.has_value(); }
   bool has_rgb() const noexcept;
   bool has_gps_time() const noexcept;
@@ -95,6 +98,19 @@ class LasReader {
   // bounded memory. Requests of ~kLasRecordBatchBytes keep the records in cache.
   std::span<const std::uint8_t> read_records(std::size_t max_points);
   std::uint64_t points_read() const noexcept { return next_; }
+  // The points read() and read_records() give in all: the header's count, or that of the
+  // COPC nodes selected below.
+  std::uint64_t points_total() const noexcept { return points_total_; }
+  // Bytes read from the file so far (header, tables and point data).
+  std::uint64_t bytes_read() const noexcept { return bytes_read_; }
+
+  // COPC: read only the octree nodes down to `max_level` (0 = the root) whose cube meets
+  // `region`, in file order; the points of the others are never read (nor their bytes).
+  // Throws InvalidArgument for a max_level on a file that is not COPC; a region alone on
+  // other files selects everything (they have no index to skip by). Rewinds.
+  void select_copc_nodes(const std::optional<Box>& region, std::optional<int> max_level);
+  // The max_level of the last selection.
+  std::optional<int> copc_level() const noexcept { return copc_level_; }
   // Back to the first point (for a second pass).
   void rewind();
 
@@ -122,8 +138,12 @@ class LasReader {
   // one's point number, and the next chunk to decode.
   std::vector<std::uint8_t> decoded_;
   std::uint64_t decoded_first_ = 0, decoded_points_ = 0;
-  std::size_t next_chunk_ = 0;
-  std::vector<std::uint64_t> chunk_first_point_;
+  std::size_t next_chunk_ = 0;                // into chunk_order_
+  std::vector<std::size_t> chunk_order_;      // the chunks read, in file order (all, or the selected COPC nodes)
+  std::vector<std::uint64_t> chunk_first_point_;  // per entry of chunk_order_
+  std::uint64_t points_total_ = 0;
+  std::optional<int> copc_level_;
+  mutable std::atomic<std::uint64_t> bytes_read_{0};
 };
 
 // Point records from a LAS or LAZ file into a LAS (.las) or LAZ (.laz, LASzip compressor 2
