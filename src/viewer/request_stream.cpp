@@ -1,6 +1,7 @@
 #include "request_stream.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
