@@ -3,6 +3,7 @@
 // budget, on all cores, and on many processes under mpirun.
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -55,6 +56,10 @@ std::uint64_t parse_bytes(const std::string& text) {
 }
 
 std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::size_t chunk_points) {
+  // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    throw InvalidArgument(path + ": not a regular file (inputs are point files on this machine)");
   std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".las" || ext == ".laz") return tile::open_las_points(path, chunk_points);

@@ -14,8 +14,10 @@ namespace {
 
 struct ViewArgs {
   std::vector<std::string> files;
-  int port = 0;
+  viewer::ServerOptions server;
 };
+
+std::string url_host(const std::string& host) { return host.find(':') != std::string::npos ? "[" + host + "]" : host; }
 
 void run_view(const ViewArgs& a) {
   std::vector<std::unique_ptr<viewer::ViewedFile>> files;
@@ -24,11 +26,11 @@ void run_view(const ViewArgs& a) {
     files.push_back(std::make_unique<viewer::ViewedFile>(path));
     voxels += files.back()->tree().voxel_count();
   }
-  viewer::Server server(std::move(files));
-  const int port = server.bind(a.port);
+  viewer::Server server(std::move(files), a.server);
+  const int port = server.bind();
   std::printf("vola view: %zu file%s, %llu voxels\n", a.files.size(), a.files.size() == 1 ? "" : "s",
               static_cast<unsigned long long>(voxels));
-  std::printf("open http://127.0.0.1:%d/ in a browser (loopback only; Ctrl-C stops)\n", port);
+  std::printf("open http://%s:%d/ in a browser (Ctrl-C stops)\n", url_host(a.server.host).c_str(), port);
   std::fflush(stdout);
   server.listen();
 }
@@ -47,10 +49,18 @@ void add_view(CLI::App& app) {
       "The page needs no network: three.js is compiled into this binary.\n\n"
       "Examples:\n"
       "  vola view scan.vol\n"
-      "  vola view survey2019.vol survey2024.vol --port 8080");
+      "  vola view survey2019.vol survey2024.vol --port 8080\n"
+      "  vola view scan.vol --host 0.0.0.0 --port 8080 --allow-host mybox.local");
   cmd->add_option("files", args->files, ".vol files to show")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--port", args->port, "Port on 127.0.0.1 (default 0: a free one, printed)")
+  cmd->add_option("--port", args->server.port, "Port to listen on (default 0: a free one, printed)")
       ->check(CLI::Range(0, 65535));
+  cmd->add_option("--host", args->server.host,
+                  "Address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 or a LAN address\n"
+                  "shows the files to the network, to anyone who can reach it)")
+      ->capture_default_str();
+  cmd->add_option("--allow-host", args->server.host_names,
+                  "A name clients may use in the URL besides localhost, 127.0.0.1, [::1] and --host\n"
+                  "(e.g. this machine's name with --host 0.0.0.0); other names get 403");
   cmd->callback([args] { run_view(*args); });
 }
 

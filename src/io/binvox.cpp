@@ -38,6 +38,29 @@ void append_run(std::vector<std::uint8_t>& out, std::uint8_t value, std::uint64_
   }
 }
 
+// Calls f(value, first cell, count) for each run from `at`, checking each against the
+// grid's `cells`; returns the number of occupied cells.
+template <class F>
+std::uint64_t walk_runs(std::span<const std::uint8_t> bytes, std::size_t at, std::uint64_t cells,
+                        const std::string& name, F&& f) {
+  std::uint64_t index = 0, occupied = 0;
+  while (index < cells) {
+    if (bytes.size() - at < 2)
+      throw FormatError(name, at, "the runs end after " + std::to_string(index) + " of " + std::to_string(cells) +
+                                      " cells (truncated file)");
+    const std::uint8_t value = bytes[at], count = bytes[at + 1];
+    if (value > 1) throw FormatError(name, at, "run value " + std::to_string(value) + " is not 0 or 1");
+    if (count > cells - index)
+      throw FormatError(name, at + 1, "a run of " + std::to_string(count) + " cells passes the grid's " +
+                                          std::to_string(cells) + " cells");
+    f(value, index, count);
+    if (value) occupied += count;
+    index += count;
+    at += 2;
+  }
+  return occupied;
+}
+
 }  // namespace
 
 VoxelGrid parse_binvox(std::span<const std::uint8_t> bytes, const std::string& name) {
@@ -102,25 +125,23 @@ VoxelGrid parse_binvox(std::span<const std::uint8_t> bytes, const std::string& n
   grid.dims = {static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(b)};
   grid.origin = translate;
   grid.voxel_size = scale / static_cast<double>(std::max({a, b, c}));
-  std::uint64_t index = 0;
-  while (index < cells) {
-    if (bytes.size() - at < 2)
-      throw FormatError(name, at, "the runs end after " + std::to_string(index) + " of " + std::to_string(cells) +
-                                      " cells (truncated file)");
-    const std::uint8_t value = bytes[at], count = bytes[at + 1];
-    if (value > 1) throw FormatError(name, at, "run value " + std::to_string(value) + " is not 0 or 1");
-    if (count > cells - index)
-      throw FormatError(name, at + 1, "a run of " + std::to_string(count) + " cells passes the grid's " +
-                                          std::to_string(cells) + " cells");
-    if (value)
-      for (std::uint64_t i = index; i < index + count; ++i) {
-        const std::uint64_t x = i / (b * c), zy = i % (b * c);
-        grid.voxels.push_back(
-            {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(zy % c), static_cast<std::uint32_t>(zy / c)});
-      }
-    index += count;
-    at += 2;
-  }
+  // First the runs alone: how many voxels they set, before storing any.
+  const std::uint64_t occupied = walk_runs(bytes, at, cells, name, [](std::uint8_t, std::uint64_t, std::uint64_t) {});
+  const std::uint64_t limit = kBinvoxVoxelAllowance + kBinvoxVoxelsPerByte * bytes.size();
+  if (occupied > limit)
+    throw FormatError(name, at, "the runs set " + std::to_string(occupied) + " voxels, more than the " +
+                                    std::to_string(limit) + " this reader holds for a file of " +
+                                    std::to_string(bytes.size()) + " bytes (kBinvoxVoxelAllowance + " +
+                                    std::to_string(kBinvoxVoxelsPerByte) + " per byte)");
+  grid.voxels.reserve(static_cast<std::size_t>(occupied));
+  walk_runs(bytes, at, cells, name, [&](std::uint8_t value, std::uint64_t first, std::uint64_t count) {
+    if (!value) return;
+    for (std::uint64_t i = first; i < first + count; ++i) {
+      const std::uint64_t x = i / (b * c), zy = i % (b * c);
+      grid.voxels.push_back(
+          {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(zy % c), static_cast<std::uint32_t>(zy / c)});
+    }
+  });
   return grid;
 }
 

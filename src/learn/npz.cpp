@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "vola/error.hpp"
@@ -57,39 +58,68 @@ std::vector<std::string> npz_array_names(const std::string& path) {
   return names;
 }
 
-io::NpyArray read_npz_array(const std::string& path, const std::string& name) {
-  Archive archive = open_archive(path);
-  const std::string member = name + std::string(kNpySuffix);
-  const zip_int64_t index = zip_name_locate(archive.get(), member.c_str(), 0);
-  if (index < 0) throw FormatError(path, std::nullopt, "no array '" + name + "' (member " + member + ") in the archive");
+namespace {
+
+// The sizes the zip directory states for `member`, checked against the archive's own
+// length: the directory is bytes of the file like any other (a ZIP64 entry can claim
+// 8 GiB of stored data in a 2.5 KB file), so a member is believed to hold no more than
+// the archive holds, times deflate's best ratio.
+zip_stat_t checked_stat(zip_t* archive, zip_int64_t index, const std::string& path, const std::string& member) {
   zip_stat_t stat;
   zip_stat_init(&stat);
-  if (zip_stat_index(archive.get(), static_cast<zip_uint64_t>(index), 0, &stat) != 0 ||
-      !(stat.valid & ZIP_STAT_SIZE) || !(stat.valid & ZIP_STAT_COMP_SIZE))
-    throw FormatError(path, std::nullopt, member + ": no sizes in the zip directory: " + archive_error(archive.get()));
+  if (zip_stat_index(archive, static_cast<zip_uint64_t>(index), 0, &stat) != 0 || !(stat.valid & ZIP_STAT_SIZE) ||
+      !(stat.valid & ZIP_STAT_COMP_SIZE))
+    throw FormatError(path, std::nullopt, member + ": no sizes in the zip directory: " + archive_error(archive));
+  std::error_code error;
+  const std::uint64_t archive_bytes = std::filesystem::file_size(path, error);
+  if (error) throw IoError("cannot read the size of " + path + ": " + error.message());
+  if (stat.comp_size > archive_bytes)
+    throw FormatError(path, std::nullopt,
+                      member + ": the zip directory states " + std::to_string(stat.comp_size) +
+                          " compressed bytes, more than the archive's " + std::to_string(archive_bytes));
   const bool stored = stat.comp_method == ZIP_CM_STORE;
   const std::uint64_t limit = stored ? stat.comp_size : stat.comp_size * kMaxDeflateRatio + 1024;
   if (stat.size > limit)
     throw FormatError(path, std::nullopt,
                       member + ": states " + std::to_string(stat.size) + " bytes, more than its " +
                           std::to_string(stat.comp_size) + " compressed bytes can hold");
+  return stat;
+}
+
+// Reads exactly `size` bytes of the member, growing the buffer as the bytes arrive
+// rather than trusting `size` up front.
+std::vector<std::uint8_t> read_member(zip_file_t* file, std::uint64_t size, const std::string& path,
+                                      const std::string& member) {
+  constexpr std::uint64_t kChunk = std::uint64_t{1} << 20;
+  std::vector<std::uint8_t> bytes;
+  while (bytes.size() < size) {
+    const std::size_t done = bytes.size();
+    bytes.resize(done + std::min(kChunk, size - done));
+    const zip_int64_t got = zip_fread(file, bytes.data() + done, bytes.size() - done);
+    if (got < 0) throw FormatError(path, std::nullopt, member + ": cannot inflate: " + zip_file_strerror(file));
+    bytes.resize(done + static_cast<std::size_t>(got));
+    if (got == 0) break;
+  }
+  if (bytes.size() != size)
+    throw FormatError(path, std::nullopt,
+                      member + ": ends after " + std::to_string(bytes.size()) + " of " + std::to_string(size) + " bytes");
+  std::uint8_t extra = 0;
+  if (zip_fread(file, &extra, 1) > 0)
+    throw FormatError(path, std::nullopt, member + ": inflates past its stated " + std::to_string(size) + " bytes");
+  return bytes;
+}
+
+}  // namespace
+
+io::NpyArray read_npz_array(const std::string& path, const std::string& name) {
+  Archive archive = open_archive(path);
+  const std::string member = name + std::string(kNpySuffix);
+  const zip_int64_t index = zip_name_locate(archive.get(), member.c_str(), 0);
+  if (index < 0) throw FormatError(path, std::nullopt, "no array '" + name + "' (member " + member + ") in the archive");
+  const zip_stat_t stat = checked_stat(archive.get(), index, path, member);
   std::unique_ptr<zip_file_t, ZipFileCloser> file(zip_fopen_index(archive.get(), static_cast<zip_uint64_t>(index), 0));
   if (!file) throw FormatError(path, std::nullopt, member + ": cannot open: " + archive_error(archive.get()));
-  std::vector<std::uint8_t> bytes(stat.size);
-  std::uint64_t done = 0;
-  while (done < bytes.size()) {
-    const zip_int64_t got = zip_fread(file.get(), bytes.data() + done, bytes.size() - done);
-    if (got < 0) throw FormatError(path, std::nullopt, member + ": cannot inflate: " + zip_file_strerror(file.get()));
-    if (got == 0) break;
-    done += static_cast<std::uint64_t>(got);
-  }
-  if (done != bytes.size())
-    throw FormatError(path, std::nullopt, member + ": ends after " + std::to_string(done) + " of " +
-                                        std::to_string(bytes.size()) + " bytes");
-  std::uint8_t extra = 0;
-  if (zip_fread(file.get(), &extra, 1) > 0)
-    throw FormatError(path, std::nullopt, member + ": inflates past its stated " + std::to_string(stat.size) + " bytes");
-  return io::parse_npy(bytes, path + ":" + member);
+  return io::parse_npy(read_member(file.get(), stat.size, path, member), path + ":" + member);
 }
 
 LabelledGrids read_labelled_grids(const std::string& path, const std::string& split_wanted) {

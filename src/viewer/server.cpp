@@ -8,6 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bounded_http_server.hpp"
+#include "request_guard.hpp"
+#include "transport.hpp"
 #include "vola/error.hpp"
 #include "web_assets.hpp"
 
@@ -19,9 +22,11 @@ struct NotFound : Error {
   using Error::Error;
 };
 
+// Text from a request (a path, a parameter, a file name) may not be UTF-8: replace what is
+// not rather than throw (a throw from httplib's error handler ends the process).
 void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
   res.status = status;
-  res.set_content(body.dump(), "application/json");
+  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), "application/json");
 }
 
 std::string param(const httplib::Request& req, const char* name) {
@@ -53,8 +58,21 @@ double real_param(const httplib::Request& req, const char* name) {
 }  // namespace
 
 struct Server::Impl {
+  Impl(std::vector<std::unique_ptr<ViewedFile>> f, ServerOptions o)
+      : files(std::move(f)), options(std::move(o)), names(names_of(options)), http(options.limits) {
+    names.set_port(options.port);
+  }
+
   std::vector<std::unique_ptr<ViewedFile>> files;
-  httplib::Server http;
+  ServerOptions options;
+  HostNames names;
+  BoundedHttpServer http;
+
+  static HostNames names_of(const ServerOptions& o) {
+    std::vector<std::string> all = o.host_names;
+    all.push_back(o.host);
+    return HostNames(std::move(all));
+  }
 
   const ViewedFile& file(const httplib::Request& req) const {
     const std::string& text = req.matches[1];
@@ -77,6 +95,22 @@ struct Server::Impl {
         send_json(res, 400, {{"error", e.what()}});
       }
     };
+  }
+
+  void guards() {
+    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+      const auto refusal = refuse_before_routing(req, names);
+      if (!refusal) return httplib::Server::HandlerResponse::Unhandled;
+      send_json(res, refusal->status, {{"error", refusal->cause}});
+      return httplib::Server::HandlerResponse::Handled;
+    });
+    // An error answer closes the connection (bounded_http_server.cpp): say so.
+    http.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
+      if (res.status >= 400) {
+        res.set_header("Connection", "close");
+        res.headers.erase("Keep-Alive");
+      }
+    });
   }
 
   void routes() {
@@ -120,8 +154,16 @@ struct Server::Impl {
       if (req.has_param("tmax")) ray.t_max = real_param(req, "tmax");
       send_json(res, 200, f.pick(level, ray));
     }));
-    http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
-      if (res.status == 404 && res.body.empty()) send_json(res, 404, {{"error", "no such path: " + req.path}});
+    // Called outside httplib's try: whatever goes wrong here must not escape.
+    http.set_error_handler([](const httplib::Request& req, httplib::Response& res) noexcept {
+      if (!res.body.empty()) return;
+      try {
+        send_json(res, res.status,
+                  {{"error", res.status == 404 ? "no such path: " + req.path
+                                               : "the request is not one this server understands (status " +
+                                                     std::to_string(res.status) + ")"}});
+      } catch (...) {
+      }
     });
     // Anything else a handler throws (bad_alloc, ...): a 500 with its message, never a crash.
     http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
@@ -137,24 +179,30 @@ struct Server::Impl {
   }
 };
 
-Server::Server(std::vector<std::unique_ptr<ViewedFile>> files) : impl_(std::make_unique<Impl>()) {
-  impl_->files = std::move(files);
+Server::Server(std::vector<std::unique_ptr<ViewedFile>> files, ServerOptions options)
+    : impl_(std::make_unique<Impl>(std::move(files), std::move(options))) {
+  impl_->guards();
   impl_->routes();
 }
 
 Server::~Server() = default;
 
-int Server::bind(int port) {
-  // Loopback only: the page and the files it shows are for this machine's user.
-  const char* host = "127.0.0.1";
-  if (port == 0) {
-    const int bound = impl_->http.bind_to_any_port(host);
-    if (bound <= 0) throw IoError("cannot bind a free port on 127.0.0.1");
-    return bound;
-  }
-  if (port < 0 || port > 65535 || !impl_->http.bind_to_port(host, port))
-    throw IoError("cannot bind 127.0.0.1:" + std::to_string(port) + " (in use or not allowed)");
-  return port;
+int Server::bind() {
+  const std::string& host = impl_->options.host;
+  const int port = impl_->options.port;
+  if (port < 0 || port > 65535) throw IoError("cannot bind port " + std::to_string(port) + ": not in 0..65535");
+  const int bound = port == 0 ? impl_->http.bind_to_any_port(host) : (impl_->http.bind_to_port(host, port) ? port : -1);
+  if (bound <= 0)
+    throw IoError("cannot bind " + host + ":" + (port == 0 ? std::string("(a free port)") : std::to_string(port)) +
+                  " (in use, not an address of this machine, or not allowed)");
+  impl_->names.set_port(bound);
+  return bound;
+}
+
+std::string Server::respond(std::string_view request) {
+  MemoryTransport transport(request);
+  impl_->http.serve(transport);
+  return std::move(transport.output());
 }
 
 void Server::listen() {

@@ -35,7 +35,11 @@ nlohmann::json json_point(const Point& p) { return nlohmann::json::array({p[0], 
 }  // namespace
 
 ViewedFile::ViewedFile(const std::string& path)
-    : path_(path), tree_(open_mapped(path, &layout_)), index_(tree_), levels_(static_cast<std::size_t>(tree_.depth())) {
+    : path_(path),
+      name_(std::filesystem::path(path).filename().string()),
+      tree_(open_mapped(path, &layout_)),
+      index_(tree_),
+      levels_(static_cast<std::size_t>(tree_.depth())) {
   classes_ = find_column(tree_, "classification");
   rgb_ = {find_column(tree_, "red"), find_column(tree_, "green"), find_column(tree_, "blue")};
   if (!rgb_[0] || !rgb_[1] || !rgb_[2]) rgb_ = {};
@@ -63,7 +67,7 @@ ViewedFile::~ViewedFile() = default;
 
 void ViewedFile::check_level(int level) const {
   if (level < 0 || level >= tree_.depth())
-    throw InvalidArgument(path_ + ": level " + std::to_string(level) + " is outside 0.." +
+    throw InvalidArgument(name_ + ": level " + std::to_string(level) + " is outside 0.." +
                           std::to_string(tree_.depth() - 1));
 }
 
@@ -85,8 +89,7 @@ nlohmann::json ViewedFile::metadata() const {
       classes.push_back({{"code", code},
                          {"name", std::string(analysis::asprs_class_name(static_cast<int>(code)))},
                          {"voxels", class_counts_[code]}});
-  return {{"name", std::filesystem::path(path_).filename().string()},
-          {"path", path_},
+  return {{"name", name_},
           {"file_bytes", layout_.file_size},
           {"voxels", tree_.voxel_count()},
           {"voxels_min", {voxels_min_.x, voxels_min_.y, voxels_min_.z}},

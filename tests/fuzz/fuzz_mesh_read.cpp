@@ -1,6 +1,6 @@
 // Fuzz entry point of the mesh reader through Assimp (io::read_mesh_with_assimp, what the
 // Assimp plugin runs, compiled into this program): the first byte picks the file kind
-// (STL, OBJ, OFF, PLY, glTF: modulo 5), the rest is the file, written to a scratch file
+// (STL, OBJ, OFF, COLLADA, glTF: modulo 5; vola reads PLY itself, not through Assimp), the rest is the file, written to a scratch file
 // with that extension. Only vola::Error may escape; what parses must hold at least one
 // and at most kMaxMeshTriangles triangles.
 #include <cstddef>
@@ -21,7 +21,7 @@ Stats& stats() {
 }
 // The extension of each selector value (fuzz_mesh_read_seeds.cpp writes seeds with it).
 extern const char* const kMeshExtensions[5];
-const char* const kMeshExtensions[5] = {"stl", "obj", "off", "ply", "gltf"};
+const char* const kMeshExtensions[5] = {"stl", "obj", "off", "dae", "gltf"};
 }  // namespace vola_fuzz
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

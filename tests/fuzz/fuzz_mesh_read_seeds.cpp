@@ -1,6 +1,6 @@
 // Seeds for fuzz_mesh_read: the small mesh files of the shared data folder (beside
 // golden/) and a tetrahedron in each kind the entry point picks (STL ascii and binary,
-// OBJ, OFF, PLY, glTF with an embedded buffer), each prefixed with its selector byte.
+// OBJ, OFF, glTF with an embedded buffer), each prefixed with its selector byte.
 // Linked into fuzz_mesh_read_replay in place of fuzz_seeds.cpp.
 #include <algorithm>
 #include <cstring>
@@ -96,24 +96,20 @@ Bytes read_all(const std::filesystem::path& path) {
 }  // namespace
 
 std::vector<Seed> synthetic_seeds() {
-  std::string obj, off = "OFF\n4 4 0\n", ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
-                                              "property float y\nproperty float z\nelement face 4\n"
-                                              "property list uchar int vertex_indices\nend_header\n";
+  std::string obj, off = "OFF\n4 4 0\n";
   for (const auto& v : kVertex) {
     const std::string xyz = std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
     obj += "v " + xyz;
     off += xyz;
-    ply += xyz;
   }
   for (const auto& f : kFace) {
     obj += "f " + std::to_string(f[0] + 1) + " " + std::to_string(f[1] + 1) + " " + std::to_string(f[2] + 1) + "\n";
     const std::string face = "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
     off += face;
-    ply += face;
   }
   return {seed("tetra_ascii.stl", "stl", text(ascii_stl())), seed("tetra_binary.stl", "stl", binary_stl()),
           seed("tetra.obj", "obj", text(obj)),                seed("tetra.off", "off", text(off)),
-          seed("tetra.ply", "ply", text(ply)),                seed("tetra.gltf", "gltf", text(gltf()))};
+          seed("tetra.gltf", "gltf", text(gltf()))};
 }
 
 // The shared data folder's mesh files of at most 64 KiB (larger ones make each

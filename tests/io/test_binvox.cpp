@@ -6,6 +6,7 @@
 #include <random>
 
 #include "io_test_data.hpp"
+#include "memory_cap.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/input.hpp"
 
@@ -199,6 +200,31 @@ TEST(Binvox, CorruptedInputIsAFormatErrorNamingTheProblem) {
   }
   // Runs past the last cell are left alone (nothing follows in a binvox file).
   EXPECT_EQ(vola::io::parse_binvox(binvox_text(head, {1, 8, 0, 0, 7}), "tail").voxels.size(), 8u);
+}
+
+}  // namespace
+
+namespace {
+
+// 255 M cells in a 2 MB file, every run (1, 255): the reader expanded them into 3 GB of
+// 12-byte voxels. Refused from the run count, under a 2 GiB address-space cap.
+TEST(Binvox, RunsThatSetMoreVoxelsThanTheFileJustifiesAreRefused) {
+  const std::size_t pairs = 1'000'000;
+  Bytes bytes = binvox_text("#binvox 1\ndim 255 1000 1000\ndata\n", {});
+  const std::size_t data_at = bytes.size();
+  for (std::size_t i = 0; i < pairs; ++i) bytes.insert(bytes.end(), {1, 255});
+  const std::string outcome = vola_test::run_with_memory_cap([&] {
+    vola::io::parse_binvox(bytes, "solid.binvox");
+    return std::string("read");
+  });
+  EXPECT_EQ(outcome.rfind("FormatError: solid.binvox: byte " + std::to_string(data_at) + ": the runs set 255000000 voxels", 0),
+            0u)
+      << outcome;
+  // A fully solid 256^3 grid (65 793 run pairs) stays within the allowance.
+  Bytes solid = binvox_text("#binvox 1\ndim 256 256 256\ndata\n", {});
+  for (std::uint64_t left = 256u * 256u * 256u; left > 0; left -= std::min<std::uint64_t>(left, 255))
+    solid.insert(solid.end(), {1, static_cast<std::uint8_t>(std::min<std::uint64_t>(left, 255))});
+  EXPECT_EQ(vola::io::parse_binvox(solid, "cube.binvox").voxels.size(), 256u * 256u * 256u);
 }
 
 }  // namespace

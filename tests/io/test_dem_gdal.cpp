@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "../mesh/mesh_test_support.hpp"
+#include "crafted_tiff.hpp"
+#include "memory_cap.hpp"
 #include "vola/error.hpp"
 #include "vola/io/dem.hpp"
 #include "vola/io/input.hpp"
@@ -181,6 +183,63 @@ TEST(DemGdal, FilesGdalCannotReadThrowFormatErrors) {
   bytes.resize(bytes.size() / 2);
   vola_test::write_bytes(dir / "half.tif", bytes);
   EXPECT_THROW(vola::io::read_dem((dir / "half.tif").string()), vola::FormatError);
+}
+
+}  // namespace
+
+namespace {
+
+std::string outcome_of_read_dem(const std::string& path) {
+  return vola_test::run_with_memory_cap([&] {
+    const auto dem = vola::io::read_dem(path);
+    return "read " + std::to_string(dem.cells.size()) + " cells";
+  });
+}
+
+// A VRT saved as .tif pulled another local file's cells into the output; a /vsicurl/
+// path made GDAL go to the network; a directory reached GDAL's directory drivers.
+TEST(DemGdal, OnlyLocalFilesOfTheDemDriversAreOpened) {
+  vola_test::TempDir dir;
+  Raster secret{2, 2, GDT_Float32, {11, 22, 33, 44}, {0, 1, 0, 0, 0, -1}, std::nullopt, 1.0, 0.0, 0};
+  write_geotiff(dir / "secret.tif", secret);
+  std::ofstream(dir / "innocent.tif")
+      << "<VRTDataset rasterXSize=\"2\" rasterYSize=\"2\"><VRTRasterBand dataType=\"Float32\" band=\"1\">"
+         "<SimpleSource><SourceFilename relativeToVRT=\"0\">"
+      << (dir / "secret.tif").string()
+      << "</SourceFilename><SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>\n";
+  const auto vrt = vola_test::format_error_of([&] { vola::io::read_dem((dir / "innocent.tif").string()); });
+  ASSERT_TRUE(vrt.has_value());
+  EXPECT_NE(vrt->cause().find("no DEM driver reads it"), std::string::npos) << vrt->what();
+  for (const std::string& path : {std::string("/vsicurl/http://127.0.0.1:9/dem.tif"),
+                                  "/vsizip/" + (dir / "x.zip").string() + "/dem.tif", (dir / "").string()}) {
+    const auto error = vola_test::format_error_of([&] { vola::io::read_dem(path); });
+    ASSERT_TRUE(error.has_value()) << path;
+    EXPECT_TRUE(error->cause().find("/vsi") != std::string::npos || error->cause().find("not a regular file") != std::string::npos)
+        << error->what();
+  }
+  EXPECT_EQ(vola::io::read_dem((dir / "secret.tif").string()).cells.size(), 4u);  // the file itself still reads
+}
+
+// A few hundred bytes declaring one deflated 2048 x 2048 strip of 256 float samples per
+// pixel: GDAL allocates the 4 GiB block on the first read. Refused from the sizes, within 2 GiB.
+TEST(DemGdal, BlocksTheFileCannotJustifyAreRefusedBeforeReading) {
+  vola_test::TempDir dir;
+  const fs::path path = dir / "block.tif";
+  vola_test::write_bytes(path, vola_io_test::crafted_tiff({2048, 2048, 256, 32, 2048, 0, 64, 8}));
+  ASSERT_LT(fs::file_size(path), 400u);
+  const std::string outcome = outcome_of_read_dem(path.string());
+  EXPECT_EQ(outcome.rfind("FormatError: " + path.string() + ": a block of 2048 x 2048 cells x 256 samples takes", 0), 0u)
+      << outcome;
+}
+
+// 16384 x 16384 sparse tiles (no data at all: GDAL reads them as zeros, each a valid
+// cell of 24 bytes of points): 6.4 GB of cells from a 33 KB file.
+TEST(DemGdal, CellsTheFileCannotJustifyAreRefusedBeforeReading) {
+  vola_test::TempDir dir;
+  const fs::path path = dir / "sparse.tif";
+  vola_test::write_bytes(path, vola_io_test::crafted_tiff({16384, 16384, 1, 32, 1, 256}));
+  const std::string outcome = outcome_of_read_dem(path.string());
+  EXPECT_EQ(outcome.rfind("FormatError: " + path.string() + ": declares 16384 x 16384 cells", 0), 0u) << outcome;
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 // .npz reading: the labelled grid layout, dtype conversions and every refusal.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "learn_test_data.hpp"
+#include "memory_cap.hpp"
 #include "test_support.hpp"
 #include "vola/error.hpp"
 #include "vola/learn/npz.hpp"
@@ -98,6 +101,62 @@ TEST(Npz, RefusesFilesThatAreNotArchives) {
   const std::string junk = (dir / "junk.npz").string();
   write_npz(junk, {{"X_train", Bytes(64, 7)}, {"y_train", labels_npy({0})}});
   EXPECT_NE(read_error(junk).find("X_train.npy"), std::string::npos) << read_error(junk);
+}
+
+// Sets the central directory's compressed and uncompressed sizes of `member` (the
+// sizes libzip reports) in the archive bytes.
+void lie_about_sizes(Bytes& zip, const std::string& member, std::uint32_t compressed, std::uint32_t size) {
+  for (std::size_t at = 0; at + 46 + member.size() <= zip.size(); ++at) {
+    if (std::memcmp(zip.data() + at, "PK\x01\x02", 4) != 0) continue;
+    const std::size_t name_length = zip[at + 28] | (zip[at + 29] << 8);
+    if (std::string(reinterpret_cast<const char*>(zip.data() + at + 46), name_length) != member) continue;
+    for (int i = 0; i < 4; ++i) {
+      zip[at + 20 + i] = static_cast<std::uint8_t>(compressed >> (8 * i));
+      zip[at + 24 + i] = static_cast<std::uint8_t>(size >> (8 * i));
+    }
+    return;
+  }
+  FAIL() << "no central directory entry for " << member;
+}
+
+// A zip directory that claims 4 GiB for a member of a few kilobytes: the reader
+// allocated what it claimed (4.35 GB for a 2.5 KB file). Run under a 2 GiB cap.
+TEST(Npz, SizesTheArchiveCannotHoldAreRefusedBeforeAllocating) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "lying.npz").string();
+  write_npz(path, {{"X_train", grids_npy(three_grids(), 32)}, {"y_train", labels_npy({0, 3, 9})}});
+  Bytes zip = vola_test::read_bytes(path);
+  lie_about_sizes(zip, "X_train.npy", 0xFFFFFF00u, 0xFFFFFF00u);
+  vola_test::write_bytes(path, zip);
+  const std::string outcome = vola_test::run_with_memory_cap([&] {
+    read_labelled_grids(path);
+    return std::string("read");
+  });
+  EXPECT_NE(outcome.find("FormatError: " + path + ": X_train.npy: the zip directory states 4294967040 compressed "
+                         "bytes, more than the archive's"),
+            std::string::npos)
+      << outcome;
+  // A size deflate could reach from the compressed bytes (3 MiB of random bytes claimed
+  // to inflate to 2.1 GB): the buffer grows with what actually inflates.
+  Bytes noise(3 << 20);
+  std::uint64_t state = 12345;
+  for (auto& b : noise) b = static_cast<std::uint8_t>((state = state * 6364136223846793005u + 1442695040888963407u) >> 56);
+  write_npz(path, {{"X_train", noise}, {"y_train", labels_npy({0})}});
+  zip = vola_test::read_bytes(path);
+  std::uint32_t compressed = 0;
+  for (std::size_t at = 0; at + 4 <= zip.size(); ++at)
+    if (std::memcmp(zip.data() + at, "PK\x01\x02", 4) == 0 && zip[at + 46] == 'X') {
+      std::memcpy(&compressed, zip.data() + at + 20, 4);
+      break;
+    }
+  ASSERT_GT(compressed, 3u << 20);
+  lie_about_sizes(zip, "X_train.npy", compressed, compressed * 680);
+  vola_test::write_bytes(path, zip);
+  const std::string inflated = vola_test::run_with_memory_cap([&] {
+    read_labelled_grids(path);
+    return std::string("read");
+  });
+  EXPECT_EQ(inflated.rfind("FormatError: " + path + ": X_train.npy: ", 0), 0u) << inflated;
 }
 
 TEST(Npz, ReadsTheModelNetTrainingSplit) {

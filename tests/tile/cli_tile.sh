@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # vola tile end to end on the Autzen survey: the same bytes for 1 and 2 threads, a tiny
 # memory budget and (with mpirun) 3 ranks; the index; queries through the index (get,
-# render, plan) open only the tiles they need; errors for mixed CRSs and bad options.
+# render, plan) open only the tiles they need; errors for mixed CRSs, bad options and
+# inputs that are not regular files.
 # Usage: cli_tile.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
 set -euo pipefail
 vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
@@ -84,6 +85,11 @@ grep -q "states no CRS to reproject from" "$tmp/err.txt" || fail "no-CRS message
 grep -q -- "--memory 'lots'" "$tmp/err.txt" || fail "--memory message: $(cat "$tmp/err.txt")"
 "$vola" tile --tile-size 256 --depth 4 -o "$tmp/none" 2> "$tmp/err.txt" && fail "no input accepted"
 grep -q "no input" "$tmp/err.txt" || fail "no-input message: $(cat "$tmp/err.txt")"
+# Inputs are regular files: a GDAL network path or a directory never reaches a reader.
+for input in "/vsicurl/http://127.0.0.1:9/dem.tif" "$tmp/one"; do
+  "$vola" tile "$input" --tile-size 256 --depth 4 -o "$tmp/notfile" 2> "$tmp/err.txt" && fail "input $input accepted"
+  grep -q "not a regular file" "$tmp/err.txt" || fail "input $input message: $(cat "$tmp/err.txt")"
+done
 
 # A tile gone from the set: queries that need it say which file, and do not crash.
 cp -r "$tmp/one" "$tmp/broken"

@@ -45,10 +45,13 @@ class ViewedFile {
   ViewedFile& operator=(const ViewedFile&) = delete;
 
   const std::string& path() const noexcept { return path_; }
+  // The file's base name: what the server shows of it (never the path it was given,
+  // which may say where the user keeps their files).
+  const std::string& name() const noexcept { return name_; }
   const Tree& tree() const noexcept { return tree_; }
   const CellIndex& cells() const noexcept { return index_; }
 
-  // Name, counts per level, grid frame, CRS, attributes, the classes present with their
+  // Name (base name only), counts per level, grid frame, CRS, attributes, the classes present with their
   // ASPRS names: what the page needs before asking for cells.
   nlohmann::json metadata() const;
   // Cells [first, first + count) of `level` as a binary batch (format above); count is
@@ -70,6 +73,7 @@ class ViewedFile {
   void check_level(int level) const;
 
   std::string path_;
+  std::string name_;
   FileLayout layout_;
   Tree tree_;
   CellIndex index_;

@@ -11,6 +11,7 @@
 
 #include "vola/error.hpp"
 #include "../reader_plugin.hpp"
+#include "gdal_confined.hpp"
 #include "readers.hpp"
 #include "vola/io/dem.hpp"
 
@@ -35,10 +36,6 @@ std::string gdal_message(const char* what) {
   const char* message = CPLGetLastErrorMsg();
   return std::string(what) + (message && *message ? std::string(": ") + message : std::string());
 }
-
-struct DatasetCloser {
-  void operator()(GDALDataset* d) const { GDALClose(d); }
-};
 
 void crs_of(const GDALDataset& dataset, DemRaster& dem) {
   const OGRSpatialReference* srs = dataset.GetSpatialRef();
@@ -65,10 +62,10 @@ DemRaster read_dem_with_gdal(const std::string& path,
   static std::once_flag registered;
   std::call_once(registered, [] { GDALAllRegister(); });
   QuietGdalErrors quiet;
-  std::unique_ptr<GDALDataset, DatasetCloser> dataset(
-      GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr)));
-  if (!dataset) throw FormatError(path, std::nullopt, gdal_message("GDAL cannot open it as a raster"));
+  const ConfinedGdalConfig confined;  // gdal_confined.hpp: one local file, nothing else
+  const Dataset dataset = open_confined_raster(path);
   if (dataset->GetRasterCount() < 1) throw FormatError(path, std::nullopt, "the raster has no band");
+  check_raster_sizes(*dataset, path);
 
   DemRaster dem;
   dem.width = static_cast<std::uint64_t>(dataset->GetRasterXSize());

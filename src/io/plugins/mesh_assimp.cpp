@@ -3,6 +3,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string_view>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -12,6 +13,7 @@
 
 #include "vola/error.hpp"
 #include "../reader_plugin.hpp"
+#include "off_header.hpp"
 #include "readers.hpp"
 #include "vola/io/mesh.hpp"
 
@@ -43,50 +45,55 @@ Point transform(const Matrix& m, const aiVector3D& v) {
   return p;
 }
 
-// The decimal number at text[at...] after blanks and '#' comment lines, saturating at
-// 2^63; nullopt when there is none. `at` moves past it.
-std::optional<std::uint64_t> next_count(std::string_view text, std::size_t& at) {
-  while (at < text.size() && (std::isspace(static_cast<unsigned char>(text[at])) || text[at] == '#')) {
-    if (text[at] == '#')
-      while (at < text.size() && text[at] != '\n') ++at;
-    else
-      ++at;
-  }
-  if (at >= text.size() || !std::isdigit(static_cast<unsigned char>(text[at]))) return std::nullopt;
-  std::uint64_t value = 0;
-  for (; at < text.size() && std::isdigit(static_cast<unsigned char>(text[at])); ++at)
-    value = std::min<std::uint64_t>(value * 10 + static_cast<std::uint64_t>(text[at] - '0'), std::uint64_t{1} << 63);
-  return value;
+// The extensions of the mesh formats vola documents (input.cpp's format table). Assimp
+// reads some forty formats, chosen by extension and then by content; the others
+// (some with references to further files, most never fuzzed here) are not opened.
+constexpr std::array<std::string_view, 7> kMeshExtensions = {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"};
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
-// Assimp's OFF reader reserves the header's vertex and face counts before reading
-// them: a 143-byte file declaring billions of faces made it allocate gigabytes (found
-// by fuzz_mesh_read). Each vertex or face takes at least two bytes of text, so counts
-// the rest of the file cannot hold are refused before Assimp sees them.
+void check_mesh_extension(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (std::find(kMeshExtensions.begin(), kMeshExtensions.end(), ext) == kMeshExtensions.end())
+    throw FormatError(path, std::nullopt,
+                      "meshes are read from .stl, .obj, .off, .gltf, .glb, .dae and .3ds files only, not '" + ext + "'");
+}
+
+// Assimp's OFF importer allocates the header's vertex and face counts before reading
+// them: a 38-byte file made it allocate 8.8 GB. Each vertex or face takes at least two
+// bytes of text, so counts the file cannot hold are refused first, read as Assimp reads
+// them (off_header.hpp).
 void check_off_counts(const std::string& path) {
+  if (lower_extension(path) != ".off") return;  // Assimp picks its OFF importer by extension
   std::ifstream in(path, std::ios::binary);
-  std::array<char, 1024> head{};
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  const std::string_view text(head.data(), static_cast<std::size_t>(in.gcount()));
-  const std::size_t keyword = text.find("OFF");
-  if (keyword == std::string_view::npos || keyword > 4) return;  // not OFF (or a prefixed ST/C/N/4 OFF)
-  std::size_t at = keyword + 3;
-  const std::size_t vertices_at = at;
-  const std::optional<std::uint64_t> vertices = next_count(text, at);
-  const std::optional<std::uint64_t> faces = vertices ? next_count(text, at) : std::nullopt;
-  if (!faces) return;  // Assimp reports a header it cannot read itself
-  std::error_code error;
-  const std::uint64_t bytes = std::filesystem::file_size(path, error);
-  if (error) return;
-  if (*vertices > bytes / 2 || *faces > bytes / 2 || *vertices + *faces > bytes / 2)
-    throw FormatError(path, vertices_at,
-                      "the OFF header declares " + std::to_string(*vertices) + " vertices and " + std::to_string(*faces) +
-                          " faces, more than the file's " + std::to_string(bytes) + " bytes can hold");
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  if (!in) throw IoError("cannot read " + path);
+  const std::string text = std::move(whole).str();
+  // Assimp converts UTF-16 and UTF-32 text first; OFF is ASCII, so those are refused
+  // rather than parsed differently from Assimp.
+  if (text.starts_with("\xff\xfe") || text.starts_with("\xfe\xff") || text.starts_with(std::string("\0\0\xfe\xff", 4)))
+    throw FormatError(path, 0, "an OFF file in UTF-16 or UTF-32 (OFF is ASCII text)");
+  std::size_t skipped = 0;
+  if (text.starts_with("\xef\xbb\xbf")) skipped = 3;  // the UTF-8 byte order mark, which Assimp drops
+  const auto counts = off_header_counts(std::string_view(text).substr(skipped));
+  if (!counts) return;  // Assimp refuses the header itself
+  const std::uint64_t bytes = text.size();
+  if (counts->vertices > bytes / 2 || counts->faces > bytes / 2 || std::uint64_t{counts->vertices} + counts->faces > bytes / 2)
+    throw FormatError(path, skipped + counts->vertices_at,
+                      "the OFF header declares " + std::to_string(counts->vertices) + " vertices and " +
+                          std::to_string(counts->faces) + " faces (as 32-bit counts), more than the file's " +
+                          std::to_string(bytes) + " bytes can hold");
 }
 
 }  // namespace
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
+  check_mesh_extension(path);
   check_off_counts(path);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
