@@ -107,6 +107,26 @@ LasFile make_laz(vola::io::laz::LaszipInfo info, std::span<const std::uint8_t> r
   return f;
 }
 
+Bytes las_file_bytes(std::uint8_t point_format, std::uint16_t record_length, std::span<const std::uint8_t> records) {
+  const bool v14 = point_format >= 6;
+  const std::uint16_t header = v14 ? 375 : 227;
+  const std::uint64_t count = records.size() / record_length;
+  Bytes f(header, 0);
+  auto put = [&f](std::size_t at, auto value) { std::memcpy(f.data() + at, &value, sizeof value); };
+  std::memcpy(f.data(), "LASF", 4);
+  f[24] = 1;
+  f[25] = v14 ? 4 : 2;
+  put(94, header);
+  put(96, std::uint32_t{header});
+  f[104] = point_format;
+  put(105, record_length);
+  put(107, static_cast<std::uint32_t>(v14 ? 0 : count));
+  for (int axis = 0; axis < 3; ++axis) put(131 + 8 * axis, 0.01);
+  if (v14) put(247, count);
+  f.insert(f.end(), records.begin(), records.end());
+  return f;
+}
+
 Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points) {
   namespace laz = vola::io::laz;
   laz::LaszipInfo info = laz::laszip_info_for(las.point_format, las.record_length);

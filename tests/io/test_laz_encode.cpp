@@ -96,6 +96,19 @@ Bytes generated_records(std::uint8_t format, std::uint16_t record_length, std::s
   return out;
 }
 
+// With VOLA_LAZ_OUT set: `records` as <name>.laz (vola's encoder, 1000-point chunks) and
+// <name>.records, for tests/laz/lazperf_roundtrip.mjs.
+void write_for_other_decoders(std::uint8_t format, std::uint16_t length, const Bytes& records, const std::string& name) {
+  const char* out_dir = std::getenv("VOLA_LAZ_OUT");
+  if (!out_dir) return;
+  const Bytes las = vola_laz_test::las_file_bytes(format, length, records);
+  const Bytes file = vola_laz_test::laz_from_las(vola_laz_test::parse_las_file(las, name), 1000);
+  std::ofstream(fs::path(out_dir) / (name + ".laz"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+  std::ofstream(fs::path(out_dir) / (name + ".records"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>(records.size()));
+}
+
 TEST(LazEncode, SharedLasFilesRoundTrip) {
   VOLA_REQUIRE_DATA(data);
   auto files = vola_io_test::files_ending(data / "las", ".las");
@@ -169,6 +182,8 @@ TEST(LazEncode, GeneratedStreamsRoundTripInEveryFormat) {
         const Bytes records = generated_records(format, length, 3000, format * 100u + extra, noise);
         laz::LaszipInfo info = laz::laszip_info_for(format, length);
         expect_round_trip(info, records, 1000);
+        write_for_other_decoders(format, length, records, "generated_f" + std::to_string(format) + "_e" +
+                                                              std::to_string(extra) + "_n" + std::to_string(int(noise * 100)));
         if (format >= 6) {  // version 4 items, and COPC-style variable chunks
           for (auto& item : info.items) item.version = 4;
           expect_round_trip(info, records, 700);
