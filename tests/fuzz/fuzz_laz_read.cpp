@@ -60,7 +60,7 @@ void read_laz(std::span<const std::uint8_t> file) {
   std::size_t at = header_size;
   for (std::uint32_t i = 0; i < vlrs && i < 64 && !found; ++i) {
     std::uint16_t record = 0, length = 0;
-    if (!get(file, at + 18, record) || !get(file, at + 20, length) || file.size() - at - 54 < length) return;
+    if (!get(file, at + 18, record) || !get(file, at + 20, length) || file.size() - at < 54 + std::size_t{length}) return;
     if (record == 22204) {
       info = laz::parse_laszip_vlr(file.subspan(at + 54, length), "fuzz", at + 54);
       found = true;
