@@ -21,9 +21,13 @@ T get(const Bytes& b, std::size_t at) {
 
 LasFile read_las_file(const vola_io_test::fs::path& path) {
   std::ifstream in(path, std::ios::binary);
+  return parse_las_file(Bytes(std::istreambuf_iterator<char>(in), {}), path.filename().string());
+}
+
+LasFile parse_las_file(Bytes bytes, std::string name) {
   LasFile f;
-  f.name = path.filename().string();
-  f.bytes.assign(std::istreambuf_iterator<char>(in), {});
+  f.name = std::move(name);
+  f.bytes = std::move(bytes);
   const Bytes& b = f.bytes;
   const auto header_size = get<std::uint16_t>(b, 94);
   f.offset_to_points = get<std::uint32_t>(b, 96);
@@ -101,6 +105,65 @@ LasFile make_laz(vola::io::laz::LaszipInfo info, std::span<const std::uint8_t> r
   const Bytes table = laz::chunk_table_bytes(info, chunks);
   f.bytes.insert(f.bytes.end(), table.begin(), table.end());
   return f;
+}
+
+Bytes las_file_bytes(std::uint8_t point_format, std::uint16_t record_length, std::span<const std::uint8_t> records) {
+  const bool v14 = point_format >= 6;
+  const std::uint16_t header = v14 ? 375 : 227;
+  const std::uint64_t count = records.size() / record_length;
+  Bytes f(header, 0);
+  auto put = [&f](std::size_t at, auto value) { std::memcpy(f.data() + at, &value, sizeof value); };
+  std::memcpy(f.data(), "LASF", 4);
+  f[24] = 1;
+  f[25] = v14 ? 4 : 2;
+  put(94, header);
+  put(96, std::uint32_t{header});
+  f[104] = point_format;
+  put(105, record_length);
+  put(107, static_cast<std::uint32_t>(v14 ? 0 : count));
+  for (int axis = 0; axis < 3; ++axis) put(131 + 8 * axis, 0.01);
+  if (v14) put(247, count);
+  f.insert(f.end(), records.begin(), records.end());
+  return f;
+}
+
+Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points) {
+  namespace laz = vola::io::laz;
+  laz::LaszipInfo info = laz::laszip_info_for(las.point_format, las.record_length);
+  const Bytes records = las_records(las);
+  const LasFile made = make_laz(info, records, chunk_points);  // the chunks and table
+  info.chunk_size = chunk_points;
+  const Bytes payload = laz::laszip_vlr_payload(info);
+  // The header and VLRs, without any padding before the point data.
+  std::size_t vlrs_end = get<std::uint16_t>(las.bytes, 94);
+  for (std::uint32_t i = 0, n = get<std::uint32_t>(las.bytes, 100); i < n; ++i)
+    vlrs_end += 54 + std::size_t{get<std::uint16_t>(las.bytes, vlrs_end + 20)};
+  Bytes out(las.bytes.begin(), las.bytes.begin() + static_cast<std::ptrdiff_t>(vlrs_end));
+  Bytes vlr(54, 0);
+  std::memcpy(vlr.data() + 2, "laszip encoded", 14);
+  const std::uint16_t record = 22204, length = static_cast<std::uint16_t>(payload.size());
+  std::memcpy(vlr.data() + 18, &record, 2);
+  std::memcpy(vlr.data() + 20, &length, 2);
+  std::memcpy(vlr.data() + 22, "vola LAZ codec", 14);
+  out.insert(out.end(), vlr.begin(), vlr.end());
+  out.insert(out.end(), payload.begin(), payload.end());
+  const auto offset_to_points = static_cast<std::uint32_t>(out.size());
+  std::uint32_t vlrs;
+  std::memcpy(&vlrs, out.data() + 100, 4);
+  ++vlrs;
+  std::memcpy(out.data() + 100, &vlrs, 4);
+  std::memcpy(out.data() + 96, &offset_to_points, 4);
+  out[104] = static_cast<std::uint8_t>(las.point_format | 0x80);
+  if (out[25] >= 4 && out.size() >= 247) std::memset(out.data() + 235, 0, 12);  // no EVLRs
+  // The chunks and table, with the offsets moved to this file's point data.
+  const std::int64_t shift = static_cast<std::int64_t>(offset_to_points) - made.offset_to_points;
+  std::uint64_t table_at;
+  std::memcpy(&table_at, made.bytes.data() + made.offset_to_points, 8);
+  table_at = static_cast<std::uint64_t>(static_cast<std::int64_t>(table_at) + shift);
+  out.resize(out.size() + 8);
+  std::memcpy(out.data() + offset_to_points, &table_at, 8);
+  out.insert(out.end(), made.bytes.begin() + made.offset_to_points + 8, made.bytes.end());
+  return out;
 }
 
 }  // namespace vola_laz_test

@@ -27,6 +27,7 @@ struct LasFile {
   std::uint64_t laszip_offset = 0;
 };
 LasFile read_las_file(const vola_io_test::fs::path& path);
+LasFile parse_las_file(Bytes bytes, std::string name);
 
 // Every record of a LAZ file, decoded chunk by chunk.
 Bytes decode_all(const LasFile& file);
@@ -41,5 +42,13 @@ Bytes las_records(const LasFile& file);
 // 1: one stream of every record right at the point data, no table.
 LasFile make_laz(vola::io::laz::LaszipInfo info, std::span<const std::uint8_t> records,
                  std::uint64_t chunk_points);
+
+// An uncompressed LAS file of `records`: LAS 1.2 (formats 0-5) or 1.4 (6-10), scale 0.01.
+Bytes las_file_bytes(std::uint8_t point_format, std::uint16_t record_length, std::span<const std::uint8_t> records);
+
+// A whole LAZ file (a real LAS header, as other readers need) holding the records of
+// the uncompressed LAS file `las`: its header and VLRs, plus the laszip VLR, point
+// format | 0x80, chunks of `chunk_points` records and the chunk table; EVLRs dropped.
+Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points);
 
 }  // namespace vola_laz_test

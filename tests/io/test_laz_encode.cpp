@@ -5,7 +5,9 @@
 // arbitrary bytes).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <random>
 
 #include "io_test_data.hpp"
@@ -45,9 +47,11 @@ Bytes generated_records(std::uint8_t format, std::uint16_t record_length, std::s
   std::uint16_t rgb[4] = {100, 200, 300, 400};
   for (std::size_t i = 0; i < count; ++i) {
     std::uint8_t* p = out.data() + i * record_length;
-    x += static_cast<std::int32_t>(any() % 200) - 100;
-    y += chance(0.05) ? static_cast<std::int32_t>(any()) : static_cast<std::int32_t>(any() % 50) - 25;
-    z += static_cast<std::int32_t>(any() % 21) - 10;
+    // Coordinates wrap like the format's 32-bit arithmetic.
+    auto step = [](std::int32_t v, std::uint32_t by) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(v) + by); };
+    x = step(x, any() % 200 - 100);
+    y = step(y, chance(0.05) ? any() : any() % 50 - 25);
+    z = step(z, any() % 21 - 10);
     if (++r > n) {
       r = 1;
       n = 1 + static_cast<int>(any() % (layered ? 15 : 5));
@@ -92,6 +96,19 @@ Bytes generated_records(std::uint8_t format, std::uint16_t record_length, std::s
   return out;
 }
 
+// With VOLA_LAZ_OUT set: `records` as <name>.laz (vola's encoder, 1000-point chunks) and
+// <name>.records, for tests/laz/lazperf_roundtrip.mjs.
+void write_for_other_decoders(std::uint8_t format, std::uint16_t length, const Bytes& records, const std::string& name) {
+  const char* out_dir = std::getenv("VOLA_LAZ_OUT");
+  if (!out_dir) return;
+  const Bytes las = vola_laz_test::las_file_bytes(format, length, records);
+  const Bytes file = vola_laz_test::laz_from_las(vola_laz_test::parse_las_file(las, name), 1000);
+  std::ofstream(fs::path(out_dir) / (name + ".laz"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+  std::ofstream(fs::path(out_dir) / (name + ".records"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>(records.size()));
+}
+
 TEST(LazEncode, SharedLasFilesRoundTrip) {
   VOLA_REQUIRE_DATA(data);
   auto files = vola_io_test::files_ending(data / "las", ".las");
@@ -116,6 +133,34 @@ TEST(LazEncode, SharedLasFilesRoundTrip) {
   EXPECT_GE(tested, 20);
 }
 
+// Whole LAZ files from the shared LAS files. With VOLA_LAZ_OUT set, each is also written
+// there as <name>.laz with its records as <name>.records, for another decoder to check
+// (tests/laz/lazperf_roundtrip.mjs).
+TEST(LazEncode, LasFilesBecomeLazFiles) {
+  VOLA_REQUIRE_DATA(data);
+  const char* out_dir = std::getenv("VOLA_LAZ_OUT");
+  for (const fs::path& path : vola_io_test::files_ending(data / "las", ".las")) {
+    const LasFile las = vola_laz_test::read_las_file(path);
+    if (las.point_format == 4 || las.point_format == 5 || las.point_format > 8) continue;
+    SCOPED_TRACE(path.filename().string());
+    const Bytes records = vola_laz_test::las_records(las);
+    const std::string stem = path.stem().string();
+    for (const std::uint32_t chunk_points : {50000u, 500u}) {
+      const Bytes file = vola_laz_test::laz_from_las(las, chunk_points);
+      const LasFile laz = vola_laz_test::parse_las_file(file, stem + ".laz");
+      EXPECT_EQ(laz.point_format, las.point_format);
+      EXPECT_EQ(laz.point_count, las.point_count);
+      EXPECT_TRUE(vola_laz_test::decode_all(laz) == records);
+      if (out_dir && chunk_points == 500u) {
+        std::ofstream(fs::path(out_dir) / (stem + ".laz"), std::ios::binary)
+            .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+        std::ofstream(fs::path(out_dir) / (stem + ".records"), std::ios::binary)
+            .write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>(records.size()));
+      }
+    }
+  }
+}
+
 TEST(LazEncode, SharedLazFilesRoundTripWithTheirOwnItems) {
   VOLA_REQUIRE_DATA(data);
   for (const fs::path& path : vola_io_test::files_ending(data / "laz", ".laz")) {
@@ -137,6 +182,8 @@ TEST(LazEncode, GeneratedStreamsRoundTripInEveryFormat) {
         const Bytes records = generated_records(format, length, 3000, format * 100u + extra, noise);
         laz::LaszipInfo info = laz::laszip_info_for(format, length);
         expect_round_trip(info, records, 1000);
+        write_for_other_decoders(format, length, records, "generated_f" + std::to_string(format) + "_e" +
+                                                              std::to_string(extra) + "_n" + std::to_string(int(noise * 100)));
         if (format >= 6) {  // version 4 items, and COPC-style variable chunks
           for (auto& item : info.items) item.version = 4;
           expect_round_trip(info, records, 700);

@@ -15,6 +15,8 @@
 #include <span>
 #include <vector>
 
+
+
 namespace vola::io::laz {
 
 inline constexpr std::uint32_t kMinLength = 0x01000000u;  // renormalise below 2^24
@@ -33,7 +35,8 @@ struct BitModel {
   std::uint32_t update_cycle = 4, until_update = 4;
 
   void reset() { *this = BitModel{}; }
-  void update() {
+  // Out of line: rare, and the decoders' hot paths stay small.
+  [[gnu::noinline]] void update() {
     if ((bit_count += update_cycle) > kBitMaxCount) {
       bit_count = (bit_count + 1) >> 1;
       bit0_count = (bit0_count + 1) >> 1;
@@ -61,7 +64,10 @@ class SymbolModel {
     table_size_ = table_shift_ = 0;
     if (decoder_table && symbols > 16) {
       std::uint32_t table_bits = 3;
-      while (symbols > (1u << (table_bits + 2))) ++table_bits;
+      // Four times the table LASzip uses: the table is the decoder's own speed-up (the
+      // format fixes only the distribution), and a finer one mostly lands on the symbol
+      // without bisecting (measured: +13% on point format 3).
+      while (symbols > (1u << table_bits)) ++table_bits;
       table_size_ = 1u << table_bits;
       table_shift_ = kSymbolShift - table_bits;
     }
@@ -81,7 +87,7 @@ class SymbolModel {
     until_update = update_cycle_ = (symbols_ + 6) >> 1;
   }
 
-  void update() {
+  [[gnu::noinline]] void update() {
     if ((total_count_ += update_cycle_) > kSymbolMaxCount) {
       total_count_ = 0;
       for (std::uint32_t k = 0; k < symbols_; ++k) total_count_ += (counts[k] = (counts[k] + 1) >> 1);

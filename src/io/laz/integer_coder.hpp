@@ -38,18 +38,21 @@ class IntegerCoder {
       corr_min_ = INT32_MIN;
       corr_max_ = INT32_MAX;
     }
+    decoder_tables_ = decoder_tables;
+    k_models_.clear();
     k_models_.resize(contexts);
-    for (auto& m : k_models_) m.create(corr_bits_ + 1, decoder_tables);
+    position_models_.clear();
     position_models_.resize(corr_bits_ + 1);
-    for (std::uint32_t i = 1; i <= corr_bits_; ++i)
-      position_models_[i].create(1u << (i <= bits_high_ ? i : bits_high_), decoder_tables);
+    k_fresh_.assign(contexts, 0);
+    position_fresh_.assign(corr_bits_ + 1, 0);
+    reset();
   }
 
-  // Back to the initial probabilities (every chunk starts from them).
+  // Back to the initial probabilities (every chunk starts from them). Models are
+  // created and reset when first used after this: a small chunk touches few of them.
   void reset() {
-    for (auto& m : k_models_) m.reset();
+    ++generation_;
     small_model_.reset();
-    for (std::uint32_t i = 1; i <= corr_bits_; ++i) position_models_[i].reset();
     k_ = 0;
   }
 
@@ -73,16 +76,33 @@ class IntegerCoder {
   }
 
  private:
+  SymbolModel& k_model(std::uint32_t context) {
+    if (k_fresh_[context] != generation_) {
+      if (k_models_[context].symbols()) k_models_[context].reset();
+      else k_models_[context].create(corr_bits_ + 1, decoder_tables_);
+      k_fresh_[context] = generation_;
+    }
+    return k_models_[context];
+  }
+  SymbolModel& position_model(std::uint32_t k) {
+    if (position_fresh_[k] != generation_) {
+      if (position_models_[k].symbols()) position_models_[k].reset();
+      else position_models_[k].create(1u << (k <= bits_high_ ? k : bits_high_), decoder_tables_);
+      position_fresh_[k] = generation_;
+    }
+    return position_models_[k];
+  }
+
   std::int32_t read_correction(ArithmeticDecoder& d, std::uint32_t context) {
-    k_ = d.decode_symbol(k_models_[context]);
+    k_ = d.decode_symbol(k_model(context));
     if (k_ == 0) return static_cast<std::int32_t>(d.decode_bit(small_model_));  // c is 0 or 1
     if (k_ >= 32) return corr_min_;
     std::uint32_t c;
     if (k_ <= bits_high_) {
-      c = d.decode_symbol(position_models_[k_]);
+      c = d.decode_symbol(position_model(k_));
     } else {
       const std::uint32_t low_bits = k_ - bits_high_;
-      c = d.decode_symbol(position_models_[k_]) << low_bits;
+      c = d.decode_symbol(position_model(k_)) << low_bits;
       c |= d.read_bits(low_bits);
     }
     // Class k holds [-(2^k - 1), -2^(k-1)] then [2^(k-1) + 1, 2^k].
@@ -98,7 +118,7 @@ class IntegerCoder {
       magnitude >>= 1;
       ++k_;
     }
-    e.encode_symbol(k_models_[context], k_);
+    e.encode_symbol(k_model(context), k_);
     if (k_ == 0) {
       e.encode_bit(small_model_, static_cast<std::uint32_t>(c));
       return;
@@ -107,19 +127,22 @@ class IntegerCoder {
     const std::int64_t shifted = c < 0 ? std::int64_t{c} + ((std::int64_t{1} << k_) - 1) : std::int64_t{c} - 1;
     const auto position = static_cast<std::uint32_t>(shifted);
     if (k_ <= bits_high_) {
-      e.encode_symbol(position_models_[k_], position);
+      e.encode_symbol(position_model(k_), position);
     } else {
       const std::uint32_t low_bits = k_ - bits_high_;
-      e.encode_symbol(position_models_[k_], position >> low_bits);
+      e.encode_symbol(position_model(k_), position >> low_bits);
       e.write_bits(low_bits, position & ((1u << low_bits) - 1));
     }
   }
 
   std::uint32_t corr_bits_ = 0, bits_high_ = 8, corr_range_ = 0, k_ = 0;
   std::int32_t corr_min_ = 0, corr_max_ = 0;
+  bool decoder_tables_ = true;
+  std::uint32_t generation_ = 0;  // a model is current when its "fresh" entry equals this
   std::vector<SymbolModel> k_models_;
   BitModel small_model_;
   std::vector<SymbolModel> position_models_;  // index k; [0] unused
+  std::vector<std::uint32_t> k_fresh_, position_fresh_;
 };
 
 // The median of the last 5 values, kept sorted with a flag that alternates which end

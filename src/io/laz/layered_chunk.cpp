@@ -21,11 +21,11 @@ std::size_t layer_count(const RecordLayout& layout) {
 }
 
 struct LayeredCoders {
-  LayeredCoders(const RecordLayout& layout, bool decoding) : point(decoding, layout.point_v4) {
+  LayeredCoders(const RecordLayout& record, bool decoding) : point(decoding, record.point_v4), layout(record) {
     if (layout.rgb_at) rgb.emplace(decoding, layout.nir, layout.rgb_v4);
     if (layout.bytes) bytes.emplace(layout.bytes, decoding, layout.bytes_v4);
   }
-  void start(const RecordLayout& layout, const std::uint8_t* first) {
+  void start(const std::uint8_t* first) {
     const std::uint32_t context = point.start(first);
     if (rgb) rgb->start(first + layout.rgb_at, context);
     if (bytes) bytes->start(first + layout.bytes_at, context);
@@ -33,7 +33,17 @@ struct LayeredCoders {
   Point14Coder point;
   std::optional<Rgb14Coder> rgb;
   std::optional<Byte14Coder> bytes;
+  RecordLayout layout;
 };
+
+// As for point-wise chunks: the last layout's coders are kept per thread, so that the
+// many small chunks of a COPC file do not each allocate their models.
+LayeredCoders& coders_for(const RecordLayout& layout, bool decoding) {
+  thread_local std::unique_ptr<LayeredCoders> cached[2];
+  auto& coders = cached[decoding ? 1 : 0];
+  if (!coders || !(coders->layout == layout)) coders = std::make_unique<LayeredCoders>(layout, decoding);
+  return *coders;
+}
 
 // Splits the chunk's layer bytes; throws when the sizes do not fit the chunk.
 std::vector<std::span<const std::uint8_t>> split_layers(const RecordLayout& layout, std::span<const std::uint8_t> chunk,
@@ -74,8 +84,8 @@ std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const s
   const auto spans = split_layers(layout, chunk, count, where, chunk_offset, source);
   std::memcpy(records, chunk.data(), n);
   if (count == 1) return 0;
-  const auto coders = std::make_unique<LayeredCoders>(layout, true);
-  coders->start(layout, records);
+  LayeredCoders* coders = &coders_for(layout, true);
+  coders->start(records);
   std::array<std::span<const std::uint8_t>, kLayers14> point_layers;
   std::copy(spans.begin(), spans.begin() + kLayers14, point_layers.begin());
   coders->point.set_layers(point_layers);
@@ -101,8 +111,8 @@ void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8
   const std::size_t n = layout.length;
   const std::size_t count = records.size() / n;
   if (count == 0) return;
-  const auto coders = std::make_unique<LayeredCoders>(layout, false);
-  coders->start(layout, records.data());
+  LayeredCoders* coders = &coders_for(layout, false);
+  coders->start(records.data());
   for (std::size_t i = 1; i < count; ++i) {
     const std::uint8_t* in = records.data() + i * n;
     const std::uint32_t context = coders->point.encode(in);

@@ -75,10 +75,11 @@ std::vector<ChunkEntry> read_chunk_table(const LaszipInfo& info, const ReadAt& r
   const auto version = load_le<std::uint32_t>(head);
   const auto chunks = load_le<std::uint32_t>(head + 4);
   if (version != 0) fail(source, table_at, "chunk table version " + std::to_string(version) + " (expected 0)");
-  // Every chunk holds at least one point.
-  if (chunks > point_count)
+  // Every chunk holds at least one point and one byte before the table.
+  if (chunks > point_count || chunks > table_at - offset_to_points - 8)
     fail(source, table_at + 4,
-         "chunk table lists " + std::to_string(chunks) + " chunks for " + std::to_string(point_count) + " points");
+         "chunk table lists " + std::to_string(chunks) + " chunks for " + std::to_string(point_count) + " points in " +
+             std::to_string(table_at - offset_to_points - 8) + " bytes");
   if (chunks == 0) {
     if (point_count) fail(source, table_at + 4, "chunk table lists no chunks for " + std::to_string(point_count) + " points");
     return {};

@@ -29,8 +29,18 @@ struct PointwiseCoders {
   std::optional<GpsTime11Coder> gps;
   std::optional<Rgb12Coder> rgb;
   std::optional<ByteCoder> bytes;
-  const RecordLayout& layout;
+  RecordLayout layout;
 };
+
+// The coders of the last layout this thread used: a file's chunks share one set, so a
+// chunk costs a reset, not the allocation of its models (COPC files have many small
+// chunks). Held on the heap: the state is large and a decoder may run on a small stack.
+PointwiseCoders& coders_for(const RecordLayout& layout, bool decoding) {
+  thread_local std::unique_ptr<PointwiseCoders> cached[2];
+  auto& coders = cached[decoding ? 1 : 0];
+  if (!coders || !(coders->layout == layout)) coders = std::make_unique<PointwiseCoders>(layout, decoding);
+  return *coders;
+}
 
 }  // namespace
 
@@ -41,14 +51,13 @@ std::uint64_t decode_pointwise_chunk(const RecordLayout& layout, std::span<const
   if (chunk.size() < n) return n - chunk.size();
   std::memcpy(records, chunk.data(), n);
   if (count == 1) return 0;
-  // Heap-held: the coders' state is large and a decoder may run on a small stack.
-  const auto coders = std::make_unique<PointwiseCoders>(layout, true);
-  coders->start(records);
+  PointwiseCoders& coders = coders_for(layout, true);
+  coders.start(records);
   ArithmeticDecoder d(chunk.subspan(n));
-  Point10Coder& point = coders->point;
-  GpsTime11Coder* gps = coders->gps ? &*coders->gps : nullptr;
-  Rgb12Coder* rgb = coders->rgb ? &*coders->rgb : nullptr;
-  ByteCoder* bytes = coders->bytes ? &*coders->bytes : nullptr;
+  Point10Coder& point = coders.point;
+  GpsTime11Coder* gps = coders.gps ? &*coders.gps : nullptr;
+  Rgb12Coder* rgb = coders.rgb ? &*coders.rgb : nullptr;
+  ByteCoder* bytes = coders.bytes ? &*coders.bytes : nullptr;
   std::uint8_t* out = records + n;
   for (std::uint64_t i = 1; i < count; ++i, out += n) {
     point.decode(d, out);
@@ -67,15 +76,15 @@ void encode_pointwise_chunk(const RecordLayout& layout, std::span<const std::uin
   const std::size_t count = records.size() / n;
   if (count == 0) return;
   out.insert(out.end(), records.begin(), records.begin() + static_cast<std::ptrdiff_t>(n));
-  const auto coders = std::make_unique<PointwiseCoders>(layout, false);
-  coders->start(records.data());
+  PointwiseCoders& coders = coders_for(layout, false);
+  coders.start(records.data());
   ArithmeticEncoder e;
   for (std::size_t i = 1; i < count; ++i) {
     const std::uint8_t* in = records.data() + i * n;
-    coders->point.encode(e, in);
-    if (coders->gps) coders->gps->encode(e, in + layout.gps_at);
-    if (coders->rgb) coders->rgb->encode(e, in + layout.rgb_at);
-    if (coders->bytes) coders->bytes->encode(e, in + layout.bytes_at);
+    coders.point.encode(e, in);
+    if (coders.gps) coders.gps->encode(e, in + layout.gps_at);
+    if (coders.rgb) coders.rgb->encode(e, in + layout.rgb_at);
+    if (coders.bytes) coders.bytes->encode(e, in + layout.bytes_at);
   }
   e.finish();
   out.insert(out.end(), e.bytes().begin(), e.bytes().end());

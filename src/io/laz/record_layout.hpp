@@ -26,6 +26,7 @@ struct RecordLayout {
   bool nir = false;          // RGBNIR14: NIR after RGB
   std::size_t bytes_at = 0;  // extra bytes
   std::size_t bytes = 0;
+  bool operator==(const RecordLayout&) const = default;
 };
 
 // Throws FormatError(source, offset_of_items, ...) for unsupported item lists.
