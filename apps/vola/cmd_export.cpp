@@ -31,7 +31,7 @@ std::string format_from_extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".ply") return "ply";
   if (ext == ".xyz" || ext == ".txt") return "xyz";
-  if (ext == ".las") return "las";
+  if (ext == ".las" || ext == ".laz") return "las";
   if (ext == ".binvox") return "binvox";
   if (ext == ".npy") return "npy";
   if (ext == ".png") return "png";
@@ -78,7 +78,10 @@ void run_export(const ExportArgs& a) {
     say("XYZ: " + std::to_string(voxels) + " voxel centres");
   } else if (format == "las") {
     const io::LasReport r = io::write_las(tree, a.output);
-    std::string what = "LAS 1.4 point format " + std::to_string(r.point_format) + ": " + std::to_string(voxels) +
+    std::string ext = std::filesystem::path(a.output).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    std::string what = std::string(ext == ".laz" ? "LAZ" : "LAS") + " 1.4 point format " +
+                       std::to_string(r.point_format) + ": " + std::to_string(voxels) +
                        " points, CRS ";
     if (r.has_crs) what += "as WKT";
     else if (geo::crs_definition(tree.georef())) what += "none (PROJ does not know EPSG:" + std::to_string(tree.georef().epsg) + ")";
@@ -119,6 +122,7 @@ void add_export(CLI::App& app) {
       "  .xyz     \"x y z [attributes]\" text, full double precision\n"
       "  .las     LAS 1.4 point format 6 (7 with red/green/blue): voxel centres, attributes\n"
       "           restored, the CRS as WKT\n"
+      "  .laz     the same, LASzip-compressed (vola's own LAZ codec)\n"
       "  .binvox  binvox voxel grid\n"
       "  .npy     uint8 0/1 array of shape (S, S, S), index [x, y, z] (depth <= 5)\n"
       "  .png     images, with one of:\n"

@@ -47,4 +47,12 @@ inline double extra_value(const std::uint8_t* p, std::uint8_t type) {
   }
 }
 
+// Whether a path names a LAZ file (".laz", any case; ".copc.laz" too).
+inline bool laz_path(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  return ext == ".laz";
+}
+
 }  // namespace vola::io::las

@@ -20,12 +20,6 @@ constexpr std::size_t kLazChunkPoints = 50000;  // LASzip's default chunk
 
 bool is_compression_record(const LasVlr& v) { return v.user_id == "laszip encoded" || v.user_id == "copc"; }
 
-bool ends_with_laz(const std::string& path) {
-  std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".laz";
-}
-
 template <class T>
 void store(std::vector<std::uint8_t>& bytes, std::size_t at, T value) {
   std::memcpy(bytes.data() + at, &value, sizeof value);  // LAS is little-endian, as every target vola builds for
@@ -108,7 +102,7 @@ void translate_las(const std::string& input, const std::string& output,
                    const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   LasReader reader(input);
   const LasHeader& hd = reader.header();
-  const bool laz_out = ends_with_laz(output);
+  const bool laz_out = las::laz_path(output);
   std::ifstream in(input, std::ios::binary);
   if (!in) throw IoError(input + ": cannot open");
 

@@ -3,15 +3,18 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <limits>
 
 #include "export_columns.hpp"
+#include "las_format.hpp"
 #include "output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/las.hpp"
 #include "vola/version.hpp"
 
 namespace vola::io {
@@ -309,11 +312,22 @@ LasReport write_las(const Tree& tree, const std::string& path) {
   const auto vlrs = header_vlrs(tree, columns, report);
   const std::vector<std::uint8_t> header = public_header(tree, columns, layout, coords, vlrs, report);
 
-  OutputFile out(path);
+  // LAZ: the LAS records first (beside the output, removed whatever happens), then
+  // compressed record for record by translate_las.
+  const bool laz = las::laz_path(path);
+  const std::string las_path = laz ? path + ".records.las" : path;
+  struct RemovedFile {
+    std::string path;
+    ~RemovedFile() {
+      if (!path.empty()) std::remove(path.c_str());
+    }
+  } scratch{laz ? las_path : std::string()};
+  OutputFile out(las_path);
   out.write(header.data(), header.size());
   for (const auto& v : vlrs) out.write(v.data(), v.size());
   write_records(out, tree, columns, layout, coords);
   out.commit();
+  if (laz) translate_las(las_path, path);
   return report;
 }
 

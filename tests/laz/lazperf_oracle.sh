@@ -2,8 +2,8 @@
 # laz-perf (npm, an independent LAZ implementation) as the oracle of vola's LAZ codec,
 # through the CLI:
 #  - every LAZ/COPC in the shared data: laz-perf's records equal vola translate's;
-#  - every shared LAS of point formats 0-3 and 6-8, compressed by vola translate: laz-perf
-#    decodes it back to the LAS's own records.
+#  - every shared LAS of point formats 0-3 and 6-8, compressed by vola translate, and .vol
+#    files exported as LAZ: laz-perf decodes them back to the LAS records.
 # Usage: lazperf_oracle.sh VOLA NODE LAZPERF_PACKAGE SHARED_DATA_DIR ($VOLA_SHARED/data wins)
 set -euo pipefail
 vola=$1 node=$2 lazperf=$3 data=${VOLA_SHARED:+$VOLA_SHARED/data}
@@ -42,6 +42,15 @@ for las in "$data"/las/*.las "$data"/las/permutations/*.las; do
   name=$(basename "$las" .las)
   "$vola" translate "$las" "$tmp/written/$name.laz" -q
   records_of "$las" "$tmp/written/$name.records"
+done
+# vola export of a .vol with attribute columns (point format 7, extra bytes) as LAZ: the
+# records of its LAS export.
+"$vola" convert "$data/las/pdal_autzen_trim.las" "$tmp/autzen.vol" --voxel-size 2 -q
+"$vola" convert "$data/las/pdal_extrabytes.las" "$tmp/extra.vol" --voxel-size 1 -q
+for name in autzen extra; do
+  "$vola" export "$tmp/$name.vol" "$tmp/written/export_$name.laz" -q
+  "$vola" export "$tmp/$name.vol" "$tmp/export_$name.las" -q
+  records_of "$tmp/export_$name.las" "$tmp/written/export_$name.records"
 done
 "$node" "$here/lazperf_roundtrip.mjs" "$lazperf" "$tmp/shared" || fail "vola's decoding of the shared LAZ files differs from laz-perf's"
 "$node" "$here/lazperf_roundtrip.mjs" "$lazperf" "$tmp/written" || fail "laz-perf does not decode vola's LAZ to the LAS's records"

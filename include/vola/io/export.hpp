@@ -55,6 +55,8 @@ struct LasReport {
   bool has_crs = false;                  // false: the tree's CRS is unknown
   std::vector<std::string> extra_bytes;  // columns written as extra-bytes fields
 };
+// A path ending in .laz gets the same records LASzip-compressed (vola/io/laz.hpp:
+// compressor 3, point format 6 or 7).
 LasReport write_las(const Tree& tree, const std::string& path);
 
 // ---- NPY dense grid ----
