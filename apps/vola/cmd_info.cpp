@@ -1,9 +1,10 @@
-// vola info: what a .vol file holds, level by level.
+// vola info: what a .vol file holds, level by level (and what a LAS/LAZ/COPC file says).
 #include <cstdio>
 #include <optional>
 #include <string>
 
 #include "commands.hpp"
+#include "info_points.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
@@ -62,6 +63,11 @@ std::string json_crs(const NamedCrs& crs) {
 }
 
 void run_info(const InfoArgs& a) {
+  if (is_point_file(a.file)) {
+    if (a.json) throw InvalidArgument(a.file + ": --json describes .vol files; this is a LAS/LAZ point file");
+    print_point_file_info(a.file);
+    return;
+  }
   FileLayout layout;
   const Tree tree = open_mapped(a.file, &layout);
   const Header& h = layout.header;
@@ -139,8 +145,8 @@ void run_info(const InfoArgs& a) {
 
 void add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
-  auto* cmd = app.add_subcommand("info", "Header, depth, mode, per-level block and voxel counts, bytes, bits per voxel, metadata");
-  cmd->add_option("file", args->file, ".vol file")->required()->check(CLI::ExistingFile);
+  auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree");
+  cmd->add_option("file", args->file, ".vol file, or a LAS/LAZ/COPC point file")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", args->json, "Print JSON instead of a table");
   cmd->callback([args] { run_info(*args); });
 }

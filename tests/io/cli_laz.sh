@@ -85,6 +85,23 @@ done
   fail "--level accepted for a LAZ that is not COPC"
 grep -q "needs a COPC file" "$tmp/err.txt" || fail "--level message: $(cat "$tmp/err.txt")"
 
+# vola info on COPC: the octree EXPECTED.txt records (levels, nodes, pages, points, spacing).
+for copc_file in "$data"/laz/*.copc.laz; do
+  name=$(basename "$copc_file")
+  "$vola" info "$copc_file" > "$tmp/info.txt" || fail "$name: info failed"
+  python3 - "$tmp/info.txt" "$(grep "^$name:" "$data/EXPECTED.txt")" <<'PY' || fail "$name: info's octree differs from EXPECTED.txt"
+import re, sys
+info, line = open(sys.argv[1]).read(), sys.argv[2]
+want = re.search(r"copc=\[levels (\d+), nodes (\d+), hierarchy pages (\d+), points in nodes (\d+), spacing ([\d.]+)\]", line)
+got = re.search(r"octree of (\d+) levels, (\d+) nodes with points \((\d+) points\), (\d+) hierarchy pages", info)
+spacing = re.search(r"root spacing ([\d.]+)", info)
+assert want and got and spacing, info
+assert (got[1], got[2], got[4], got[3]) == (want[1], want[2], want[3], want[4]), (got.groups(), want.groups())
+assert abs(float(spacing[1]) - float(want[5])) < 1e-3, (spacing[1], want[5])
+PY
+done
+"$vola" info "$data/laz/pdal_autzen_trim.laz" | grep -q "compressor 2 (point-wise chunked)" || fail "info names no LAZ compressor"
+
 # A wave-packet format is refused with the reason, not written wrongly.
 if "$vola" translate "$data/las/laspy_simple1_3.las" "$tmp/w.laz" -q 2> "$tmp/err.txt"; then
   fail "a wave-packet LAS was written as LAZ"

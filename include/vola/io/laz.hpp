@@ -50,6 +50,9 @@ struct Item {
   bool operator==(const Item&) const = default;
 };
 
+// "POINT10(20) version 2", for people.
+std::string describe_item(const Item& item);
+
 inline constexpr std::uint32_t kVariableChunkSize = 0xFFFFFFFFu;
 
 // The laszip VLR. compressor: 1 point-wise, 2 point-wise chunked, 3 layered chunked;

@@ -30,11 +30,6 @@ const char* item_name(std::uint16_t type) {
   }
 }
 
-std::string describe(const Item& item) {
-  const char* name = item_name(item.type);
-  return (name ? std::string(name) : "item type " + std::to_string(item.type)) + "(" + std::to_string(item.size) +
-         ") version " + std::to_string(item.version);
-}
 
 // Walks the item list in the fixed order of a record's parts.
 class ItemCursor {
@@ -47,16 +42,16 @@ class ItemCursor {
     if (at_ == info_.items.size() || info_.items[at_].type != type) return nullptr;
     const Item& item = info_.items[at_];
     if (item.type == kWavePacket13 || item.type == kWavePacket14)
-      fail("wave packets (" + describe(item) + ") are not supported");
-    if (size ? item.size != size : item.size == 0) fail(describe(item) + " has the wrong size");
+      fail("wave packets (" + describe_item(item) + ") are not supported");
+    if (size ? item.size != size : item.size == 0) fail(describe_item(item) + " has the wrong size");
     const bool supported = layered ? (item.version == 3 || item.version == 4) : item.version == 2;
-    if (!supported) fail(describe(item) + " is not supported (point-wise items need version 2, layered 3 or 4)");
+    if (!supported) fail(describe_item(item) + " is not supported (point-wise items need version 2, layered 3 or 4)");
     ++at_;
     return &item;
   }
   void finish() {
     if (at_ != info_.items.size())
-      fail(describe(info_.items[at_]) + " cannot follow the items before it (compressor " +
+      fail(describe_item(info_.items[at_]) + " cannot follow the items before it (compressor " +
            std::to_string(info_.compressor) + ")");
   }
   [[noreturn]] void fail(const std::string& cause) const {
@@ -71,6 +66,12 @@ class ItemCursor {
 };
 
 }  // namespace
+
+std::string describe_item(const Item& item) {
+  const char* name = item_name(item.type);
+  return (name ? std::string(name) : "item type " + std::to_string(item.type)) + "(" + std::to_string(item.size) +
+         ") version " + std::to_string(item.version);
+}
 
 std::size_t LaszipInfo::record_length() const {
   std::size_t n = 0;

@@ -1,0 +1,13 @@
+// vola info on point files (LAS, LAZ, COPC) as well as .vol files.
+#pragma once
+
+#include <string>
+
+namespace vola::cli {
+
+// Whether the file starts with a LAS signature ("LASF"): LAS, LAZ and COPC files.
+bool is_point_file(const std::string& path);
+// The header, (E)VLRs, CRS, compression and COPC octree of a LAS/LAZ/COPC file.
+void print_point_file_info(const std::string& path);
+
+}  // namespace vola::cli
