@@ -203,10 +203,14 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
 }
 
 
+LasReader::~LasReader() { settle_laz_prefetch(); }
+
 void LasReader::rewind() {
   next_ = 0;
-  next_chunk_ = 0;
-  decoded_first_ = decoded_points_ = 0;
+  settle_laz_prefetch();
+  current_.first = current_.count = 0;
+  batch_chunk_ = 0;
+  batch_point_ = 0;
   if (in_) {
     in_->clear();
     in_->seekg(header_.offset_to_points);

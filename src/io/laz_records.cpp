@@ -48,8 +48,8 @@ void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optiona
   const LasHeader& hd = header_;
   if (max_level && !hd.copc)
     throw InvalidArgument(path_ + ": a level of detail needs a COPC file (an octree of chunks); this one is not");
+  settle_laz_prefetch();  // the batch decoded ahead reads chunk_order_
   chunk_order_.clear();
-  chunk_first_point_.clear();
   points_total_ = 0;
   copc_level_ = max_level;
   std::vector<std::uint64_t> wanted;  // byte offsets of the selected nodes' chunks
@@ -68,48 +68,72 @@ void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optiona
   for (std::size_t c = 0; c < hd.laz_chunks.size(); ++c) {
     if (hd.copc && !std::binary_search(wanted.begin(), wanted.end(), hd.laz_chunks[c].byte_offset)) continue;
     chunk_order_.push_back(c);
-    chunk_first_point_.push_back(points_total_);
     points_total_ += hd.laz_chunks[c].point_count;
   }
   rewind();
 }
 
-// The next chunks (as many as there are threads, the first one at least) decoded into
-// decoded_, in parallel when the file is read with pread (a stream is read serially).
-void LasReader::decode_laz_batch() {
+// Chunks chunk_order_[begin ...] (one per thread, one at least) decoded into `batch`, in
+// parallel when the file is read with pread (a stream is read serially). The buffers are
+// reused from batch to batch: no fresh pages to fault in and zero for every chunk.
+void LasReader::decode_laz_batch(LazBatch& batch, std::size_t begin) const {
   const std::size_t threads = in_ ? 1 : thread_count();
-  const std::size_t begin = next_chunk_, end = std::min(chunk_order_.size(), begin + threads);
-  std::vector<std::vector<std::uint8_t>> records(end - begin);
+  batch.first = begin;
+  batch.count = std::min(chunk_order_.size() - begin, threads);
+  if (batch.records.size() < batch.count) batch.records.resize(batch.count);
   ParallelOptions options;
   options.threads = static_cast<unsigned>(threads);
   options.name = "las.decode_laz";
   parallel_for(
-      end - begin, [&](const Chunk& chunk) { decode_laz_chunk(chunk_order_[begin + chunk.index], records[chunk.index]); },
+      batch.count,
+      [&](const Chunk& chunk) { decode_laz_chunk(chunk_order_[begin + chunk.index], batch.records[chunk.index]); },
       options);
-  std::size_t bytes = 0;
-  for (const auto& r : records) bytes += r.size();
-  decoded_.resize(bytes);
-  std::size_t at = 0;
-  for (const auto& r : records) {
-    std::copy(r.begin(), r.end(), decoded_.begin() + static_cast<std::ptrdiff_t>(at));
-    at += r.size();
-  }
-  decoded_first_ = chunk_first_point_[begin];
-  decoded_points_ = bytes / header_.record_length;
-  next_chunk_ = end;
 }
 
-std::span<const std::uint8_t> LasReader::read_laz_records(std::size_t max_points) {
-  const LasHeader& hd = header_;
-  if (next_ >= decoded_first_ + decoded_points_) {
-    if (next_chunk_ >= chunk_order_.size()) return {};
-    decode_laz_batch();
+// Waits for the batch being decoded ahead, if any; its error is dropped (a rewind or
+// the end of the reader makes it moot).
+void LasReader::settle_laz_prefetch() noexcept {
+  if (!prefetch_.valid()) return;
+  try {
+    prefetch_.get();
+  } catch (...) {
   }
-  const std::uint64_t skip = next_ - decoded_first_;
-  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, decoded_points_ - skip));
-  const std::size_t length = hd.record_length;
-  next_ += n;
-  return {decoded_.data() + skip * length, n * length};
+}
+
+// Records of the current batch's chunks in order; when they run out, the batch decoded
+// ahead (on other threads, while the caller worked on these records) takes its place
+// and the one after it starts decoding.
+std::span<const std::uint8_t> LasReader::read_laz_records(std::size_t max_points) {
+  const std::size_t length = header_.record_length;
+  for (;;) {
+    if (batch_chunk_ < current_.count) {
+      const std::vector<std::uint8_t>& records = current_.records[batch_chunk_];
+      const std::uint64_t points = records.size() / length;
+      if (batch_point_ < points) {
+        const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, points - batch_point_));
+        const std::span<const std::uint8_t> out(records.data() + batch_point_ * length, n * length);
+        batch_point_ += n;
+        next_ += n;
+        return out;
+      }
+      ++batch_chunk_;
+      batch_point_ = 0;
+      continue;
+    }
+    const std::size_t begin = current_.first + current_.count;
+    if (begin >= chunk_order_.size()) return {};
+    if (prefetch_.valid()) {
+      prefetch_.get();  // rethrows the ahead batch's error, in order
+      std::swap(current_, ahead_);
+    } else {
+      decode_laz_batch(current_, begin);
+    }
+    batch_chunk_ = 0;
+    batch_point_ = 0;
+    const std::size_t after = current_.first + current_.count;
+    if (!in_ && after < chunk_order_.size())
+      prefetch_ = std::async(std::launch::async, [this, after] { decode_laz_batch(ahead_, after); });
+  }
 }
 
 }  // namespace vola::io

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <memory>
 #include <span>
 #include <optional>
@@ -86,6 +87,9 @@ class LasReader {
   explicit LasReader(const std::string& path);
   // The same over bytes in memory (copied); `name` labels errors.
   LasReader(std::span<const std::uint8_t> bytes, const std::string& name);
+  ~LasReader();
+  LasReader(const LasReader&) = delete;
+  LasReader& operator=(const LasReader&) = delete;
   const LasHeader& header() const noexcept { return header_; }
   const std::string& path() const noexcept { return path_; }
   // Reads up to `max_points` points into `chunk` (cleared first); 0 at the end. With
@@ -123,8 +127,15 @@ class LasReader {
   std::string path_;
   void read_header();
   void fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* out) const;
+  // LAZ: a batch of chunks decoded together, one per thread (records[i]: chunk
+  // chunk_order_[first + i]).
+  struct LazBatch {
+    std::vector<std::vector<std::uint8_t>> records;
+    std::size_t first = 0, count = 0;
+  };
   std::span<const std::uint8_t> read_laz_records(std::size_t max_points);
-  void decode_laz_batch();
+  void decode_laz_batch(LazBatch& batch, std::size_t begin) const;
+  void settle_laz_prefetch() noexcept;
 
   std::unique_ptr<std::istream> in_;         // only for a file that pread() cannot read (a pipe)
   std::shared_ptr<const int> fd_;            // a regular file, open for pread()
@@ -134,13 +145,13 @@ class LasReader {
   LasHeader header_;
   std::uint64_t next_ = 0;
   std::vector<std::uint8_t> buffer_;
-  // LAZ: records of the chunks decoded last (a batch decoded on all cores), the first
-  // one's point number, and the next chunk to decode.
-  std::vector<std::uint8_t> decoded_;
-  std::uint64_t decoded_first_ = 0, decoded_points_ = 0;
-  std::size_t next_chunk_ = 0;                // into chunk_order_
+  // LAZ: the batch being read (chunk batch_chunk_ of it, from point batch_point_), and
+  // the next one, decoded ahead on other threads (prefetch_) while this one is read.
+  LazBatch current_, ahead_;
+  std::size_t batch_chunk_ = 0;
+  std::uint64_t batch_point_ = 0;
+  std::future<void> prefetch_;
   std::vector<std::size_t> chunk_order_;      // the chunks read, in file order (all, or the selected COPC nodes)
-  std::vector<std::uint64_t> chunk_first_point_;  // per entry of chunk_order_
   std::uint64_t points_total_ = 0;
   std::optional<int> copc_level_;
   mutable std::atomic<std::uint64_t> bytes_read_{0};
