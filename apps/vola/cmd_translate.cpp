@@ -1,5 +1,5 @@
 // vola translate: point files to point files, point by point, no voxels (PDAL's
-// translate): LAS and LAZ in, LAS and LAZ out, every record as it was.
+// translate): LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI in; LAS, LAZ, PLY, XYZ out.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +10,7 @@
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/translate.hpp"
 
 namespace vola::cli {
 
@@ -27,24 +28,21 @@ std::string lower_extension(const std::string& path) {
 }
 
 void run_translate(const TranslateArgs& a) {
-  for (const std::string* path : {&a.input, &a.output}) {
-    const std::string ext = lower_extension(*path);
-    if (ext != ".las" && ext != ".laz")
-      throw InvalidArgument(*path + ": vola translate reads and writes .las and .laz (LAS 1.0-1.4, LAZ, COPC)");
-  }
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<Progress> progress;
   if (!a.quiet) progress = std::make_unique<Progress>("translating points");
-  io::translate_las(a.input, a.output, [&](std::uint64_t done, std::uint64_t total) {
+  io::translate_points(a.input, a.output, [&](std::uint64_t done, std::uint64_t total) {
     if (progress) progress->update(done, total);
   });
   if (!progress) return;
   progress->finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const io::LasReader written(a.output);
-  std::printf("points:  %llu, point format %u, %u bytes a record\n",
-              static_cast<unsigned long long>(written.header().point_count), written.header().point_format,
-              written.header().record_length);
+  if (lower_extension(a.output) == ".las" || lower_extension(a.output) == ".laz") {
+    const io::LasReader written(a.output);
+    std::printf("points:  %llu, point format %u, %u bytes a record\n",
+                static_cast<unsigned long long>(written.header().point_count), written.header().point_format,
+                written.header().record_length);
+  }
   std::printf("file:    %llu bytes (%s), input %llu bytes\n",
               static_cast<unsigned long long>(std::filesystem::file_size(a.output)), a.output.c_str(),
               static_cast<unsigned long long>(std::filesystem::file_size(a.input)));
@@ -55,17 +53,22 @@ void run_translate(const TranslateArgs& a) {
 
 void add_translate(CLI::App& app) {
   auto args = std::make_shared<TranslateArgs>();
-  auto* cmd = app.add_subcommand("translate", "Point files to point files, record for record (LAS <-> LAZ), no voxels");
+  auto* cmd = app.add_subcommand("translate", "Point files to point files, point by point, no voxels (LAS <-> LAZ, to PLY, XYZ)");
   cmd->footer(
       "Every point record is copied as it is, in order: coordinates, returns, classes, GPS time,\n"
       "colour, NIR, extra bytes; the header, the CRS and the other (E)VLRs too. A .laz output is\n"
       "LASzip-compressed (compressor 2 for point formats 0-3, 3 for 6-8) in chunks of 50000 points.\n"
+      "A .ply (binary) or .xyz output holds x y z and every field as a named column, from any\n"
+      "point file vola reads (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI); LAS/LAZ outputs need\n"
+      "LAS/LAZ/COPC input.\n"
       "Examples:\n"
       "  vola translate survey.laz survey.las     # decompress\n"
       "  vola translate survey.las survey.laz     # compress\n"
-      "  vola translate cloud.copc.laz cloud.las  # a COPC file's points, in its chunk order");
-  cmd->add_option("input", args->input, "Input .las or .laz (COPC too)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("output", args->output, "Output .las or .laz")->required();
+      "  vola translate cloud.copc.laz cloud.las  # a COPC file's points, in its chunk order\n"
+      "  vola translate survey.laz survey.ply     # for tools that read PLY, every field kept");
+  cmd->add_option("input", args->input, "Input point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("output", args->output, "Output .las, .laz, .ply or .xyz")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_translate(*args); });
 }

@@ -29,10 +29,9 @@ void require_complete_columns(const Tree& tree) {
                             " values for " + std::to_string(tree.voxel_count()) + " voxels");
 }
 
-std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken) {
-  std::vector<std::string> names;
-  for (const auto& column : attributes.columns()) {
-    std::string name = column.name();
+std::vector<std::string> token_names(const std::vector<std::string>& names, std::vector<std::string> taken) {
+  std::vector<std::string> out;
+  for (std::string name : names) {
     for (char& c : name)
       if (c <= ' ' || c > '~') c = '_';
     if (name.empty()) name = "attribute";
@@ -40,9 +39,31 @@ std::vector<std::string> token_names(const Attributes& attributes, std::vector<s
     for (int n = 2; std::find(taken.begin(), taken.end(), unique) != taken.end(); ++n)
       unique = name + "_" + std::to_string(n);
     taken.push_back(unique);
-    names.push_back(std::move(unique));
+    out.push_back(std::move(unique));
   }
-  return names;
+  return out;
+}
+
+std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken) {
+  std::vector<std::string> names;
+  for (const auto& column : attributes.columns()) names.push_back(column.name());
+  return token_names(names, std::move(taken));
+}
+
+const char* ply_type(ValueType type) {
+  switch (type) {
+    case ValueType::u8: return "uchar";
+    case ValueType::u16: return "ushort";
+    case ValueType::u32: return "uint";
+    case ValueType::i8: return "char";
+    case ValueType::i16: return "short";
+    case ValueType::i32: return "int";
+    case ValueType::f32: return "float";
+    case ValueType::u64:  // PLY has no 64-bit integers
+    case ValueType::i64:
+    case ValueType::f64: return "double";
+  }
+  return "double";
 }
 
 void append_number(std::string& out, double value) {

@@ -17,6 +17,10 @@ void require_complete_columns(const Tree& tree);
 // One name per column: characters that are not printable ASCII (or are spaces) become
 // '_', and a name equal to one in `taken` or to an earlier column's gets "_2", "_3"...
 std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken);
+std::vector<std::string> token_names(const std::vector<std::string>& names, std::vector<std::string> taken);
+
+// The PLY property type of a column's values (64-bit integers, which PLY lacks: double).
+const char* ply_type(ValueType type);
 
 // The shortest text that reads back as the same double.
 void append_number(std::string& out, double value);

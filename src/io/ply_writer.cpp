@@ -43,22 +43,6 @@ bool colours_use_16_bits(const Attributes& attributes) {
   return false;
 }
 
-const char* ply_type(ValueType type) {
-  switch (type) {
-    case ValueType::u8: return "uchar";
-    case ValueType::u16: return "ushort";
-    case ValueType::u32: return "uint";
-    case ValueType::i8: return "char";
-    case ValueType::i16: return "short";
-    case ValueType::i32: return "int";
-    case ValueType::f32: return "float";
-    case ValueType::u64:  // PLY has no 64-bit integers
-    case ValueType::i64:
-    case ValueType::f64: return "double";
-  }
-  return "double";
-}
-
 std::vector<PlyField> ply_fields(const Tree& tree, std::vector<std::string> taken) {
   std::vector<PlyField> fields;
   const auto names = token_names(tree.attributes(), std::move(taken));

@@ -102,6 +102,39 @@ PY
 done
 "$vola" info "$data/laz/pdal_autzen_trim.laz" | grep -q "compressor 2 (point-wise chunked)" || fail "info names no LAZ compressor"
 
+# vola translate to PLY and XYZ keeps every field of every record, in order (laspy_simple.laz:
+# point format 3), checked against the records of its decoded LAS.
+"$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.las" -q
+"$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.ply" -q
+"$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.xyz" -q
+# numpy: Debian's python3-numpy, for /usr/bin/python3 (the python3 first on PATH may lack it).
+"${VOLA_PYTHON:-/usr/bin/python3}" - "$tmp/simple.las" "$tmp/simple.ply" "$tmp/simple.xyz" <<'PY' || fail "PLY/XYZ translation lost or changed fields"
+import struct, sys
+import numpy as np
+d = open(sys.argv[1], "rb").read()
+offset, count = struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<I", d, 107)[0]
+scale, origin = np.array(struct.unpack_from("<3d", d, 131)), np.array(struct.unpack_from("<3d", d, 155))
+las = np.frombuffer(d, offset=offset, count=count, dtype=np.dtype([("xyz", "<i4", 3), ("intensity", "<u2"),
+      ("returns", "u1"), ("classification", "u1"), ("angle", "i1"), ("user_data", "u1"), ("point_source_id", "<u2"),
+      ("gps_time", "<f8"), ("red", "<u2"), ("green", "<u2"), ("blue", "<u2")]))
+ply = open(sys.argv[2], "rb").read()
+body = ply.index(b"end_header\n") + len(b"end_header\n")
+names = [l.split()[-1].decode() for l in ply[:body].split(b"\n") if l.startswith(b"property")]
+types = {b"double": "<f8", b"ushort": "<u2", b"uchar": "u1"}
+dtype = np.dtype([(l.split()[-1].decode(), types[l.split()[1]]) for l in ply[:body].split(b"\n") if l.startswith(b"property")])
+p = np.frombuffer(ply, offset=body, count=count, dtype=dtype)
+xyz = las["xyz"] * scale + origin
+assert np.array_equal(np.stack([p["x"], p["y"], p["z"]], 1), xyz), "coordinates"
+for f in ("intensity", "classification", "user_data", "point_source_id", "gps_time", "red", "green", "blue"):
+    assert np.array_equal(p[f], las[f]), f
+assert np.array_equal(p["return_number"], las["returns"] & 7) and np.array_equal(p["number_of_returns"], (las["returns"] >> 3) & 7)
+text = np.loadtxt(sys.argv[3], comments="#")
+assert text.shape[0] == count and np.allclose(text[:, :3], xyz, atol=0.5 * scale.max(), rtol=0), "xyz text"
+assert np.array_equal(text[:, 9], las["gps_time"]), "gps_time text"
+PY
+"$vola" translate "$data/ply/trimesh_bunny_ascii.ply" "$tmp/b.las" 2> "$tmp/err.txt" && fail "PLY written as LAS"
+grep -q "LAS and LAZ are written from LAS" "$tmp/err.txt" || fail "PLY to LAS message: $(cat "$tmp/err.txt")"
+
 # A wave-packet format is refused with the reason, not written wrongly.
 if "$vola" translate "$data/las/laspy_simple1_3.las" "$tmp/w.laz" -q 2> "$tmp/err.txt"; then
   fail "a wave-packet LAS was written as LAZ"

@@ -1,0 +1,187 @@
+// vola translate beyond LAS <-> LAZ: any point file vola reads, as points with named
+// columns (a PointCloud), written as PLY or XYZ text, point by point in input order. A
+// LAS/LAZ/COPC input gives every field of its records: intensity, return number and
+// count, classification, user data, point source id, GPS time, colour, extra bytes.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+
+#include "export_columns.hpp"
+#include "las_format.hpp"
+#include "output_file.hpp"
+#include "vola/error.hpp"
+#include "vola/io/input.hpp"
+#include "vola/io/las.hpp"
+#include "vola/io/translate.hpp"
+
+namespace vola::io {
+
+namespace {
+
+// The columns of a LAS file's records, in record order.
+PointCloud las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                           int& coordinate_digits) {
+  LasReader reader(path);
+  const LasHeader& hd = reader.header();
+  // Coordinates at the file's own precision: as many decimals as the finest scale needs.
+  const double finest = std::min({hd.scale[0], hd.scale[1], hd.scale[2]});
+  coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
+  PointCloud cloud;
+  const auto add = [&](const char* name, ValueType type) { cloud.attributes.push_back({name, type, Reduction::last, {}}); };
+  add("intensity", ValueType::u16);
+  add("return_number", ValueType::u8);
+  add("number_of_returns", ValueType::u8);
+  add("classification", ValueType::u8);
+  add("user_data", ValueType::u8);
+  add("point_source_id", ValueType::u16);
+  if (hd.has_gps_time()) add("gps_time", ValueType::f64);
+  if (hd.has_rgb()) {
+    add("red", ValueType::u16);
+    add("green", ValueType::u16);
+    add("blue", ValueType::u16);
+  }
+  for (const auto& f : hd.extra_fields) cloud.attributes.push_back({f.name, ValueType::f64, Reduction::last, {}});
+  LasChunk chunk;
+  while (reader.read(chunk, std::size_t{1} << 20) > 0) {
+    cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
+    std::size_t c = 0;
+    const auto append = [&](const auto& values) {
+      auto& column = cloud.attributes[c++].values;
+      column.insert(column.end(), values.begin(), values.end());
+    };
+    append(chunk.intensity);
+    append(chunk.return_number);
+    append(chunk.number_of_returns);
+    append(chunk.classification);
+    append(chunk.user_data);
+    append(chunk.point_source_id);
+    if (hd.has_gps_time()) append(chunk.gps_time);
+    if (hd.has_rgb()) {
+      append(chunk.red);
+      append(chunk.green);
+      append(chunk.blue);
+    }
+    for (const auto& e : chunk.extra) append(e);
+    if (progress) progress(reader.points_read(), reader.points_total());
+  }
+  return cloud;
+}
+
+std::vector<std::string> column_names(const PointCloud& cloud) {
+  std::vector<std::string> names;
+  for (const auto& a : cloud.attributes) names.push_back(a.name);
+  return token_names(names, {"x", "y", "z"});
+}
+
+template <class T>
+void append_as(std::string& out, double v) {
+  const T t = static_cast<T>(v);
+  out.append(reinterpret_cast<const char*>(&t), sizeof t);
+}
+
+// One value in the column's PLY type, little-endian (the machines vola builds for).
+void append_binary(std::string& out, ValueType type, double v) {
+  switch (type) {
+    case ValueType::u8: return append_as<std::uint8_t>(out, v);
+    case ValueType::u16: return append_as<std::uint16_t>(out, v);
+    case ValueType::u32: return append_as<std::uint32_t>(out, v);
+    case ValueType::i8: return append_as<std::int8_t>(out, v);
+    case ValueType::i16: return append_as<std::int16_t>(out, v);
+    case ValueType::i32: return append_as<std::int32_t>(out, v);
+    case ValueType::f32: return append_as<float>(out, v);
+    default: return append_as<double>(out, v);
+  }
+}
+
+void write_ply_points(const PointCloud& cloud, const std::string& path) {
+  const auto names = column_names(cloud);
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by vola translate\nelement vertex " +
+                       std::to_string(cloud.size()) + "\nproperty double x\nproperty double y\nproperty double z\n";
+  for (std::size_t c = 0; c < names.size(); ++c)
+    header += std::string("property ") + ply_type(cloud.attributes[c].type) + " " + names[c] + "\n";
+  header += "end_header\n";
+  OutputFile out(path);
+  out.write(header);
+  std::string buffer;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    buffer.append(reinterpret_cast<const char*>(&cloud.xyz[3 * i]), 3 * sizeof(double));
+    for (const auto& a : cloud.attributes) append_binary(buffer, a.type, a.values[i]);
+    if (buffer.size() >= (std::size_t{1} << 16)) {
+      out.write(buffer);
+      buffer.clear();
+    }
+  }
+  out.write(buffer);
+  out.commit();
+}
+
+void append_fixed(std::string& out, double v, int digits) {
+  char s[64];
+  const auto r = digits >= 0 ? std::to_chars(s, s + sizeof s, v, std::chars_format::fixed, digits)
+                             : std::to_chars(s, s + sizeof s, v);
+  out.append(s, r.ptr);
+}
+
+void write_xyz_points(const PointCloud& cloud, const std::string& path, int coordinate_digits) {
+  std::string line = "# x y z";
+  for (const auto& name : column_names(cloud)) line += " " + name;
+  line += '\n';
+  OutputFile out(path);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      if (a) line += ' ';
+      append_fixed(line, cloud.xyz[3 * i + static_cast<std::size_t>(a)], coordinate_digits);
+    }
+    for (const auto& attribute : cloud.attributes) {
+      line += ' ';
+      append_number(line, attribute.values[i]);
+    }
+    line += '\n';
+    if (line.size() >= (std::size_t{1} << 16)) {
+      out.write(line);
+      line.clear();
+    }
+  }
+  out.write(line);
+  out.commit();
+}
+
+std::string extension_of(const std::string& path) {
+  const auto dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace
+
+void translate_points(const std::string& input, const std::string& output,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  const std::string out_ext = extension_of(output);
+  const bool las_in = find_input_format(input, "auto").name == "las";
+  if (out_ext == ".las" || out_ext == ".laz") {
+    if (!las_in)
+      throw InvalidArgument(output + ": LAS and LAZ are written from LAS, LAZ or COPC input only (record for record); "
+                                     "write " + input + " as .ply or .xyz");
+    return translate_las(input, output, progress);
+  }
+  if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
+    throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply and .xyz (or .txt)");
+  int digits = -1;  // shortest round trip, unless the input has a precision
+  PointCloud cloud;
+  if (las_in) {
+    cloud = las_point_table(input, progress, digits);
+  } else {
+    InputOptions options;
+    options.attributes = true;
+    Input in = read_input(input, "auto", options);
+    if (in.is_mesh() || in.grid || in.terrain)
+      throw InvalidArgument(input + ": vola translate takes point files; this is " + in.format + " input");
+    cloud = std::move(in.cloud);
+  }
+  if (out_ext == ".ply") write_ply_points(cloud, output);
+  else write_xyz_points(cloud, output, digits);
+}
+
+}  // namespace vola::io
