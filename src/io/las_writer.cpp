@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <functional>
 #include <limits>
 
 #include "export_columns.hpp"
@@ -88,15 +89,20 @@ struct LasColumns {
   const AttributeColumn* blue = nullptr;
   const AttributeColumn* intensity = nullptr;
   const AttributeColumn* classification = nullptr;
-  const AttributeColumn* returns = nullptr;
+  const AttributeColumn* returns = nullptr;          // number_of_returns
+  const AttributeColumn* return_number = nullptr;    // point files; a voxel is return 1
+  const AttributeColumn* user_data = nullptr;
+  const AttributeColumn* point_source_id = nullptr;
+  const AttributeColumn* gps_time = nullptr;
   std::vector<const AttributeColumn*> extra;
   std::vector<std::string> extra_names;  // at most 32 bytes, unique
   bool rgb() const noexcept { return red && green && blue; }
 };
 
-LasColumns sort_columns(const Tree& tree) {
+// The columns that have a LAS field of their own, by name; the others (but "height",
+// which readers derive from z) become extra bytes.
+LasColumns sort_columns(const Attributes& a) {
   LasColumns c;
-  const Attributes& a = tree.attributes();
   if (a.find("red") && a.find("green") && a.find("blue")) {
     c.red = a.find("red");
     c.green = a.find("green");
@@ -105,10 +111,15 @@ LasColumns sort_columns(const Tree& tree) {
   c.intensity = a.find("intensity");
   c.classification = a.find("classification");
   c.returns = a.find("number_of_returns");
+  c.return_number = a.find("return_number");
+  c.user_data = a.find("user_data");
+  c.point_source_id = a.find("point_source_id");
+  c.gps_time = a.find("gps_time");
   for (const auto& column : a.columns()) {
     const std::string& name = column.name();
     const bool standard = name == "intensity" || name == "classification" || name == "number_of_returns" ||
-                          (c.rgb() && (name == "red" || name == "green" || name == "blue"));
+                          name == "return_number" || name == "user_data" || name == "point_source_id" ||
+                          name == "gps_time" || (c.rgb() && (name == "red" || name == "green" || name == "blue"));
     if (standard || name == "height") continue;
     std::string short_name = name.substr(0, 32);
     for (int n = 2; std::find(c.extra_names.begin(), c.extra_names.end(), short_name) != c.extra_names.end(); ++n) {
@@ -137,40 +148,50 @@ std::vector<std::uint8_t> vlr(const std::string& user_id, std::uint16_t record_i
   return bytes;
 }
 
-std::vector<std::uint8_t> extra_bytes_vlr(const LasColumns& c) {
+std::vector<std::uint8_t> extra_bytes_vlr(const LasColumns& c, bool voxels) {
   std::vector<std::uint8_t> data(c.extra.size() * kExtraBytesDescriptorSize);
   for (std::size_t i = 0; i < c.extra.size(); ++i) {
     const std::size_t at = i * kExtraBytesDescriptorSize;
     data[at + 2] = extra_bytes_type(c.extra[i]->type());
     put_text(data, at + 4, 32, c.extra_names[i]);
-    put_text(data, at + 160, 32, "vola " + std::string(name_of(c.extra[i]->reduction())) + " per voxel");
+    if (voxels) put_text(data, at + 160, 32, "vola " + std::string(name_of(c.extra[i]->reduction())) + " per voxel");
   }
   return vlr("LASF_Spec", 4, "Extra Bytes Record", data);
 }
 
-// The CRS as WKT1 when PROJ can write it, else the tree's WKT as stored; nullopt when
-// the tree has no CRS or only an EPSG code PROJ does not know.
-std::optional<std::string> las_wkt(const Tree& tree) {
-  const auto definition = geo::crs_definition(tree.georef());
-  if (!definition) return std::nullopt;
+// What the writer writes, whether voxel centres or points: `count` positions in order
+// (for_each), their bounds, their columns (one value per position) and their CRS.
+struct LasPoints {
+  std::uint64_t count = 0;
+  std::function<void(const std::function<void(const Point&)>&)> for_each;
+  Point min{}, max{};
+  const Attributes* attributes = nullptr;
+  std::optional<std::string> crs;  // a definition PROJ reads (WKT or "EPSG:<code>")
+  std::string crs_wkt;             // the WKT as stored, when PROJ cannot rewrite it
+  bool voxels = false;             // voxel centres (columns are reductions per voxel)
+};
+
+// The CRS as WKT1 when PROJ can write it, else the WKT as stored; nullopt when there is
+// no CRS or only an EPSG code PROJ does not know.
+std::optional<std::string> las_wkt(const LasPoints& points) {
+  if (!points.crs) return std::nullopt;
   try {
-    return geo::crs_wkt1(*definition);
+    return geo::crs_wkt1(*points.crs);
   } catch (const Error&) {
-    if (!tree.georef().crs_wkt.empty()) return tree.georef().crs_wkt;
+    if (!points.crs_wkt.empty()) return points.crs_wkt;
     return std::nullopt;
   }
 }
 
-// Voxel centres as LAS stores them: integers of `scale` from the grid's origin.
+// Positions as LAS stores them: integers of `scale` from `offset`.
 struct LasCoordinates {
-  Quantizer quantizer;
   double scale = 1.0;
   Point offset{};
 
   std::int32_t integer(const Point& p, int axis) const {
     const double v = std::nearbyint((p[axis] - offset[axis]) / scale);
     if (!(std::abs(v) <= 2147483647.0))
-      throw InvalidArgument("voxel centre " + std::to_string(p[axis]) + " does not fit a 32-bit LAS coordinate");
+      throw InvalidArgument("coordinate " + std::to_string(p[axis]) + " does not fit a 32-bit LAS coordinate");
     return static_cast<std::int32_t>(v);
   }
 };
@@ -192,40 +213,29 @@ RecordLayout record_layout(const LasColumns& columns) {
 }
 
 // The VLRs: the CRS as WKT (when known) and the extra-bytes descriptors.
-std::vector<std::vector<std::uint8_t>> header_vlrs(const Tree& tree, const LasColumns& columns, LasReport& report) {
+std::vector<std::vector<std::uint8_t>> header_vlrs(const LasPoints& points, const LasColumns& columns,
+                                                   LasReport& report) {
   std::vector<std::vector<std::uint8_t>> vlrs;
-  if (const auto wkt = las_wkt(tree)) {
+  if (const auto wkt = las_wkt(points)) {
     std::vector<std::uint8_t> data(wkt->begin(), wkt->end());
     data.push_back(0);
     vlrs.push_back(vlr("LASF_Projection", 2112, "OGC WKT coordinate system", data));
     report.has_crs = true;
   }
-  if (!columns.extra.empty()) vlrs.push_back(extra_bytes_vlr(columns));
+  if (!columns.extra.empty()) vlrs.push_back(extra_bytes_vlr(columns, points.voxels));
   return vlrs;
 }
 
-// Scale, offset and bounds of the header. The bounds are those of the points as stored:
-// centres are monotonic in the voxel index, so the extreme voxels give them.
-void put_scale_and_bounds(std::vector<std::uint8_t>& h, const Tree& tree, const LasCoordinates& coords) {
-  for (int a = 0; a < 3; ++a) {
-    put<double>(h, 131 + 8 * a, coords.scale);
-    put<double>(h, 155 + 8 * a, coords.offset[a]);
-  }
-  if (tree.empty()) return;
-  Voxel low{tree.side(), tree.side(), tree.side()}, high{0, 0, 0};
-  tree.for_each_voxel([&](const Voxel& v) {
-    low = {std::min(low.x, v.x), std::min(low.y, v.y), std::min(low.z, v.z)};
-    high = {std::max(high.x, v.x), std::max(high.y, v.y), std::max(high.z, v.z)};
-  });
-  const Point min = coords.quantizer.center(low), max = coords.quantizer.center(high);
-  for (int a = 0; a < 3; ++a) {
-    put<double>(h, 179 + 16 * a, coords.integer(max, a) * coords.scale + coords.offset[a]);
-    put<double>(h, 187 + 16 * a, coords.integer(min, a) * coords.scale + coords.offset[a]);
-  }
+// Return number and number of returns of record `rank`: a voxel (no return_number
+// column) is return 1 of its number_of_returns (1 without that column; 0 of 0 for 0).
+std::pair<std::uint32_t, std::uint32_t> returns_of(const LasColumns& columns, std::size_t rank) {
+  const std::uint32_t count = field_value(columns.returns, rank, 15.0, 1);
+  const std::uint32_t number = columns.return_number ? field_value(columns.return_number, rank, 15.0, 0) : count ? 1 : 0;
+  return {number, count};
 }
 
 // The LAS 1.4 public header block.
-std::vector<std::uint8_t> public_header(const Tree& tree, const LasColumns& columns, const RecordLayout& layout,
+std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumns& columns, const RecordLayout& layout,
                                         const LasCoordinates& coords, const std::vector<std::vector<std::uint8_t>>& vlrs,
                                         const LasReport& report) {
   std::size_t offset_to_points = kHeaderSize;
@@ -248,33 +258,36 @@ std::vector<std::uint8_t> public_header(const Tree& tree, const LasColumns& colu
   h[104] = report.point_format;
   put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(layout.length));
   // Legacy 32-bit counts stay 0: formats 6-10 use the 64-bit ones.
-  put_scale_and_bounds(h, tree, coords);
-  put<std::uint64_t>(h, 247, tree.voxel_count());
-  // Every point is return 1 of its pulse, but for a number_of_returns of 0 (return 0).
-  std::uint64_t first_returns = tree.voxel_count();
-  if (columns.returns)
-    for (std::size_t r = 0; r < columns.returns->size(); ++r)
-      if (field_value(columns.returns, r, 15.0, 1) == 0) --first_returns;
+  for (int a = 0; a < 3; ++a) {
+    put<double>(h, 131 + 8 * a, coords.scale);
+    put<double>(h, 155 + 8 * a, coords.offset[a]);
+    if (points.count == 0) continue;  // bounds as stored: the extreme positions, rounded to the scale
+    put<double>(h, 179 + 16 * a, coords.integer(points.max, a) * coords.scale + coords.offset[a]);
+    put<double>(h, 187 + 16 * a, coords.integer(points.min, a) * coords.scale + coords.offset[a]);
+  }
+  put<std::uint64_t>(h, 247, points.count);
+  std::uint64_t first_returns = 0;  // points by return number: those that are return 1
+  for (std::size_t r = 0; r < points.count; ++r) first_returns += returns_of(columns, r).first == 1;
   put<std::uint64_t>(h, 255, first_returns);
   return h;
 }
 
-// One point record per voxel, in rank order, written in 64 KiB batches.
-void write_records(OutputFile& out, const Tree& tree, const LasColumns& columns, const RecordLayout& layout,
+// One point record per position, in order, written in 64 KiB batches.
+void write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns, const RecordLayout& layout,
                    const LasCoordinates& coords) {
   std::vector<std::uint8_t> record(layout.length);
   std::string buffer;
   std::size_t rank = 0;
-  tree.for_each_voxel([&](const Voxel& v) {
+  points.for_each([&](const Point& p) {
     std::fill(record.begin(), record.end(), 0);
-    const Point p = coords.quantizer.center(v);
     for (int a = 0; a < 3; ++a) put<std::int32_t>(record, 4 * static_cast<std::size_t>(a), coords.integer(p, a));
     put<std::uint16_t>(record, 12, static_cast<std::uint16_t>(field_value(columns.intensity, rank, 65535.0, 0)));
-    // One pulse per voxel: return 1 of number_of_returns (1 without the column).
-    const std::uint32_t returns = field_value(columns.returns, rank, 15.0, 1);
-    const std::uint32_t return_number = returns ? 1 : 0;
-    record[14] = static_cast<std::uint8_t>(return_number | returns << 4);
+    const auto [number, count] = returns_of(columns, rank);
+    record[14] = static_cast<std::uint8_t>(number | count << 4);
     record[16] = static_cast<std::uint8_t>(field_value(columns.classification, rank, 255.0, 0));
+    record[17] = static_cast<std::uint8_t>(field_value(columns.user_data, rank, 255.0, 0));
+    put<std::uint16_t>(record, 20, static_cast<std::uint16_t>(field_value(columns.point_source_id, rank, 65535.0, 0)));
+    if (columns.gps_time) put<double>(record, 22, columns.gps_time->get(rank));
     if (columns.rgb()) {
       put<std::uint16_t>(record, 30, colour_value(*columns.red, rank));
       put<std::uint16_t>(record, 32, colour_value(*columns.green, rank));
@@ -296,22 +309,16 @@ void write_records(OutputFile& out, const Tree& tree, const LasColumns& columns,
   out.write(buffer);
 }
 
-}  // namespace
-
-LasReport write_las(const Tree& tree, const std::string& path) {
-  require_complete_columns(tree);
-  const LasColumns columns = sort_columns(tree);
+// The points as LAS (or, for a .laz path, LAS records then compressed by translate_las).
+LasReport write_points(const LasPoints& points, const LasCoordinates& coords, const std::string& path) {
+  const LasColumns columns = sort_columns(*points.attributes);
   LasReport report;
   report.point_format = columns.rgb() ? 7 : 6;
   report.extra_bytes = columns.extra_names;
+  report.scale = coords.scale;
   const RecordLayout layout = record_layout(columns);
-  const Frame frame = tree.frame();
-  const double extent = frame.voxel_size * static_cast<double>(tree.side());
-  report.scale = choose_scale(frame.voxel_size, extent);
-  const LasCoordinates coords{tree.quantizer(), report.scale, frame.origin};
-  const auto vlrs = header_vlrs(tree, columns, report);
-  const std::vector<std::uint8_t> header = public_header(tree, columns, layout, coords, vlrs, report);
-
+  const auto vlrs = header_vlrs(points, columns, report);
+  const std::vector<std::uint8_t> header = public_header(points, columns, layout, coords, vlrs, report);
   // LAZ: the LAS records first (beside the output, removed whatever happens), then
   // compressed record for record by translate_las.
   const bool laz = las::laz_path(path);
@@ -325,10 +332,70 @@ LasReport write_las(const Tree& tree, const std::string& path) {
   OutputFile out(las_path);
   out.write(header.data(), header.size());
   for (const auto& v : vlrs) out.write(v.data(), v.size());
-  write_records(out, tree, columns, layout, coords);
+  write_records(out, points, columns, layout, coords);
   out.commit();
   if (laz) translate_las(las_path, path);
   return report;
+}
+
+}  // namespace
+
+LasReport write_las(const Tree& tree, const std::string& path) {
+  require_complete_columns(tree);
+  const Quantizer quantizer = tree.quantizer();
+  LasPoints points;
+  points.count = tree.voxel_count();
+  points.voxels = true;
+  points.for_each = [&](const std::function<void(const Point&)>& f) {
+    tree.for_each_voxel([&](const Voxel& v) { f(quantizer.center(v)); });
+  };
+  if (!tree.empty()) {  // centres are monotonic in the voxel index: the extreme voxels bound them
+    Voxel low{tree.side(), tree.side(), tree.side()}, high{0, 0, 0};
+    tree.for_each_voxel([&](const Voxel& v) {
+      low = {std::min(low.x, v.x), std::min(low.y, v.y), std::min(low.z, v.z)};
+      high = {std::max(high.x, v.x), std::max(high.y, v.y), std::max(high.z, v.z)};
+    });
+    points.min = quantizer.center(low);
+    points.max = quantizer.center(high);
+  }
+  points.attributes = &tree.attributes();
+  points.crs = geo::crs_definition(tree.georef());
+  points.crs_wkt = tree.georef().crs_wkt;
+  const Frame frame = tree.frame();
+  const double extent = frame.voxel_size * static_cast<double>(tree.side());
+  return write_points(points, LasCoordinates{choose_scale(frame.voxel_size, extent), frame.origin}, path);
+}
+
+LasReport write_las(const PointCloud& cloud, const std::string& path, const std::optional<std::uint32_t>& epsg,
+                    const std::string& wkt) {
+  Attributes attributes;
+  for (const auto& a : cloud.attributes) {
+    if (a.values.size() != cloud.size())
+      throw InvalidArgument("column " + a.name + " holds " + std::to_string(a.values.size()) + " values for " +
+                            std::to_string(cloud.size()) + " points");
+    AttributeColumn column(a.name, a.type, a.reduction, cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) column.set(i, a.values[i]);
+    attributes.add(std::move(column));
+  }
+  LasPoints points;
+  points.count = cloud.size();
+  points.for_each = [&](const std::function<void(const Point&)>& f) {
+    for (std::size_t i = 0; i < cloud.size(); ++i) f({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]});
+  };
+  const Box box = cloud.bounds();
+  points.min = box.min;
+  points.max = box.max;
+  points.attributes = &attributes;
+  if (!wkt.empty()) points.crs = wkt;
+  else if (epsg) points.crs = "EPSG:" + std::to_string(*epsg);
+  points.crs_wkt = wkt;
+  // The finest power of ten that keeps every coordinate, counted from the minimum, in 32 bits.
+  double extent = 0.0;
+  for (int a = 0; a < 3; ++a) extent = std::max(extent, box.max[a] - box.min[a]);
+  const double scale = power_of_ten(static_cast<int>(std::ceil(std::log10(std::max(extent, 1e-9) / 2.0e9))));
+  Point offset{};
+  for (int a = 0; a < 3; ++a) offset[a] = std::floor(box.min[a] / scale) * scale;
+  return write_points(points, LasCoordinates{scale, offset}, path);
 }
 
 }  // namespace vola::io

@@ -11,6 +11,7 @@
 #include "las_format.hpp"
 #include "output_file.hpp"
 #include "vola/error.hpp"
+#include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/translate.hpp"
@@ -160,27 +161,24 @@ void translate_points(const std::string& input, const std::string& output,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const std::string out_ext = extension_of(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
-  if (out_ext == ".las" || out_ext == ".laz") {
-    if (!las_in)
-      throw InvalidArgument(output + ": LAS and LAZ are written from LAS, LAZ or COPC input only (record for record); "
-                                     "write " + input + " as .ply or .xyz");
-    return translate_las(input, output, progress);
-  }
-  if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
+  if ((out_ext == ".las" || out_ext == ".laz") && las_in) return translate_las(input, output, progress);
+  if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt" && out_ext != ".las" && out_ext != ".laz")
     throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply and .xyz (or .txt)");
   int digits = -1;  // shortest round trip, unless the input has a precision
   PointCloud cloud;
+  Input in;
   if (las_in) {
     cloud = las_point_table(input, progress, digits);
   } else {
     InputOptions options;
     options.attributes = true;
-    Input in = read_input(input, "auto", options);
+    in = read_input(input, "auto", options);
     if (in.is_mesh() || in.grid || in.terrain)
       throw InvalidArgument(input + ": vola translate takes point files; this is " + in.format + " input");
     cloud = std::move(in.cloud);
   }
   if (out_ext == ".ply") write_ply_points(cloud, output);
+  else if (out_ext == ".las" || out_ext == ".laz") write_las(cloud, output, in.epsg, in.wkt);
   else write_xyz_points(cloud, output, digits);
 }
 

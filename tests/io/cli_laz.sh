@@ -132,8 +132,28 @@ text = np.loadtxt(sys.argv[3], comments="#")
 assert text.shape[0] == count and np.allclose(text[:, :3], xyz, atol=0.5 * scale.max(), rtol=0), "xyz text"
 assert np.array_equal(text[:, 9], las["gps_time"]), "gps_time text"
 PY
-"$vola" translate "$data/ply/trimesh_bunny_ascii.ply" "$tmp/b.las" 2> "$tmp/err.txt" && fail "PLY written as LAS"
-grep -q "LAS and LAZ are written from LAS" "$tmp/err.txt" || fail "PLY to LAS message: $(cat "$tmp/err.txt")"
+# Other point files to LAS and LAZ: the same points and columns come back (PDAL's PLY,
+# PCL's coloured PCD), at the written scale; meshes are refused.
+for cloud in "$data/ply/pdal_simple_binary.ply" "$data/pcd/pcl_milk_color.pcd"; do
+  "$vola" translate "$cloud" "$tmp/cloud.xyz" -q
+  "$vola" translate "$cloud" "$tmp/cloud.laz" -q
+  "$vola" translate "$tmp/cloud.laz" "$tmp/cloud_back.xyz" -q
+  "${VOLA_PYTHON:-/usr/bin/python3}" - "$tmp/cloud.xyz" "$tmp/cloud_back.xyz" <<'PY' || fail "$(basename "$cloud") to LAZ and back changed points"
+import sys
+import numpy as np
+a, b = np.loadtxt(sys.argv[1], comments="#", ndmin=2), np.loadtxt(sys.argv[2], comments="#", ndmin=2)
+names_a = open(sys.argv[1]).readline().split()[1:]
+names_b = open(sys.argv[2]).readline().split()[1:]
+assert a.shape[0] == b.shape[0] and a.shape[0] > 0, (a.shape, b.shape)
+scale = 10.0 ** np.ceil(np.log10(np.ptp(a[:, :3], axis=0).max() / 2e9))  # the writer's documented scale
+assert np.abs(a[:, :3] - b[:, :3]).max() <= 0.51 * scale, "coordinates moved more than half the scale"
+for i, name in enumerate(names_a[3:], 3):
+    if name in ("red", "green", "blue", "intensity", "classification"):
+        assert np.array_equal(a[:, i], b[:, names_b.index(name)]), name
+PY
+done
+"$vola" translate "$data/ply/trimesh_bunny_ascii.ply" "$tmp/b.las" 2> "$tmp/err.txt" && fail "a mesh written as points"
+grep -q "takes point files" "$tmp/err.txt" || fail "mesh message: $(cat "$tmp/err.txt")"
 
 # A wave-packet format is refused with the reason, not written wrongly.
 if "$vola" translate "$data/las/laspy_simple1_3.las" "$tmp/w.laz" -q 2> "$tmp/err.txt"; then

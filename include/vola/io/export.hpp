@@ -9,9 +9,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "vola/builder.hpp"
 #include "vola/tree.hpp"
 
 namespace vola::io {
@@ -58,6 +60,13 @@ struct LasReport {
 // A path ending in .laz gets the same records LASzip-compressed (vola/io/laz.hpp:
 // compressor 3, point format 6 or 7).
 LasReport write_las(const Tree& tree, const std::string& path);
+// Points (not voxels) as LAS/LAZ 1.4 format 6 or 7, in order: the columns named as LAS
+// fields (intensity, return_number, number_of_returns, classification, user_data,
+// point_source_id, gps_time, red/green/blue) go into them, the others into extra bytes;
+// scale the finest power of ten that keeps the extent in 32-bit integers, offset the
+// minimum; the CRS (WKT, else the code) as WKT1.
+LasReport write_las(const PointCloud& cloud, const std::string& path, const std::optional<std::uint32_t>& epsg = {},
+                    const std::string& wkt = {});
 
 // ---- NPY dense grid ----
 // A uint8 array of 0/1, shape (S, S, S) for S = tree.side(), indexed [x, y, z] (C order:

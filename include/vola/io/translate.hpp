@@ -10,6 +10,7 @@ namespace vola::io {
 // `input` (any point format vola reads: LAS, LAZ, COPC, PLY, PCD, XYZ/TXT/CSV, NPY,
 // KITTI) into `output`, by its extension:
 //   .las, .laz  record for record from LAS/LAZ/COPC input (translate_las in las.hpp);
+//               other input as LAS 1.4 format 6/7 points (io::write_las of a cloud);
 //   .ply        binary PLY: x y z as double, then every column in its own type;
 //   .xyz, .txt  text, "# x y z names..." then one point a line (LAS input: coordinates
 //               at the file's precision).
