@@ -91,6 +91,9 @@ void run_export(const ExportArgs& a) {
       for (const auto& name : r.extra_bytes) what += " " + name;
     }
     say(what);
+    if (r.clamped_intensities)  // a warning, even with -q: values were changed
+      std::fprintf(stderr, "vola: warning: %llu intensities above LAS's 65535 were written as 65535\n",
+                   static_cast<unsigned long long>(r.clamped_intensities));
   } else if (format == "binvox") {
     io::write_binvox(tree, a.output);
     say("binvox: " + std::to_string(voxels) + " voxels");

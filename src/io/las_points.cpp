@@ -29,9 +29,22 @@ std::vector<AttributeSpec> las_attributes(const LasHeader& hd) {
   specs.push_back({"classification", ValueType::u8, Reduction::majority});
   specs.push_back({"height", ValueType::f32, Reduction::mean});
   specs.push_back({"number_of_returns", ValueType::u8, Reduction::max});
-  for (const auto& f : hd.extra_fields) specs.push_back({f.name, ValueType::f64, Reduction::mean});
+  for (const auto& f : hd.extra_fields)
+    if (f.name != "height") specs.push_back({f.name, ValueType::f64, Reduction::mean});
   return specs;
 }
+
+namespace {
+
+// An extra-bytes field named "height" (vola's LAS export writes the voxels' mean z there)
+// is the height column; without one, height is the point's z.
+const std::vector<double>* height_field(const LasHeader& hd, const LasChunk& chunk) {
+  for (std::size_t f = 0; f < hd.extra_fields.size(); ++f)
+    if (hd.extra_fields[f].name == "height") return &chunk.extra[f];
+  return nullptr;
+}
+
+}  // namespace
 
 void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vector<std::vector<double>>& values) {
   const std::size_t n = chunk.size();
@@ -49,9 +62,11 @@ void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vecto
   }
   column([&](std::size_t i) { return static_cast<double>(chunk.intensity[i]); });
   column([&](std::size_t i) { return static_cast<double>(chunk.classification[i]); });
-  column([&](std::size_t i) { return chunk.xyz[3 * i + 2]; });
+  if (const std::vector<double>* height = height_field(hd, chunk)) column([&](std::size_t i) { return (*height)[i]; });
+  else column([&](std::size_t i) { return chunk.xyz[3 * i + 2]; });
   column([&](std::size_t i) { return static_cast<double>(chunk.number_of_returns[i]); });
-  for (const auto& extra : chunk.extra) column([&](std::size_t i) { return extra[i]; });
+  for (std::size_t f = 0; f < chunk.extra.size(); ++f)
+    if (hd.extra_fields[f].name != "height") column([&](std::size_t i) { return chunk.extra[f][i]; });
 }
 
 void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::uint64_t>& payloads) {

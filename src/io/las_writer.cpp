@@ -99,8 +99,9 @@ struct LasColumns {
   bool rgb() const noexcept { return red && green && blue; }
 };
 
-// The columns that have a LAS field of their own, by name; the others (but "height",
-// which readers derive from z) become extra bytes.
+// The columns that have a LAS field of their own, by name; the others become extra bytes
+// ("height" too: a voxel's mean z is not its centre's z, and vola's LAS reader takes an
+// extra-bytes "height" back as the height column).
 LasColumns sort_columns(const Attributes& a) {
   LasColumns c;
   if (a.find("red") && a.find("green") && a.find("blue")) {
@@ -120,7 +121,7 @@ LasColumns sort_columns(const Attributes& a) {
     const bool standard = name == "intensity" || name == "classification" || name == "number_of_returns" ||
                           name == "return_number" || name == "user_data" || name == "point_source_id" ||
                           name == "gps_time" || (c.rgb() && (name == "red" || name == "green" || name == "blue"));
-    if (standard || name == "height") continue;
+    if (standard) continue;
     std::string short_name = name.substr(0, 32);
     for (int n = 2; std::find(c.extra_names.begin(), c.extra_names.end(), short_name) != c.extra_names.end(); ++n) {
       const std::string number = std::to_string(n);
@@ -273,8 +274,10 @@ std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumn
 }
 
 // One point record per position, in order, written in 64 KiB batches.
-void write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns, const RecordLayout& layout,
-                   const LasCoordinates& coords) {
+// Returns how many intensities were above the field's 65535 (written as 65535).
+std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns,
+                            const RecordLayout& layout, const LasCoordinates& coords) {
+  std::uint64_t clamped_intensities = 0;
   std::vector<std::uint8_t> record(layout.length);
   std::string buffer;
   std::size_t rank = 0;
@@ -282,6 +285,7 @@ void write_records(OutputFile& out, const LasPoints& points, const LasColumns& c
     std::fill(record.begin(), record.end(), 0);
     for (int a = 0; a < 3; ++a) put<std::int32_t>(record, 4 * static_cast<std::size_t>(a), coords.integer(p, a));
     put<std::uint16_t>(record, 12, static_cast<std::uint16_t>(field_value(columns.intensity, rank, 65535.0, 0)));
+    if (columns.intensity && columns.intensity->get(rank) > 65535.0) ++clamped_intensities;
     const auto [number, count] = returns_of(columns, rank);
     record[14] = static_cast<std::uint8_t>(number | count << 4);
     record[16] = static_cast<std::uint8_t>(field_value(columns.classification, rank, 255.0, 0));
@@ -307,6 +311,7 @@ void write_records(OutputFile& out, const LasPoints& points, const LasColumns& c
     ++rank;
   });
   out.write(buffer);
+  return clamped_intensities;
 }
 
 // The points as LAS (or, for a .laz path, LAS records then compressed by translate_las).
@@ -332,7 +337,7 @@ LasReport write_points(const LasPoints& points, const LasCoordinates& coords, co
   OutputFile out(las_path);
   out.write(header.data(), header.size());
   for (const auto& v : vlrs) out.write(v.data(), v.size());
-  write_records(out, points, columns, layout, coords);
+  report.clamped_intensities = write_records(out, points, columns, layout, coords);
   out.commit();
   if (laz) translate_las(las_path, path);
   return report;

@@ -141,7 +141,41 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
 }
 
 // What a property means to vola.
-enum class Role : std::uint8_t { x, y, z, red, green, blue, indices, skip };
+enum class Role : std::uint8_t { x, y, z, red, green, blue, indices, skip, attribute };
+
+ValueType value_type_of(PlyType t) {
+  switch (t) {
+    case PlyType::i8: return ValueType::i8;
+    case PlyType::u8: return ValueType::u8;
+    case PlyType::i16: return ValueType::i16;
+    case PlyType::u16: return ValueType::u16;
+    case PlyType::i32: return ValueType::i32;
+    case PlyType::u32: return ValueType::u32;
+    case PlyType::f32: return ValueType::f32;
+    case PlyType::f64: return ValueType::f64;
+  }
+  return ValueType::f64;
+}
+
+// The vertex's other scalar properties (intensity, normals, scalar fields, labels...)
+// as attribute columns: role `attribute`, column[p] their place in cloud.attributes.
+// Class-like names take the majority of a voxel's points, the others the mean.
+std::vector<std::size_t> attribute_columns(const std::vector<Property>& properties, std::vector<Role>& roles,
+                                           PointCloud& cloud) {
+  std::vector<std::size_t> column(properties.size(), 0);
+  for (std::size_t p = 0; p < properties.size(); ++p) {
+    if (properties[p].list || roles[p] != Role::skip) continue;
+    const std::string& name = properties[p].name;
+    const bool dup = std::any_of(cloud.attributes.begin(), cloud.attributes.end(),
+                                 [&](const PointAttribute& a) { return a.name == name; });
+    if (dup) continue;  // a second property of one name stays unread
+    const bool label = name == "classification" || name == "class" || name == "label" || name == "scalar_Classification";
+    roles[p] = Role::attribute;
+    column[p] = cloud.attributes.size();
+    cloud.attributes.push_back({name, value_type_of(properties[p].type), label ? Reduction::majority : Reduction::mean, {}});
+  }
+  return column;
+}
 
 // Binary element data of either byte order; every read is checked against the end.
 class BinaryInput {
@@ -257,6 +291,7 @@ void read_body(In& in, const Header& h, const InputOptions& options, Input& out,
     // An element without properties has no bytes: nothing to read, however large its count.
     if (e.properties.empty()) continue;
     std::vector<Role> roles(e.properties.size(), Role::skip);
+    std::vector<std::size_t> column;  // Role::attribute: the property's column
     std::optional<ColourColumns> colours;
     if (&e == vertex) {
       std::optional<ColourScale> scale[3];
@@ -282,6 +317,7 @@ void read_body(In& in, const Header& h, const InputOptions& options, Input& out,
         colours.emplace(out.cloud, *scale[0], options.attributes, options.payload);
         colours->reserve(static_cast<std::size_t>(reservable));
       }
+      if (options.attributes) column = attribute_columns(e.properties, roles, out.cloud);
     } else if (&e == face) {
       for (std::size_t p = 0; p < e.properties.size(); ++p)
         if (e.properties[p].list && (e.properties[p].name == "vertex_indices" || e.properties[p].name == "vertex_index")) {
@@ -298,6 +334,7 @@ void read_body(In& in, const Header& h, const InputOptions& options, Input& out,
         const Role role = roles[p];
         if (!prop.list) {
           if (role == Role::skip) in.skip(prop.type, 1);
+          else if (role == Role::attribute) out.cloud.attributes[column[p]].values.push_back(in.read(prop.type));
           else v[static_cast<int>(role)] = in.read(prop.type);
           continue;
         }

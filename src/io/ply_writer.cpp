@@ -21,15 +21,16 @@ struct PlyField {
   const AttributeColumn* column;
   std::string name;
   const char* type;  // PLY type name
-  // colour_u16_to_u8: value / 256; colour_u8_in_u16: the value as is (8-bit colours
-  // stored in 16-bit fields, as many LAS files do).
-  enum class Conversion { copy, colour_u16_to_u8, colour_u8_in_u16, integer_to_double } conversion;
+  // colour_u8_in_u16: the value as is, as uchar (8-bit colours stored in 16-bit fields,
+  // as many LAS files do). Colours that use the 16-bit range stay ushort (copy): cutting
+  // them to 8 bits lost what a reader can keep.
+  enum class Conversion { copy, colour_u8_in_u16, integer_to_double } conversion;
 };
 
 bool is_colour(const AttributeColumn& c) { return c.name() == "red" || c.name() == "green" || c.name() == "blue"; }
 
 // Do the u16 colour columns use the 16-bit range? If none exceeds 255, they hold 8-bit
-// colours, which / 256 would turn black.
+// colours, written as uchar (what most PLY readers expect of colours).
 bool colours_use_16_bits(const Attributes& attributes) {
   for (const auto& c : attributes.columns()) {
     if (!is_colour(c) || c.type() != ValueType::u16) continue;
@@ -51,9 +52,9 @@ std::vector<PlyField> ply_fields(const Tree& tree, std::vector<std::string> take
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const AttributeColumn& c = columns[i];
     PlyField f{&c, names[i], ply_type(c.type()), PlyField::Conversion::copy};
-    if (is_colour(c) && c.type() == ValueType::u16) {
+    if (is_colour(c) && c.type() == ValueType::u16 && !wide_colours) {
       f.type = "uchar";
-      f.conversion = wide_colours ? PlyField::Conversion::colour_u16_to_u8 : PlyField::Conversion::colour_u8_in_u16;
+      f.conversion = PlyField::Conversion::colour_u8_in_u16;
     } else if (c.type() == ValueType::u64 || c.type() == ValueType::i64) {
       f.conversion = PlyField::Conversion::integer_to_double;
     }
@@ -69,11 +70,10 @@ void append_binary(std::string& out, const PlyField& f, std::size_t rank) {
     case PlyField::Conversion::copy:
       out.append(reinterpret_cast<const char*>(p), size);
       return;
-    case PlyField::Conversion::colour_u16_to_u8:
     case PlyField::Conversion::colour_u8_in_u16: {
       std::uint16_t v;
       std::memcpy(&v, p, 2);
-      out.push_back(static_cast<char>(f.conversion == PlyField::Conversion::colour_u16_to_u8 ? v >> 8 : v));
+      out.push_back(static_cast<char>(v));
       return;
     }
     case PlyField::Conversion::integer_to_double: {
@@ -87,9 +87,6 @@ void append_binary(std::string& out, const PlyField& f, std::size_t rank) {
 void append_text(std::string& out, const PlyField& f, std::size_t rank) {
   switch (f.conversion) {
     case PlyField::Conversion::copy: return append_value(out, *f.column, rank);
-    case PlyField::Conversion::colour_u16_to_u8:
-      out += std::to_string(static_cast<unsigned>(f.column->get(rank)) >> 8);
-      return;
     case PlyField::Conversion::colour_u8_in_u16:
       out += std::to_string(static_cast<unsigned>(f.column->get(rank)));
       return;

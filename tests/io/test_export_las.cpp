@@ -18,19 +18,21 @@ namespace {
 using namespace vola_export_test;
 using vola_test::TempDir;
 
-// The LAS reader's columns for the export's: every column but height comes back by name.
+// The LAS reader's columns for the export's: every column comes back by name, "height"
+// too (written as extra bytes: a voxel's mean z is not its centre's z). Without a height
+// column, the reader's height is the z of the one point per voxel, the centre.
 void expect_same_attributes(const vola::Tree& original, const vola::Tree& again) {
   const vola::Quantizer q = original.quantizer();
+  const bool has_height = original.attributes().find("height") != nullptr;
   original.for_each_voxel([&](const vola::Voxel& v) {
     const auto r0 = original.rank(v), r1 = again.rank(v);
     ASSERT_TRUE(r0 && r1);
     for (const auto& column : original.attributes().columns()) {
-      if (column.name() == "height") continue;
       const vola::AttributeColumn* back = again.attributes().find(column.name());
       ASSERT_NE(back, nullptr) << column.name() << " did not come back";
       ASSERT_EQ(back->get(*r1), column.get(*r0)) << column.name();
     }
-    // height: the reader's mean z, now of one point at the voxel centre.
+    if (has_height) return;
     const vola::AttributeColumn* height = again.attributes().find("height");
     ASSERT_NE(height, nullptr);
     const double z = q.center(v)[2];
@@ -238,13 +240,27 @@ TEST(LasExport, AutzenSurveyRoundTrips) {
   const auto report = vola::io::write_las(tree, file.string());
   EXPECT_EQ(report.point_format, 7);
   EXPECT_TRUE(report.has_crs);
-  EXPECT_TRUE(report.extra_bytes.empty());
+  EXPECT_EQ(report.extra_bytes, std::vector<std::string>{"height"});  // the survey's mean z per voxel
   const vola::io::Input in = vola::io::read_input(file.string(), "auto", {});
   ASSERT_FALSE(in.wkt.empty());
   EXPECT_EQ(vola::geo::epsg_from_wkt(in.wkt), 26910u);
   const vola::Tree again = rebuild(in, grid);
   EXPECT_EQ(vola_test::voxel_set(again), vola_test::voxel_set(tree));
   expect_same_attributes(tree, again);
+}
+
+// LAS intensity is 16-bit: wider values are written as 65535 and the report counts them
+// (the CLI warns), instead of a silent clamp.
+TEST(LasExport, IntensitiesAboveSixteenBitsAreCounted) {
+  vola::Tree tree = vola::build_from_voxels(std::vector<vola::Voxel>{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}, 1);
+  vola::AttributeColumn intensity("intensity", vola::ValueType::u32, vola::Reduction::mean, 3);
+  intensity.set(0, 70000);
+  intensity.set(1, 65535);
+  intensity.set(2, 1e9);
+  tree.attributes().add(std::move(intensity));
+  TempDir dir;
+  const auto report = vola::io::write_las(tree, (dir / "wide.las").string());
+  EXPECT_EQ(report.clamped_intensities, 2u);
 }
 
 TEST(LasExport, EmptyTree) {

@@ -13,6 +13,7 @@
 #include "export_test_support.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/ply.hpp"
 
 namespace {
 
@@ -186,12 +187,17 @@ vola::PointCloud vertex_points(const PlyFile& ply) {
   return cloud;
 }
 
-// The value a PLY property should hold for a column: u16 colours narrowed to uchar.
-double expected_ply_value(const vola::AttributeColumn& column, std::size_t rank, bool wide_colours) {
-  const double v = column.get(rank);
-  const bool colour = column.name() == "red" || column.name() == "green" || column.name() == "blue";
-  if (colour && column.type() == vola::ValueType::u16) return wide_colours ? std::floor(v / 256.0) : v;
-  return v;
+// The value a PLY property should hold for a column: the column's own (16-bit colours
+// stay 16-bit; 8-bit colours in 16-bit columns become uchar with the same value).
+double expected_ply_value(const vola::AttributeColumn& column, std::size_t rank) { return column.get(rank); }
+
+// Does any colour column use the 16-bit range (then colours are written as ushort)?
+bool wide_colours(const vola::Tree& tree) {
+  for (const char* name : {"red", "green", "blue"})
+    if (const auto* c = tree.attributes().find(name))
+      for (std::size_t r = 0; r < c->size(); ++r)
+        if (c->type() == vola::ValueType::u16 && c->get(r) > 255) return true;
+  return false;
 }
 
 // ---- Centres ----
@@ -217,7 +223,7 @@ TEST_P(PlyCentres, RoundTripKeepsVoxelsAndAttributes) {
         const vola::Point c = q.center(vola_test::to_voxel(sequence[i]));
         for (int a = 0; a < 3; ++a) ASSERT_EQ(vertex.rows[i][a], c[a]);
         for (const auto& column : s.tree.attributes().columns())
-          ASSERT_EQ(vertex.rows[i][vertex.index_of(column.name())], expected_ply_value(column, i, true))
+          ASSERT_EQ(vertex.rows[i][vertex.index_of(column.name())], expected_ply_value(column, i))
               << column.name() << " at rank " << i;
       }
     }
@@ -231,7 +237,8 @@ TEST(PlyCentres, PropertyTypesFollowTheColumns) {
   const PlyFile ply = export_and_parse(s.tree, {});
   const PlyElement& vertex = ply.element("vertex");
   EXPECT_EQ(vertex.type_of("x"), "double");
-  EXPECT_EQ(vertex.type_of("red"), "uchar");  // viewers expect 8-bit colours
+  // 16-bit colours stay ushort (cutting them to 8 bits lost what readers keep); 8-bit ones uchar.
+  EXPECT_EQ(vertex.type_of("red"), wide_colours(s.tree) ? "ushort" : "uchar");
   EXPECT_EQ(vertex.type_of("intensity"), "ushort");
   EXPECT_EQ(vertex.type_of("classification"), "uchar");
   EXPECT_EQ(vertex.type_of("reflectance"), "float");
@@ -254,6 +261,32 @@ TEST(PlyCentres, EightBitColoursInSixteenBitColumnsStayAsTheyAre) {
     EXPECT_EQ(vertex.rows[0][vertex.index_of(name)], 17);
     EXPECT_EQ(vertex.rows[1][vertex.index_of(name)], 255);
   }
+}
+
+// 16-bit colours keep every bit through PLY and back (they were cut to 8: 60000 -> 234,
+// 255 -> 0), and vola's PLY reader reads them back as the same 16-bit values.
+TEST(PlyCentres, SixteenBitColoursRoundTrip) {
+  vola::Tree tree = vola::build_from_voxels(std::vector<vola::Voxel>{{0, 0, 0}, {1, 2, 3}}, 1);
+  for (const char* name : {"red", "green", "blue"}) {
+    vola::AttributeColumn c(name, vola::ValueType::u16, vola::Reduction::mean, 2);
+    c.set(0, 60000);
+    c.set(1, 255);
+    tree.attributes().add(std::move(c));
+  }
+  const PlyFile ply = export_and_parse(tree, {});
+  const PlyElement& vertex = ply.element("vertex");
+  const vola_test::TempDir dir;
+  const std::string path = (dir.path() / "colours.ply").string();
+  vola::io::write_ply(tree, path, {});
+  const vola::io::Input back = vola::io::read_ply(path);
+  for (const char* name : {"red", "green", "blue"}) {
+    EXPECT_EQ(vertex.type_of(name), "ushort");
+    EXPECT_EQ(vertex.rows[0][vertex.index_of(name)], 60000);
+    EXPECT_EQ(vertex.rows[1][vertex.index_of(name)], 255);
+  }
+  ASSERT_GE(back.cloud.attributes.size(), 3u);
+  EXPECT_EQ(back.cloud.attributes[0].name, "red");
+  EXPECT_EQ(back.cloud.attributes[0].values, (std::vector<double>{60000, 255}));
 }
 
 TEST(PlyCentres, SixtyFourBitAndOddlyNamedColumns) {
@@ -411,7 +444,7 @@ TEST_P(PlyCubesRandom, SurfaceIsExactClosedAndOutward) {
         ASSERT_FALSE(s.voxels.count(outside)) << "face " << f << " faces into a voxel";
         const auto rank = s.tree.rank(vola_test::to_voxel(inside));
         for (const auto& column : s.tree.attributes().columns())
-          ASSERT_EQ(face.rows[f][face.index_of(column.name())], expected_ply_value(column, *rank, true));
+          ASSERT_EQ(face.rows[f][face.index_of(column.name())], expected_ply_value(column, *rank));
       }
       EXPECT_EQ(six_volume, 6 * static_cast<std::int64_t>(s.voxels.size()));
       EXPECT_TRUE(std::all_of(used.begin(), used.end(), [](bool u) { return u; })) << "unused vertices";

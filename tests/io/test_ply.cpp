@@ -3,6 +3,8 @@
 // truncated and corrupted input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -20,6 +22,8 @@ struct SlowPly {
   std::vector<double> xyz;
   std::vector<double> rgb;  // empty without uchar red/green/blue
   std::vector<std::vector<std::int64_t>> faces;
+  std::vector<std::string> other_names;     // the vertex's other scalar properties
+  std::vector<std::vector<double>> others;  // their values, one vector per name
 };
 
 double read_value(std::istream& in, const std::string& type, bool ascii, bool big) {
@@ -109,6 +113,21 @@ SlowPly slow_read(const Bytes& bytes) {
         for (const char* a : {"x", "y", "z"}) out.xyz.push_back(scalars.at(a));
         if (has_rgb)
           for (const char* c : {"red", "green", "blue"}) out.rgb.push_back(scalars.at(c));
+        // Every other scalar property, once per name, in the header's order.
+        std::size_t k = 0;
+        for (const auto& p : props[e]) {
+          const bool own = p.name == "x" || p.name == "y" || p.name == "z" ||
+                           (has_rgb && (p.name == "red" || p.name == "green" || p.name == "blue"));
+          if (p.list || own) continue;
+          if (std::find(out.other_names.begin(), out.other_names.begin() + static_cast<std::ptrdiff_t>(k), p.name) !=
+              out.other_names.begin() + static_cast<std::ptrdiff_t>(k))
+            continue;
+          if (out.other_names.size() == k) {
+            out.other_names.push_back(p.name);
+            out.others.emplace_back();
+          }
+          out.others[k++].push_back(scalars.at(p.name));
+        }
       }
     }
   }
@@ -123,11 +142,16 @@ void expect_same_as_slow(const Bytes& bytes, const std::string& label) {
   const vola::io::Input in = vola::io::parse_ply(bytes, label, options);
   const SlowPly slow = slow_read(bytes);
   ASSERT_EQ(in.cloud.xyz, slow.xyz);
+  // The vertex's other scalar properties follow the colours, in the header's order.
+  const std::size_t colours = slow.rgb.empty() ? 0 : 3;
+  ASSERT_EQ(in.cloud.attributes.size(), colours + slow.others.size());
+  for (std::size_t k = 0; k < slow.others.size(); ++k) {
+    EXPECT_EQ(in.cloud.attributes[colours + k].name, slow.other_names[k]);
+    EXPECT_EQ(in.cloud.attributes[colours + k].values, slow.others[k]) << slow.other_names[k];
+  }
   if (slow.rgb.empty()) {
-    EXPECT_TRUE(in.cloud.attributes.empty());
     EXPECT_TRUE(in.cloud.payload.empty());
   } else {
-    ASSERT_EQ(in.cloud.attributes.size(), 3u);
     ASSERT_EQ(in.cloud.payload.size(), in.cloud.size());
     for (std::size_t i = 0; i < in.cloud.size(); ++i) {
       for (std::size_t c = 0; c < 3; ++c) ASSERT_EQ(in.cloud.attributes[c].values[i], slow.rgb[3 * i + c]) << i;
@@ -177,7 +201,9 @@ TEST(Ply, SharedFilesMatchExpectedAndTheSlowReader) {
 TEST(Ply, VertexColoursOfTheCycloidBecomeAttributes) {
   VOLA_REQUIRE_DATA(data);
   const auto in = vola::io::read_ply((data / "ply" / "trimesh_cycloidal_binle.ply").string());
-  ASSERT_EQ(in.cloud.attributes.size(), 3u);
+  ASSERT_EQ(in.cloud.attributes.size(), 4u);  // red, green, blue, then the alpha property
+  EXPECT_EQ(in.cloud.attributes[3].name, "alpha");
+  EXPECT_EQ(in.cloud.attributes[3].type, vola::ValueType::u8);
   EXPECT_EQ(in.cloud.attributes[0].name, "red");
   EXPECT_EQ(in.cloud.attributes[0].type, vola::ValueType::u16);
   EXPECT_EQ(in.cloud.attributes[0].reduction, vola::Reduction::mean);

@@ -47,8 +47,8 @@ void write_xyz(const Tree& tree, const std::string& path);
 // would overflow 32-bit integers), the offset the grid origin, so every centre is
 // exact to well below a voxel. Columns: red/green/blue (u8 columns widened by 257),
 // intensity, classification and number_of_returns go to the standard fields (rounded
-// and clamped to their ranges); "height" is skipped, since a LAS reader derives it
-// from z; every other column becomes an extra-bytes field (LAS 1.4 "LASF_Spec" 4) of
+// and clamped to their ranges, counted in the report for intensity); every other column,
+// "height" included, becomes an extra-bytes field (LAS 1.4 "LASF_Spec" 4) of
 // the column's type. The CRS goes into an OGC WKT record ("LASF_Projection" 2112, WKT
 // bit set): the tree's WKT, else its EPSG code's, converted to WKT1 through PROJ.
 struct LasReport {
@@ -56,6 +56,7 @@ struct LasReport {
   double scale = 0.0;
   bool has_crs = false;                  // false: the tree's CRS is unknown
   std::vector<std::string> extra_bytes;  // columns written as extra-bytes fields
+  std::uint64_t clamped_intensities = 0;  // intensities above LAS's 16 bits, written as 65535
 };
 // A path ending in .laz gets the same records LASzip-compressed (vola/io/laz.hpp:
 // compressor 3, point format 6 or 7).
