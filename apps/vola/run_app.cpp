@@ -5,12 +5,17 @@
 #include <new>
 
 #include "option_flags.hpp"
+#include "suggest.hpp"
 #include "vola/error.hpp"
 #include "vola/version.hpp"
 
 namespace vola::cli {
 
 int run_app(CLI::App& app, int argc, char** argv) {
+  if (const auto unknown = unknown_subcommand(app, argc, argv)) {
+    std::fprintf(stderr, "vola: %s\n", unknown->c_str());
+    return 1;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
