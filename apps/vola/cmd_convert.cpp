@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "progress.hpp"
 #include "vola/convert.hpp"
 #include "vola/error.hpp"
@@ -78,6 +79,8 @@ void run_convert(ConvertArgs& a) {
       convert(a.input, options, [&progress](std::uint64_t done, std::uint64_t total) { progress.update(done, total); },
               &report);
   progress.finish();
+  for (const auto& warning : report.warnings)  // shown with -q too: they are about the result
+    std::fprintf(stderr, "vola: warning: %s\n", with_flags(warning).c_str());
   WriteOptions w;
   w.layout = options.dense ? Layout::dense : Layout::sparse;
   w.compress = options.compress;

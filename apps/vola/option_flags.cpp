@@ -17,16 +17,17 @@ std::string flag_of(const std::string& option) {
   return flag;
 }
 
-std::string in_flags(const OptionError& error) {
-  std::string cause = error.cause();
-  for (std::size_t open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
-    const std::size_t close = cause.find('`', open + 1);
+std::string with_flags(std::string text) {
+  for (std::size_t open = text.find('`'); open != std::string::npos; open = text.find('`', open)) {
+    const std::size_t close = text.find('`', open + 1);
     if (close == std::string::npos) break;
-    const std::string flag = flag_of(cause.substr(open + 1, close - open - 1));
-    cause.replace(open, close - open + 1, flag);
+    const std::string flag = flag_of(text.substr(open + 1, close - open - 1));
+    text.replace(open, close - open + 1, flag);
     open += flag.size();
   }
-  return flag_of(error.option()) + ": " + cause;
+  return text;
 }
+
+std::string in_flags(const OptionError& error) { return flag_of(error.option()) + ": " + with_flags(error.cause()); }
 
 }  // namespace vola::cli

@@ -15,5 +15,7 @@ std::string flag_of(const std::string& option);
 // "voxel_size: grid quantization needs a `voxel_size` or a `depth`" ->
 // "--voxel-size: grid quantization needs a --voxel-size or a --depth"
 std::string in_flags(const OptionError& error);
+// A library message with each `member` named as its flag (warnings, causes).
+std::string with_flags(std::string text);
 
 }  // namespace vola::cli

@@ -80,6 +80,9 @@ struct ConvertReport {
   // Bytes of the input read, when the reader counts them (LAS, LAZ, COPC): with a COPC
   // file's --level or a grid bbox, less than the file.
   std::optional<std::uint64_t> bytes_read;
+  // What a careful user should know about the result (a CRS relabelled, voxels in
+  // degrees): one sentence each, for the front end to show.
+  std::vector<std::string> warnings;
 };
 
 // (done, total) in any unit, now and then during long reads.

@@ -103,6 +103,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.epsg = crs.epsg;
     report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
     if (input.bytes_read) report.bytes_read = input.bytes_read();
+    report.warnings = crs_warnings(path, options, input, crs);
     *report_out = std::move(report);
   }
   return tree;

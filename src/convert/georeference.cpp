@@ -10,6 +10,29 @@ ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, co
   return resolve_crs(std::span(&stated, 1), options.epsg);
 }
 
+std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
+                                      const ResolvedCrs& crs) {
+  std::vector<std::string> out;
+  try {
+    const std::string stated = !input.wkt.empty() ? input.wkt : input.epsg ? "EPSG:" + std::to_string(*input.epsg) : "";
+    if (options.epsg && options.target_crs.empty() && !stated.empty() &&
+        !geo::same_crs(stated, "EPSG:" + std::to_string(*options.epsg)))
+      out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `epsg` " +
+                    std::to_string(*options.epsg) + " relabels its coordinates without moving them (to move them, " +
+                    "give `target_crs`)");
+    const std::string result = !crs.wkt.empty() ? crs.wkt : crs.epsg ? "EPSG:" + std::to_string(*crs.epsg) : "";
+    if (!result.empty() && !input.grid && !input.is_mesh()) {
+      const geo::CrsDescription d = geo::describe_crs(result);
+      if (d.kind.rfind("geographic", 0) == 0)
+        out.push_back("the CRS (" + d.name + ") is geographic: voxels are degrees of longitude and latitude by " +
+                      "units of height, not cubes; give `target_crs` (a projected CRS such as UTM) for cubes");
+    }
+  } catch (const Error&) {
+    // A CRS PROJ cannot read draws no warning here; the conversion reports it if it matters.
+  }
+  return out;
+}
+
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
 
 std::string crs_definition_of(const std::string& given) {

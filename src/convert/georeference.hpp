@@ -25,6 +25,12 @@ ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io
 // A CRS as the user may give it: "32610" means "EPSG:32610"; anything else as it is.
 std::string crs_definition_of(const std::string& given);
 
+// Warnings about the CRS of a conversion: `epsg` given for an input that states another
+// CRS (the coordinates are relabelled, not moved), and a geographic CRS (voxels whose x
+// and y are degrees while z is in metres or feet).
+std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
+                                      const ResolvedCrs& crs);
+
 // The code the VOLA header carries: the known one, else the reference's default (2000).
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known);
 
