@@ -6,11 +6,14 @@
 
 #include "option_flags.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 #include "vola/version.hpp"
 
 namespace vola::cli {
 
 int run_app(CLI::App& app, int argc, char** argv) {
+  // Ctrl-C or a kill in the middle of a write leaves the old file and no temporary.
+  remove_temporaries_on_signal();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -10,6 +10,7 @@
 #include "extension.hpp"
 #include "mapped_file.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
@@ -174,11 +175,6 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   return tree;
 }
 
-void write_all(std::FILE* f, const void* data, std::size_t size, const std::string& path) {
-  if (size && std::fwrite(data, 1, size, f) != size)
-    VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
-}
-
 }  // namespace
 
 bool compression_available() noexcept { return detail::zstd_available(); }
@@ -239,37 +235,13 @@ std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& option
   return out;
 }
 
-namespace {
-// The temporary file of write(): closed and removed unless the write got to the rename,
-// whichever way it fails (an exception unwinding, or nothing to unwind without them).
-struct PartFile {
-  std::string path;
-  std::FILE* file = nullptr;
-  bool keep = false;  // leave the path alone: renamed into place, or never created
-  ~PartFile() {
-    if (file) std::fclose(file);
-    if (!keep) std::remove(path.c_str());
-  }
-};
-}  // namespace
-
 void write(const Tree& tree, const std::string& path, const WriteOptions& options) {
   const Pieces p = assemble(tree, options);
-  PartFile part{path + ".part"};
-  part.file = std::fopen(part.path.c_str(), "wb");
-  if (!part.file) {
-    part.keep = true;
-    VOLA_THROW(IoError(path + ": cannot create: " + std::strerror(errno)));
-  }
-  write_all(part.file, p.header, kHeaderSize, path);
-  write_all(part.file, p.body.data(), 8 * p.body.size(), path);
-  p.extension.for_each([&](std::span<const std::uint8_t> piece) { write_all(part.file, piece.data(), piece.size(), path); });
-  std::FILE* f = part.file;
-  part.file = nullptr;
-  if (std::fclose(f) != 0) VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
-  if (std::rename(part.path.c_str(), path.c_str()) != 0)
-    VOLA_THROW(IoError(path + ": cannot rename from " + part.path + ": " + std::strerror(errno)));
-  part.keep = true;
+  OutputFile out(path);
+  out.write(p.header, kHeaderSize);
+  out.write(p.body.data(), 8 * p.body.size());
+  p.extension.for_each([&](std::span<const std::uint8_t> piece) { out.write(piece.data(), piece.size()); });
+  out.commit();
 }
 
 Tree parse(std::span<const std::uint8_t> bytes, const std::string& name, FileLayout* layout) {
