@@ -17,6 +17,8 @@ VOLA_INLINE_NAMESPACE_BEGIN
 
 namespace {
 
+constexpr std::uint8_t kExtensionBit = 0x80;  // in the mode byte: Header::extension
+
 // The pieces of a file, so that write() can stream them without one big copy.
 struct Pieces {
   std::uint8_t header[kHeaderSize];
@@ -54,8 +56,10 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
       p.body = tree.words();
     }
   }
-  if (options.compress || detail::needs_extension(tree))
+  if (options.compress || detail::needs_extension(tree)) {
     detail::append_extension(tree, options.compress, options.compression_level, p.extension);
+    h.extension = true;
+  }
   encode_header(h, p.header);
   return p;
 }
@@ -152,6 +156,10 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     info.level_bytes = 8 * words;
     extension_at = kHeaderSize + 8 * words;
   }
+  if (extension_at == bytes.size() && h.extension && h.version != kVersionCompressed)
+    VOLA_THROW(FormatError(name, extension_at,
+                           "the header says a vola extension (frame, CRS, attributes) follows the levels, but the "
+                           "file ends with them: the file is cut"));
   if (extension_at < bytes.size()) {
     const auto rest = bytes.subspan(extension_at);
     if (!detail::starts_extension(rest))
@@ -184,7 +192,7 @@ void encode_header(const Header& h, std::uint8_t* out) {
   detail::ByteWriter w(bytes);
   w.put(h.header_size);
   w.put(h.version);
-  w.put(static_cast<std::uint8_t>(h.layout));
+  w.put(static_cast<std::uint8_t>(static_cast<std::uint8_t>(h.layout) | (h.extension ? kExtensionBit : 0)));
   w.put(h.depth);
   w.put(h.nbits);
   w.put(h.epsg);
@@ -208,8 +216,11 @@ Header decode_header(std::span<const std::uint8_t> bytes, const std::string& nam
   if (h.version != kVersionPlain && h.version != kVersionCompressed)
     VOLA_THROW(FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)"));
   const auto mode = r.get<std::uint8_t>("mode");
-  if (mode > 1) VOLA_THROW(FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)"));
-  h.layout = static_cast<Layout>(mode);
+  h.extension = (mode & kExtensionBit) != 0;
+  const auto layout = static_cast<std::uint8_t>(mode & 0x7Fu);
+  if (layout > 1)
+    VOLA_THROW(FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)"));
+  h.layout = static_cast<Layout>(layout);
   h.depth = r.get<std::uint8_t>("depth");
   if (h.depth < kMinDepth || h.depth > kMaxDepth)
     VOLA_THROW(FormatError(name, 7, "depth " + std::to_string(h.depth) + " is outside 1..10"));
