@@ -55,7 +55,7 @@ TEST(Extension, GridFilesCarryTheirFrame) {
     const vola::Tree back = vola::parse(bytes, "grid", &layout);
     ASSERT_GT(layout.extension_offset, 0u);
     EXPECT_EQ(layout.extension_offset + layout.extension_bytes, bytes.size());
-    EXPECT_EQ(layout.extension_version, 1u);
+    EXPECT_EQ(layout.extension_version, 2u);
     EXPECT_EQ(std::memcmp(bytes.data() + layout.extension_offset, kMagic, 8), 0);
     EXPECT_EQ(layout.extension_offset % 8, 0u);
     ASSERT_TRUE(back.stored_frame().has_value());
@@ -70,7 +70,7 @@ TEST(Extension, GridFilesCarryTheirFrame) {
       EXPECT_TRUE(back.contains(v));
     }
   }
-  EXPECT_EQ(vola::serialize(tree).size() - level_bytes(tree), 16u + 16u + 40u);  // magic etc + frame record
+  EXPECT_EQ(vola::serialize(tree).size() - level_bytes(tree), 16u + 16u + 40u + 16u);  // magic etc, frame, trailer
 }
 
 TEST(Extension, LevelOfDetailOfAToolkitTreeIsWrittenWithAGridFrame) {
@@ -130,11 +130,12 @@ TEST(Extension, UnknownRecordsAreSkipped) {
   const std::size_t at = level_bytes(tree);
   // A record of a later version: tag 99, 5 bytes, padded to 8.
   put_le<std::uint32_t>(bytes, at + 12, get_le<std::uint32_t>(bytes, at + 12) + 1);
-  const std::size_t record = bytes.size();
-  bytes.resize(record + 16 + 8, 0);
+  const std::size_t record = bytes.size() - 16;  // before the trailer
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(record), 16 + 8, 0);
   put_le<std::uint32_t>(bytes, record, 99);
   put_le<std::uint64_t>(bytes, record + 8, 5);
   std::memcpy(bytes.data() + record + 16, "later", 5);
+  reseal_extension(bytes, at);
   const vola::Tree back = vola::parse(bytes, "later");
   ASSERT_TRUE(back.stored_frame().has_value());
   EXPECT_EQ(*back.stored_frame(), *tree.stored_frame());

@@ -162,8 +162,9 @@ TEST(FileErrors, ExtensionRecordLengthPastTheEnd) {
   // Extension: magic (8), version (4), record count (4); the first record's header
   // is tag (4), flags (4), length (8); its body starts 32 bytes into the extension.
   ASSERT_EQ(get_le<std::uint64_t>(bytes, at + 24), 40u);  // the frame record
-  put_le<std::uint64_t>(bytes, at + 24, 41);
-  expect_format_error(bytes, at + 32, "record body needs 41 bytes but only 40 remain");
+  // 40 bytes of frame, then the 16-byte trailer.
+  put_le<std::uint64_t>(bytes, at + 24, 57);
+  expect_format_error(bytes, at + 32, "record body needs 57 bytes but only 56 remain");
   put_le<std::uint64_t>(bytes, at + 24, ~std::uint64_t{0});
   expect_format_error(bytes, at + 32, "record body needs 18446744073709551615 bytes");
 }
@@ -172,7 +173,8 @@ TEST(FileErrors, ExtensionWithMoreRecordsThanItHolds) {
   std::uint64_t at = 0;
   auto bytes = file_with_extension(at);
   put_le<std::uint32_t>(bytes, at + 12, 2);
-  expect_format_error(bytes, bytes.size(), "record tag needs 4 bytes but only 0 remain");
+  // The second record's head is the trailer; its "length" runs past the end.
+  expect_format_error(bytes, bytes.size(), "record body needs");
 }
 
 TEST(FileErrors, ExtensionFollowedByBytes) {
@@ -231,9 +233,10 @@ TEST(FileErrors, AttributeTwiceUnderOneName) {
   const vola::Tree tree = vola::build(cloud, {.depth = 1});
   auto bytes = vola::serialize(tree);
   // Rename "b" to "a": the name is the last byte before the values of the last record.
-  const std::size_t b_at = bytes.size() - 8;  // record padded to 8: "b", 2 values, 5 zero bytes
+  const std::size_t b_at = bytes.size() - 16 - 8;  // before the trailer: "b", 2 values, 5 zero bytes
   ASSERT_EQ(bytes[b_at], 'b');
   bytes[b_at] = 'a';
+  reseal_extension(bytes, 80 + 8 * tree.words().size());
   const std::size_t record = b_at - 32;  // 16-byte record header + 16-byte attribute header
   expect_format_error(bytes, record, "attribute 'a' appears twice");
 }
@@ -310,8 +313,9 @@ TEST(FileErrors, CorruptCompressedLevels) {
   // The levels record is the last one; scramble the zstd frame magic inside it.
   vola::FileLayout layout;
   vola::parse(bytes, "ok", &layout);
-  const std::size_t data = bytes.size() - ((layout.compressed_level_bytes + 7) / 8) * 8;
+  const std::size_t data = bytes.size() - 16 - ((layout.compressed_level_bytes + 7) / 8) * 8;
   bytes[data] ^= 0xFF;
+  reseal_extension(bytes, 80);
   const auto error = format_error_of([&] { (void)vola::parse(bytes, "z"); });
   ASSERT_TRUE(error.has_value());
   EXPECT_THAT(error->cause(), HasSubstr("zstd"));

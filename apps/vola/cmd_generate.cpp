@@ -1,12 +1,12 @@
 // vola generate: the project's own data, e.g. a city block as an XYZ point cloud.
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "commands.hpp"
 #include "progress.hpp"
 #include "text_output.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 #include "vola/synth/city.hpp"
 
 namespace vola::cli {
@@ -22,27 +22,25 @@ struct GenerateArgs {
 
 void run_generate(const GenerateArgs& a) {
   if (a.scene != "city") throw InvalidArgument("scene '" + a.scene + "' is not known (city)");
-  std::FILE* f = std::freopen(a.output.c_str(), "w", stdout);
-  if (!f) throw IoError(a.output + ": cannot create");
+  OutputFile file(a.output);
   synth::CityOptions o;
   o.points = a.points;
   o.seed = a.seed;
   o.size = a.size;
   Progress progress("generating " + a.output);
   std::uint64_t done = 0;
-  {
-    TextOutput out;
-    out.text("# x y z intensity classification (ASPRS: 2 ground, 5 vegetation, 6 building); vola generate city\n");
-    synth::generate_city(o, [&](const synth::CityPoint& p) {
-      // Millimetre precision, as a LIDAR survey delivers.
-      out.number(std::round(p.x * 1000.0) / 1000.0).ch(' ').number(std::round(p.y * 1000.0) / 1000.0).ch(' ');
-      out.number(std::round(p.z * 1000.0) / 1000.0).ch(' ').number(std::uint64_t{p.intensity}).ch(' ');
-      out.number(std::uint64_t{p.classification}).ch('\n');
-      if ((++done & 0xFFFF) == 0) progress.update(done, a.points);
-    });
-  }
+  TextOutput out(file.stream(), a.output);
+  out.text("# x y z intensity classification (ASPRS: 2 ground, 5 vegetation, 6 building); vola generate city\n");
+  synth::generate_city(o, [&](const synth::CityPoint& p) {
+    // Millimetre precision, as a LIDAR survey delivers.
+    out.number(std::round(p.x * 1000.0) / 1000.0).ch(' ').number(std::round(p.y * 1000.0) / 1000.0).ch(' ');
+    out.number(std::round(p.z * 1000.0) / 1000.0).ch(' ').number(std::uint64_t{p.intensity}).ch(' ');
+    out.number(std::uint64_t{p.classification}).ch('\n');
+    if ((++done & 0xFFFF) == 0) progress.update(done, a.points);
+  });
+  out.flush();
+  file.commit();
   progress.update(a.points, a.points);
-  if (std::fclose(stdout) != 0) throw IoError(a.output + ": write failed");
 }
 
 }  // namespace

@@ -2,13 +2,14 @@
 // with --avoid, the trajectory of a reactive agent that only looks along a fan of rays.
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/raycast/avoidance.hpp"
 #include "vola/raycast/path_planner.hpp"
 #include "vola/raycast/world.hpp"
@@ -17,6 +18,13 @@
 namespace vola::cli {
 
 namespace {
+
+// A path is a few kilobytes: formatted in memory, then written whole or not at all.
+void write_whole(const std::string& path, const std::string& text) {
+  OutputFile out(path);
+  out.write(text);
+  out.commit();
+}
 
 struct PlanArgs {
   std::string input, output = "path.csv", ply;
@@ -86,22 +94,20 @@ void run_plan(const PlanArgs& a) {
   }
   std::vector<Point> points;
   for (const Point& p : path.points) points.push_back(a.grid ? p : raycast::grid_to_world(frame, p));
-  std::ofstream csv(a.output);
-  if (!csv) throw IoError("cannot create " + a.output);
+  std::ostringstream csv;
   csv.precision(17);
   csv << "x,y,z\n";
   for (const Point& p : points) csv << p[0] << ',' << p[1] << ',' << p[2] << '\n';
-  if (!csv.flush()) throw IoError("cannot write " + a.output);
+  write_whole(a.output, csv.str());
   if (!a.ply.empty()) {
-    std::ofstream ply(a.ply);
-    if (!ply) throw IoError("cannot create " + a.ply);
+    std::ostringstream ply;
     ply.precision(17);
     ply << "ply\nformat ascii 1.0\nelement vertex " << points.size() << "\nproperty double x\nproperty double y\n"
         << "property double z\nelement edge " << (points.empty() ? 0 : points.size() - 1)
         << "\nproperty int vertex1\nproperty int vertex2\nend_header\n";
     for (const Point& p : points) ply << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
     for (std::size_t i = 1; i < points.size(); ++i) ply << i - 1 << ' ' << i << '\n';
-    if (!ply.flush()) throw IoError("cannot write " + a.ply);
+    write_whole(a.ply, ply.str());
   }
   if (a.avoid) {
     if (!flight.reached)

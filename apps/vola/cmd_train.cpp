@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
+#include "vola/output_stream.hpp"
 #include "vola/learn/classifier.hpp"
 
 namespace vola::cli {
@@ -98,9 +99,9 @@ void run_train(TrainArgs& a) {
     run["checkpoint"] = options.checkpoint_path;
     run["epochs_done"] = r.epoch;
     run["epochs"] = epochs;
-    std::ofstream out(json_path);
+    OutputStream out(json_path);
     out << run.dump(2) << '\n';
-    if (!out.flush()) throw IoError("cannot write " + json_path);
+    out.commit();
   };
   const auto reports = learn::train(train_set, validation_set, options, callbacks);
   if (reports.empty())

@@ -61,6 +61,7 @@ void run_voxels(const VoxelsArgs& a) {
     out.number(std::uint64_t{v.x}).ch(' ').number(std::uint64_t{v.y}).ch(' ').number(std::uint64_t{v.z});
     print_tail(out, tree, a, rank, block);
   });
+  out.finish();
 }
 
 // The CRS to transform from: --crs, else what the file says; a file without one is an
@@ -88,6 +89,7 @@ void run_coords(const VoxelsArgs& a) {
     out.number(p[0]).ch(' ').number(p[1]).ch(' ').number(p[2]);
     print_tail(out, tree, a, rank, block);
   });
+  out.finish();
 }
 
 void add_common(CLI::App* cmd, VoxelsArgs& args) {

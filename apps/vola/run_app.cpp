@@ -7,6 +7,7 @@
 #include "option_flags.hpp"
 #include "suggest.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 #include "vola/version.hpp"
 
 namespace vola::cli {
@@ -16,6 +17,8 @@ int run_app(CLI::App& app, int argc, char** argv) {
     std::fprintf(stderr, "vola: %s\n", unknown->c_str());
     return 1;
   }
+  // Ctrl-C or a kill in the middle of a write leaves the old file and no temporary.
+  remove_temporaries_on_signal();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,10 +1,15 @@
 // Fast line output for commands that print one line per voxel (millions of lines):
-// numbers formatted with std::to_chars into a large buffer, flushed to stdout.
+// numbers formatted with std::to_chars into a large buffer, flushed to a stream
+// (stdout, or an OutputFile's). finish() reports a failed write; the destructor must not
+// throw (a throwing destructor ends the process with SIGABRT, as `vola generate` did on
+// a full disk), so what it flushes on the way out of an error is best effort.
 #pragma once
 
 #include <charconv>
 #include <cstdint>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -14,8 +19,14 @@ namespace vola::cli {
 
 class TextOutput {
  public:
-  TextOutput() { buffer_.reserve(kSize + 128); }
-  ~TextOutput() { flush(); }
+  TextOutput() : TextOutput(stdout, "standard output") {}
+  // `name` labels errors.
+  TextOutput(std::FILE* stream, std::string name) : stream_(stream), name_(std::move(name)) { buffer_.reserve(kSize + 128); }
+  ~TextOutput() {
+    if (!buffer_.empty()) std::fwrite(buffer_.data(), 1, buffer_.size(), stream_);
+  }
+  TextOutput(const TextOutput&) = delete;
+  TextOutput& operator=(const TextOutput&) = delete;
   TextOutput& text(std::string_view s) {
     buffer_.append(s);
     return maybe_flush();
@@ -34,9 +45,15 @@ class TextOutput {
     return maybe_flush();
   }
   void flush() {
-    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), stdout) != buffer_.size())
-      throw IoError("cannot write to standard output");
+    // Cleared even when the write fails, so that the destructor does not write it again.
+    const bool written = buffer_.empty() || std::fwrite(buffer_.data(), 1, buffer_.size(), stream_) == buffer_.size();
     buffer_.clear();
+    if (!written) throw IoError(failure());
+  }
+  // Everything written, or IoError.
+  void finish() {
+    flush();
+    if (std::fflush(stream_) != 0 || std::ferror(stream_)) throw IoError(failure());
   }
 
  private:
@@ -52,6 +69,9 @@ class TextOutput {
     if (buffer_.size() >= kSize) flush();
     return *this;
   }
+  std::string failure() const { return name_ + ": write failed: " + std::strerror(errno); }
+  std::FILE* stream_;
+  std::string name_;
   std::string buffer_;
 };
 

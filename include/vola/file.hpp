@@ -26,6 +26,10 @@ struct Header {
   std::uint32_t header_size = kHeaderSize;
   std::uint16_t version = kVersionPlain;
   Layout layout = Layout::sparse;
+  // Bit 7 of the mode byte (vola's; the reference reader ignores the mode byte): our
+  // extension follows the levels, so a file that ends with its levels was cut there.
+  // Files written before it have the extension without the bit, and still read.
+  bool extension = false;
   std::uint8_t depth = 1;
   std::uint32_t nbits = 0;
   std::uint32_t epsg = 2000;

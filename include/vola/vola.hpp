@@ -6,6 +6,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/frame.hpp"
+#include "vola/output_file.hpp"
 #include "vola/key.hpp"
 #include "vola/setops.hpp"
 #include "vola/stream_builder.hpp"

@@ -3,9 +3,13 @@
 #include <sndfile.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <fstream>
 #include <memory>
+#include <string_view>
 
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola::audio {
 
@@ -17,6 +21,41 @@ struct SndfileCloser {
 using SndfilePtr = std::unique_ptr<SNDFILE, SndfileCloser>;
 
 constexpr sf_count_t kChunkFrames = 65536;
+
+std::uint32_t le32(const unsigned char* p) {
+  return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
+}
+
+// libsndfile reads a cut WAV as a shorter sound and says nothing: its header's data
+// chunk size is clamped to what the file holds. A RIFF WAV states that size, so a file
+// shorter than the chunks it declares is refused, naming the size field's offset.
+// Other formats (and streamed WAVs, whose size is 0 or ~0) are left to libsndfile.
+void check_wav_not_cut(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return;  // sf_open reports it
+  const auto file_size = static_cast<std::uint64_t>(in.tellg());
+  unsigned char head[12];
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(head), 12) || std::string_view(reinterpret_cast<char*>(head), 4) != "RIFF" ||
+      std::string_view(reinterpret_cast<char*>(head) + 8, 4) != "WAVE")
+    return;
+  std::uint64_t at = 12;
+  unsigned char chunk[8];
+  while (at + 8 <= file_size) {
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return;
+    const std::uint64_t size = le32(chunk + 4);
+    const bool data = std::string_view(reinterpret_cast<char*>(chunk), 4) == "data";
+    if (data && (size == 0 || size == 0xFFFFFFFFu)) return;
+    if (at + 8 + size > file_size)
+      throw FormatError(path, at + 4,
+                        "the \"" + std::string(reinterpret_cast<char*>(chunk), 4) + "\" chunk declares " +
+                            std::to_string(size) + " bytes but the file ends " + std::to_string(file_size - at - 8) +
+                            " bytes after its start: the file is cut");
+    if (data) return;
+    at += 8 + size + (size & 1);
+  }
+}
 
 }  // namespace
 
@@ -34,6 +73,7 @@ Sound read_sound(const std::string& path) {
   SF_INFO info{};
   SndfilePtr file(sf_open(path.c_str(), SFM_READ, &info));
   if (!file) throw IoError(path + ": cannot read sound: " + sf_strerror(nullptr));
+  if ((info.format & SF_FORMAT_TYPEMASK) == SF_FORMAT_WAV) check_wav_not_cut(path);
   if (info.channels <= 0 || info.channels > 256 || info.samplerate <= 0)
     throw FormatError(path, std::nullopt, "implausible sound header (" + std::to_string(info.channels) + " channels, " +
                                               std::to_string(info.samplerate) + " Hz)");
@@ -68,7 +108,9 @@ void write_wav(const std::string& path, const Sound& sound, SampleFormat format)
   if (!sf_format_check(&info))
     throw InvalidArgument(path + ": libsndfile cannot write this WAV (" + std::to_string(info.channels) + " channels, " +
                           std::to_string(info.samplerate) + " Hz)");
-  SndfilePtr file(sf_open(path.c_str(), SFM_WRITE, &info));
+  OutputFile output(path);
+  // libsndfile seeks back to finish the header: it writes the descriptor itself.
+  SndfilePtr file(sf_open_fd(output.descriptor(), SFM_WRITE, &info, SF_FALSE));
   if (!file) throw IoError(path + ": cannot create: " + sf_strerror(nullptr));
   // PCM output clips instead of wrapping around.
   sf_command(file.get(), SFC_SET_CLIPPING, nullptr, SF_TRUE);
@@ -82,6 +124,7 @@ void write_wav(const std::string& path, const Sound& sound, SampleFormat format)
       throw IoError(path + ": cannot write: " + sf_strerror(file.get()));
   }
   if (sf_close(file.release()) != 0) throw IoError(path + ": cannot finish writing");
+  output.commit();
 }
 
 }  // namespace vola::audio

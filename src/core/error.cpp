@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
@@ -18,6 +19,8 @@ namespace detail {
 void fail(const Error& error) noexcept {
   if (const ErrorHandler h = handler.load()) h(error.what());
   std::fprintf(stderr, "vola: %s\n", error.what());
+  // No destructor runs on this path: the half-written files would stay.
+  remove_live_temporaries();
   std::abort();
 }
 }  // namespace detail

@@ -5,6 +5,7 @@
 
 #include "bytes.hpp"
 #include "codec.hpp"
+#include "crc32c.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
@@ -27,6 +28,12 @@ void begin_record(ByteWriter& w, RecordTag tag, std::uint32_t flags, std::uint64
   w.put(length);
 }
 
+std::string hex32(std::uint32_t v) {
+  char s[11] = "0x";
+  for (int i = 0; i < 8; ++i) s[2 + i] = "0123456789abcdef"[(v >> (28 - 4 * i)) & 15u];
+  return s;
+}
+
 std::span<const std::uint8_t> as_bytes(const std::string& s) {
   return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
 }
@@ -35,6 +42,36 @@ void check_ratio(ByteReader& r, std::uint64_t raw, std::uint64_t packed) {
   if (raw > packed * kMaxRatio + kRatioSlack)
     r.fail("record claims " + std::to_string(raw) + " bytes from " + std::to_string(packed) +
            " compressed bytes, more than any real data compresses");
+}
+
+// The length and the checksum cover the whole extension (the length field included), so
+// a cut or a flipped bit anywhere in it, attribute values too, is an error rather than
+// lost or wrong metadata.
+void append_trailer(ExtensionPieces& out) {
+  ByteWriter w(out.own);
+  w.put(static_cast<std::uint64_t>(out.size() + kTrailerSize));
+  std::uint32_t crc = 0;
+  out.for_each([&](std::span<const std::uint8_t> piece) { crc = crc32c(piece, crc); });
+  w.put(crc);
+  w.put(std::uint32_t{0});
+}
+
+// Checks the trailer that ends a version-2 extension; `r` is just past the last record.
+void check_trailer(ByteReader& r, std::span<const std::uint8_t> bytes, std::uint64_t base) {
+  const std::uint64_t at = r.offset();
+  if (r.remaining() < kTrailerSize)
+    r.fail("the extension ends " + std::to_string(r.remaining()) +
+           " bytes after its last record, before its length and checksum: the file is cut");
+  const auto length = r.get<std::uint64_t>("extension length");
+  const std::uint32_t actual = crc32c(bytes.first(static_cast<std::size_t>(at - base + 8)));
+  const auto stored = r.get<std::uint32_t>("extension checksum");
+  if (r.get<std::uint32_t>("reserved") != 0) r.fail_at(at + 12, "the extension trailer's reserved word is not 0");
+  if (length != at - base + kTrailerSize)
+    r.fail_at(at, "the extension says it is " + std::to_string(length) + " bytes long, it is " +
+                      std::to_string(at - base + kTrailerSize));
+  if (stored != actual)
+    r.fail_at(at + 8, "extension checksum " + hex32(stored) + " does not match its bytes (" + hex32(actual) +
+                          "): the extension is corrupt");
 }
 
 }  // namespace
@@ -127,6 +164,7 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
     for (const auto& compressed : frames) w.put_bytes(compressed);
     while ((w.size() + borrowed_bytes) % 8) w.put(std::uint8_t{0});
   }
+  append_trailer(out);
 }
 
 namespace {
@@ -262,6 +300,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         break;  // a record of a later version: skipped
     }
   }
+  if (out.version >= kFirstVersionWithTrailer) check_trailer(r, bytes, base);
   if (r.remaining() != 0)
     r.fail(std::to_string(r.remaining()) + " bytes follow the last extension record");
   return out;

@@ -1,7 +1,10 @@
 // Internal: our extension after the levels (docs/FILE_FORMAT.md).
 //   "VOLAEXT\0", u32 version, u32 record count, then records:
-//   u32 tag, u32 flags, u64 length, `length` bytes, zero padding to 8 bytes.
-// Unknown tags are skipped, so later versions can add records.
+//   u32 tag, u32 flags, u64 length, `length` bytes, zero padding to 8 bytes;
+//   from version 2 a trailer: u64 extension length (magic to trailer end), u32 CRC-32C
+//   of every extension byte before it, u32 zero.
+// Unknown tags are skipped, so later versions can add records. Version-1 extensions
+// (no trailer) still read.
 #pragma once
 
 #include <cstdint>
@@ -19,7 +22,9 @@ VOLA_INLINE_NAMESPACE_BEGIN
 namespace detail {
 
 inline constexpr std::uint8_t kExtensionMagic[8] = {'V', 'O', 'L', 'A', 'E', 'X', 'T', 0};
-inline constexpr std::uint32_t kExtensionVersion = 1;
+inline constexpr std::uint32_t kExtensionVersion = 2;
+inline constexpr std::uint32_t kFirstVersionWithTrailer = 2;
+inline constexpr std::uint64_t kTrailerSize = 16;
 
 enum class RecordTag : std::uint32_t { frame = 1, crs_wkt = 2, attribute = 3, levels = 4 };
 

@@ -10,11 +10,14 @@
 #include "extension.hpp"
 #include "mapped_file.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 namespace {
+
+constexpr std::uint8_t kExtensionBit = 0x80;  // in the mode byte: Header::extension
 
 // The pieces of a file, so that write() can stream them without one big copy.
 struct Pieces {
@@ -53,8 +56,10 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
       p.body = tree.words();
     }
   }
-  if (options.compress || detail::needs_extension(tree))
+  if (options.compress || detail::needs_extension(tree)) {
     detail::append_extension(tree, options.compress, options.compression_level, p.extension);
+    h.extension = true;
+  }
   encode_header(h, p.header);
   return p;
 }
@@ -151,6 +156,10 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     info.level_bytes = 8 * words;
     extension_at = kHeaderSize + 8 * words;
   }
+  if (extension_at == bytes.size() && h.extension && h.version != kVersionCompressed)
+    VOLA_THROW(FormatError(name, extension_at,
+                           "the header says a vola extension (frame, CRS, attributes) follows the levels, but the "
+                           "file ends with them: the file is cut"));
   if (extension_at < bytes.size()) {
     const auto rest = bytes.subspan(extension_at);
     if (!detail::starts_extension(rest))
@@ -174,11 +183,6 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   return tree;
 }
 
-void write_all(std::FILE* f, const void* data, std::size_t size, const std::string& path) {
-  if (size && std::fwrite(data, 1, size, f) != size)
-    VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
-}
-
 }  // namespace
 
 bool compression_available() noexcept { return detail::zstd_available(); }
@@ -188,7 +192,7 @@ void encode_header(const Header& h, std::uint8_t* out) {
   detail::ByteWriter w(bytes);
   w.put(h.header_size);
   w.put(h.version);
-  w.put(static_cast<std::uint8_t>(h.layout));
+  w.put(static_cast<std::uint8_t>(static_cast<std::uint8_t>(h.layout) | (h.extension ? kExtensionBit : 0)));
   w.put(h.depth);
   w.put(h.nbits);
   w.put(h.epsg);
@@ -212,8 +216,11 @@ Header decode_header(std::span<const std::uint8_t> bytes, const std::string& nam
   if (h.version != kVersionPlain && h.version != kVersionCompressed)
     VOLA_THROW(FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)"));
   const auto mode = r.get<std::uint8_t>("mode");
-  if (mode > 1) VOLA_THROW(FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)"));
-  h.layout = static_cast<Layout>(mode);
+  h.extension = (mode & kExtensionBit) != 0;
+  const auto layout = static_cast<std::uint8_t>(mode & 0x7Fu);
+  if (layout > 1)
+    VOLA_THROW(FormatError(name, 6, "mode " + std::to_string(mode) + " is neither 0 (sparse) nor 1 (dense)"));
+  h.layout = static_cast<Layout>(layout);
   h.depth = r.get<std::uint8_t>("depth");
   if (h.depth < kMinDepth || h.depth > kMaxDepth)
     VOLA_THROW(FormatError(name, 7, "depth " + std::to_string(h.depth) + " is outside 1..10"));
@@ -239,37 +246,13 @@ std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& option
   return out;
 }
 
-namespace {
-// The temporary file of write(): closed and removed unless the write got to the rename,
-// whichever way it fails (an exception unwinding, or nothing to unwind without them).
-struct PartFile {
-  std::string path;
-  std::FILE* file = nullptr;
-  bool keep = false;  // leave the path alone: renamed into place, or never created
-  ~PartFile() {
-    if (file) std::fclose(file);
-    if (!keep) std::remove(path.c_str());
-  }
-};
-}  // namespace
-
 void write(const Tree& tree, const std::string& path, const WriteOptions& options) {
   const Pieces p = assemble(tree, options);
-  PartFile part{path + ".part"};
-  part.file = std::fopen(part.path.c_str(), "wb");
-  if (!part.file) {
-    part.keep = true;
-    VOLA_THROW(IoError(path + ": cannot create: " + std::strerror(errno)));
-  }
-  write_all(part.file, p.header, kHeaderSize, path);
-  write_all(part.file, p.body.data(), 8 * p.body.size(), path);
-  p.extension.for_each([&](std::span<const std::uint8_t> piece) { write_all(part.file, piece.data(), piece.size(), path); });
-  std::FILE* f = part.file;
-  part.file = nullptr;
-  if (std::fclose(f) != 0) VOLA_THROW(IoError(path + ": write failed: " + std::strerror(errno)));
-  if (std::rename(part.path.c_str(), path.c_str()) != 0)
-    VOLA_THROW(IoError(path + ": cannot rename from " + part.path + ": " + std::strerror(errno)));
-  part.keep = true;
+  OutputFile out(path);
+  out.write(p.header, kHeaderSize);
+  out.write(p.body.data(), 8 * p.body.size());
+  p.extension.for_each([&](std::span<const std::uint8_t> piece) { out.write(piece.data(), piece.size()); });
+  out.commit();
 }
 
 Tree parse(std::span<const std::uint8_t> bytes, const std::string& name, FileLayout* layout) {

@@ -11,6 +11,7 @@
 #include "file_bytes.hpp"
 #include "header_words.hpp"
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola::io {
 
@@ -182,10 +183,9 @@ std::vector<std::uint8_t> serialize_binvox(const Tree& tree) {
 
 void write_binvox(const Tree& tree, const std::string& path) {
   const auto bytes = serialize_binvox(tree);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw IoError(path + ": cannot create");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw IoError(path + ": cannot write");
+  OutputFile out(path);
+  out.write(bytes.data(), bytes.size());
+  out.commit();
 }
 
 }  // namespace vola::io

@@ -2,6 +2,7 @@
 // keys or WKT) and the extra-bytes fields, each checked against the file's size before
 // anything is allocated for it.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <optional>
@@ -46,6 +47,21 @@ struct HeaderCounts {
   std::uint32_t evlr_count = 0;
 };
 
+const char* not_a_number(double v) {
+  return std::isnan(v) ? "NaN" : std::isinf(v) ? "infinite" : v == 0.0 ? "0" : nullptr;
+}
+
+// A coordinate is offset + scale * integer: a NaN, infinite or zero scale (or a NaN or
+// infinite offset) makes every point NaN or the same, which the builders then drop or
+// pile up silently. Refused here, where the file and the field's offset are known.
+void check_scale_and_offset(const HeaderSource& src, const LasHeader& hd, int a) {
+  const char axis = static_cast<char>('x' + a);
+  if (const char* what = not_a_number(hd.scale[a]))
+    src.fail(131 + 8 * static_cast<std::uint64_t>(a), std::string(1, axis) + " scale is " + what);
+  if (const char* what = not_a_number(hd.offset[a]); what && hd.offset[a] != 0.0)
+    src.fail(155 + 8 * static_cast<std::uint64_t>(a), std::string(1, axis) + " offset is " + what);
+}
+
 HeaderCounts parse_public_block(const HeaderSource& src, LasHeader& hd) {
   if (src.file_size < 227)
     src.fail(src.file_size, "a LAS file has at least a 227-byte header; this file has " + std::to_string(src.file_size) +
@@ -70,6 +86,7 @@ HeaderCounts parse_public_block(const HeaderSource& src, LasHeader& hd) {
     hd.offset[a] = load_le<double>(&h[155 + 8 * a]);
     hd.max[a] = load_le<double>(&h[179 + 16 * a]);
     hd.min[a] = load_le<double>(&h[187 + 16 * a]);
+    check_scale_and_offset(src, hd, a);
   }
   const std::uint16_t min_header = hd.version_minor >= 4 ? 375 : hd.version_minor == 3 ? 235 : 227;
   if (hd.header_size < min_header || hd.header_size > src.file_size)

@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "las_format.hpp"
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/io/las.hpp"
 

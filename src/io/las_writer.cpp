@@ -11,7 +11,7 @@
 
 #include "export_columns.hpp"
 #include "las_format.hpp"
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/export.hpp"

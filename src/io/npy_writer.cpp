@@ -2,7 +2,7 @@
 #include <string>
 #include <vector>
 
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
 

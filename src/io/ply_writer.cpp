@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "export_columns.hpp"
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
 #include "vola/version.hpp"

@@ -4,7 +4,7 @@
 
 #include <csetjmp>
 
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 
 namespace vola::io {

@@ -1,6 +1,6 @@
 // XYZ text: one voxel centre per line, "x y z [attribute values...]".
 #include "export_columns.hpp"
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/io/export.hpp"
 
 namespace vola::io {

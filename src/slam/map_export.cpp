@@ -11,6 +11,7 @@
 #include "tsdf_reader.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
+#include "vola/output_stream.hpp"
 
 namespace vola::slam {
 
@@ -210,8 +211,7 @@ Mesh marching_cubes(const Store& store) {
 }
 
 void write_ply(const std::string& path, const Mesh& mesh, bool with_colour) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw IoError(path + ": cannot create");
+  OutputStream out(path);
   out << "ply\nformat binary_little_endian 1.0\ncomment vola fuse: marching cubes of the TSDF\nelement vertex "
       << mesh.vertices.size() << "\nproperty float x\nproperty float y\nproperty float z\n";
   if (with_colour) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -226,8 +226,7 @@ void write_ply(const std::string& path, const Mesh& mesh, bool with_colour) {
     out.write(&three, 1);
     out.write(reinterpret_cast<const char*>(t.data()), 12);
   }
-  out.flush();
-  if (!out) throw IoError(path + ": write failed");
+  out.commit();
 }
 
 MapMemory map_memory(const SparseTsdfStore& store) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "vola/error.hpp"
+#include "vola/output_stream.hpp"
 
 namespace vola::slam {
 
@@ -130,10 +131,9 @@ Intrinsics read_intrinsics(const std::string& file) {
 }
 
 void write_intrinsics(const std::string& file, const Intrinsics& k) {
-  std::ofstream out(file);
+  OutputStream out(file);
   out << "# fx fy cx cy (pixels)\n" << std::setprecision(17) << k.fx << ' ' << k.fy << ' ' << k.cx << ' ' << k.cy << '\n';
-  out.flush();
-  if (!out) throw IoError(file + ": write failed");
+  out.commit();
 }
 
 std::vector<TimedPath> read_timed_list(const std::string& file) {
@@ -169,8 +169,7 @@ std::vector<StampedPose> read_numbered_poses(const std::string& file) {
 }
 
 void write_trajectory(const std::string& file, const std::vector<StampedPose>& poses) {
-  std::ofstream out(file);
-  if (!out) throw IoError(file + ": cannot create");
+  OutputStream out(file);
   out << "# timestamp tx ty tz qx qy qz qw\n" << std::setprecision(17);
   for (const auto& p : poses) {
     const Eigen::Quaterniond q(p.pose.linear());
@@ -178,8 +177,7 @@ void write_trajectory(const std::string& file, const std::vector<StampedPose>& p
     out << p.timestamp << ' ' << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z()
         << ' ' << q.w() << '\n';
   }
-  out.flush();
-  if (!out) throw IoError(file + ": write failed");
+  out.commit();
 }
 
 std::vector<std::pair<std::size_t, std::size_t>> associate(const std::vector<double>& a, const std::vector<double>& b,

@@ -5,9 +5,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
+#include "vola/output_stream.hpp"
 #include "vola/raycast/world.hpp"
 
 namespace vola::slam {
@@ -226,9 +228,10 @@ void generate_sequence(const Tree& scene, const std::vector<Pose>& poses, const 
   const fs::path dir(directory);
   fs::create_directories(dir / "depth");
   if (options.colour) fs::create_directories(dir / "rgb");
-  std::ofstream depth_list(dir / "depth.txt"), truth(dir / "groundtruth.txt"), rgb_list;
-  if (options.colour) rgb_list.open(dir / "rgb.txt");
-  if (!depth_list || !truth || (options.colour && !rgb_list)) throw IoError(directory + ": cannot write the lists");
+  OutputStream depth_list((dir / "depth.txt").string()), truth((dir / "groundtruth.txt").string());
+  std::optional<OutputStream> rgb_file;
+  if (options.colour) rgb_file.emplace((dir / "rgb.txt").string());
+  std::ostream& rgb_list = rgb_file ? static_cast<std::ostream&>(*rgb_file) : depth_list;  // used only with colour
   depth_list << "# depth maps: timestamp filename (vola rgbd-generate)\n" << std::fixed << std::setprecision(6);
   truth << "# ground truth trajectory: timestamp tx ty tz qx qy qz qw\n" << std::setprecision(17);
   if (options.colour) rgb_list << "# colour images: timestamp filename\n" << std::fixed << std::setprecision(6);
@@ -252,10 +255,9 @@ void generate_sequence(const Tree& scene, const std::vector<Pose>& poses, const 
           << ' ' << p.y() << ' ' << p.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
     if (progress) progress(i + 1, poses.size());
   }
-  depth_list.flush();
-  truth.flush();
-  if (options.colour) rgb_list.flush();
-  if (!depth_list || !truth || (options.colour && !rgb_list)) throw IoError(directory + ": write failed");
+  depth_list.commit();
+  truth.commit();
+  if (rgb_file) rgb_file->commit();
 }
 
 }  // namespace vola::slam

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "vola/error.hpp"
+#include "vola/output_stream.hpp"
 
 namespace vola::tile {
 
@@ -94,14 +95,9 @@ void write_tile_index(const TileIndexFile& index, const std::string& path) {
     features.push_back(std::move(f));
   }
   root["features"] = std::move(features);
-  const std::string part = path + ".part";
-  {
-    std::ofstream out(part, std::ios::binary);
-    if (!out) throw IoError(part + ": cannot create");
-    out << root.dump(1) << '\n';
-    if (!out.flush()) throw IoError(part + ": cannot write");
-  }
-  if (std::rename(part.c_str(), path.c_str()) != 0) throw IoError(path + ": cannot rename " + part + " to it");
+  OutputStream out(path);
+  out << root.dump(1) << '\n';
+  out.commit();
 }
 
 TileIndexFile read_tile_index(const std::string& path) {

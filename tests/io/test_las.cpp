@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 
@@ -165,6 +166,34 @@ TEST(Las, TruncatedAndCorruptFilesAreRefused) {
   bad = bytes;
   bad[100] = 200;  // 200 VLRs that are not there
   expect_error(bad, "VLR count past the end");
+}
+
+// A NaN, infinite or zero scale made every point NaN (or one point), and the builders
+// dropped them all with exit status 0; a NaN offset likewise.
+TEST(Las, ScalesAndOffsetsThatMakeNoCoordinateAreRefusedWithTheirOffset) {
+  VOLA_REQUIRE_DATA(data);
+  const auto bytes = vola_test::read_bytes(data / "las" / "pdal_autzen_pf1.las");
+  const vola_test::TempDir dir;
+  const auto path = (dir.path() / "scaled.las").string();
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    std::size_t at;
+    double value;
+    const char* cause;
+  };
+  for (const Case& c : {Case{131, nan, "x scale is NaN"}, Case{139, 0.0, "y scale is 0"},
+                        Case{147, -inf, "z scale is infinite"}, Case{155, nan, "x offset is NaN"},
+                        Case{171, inf, "z offset is infinite"}}) {
+    SCOPED_TRACE(c.cause);
+    auto bad = bytes;
+    vola_test::put_le(bad, c.at, c.value);
+    vola_test::write_bytes(path, bad);
+    const auto error = vola_test::format_error_of([&] { vola::io::LasReader reader(path); });
+    ASSERT_TRUE(error.has_value());
+    EXPECT_EQ(error->file(), path);
+    EXPECT_EQ(error->offset(), c.at);
+    EXPECT_EQ(error->cause(), c.cause);
+  }
 }
 
 }  // namespace

@@ -240,6 +240,21 @@ TempDir::~TempDir() {
   fs::remove_all(path_, ignored);
 }
 
+std::uint32_t slow_crc32c(const std::uint8_t* bytes, std::size_t size) {
+  std::uint32_t crc = ~0u;
+  for (std::size_t i = 0; i < size; ++i) {
+    crc ^= bytes[i];
+    for (int b = 0; b < 8; ++b) crc = (crc >> 1) ^ ((crc & 1u) ? 0x82F63B78u : 0u);
+  }
+  return ~crc;
+}
+
+void reseal_extension(std::vector<std::uint8_t>& bytes, std::size_t at) {
+  const std::size_t trailer = bytes.size() - 16;
+  put_le<std::uint64_t>(bytes, trailer, bytes.size() - at);
+  put_le<std::uint32_t>(bytes, trailer + 8, slow_crc32c(bytes.data() + at, trailer + 8 - at));
+}
+
 std::vector<std::uint8_t> raw_file(const RawHeader& h, const std::vector<std::uint64_t>& words) {
   std::vector<std::uint8_t> out(80 + 8 * words.size(), 0);
   put_le(out, 0, h.header_size);

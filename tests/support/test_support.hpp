@@ -121,6 +121,12 @@ struct RawHeader {
 };
 std::vector<std::uint8_t> raw_file(const RawHeader& header, const std::vector<std::uint64_t>& words);
 
+// CRC-32C one bit at a time: the slow twin of the library's.
+std::uint32_t slow_crc32c(const std::uint8_t* bytes, std::size_t size);
+// Rewrites the trailer (length, CRC-32C) of the version-2 extension that starts at `at`
+// and ends the file, so that a test that alters one field reaches that field's check.
+void reseal_extension(std::vector<std::uint8_t>& bytes, std::size_t at);
+
 // The FormatError `f` throws, or nullopt when it throws none (other exceptions pass).
 template <class F>
 std::optional<vola::FormatError> format_error_of(F&& f) {

@@ -1,0 +1,165 @@
+#include "vola/output_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+
+#include "vola/error.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+namespace {
+
+// The table of live temporaries. A signal handler may read it at any instant on any
+// thread, so it is fixed-size and lock-free: a slot's path is written while its state
+// is `filling` and only read by the handler once the state is `live` (release/acquire).
+enum SlotState : int { kFree = 0, kFilling = 1, kLive = 2 };
+constexpr int kSlots = 64;
+constexpr std::size_t kPathBytes = 4096;
+struct Slot {
+  std::atomic<int> state{kFree};
+  char path[kPathBytes];
+};
+Slot slots[kSlots];
+std::atomic<unsigned> counter{0};
+
+int claim_slot(const std::string& path) noexcept {
+  if (path.size() >= kPathBytes) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = kFree;
+    if (!slots[i].state.compare_exchange_strong(expected, kFilling, std::memory_order_acquire)) continue;
+    std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
+    slots[i].state.store(kLive, std::memory_order_release);
+    return i;
+  }
+  return -1;  // full: this temporary is still removed on errors, just not on signals
+}
+
+void release_slot(int i) noexcept {
+  if (i < 0) return;
+  slots[i].state.store(kFilling, std::memory_order_relaxed);  // the handler skips it from now on
+  slots[i].state.store(kFree, std::memory_order_release);
+}
+
+std::string directory_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+// The rename is only durable once the directory entry is: failures here are not
+// reported, since the new file is already in place and the old one gone.
+void sync_directory(const std::string& path) noexcept {
+  const int fd = ::open(directory_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+void on_signal(int signal) {
+  detail::remove_live_temporaries();
+  struct sigaction action {};
+  action.sa_handler = SIG_DFL;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(signal, &action, nullptr);
+  // Blocked while this handler runs: delivered, with the default action, on return.
+  ::raise(signal);
+}
+
+}  // namespace
+
+namespace detail {
+void remove_live_temporaries() noexcept {
+  for (Slot& s : slots)
+    if (s.state.load(std::memory_order_acquire) == kLive) ::unlink(s.path);
+}
+}  // namespace detail
+
+void remove_temporaries_on_signal() noexcept {
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    if (::sigaction(signal, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) continue;
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(signal, &action, nullptr);
+  }
+}
+
+OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
+  temporary_ = path_ + "." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1)) + ".part";
+  // Registered before it exists: a signal between open() and the table would leave it.
+  slot_ = claim_slot(temporary_);
+  const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    const int e = errno;
+    release_slot(slot_);
+    slot_ = -1;
+    VOLA_THROW(IoError(path_ + ": cannot create " + temporary_ + ": " + std::strerror(e)));
+  }
+  // A replaced file keeps its permissions (the temporary has the umask's).
+  struct stat old {};
+  if (::stat(path_.c_str(), &old) == 0 && S_ISREG(old.st_mode)) ::fchmod(fd, old.st_mode & 07777);
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    const int e = errno;
+    ::close(fd);
+    discard();
+    VOLA_THROW(IoError(path_ + ": cannot open " + temporary_ + ": " + std::strerror(e)));
+  }
+  // Writers emit many small records: a large buffer keeps the system calls few.
+  std::setvbuf(file_, nullptr, _IOFBF, std::size_t{1} << 20);
+}
+
+OutputFile::~OutputFile() { discard(); }
+
+void OutputFile::discard() noexcept {
+  if (file_) std::fclose(file_);
+  file_ = nullptr;
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+  release_slot(slot_);
+  slot_ = -1;
+  temporary_.clear();
+}
+
+int OutputFile::descriptor() const noexcept { return file_ ? ::fileno(file_) : -1; }
+
+void OutputFile::write(const void* data, std::size_t size) {
+  if (!file_) VOLA_THROW(IoError(path_ + ": write after a failed write or commit"));
+  if (size != 0 && std::fwrite(data, 1, size, file_) != size) {
+    const int e = errno;
+    discard();
+    VOLA_THROW(IoError(path_ + ": write failed: " + std::strerror(e)));
+  }
+}
+
+void OutputFile::commit() {
+  int e = 0;
+  if (!file_) e = EBADF;
+  else if (std::fflush(file_) != 0 || std::ferror(file_)) e = errno ? errno : EIO;
+  else if (::fsync(::fileno(file_)) != 0) e = errno;
+  if (file_ && std::fclose(file_) != 0 && e == 0) e = errno;
+  file_ = nullptr;
+  if (e != 0) {
+    discard();
+    VOLA_THROW(IoError(path_ + ": write failed: " + std::strerror(e)));
+  }
+  if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    e = errno;
+    discard();
+    VOLA_THROW(IoError(path_ + ": cannot rename " + temporary_ + " onto it: " + std::strerror(e)));
+  }
+  release_slot(slot_);
+  slot_ = -1;
+  temporary_.clear();
+  sync_directory(path_);
+}
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

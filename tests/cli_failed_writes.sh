@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# Failed writes and killed processes leave the old file intact and no temporary.
+#
+#   cli_failed_writes.sh VOLA_BINARY SHARED_DIR      ($VOLA_SHARED overrides SHARED_DIR)
+#
+# Each writer runs with a file-size limit of 0 (`ulimit -f 0`, SIGXFSZ ignored), so every
+# write to a regular file fails with EFBIG, over an existing output holding "old": the
+# command must exit 1 with a message (not a signal), the output must still say "old",
+# and no .part file may be left. Then `vola generate` of a large scene is killed with
+# SIGTERM and SIGINT while its temporary is being written: it must die of that signal
+# with the old output intact and no temporary left. Finally a cut WAV is refused.
+# Exit status: 0 all good, 1 failures, 77 shared folder missing (outside CI).
+set -uo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 VOLA_BINARY SHARED_DIR" >&2
+  exit 2
+fi
+vola=$(realpath "$1")
+shared=$(realpath "${VOLA_SHARED:-$2}")
+dry=$shared/data/audio/codec2_speech_orig_16k.wav
+if [[ ! -f $dry ]]; then
+  if [[ -n ${CI:-} ]]; then
+    echo "FAIL: $dry is missing (CI is set)" >&2
+    exit 1
+  fi
+  echo "SKIP: $dry is missing" >&2
+  exit 77
+fi
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+failures=0
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+
+# A 6 x 4 x 3 m room of 25 cm voxels (for sonify and plan) and a generated city.
+awk 'BEGIN { for (i = 0; i <= 24; i++) for (j = 0; j <= 16; j++) for (k = 0; k <= 12; k++)
+  if (i == 0 || i == 24 || j == 0 || j == 16 || k == 0 || k == 12) print i * 0.25, j * 0.25, k * 0.25 }' > room.xyz
+"$vola" convert room.xyz room.vol --voxel-size 0.25 > /dev/null || fail "convert room"
+"$vola" generate city city.xyz --points 20000 > /dev/null 2>&1 || fail "generate city"
+"$vola" convert city.xyz city.vol --voxel-size 2 > /dev/null || fail "convert city"
+
+# fails_keeping NAME OUTPUT COMMAND...: COMMAND writes OUTPUT under a zero file-size limit.
+fails_keeping() {
+  local name=$1 output=$2
+  shift 2
+  mkdir -p out && rm -f out/*
+  echo old > "out/$output"
+  local message status
+  # stderr to a pipe: the limit applies to regular files only.
+  message=$( (trap '' XFSZ; ulimit -f 0; exec "$@") 2>&1 >/dev/null)
+  status=$?
+  [[ $status -eq 1 ]] || fail "$name: exit status $status, expected 1 ($message)"
+  [[ -n $message ]] || fail "$name: no message"
+  [[ $(cat "out/$output") == old ]] || fail "$name: the old $output was replaced or cut ($(stat -c %s "out/$output") bytes)"
+  local left
+  left=$(ls out | grep -v "^$output\$")
+  [[ -z $left ]] || fail "$name: left behind: $left"
+}
+
+fails_keeping "convert .vol" c.vol "$vola" convert city.xyz out/c.vol --voxel-size 1
+fails_keeping "generate" g.xyz "$vola" generate city out/g.xyz --points 5000
+fails_keeping "export binvox" e.binvox "$vola" export city.vol out/e.binvox -q
+fails_keeping "export ply" e.ply "$vola" export city.vol out/e.ply -q
+fails_keeping "export png map" e.png "$vola" export city.vol out/e.png --map -q
+fails_keeping "render png" r.png "$vola" render city.vol -o out/r.png --size 64x48 -q
+fails_keeping "plan csv" p.csv "$vola" plan room.vol --from 1 1 1 --to 5 3 2 -o out/p.csv -q
+fails_keeping "sonify wav" s.wav "$vola" sonify room.vol --source 2 1.5 1.25 --listener 4 3 2 --in "$dry" \
+  --out out/s.wav -q
+
+# killed_while_writing SIGNAL: generate a scene large enough to take seconds to write,
+# kill it once its temporary holds bytes.
+killed_while_writing() {
+  local signal=$1
+  mkdir -p big && rm -f big/*
+  echo old > big/city.xyz
+  # A background job of a script starts with SIGINT ignored: give it the default back.
+  env --default-signal="$signal" "$vola" generate city big/city.xyz --points 50000000 > /dev/null 2>&1 &
+  local pid=$! part="" i
+  for ((i = 0; i < 500; i++)); do
+    part=$(find big -name 'city.xyz.*.part' -size +0 | head -n 1)
+    [[ -n $part ]] && break
+    sleep 0.02
+  done
+  [[ -n $part ]] || fail "SIG$signal: no temporary appeared"
+  kill -s "$signal" "$pid"
+  wait "$pid"
+  local status=$?
+  local expected=$((128 + $(kill -l "$signal")))
+  [[ $status -eq $expected ]] || fail "SIG$signal: exit status $status, expected $expected (killed by the signal)"
+  [[ $(cat big/city.xyz) == old ]] || fail "SIG$signal: the old output was replaced or cut"
+  local left
+  left=$(ls big | grep -v '^city.xyz$')
+  [[ -z $left ]] || fail "SIG$signal: left behind: $left"
+}
+killed_while_writing TERM
+killed_while_writing INT
+
+# A WAV cut in its data chunk: libsndfile would read the shorter sound without a word.
+size=$(stat -c %s "$dry")
+head -c $((size / 2)) "$dry" > cut.wav
+message=$("$vola" sonify room.vol --source 2 1.5 1.25 --listener 4 3 2 --in cut.wav --out cut_out.wav -q 2>&1)
+status=$?
+[[ $status -eq 1 ]] || fail "cut WAV: exit status $status, expected 1"
+[[ $message == *"cut.wav: byte "*"the file is cut"* ]] || fail "cut WAV: message '$message' names no file, offset and cause"
+[[ ! -e cut_out.wav ]] || fail "cut WAV: an output was written"
+
+if [[ $failures -ne 0 ]]; then
+  echo "$failures failure(s)" >&2
+  exit 1
+fi
+echo "all failed writes kept the old files"

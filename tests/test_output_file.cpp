@@ -1,0 +1,166 @@
+// OutputFile: a file appears whole or not at all. The failing cases run in a forked
+// child: one with a file-size limit (RLIMIT_FSIZE, SIGXFSZ ignored) so that writes fail
+// with EFBIG as on a full disk, one killed by SIGTERM while its temporary is open.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/output_file.hpp"
+
+namespace {
+
+using vola_test::TempDir;
+namespace fs = std::filesystem;
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string text_of(const fs::path& path) {
+  const auto bytes = vola_test::read_bytes(path);
+  return {bytes.begin(), bytes.end()};
+}
+
+void put_text(const fs::path& path, const std::string& text) { vola_test::write_bytes(path, {text.begin(), text.end()}); }
+
+// Runs `body` in a child whose files may not grow past `limit` bytes; returns its exit
+// status (the body returns it), or -signal when it died of a signal.
+int in_child_with_file_limit(rlim_t limit, const std::function<int()>& body) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit r{limit, limit};
+    ::setrlimit(RLIMIT_FSIZE, &r);
+    int status = 3;
+    try {
+      status = body();
+    } catch (...) {
+      status = 4;
+    }
+    ::_exit(status);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+TEST(OutputFile, CommitReplacesTheOldFileWholeKeepingItsPermissions) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  ::chmod(path.c_str(), 0640);
+  {
+    vola::OutputFile out(path.string());
+    out.write("new ");
+    out.write("text");
+    EXPECT_EQ(text_of(path), "old");  // nothing at the final name before commit()
+    out.commit();
+  }
+  EXPECT_EQ(text_of(path), "new text");
+  struct stat st {};
+  ASSERT_EQ(::stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u);
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
+}
+
+TEST(OutputFile, AnUncommittedFileLeavesNothing) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  {
+    vola::OutputFile out(path.string());
+    out.write("half of it");
+    EXPECT_EQ(names_in(dir.path()).size(), 2u);  // the temporary, beside the old file
+  }
+  EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
+}
+
+TEST(OutputFile, AFailedWriteKeepsTheOldFileAndLeavesNoTemporary) {
+  TempDir dir;
+  const fs::path path = dir / "out.bin";
+  put_text(path, "old");
+  const int status = in_child_with_file_limit(4096, [&] {
+    vola::OutputFile out(path.string());
+    const std::vector<char> block(1 << 20, 'x');
+    try {
+      out.write(block.data(), block.size());
+      out.commit();
+    } catch (const vola::IoError& e) {
+      return std::string(e.what()).find("File too large") != std::string::npos ? 0 : 1;
+    }
+    return 2;  // no error
+  });
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.bin"});
+}
+
+TEST(OutputFile, AFailedVolWriteKeepsTheOldFile) {
+  TempDir dir;
+  const fs::path path = dir / "big.vol";
+  put_text(path, "old");
+  std::vector<vola::Voxel> voxels;
+  for (std::uint32_t i = 0; i < 200000; ++i) voxels.push_back({i % 1024, (i / 1024) * 5 % 1024, i % 7});
+  const vola::Tree tree = vola::build_from_voxels(voxels, 5);
+  const int status = in_child_with_file_limit(8192, [&] {
+    try {
+      vola::write(tree, path.string());
+    } catch (const vola::IoError&) {
+      return 0;
+    }
+    return 2;
+  });
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"big.vol"});
+}
+
+TEST(OutputFile, SigtermRemovesTheTemporaryAndEndsByTheSignal) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    vola::remove_temporaries_on_signal();
+    vola::OutputFile out(path.string());
+    out.write("half of it");
+    std::fflush(out.stream());
+    const char one = '1';
+    if (::write(ready[1], &one, 1) != 1) ::_exit(5);
+    for (;;) ::pause();
+  }
+  char got = 0;
+  ASSERT_EQ(::read(ready[0], &got, 1), 1);
+  EXPECT_EQ(names_in(dir.path()).size(), 2u);  // the temporary is there
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ::close(ready[0]);
+  ::close(ready[1]);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
+}
+
+}  // namespace
