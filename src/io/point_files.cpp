@@ -9,7 +9,7 @@
 
 #include "export_columns.hpp"
 #include "las_format.hpp"
-#include "output_file.hpp"
+#include "vola/output_file.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
