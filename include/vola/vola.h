@@ -196,6 +196,16 @@ VOLA_C_API vola_status vola_convert(const char *input, const vola_convert_option
 VOLA_C_API vola_status vola_convert_file(const char *input, const char *output, const vola_convert_options *options,
                                          vola_convert_report *report);
 
+/* ---- points out ---- */
+
+/* The tree's voxel centres as LAS 1.4 (point format 6, or 7 with colour; attribute
+ * columns into LAS fields and extra bytes; the CRS as WKT); a path ending in .laz is
+ * LASzip-compressed. As `vola export TREE OUT.las|.laz`. */
+VOLA_C_API vola_status vola_export_las(const vola_tree *tree, const char *path);
+/* Point file to point file, point by point, no voxels, as `vola translate IN OUT`: LAS,
+ * LAZ, COPC, PLY, PCD, XYZ, NPY or KITTI in; LAS, LAZ, PLY or XYZ out (by extension). */
+VOLA_C_API vola_status vola_translate(const char *input, const char *output);
+
 /* ---- attributes ---- */
 
 /* Name of attribute column `index` (< attribute_count), valid while the tree lives. */

@@ -10,7 +10,9 @@
 #include "vola/builder.hpp"
 #include "vola/convert.hpp"
 #include "vola/file.hpp"
+#include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/translate.hpp"
 
 namespace vola::python {
 
@@ -204,6 +206,19 @@ void bind_building(py::module_& m) {
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
         "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
         "first (grid options then in its units); level=L reads a COPC file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for.");
+  m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output) {
+        py::gil_scoped_release release;
+        with_python_names([&] { vola::io::translate_points(input.string(), output.string()); });
+      }, py::arg("input"), py::arg("output"),
+      "Point file to point file, point by point, no voxels (`vola translate`): LAS, LAZ, COPC, PLY, PCD, XYZ,\n"
+      "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.");
+  m.def("export_las", [](const Tree& tree, const std::filesystem::path& path) {
+        py::gil_scoped_release release;
+        with_python_names([&] { vola::io::write_las(tree, path.string()); });
+      }, py::arg("tree"), py::arg("path"),
+      "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
+      "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"
+      "ending in .laz is LASzip-compressed.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

@@ -1,6 +1,9 @@
 """vola.convert against `vola convert` (the same readers and rules, so the same file)
 and against what the input files are known to hold."""
 
+import hashlib
+import pathlib
+import struct
 import subprocess
 
 import numpy as np
@@ -69,3 +72,30 @@ def test_convert_errors_name_the_problem(tmp_path, las_file):
         vola.convert(bad, voxel_size=1.0)
     formats = dict(vola.input_formats())
     assert ".las" in formats["las"] and ".npy" in formats["npy"]
+
+
+def _las_records(path):
+    """The point records of a LAS file: count x record length bytes after the offset."""
+    data = pathlib.Path(path).read_bytes()
+    offset, length = struct.unpack_from("<I", data, 96)[0], struct.unpack_from("<H", data, 105)[0]
+    count = struct.unpack_from("<I", data, 107)[0] or struct.unpack_from("<Q", data, 247)[0]
+    return data[offset:offset + count * length]
+
+
+def test_translate_and_export_las_like_the_cli(tmp_path, shared_data, vola_cli):
+    laz = shared_data / "laz" / "pdal_autzen_trim.laz"
+    # LAZ -> LAS: the records laz-perf decoded (EXPECTED.txt), as the CLI writes them.
+    vola.translate(laz, tmp_path / "py.las")
+    subprocess.run([vola_cli, "translate", str(laz), str(tmp_path / "cli.las"), "-q"], check=True)
+    line = next(l for l in (shared_data / "EXPECTED.txt").read_text().splitlines() if l.startswith(laz.name + ":"))
+    expected = line.split("points_sha256=")[1].split()[0]
+    assert hashlib.sha256(_las_records(tmp_path / "py.las")).hexdigest() == expected
+    assert _las_records(tmp_path / "py.las") == _las_records(tmp_path / "cli.las")
+    # A tree out as LAZ: the same records as its LAS export, back through translate.
+    tree = vola.convert(laz, voxel_size=4.0)
+    vola.export_las(tree, tmp_path / "tree.laz")
+    vola.export_las(tree, tmp_path / "tree.las")
+    vola.translate(tmp_path / "tree.laz", tmp_path / "tree_back.las")
+    assert _las_records(tmp_path / "tree_back.las") == _las_records(tmp_path / "tree.las")
+    with pytest.raises(vola.InvalidArgument, match="writes .las, .laz, .ply"):
+        vola.translate(laz, tmp_path / "points.obj")

@@ -34,12 +34,14 @@ from ._vola import (
     build_from_voxels,
     compression_available,
     convert,
+    export_las,
     from_dense,
     input_formats,
     open_mapped,
     open_tiles,
     parse,
     read,
+    translate,
 )
 
 __all__ = [
@@ -54,6 +56,7 @@ __all__ = [
     "build_from_voxels",
     "compression_available",
     "convert",
+    "export_las",
     "from_dense",
     "input_formats",
     "open",
@@ -61,6 +64,7 @@ __all__ = [
     "open_tiles",
     "parse",
     "read",
+    "translate",
 ]
 
 
