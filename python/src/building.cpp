@@ -22,7 +22,7 @@ namespace {
 
 Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
                   std::optional<std::array<double, 3>> origin, const py::dict& attributes, const py::dict& reductions,
-                  std::uint32_t epsg) {
+                  std::uint32_t epsg, const std::string& crs_wkt) {
   const auto xyz = rows_of_three<double>(points, "points");
   const auto n = static_cast<std::size_t>(xyz.shape(0));
   vola::PointCloud cloud;
@@ -59,6 +59,7 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
   py::gil_scoped_release release;
   Tree tree = vola::build(cloud, options);
   tree.georef().epsg = epsg;
+  tree.georef().crs_wkt = crs_wkt;  // kept in the extension, as vola convert keeps a WKT
   return tree;
 }
 
@@ -173,11 +174,12 @@ Tree convert(const std::filesystem::path& path, int depth,
 void bind_building(py::module_& m) {
   m.def("build", &build_points, py::arg("points"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0,
         py::arg("quantize") = "grid", py::arg("origin") = py::none(), py::arg("attributes") = py::dict(),
-        py::arg("reductions") = py::dict(), py::arg("epsg") = 2000u,
+        py::arg("reductions") = py::dict(), py::arg("epsg") = 2000u, py::arg("crs_wkt") = "",
         "Builds a tree from an (N, 3) array of world points.\n"
         "quantize='grid': voxel_size and/or depth; origin defaults to the bbox minimum snapped to the voxel size.\n"
         "quantize='toolkit': the reference's rounding, needs depth.\n"
-        "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: 'mean'|'max'|'min'|'majority'|'last'}.");
+        "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: 'mean'|'max'|'min'|'majority'|'last'}.\n"
+        "epsg: the header's CRS code; crs_wkt: the CRS as WKT (for a CRS with no code), kept in the file.");
   m.def("build_from_voxels", &build_voxels, py::arg("voxels"), py::arg("depth"),
         "Builds a tree from an (N, 3) array of integer voxels, each below 4**depth (duplicates allowed).");
   m.def("from_dense", &from_dense, py::arg("grid"), py::arg("origin") = py::none(), py::arg("voxel_size") = py::none(),

@@ -243,7 +243,15 @@ py::class_<Tree> bind_tree(py::module_& m) {
       .def("write", &write_file, py::arg("path"), py::arg("dense") = false, py::arg("compress") = false,
            "Writes a .vol file (through a temporary file and a rename). dense: the reference's dense layout\n"
            "(depth <= 5); compress: zstd levels (a version-2 file only vola reads).")
-      .def("to_bytes", &to_bytes, py::arg("dense") = false, py::arg("compress") = false, "The .vol file's bytes.");
+      .def("to_bytes", &to_bytes, py::arg("dense") = false, py::arg("compress") = false, "The .vol file's bytes.")
+      // Pickled as its .vol bytes (what the file would hold: levels, attributes, CRS), so
+      // trees travel to multiprocessing workers and into caches.
+      .def(py::pickle([](const Tree& t) { return to_bytes(t, false, false); },
+                      [](const py::bytes& data) {
+                        const std::string bytes = data;
+                        return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
+                                           "<pickle>");
+                      }));
 }
 
 }  // namespace vola::python

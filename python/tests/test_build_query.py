@@ -144,3 +144,19 @@ def test_attributes_reduce_per_voxel_like_numpy(cloud):
     np.testing.assert_array_equal(view, highest)
     with pytest.raises(KeyError, match="colour"):
         vola.build(cloud, voxel_size=1.0).attribute("colour")
+
+
+def test_trees_pickle_with_their_attributes_and_crs(tmp_path):
+    import pickle
+
+    rng = np.random.default_rng(5)
+    points = rng.uniform(0, 10, size=(500, 3))
+    wkt = 'LOCAL_CS["site grid",UNIT["metre",1]]'
+    tree = vola.build(points, voxel_size=1.0, attributes={"v": np.arange(500.0)}, crs_wkt=wkt)
+    assert tree.crs_wkt == wkt  # a WKT given to build is kept, not dropped
+    tree.write(str(tmp_path / "t.vol"))
+    for t in (tree, vola.open_mapped(str(tmp_path / "t.vol"))):  # in memory, and mapped
+        back = pickle.loads(pickle.dumps(t))
+        assert np.array_equal(back.voxels(), tree.voxels())
+        assert np.array_equal(back.attribute("v"), tree.attribute("v"))
+        assert back.crs_wkt == wkt and back.voxel_size == tree.voxel_size
