@@ -13,3 +13,10 @@ cmake --build "$work/build" >/dev/null
 "$work/build/consumer_modules"
 "$work/build/consumer_tile" "$work"
 for component in viewer slam audio learn; do "$work/build/consumer_$component"; done
+# The same consumer against the build tree, no install.
+cmake -S "$source_dir" -B "$work/from_build" -Dvola_DIR="$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/from_build" >/dev/null
+"$work/from_build/consumer" "$work/points_build.vol"
+"$work/from_build/consumer_convert" "$work"
+"$work/from_build/consumer_modules"
+for component in viewer slam audio learn; do "$work/from_build/consumer_$component"; done
