@@ -16,6 +16,7 @@ namespace {
 struct InfoArgs {
   std::string file;
   bool json = false;
+  bool summary = false;
 };
 
 std::string quoted(const std::string& s) {
@@ -34,6 +35,11 @@ struct NamedCrs {
   std::optional<geo::CrsDescription> description;
   std::string problem;  // why PROJ could not name a CRS the file states
 };
+
+// A .vol file by its extension (the others are read as point files).
+bool is_vol_file(const std::string& path) {
+  return path.size() >= 4 && (path.compare(path.size() - 4, 4, ".vol") == 0 || path.compare(path.size() - 4, 4, ".VOL") == 0);
+}
 
 NamedCrs name_crs(const Tree& tree) {
   NamedCrs out;
@@ -63,11 +69,13 @@ std::string json_crs(const NamedCrs& crs) {
 }
 
 void run_info(const InfoArgs& a) {
-  if (is_point_file(a.file)) {
-    if (a.json) throw InvalidArgument(a.file + ": --json describes .vol files; this is a LAS/LAZ point file");
-    print_point_file_info(a.file);
+  if (is_point_file(a.file) || !is_vol_file(a.file)) {
+    if (a.json) throw InvalidArgument(a.file + ": --json describes .vol files; this is a point file");
+    if (is_point_file(a.file)) print_point_file_info(a.file, a.summary);
+    else print_point_cloud_info(a.file, a.summary);
     return;
   }
+  if (a.summary) throw InvalidArgument("--summary reads the points of a point file; " + a.file + " is a .vol file");
   FileLayout layout;
   const Tree tree = open_mapped(a.file, &layout);
   const Header& h = layout.header;
@@ -146,8 +154,11 @@ void run_info(const InfoArgs& a) {
 void add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree");
-  cmd->add_option("file", args->file, ".vol file, or a LAS/LAZ/COPC point file")->required()->check(CLI::ExistingFile);
-  cmd->add_flag("--json", args->json, "Print JSON instead of a table");
+  cmd->add_option("file", args->file, ".vol file, or a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--json", args->json, "Print JSON instead of a table (.vol files)");
+  cmd->add_flag("--summary", args->summary,
+                "Point files: read every point for their own bounds, column ranges and points per class (like pdal "
+                "info --summary)");
   cmd->callback([args] { run_info(*args); });
 }
 

@@ -2,11 +2,15 @@
 // the COPC octree say, read without decoding a point.
 #include "info_points.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <map>
 #include <string>
 
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/analysis/census.hpp"
+#include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
 
 namespace vola::cli {
@@ -54,7 +58,61 @@ void print_copc(const io::CopcHierarchy& copc) {
                 static_cast<unsigned long long>(per_level[l]), i.spacing / static_cast<double>(std::uint64_t{1} << l));
 }
 
+// The column named `name`, or nullptr.
+const PointAttribute* column_named(const PointCloud& cloud, const std::string& name) {
+  for (const auto& a : cloud.attributes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+// Every point read: the count, the points' own bounds, each column's range and, for a
+// classification column, the count per class with ASPRS's names (as pdal info
+// --summary reports them).
+void print_summary(const PointCloud& cloud) {
+  const Box box = cloud.bounds();
+  std::printf("summary:     %zu points read\n", cloud.size());
+  std::printf("             min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the points')\n", box.min[0],
+              box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
+  for (const auto& a : cloud.attributes) {
+    if (a.values.empty()) continue;
+    const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
+    std::printf("column:      %s: %.9g .. %.9g\n", a.name.c_str(), *lo, *hi);
+  }
+  if (const PointAttribute* classes = column_named(cloud, "classification")) {
+    std::map<int, std::uint64_t> counts;
+    for (const double c : classes->values) ++counts[static_cast<int>(c)];
+    for (const auto& [code, n] : counts)
+      std::printf("class:       %3d %-38s %llu\n", code, std::string(analysis::asprs_class_name(code)).c_str(),
+                  static_cast<unsigned long long>(n));
+  }
+}
+
 }  // namespace
+
+void print_point_cloud_info(const std::string& path, bool summary) {
+  io::InputOptions options;
+  options.attributes = true;
+  const io::Input in = io::read_input(path, "auto", options);
+  if (in.is_mesh() || in.grid || in.terrain)
+    throw InvalidArgument(path + ": vola info describes .vol and point files; this is " + in.format +
+                          " input (convert it with vola convert, then vola info the .vol)");
+  std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
+  std::printf("points:      %zu\n", in.cloud.size());
+  const std::string definition = !in.wkt.empty() ? in.wkt : in.epsg ? "EPSG:" + std::to_string(*in.epsg) : "";
+  std::string crs = "none stated";
+  if (!definition.empty()) {
+    try {
+      crs = geo::crs_summary(geo::describe_crs(definition));
+    } catch (const Error& e) {
+      crs = "not readable by PROJ (" + std::string(e.what()) + ")";
+    }
+  }
+  std::printf("crs:         %s\n", crs.c_str());
+  std::printf("columns:    ");
+  for (const auto& a : in.cloud.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
+  std::printf("%s\n", in.cloud.attributes.empty() ? " none" : "");
+  if (summary) print_summary(in.cloud);
+}
 
 bool is_point_file(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
@@ -65,8 +123,8 @@ bool is_point_file(const std::string& path) {
   return las;
 }
 
-void print_point_file_info(const std::string& path) {
-  const io::LasReader reader(path);
+void print_point_file_info(const std::string& path, bool summary) {
+  io::LasReader reader(path);
   const io::LasHeader& hd = reader.header();
   std::printf("file:        %s (%s %s)\n", path.c_str(), hd.copc ? "COPC" : hd.compressed() ? "LAZ" : "LAS",
               hd.version().c_str());
@@ -86,6 +144,7 @@ void print_point_file_info(const std::string& path) {
                 v.description.c_str());
   if (hd.compressed()) print_compression(hd);
   if (hd.copc) print_copc(*hd.copc);
+  if (summary) print_summary(io::las_points(reader, true, false));
 }
 
 }  // namespace vola::cli

@@ -7,7 +7,11 @@ namespace vola::cli {
 
 // Whether the file starts with a LAS signature ("LASF"): LAS, LAZ and COPC files.
 bool is_point_file(const std::string& path);
-// The header, (E)VLRs, CRS, compression and COPC octree of a LAS/LAZ/COPC file.
-void print_point_file_info(const std::string& path);
+// The header, (E)VLRs, CRS, compression and COPC octree of a LAS/LAZ/COPC file; with
+// `summary`, every point read too (count, bounds, column ranges, points per class).
+void print_point_file_info(const std::string& path, bool summary);
+// Any other point file vola reads (PLY, PCD, XYZ, NPY, KITTI): count, CRS, columns; with
+// `summary`, bounds, column ranges and points per class.
+void print_point_cloud_info(const std::string& path, bool summary);
 
 }  // namespace vola::cli

@@ -101,6 +101,18 @@ assert abs(float(spacing[1]) - float(want[5])) < 1e-3, (spacing[1], want[5])
 PY
 done
 "$vola" info "$data/laz/pdal_autzen_trim.laz" | grep -q "compressor 2 (point-wise chunked)" || fail "info names no LAZ compressor"
+# vola info --summary reads every point: the points per class laz-perf found (EXPECTED.txt).
+for laz in "$data"/laz/*.laz; do
+  name=$(basename "$laz")
+  "$vola" info "$laz" --summary > "$tmp/summary.txt" || fail "$name: info --summary failed"
+  python3 - "$tmp/summary.txt" "$(grep "^$name:" "$data/EXPECTED.txt")" <<'PY' || fail "$name: classes differ from EXPECTED.txt"
+import re, sys
+summary, line = open(sys.argv[1]).read(), sys.argv[2]
+want = {int(k): int(v) for k, v in re.findall(r"(\d+): (\d+)", re.search(r"classes=\{([^}]*)\}", line).group(1))}
+got = {int(c): int(n) for c, n in re.findall(r"^class: +(\d+) .* (\d+)$", summary, re.M)}
+assert got == want, (got, want)
+PY
+done
 
 # vola translate to PLY and XYZ keeps every field of every record, in order (laspy_simple.laz:
 # point format 3), checked against the records of its decoded LAS.
