@@ -75,7 +75,7 @@ class SymbolModel {
       table_size_ = 1u << table_bits;
       table_shift_ = kSymbolShift - table_bits;
     }
-    storage_ = std::make_unique<std::uint32_t[]>(2 * std::size_t{symbols} + (table_size_ ? table_size_ + 2 : 0));
+    storage_ = std::make_unique<std::uint32_t[]>(2 * std::size_t{symbols} + (table_size_ ? table_size_ + 2 + kTableSlack : 0));
     distribution = storage_.get();
     counts = distribution + symbols;
     table = table_size_ ? counts + symbols : nullptr;
@@ -97,23 +97,37 @@ class SymbolModel {
       for (std::uint32_t k = 0; k < symbols_; ++k) total_count_ += (counts[k] = (counts[k] + 1) >> 1);
     }
     const std::uint32_t scale = 0x80000000u / total_count_;
-    std::uint32_t sum = 0, s = 0;
+    std::uint32_t sum = 0;
     for (std::uint32_t k = 0; k < symbols_; ++k) {
       distribution[k] = (scale * sum) >> (31 - kSymbolShift);
       sum += counts[k];
-      if (table) {
-        const std::uint32_t w = distribution[k] >> table_shift_;
-        while (s < w) table[++s] = k - 1;
-      }
     }
-    if (table) {
-      table[0] = 0;
-      while (s <= table_size_) table[++s] = symbols_ - 1;
-    }
+    if (table) fill_table();
     update_cycle_ = (5 * update_cycle_) >> 2;
     const std::uint32_t max_cycle = (symbols_ + 6) << 3;
     if (update_cycle_ > max_cycle) update_cycle_ = max_cycle;
     until_update = update_cycle_;
+  }
+
+  // table[j] = the last symbol whose distribution, in table units, is below j. Writes
+  // kTableSlack entries at a time (one store for most symbols, which span a few
+  // entries, instead of a loop whose exit a predictor misses at every symbol); writes
+  // past a symbol's entries are overwritten by the next symbols, and the slack after
+  // the table takes the last ones.
+  static constexpr std::uint32_t kTableSlack = 8;
+  void fill_table() {
+    std::uint32_t s = 0;  // entries 1..s are final
+    for (std::uint32_t k = 1; k < symbols_; ++k) {
+      const std::uint32_t w = distribution[k] >> table_shift_;
+      std::uint32_t* at = table + s + 1;
+      do {
+        for (std::uint32_t i = 0; i < kTableSlack; ++i) at[i] = k - 1;
+        at += kTableSlack;
+      } while (at <= table + w);
+      s = w;
+    }
+    table[0] = 0;
+    for (std::uint32_t j = s + 1; j <= table_size_ + 1; ++j) table[j] = symbols_ - 1;
   }
 
   std::uint32_t symbols() const { return symbols_; }
@@ -226,7 +240,8 @@ class ArithmeticDecoder {
   // 4 bytes of the end it goes byte by byte so as never to read past the span.
   void renormalise() {
     if (end_ - pos_ >= 4) [[likely]] {
-      const unsigned shift = static_cast<unsigned>(std::countl_zero(length_)) & 24u;  // 0, 8, 16 or 24
+      // 0, 8, 16 or 24 (length is never 0; "| 1" spares the compiler's test for it)
+      const unsigned shift = static_cast<unsigned>(std::countl_zero(length_ | 1u)) & 24u;
       std::uint32_t word;
       std::memcpy(&word, pos_, 4);
       if constexpr (std::endian::native == std::endian::little) word = __builtin_bswap32(word);
