@@ -166,7 +166,11 @@ class ArithmeticDecoder {
     value_ |= next_byte();
   }
 
-  std::uint32_t decode_bit(BitModel& m) {
+  // The decoding calls are always inlined: the item decoders then hold the decoder's
+  // state (value, length, position) in registers across a whole point, rather than
+  // storing and reloading it around every call (one symbol's result is the next one's
+  // input, so each round trip through memory adds to every symbol's latency).
+  [[gnu::always_inline]] std::uint32_t decode_bit(BitModel& m) {
     const std::uint32_t x = m.bit0_prob * (length_ >> kBitShift);
     const std::uint32_t bit = value_ >= x;
     // Select rather than branch: the bit is as unpredictable as the data.
@@ -178,16 +182,20 @@ class ArithmeticDecoder {
     return bit;
   }
 
-  std::uint32_t decode_symbol(SymbolModel& m) {
-    if (!m.table) [[unlikely]] return decode_symbol_by_bisection(m);
+  [[gnu::always_inline]] std::uint32_t decode_symbol(SymbolModel& m) {
     const std::uint32_t unit = length_ >> kSymbolShift;
     const std::uint32_t dv = value_ / unit;
-    std::uint32_t t = dv >> m.table_shift();
-    // Only a corrupt stream (value >= length) reaches past the table.
-    if (t > m.table_size()) t = m.table_size();
-    std::uint32_t sym = m.table[t];
-    std::uint32_t n = m.table[t + 1] + 1;
-    while (n > sym + 1) [[unlikely]] {  // bisect between the table's bounds
+    // The table narrows the candidates to [sym, n); a model without one (an encoder's)
+    // bisects them all. distribution[k] > dv is distribution[k] * unit > value.
+    std::uint32_t sym = 0, n = m.symbols();
+    if (m.table) [[likely]] {
+      std::uint32_t t = dv >> m.table_shift();
+      // Only a corrupt stream (value >= length) reaches past the table.
+      if (t > m.table_size()) t = m.table_size();
+      sym = m.table[t];
+      n = m.table[t + 1] + 1;
+    }
+    while (n > sym + 1) [[unlikely]] {
       const std::uint32_t k = (sym + n) >> 1;
       if (m.distribution[k] > dv) n = k; else sym = k;
     }
@@ -204,23 +212,15 @@ class ArithmeticDecoder {
   }
 
   // `bits` (1..32) raw bits; above 19 the low 16 come first, as the encoder wrote them.
-  std::uint32_t read_bits(unsigned bits) {
+  [[gnu::always_inline]] std::uint32_t read_bits(unsigned bits) {
     if (bits > 19) {
       const std::uint32_t low = read_short();
-      return (read_bits(bits - 16) << 16) | low;
+      return (read_few_bits(bits - 16) << 16) | low;
     }
-    const std::uint32_t sym = value_ / (length_ >>= bits);
-    value_ -= length_ * sym;
-    renormalise();
-    return sym & ((1u << bits) - 1);
+    return read_few_bits(bits);
   }
-  std::uint32_t read_short() {
-    const std::uint32_t sym = value_ / (length_ >>= 16);
-    value_ -= length_ * sym;
-    renormalise();
-    return sym & 0xFFFFu;
-  }
-  std::uint32_t read_int() {
+  [[gnu::always_inline]] std::uint32_t read_short() { return read_few_bits(16); }
+  [[gnu::always_inline]] std::uint32_t read_int() {
     const std::uint32_t low = read_short();
     return (read_short() << 16) | low;
   }
@@ -229,6 +229,13 @@ class ArithmeticDecoder {
   std::uint64_t overrun() const { return overrun_; }
 
  private:
+  // 1..19 bits.
+  [[gnu::always_inline]] std::uint32_t read_few_bits(unsigned bits) {
+    const std::uint32_t sym = value_ / (length_ >>= bits);
+    value_ -= length_ * sym;
+    renormalise();
+    return sym & ((1u << bits) - 1);
+  }
   std::uint32_t next_byte() {
     if (pos_ < end_) return *pos_++;
     ++overrun_;
@@ -238,7 +245,7 @@ class ArithmeticDecoder {
   // length has leading zero bytes. No branch on whether (or how far) to renormalise:
   // about one symbol in three does, a coin toss that a branch predictor loses. Within
   // 4 bytes of the end it goes byte by byte so as never to read past the span.
-  void renormalise() {
+  [[gnu::always_inline]] void renormalise() {
     if (end_ - pos_ >= 4) [[likely]] {
       // 0, 8, 16 or 24 (length is never 0; "| 1" spares the compiler's test for it)
       const unsigned shift = static_cast<unsigned>(std::countl_zero(length_ | 1u)) & 24u;
@@ -249,33 +256,29 @@ class ArithmeticDecoder {
       length_ <<= shift;
       pos_ += shift >> 3;
     } else if (length_ < kMinLength) {
-      do {
-        value_ = (value_ << 8) | next_byte();
-      } while ((length_ <<= 8) < kMinLength);
+      const Refill r = refill_near_end(pos_, end_, value_, length_);
+      pos_ = r.pos;
+      value_ = r.value;
+      length_ = r.length;
+      overrun_ += r.missing;
     }
   }
-
-  // Models without a decoder table (an encoder's) bisect the distribution directly.
-  [[gnu::noinline]] std::uint32_t decode_symbol_by_bisection(SymbolModel& m) {
-    std::uint32_t sym = 0, x = 0, y = length_;
-    length_ >>= kSymbolShift;
-    std::uint32_t n = m.symbols(), k = n >> 1;
+  // Out of line, and on values rather than on the decoder: a call given the decoder's
+  // address would make the inlined callers keep its state in memory.
+  struct Refill {
+    const std::uint8_t* pos;
+    std::uint32_t value, length, missing;
+  };
+  [[gnu::noinline]] static Refill refill_near_end(const std::uint8_t* pos, const std::uint8_t* end, std::uint32_t value,
+                                                  std::uint32_t length) {
+    std::uint32_t missing = 0;
     do {
-      const std::uint32_t z = length_ * m.distribution[k];
-      if (z > value_) {
-        n = k;
-        y = z;
-      } else {
-        sym = k;
-        x = z;
-      }
-    } while ((k = (sym + n) >> 1) != sym);
-    value_ -= x;
-    length_ = y - x;
-    renormalise();
-    ++m.counts[sym];
-    if (--m.until_update == 0) m.update();
-    return sym;
+      std::uint32_t byte = 0;
+      if (pos < end) byte = *pos++;
+      else ++missing;
+      value = (value << 8) | byte;
+    } while ((length <<= 8) < kMinLength);
+    return {pos, value, length, missing};
   }
 
   const std::uint8_t* pos_ = nullptr;
