@@ -75,10 +75,13 @@ class SymbolModel {
       table_size_ = 1u << table_bits;
       table_shift_ = kSymbolShift - table_bits;
     }
-    storage_ = std::make_unique<std::uint32_t[]>(2 * std::size_t{symbols} + (table_size_ ? table_size_ + 2 + kTableSlack : 0));
+    storage_ = std::make_unique<std::uint32_t[]>(2 * std::size_t{symbols});
     distribution = storage_.get();
     counts = distribution + symbols;
-    table = table_size_ ? counts + symbols : nullptr;
+    // 16-bit entries (symbols <= 2048): a decoder's hot tables take half the cache
+    // (measured +2.5% on point format 3, whose RGB and GPS models have 256-516 symbols).
+    table_storage_.reset(table_size_ ? new std::uint16_t[table_size_ + 2 + kTableSlack] : nullptr);
+    table = table_storage_.get();
     reset();
   }
 
@@ -119,15 +122,15 @@ class SymbolModel {
     std::uint32_t s = 0;  // entries 1..s are final
     for (std::uint32_t k = 1; k < symbols_; ++k) {
       const std::uint32_t w = distribution[k] >> table_shift_;
-      std::uint32_t* at = table + s + 1;
+      std::uint16_t* at = table + s + 1;
       do {
-        for (std::uint32_t i = 0; i < kTableSlack; ++i) at[i] = k - 1;
+        for (std::uint32_t i = 0; i < kTableSlack; ++i) at[i] = static_cast<std::uint16_t>(k - 1);
         at += kTableSlack;
       } while (at <= table + w);
       s = w;
     }
     table[0] = 0;
-    for (std::uint32_t j = s + 1; j <= table_size_ + 1; ++j) table[j] = symbols_ - 1;
+    for (std::uint32_t j = s + 1; j <= table_size_ + 1; ++j) table[j] = static_cast<std::uint16_t>(symbols_ - 1);
   }
 
   std::uint32_t symbols() const { return symbols_; }
@@ -137,11 +140,12 @@ class SymbolModel {
 
   std::uint32_t* distribution = nullptr;
   std::uint32_t* counts = nullptr;
-  std::uint32_t* table = nullptr;
+  std::uint16_t* table = nullptr;
   std::uint32_t until_update = 0;
 
  private:
   std::unique_ptr<std::uint32_t[]> storage_;
+  std::unique_ptr<std::uint16_t[]> table_storage_;
   std::uint32_t symbols_ = 0, last_symbol_ = 0, table_size_ = 0, table_shift_ = 0;
   std::uint32_t total_count_ = 0, update_cycle_ = 0;
 };
