@@ -100,10 +100,14 @@ class SymbolModel {
       for (std::uint32_t k = 0; k < symbols_; ++k) total_count_ += (counts[k] = (counts[k] + 1) >> 1);
     }
     const std::uint32_t scale = 0x80000000u / total_count_;
+    // Locals: the stores below would otherwise make the compiler reload the members.
+    std::uint32_t* const dist = distribution;
+    const std::uint32_t* const count = counts;
+    const std::uint32_t symbols = symbols_;
     std::uint32_t sum = 0;
-    for (std::uint32_t k = 0; k < symbols_; ++k) {
-      distribution[k] = (scale * sum) >> (31 - kSymbolShift);
-      sum += counts[k];
+    for (std::uint32_t k = 0; k < symbols; ++k) {
+      dist[k] = (scale * sum) >> (31 - kSymbolShift);
+      sum += count[k];
     }
     if (table) fill_table();
     update_cycle_ = (5 * update_cycle_) >> 2;
@@ -119,18 +123,23 @@ class SymbolModel {
   // the table takes the last ones.
   static constexpr std::uint32_t kTableSlack = 8;
   void fill_table() {
+    std::uint16_t* const entries = table;
+    const std::uint32_t* const dist = distribution;
+    const std::uint32_t symbols = symbols_, shift = table_shift_;
     std::uint32_t s = 0;  // entries 1..s are final
-    for (std::uint32_t k = 1; k < symbols_; ++k) {
-      const std::uint32_t w = distribution[k] >> table_shift_;
-      std::uint16_t* at = table + s + 1;
+    for (std::uint32_t k = 1; k < symbols; ++k) {
+      const std::uint32_t w = dist[k] >> shift;
+      std::uint16_t block[kTableSlack];
+      for (auto& e : block) e = static_cast<std::uint16_t>(k - 1);
+      std::uint32_t j = s + 1;
       do {
-        for (std::uint32_t i = 0; i < kTableSlack; ++i) at[i] = static_cast<std::uint16_t>(k - 1);
-        at += kTableSlack;
-      } while (at <= table + w);
+        std::memcpy(entries + j, block, sizeof block);
+        j += kTableSlack;
+      } while (j <= w);
       s = w;
     }
-    table[0] = 0;
-    for (std::uint32_t j = s + 1; j <= table_size_ + 1; ++j) table[j] = static_cast<std::uint16_t>(symbols_ - 1);
+    entries[0] = 0;
+    for (std::uint32_t j = s + 1; j <= table_size_ + 1; ++j) entries[j] = static_cast<std::uint16_t>(symbols - 1);
   }
 
   std::uint32_t symbols() const { return symbols_; }
@@ -162,6 +171,7 @@ class ArithmeticDecoder {
   void start(std::span<const std::uint8_t> bytes) {
     pos_ = bytes.data();
     end_ = bytes.data() + bytes.size();
+    whole_words_end_ = bytes.size() >= 4 ? end_ - 3 : bytes.data();
     overrun_ = 0;
     length_ = kMaxLength;
     value_ = next_byte() << 24;
@@ -250,7 +260,7 @@ class ArithmeticDecoder {
   // about one symbol in three does, a coin toss that a branch predictor loses. Within
   // 4 bytes of the end it goes byte by byte so as never to read past the span.
   [[gnu::always_inline]] void renormalise() {
-    if (end_ - pos_ >= 4) [[likely]] {
+    if (pos_ < whole_words_end_) [[likely]] {
       // 0, 8, 16 or 24 (length is never 0; "| 1" spares the compiler's test for it)
       const unsigned shift = static_cast<unsigned>(std::countl_zero(length_ | 1u)) & 24u;
       std::uint32_t word;
@@ -287,6 +297,7 @@ class ArithmeticDecoder {
 
   const std::uint8_t* pos_ = nullptr;
   const std::uint8_t* end_ = nullptr;
+  const std::uint8_t* whole_words_end_ = nullptr;  // 4 bytes can be read before this
   std::uint64_t overrun_ = 0;
   std::uint32_t value_ = 0, length_ = kMaxLength;
 };
