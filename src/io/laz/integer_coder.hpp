@@ -58,7 +58,8 @@ class IntegerCoder {
 
   std::uint32_t k() const { return k_; }
 
-  std::int32_t decode(ArithmeticDecoder& d, std::int32_t prediction, std::uint32_t context = 0) {
+  // Inlined like the decoder's calls (see ArithmeticDecoder).
+  [[gnu::always_inline]] std::int32_t decode(ArithmeticDecoder& d, std::int32_t prediction, std::uint32_t context = 0) {
     std::uint32_t real = static_cast<std::uint32_t>(prediction) + static_cast<std::uint32_t>(read_correction(d, context));
     // Values wrap inside the coder's range (16-bit values stay in 0..65535).
     if (corr_range_) {
@@ -76,24 +77,27 @@ class IntegerCoder {
   }
 
  private:
-  SymbolModel& k_model(std::uint32_t context) {
-    if (k_fresh_[context] != generation_) {
-      if (k_models_[context].symbols()) k_models_[context].reset();
-      else k_models_[context].create(corr_bits_ + 1, decoder_tables_);
-      k_fresh_[context] = generation_;
-    }
+  [[gnu::always_inline]] SymbolModel& k_model(std::uint32_t context) {
+    if (k_fresh_[context] != generation_) [[unlikely]] refresh_k_model(context);
     return k_models_[context];
   }
-  SymbolModel& position_model(std::uint32_t k) {
-    if (position_fresh_[k] != generation_) {
-      if (position_models_[k].symbols()) position_models_[k].reset();
-      else position_models_[k].create(1u << (k <= bits_high_ ? k : bits_high_), decoder_tables_);
-      position_fresh_[k] = generation_;
-    }
+  [[gnu::always_inline]] SymbolModel& position_model(std::uint32_t k) {
+    if (position_fresh_[k] != generation_) [[unlikely]] refresh_position_model(k);
     return position_models_[k];
   }
+  // Out of line: once per model and chunk, and the inlined decoders stay small.
+  [[gnu::noinline]] void refresh_k_model(std::uint32_t context) {
+    if (k_models_[context].symbols()) k_models_[context].reset();
+    else k_models_[context].create(corr_bits_ + 1, decoder_tables_);
+    k_fresh_[context] = generation_;
+  }
+  [[gnu::noinline]] void refresh_position_model(std::uint32_t k) {
+    if (position_models_[k].symbols()) position_models_[k].reset();
+    else position_models_[k].create(1u << (k <= bits_high_ ? k : bits_high_), decoder_tables_);
+    position_fresh_[k] = generation_;
+  }
 
-  std::int32_t read_correction(ArithmeticDecoder& d, std::uint32_t context) {
+  [[gnu::always_inline]] std::int32_t read_correction(ArithmeticDecoder& d, std::uint32_t context) {
     k_ = d.decode_symbol(k_model(context));
     if (k_ == 0) return static_cast<std::int32_t>(d.decode_bit(small_model_));  // c is 0 or 1
     if (k_ >= 32) return corr_min_;

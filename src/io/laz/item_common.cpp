@@ -1,4 +1,5 @@
-// GPS time sequences and RGB prediction, shared by the point-wise and layered items.
+// The encoding halves of the GPS time sequences and the RGB prediction (the decoding
+// halves are inline in the header).
 #include "item_common.hpp"
 
 #include <algorithm>
@@ -7,13 +8,6 @@
 namespace vola::io::laz {
 namespace {
 
-// Products of steps wrap like the format's 32-bit arithmetic.
-std::int32_t times(std::int32_t a, std::int32_t b) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-}
-std::uint64_t plus(std::uint64_t time, std::int32_t diff) {
-  return time + static_cast<std::uint64_t>(static_cast<std::int64_t>(diff));
-}
 // The difference of two times' bit patterns when it fits 32 bits.
 bool small_difference(std::uint64_t time, std::uint64_t base, std::int32_t& diff) {
   const auto d = static_cast<std::int64_t>(time - base);
@@ -22,87 +16,6 @@ bool small_difference(std::uint64_t time, std::uint64_t base, std::int32_t& diff
 }
 
 }  // namespace
-
-void GpsTimeCoder::count_extreme(std::int32_t diff) {
-  // Four extreme steps in a row become the sequence's new regular step.
-  if (++extremes_[last_] > 3) {
-    diffs_[last_] = diff;
-    extremes_[last_] = 0;
-  }
-}
-
-void GpsTimeCoder::decode_full(ArithmeticDecoder& d) {
-  next_ = (next_ + 1) & 3;
-  const auto high = static_cast<std::uint32_t>(ic_.decode(d, static_cast<std::int32_t>(times_[last_] >> 32), 8));
-  times_[next_] = (std::uint64_t{high} << 32) | d.read_int();
-  last_ = next_;
-  diffs_[last_] = 0;
-  extremes_[last_] = 0;
-}
-
-void GpsTimeCoder::decode_with_step(ArithmeticDecoder& d, std::uint32_t multi) {
-  const std::int32_t step = diffs_[last_];
-  std::int32_t diff;
-  if (multi == 0) {
-    diff = ic_.decode(d, 0, 7);
-    count_extreme(diff);
-  } else if (multi < static_cast<std::uint32_t>(kMulti)) {
-    diff = ic_.decode(d, times(static_cast<std::int32_t>(multi), step), multi < 10 ? 2 : 3);
-  } else if (multi == static_cast<std::uint32_t>(kMulti)) {
-    diff = ic_.decode(d, times(kMulti, step), 4);
-    count_extreme(diff);
-  } else {
-    const std::int32_t negative = kMulti - static_cast<std::int32_t>(multi);
-    if (negative > kMultiMinus) {
-      diff = ic_.decode(d, times(negative, step), 5);
-    } else {
-      diff = ic_.decode(d, times(kMultiMinus, step), 6);
-      count_extreme(diff);
-    }
-  }
-  times_[last_] = plus(times_[last_], diff);
-}
-
-std::uint64_t GpsTimeCoder::decode(ArithmeticDecoder& d) {
-  // A jump to another sequence is followed by a code in that sequence; a sound stream
-  // jumps at most once per point, so the bound only stops corrupt input.
-  for (int jumps = 0; jumps < 4; ++jumps) {
-    if (diffs_[last_] == 0) {
-      const std::uint32_t code = d.decode_symbol(zero_diff_) + (layered_ ? 1 : 0);
-      if (code == 0) return times_[last_];
-      if (code == 1) {
-        diffs_[last_] = ic_.decode(d, 0, 0);
-        times_[last_] = plus(times_[last_], diffs_[last_]);
-        extremes_[last_] = 0;
-        return times_[last_];
-      }
-      if (code == 2) {
-        decode_full(d);
-        return times_[last_];
-      }
-      last_ = (last_ + code - 2) & 3;
-      continue;
-    }
-    std::uint32_t multi = d.decode_symbol(multi_);
-    if (layered_ && multi >= kUnchanged) ++multi;  // to the point-wise numbering
-    if (multi == 1) {
-      times_[last_] = plus(times_[last_], ic_.decode(d, diffs_[last_], 1));
-      extremes_[last_] = 0;
-      return times_[last_];
-    }
-    if (multi < kCodeFull) {
-      if (!layered_ && multi == kUnchanged) return times_[last_];
-      decode_with_step(d, multi);
-      return times_[last_];
-    }
-    if (multi == kCodeFull) {
-      decode_full(d);
-      return times_[last_];
-    }
-    last_ = (last_ + multi - kCodeFull) & 3;
-  }
-  return times_[last_];
-}
 
 void GpsTimeCoder::encode_full(ArithmeticEncoder& e, std::uint64_t time) {
   ic_.encode(e, static_cast<std::int32_t>(times_[last_] >> 32), static_cast<std::int32_t>(time >> 32), 8);
@@ -126,17 +39,17 @@ void GpsTimeCoder::encode_with_step(ArithmeticEncoder& e, std::int32_t diff) {
     extremes_[last_] = 0;
   } else if (multi > 0 && multi < kMulti) {
     e.encode_symbol(multi_, static_cast<std::uint32_t>(multi));
-    ic_.encode(e, times(multi, step), diff, multi < 10 ? 2 : 3);
+    ic_.encode(e, wrapping_times(multi, step), diff, multi < 10 ? 2 : 3);
   } else if (multi >= kMulti) {
     e.encode_symbol(multi_, kMulti);
-    ic_.encode(e, times(kMulti, step), diff, 4);
+    ic_.encode(e, wrapping_times(kMulti, step), diff, 4);
     count_extreme(diff);
   } else if (multi < 0 && multi > kMultiMinus) {
     e.encode_symbol(multi_, static_cast<std::uint32_t>(kMulti - multi));
-    ic_.encode(e, times(multi, step), diff, 5);
+    ic_.encode(e, wrapping_times(multi, step), diff, 5);
   } else if (multi < 0) {
     e.encode_symbol(multi_, static_cast<std::uint32_t>(kMulti - kMultiMinus));
-    ic_.encode(e, times(kMultiMinus, step), diff, 6);
+    ic_.encode(e, wrapping_times(kMultiMinus, step), diff, 6);
     count_extreme(diff);
   } else {
     e.encode_symbol(multi_, 0);
@@ -176,42 +89,6 @@ void GpsTimeCoder::encode(ArithmeticEncoder& e, std::uint64_t time) {
   }
   e.encode_symbol(diffs_[last_] == 0 ? zero_diff_ : multi_, (diffs_[last_] == 0 ? 2 : kCodeFull) - shift);
   encode_full(e, time);
-}
-
-void decode_rgb(ArithmeticDecoder& d, RgbModels& m, const std::uint16_t last[3], std::uint16_t out[3]) {
-  const std::uint32_t used = d.decode_symbol(m.used);
-  auto low = [](std::uint32_t v) { return static_cast<std::int32_t>(v & 0xFF); };
-  auto high = [](std::uint32_t v) { return static_cast<std::int32_t>(v >> 8); };
-  std::uint32_t r = (used & 1) ? fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[0])) + low(last[0])) : low(last[0]);
-  r |= std::uint32_t{(used & 2) ? fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[1])) + high(last[0]))
-                                 : static_cast<std::uint8_t>(high(last[0]))} << 8;
-  out[0] = static_cast<std::uint16_t>(r);
-  if (!(used & 64)) {  // grey: green and blue equal red
-    out[1] = out[2] = out[0];
-    return;
-  }
-  std::int32_t diff = low(r) - low(last[0]);
-  std::uint32_t g = (used & 4) ? fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[2])) + clamp8(diff + low(last[1])))
-                               : low(last[1]);
-  std::uint32_t b = 0;
-  if (used & 16) {
-    diff = (diff + (low(g) - low(last[1]))) / 2;
-    b = fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[4])) + clamp8(diff + low(last[2])));
-  } else {
-    b = low(last[2]);
-  }
-  diff = high(r) - high(last[0]);
-  std::uint32_t gh = (used & 8) ? fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[3])) + clamp8(diff + high(last[1])))
-                                : high(last[1]);
-  g |= gh << 8;
-  if (used & 32) {
-    diff = (diff + (high(g) - high(last[1]))) / 2;
-    b |= std::uint32_t{fold8(static_cast<std::int32_t>(d.decode_symbol(m.diff[5])) + clamp8(diff + high(last[2])))} << 8;
-  } else {
-    b |= last[2] & 0xFF00u;
-  }
-  out[1] = static_cast<std::uint16_t>(g);
-  out[2] = static_cast<std::uint16_t>(b);
 }
 
 void encode_rgb(ArithmeticEncoder& e, RgbModels& m, const std::uint16_t last[3], const std::uint16_t in[3]) {

@@ -44,7 +44,7 @@ class Point10Coder {
     last_[12] = last_[13] = 0;  // the intensity history starts at 0, not at the first point's
   }
 
-  void decode(ArithmeticDecoder& d, std::uint8_t* out) {
+  [[gnu::always_inline]] void decode(ArithmeticDecoder& d, std::uint8_t* out) {
     const std::uint32_t changed = d.decode_symbol(changed_);
     std::uint32_t m, n;
     if (changed) {
@@ -108,7 +108,7 @@ class Point10Coder {
   }
 
  private:
-  void decode_xyz(ArithmeticDecoder& d, std::uint32_t m, std::uint32_t n, std::uint32_t l) {
+  [[gnu::always_inline]] void decode_xyz(ArithmeticDecoder& d, std::uint32_t m, std::uint32_t n, std::uint32_t l) {
     const std::int32_t dx = dx_.decode(d, x_median_[m].get(), n == 1);
     add(0, dx);
     x_median_[m].add(dx);
@@ -142,7 +142,7 @@ class GpsTime11Coder {
  public:
   explicit GpsTime11Coder(bool decoding) : gps_(false, decoding) {}
   void start(const std::uint8_t* first) { gps_.start(load_le<std::uint64_t>(first)); }
-  void decode(ArithmeticDecoder& d, std::uint8_t* out) {
+  [[gnu::always_inline]] void decode(ArithmeticDecoder& d, std::uint8_t* out) {
     const std::uint64_t t = gps_.decode(d);
     std::memcpy(out, &t, 8);
   }
@@ -159,7 +159,7 @@ class Rgb12Coder {
     models_.reset();
     load_u16s(first, last_, 3);
   }
-  void decode(ArithmeticDecoder& d, std::uint8_t* out) {
+  [[gnu::always_inline]] void decode(ArithmeticDecoder& d, std::uint8_t* out) {
     std::uint16_t rgb[3];
     decode_rgb(d, models_, last_, rgb);
     std::memcpy(last_, rgb, sizeof rgb);
@@ -188,7 +188,7 @@ class ByteCoder {
     for (auto& m : models_) m.reset();
     std::memcpy(last_.data(), first, last_.size());
   }
-  void decode(ArithmeticDecoder& d, std::uint8_t* out) {
+  [[gnu::always_inline]] void decode(ArithmeticDecoder& d, std::uint8_t* out) {
     for (std::size_t i = 0; i < last_.size(); ++i)
       last_[i] = static_cast<std::uint8_t>(last_[i] + d.decode_symbol(models_[i]));
     std::memcpy(out, last_.data(), last_.size());
