@@ -1,6 +1,9 @@
 // vola get: one voxel's occupancy, rank, payload and attributes.
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "commands.hpp"
 #include "vola/error.hpp"
@@ -17,13 +20,20 @@ struct GetArgs {
   bool world = false;
 };
 
+// Reads everything first and checks the mapping (a file cut meanwhile reads as zeros),
+// then prints: no line comes from a lost mapping.
 void print_voxel(const Tree& tree, const Voxel& v) {
   const auto rank = tree.rank(v);
+  const auto payload = rank ? tree.voxel_payload(v) : std::nullopt;
+  std::vector<std::pair<std::string, double>> values;
+  if (rank)
+    for (const auto& c : tree.attributes().columns()) values.emplace_back(c.name(), c.get(*rank));
+  check_mapped(tree);
   std::printf("voxel %u %u %u: %s\n", v.x, v.y, v.z, rank ? "occupied" : "empty");
   if (!rank) return;
   std::printf("rank %llu\n", static_cast<unsigned long long>(*rank));
-  if (const auto p = tree.voxel_payload(v)) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*p));
-  for (const auto& c : tree.attributes().columns()) std::printf("%s %.17g\n", c.name().c_str(), c.get(*rank));
+  if (payload) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*payload));
+  for (const auto& [name, value] : values) std::printf("%s %.17g\n", name.c_str(), value);
 }
 
 // A tile set: the point is in world coordinates; only its tile is opened.
