@@ -41,8 +41,10 @@ void get_from_tiles(const GetArgs& a) {
   const tile::TileSet tiles(a.file);
   const Point p{a.position[0], a.position[1], a.position[2]};
   const tile::TileLookup found = tiles.locate(p);
-  std::printf("tile %d %d %d: %s\n", found.tile.i, found.tile.j, found.tile.k,
-              found.in_tile ? tile::tile_file_name(found.tile).c_str() : "not in the set (no points there)");
+  std::string file = "not in the set (no points there)";
+  for (const tile::TileEntry& e : tiles.index().tiles)
+    if (found.in_tile && e.tile == found.tile) file = e.file;  // as the index names it: inside its generation
+  std::printf("tile %d %d %d: %s\n", found.tile.i, found.tile.j, found.tile.k, file.c_str());
   if (!found.in_tile) {
     std::printf("voxel %u %u %u: empty\n", found.voxel.x, found.voxel.y, found.voxel.z);
     return;
