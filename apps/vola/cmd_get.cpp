@@ -1,6 +1,9 @@
 // vola get: one voxel's occupancy, rank, payload and attributes.
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "commands.hpp"
 #include "vola/error.hpp"
@@ -17,13 +20,20 @@ struct GetArgs {
   bool world = false;
 };
 
+// Reads everything first and checks the mapping (a file cut meanwhile reads as zeros),
+// then prints: no line comes from a lost mapping.
 void print_voxel(const Tree& tree, const Voxel& v) {
   const auto rank = tree.rank(v);
+  const auto payload = rank ? tree.voxel_payload(v) : std::nullopt;
+  std::vector<std::pair<std::string, double>> values;
+  if (rank)
+    for (const auto& c : tree.attributes().columns()) values.emplace_back(c.name(), c.get(*rank));
+  check_mapped(tree);
   std::printf("voxel %u %u %u: %s\n", v.x, v.y, v.z, rank ? "occupied" : "empty");
   if (!rank) return;
   std::printf("rank %llu\n", static_cast<unsigned long long>(*rank));
-  if (const auto p = tree.voxel_payload(v)) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*p));
-  for (const auto& c : tree.attributes().columns()) std::printf("%s %.17g\n", c.name().c_str(), c.get(*rank));
+  if (payload) std::printf("payload 0x%016llx\n", static_cast<unsigned long long>(*payload));
+  for (const auto& [name, value] : values) std::printf("%s %.17g\n", name.c_str(), value);
 }
 
 // A tile set: the point is in world coordinates; only its tile is opened.
@@ -31,8 +41,10 @@ void get_from_tiles(const GetArgs& a) {
   const tile::TileSet tiles(a.file);
   const Point p{a.position[0], a.position[1], a.position[2]};
   const tile::TileLookup found = tiles.locate(p);
-  std::printf("tile %d %d %d: %s\n", found.tile.i, found.tile.j, found.tile.k,
-              found.in_tile ? tile::tile_file_name(found.tile).c_str() : "not in the set (no points there)");
+  std::string file = "not in the set (no points there)";
+  for (const tile::TileEntry& e : tiles.index().tiles)
+    if (found.in_tile && e.tile == found.tile) file = e.file;  // as the index names it: inside its generation
+  std::printf("tile %d %d %d: %s\n", found.tile.i, found.tile.j, found.tile.k, file.c_str());
   if (!found.in_tile) {
     std::printf("voxel %u %u %u: empty\n", found.voxel.x, found.voxel.y, found.voxel.z);
     return;

@@ -72,11 +72,23 @@ void write(const Tree& tree, const std::string& path, const WriteOptions& option
 // Parses bytes (copied into the tree). `name` labels errors.
 Tree parse(std::span<const std::uint8_t> bytes, const std::string& name = {},
            FileLayout* layout = nullptr);
-// Reads a file into memory.
+// Reads a file into memory (read(2), no mapping: a file cut meanwhile is a short read).
 Tree read(const std::string& path, FileLayout* layout = nullptr);
 // Maps a file: a sparse uncompressed file's levels are used in place, never copied.
 // Dense and compressed files are decoded into memory.
+//
+// The tree reads the file's pages as it goes, so it sees the file as it is now: when
+// another process cuts the file while it is mapped, the pages past the new end are gone.
+// Instead of ending the process with SIGBUS, vola then replaces the whole mapping with
+// zero pages (a SIGBUS handler installed by the first open_mapped(), which passes every
+// other SIGBUS to the handler that was there before): reads go on, return zeros and
+// mean nothing, and check_mapped() says so. A program that installs its own SIGBUS
+// handler afterwards replaces this guard.
 Tree open_mapped(const std::string& path, FileLayout* layout = nullptr);
+// Throws IoError naming the file when `tree` (or a tree sharing its words, e.g. a level
+// of detail) maps a file that was cut since it was opened; does nothing otherwise. Call
+// it after reading a mapped tree and before trusting what was read.
+void check_mapped(const Tree& tree);
 
 Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name);
 void encode_header(const Header& header, std::uint8_t* out);

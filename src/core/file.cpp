@@ -260,13 +260,34 @@ Tree parse(std::span<const std::uint8_t> bytes, const std::string& name, FileLay
 }
 
 Tree read(const std::string& path, FileLayout* layout) {
-  const auto file = detail::MappedFile::open(path);
+  const auto file = detail::MappedFile::load(path);
   return decode(file->bytes(), path, nullptr, layout);
 }
 
 Tree open_mapped(const std::string& path, FileLayout* layout) {
   const auto file = detail::MappedFile::open(path);
-  return decode(file->bytes(), path, file, layout);
+  const auto bytes = file->bytes();
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  // Cut while being checked: the zeros read since make a misleading FormatError; say what happened.
+  try {
+    Tree tree = decode(bytes, path, file, layout);
+    check_mapped(tree);
+    return tree;
+  } catch (const FormatError&) {
+    if (detail::MappedFile::lost_at(bytes.data()) == nullptr) throw;
+  }
+  VOLA_THROW(IoError(path + ": the file was cut (truncated or rewritten in place) while it was being opened"));
+#else
+  return decode(bytes, path, file, layout);
+#endif
+}
+
+void check_mapped(const Tree& tree) {
+  if (!tree.is_mapped()) return;
+  if (const detail::MappedFile* lost = detail::MappedFile::lost_at(tree.words().data()))
+    VOLA_THROW(IoError(lost->path() +
+                       ": the file was cut (truncated or rewritten in place) while mapped; what was read from it "
+                       "since is void: open it again"));
 }
 
 VOLA_INLINE_NAMESPACE_END

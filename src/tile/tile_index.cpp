@@ -1,5 +1,6 @@
 #include "vola/tile/tile_index.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -141,6 +142,10 @@ TileIndexFile read_tile_index(const std::string& path) {
       TileEntry t;
       t.tile = tile_of(p.at("tile"), path, where);
       t.file = relative_file(p.at("file"), path, where);
+      const Box box = index.grid.tile_box(t.tile);  // TileSet's ray and region arithmetic needs finite boxes
+      for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]))
+          bad(path, where + ": the tile lies beyond the range of coordinates (origin + index x tile size overflows)");
       t.points = p.value("points", std::uint64_t{0});
       t.voxels = p.value("voxels", std::uint64_t{0});
       t.bytes = p.value("bytes", std::uint64_t{0});

@@ -77,6 +77,7 @@ TileLookup TileSet::locate(const Point& world) const {
   if (!t) return out;
   out.in_tile = true;
   out.rank = t->rank(out.voxel);
+  check_mapped(*t);  // a tile cut since it was opened reads as zeros: an error, not an answer
   return out;
 }
 
@@ -125,7 +126,9 @@ std::optional<TileHit> TileSet::cast(const raycast::Ray& world_ray) const {
         const_cast<Opened*>(opened)->caster = std::make_unique<raycast::RayCaster>(opened->tree);
       });
       raycast::Ray local = raycast::world_ray_to_grid(g.tile_frame(t), world_ray);
-      if (const auto hit = opened->caster->cast(local)) return TileHit{t, hit->voxel, hit->t * voxel, hit->normal};
+      const auto hit = opened->caster->cast(local);
+      check_mapped(opened->tree);
+      if (hit) return TileHit{t, hit->voxel, hit->t * voxel, hit->normal};
     }
     const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
     if (!(next[a] <= t1)) return std::nullopt;
@@ -160,6 +163,7 @@ Tree TileSet::mosaic(const Box& box) const {
     const auto oy = static_cast<std::uint32_t>((t.j - first[1]) * side);
     const auto oz = static_cast<std::uint32_t>((t.k - first[2]) * side);
     tree->for_each_voxel([&](const Voxel& v) { keys.push_back(encode(ox + v.x, oy + v.y, oz + v.z)); });
+    check_mapped(*tree);
   }
   Tree out = build_from_keys(std::move(keys), g.depth + extra);
   const TileIndex corner{static_cast<std::int32_t>(first[0]), static_cast<std::int32_t>(first[1]),

@@ -1,6 +1,5 @@
 #include "vola/tile/tiler.hpp"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +12,7 @@
 #include <map>
 #include <optional>
 
+#include "generation.hpp"
 #include "overviews.hpp"
 #include "spill.hpp"
 #include "tile_georef.hpp"
@@ -177,6 +177,7 @@ struct Tiling {
   TileSummary summary;
   std::chrono::steady_clock::time_point mark = std::chrono::steady_clock::now();
   std::optional<detail::TileGeoref> georef;  // the tiles' and overviews' CRS and lat/lon
+  fs::path tile_dir;  // this run's generation folder: tiles and overviews are written there
 
   int owner(std::size_t position) const { return static_cast<int>(position % static_cast<std::size_t>(ranks)); }
   std::uint64_t per_worker() const { return options.memory_budget / workers; }
@@ -334,7 +335,7 @@ std::vector<BuiltTile> Tiling::build() {
       std::vector<Key>().swap(keys);
       tree.set_frame(grid.tile_frame(t));
       georef->apply(tree, all_stats.at(t).bbox);
-      const std::string path = (fs::path(options.output_dir) / tile_file_name(t)).string();
+      const std::string path = (tile_dir / tile_file_name(t)).string();
       write(tree, path);
       built[p] = {tree.voxel_count(), static_cast<std::uint64_t>(fs::file_size(path))};
       const std::size_t done = ++tiles_done;
@@ -406,11 +407,15 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
     throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
   const unsigned workers = resolve_thread_count(options.threads);
   fs::create_directories(options.output_dir);
+  const detail::Generation generation = detail::begin_generation(options.output_dir, comm);
   const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);
-  // Declared before the run, so that the spill files close before their folder goes.
-  const RemovedFolder spill{spill_root / ("rank-" + std::to_string(comm.rank()) + "-" + std::to_string(::getpid()))};
+  detail::remove_stale_spill(spill_root);
+  // Declared before the run, so that the spill files close before their folder goes, on
+  // every exit but a kill (which the next run's remove_stale_spill covers).
+  const RemovedFolder spill{spill_root / detail::spill_folder_name(comm.rank())};
   fs::create_directories(spill.dir);
   Tiling run(options, comm, workers);
+  run.tile_dir = generation.dir();
   for (unsigned w = 0; w <= workers; ++w)
     run.files.push_back(std::make_unique<SpillFile>((spill.dir / ("worker-" + std::to_string(w) + ".keys")).string()));
   for (const auto& f : run.files) run.file_views.push_back(f.get());
@@ -425,16 +430,20 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   // 5. The overview pyramid, level by level (each level reads the one below).
   if (options.overviews) {
     comm.barrier();  // every rank's tiles are on disk
-    const OverviewContext context{grid, options.output_dir, *run.georef, workers};
+    const OverviewContext context{grid, generation.dir().string(), *run.georef, workers};
     index.overviews = build_overviews(index.tiles, context, comm, options.progress);
     summary.overview_files = index.overviews.size();
     summary.seconds_overviews = seconds_since(run.mark);
   }
+  // Files were named inside the generation folder; the index lives one level up.
+  for (TileEntry& t : index.tiles) t.file = generation.name + "/" + t.file;
+  for (OverviewEntry& o : index.overviews) o.file = generation.name + "/" + o.file;
   if (run.rank == 0) {
     summary.index_path = (fs::path(options.output_dir) / kIndexFileName).string();
-    write_tile_index(index, summary.index_path);
+    write_tile_index(index, summary.index_path);  // the switch: whole, by rename
   }
   comm.barrier();
+  if (run.rank == 0) detail::retire_previous(generation);
   return summary;
 }
 

@@ -35,7 +35,7 @@ for f in index["features"]:
     assert abs(ring[1][0] - ring[0][0] - 256) < 1e-9
 assert len(v["overviews"]) >= 2 and v["overviews"][-1]["level"] >= 1
 PY
-ls "$tmp/one/overviews/L1/"*.vol > /dev/null || fail "no overview files"
+ls "$tmp/one/.generation-1/overviews/L1/"*.vol > /dev/null || fail "no overview files"
 
 # get: the centre of a voxel of one tile, through the index, opens that tile only.
 first_tile=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['features'][0]['properties']['file'])" "$index")

@@ -41,6 +41,8 @@ class TileSet {
   const TileIndexFile& index() const noexcept { return index_; }
   const TileGrid& grid() const noexcept { return index_.grid; }
   // The tile's tree, mapped on first use (thread-safe); nullptr when the set has none.
+  // locate(), cast() and mosaic() throw IoError naming the tile when its file was cut
+  // since it was opened; whoever reads tree() itself calls check_mapped() (vola/file.hpp).
   const Tree* tree(const TileIndex& tile) const;
   std::size_t tiles_opened() const;
   // The world box of every tile together.

@@ -1,0 +1,128 @@
+// A mapped .vol cut by someone else while open: reading the lost pages must not end the
+// process with SIGBUS; check_mapped() names the file instead. Each case runs in a forked
+// child (a regression dies of SIGBUS there, and the test reads the signal).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "vola/builder.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+volatile std::uint64_t sink = 0;  // keeps the reads of the cut mapping from being optimized away
+
+// The child's exit status (the body returns it), or -signal when it died of one.
+int in_child(const std::function<int()>& body) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    int status = 3;
+    try {
+      status = body();
+    } catch (...) {
+      status = 4;
+    }
+    ::_exit(status);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFSIGNALED(status) ? -WTERMSIG(status) : WEXITSTATUS(status);
+}
+
+// A tree whose levels span many pages, so that cutting the file to its header leaves
+// most of the mapping past the end.
+vola::Tree scattered_tree() {
+  std::mt19937 random(21);
+  std::uniform_int_distribution<std::uint32_t> coordinate(0, vola::side_of(7) - 1);
+  std::vector<vola::Voxel> voxels(200000);
+  for (auto& v : voxels) v = {coordinate(random), coordinate(random), coordinate(random)};
+  return vola::build_from_voxels(voxels, 7);
+}
+
+TEST(MappedShrink, ReadingAFileCutWhileMappedIsAnErrorNotSigbus) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "cut.vol";
+  const vola::Tree original = scattered_tree();
+  vola::write(original, path.string());
+  ASSERT_GT(fs::file_size(path), 64u * 4096u);
+  const int status = in_child([&] {
+    const vola::Tree mapped = vola::open_mapped(path.string());
+    vola::check_mapped(mapped);  // whole: nothing to say
+    // Half: the upper levels stay, the walk reaches leaf words past the new end (a cut
+    // within the first page would read zeros there and stop the walk at the root).
+    fs::resize_file(path, fs::file_size(path) / 2);
+    std::uint64_t seen = 0;
+    mapped.for_each_voxel([&](const vola::Voxel& v) { seen += mapped.contains(v) ? 1 : 0; });
+    sink = seen;  // the reads must happen
+    try {
+      vola::check_mapped(mapped);
+    } catch (const vola::IoError& e) {
+      const std::string what = e.what();
+      return what.find(path.string()) == 0 && what.find("cut") != std::string::npos ? 0 : 5;
+    }
+    return 6;  // the loss went unreported
+  });
+  EXPECT_EQ(status, 0) << (status == -SIGBUS ? "died of SIGBUS" : "exit status / -signal");
+}
+
+TEST(MappedShrink, LookupsOfALevelOfDetailAfterTheCutAreReportedToo) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "lod.vol";
+  vola::write(scattered_tree(), path.string());
+  const int status = in_child([&] {
+    const vola::Tree mapped = vola::open_mapped(path.string());
+    const vola::Tree coarse = mapped.level_of_detail(6);
+    fs::resize_file(path, 0);
+    std::uint64_t seen = 0;
+    for (std::uint32_t x = 0; x < coarse.side(); ++x)
+      for (std::uint32_t y = 0; y < coarse.side(); y += 7) seen += coarse.contains(x, y, x) ? 1 : 0;
+    sink = seen;
+    try {
+      vola::check_mapped(coarse);
+    } catch (const vola::IoError&) {
+      return 0;
+    }
+    return 6;
+  });
+  EXPECT_EQ(status, 0) << (status == -SIGBUS ? "died of SIGBUS" : "exit status / -signal");
+}
+
+TEST(MappedShrink, FilesReadIntoMemoryAndUncutMappingsSayNothing) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "whole.vol";
+  const vola::Tree original = scattered_tree();
+  vola::write(original, path.string());
+  const vola::Tree read = vola::read(path.string());
+  const vola::Tree mapped = vola::open_mapped(path.string());
+  EXPECT_NO_THROW(vola::check_mapped(read));
+  EXPECT_NO_THROW(vola::check_mapped(mapped));
+  EXPECT_TRUE(mapped.is_mapped());
+  EXPECT_EQ(mapped.voxel_count(), original.voxel_count());
+}
+
+// The guard handles faults in vola's mappings only: any other SIGBUS still ends the
+// process by SIGBUS, as it would without vola.
+TEST(MappedShrink, OtherSigbusStillEndsTheProcess) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "any.vol";
+  vola::write(scattered_tree(), path.string());
+  const int status = in_child([&] {
+    const vola::Tree mapped = vola::open_mapped(path.string());  // installs the guard
+    ::raise(SIGBUS);
+    return mapped.empty() ? 7 : 8;
+  });
+  EXPECT_EQ(status, -SIGBUS);
+}
+
+}  // namespace
