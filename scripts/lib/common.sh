@@ -21,6 +21,9 @@ command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
 # 3D CNN classification (vola_learn): libtorch (CPU) and libzip for .npz, found through pkg-config.
 VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
 
+# The occupancy map's tests compare with OctoMap cell by cell (a test-only dependency).
+VOLA_BUILD_PACKAGES+=(liboctomap-dev)
+
 # vola tile under mpirun: Open MPI (the tests run 3 ranks on one machine).
 VOLA_BUILD_PACKAGES+=(libopenmpi-dev openmpi-bin)
 

@@ -1,0 +1,117 @@
+// A mutable probabilistic occupancy map that takes range scans the way OctoMap does and
+// freezes into VOLA trees.
+//
+// Voxel (i, j, k) covers [i*R, (i+1)*R) on each axis, i = floor(x / R), so voxel indices
+// line up cell for cell with OctoMap's keys (key = i + 32768) when R is a power of two
+// (OctoMap computes floor(x * (1/R)), which differs from floor(x / R) only where x / R
+// rounds across an integer).
+//
+// A voxel holds a float log-odds, 0 before its first update. One scan is one batch, as in
+// OctoMap's insertPointCloud (computeUpdate, then updateNode):
+//  - every point is a ray from the sensor origin; the voxels it passes get a miss and its
+//    end voxel (the one holding the point) a hit;
+//  - "passes" is exact: a voxel is passed when the segment origin -> point spends a
+//    positive length inside it (cells half-open), plus the origin's own voxel; the end
+//    voxel is never passed; a ray through an edge or corner does not pass the voxels it
+//    only touches there;
+//  - a voxel both hit and passed in one scan counts as hit; every voxel gets at most one
+//    update per scan, so the result does not depend on point order or thread count;
+//  - a point farther than max_range (when > 0) is cut at max_range: the segment up to the
+//    cut point passes voxels as above (the cut point's voxel excluded) and nothing is hit;
+//  - an update adds the hit or miss log-odds (float) and clamps to [clamp_min, clamp_max].
+//
+// Costs: a scan of n rays of m voxels each is O(n m) hash operations, run in parallel with
+// vola::parallel_for (per-worker voxel sets merged before the map changes).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "vola/frame.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::map {
+
+// OctoMap's conversion, kept bit for bit: the float of log(p / (1 - p)) in double.
+inline float log_odds(double probability) noexcept {
+  return static_cast<float>(std::log(probability / (1.0 - probability)));
+}
+
+// OctoMap's defaults (OccupancyOcTreeBase): hit 0.7, miss 0.4, clamping 0.1192 / 0.971,
+// occupied at probability 0.5 and above.
+struct SensorModel {
+  float hit = log_odds(0.7);
+  float miss = log_odds(0.4);
+  float clamp_min = log_odds(0.1192);
+  float clamp_max = log_odds(0.971);
+  float occupied_at = log_odds(0.5);
+  // Throws OptionError unless every value is finite, hit > 0 > miss and
+  // clamp_min <= occupied_at <= clamp_max.
+  void check() const;
+};
+
+struct VoxelIndex {
+  std::int32_t i = 0, j = 0, k = 0;
+  friend bool operator==(const VoxelIndex&, const VoxelIndex&) = default;
+  friend auto operator<=>(const VoxelIndex&, const VoxelIndex&) = default;
+};
+
+// Indices span -kIndexLimit .. kIndexLimit - 1 per axis (21 bits each, packed in one
+// 64-bit hash key): +-104 km at 0.1 m voxels.
+inline constexpr std::int32_t kIndexLimit = 1 << 20;
+
+struct ScanReport {
+  std::uint64_t points = 0;        // points offered
+  std::uint64_t not_finite = 0;    // skipped: a NaN or infinite coordinate
+  std::uint64_t outside = 0;       // skipped: voxel index beyond +-kIndexLimit
+  std::uint64_t cut = 0;           // beyond max_range: free up to it, no hit
+  std::uint64_t hit_voxels = 0;    // voxels updated as hit
+  std::uint64_t free_voxels = 0;   // voxels updated as free
+};
+
+class OccupancyMap {
+ public:
+  // Throws OptionError ("voxel_size") unless voxel_size is finite and > 0.
+  explicit OccupancyMap(double voxel_size, SensorModel model = {});
+
+  // One scan: xyz holds x y z per point in the world frame; origin is the sensor's
+  // position. Throws InvalidArgument when the origin is not finite or outside the index
+  // range, or max_range is negative or NaN. threads = 0: vola::thread_count().
+  ScanReport insert_scan(std::span<const double> xyz, const Point& origin, double max_range = 0.0,
+                         unsigned threads = 0);
+
+  double voxel_size() const noexcept { return voxel_size_; }
+  const SensorModel& model() const noexcept { return model_; }
+  std::size_t size() const noexcept { return cells_.size(); }
+  // The voxel holding a world point (floor(x / R) per axis); nullopt when not finite or
+  // outside the index range.
+  std::optional<VoxelIndex> voxel_of(const Point& p) const noexcept;
+  // The log-odds of a voxel, nullopt when never updated (unknown).
+  std::optional<float> log_odds(const VoxelIndex& v) const;
+  bool occupied(float value) const noexcept { return value >= model_.occupied_at; }
+  // Every known voxel with its log-odds, sorted by index.
+  std::vector<std::pair<VoxelIndex, float>> voxels() const;
+
+  // Packing used by the hash map and the per-scan sets (exposed for the tests).
+  static std::uint64_t pack(const VoxelIndex& v) noexcept;
+  static VoxelIndex unpack(std::uint64_t key) noexcept;
+
+ private:
+  double voxel_size_;
+  SensorModel model_;
+  std::unordered_map<std::uint64_t, float> cells_;
+};
+
+// Which voxels a frozen tree holds.
+enum class VoxelState { occupied, free };
+
+// The voxels of one state as a VOLA tree in grid quantization (voxel size R, origin a
+// multiple of R so that the tree's voxels are the map's), with the attribute column
+// "log_odds" (f32). An empty state gives an empty tree.
+Tree freeze(const OccupancyMap& map, VoxelState state);
+
+}  // namespace vola::map
