@@ -24,6 +24,9 @@ enum class ValueType : std::uint8_t { u8 = 0, u16, u32, u64, i8, i16, i32, i64, 
 enum class Reduction : std::uint8_t { last = 0, mean, max, min, majority };
 
 std::size_t size_of(ValueType type) noexcept;
+// `value` stored at `out` as `type` little-endian bytes: integers rounded to nearest and
+// clamped to the type's range (NaN as 0), as every attribute column stores values.
+void store_value(ValueType type, double value, std::byte* out) noexcept;
 std::string_view name_of(ValueType type) noexcept;
 std::string_view name_of(Reduction reduction) noexcept;
 std::optional<ValueType> parse_value_type(std::string_view name) noexcept;

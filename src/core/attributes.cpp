@@ -81,9 +81,8 @@ double AttributeColumn::get(std::size_t rank) const {
   return 0.0;
 }
 
-void AttributeColumn::set(std::size_t rank, double value) {
-  std::byte* p = bytes_.data() + rank * size_of(type_);
-  switch (type_) {
+void store_value(ValueType type, double value, std::byte* p) noexcept {
+  switch (type) {
     case ValueType::u8: return store<std::uint8_t>(p, value);
     case ValueType::u16: return store<std::uint16_t>(p, value);
     case ValueType::u32: return store<std::uint32_t>(p, value);
@@ -95,6 +94,10 @@ void AttributeColumn::set(std::size_t rank, double value) {
     case ValueType::f32: return store<float>(p, value);
     case ValueType::f64: return store<double>(p, value);
   }
+}
+
+void AttributeColumn::set(std::size_t rank, double value) {
+  store_value(type_, value, bytes_.data() + rank * size_of(type_));
 }
 
 const AttributeColumn* Attributes::find(std::string_view name) const noexcept {

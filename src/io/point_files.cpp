@@ -75,24 +75,12 @@ std::vector<std::string> column_names(const PointCloud& cloud) {
   return token_names(names, {"x", "y", "z"});
 }
 
-template <class T>
-void append_as(std::string& out, double v) {
-  const T t = static_cast<T>(v);
-  out.append(reinterpret_cast<const char*>(&t), sizeof t);
-}
-
-// One value in the column's PLY type, little-endian (the machines vola builds for).
+// One value in the column's PLY type (64-bit integers as double, which PLY has instead).
 void append_binary(std::string& out, ValueType type, double v) {
-  switch (type) {
-    case ValueType::u8: return append_as<std::uint8_t>(out, v);
-    case ValueType::u16: return append_as<std::uint16_t>(out, v);
-    case ValueType::u32: return append_as<std::uint32_t>(out, v);
-    case ValueType::i8: return append_as<std::int8_t>(out, v);
-    case ValueType::i16: return append_as<std::int16_t>(out, v);
-    case ValueType::i32: return append_as<std::int32_t>(out, v);
-    case ValueType::f32: return append_as<float>(out, v);
-    default: return append_as<double>(out, v);
-  }
+  if (type == ValueType::u64 || type == ValueType::i64) type = ValueType::f64;
+  std::byte bytes[8];
+  store_value(type, v, bytes);
+  out.append(reinterpret_cast<const char*>(bytes), size_of(type));
 }
 
 void write_ply_points(const PointCloud& cloud, const std::string& path) {
