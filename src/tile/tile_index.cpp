@@ -1,7 +1,9 @@
 #include "vola/tile/tile_index.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -34,16 +36,33 @@ ordered_json box_array(const Box& b) {
   throw FormatError(path, 0, "not a vola tile index: " + what);
 }
 
+// A JSON number as an integer of type Int, refused unless it is one and fits: nlohmann's
+// get<Int>() converts any number, and a double beyond Int's range is undefined behaviour.
+template <class Int>
+Int whole(const json& j, const std::string& path, const std::string& what) {
+  constexpr auto lo = static_cast<long double>(std::numeric_limits<Int>::min());
+  constexpr auto hi = static_cast<long double>(std::numeric_limits<Int>::max());
+  long double v = 0;
+  if (j.is_number_unsigned()) v = static_cast<long double>(j.get<std::uint64_t>());
+  else if (j.is_number_integer()) v = static_cast<long double>(j.get<std::int64_t>());
+  else if (j.is_number_float() && std::isfinite(j.get<double>()) && j.get<double>() == std::floor(j.get<double>()))
+    v = j.get<double>();
+  else bad(path, what + " must be an integer");
+  if (v < lo || v > hi) bad(path, what + " is out of range");
+  return static_cast<Int>(v);
+}
+
+// An optional count member: 0 when absent.
+std::uint64_t count_of(const json& object, const char* key, const std::string& path) {
+  return object.contains(key) ? whole<std::uint64_t>(object[key], path, std::string("\"") + key + "\"") : 0;
+}
+
 TileIndex tile_of(const json& j, const std::string& path, const std::string& where) {
   if (!j.is_array() || j.size() != 3) bad(path, where + ": \"tile\" must be [i, j, k]");
   TileIndex t;
-  try {
-    t.i = j[0].get<std::int32_t>();
-    t.j = j[1].get<std::int32_t>();
-    t.k = j[2].get<std::int32_t>();
-  } catch (const json::exception&) {
-    bad(path, where + ": \"tile\" must hold three integers");
-  }
+  t.i = whole<std::int32_t>(j[0], path, where + ": \"tile\"");
+  t.j = whole<std::int32_t>(j[1], path, where + ": \"tile\"");
+  t.k = whole<std::int32_t>(j[2], path, where + ": \"tile\"");
   return t;
 }
 
@@ -115,19 +134,20 @@ TileIndexFile read_tile_index(const std::string& path) {
   if (!root.is_object() || !root.contains("vola") || !root["vola"].is_object())
     bad(path, "no \"vola\" member (write one with vola tile)");
   const json& v = root["vola"];
-  if (v.value("format", "") != "vola-tile-index") bad(path, "\"vola\".\"format\" is not \"vola-tile-index\"");
-  if (v.value("version", 0) != 1) bad(path, "unsupported \"vola\".\"version\" (this vola reads version 1)");
   TileIndexFile index;
-  try {
+  try {  // a member of the wrong JSON type throws json::type_error: a FormatError below
+    if (v.value("format", "") != "vola-tile-index") bad(path, "\"vola\".\"format\" is not \"vola-tile-index\"");
+    if (!v.contains("version") || whole<int>(v["version"], path, "\"version\"") != 1)
+      bad(path, "unsupported \"vola\".\"version\" (this vola reads version 1)");
     const auto origin = v.at("origin");
     if (!origin.is_array() || origin.size() != 3) bad(path, "\"origin\" must be [x, y, z]");
     for (int a = 0; a < 3; ++a) index.grid.origin[a] = origin[a].get<double>();
     index.grid.tile_size = v.at("tile_size").get<double>();
-    index.grid.depth = v.at("depth").get<int>();
-    if (!v.at("epsg").is_null()) index.epsg = v.at("epsg").get<std::uint32_t>();
+    index.grid.depth = whole<int>(v.at("depth"), path, "\"depth\"");
+    if (!v.at("epsg").is_null()) index.epsg = whole<std::uint32_t>(v.at("epsg"), path, "\"epsg\"");
     index.crs_wkt = v.value("crs_wkt", "");
-    index.points_in = v.value("points_in", std::uint64_t{0});
-    index.points_outside = v.value("points_outside", std::uint64_t{0});
+    index.points_in = count_of(v, "points_in", path);
+    index.points_outside = count_of(v, "points_outside", path);
     try {
       index.grid.check();
     } catch (const InvalidArgument& e) {
@@ -146,9 +166,9 @@ TileIndexFile read_tile_index(const std::string& path) {
       for (int a = 0; a < 3; ++a)
         if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]))
           bad(path, where + ": the tile lies beyond the range of coordinates (origin + index x tile size overflows)");
-      t.points = p.value("points", std::uint64_t{0});
-      t.voxels = p.value("voxels", std::uint64_t{0});
-      t.bytes = p.value("bytes", std::uint64_t{0});
+      t.points = count_of(p, "points", path);
+      t.voxels = count_of(p, "voxels", path);
+      t.bytes = count_of(p, "bytes", path);
       if (p.contains("bbox") && p["bbox"].is_array() && p["bbox"].size() == 6)
         for (int a = 0; a < 3; ++a) {
           t.bbox.min[a] = p["bbox"][a].get<double>();
@@ -161,10 +181,10 @@ TileIndexFile read_tile_index(const std::string& path) {
       for (const json& o : v["overviews"]) {
         const std::string where = "overview " + std::to_string(n++);
         OverviewEntry e;
-        e.level = o.at("level").get<int>();
+        e.level = whole<int>(o.at("level"), path, "an overview's \"level\"");
         e.tile = tile_of(o.at("tile"), path, where);
         e.file = relative_file(o.at("file"), path, where);
-        e.voxels = o.value("voxels", std::uint64_t{0});
+        e.voxels = count_of(o, "voxels", path);
         index.overviews.push_back(std::move(e));
       }
     }
