@@ -1,4 +1,5 @@
 // vola info: what a .vol file holds, level by level (and what a LAS/LAZ/COPC file says).
+#include <charconv>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -18,6 +19,12 @@ struct InfoArgs {
   bool json = false;
   bool summary = false;
 };
+
+std::string shortest(double v) {
+  char text[32];
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
 
 std::string quoted(const std::string& s) {
   std::string out = "\"";
@@ -116,11 +123,13 @@ void run_info(const InfoArgs& a) {
               tree.side(), h.nbits);
   std::printf("crs:         %s\n", crs_line(crs, h.epsg).c_str());
   std::printf("header:      EPSG code %u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
-  std::printf("bbox:        min (%.17g, %.17g, %.17g)\n             max (%.17g, %.17g, %.17g)\n", h.bbox.min[0],
-              h.bbox.min[1], h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2]);
-  std::printf("grid:        %s quantization, voxel size %.9g, origin (%.9g, %.9g, %.9g)%s\n",
-              frame.quantization == Quantization::grid ? "grid" : "toolkit", frame.voxel_size, frame.origin[0],
-              frame.origin[1], frame.origin[2], tree.stored_frame() ? "" : " (from the header bbox)");
+  // Coordinates as the shortest text that reads back as the same double: the file's own
+  // precision (636001.76, not 636001.76000000001, nor 6.36001760e+05 cut to 9 digits).
+  const auto triple = [](const Point& p) { return shortest(p[0]) + ", " + shortest(p[1]) + ", " + shortest(p[2]); };
+  std::printf("bbox:        min (%s)\n             max (%s)\n", triple(h.bbox.min).c_str(), triple(h.bbox.max).c_str());
+  std::printf("grid:        %s quantization, voxel size %s, origin (%s)%s\n",
+              frame.quantization == Quantization::grid ? "grid" : "toolkit", shortest(frame.voxel_size).c_str(),
+              triple(frame.origin).c_str(), tree.stored_frame() ? "" : " (from the header bbox)");
   std::printf("voxels:      %llu occupied, %.2f bits per occupied voxel (whole file)\n",
               static_cast<unsigned long long>(tree.voxel_count()), bits);
   std::printf("levels:      level  blocks      occupied cells  bytes\n");
