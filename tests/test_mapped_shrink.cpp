@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "child_process.hpp"
 #include "test_support.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -23,22 +24,7 @@ namespace fs = std::filesystem;
 
 volatile std::uint64_t sink = 0;  // keeps the reads of the cut mapping from being optimized away
 
-// The child's exit status (the body returns it), or -signal when it died of one.
-int in_child(const std::function<int()>& body) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    int status = 3;
-    try {
-      status = body();
-    } catch (...) {
-      status = 4;
-    }
-    ::_exit(status);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFSIGNALED(status) ? -WTERMSIG(status) : WEXITSTATUS(status);
-}
+using vola_test::in_child;
 
 // A tree whose levels span many pages, so that cutting the file to its header leaves
 // most of the mapping past the end.

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "child_process.hpp"
 #include "test_support.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -40,25 +41,15 @@ std::string text_of(const fs::path& path) {
 
 void put_text(const fs::path& path, const std::string& text) { vola_test::write_bytes(path, {text.begin(), text.end()}); }
 
-// Runs `body` in a child whose files may not grow past `limit` bytes; returns its exit
-// status (the body returns it), or -signal when it died of a signal.
+// The body in a child whose files may not grow past `limit` bytes (writes then fail with
+// EFBIG; SIGXFSZ ignored).
 int in_child_with_file_limit(rlim_t limit, const std::function<int()>& body) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
+  return vola_test::in_child([&] {
     ::signal(SIGXFSZ, SIG_IGN);
     const rlimit r{limit, limit};
     ::setrlimit(RLIMIT_FSIZE, &r);
-    int status = 3;
-    try {
-      status = body();
-    } catch (...) {
-      status = 4;
-    }
-    ::_exit(status);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+    return body();
+  });
 }
 
 TEST(OutputFile, CommitReplacesTheOldFileWholeKeepingItsPermissions) {
