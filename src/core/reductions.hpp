@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -25,6 +26,13 @@ namespace detail {
 // reduction loop forever).
 inline bool value_before(double a, double b) noexcept { return std::isnan(b) ? !std::isnan(a) : a < b; }
 inline bool same_value(double a, double b) noexcept { return a == b || (std::isnan(a) && std::isnan(b)); }
+// The one representative of a class of same_value values that a majority stores: +0 for
+// either zero, the default quiet NaN for any NaN. Which member a sort puts first is
+// not specified, so without this the stored bytes would depend on the algorithm.
+inline double canonical_value(double v) noexcept {
+  if (std::isnan(v)) return std::numeric_limits<double>::quiet_NaN();
+  return v == 0.0 ? 0.0 : v;
+}
 
 // The partial of older points combined with the partial of newer ones. mean: the sum
 // (finish() divides); last: the newer. Not for majority, whose partial is a histogram.
@@ -82,7 +90,7 @@ inline double majority_of(std::vector<double>& values) {
   distinct_counts(values, [&](double value, std::uint32_t count) {
     if (count > best_count) best = value, best_count = count;
   });
-  return best;
+  return canonical_value(best);
 }
 
 }  // namespace detail

@@ -184,7 +184,7 @@ void store_majority(std::span<const Key> keys, const Partial& p, AttributeColumn
     std::size_t best = k;
     for (; k < p.pair_key.size() && p.pair_key[k] == keys[v]; ++k)
       if (p.pair_count[k] > p.pair_count[best]) best = k;
-    column.set(v, p.pair_value[best]);
+    column.set(v, detail::canonical_value(p.pair_value[best]));
   }
 }
 

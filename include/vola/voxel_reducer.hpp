@@ -1,0 +1,55 @@
+// Attribute reductions into a tree whose voxels are already known: points arrive with
+// their voxel's rank (Tree::rank, or any rank in key order) and one value per attribute,
+// and each voxel's partial is updated in place. Memory follows voxels, not points, and
+// nothing is sorted or merged: the second pass of a two-pass conversion (occupancy
+// first, then attributes) and the per-tile attribute build of `vola tile` use it.
+//
+// Points fold in the order they are added, so the values equal vola::build's over the
+// same points in the same order, bit for bit (means: the same summation order).
+// Reductions and their NaN rules are those of reductions.hpp: mean, max, min (NaN
+// skipped unless every value is NaN), last, majority (exact counts; ties to the
+// smallest value; NaN one value after every number). A voxel no point reached gets 0.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "vola/attributes.hpp"
+#include "vola/stream_builder.hpp"
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+
+class VoxelReducer {
+ public:
+  VoxelReducer(std::vector<AttributeSpec> specs, std::uint64_t voxels);
+  ~VoxelReducer();
+  VoxelReducer(VoxelReducer&&) noexcept;
+  VoxelReducer& operator=(VoxelReducer&&) noexcept;
+
+  // n points in input order: ranks[i] the voxel of point i (below `voxels`), values[a][i]
+  // its value of attribute a. Throws InvalidArgument on a rank out of range or arrays of
+  // other lengths.
+  void add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values);
+  // One point: values[a] for attribute a.
+  void add(std::uint64_t rank, std::span<const double> values);
+
+  // The columns, in the order of the specs; the reducer is empty afterwards.
+  std::vector<AttributeColumn> finish();
+  // Moves the columns into the tree's attributes (the tree has `voxels` voxels).
+  void finish_into(Tree& tree);
+
+  std::uint64_t voxels() const noexcept;
+  // Bytes held by the partials now.
+  std::size_t memory_bytes() const noexcept;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,115 @@
+// VoxelReducer (points with their voxel's rank, reduced in place) against vola::build
+// over the same points in the same order: bit-identical columns for every reduction,
+// NaN rules included, however the points are split into calls.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "vola/vola.hpp"
+#include "vola/voxel_reducer.hpp"
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+vola::PointCloud random_cloud(std::uint64_t seed, std::size_t n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(0.0, 20.0), any(-1e6, 1e6);
+  std::uniform_int_distribution<int> small(0, 4), byte(0, 255);
+  vola::PointCloud cloud;
+  const std::vector<std::pair<vola::ValueType, vola::Reduction>> columns = {
+      {vola::ValueType::f64, vola::Reduction::mean},     {vola::ValueType::f32, vola::Reduction::mean},
+      {vola::ValueType::u16, vola::Reduction::max},      {vola::ValueType::i32, vola::Reduction::min},
+      {vola::ValueType::u8, vola::Reduction::last},      {vola::ValueType::u8, vola::Reduction::majority},
+      {vola::ValueType::f64, vola::Reduction::majority}, {vola::ValueType::f64, vola::Reduction::max}};
+  for (std::size_t c = 0; c < columns.size(); ++c)
+    cloud.attributes.push_back({"a" + std::to_string(c), columns[c].first, columns[c].second, {}});
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
+    const bool nan = rng() % 7 == 0;
+    cloud.attributes[0].values.push_back(any(rng));  // means of large values: the order of summation shows
+    cloud.attributes[1].values.push_back(small(rng) * 0.1);
+    cloud.attributes[2].values.push_back(byte(rng));
+    cloud.attributes[3].values.push_back(small(rng) - 2);
+    cloud.attributes[4].values.push_back(byte(rng));
+    cloud.attributes[5].values.push_back(small(rng));
+    cloud.attributes[6].values.push_back(nan ? kNaN : small(rng) == 0 ? -0.0 : small(rng));  // NaN, -0 and 0
+    cloud.attributes[7].values.push_back(nan ? kNaN : any(rng));
+  }
+  return cloud;
+}
+
+class VoxelReducerEqualsBuild : public ::testing::TestWithParam<int> {};
+
+TEST_P(VoxelReducerEqualsBuild, BitForBit) {
+  const auto seed = static_cast<std::uint64_t>(GetParam());
+  const vola::PointCloud cloud = random_cloud(seed, 30000);
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::grid;
+  options.voxel_size = 1.0 + static_cast<double>(seed % 3);  // 1..3: tens to hundreds of points a voxel
+  const vola::Tree expected = vola::build(cloud, options);
+
+  vola::BuildOptions occupancy = options;
+  vola::PointCloud xyz_only;
+  xyz_only.xyz = cloud.xyz;
+  vola::Tree got = vola::build(xyz_only, occupancy);
+  std::vector<vola::AttributeSpec> specs;
+  for (const auto& a : cloud.attributes) specs.push_back({a.name, a.type, a.reduction});
+  vola::VoxelReducer reducer(specs, got.voxel_count());
+  const vola::Quantizer quantizer = vola::Quantizer::grid(got.frame().origin, got.frame().voxel_size, got.depth());
+  std::mt19937_64 rng(seed + 5);
+  for (std::size_t at = 0; at < cloud.size();) {
+    const std::size_t n = std::min<std::size_t>(cloud.size() - at, 1 + rng() % 2000);
+    std::vector<std::uint64_t> ranks;
+    for (std::size_t i = at; i < at + n; ++i) {
+      vola::Voxel v;
+      ASSERT_TRUE(quantizer.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v));
+      ranks.push_back(*got.rank(v));
+    }
+    std::vector<std::span<const double>> values;
+    for (const auto& a : cloud.attributes) values.emplace_back(a.values.data() + at, n);
+    reducer.add(ranks, values);
+    at += n;
+  }
+  reducer.finish_into(got);
+  ASSERT_EQ(got.attributes().size(), expected.attributes().size());
+  for (std::size_t c = 0; c < got.attributes().size(); ++c) {
+    const auto& g = got.attributes().columns()[c];
+    const auto& e = expected.attributes().columns()[c];
+    ASSERT_EQ(g.type(), e.type());
+    ASSERT_EQ(g.reduction(), e.reduction());
+    ASSERT_TRUE(std::equal(g.bytes().begin(), g.bytes().end(), e.bytes().begin(), e.bytes().end()))
+        << "column " << c << " (" << vola::name_of(e.reduction()) << ")";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, VoxelReducerEqualsBuild, ::testing::Range(1, 7));
+
+TEST(VoxelReducer, RefusesRanksOutOfRangeAndMismatchedArrays) {
+  vola::VoxelReducer reducer({{"m", vola::ValueType::f32, vola::Reduction::mean}}, 3);
+  const std::vector<double> values{1.0, 2.0};
+  const std::vector<std::span<const double>> columns{values};
+  const std::vector<std::uint64_t> bad{0, 3}, short_ranks{0};
+  EXPECT_THROW(reducer.add(bad, columns), vola::InvalidArgument);
+  EXPECT_THROW(reducer.add(short_ranks, columns), vola::InvalidArgument);
+  EXPECT_THROW(reducer.add(std::span<const std::uint64_t>(bad.data(), 1), {}), vola::InvalidArgument);
+}
+
+// A voxel no point reached reads 0 in every column (never NaN from an empty max).
+TEST(VoxelReducer, UnreachedVoxelsAreZero) {
+  vola::VoxelReducer reducer({{"hi", vola::ValueType::f64, vola::Reduction::max},
+                              {"m", vola::ValueType::f64, vola::Reduction::mean},
+                              {"c", vola::ValueType::f64, vola::Reduction::majority}},
+                             2);
+  reducer.add(1, std::vector<double>{5.0, 4.0, 3.0});
+  const auto columns = reducer.finish();
+  for (const auto& c : columns) EXPECT_EQ(c.get(0), 0.0) << c.name();
+  EXPECT_EQ(columns[0].get(1), 5.0);
+  EXPECT_EQ(columns[1].get(1), 4.0);
+  EXPECT_EQ(columns[2].get(1), 3.0);
+}
+
+}  // namespace
