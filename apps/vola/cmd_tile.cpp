@@ -28,7 +28,7 @@ struct TileArgs {
   std::optional<std::uint32_t> crs;
   std::string target_crs;
   unsigned threads = 0;
-  bool no_overviews = false, quiet = false;
+  bool no_overviews = false, no_attributes = false, quiet = false;
   std::uint64_t generate = 0;
   double density = 10.0;
   std::uint64_t seed = 1;
@@ -55,7 +55,7 @@ std::uint64_t parse_bytes(const std::string& text) {
   return static_cast<std::uint64_t>(value * scale);
 }
 
-std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::size_t chunk_points) {
+std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::size_t chunk_points, bool attributes) {
   // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
@@ -63,7 +63,7 @@ std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::siz
   std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".las" || ext == ".laz") return tile::open_las_points(path, chunk_points);
-  return tile::open_file_points(path);
+  return tile::open_file_points(path, attributes);
 }
 
 // With --target-crs, every input moved from its own CRS (--crs, else what it says) into
@@ -100,7 +100,7 @@ void run_tile(const TileArgs& a) {
     if (a.chunk_points == 0) throw InvalidArgument("--chunk-points must be positive");
     if (a.crs) resolve_crs({}, a.crs);  // an unknown code fails before any work
     std::vector<std::unique_ptr<tile::PointSource>> sources;
-    for (const std::string& path : a.inputs) sources.push_back(open_source(path, a.chunk_points));
+    for (const std::string& path : a.inputs) sources.push_back(open_source(path, a.chunk_points, !a.no_attributes));
     if (a.generate) {
       tile::SurveyOptions survey;
       survey.points = a.generate;
@@ -117,6 +117,7 @@ void run_tile(const TileArgs& a) {
     options.memory_budget = parse_bytes(a.memory);
     options.threads = a.threads;
     options.overviews = !a.no_overviews;
+    options.attributes = !a.no_attributes;
     reproject_sources(a, sources);
     if (a.target_crs.empty()) resolve_tile_crs(a, sources, options);
     else resolve_tile_crs(TileArgs{}, sources, options);  // every source now states the target
@@ -140,6 +141,7 @@ void run_tile(const TileArgs& a) {
     const tile::TileSummary summary = tile::make_tiles(views, options, *comm);
     if (progress) progress->finish();
     if (!talk) return;
+    for (const std::string& w : summary.warnings) std::fprintf(stderr, "vola: warning: %s\n", w.c_str());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("inputs:         %zu (%llu points)\n", sources.size(), static_cast<unsigned long long>(points));
     std::printf("crs:            %s\n", options.epsg ? ("EPSG:" + std::to_string(*options.epsg)).c_str()
@@ -154,6 +156,9 @@ void run_tile(const TileArgs& a) {
                 static_cast<unsigned long long>(summary.tiles), static_cast<unsigned long long>(summary.voxels),
                 static_cast<unsigned long long>(summary.tile_bytes),
                 summary.voxels ? 8.0 * static_cast<double>(summary.tile_bytes) / static_cast<double>(summary.voxels) : 0.0);
+    std::string columns;
+    for (const std::string& name : summary.attributes) columns += (columns.empty() ? "" : ", ") + name;
+    std::printf("attributes:     %s\n", columns.empty() ? "none (occupancy only)" : columns.c_str());
     std::printf("overviews:      %llu files\n", static_cast<unsigned long long>(summary.overview_files));
     std::printf("spilled:        %llu runs, %llu bytes (rank 0 of %d)\n", static_cast<unsigned long long>(summary.spill_runs),
                 static_cast<unsigned long long>(summary.spill_bytes), comm->size());
@@ -182,7 +187,8 @@ void add_tile(CLI::App& app) {
       "(each level 4x coarser, covering 4x4x4 tiles of the level below).\n"
       "Memory: voxel keys are bucketed per tile and spilled to disk as sorted runs whenever the\n"
       "--memory budget is reached, so inputs far larger than memory tile within it; a single tile's\n"
-      "voxel keys (8 bytes each) must fit the budget. The files are byte-identical whatever\n"
+      "voxel keys (8 bytes each) must fit the budget; with attributes every point's values are spilled\n"
+      "too and reduced into its voxel in input order. The files are byte-identical whatever\n"
       "--threads, and under mpirun whatever the number of ranks (each rank reads a share of the\n"
       "chunks; keys travel to each tile's owner by message; OUTDIR must be visible to every rank).\n"
       "Examples:\n"
@@ -207,6 +213,9 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");
   cmd->add_option("--threads", args->threads, "Threads per process (0 = all cores)")->capture_default_str();
   cmd->add_flag("--no-overviews", args->no_overviews, "Write no overview pyramid");
+  cmd->add_flag("--no-attributes", args->no_attributes,
+                "Occupancy only: drop the attribute columns (by default every tile keeps the columns vola convert "
+                "keeps from the inputs, e.g. colour, intensity, classification; overviews reduce them further)");
   cmd->add_option("--generate-survey", args->generate,
                   "Also tile a generated survey of N points (city blocks of 200 m, streamed, never stored)");
   cmd->add_option("--survey-density", args->density, "Generated survey: points per square metre")->capture_default_str()

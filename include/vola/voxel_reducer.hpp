@@ -34,7 +34,7 @@ class VoxelReducer {
   // its value of attribute a. Throws InvalidArgument on a rank out of range or arrays of
   // other lengths.
   void add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values);
-  // One point: values[a] for attribute a.
+  // One point: values[a] for attribute a (buffered, and reduced in batches, in order).
   void add(std::uint64_t rank, std::span<const double> values);
 
   // The columns, in the order of the specs; the reducer is empty afterwards.
@@ -47,6 +47,8 @@ class VoxelReducer {
   std::size_t memory_bytes() const noexcept;
 
  private:
+  void flush_pending();
+  void add_now(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values);
   struct State;
   std::unique_ptr<State> state_;
 };

@@ -57,6 +57,9 @@ struct VoxelReducer::State {
   std::vector<std::uint32_t> points;       // per voxel
   std::vector<std::vector<double>> value;  // per attribute but majority: sum or value per voxel
   std::vector<MajorityPartial> majority;   // per attribute (used by majority ones only)
+  // Points added one at a time, reduced in batches.
+  std::vector<std::uint64_t> pending_ranks;
+  std::vector<std::vector<double>> pending_values;
 };
 
 VoxelReducer::VoxelReducer(std::vector<AttributeSpec> specs, std::uint64_t voxels) : state_(std::make_unique<State>()) {
@@ -95,6 +98,20 @@ std::size_t VoxelReducer::memory_bytes() const noexcept {
 }
 
 void VoxelReducer::add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values) {
+  flush_pending();
+  add_now(ranks, values);
+}
+
+void VoxelReducer::flush_pending() {
+  State& s = *state_;
+  if (s.pending_ranks.empty()) return;
+  std::vector<std::span<const double>> values(s.pending_values.begin(), s.pending_values.end());
+  add_now(s.pending_ranks, values);
+  s.pending_ranks.clear();
+  for (auto& v : s.pending_values) v.clear();
+}
+
+void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values) {
   State& s = *state_;
   if (values.size() != s.specs.size())
     VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(values.size()) + " attribute arrays for " +
@@ -127,13 +144,19 @@ void VoxelReducer::add(std::span<const std::uint64_t> ranks, std::span<const std
 }
 
 void VoxelReducer::add(std::uint64_t rank, std::span<const double> values) {
-  std::vector<std::span<const double>> columns;
-  columns.reserve(values.size());
-  for (const double& v : values) columns.emplace_back(&v, 1);
-  add(std::span<const std::uint64_t>(&rank, 1), columns);
+  State& s = *state_;
+  if (values.size() != s.specs.size())
+    VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(values.size()) + " values for " +
+                               std::to_string(s.specs.size()) + " attributes"));
+  constexpr std::size_t kBatch = 4096;  // points reduced at once: a batch stays in cache
+  s.pending_values.resize(s.specs.size());
+  s.pending_ranks.push_back(rank);
+  for (std::size_t a = 0; a < values.size(); ++a) s.pending_values[a].push_back(values[a]);
+  if (s.pending_ranks.size() == kBatch) flush_pending();
 }
 
 std::vector<AttributeColumn> VoxelReducer::finish() {
+  flush_pending();
   State& s = *state_;
   std::vector<AttributeColumn> columns;
   for (std::size_t a = 0; a < s.specs.size(); ++a) {
@@ -167,6 +190,7 @@ std::vector<AttributeColumn> VoxelReducer::finish() {
     columns.push_back(std::move(column));
   }
   s.points = {};
+  s.pending_values = {};
   s.voxels = 0;
   return columns;
 }

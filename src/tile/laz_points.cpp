@@ -31,6 +31,17 @@ class LazPoints final : public PointSource {
         xyz[3 * i + a] = static_cast<double>(load_le<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
     }
   }
+  std::vector<AttributeSpec> attributes() const override { return io::las_attributes(reader_->header()); }
+  void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
+                              std::vector<std::vector<double>>& values) const override {
+    thread_local std::vector<std::uint8_t> records;
+    thread_local io::LasChunk decoded;
+    reader_->decode_laz_chunk(static_cast<std::size_t>(chunk), records);
+    decoded.clear();
+    io::decode_las_records(reader_->header(), records, decoded);
+    io::las_attribute_values(reader_->header(), decoded, values);
+    xyz.swap(decoded.xyz);
+  }
 
  private:
   static std::string path_of(const io::LasReader& reader) { return reader.path(); }

@@ -1,6 +1,7 @@
 #include "overviews.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -9,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/parallel.hpp"
+#include "vola/voxel_reducer.hpp"
 
 namespace vola::tile {
 
@@ -33,21 +35,70 @@ Box unite(const Box& a, const Box& b) {
   return u;
 }
 
+// A child's offset in the parent's voxels, per axis: children are 4x4x4 tiles, each a
+// quarter of the parent's voxels along an axis.
+std::array<std::uint32_t, 3> child_offset(const TileIndex& parent, const Node& child, int depth) {
+  const std::uint32_t child_span = side_of(depth - 1);
+  return {static_cast<std::uint32_t>(child.tile.i - 4 * parent.i) * child_span,
+          static_cast<std::uint32_t>(child.tile.j - 4 * parent.j) * child_span,
+          static_cast<std::uint32_t>(child.tile.k - 4 * parent.k) * child_span};
+}
+
+Tree open_child(const Node& child, const OverviewContext& c) {
+  Tree tree = open_mapped((fs::path(c.output_dir) / child.file).string());
+  if (tree.depth() != c.grid.depth)
+    throw FormatError(child.file, 0, "depth " + std::to_string(tree.depth()) + " differs from the tile set's " +
+                                         std::to_string(c.grid.depth));
+  return tree;
+}
+
+// The parent's attribute columns: each child voxel's values reduced into the parent
+// voxel that covers it, by the column's own reduction (a mean is the mean of the finer
+// voxels' values, each finer voxel counting once), children in index order and voxels
+// in rank order, so the result is the same whoever builds it. Children are opened a
+// second time rather than kept open: only one child's columns are in memory at once.
+void reduce_children(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c,
+                     Tree& tree) {
+  std::vector<AttributeSpec> specs;
+  {
+    const Tree first = open_child(*children.front(), c);
+    for (const AttributeColumn& column : first.attributes().columns())
+      specs.push_back({column.name(), column.type(), column.reduction()});
+  }
+  if (specs.empty()) return;
+  VoxelReducer reducer(specs, tree.voxel_count());
+  std::vector<double> values(specs.size());
+  for (const Node* child : children) {
+    const Tree tree_of_child = open_child(*child, c);
+    std::vector<const AttributeColumn*> columns;
+    for (const AttributeSpec& spec : specs) {
+      const AttributeColumn* column = tree_of_child.attributes().find(spec.name);
+      if (!column || column->type() != spec.type || column->reduction() != spec.reduction)
+        throw FormatError(child->file, 0, "has no attribute column '" + spec.name + "' like its neighbours'");
+      columns.push_back(column);
+    }
+    const auto [ox, oy, oz] = child_offset(parent, *child, c.grid.depth);
+    std::uint64_t rank = 0;
+    tree_of_child.for_each_voxel([&](const Voxel& v) {
+      for (std::size_t a = 0; a < specs.size(); ++a) values[a] = columns[a]->get(rank);
+      ++rank;
+      reducer.add(*tree.rank(Voxel{ox + v.x / 4, oy + v.y / 4, oz + v.z / 4}), values);
+    });
+  }
+  reducer.finish_into(tree);
+}
+
 Tree build_parent(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c) {
   const int depth = c.grid.depth;
-  const std::uint32_t child_span = side_of(depth - 1);  // a child's level depth-2 grid
   std::vector<Key> keys;
   for (const Node* child : children) {
-    const Tree tree = open_mapped((fs::path(c.output_dir) / child->file).string());
-    if (tree.depth() != depth)
-      throw FormatError(child->file, 0, "depth " + std::to_string(tree.depth()) + " differs from the tile set's " +
-                                            std::to_string(depth));
-    const std::uint32_t ox = static_cast<std::uint32_t>(child->tile.i - 4 * parent.i) * child_span;
-    const std::uint32_t oy = static_cast<std::uint32_t>(child->tile.j - 4 * parent.j) * child_span;
-    const std::uint32_t oz = static_cast<std::uint32_t>(child->tile.k - 4 * parent.k) * child_span;
+    const Tree tree = open_child(*child, c);
+    const auto [ox, oy, oz] = child_offset(parent, *child, depth);
     tree.for_each_node(depth - 2, [&](const Voxel& cell) { keys.push_back(encode(ox + cell.x, oy + cell.y, oz + cell.z)); });
   }
-  return build_from_keys(std::move(keys), depth);
+  Tree tree = build_from_keys(std::move(keys), depth);
+  reduce_children(parent, children, c, tree);
+  return tree;
 }
 
 }  // namespace

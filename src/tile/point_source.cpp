@@ -60,32 +60,54 @@ class LasPoints final : public PointSource {
   std::uint64_t point_count() const noexcept override { return header_.point_count; }
 
   void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
-    const std::uint64_t first = chunk * chunk_points_;
-    const std::uint64_t n = first < header_.point_count ? std::min<std::uint64_t>(chunk_points_, header_.point_count - first) : 0;
+    const std::span<const std::uint8_t> records = records_of(chunk);
+    const std::size_t n = records.size() / header_.record_length;
     xyz.resize(3 * n);
-    const std::size_t length = header_.record_length;
-    const std::uint8_t* record = data_ + header_.offset_to_points + first * length;
     const auto& s = header_.scale;
     const auto& o = header_.offset;
     double* out = xyz.data();
     // Every point format starts with X, Y, Z as little-endian int32 (ASPRS LAS 1.4, 2.6).
-    for (std::uint64_t p = 0; p < n; ++p, record += length, out += 3) {
+    for (const std::uint8_t* record = records.data(); record < records.data() + records.size();
+         record += header_.record_length, out += 3) {
       std::int32_t v[3];
       std::memcpy(v, record, sizeof v);
       out[0] = v[0] * s[0] + o[0];
       out[1] = v[1] * s[1] + o[1];
       out[2] = v[2] * s[2] + o[2];
     }
-    // Done with these pages: drop them from this process (the page cache keeps them), so
-    // that resident memory stays within the budget however large the file. A page shared
-    // with a neighbouring chunk is simply read back in from the cache if still needed.
-    const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    const auto begin = reinterpret_cast<std::uintptr_t>(data_ + header_.offset_to_points + first * length) & ~(page - 1);
-    const auto end = reinterpret_cast<std::uintptr_t>(record) & ~(page - 1);
-    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+    release(records);
+  }
+
+  std::vector<AttributeSpec> attributes() const override { return io::las_attributes(header_); }
+
+  void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
+                              std::vector<std::vector<double>>& values) const override {
+    const std::span<const std::uint8_t> records = records_of(chunk);
+    thread_local io::LasChunk decoded;
+    decoded.clear();
+    io::decode_las_records(header_, records, decoded);
+    release(records);
+    io::las_attribute_values(header_, decoded, values);
+    xyz.swap(decoded.xyz);
   }
 
  private:
+  // Chunk c's records, straight from the map.
+  std::span<const std::uint8_t> records_of(std::uint64_t chunk) const {
+    const std::uint64_t first = chunk * chunk_points_;
+    const std::uint64_t n = first < header_.point_count ? std::min<std::uint64_t>(chunk_points_, header_.point_count - first) : 0;
+    return {data_ + header_.offset_to_points + first * header_.record_length, n * header_.record_length};
+  }
+  // Done with these pages: drop them from this process (the page cache keeps them), so
+  // that resident memory stays within the budget however large the file. A page shared
+  // with a neighbouring chunk is simply read back in from the cache if still needed.
+  static void release(std::span<const std::uint8_t> records) {
+    const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto begin = reinterpret_cast<std::uintptr_t>(records.data()) & ~(page - 1);
+    const auto end = reinterpret_cast<std::uintptr_t>(records.data() + records.size()) & ~(page - 1);
+    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+  }
+
   std::string name_;
   std::size_t chunk_points_;
   io::LasHeader header_;
@@ -95,14 +117,18 @@ class LasPoints final : public PointSource {
 
 class WholeFilePoints final : public PointSource {
  public:
-  explicit WholeFilePoints(const std::string& path) : name_(path) {
+  WholeFilePoints(const std::string& path, bool attributes) : name_(path) {
     io::InputOptions options;
-    options.attributes = false;
+    options.attributes = attributes;
     io::Input input = io::read_input(path, "auto", options);
     if (input.is_mesh() || input.grid || input.terrain)
       throw InvalidArgument(path + ": vola tile takes point clouds (LAS, XYZ/TXT/CSV, PLY, PCD, NPY, KITTI); convert " +
                             input.format + " input with vola convert");
     xyz_ = std::move(input.cloud.xyz);
+    for (auto& column : input.cloud.attributes) {
+      specs_.push_back({column.name, column.type, column.reduction});
+      values_.push_back(std::move(column.values));
+    }
     epsg = input.epsg;
     wkt = input.wkt;
   }
@@ -110,10 +136,18 @@ class WholeFilePoints final : public PointSource {
   std::uint64_t chunk_count() const noexcept override { return 1; }
   std::uint64_t point_count() const noexcept override { return xyz_.size() / 3; }
   void read_chunk(std::uint64_t, std::vector<double>& xyz) const override { xyz = xyz_; }
+  std::vector<AttributeSpec> attributes() const override { return specs_; }
+  void read_chunk_with_values(std::uint64_t, std::vector<double>& xyz,
+                              std::vector<std::vector<double>>& values) const override {
+    xyz = xyz_;
+    values = values_;
+  }
 
  private:
   std::string name_;
   std::vector<double> xyz_;
+  std::vector<AttributeSpec> specs_;
+  std::vector<std::vector<double>> values_;
 };
 
 class GeneratedSurvey final : public PointSource {
@@ -163,7 +197,9 @@ std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_
   return std::make_unique<LasPoints>(path, chunk_points);
 }
 
-std::unique_ptr<PointSource> open_file_points(const std::string& path) { return std::make_unique<WholeFilePoints>(path); }
+std::unique_ptr<PointSource> open_file_points(const std::string& path, bool attributes) {
+  return std::make_unique<WholeFilePoints>(path, attributes);
+}
 
 std::unique_ptr<PointSource> generated_survey(const SurveyOptions& options) {
   return std::make_unique<GeneratedSurvey>(options);

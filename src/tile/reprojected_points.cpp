@@ -26,6 +26,17 @@ class ReprojectedPoints final : public PointSource {
   std::uint64_t point_count() const noexcept override { return source_->point_count(); }
   void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
     source_->read_chunk(chunk, xyz);
+    transform(xyz);
+  }
+  std::vector<AttributeSpec> attributes() const override { return source_->attributes(); }
+  void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
+                              std::vector<std::vector<double>>& values) const override {
+    source_->read_chunk_with_values(chunk, xyz, values);
+    transform(xyz);
+  }
+
+ private:
+  void transform(std::vector<double>& xyz) const {
     std::unique_ptr<geo::Reprojection> reprojection = borrow();
     try {
       reprojection->transform(xyz);
@@ -36,7 +47,6 @@ class ReprojectedPoints final : public PointSource {
     give_back(std::move(reprojection));
   }
 
- private:
   std::unique_ptr<geo::Reprojection> borrow() const {
     {
       const std::lock_guard lock(mutex_);

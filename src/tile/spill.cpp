@@ -106,4 +106,41 @@ std::vector<Key> merge_runs(std::span<const Run> runs, std::span<const SpillFile
   return out;
 }
 
+void merge_records(std::span<const Run> runs, std::span<const SpillFile* const> files, std::size_t words,
+                   std::size_t buffer_records, const std::function<void(const std::uint64_t*)>& visit) {
+  struct Cursor {
+    const SpillFile* file;
+    std::uint64_t next_offset, left;  // records not yet loaded
+    std::vector<std::uint64_t> buffer;
+    std::size_t at = 0, loaded = 0;  // records
+  };
+  const std::size_t per_buffer = std::max<std::size_t>(1, buffer_records);
+  std::vector<Cursor> cursors;
+  const auto refill = [&](Cursor& c) {
+    if (c.left == 0) return false;
+    c.loaded = static_cast<std::size_t>(std::min<std::uint64_t>(c.left, per_buffer));
+    c.buffer.resize(c.loaded * words);
+    c.file->read(c.next_offset, c.buffer);
+    c.next_offset += c.loaded * words * sizeof(std::uint64_t);
+    c.left -= c.loaded;
+    c.at = 0;
+    return true;
+  };
+  for (const Run& r : runs) {
+    if (r.count == 0) continue;
+    cursors.push_back(Cursor{files[r.file], r.offset, r.count, {}, 0, 0});
+    refill(cursors.back());
+  }
+  using Entry = std::pair<std::uint64_t, std::size_t>;  // sequence number, cursor
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
+  for (std::size_t i = 0; i < cursors.size(); ++i) heap.emplace(cursors[i].buffer[1], i);
+  while (!heap.empty()) {
+    const std::size_t i = heap.top().second;
+    heap.pop();
+    Cursor& c = cursors[i];
+    visit(c.buffer.data() + c.at * words);
+    if (++c.at < c.loaded || refill(c)) heap.emplace(c.buffer[c.at * words + 1], i);
+  }
+}
+
 }  // namespace vola::tile::detail

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -35,6 +36,14 @@ class SpillFile {
   int fd_ = -1;
   std::uint64_t end_ = 0;
 };
+
+// Runs of attribute records: `words` words each (the voxel key in its tile, the point's
+// sequence number, then one value per attribute as the bits of a double), each run
+// sorted by sequence number. visit(record) sees every record of the runs in sequence
+// order (one k-way merge, each run read through a buffer of `buffer_records` records),
+// so that the values reduce in the order the points came, whoever read them.
+void merge_records(std::span<const Run> runs, std::span<const SpillFile* const> files, std::size_t words,
+                   std::size_t buffer_records, const std::function<void(const std::uint64_t*)>& visit);
 
 // Sorted unique keys of many sorted unique runs (one k-way merge), reading each run
 // through a buffer of `buffer_keys` keys.

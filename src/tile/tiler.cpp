@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "vola/file.hpp"
 #include "vola/parallel.hpp"
 #include "vola/tile/tile_index.hpp"
+#include "vola/voxel_reducer.hpp"
 
 namespace vola::tile {
 
@@ -53,14 +55,31 @@ void sort_unique(std::vector<Key>& keys, int depth) {
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
 
-// One worker of the bucket phase: per-tile key buffers spilled as sorted unique runs.
+// Counts what a growing buffer holds room for: `held` grows with its capacity.
+template <class Push>
+void push_counted(std::vector<std::uint64_t>& buffer, std::uint64_t& held, Push&& push) {
+  const std::size_t before = buffer.capacity();
+  push();
+  held += buffer.capacity() - before;
+}
+
+// One worker of the bucket phase: per-tile key buffers spilled as sorted unique runs;
+// with attributes, per-tile attribute records too (voxel key, sequence number, values),
+// spilled as runs in sequence order.
 class Bucketer {
  public:
-  Bucketer(const TileGrid& grid, SpillFile& file, std::uint32_t file_id, std::uint64_t limit_keys)
-      : grid_(grid), locator_(grid), file_(file), file_id_(file_id), limit_(std::max<std::uint64_t>(limit_keys, 1024)) {}
+  Bucketer(const TileGrid& grid, SpillFile& file, SpillFile* value_file, std::uint32_t file_id, std::uint64_t limit_words,
+           std::size_t attribute_count)
+      : grid_(grid), locator_(grid), file_(file), value_file_(value_file), file_id_(file_id),
+        limit_(std::max<std::uint64_t>(limit_words, 1024)), attributes_(attribute_count) {}
 
-  void add(const std::vector<double>& xyz) {
+  // A chunk's points, point p with sequence number first_sequence + p and values[a][p].
+  void add(const std::vector<double>& xyz, const std::vector<std::vector<double>>& values, std::uint64_t first_sequence) {
     const std::size_t n = xyz.size() / 3;
+    if (values.size() != attributes_) throw Error("tile: a chunk's attribute values do not match its columns");
+    for (const auto& v : values)
+      if (v.size() != n) throw Error("tile: a chunk has " + std::to_string(v.size()) + " attribute values for " +
+                                     std::to_string(n) + " points");
     for (std::size_t p = 0; p < n; ++p) {
       const Point point{xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]};
       TileIndex t;
@@ -72,12 +91,15 @@ class Bucketer {
       Slot& slot = slot_of(t);
       std::vector<Key>* keys = slot.keys;
       TileStat* stat = slot.stat;
-      if (keys->size() == keys->capacity()) {  // the budget counts what the buffers hold, growth included
-        const std::size_t before = keys->capacity();
-        keys->push_back(key);
-        held_ += keys->capacity() - before;
-      } else {
-        keys->push_back(key);
+      // The budget counts what the buffers hold, growth included.
+      push_counted(*keys, held_, [&] { keys->push_back(key); });
+      if (attributes_) {
+        std::vector<std::uint64_t>& records = *slot.records;
+        push_counted(records, held_, [&] {
+          records.push_back(key);
+          records.push_back(first_sequence + p);
+          for (std::size_t a = 0; a < attributes_; ++a) records.push_back(std::bit_cast<std::uint64_t>(values[a][p]));
+        });
       }
       ++stat->points;
       for (int a = 0; a < 3; ++a) {
@@ -96,11 +118,19 @@ class Bucketer {
       ++run_count_;
       std::vector<Key>().swap(keys);  // give the memory back: the budget counts it
     }
+    for (auto& [tile, records] : records_) {
+      if (records.empty()) continue;
+      in_sequence_order(records);
+      const std::size_t words = 2 + attributes_;
+      value_runs_[tile].push_back(Run{file_id_, value_file_->append(records), records.size() / words});
+      std::vector<std::uint64_t>().swap(records);
+    }
     held_ = 0;
   }
 
   const StatMap& stats() const noexcept { return stats_; }
   const RunMap& runs() const noexcept { return runs_; }
+  const RunMap& value_runs() const noexcept { return value_runs_; }
   std::uint64_t outside() const noexcept { return outside_; }
   std::uint64_t run_count() const noexcept { return run_count_; }
 
@@ -110,27 +140,46 @@ class Bucketer {
   struct Slot {
     TileIndex tile;
     std::vector<Key>* keys = nullptr;
+    std::vector<std::uint64_t>* records = nullptr;
     TileStat* stat = nullptr;
   };
   Slot& slot_of(const TileIndex& t) {
     const auto h = (static_cast<std::uint32_t>(t.i) * 0x9E3779B1u) ^ (static_cast<std::uint32_t>(t.j) * 0x85EBCA77u) ^
                    (static_cast<std::uint32_t>(t.k) * 0xC2B2AE3Du);
     Slot& slot = cache_[(h >> 24) & (cache_.size() - 1)];
-    if (!slot.keys || slot.tile != t) slot = Slot{t, &buckets_[t], &stats_[t]};  // map nodes never move
+    if (!slot.keys || slot.tile != t) slot = Slot{t, &buckets_[t], &records_[t], &stats_[t]};  // map nodes never move
     return slot;
+  }
+  // Records are appended chunk by chunk, and a worker takes chunks in increasing order,
+  // so they are in sequence order already; sorted here should that ever not hold.
+  void in_sequence_order(std::vector<std::uint64_t>& records) const {
+    const std::size_t words = 2 + attributes_, n = records.size() / words;
+    bool sorted = true;
+    for (std::size_t r = 1; r < n && sorted; ++r) sorted = records[r * words + 1] > records[(r - 1) * words + 1];
+    if (sorted) return;
+    std::vector<std::size_t> order(n);
+    for (std::size_t r = 0; r < n; ++r) order[r] = r;
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return records[x * words + 1] < records[y * words + 1]; });
+    std::vector<std::uint64_t> out(records.size());
+    for (std::size_t r = 0; r < n; ++r)
+      std::copy_n(records.begin() + static_cast<std::ptrdiff_t>(order[r] * words), words, out.begin() + static_cast<std::ptrdiff_t>(r * words));
+    records.swap(out);
   }
 
   std::array<Slot, 64> cache_{};
   const TileGrid& grid_;
   const Locator locator_;
   SpillFile& file_;
+  SpillFile* value_file_;  // with attributes
   std::uint32_t file_id_;
   std::uint64_t limit_;
-  std::uint64_t held_ = 0;  // keys the buffers have room for
+  std::size_t attributes_;
+  std::uint64_t held_ = 0;  // words the buffers have room for
   std::uint64_t outside_ = 0, run_count_ = 0;
   std::map<TileIndex, std::vector<Key>> buckets_;
+  std::map<TileIndex, std::vector<std::uint64_t>> records_;
   StatMap stats_;
-  RunMap runs_;
+  RunMap runs_, value_runs_;
 };
 
 // Little-endian-agnostic packing of plain values (all ranks run the same binary).
@@ -172,6 +221,13 @@ struct Tiling {
   std::vector<std::unique_ptr<SpillFile>> files;  // one per worker, the last for runs from other ranks
   std::vector<const SpillFile*> file_views;
   RunMap runs;             // this rank's sorted runs per tile
+  // With attributes: the columns every tile gets, and their records' spill files and runs
+  // (as for keys).
+  std::vector<AttributeSpec> specs;
+  std::map<const PointSource*, std::vector<std::size_t>> columns_of;  // spec a -> the source's column
+  std::vector<std::unique_ptr<SpillFile>> value_files;
+  std::vector<const SpillFile*> value_file_views;
+  RunMap value_runs;
   StatMap all_stats;       // every rank's points and bbox per tile
   std::vector<TileIndex> tiles;  // every tile, in order; tile p belongs to rank p % ranks
   TileSummary summary;
@@ -189,6 +245,22 @@ struct Tiling {
   std::vector<Key> merged(const std::vector<Run>& tile_runs) const {
     return detail::merge_runs(tile_runs, file_views, merge_buffer(tile_runs.size()));
   }
+  std::size_t record_words() const { return 2 + specs.size(); }
+  // A tile's attribute records in sequence order, each visited once.
+  void visit_records(const std::vector<Run>& tile_runs, const std::function<void(const std::uint64_t*)>& visit) const {
+    detail::merge_records(tile_runs, value_file_views, record_words(), merge_buffer(tile_runs.size()) / record_words(),
+                          visit);
+  }
+  void reduce_attributes(const TileIndex& t, Tree& tree) const;
+  // A chunk's points and its values of `specs`, in their order.
+  void read_values(const PointSource& source, std::uint64_t chunk, std::vector<double>& xyz,
+                   std::vector<std::vector<double>>& values) const {
+    thread_local std::vector<std::vector<double>> all;
+    source.read_chunk_with_values(chunk, xyz, all);
+    const std::vector<std::size_t>& column = columns_of.at(&source);
+    values.resize(column.size());
+    for (std::size_t a = 0; a < column.size(); ++a) values[a].swap(all.at(column[a]));
+  }
 
   void bucket(const std::vector<const PointSource*>& sources);
   void share_statistics(const StatMap& stats, std::uint64_t points_read, std::uint64_t outside);
@@ -202,33 +274,47 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   const TileGrid& grid = options.grid;
   // Every worker's buffers share 35% of the budget: sorting a buffer needs as much
   // again, and the chunk being read, the maps and the allocator take the rest.
-  const std::uint64_t limit_keys = options.memory_budget * 35 / 100 / workers / sizeof(Key);
-  std::vector<std::pair<const PointSource*, std::uint64_t>> chunks;  // global chunk g -> rank g % ranks
+  const std::uint64_t limit_words = options.memory_budget * 35 / 100 / workers / sizeof(Key);
+  struct SourceChunk {
+    const PointSource* source;
+    std::uint64_t chunk, global;  // global chunk g -> rank g % ranks
+  };
+  std::vector<SourceChunk> chunks;
   std::uint64_t global = 0;
   for (const PointSource* s : sources)
     for (std::uint64_t c = 0; c < s->chunk_count(); ++c, ++global)
-      if (owner(global) == rank) chunks.emplace_back(s, c);
+      if (owner(global) == rank) chunks.push_back({s, c, global});
 
   std::vector<std::unique_ptr<Bucketer>> bucketers;
   for (unsigned w = 0; w < workers; ++w)
-    bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], w, limit_keys));
+    bucketers.push_back(std::make_unique<Bucketer>(grid, *files[w], specs.empty() ? nullptr : value_files[w].get(), w,
+                                                   limit_words, specs.size()));
   std::atomic<std::uint64_t> chunks_done{0}, points_read{0};
   // Worker w fills bucketers[w]; progress is reported by worker 0, the calling thread.
   ParallelOptions bucketing;
   bucketing.threads = workers;
   bucketing.name = "tile.bucket";
   std::vector<std::vector<double>> xyz(workers);
+  std::vector<std::vector<std::vector<double>>> values(workers);
   const auto bucket_chunks = [&](const Chunk& chunk) {
     for (std::size_t c = chunk.begin; c < chunk.end; ++c) {
-      chunks[c].first->read_chunk(chunks[c].second, xyz[chunk.worker]);
-      points_read += xyz[chunk.worker].size() / 3;
-      bucketers[chunk.worker]->add(xyz[chunk.worker]);
+      std::vector<double>& points = xyz[chunk.worker];
+      std::vector<std::vector<double>>& point_values = values[chunk.worker];
+      if (specs.empty()) chunks[c].source->read_chunk(chunks[c].chunk, points);
+      else read_values(*chunks[c].source, chunks[c].chunk, points, point_values);
+      if (points.size() / 3 > std::numeric_limits<std::uint32_t>::max())
+        throw Error(chunks[c].source->name() + ": a chunk of more than 2^32 points");
+      points_read += points.size() / 3;
+      // A point's sequence number: its chunk's place among all inputs' chunks, then its
+      // place in the chunk: the order of the points whoever reads them.
+      bucketers[chunk.worker]->add(points, point_values, chunks[c].global << 32);
       const std::uint64_t done = ++chunks_done;
       if (talk && chunk.worker == 0) options.progress("bucketing points", done, chunks.size());
     }
   };
   parallel_for(chunks.size(), bucket_chunks, bucketing);
   xyz.clear();
+  values.clear();
   ParallelOptions flushing;  // every bucketer's last buffer, sorted and spilled
   flushing.threads = workers;
   flushing.chunks = workers;
@@ -241,6 +327,7 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   for (const auto& b : bucketers) {
     for (const auto& [t, st] : b->stats()) stats[t].merge(st);
     for (const auto& [t, r] : b->runs()) runs[t].insert(runs[t].end(), r.begin(), r.end());
+    for (const auto& [t, r] : b->value_runs()) value_runs[t].insert(value_runs[t].end(), r.begin(), r.end());
     outside += b->outside();
     summary.spill_runs += b->run_count();
   }
@@ -288,14 +375,31 @@ void Tiling::exchange() {
         }
       }
       auto gathered = comm.gather(root, keys);
+      if (root == rank)
+        for (int r = 0; r < ranks; ++r)
+          if (r != rank && !gathered[r].empty())
+            runs[tiles[p]].push_back(Run{received, files[received]->append(gathered[r]), gathered[r].size()});
+      if (!specs.empty()) {  // the attribute records, merged into one run in sequence order
+        std::vector<std::uint64_t> records;
+        if (root != rank) {
+          if (const auto it = value_runs.find(tiles[p]); it != value_runs.end()) {
+            visit_records(it->second, [&](const std::uint64_t* r) { records.insert(records.end(), r, r + record_words()); });
+            value_runs.erase(it);
+          }
+        }
+        auto gathered_records = comm.gather(root, records);
+        if (root == rank)
+          for (int r = 0; r < ranks; ++r)
+            if (r != rank && !gathered_records[r].empty())
+              value_runs[tiles[p]].push_back(Run{received, value_files[received]->append(gathered_records[r]),
+                                                 gathered_records[r].size() / record_words()});
+      }
       if (root != rank) continue;
-      for (int r = 0; r < ranks; ++r)
-        if (r != rank && !gathered[r].empty())
-          runs[tiles[p]].push_back(Run{received, files[received]->append(gathered[r]), gathered[r].size()});
       if (talk) options.progress("exchanging tiles", p + 1, tiles.size());
     }
   }
   for (const auto& f : files) summary.spill_bytes += f->size();
+  for (const auto& f : value_files) summary.spill_bytes += f->size();
   summary.seconds_exchange = seconds_since(mark);
 }
 
@@ -333,6 +437,7 @@ std::vector<BuiltTile> Tiling::build() {
       }
       Tree tree = build_from_sorted_keys(keys, grid.depth);
       std::vector<Key>().swap(keys);
+      reduce_attributes(t, tree);
       tree.set_frame(grid.tile_frame(t));
       georef->apply(tree, all_stats.at(t).bbox);
       const std::string path = (tile_dir / tile_file_name(t)).string();
@@ -345,6 +450,8 @@ std::vector<BuiltTile> Tiling::build() {
   parallel_for(owned.size(), build_tiles, building);
   files.clear();  // the spill files go as soon as the tiles are written
   file_views.clear();
+  value_files.clear();
+  value_file_views.clear();
   summary.seconds_build = seconds_since(mark);
 
   std::vector<std::uint8_t> results;
@@ -361,6 +468,23 @@ std::vector<BuiltTile> Tiling::build() {
     }
   }
   return built;
+}
+
+// The tile's attribute columns: its records reduced into its voxels in sequence order,
+// so that a voxel's value does not depend on which worker, run or rank held its points.
+void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
+  if (specs.empty()) return;
+  VoxelReducer reducer(specs, tree.voxel_count());
+  if (const auto it = value_runs.find(t); it != value_runs.end()) {
+    std::vector<double> values(specs.size());
+    visit_records(it->second, [&](const std::uint64_t* record) {
+      const std::optional<std::uint64_t> r = tree.rank(decode(record[0]));
+      if (!r) throw Error("tile: an attribute record names a voxel the tile does not hold");
+      for (std::size_t a = 0; a < specs.size(); ++a) values[a] = std::bit_cast<double>(record[2 + a]);
+      reducer.add(*r, values);
+    });
+  }
+  reducer.finish_into(tree);
 }
 
 // The tile index (without overviews) and the summary's totals.
@@ -385,6 +509,30 @@ TileIndexFile Tiling::index(const std::vector<BuiltTile>& built) {
   }
   summary.tiles = tiles.size();
   return index;
+}
+
+// The attribute columns every source carries (same name, type and reduction), in the
+// order the sources name them; a column some source lacks is left out, with a warning.
+std::vector<AttributeSpec> common_attributes(const std::vector<const PointSource*>& sources,
+                                             std::vector<std::string>& warnings) {
+  std::vector<std::vector<AttributeSpec>> of;
+  for (const PointSource* s : sources) of.push_back(s->attributes());
+  std::vector<AttributeSpec> common;
+  std::vector<std::string> seen;
+  for (const auto& specs : of)
+    for (const AttributeSpec& spec : specs) {
+      if (std::find(seen.begin(), seen.end(), spec.name) != seen.end()) continue;
+      seen.push_back(spec.name);
+      std::size_t lacking = 0;
+      while (lacking < of.size() && std::any_of(of[lacking].begin(), of[lacking].end(), [&](const AttributeSpec& o) {
+               return o.name == spec.name && o.type == spec.type && o.reduction == spec.reduction;
+             }))
+        ++lacking;
+      if (lacking == of.size()) common.push_back(spec);
+      else warnings.push_back("attribute '" + spec.name + "' is left out: " + sources[lacking]->name() +
+                              " has no such column (of the same type and reduction)");
+    }
+  return common;
 }
 
 // A folder that is removed with everything in it when this goes out of scope.
@@ -419,6 +567,19 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   for (unsigned w = 0; w <= workers; ++w)
     run.files.push_back(std::make_unique<SpillFile>((spill.dir / ("worker-" + std::to_string(w) + ".keys")).string()));
   for (const auto& f : run.files) run.file_views.push_back(f.get());
+  if (options.attributes) run.specs = common_attributes(sources, run.summary.warnings);
+  for (const PointSource* source : sources) {
+    const std::vector<AttributeSpec> own = source->attributes();
+    for (const AttributeSpec& spec : run.specs)
+      run.columns_of[source].push_back(static_cast<std::size_t>(
+          std::find_if(own.begin(), own.end(), [&](const AttributeSpec& o) { return o.name == spec.name; }) - own.begin()));
+  }
+  if (!run.specs.empty())
+    for (unsigned w = 0; w <= workers; ++w)
+      run.value_files.push_back(
+          std::make_unique<SpillFile>((spill.dir / ("worker-" + std::to_string(w) + ".values")).string()));
+  for (const auto& f : run.value_files) run.value_file_views.push_back(f.get());
+  for (const AttributeSpec& spec : run.specs) run.summary.attributes.push_back(spec.name);
   run.georef.emplace(options.epsg, options.crs_wkt);
 
   run.bucket(sources);

@@ -19,6 +19,16 @@ las=$data/las/pdal_autzen_trim.las
 grep -q '^tiles: ' "$tmp/one.txt" || fail "no summary: $(cat "$tmp/one.txt")"
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/two" --threads 2 --memory 1M --chunk-points 5000 -q
 diff -r "$tmp/one" "$tmp/two" > /dev/null || fail "2 threads, 1 MiB and small chunks give other bytes than 1 thread"
+# The tiles carry the survey's attribute columns, overviews too; --no-attributes drops them.
+grep -q '^attributes: .*classification' "$tmp/one.txt" || fail "summary names no attributes: $(cat "$tmp/one.txt")"
+some_tile=$(ls "$tmp/one/.generation-1/"tile_*.vol | head -1)
+some_overview=$(ls "$tmp/one/.generation-1/overviews/L1/"*.vol | head -1)
+for f in "$some_tile" "$some_overview"; do
+  "$vola" info "$f" | grep -q '^attribute: *intensity (u16, mean' || fail "$f has no intensity column"
+done
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/bare" --no-attributes --no-overviews > "$tmp/bare.txt"
+grep -q '^attributes: *none' "$tmp/bare.txt" || fail "--no-attributes summary: $(cat "$tmp/bare.txt")"
+"$vola" info "$(ls "$tmp/bare/.generation-1/"tile_*.vol | head -1)" | grep -q '^attribute:' && fail "--no-attributes tile has columns"
 
 index=$tmp/one/index.geojson
 python3 - "$index" "$las" <<'PY' || fail "index check"
@@ -109,4 +119,7 @@ export OMPI_MCA_btl_vader_single_copy_mechanism=none  # no ptrace between ranks 
 mpirun --allow-run-as-root --oversubscribe -np 3 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/mpi" \
   --threads 1 --chunk-points 7000 -q || fail "mpirun -np 3 vola tile failed"
 diff -r "$tmp/one" "$tmp/mpi" > /dev/null || fail "3 MPI ranks give other bytes than one process"
+mpirun --allow-run-as-root --oversubscribe -np 2 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/mpi2" \
+  --threads 2 --memory 1M -q || fail "mpirun -np 2 vola tile failed"
+diff -r "$tmp/one" "$tmp/mpi2" > /dev/null || fail "2 MPI ranks (2 threads, 1 MiB) give other bytes than one process"
 echo "cli_tile: OK"

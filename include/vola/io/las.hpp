@@ -80,6 +80,9 @@ struct LasChunk {
   void clear();
 };
 
+// Point records (header.record_length bytes each) decoded and appended to `chunk`.
+void decode_las_records(const LasHeader& header, std::span<const std::uint8_t> records, LasChunk& chunk);
+
 class LasReader {
  public:
   // Reads and checks the header and (E)VLRs, and for LAZ the laszip VLR and the chunk

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "vola/frame.hpp"
+#include "vola/stream_builder.hpp"
 
 namespace vola::tile {
 
@@ -23,6 +24,18 @@ class PointSource {
   // threads at once. Throws vola::Error (file, offset, cause) on bad input.
   virtual void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const = 0;
 
+  // The attribute columns the points carry, as `vola convert` keeps them from this
+  // format (LAS: colour, intensity, classification, height, returns, extra bytes); none
+  // by default.
+  virtual std::vector<AttributeSpec> attributes() const { return {}; }
+  // The chunk's points as read_chunk gives them, and values[a] (one per point) for each
+  // entry a of attributes(). The default reads the points and has no values.
+  virtual void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
+                                      std::vector<std::vector<double>>& values) const {
+    read_chunk(chunk, xyz);
+    values.clear();
+  }
+
   // What the input says its CRS is (nothing for generated points).
   std::optional<std::uint32_t> epsg;
   std::string wkt;
@@ -32,8 +45,9 @@ class PointSource {
 // [c * chunk_points, (c + 1) * chunk_points), decoded straight from the map. A LAZ or
 // COPC file: chunk c is the file's own LAZ chunk c (chunk_points unused).
 std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_t chunk_points = std::size_t{1} << 20);
-// Any other point format `vola convert` reads, read whole (one chunk).
-std::unique_ptr<PointSource> open_file_points(const std::string& path);
+// Any other point format `vola convert` reads, read whole (one chunk), with the
+// attribute columns the format carries unless `attributes` is false.
+std::unique_ptr<PointSource> open_file_points(const std::string& path, bool attributes = true);
 
 // `source`'s points moved from CRS `from` into CRS `to` (any definition PROJ reads) as
 // each chunk is read; the result states `to` as its CRS. Throws vola::Error when PROJ

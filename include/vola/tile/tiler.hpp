@@ -37,6 +37,10 @@ struct TileOptions {
   std::uint64_t memory_budget = std::uint64_t{2} << 30;
   unsigned threads = 0;  // 0 = vola::thread_count() (all cores unless set)
   bool overviews = true;
+  // Keep the inputs' attribute columns (those every input carries, as `vola convert`
+  // keeps them, with the same reductions): points are reduced into each tile's voxels in
+  // input order, so the values do not depend on threads, memory or ranks either.
+  bool attributes = true;
   // The CRS written into every tile (header code and WKT); the caller resolves it.
   std::optional<std::uint32_t> epsg;
   std::string crs_wkt;
@@ -54,6 +58,8 @@ struct TileSummary {
   std::uint64_t spill_runs = 0;       // this rank's
   std::uint64_t spill_bytes = 0;      // this rank's
   std::string index_path;
+  std::vector<std::string> attributes;  // the columns every tile carries
+  std::vector<std::string> warnings;    // columns left out, and why
   // Wall time of each step on this rank.
   double seconds_bucket = 0, seconds_exchange = 0, seconds_build = 0, seconds_overviews = 0;
 };
