@@ -2,7 +2,9 @@
 // mapped on demand.
 #include "python_support.hpp"
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <filesystem>
 #include <memory>
 
@@ -24,6 +26,34 @@ py::object tiles_contain(const vola::tile::TileSet& tiles, const py::handle& inp
     for (py::ssize_t i = 0; i < n; ++i, p += 3) hit[i] = tiles.locate(vola::Point{p[0], p[1], p[2]}).rank.has_value();
   }
   if (single_row(input)) return py::bool_(hit[0]);
+  return std::move(out);
+}
+
+// Attribute `name` at each world point's voxel: NaN where no tile has the voxel.
+py::object tiles_values(const vola::tile::TileSet& tiles, const py::handle& input, const std::string& name) {
+  const auto& names = tiles.index().attributes;
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string known;
+    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw py::key_error("no attribute '" + name + "' (the tile set has: " + (known.empty() ? "none" : known) + ")");
+  }
+  const auto xyz = rows_of_three<double>(input, "points");
+  const auto n = xyz.shape(0);
+  py::array_t<double> out(n);
+  double* value = out.mutable_data();
+  const double* p = xyz.data();
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t i = 0; i < n; ++i, p += 3) {
+      value[i] = std::numeric_limits<double>::quiet_NaN();
+      const vola::tile::TileLookup hit = tiles.locate(vola::Point{p[0], p[1], p[2]});
+      if (!hit.rank) continue;
+      const vola::AttributeColumn* column = tiles.tree(hit.tile)->attributes().find(name);
+      if (!column) throw vola::FormatError(name, 0, "a tile of the set has no such column, though the index lists it");
+      value[i] = column->get(*hit.rank);
+    }
+  }
+  if (single_row(input)) return py::float_(value[0]);
   return std::move(out);
 }
 
@@ -58,6 +88,11 @@ void bind_tiles(py::module_& m) {
       })
       .def_property_readonly("tiles_opened", &vola::tile::TileSet::tiles_opened, "How many tiles queries have mapped so far.")
       .def("__len__", [](const vola::tile::TileSet& t) { return t.index().tiles.size(); })
+      .def_property_readonly("attributes", [](const vola::tile::TileSet& t) { return t.index().attributes; },
+                             "The attribute columns every tile carries (e.g. ['red', ..., 'classification']).")
+      .def("values", &tiles_values, py::arg("points"), py::arg("name"),
+           "World points (M, 3) -> (M,) float64: attribute `name` of each point's voxel, NaN where no tile "
+           "has the voxel. Opens only the tiles hit.")
       .def("tiles", &tile_entries, "Every tile: {tile: (i, j, k), file, points, voxels, bytes}, from the index.")
       .def("contains", &tiles_contain, py::arg("points"),
            "World points (M, 3) -> (M,) bool: is each point's voxel occupied? Opens only the tiles hit.")

@@ -50,6 +50,25 @@ def test_tile_set_opens_lazily_and_answers_in_world_coordinates(tile_index: path
     assert tiles.tile(10**6, 0, 0) is None
 
 
+def test_tile_set_reads_the_attribute_columns(tile_index: pathlib.Path, shared_data) -> None:
+    tiles = vola.open_tiles(tile_index)
+    assert tiles.attributes == ["red", "green", "blue", "intensity", "classification", "height",
+                                "number_of_returns"]
+    first = tiles.tiles()[0]
+    tree = tiles.tile(*first["tile"])
+    centres = tree.centers()
+    for name in ("intensity", "classification", "height"):
+        np.testing.assert_array_equal(tiles.values(centres, name), tree.attribute(name).astype(np.float64))
+    # The tile's classification equals the majority of the survey's points in each voxel.
+    survey = vola.convert(shared_data / "las" / "pdal_autzen_trim.las", voxel_size=1.0, origin=(0.0, 0.0, 0.0))
+    in_survey = survey.world_to_voxel(centres)[0]
+    rows = survey.rank(in_survey)
+    np.testing.assert_array_equal(tiles.values(centres, "classification"), survey.attribute("classification")[rows])
+    assert np.isnan(tiles.values([1e7, 1e7, 0.0], "intensity"))
+    with pytest.raises(KeyError, match="has: red"):
+        tiles.values(centres, "nope")
+
+
 def test_bad_index_raises_format_error(tmp_path: pathlib.Path) -> None:
     bad = tmp_path / "index.geojson"
     bad.write_text('{"type": "FeatureCollection"}')

@@ -100,6 +100,7 @@ void write_tile_index(const TileIndexFile& index, const std::string& path) {
   for (const TileEntry& t : index.tiles) voxels += t.voxels;
   vola["tiles"] = index.tiles.size();
   vola["voxels"] = voxels;
+  vola["attributes"] = index.attributes;
   ordered_json overviews = ordered_json::array();
   for (const OverviewEntry& o : index.overviews)
     overviews.push_back({{"level", o.level}, {"tile", tile_array(o.tile)}, {"file", o.file}, {"voxels", o.voxels}});
@@ -148,6 +149,13 @@ TileIndexFile read_tile_index(const std::string& path) {
     index.crs_wkt = v.value("crs_wkt", "");
     index.points_in = count_of(v, "points_in", path);
     index.points_outside = count_of(v, "points_outside", path);
+    if (v.contains("attributes")) {  // absent in indexes written before tiles had columns
+      if (!v["attributes"].is_array()) bad(path, "\"attributes\" must be a list of column names");
+      for (const json& name : v["attributes"]) {
+        if (!name.is_string()) bad(path, "\"attributes\" must be a list of column names");
+        index.attributes.push_back(name.get<std::string>());
+      }
+    }
     try {
       index.grid.check();
     } catch (const InvalidArgument& e) {

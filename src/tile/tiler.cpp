@@ -495,6 +495,7 @@ TileIndexFile Tiling::index(const std::vector<BuiltTile>& built) {
   index.crs_wkt = options.crs_wkt;
   index.points_in = summary.points_in;
   index.points_outside = summary.points_outside;
+  index.attributes = summary.attributes;
   for (std::size_t p = 0; p < tiles.size(); ++p) {
     TileEntry e;
     e.tile = tiles[p];

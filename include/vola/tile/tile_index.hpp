@@ -38,6 +38,7 @@ struct TileIndexFile {
   std::string crs_wkt;
   std::uint64_t points_in = 0;
   std::uint64_t points_outside = 0;
+  std::vector<std::string> attributes;   // the attribute columns every tile and overview carries
   std::vector<TileEntry> tiles;          // sorted by tile index
   std::vector<OverviewEntry> overviews;  // by level, then tile index
 };
