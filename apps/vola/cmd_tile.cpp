@@ -32,7 +32,7 @@ struct TileArgs {
   std::uint64_t generate = 0;
   double density = 10.0;
   std::uint64_t seed = 1;
-  std::size_t chunk_points = std::size_t{1} << 20;
+  std::size_t chunk_points = 0;  // 0: tile::chunk_points_for the options
 };
 
 // "2G", "512M", "1.5G", "300000000" -> bytes.
@@ -97,10 +97,14 @@ void run_tile(const TileArgs& a) {
   const bool talk = comm->rank() == 0 && !a.quiet;
   try {
     if (a.inputs.empty() && a.generate == 0) throw InvalidArgument("no input: give point files or --generate-survey N");
-    if (a.chunk_points == 0) throw InvalidArgument("--chunk-points must be positive");
     if (a.crs) resolve_crs({}, a.crs);  // an unknown code fails before any work
+    tile::TileOptions options;
+    options.memory_budget = parse_bytes(a.memory);
+    options.threads = a.threads;
+    options.attributes = !a.no_attributes;
+    const std::size_t chunk_points = a.chunk_points ? a.chunk_points : tile::chunk_points_for(options);
     std::vector<std::unique_ptr<tile::PointSource>> sources;
-    for (const std::string& path : a.inputs) sources.push_back(open_source(path, a.chunk_points, !a.no_attributes));
+    for (const std::string& path : a.inputs) sources.push_back(open_source(path, chunk_points, options.attributes));
     if (a.generate) {
       tile::SurveyOptions survey;
       survey.points = a.generate;
@@ -108,16 +112,12 @@ void run_tile(const TileArgs& a) {
       survey.seed = a.seed;
       sources.push_back(tile::generated_survey(survey));
     }
-    tile::TileOptions options;
     options.grid.tile_size = a.tile_size;
     options.grid.depth = a.depth;
     if (!a.origin.empty()) options.grid.origin = {a.origin[0], a.origin[1], a.origin[2]};
     options.output_dir = a.output;
     options.spill_dir = a.spill_dir;
-    options.memory_budget = parse_bytes(a.memory);
-    options.threads = a.threads;
     options.overviews = !a.no_overviews;
-    options.attributes = !a.no_attributes;
     reproject_sources(a, sources);
     if (a.target_crs.empty()) resolve_tile_crs(a, sources, options);
     else resolve_tile_crs(TileArgs{}, sources, options);  // every source now states the target
@@ -221,7 +221,9 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--survey-density", args->density, "Generated survey: points per square metre")->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "Generated survey: seed")->capture_default_str();
-  cmd->add_option("--chunk-points", args->chunk_points, "LAS points per work unit")->capture_default_str();
+  cmd->add_option("--chunk-points", args->chunk_points,
+                  "LAS points per work unit (default: 2^20, or fewer with attributes when --memory is small)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_tile(*args); });
 }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <span>
 
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -57,8 +58,9 @@ Tree open_child(const Node& child, const OverviewContext& c) {
 // voxels' values, each finer voxel counting once), children in index order and voxels
 // in rank order, so the result is the same whoever builds it. Children are opened a
 // second time rather than kept open: only one child's columns are in memory at once.
+// `keys`: the parent's voxel keys, sorted; a voxel's rank is its place among them.
 void reduce_children(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c,
-                     Tree& tree) {
+                     std::span<const Key> keys, Tree& tree) {
   std::vector<AttributeSpec> specs;
   {
     const Tree first = open_child(*children.front(), c);
@@ -78,11 +80,16 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
       columns.push_back(column);
     }
     const auto [ox, oy, oz] = child_offset(parent, *child, c.grid.depth);
-    std::uint64_t rank = 0;
+    // A child's voxels come in key order, and so do the parent voxels that cover them
+    // (the child is an aligned block of the parent): one walk along the parent's keys.
+    std::size_t at = 0, rank = 0;
     tree_of_child.for_each_voxel([&](const Voxel& v) {
+      const Key up = encode(ox + v.x / 4, oy + v.y / 4, oz + v.z / 4);
+      if (rank == 0) at = static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), up) - keys.begin());
+      while (keys[at] < up) ++at;
       for (std::size_t a = 0; a < specs.size(); ++a) values[a] = columns[a]->get(rank);
       ++rank;
-      reducer.add(*tree.rank(Voxel{ox + v.x / 4, oy + v.y / 4, oz + v.z / 4}), values);
+      reducer.add(at, values);
     });
   }
   reducer.finish_into(tree);
@@ -96,8 +103,10 @@ Tree build_parent(const TileIndex& parent, const std::vector<const Node*>& child
     const auto [ox, oy, oz] = child_offset(parent, *child, depth);
     tree.for_each_node(depth - 2, [&](const Voxel& cell) { keys.push_back(encode(ox + cell.x, oy + cell.y, oz + cell.z)); });
   }
-  Tree tree = build_from_keys(std::move(keys), depth);
-  reduce_children(parent, children, c, tree);
+  radix_sort(keys, nullptr, 6 * depth);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  Tree tree = build_from_sorted_keys(keys, depth);
+  reduce_children(parent, children, c, keys, tree);
   return tree;
 }
 

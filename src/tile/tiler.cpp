@@ -88,13 +88,13 @@ class Bucketer {
         ++outside_;
         continue;
       }
-      Slot& slot = slot_of(t);
-      std::vector<Key>* keys = slot.keys;
-      TileStat* stat = slot.stat;
+      TileBuffers& buffers = *slot_of(t).buffers;
+      std::vector<Key>* keys = &buffers.keys;
+      TileStat* stat = &buffers.stat;
       // The budget counts what the buffers hold, growth included.
       push_counted(*keys, held_, [&] { keys->push_back(key); });
       if (attributes_) {
-        std::vector<std::uint64_t>& records = *slot.records;
+        std::vector<std::uint64_t>& records = buffers.records;
         push_counted(records, held_, [&] {
           records.push_back(key);
           records.push_back(first_sequence + p);
@@ -111,14 +111,16 @@ class Bucketer {
   }
 
   void flush() {
-    for (auto& [tile, keys] : buckets_) {
+    for (auto& [tile, buffers] : tiles_) {
+      std::vector<Key>& keys = buffers.keys;
       if (keys.empty()) continue;
       sort_unique(keys, grid_.depth);
       runs_[tile].push_back(Run{file_id_, file_.append(keys), keys.size()});
       ++run_count_;
       std::vector<Key>().swap(keys);  // give the memory back: the budget counts it
     }
-    for (auto& [tile, records] : records_) {
+    for (auto& [tile, buffers] : tiles_) {
+      std::vector<std::uint64_t>& records = buffers.records;
       if (records.empty()) continue;
       in_sequence_order(records);
       const std::size_t words = 2 + attributes_;
@@ -128,7 +130,11 @@ class Bucketer {
     held_ = 0;
   }
 
-  const StatMap& stats() const noexcept { return stats_; }
+  StatMap stats() const {
+    StatMap out;
+    for (const auto& [tile, buffers] : tiles_) out[tile] = buffers.stat;
+    return out;
+  }
   const RunMap& runs() const noexcept { return runs_; }
   const RunMap& value_runs() const noexcept { return value_runs_; }
   std::uint64_t outside() const noexcept { return outside_; }
@@ -137,17 +143,20 @@ class Bucketer {
  private:
   // A direct-mapped cache in front of the maps: points come from a few tiles at a time,
   // often interleaved, and a map lookup per point would cost more than placing it.
+  struct TileBuffers {
+    std::vector<Key> keys;
+    std::vector<std::uint64_t> records;  // with attributes
+    TileStat stat;
+  };
   struct Slot {
     TileIndex tile;
-    std::vector<Key>* keys = nullptr;
-    std::vector<std::uint64_t>* records = nullptr;
-    TileStat* stat = nullptr;
+    TileBuffers* buffers = nullptr;
   };
   Slot& slot_of(const TileIndex& t) {
     const auto h = (static_cast<std::uint32_t>(t.i) * 0x9E3779B1u) ^ (static_cast<std::uint32_t>(t.j) * 0x85EBCA77u) ^
                    (static_cast<std::uint32_t>(t.k) * 0xC2B2AE3Du);
     Slot& slot = cache_[(h >> 24) & (cache_.size() - 1)];
-    if (!slot.keys || slot.tile != t) slot = Slot{t, &buckets_[t], &records_[t], &stats_[t]};  // map nodes never move
+    if (!slot.buffers || slot.tile != t) slot = Slot{t, &tiles_[t]};  // map nodes never move
     return slot;
   }
   // Records are appended chunk by chunk, and a worker takes chunks in increasing order,
@@ -166,7 +175,7 @@ class Bucketer {
     records.swap(out);
   }
 
-  std::array<Slot, 64> cache_{};
+  std::array<Slot, 256> cache_{};
   const TileGrid& grid_;
   const Locator locator_;
   SpillFile& file_;
@@ -176,9 +185,7 @@ class Bucketer {
   std::size_t attributes_;
   std::uint64_t held_ = 0;  // words the buffers have room for
   std::uint64_t outside_ = 0, run_count_ = 0;
-  std::map<TileIndex, std::vector<Key>> buckets_;
-  std::map<TileIndex, std::vector<std::uint64_t>> records_;
-  StatMap stats_;
+  std::map<TileIndex, TileBuffers> tiles_;
   RunMap runs_, value_runs_;
 };
 
@@ -546,6 +553,13 @@ struct RemovedFolder {
 };
 
 }  // namespace
+
+std::size_t chunk_points_for(const TileOptions& options) {
+  constexpr std::uint64_t kMost = std::uint64_t{1} << 20, kLeast = 4096, kBytesInFlight = 160;
+  if (!options.attributes) return kMost;
+  const std::uint64_t workers = resolve_thread_count(options.threads);
+  return static_cast<std::size_t>(std::clamp<std::uint64_t>(options.memory_budget / 4 / workers / kBytesInFlight, kLeast, kMost));
+}
 
 TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
                        Communicator& comm) {

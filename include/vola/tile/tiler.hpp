@@ -64,6 +64,12 @@ struct TileSummary {
   double seconds_bucket = 0, seconds_exchange = 0, seconds_build = 0, seconds_overviews = 0;
 };
 
+// Points per work unit (a LAS source's chunk) that suit the options: 2^20 for occupancy;
+// with attributes, fewer when the budget is small, so that the chunks being read (about
+// 160 bytes a point in flight with their decoded fields and values) take at most a
+// quarter of it. Any chunking gives the same tiles.
+std::size_t chunk_points_for(const TileOptions& options);
+
 // Throws vola::Error on bad input or when the output cannot be written. Every rank of
 // `comm` must call it with the same sources and options.
 TileSummary make_tiles(const std::vector<const PointSource*>& sources, const TileOptions& options,
