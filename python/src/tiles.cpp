@@ -15,18 +15,25 @@ namespace vola::python {
 namespace {
 
 
-py::object tiles_contain(const vola::tile::TileSet& tiles, const py::handle& input) {
+// One value of type T per world point (M, 3): answer(lookup) for each point's tile lookup,
+// without the GIL; a single point (3,) gives a Python scalar.
+template <class T, class Answer>
+py::object per_point(const vola::tile::TileSet& tiles, const py::handle& input, Answer&& answer) {
   const auto xyz = rows_of_three<double>(input, "points");
   const auto n = xyz.shape(0);
-  py::array_t<bool> out(n);
-  bool* hit = out.mutable_data();
+  py::array_t<T> out(n);
+  T* value = out.mutable_data();
   const double* p = xyz.data();
   {
     py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i < n; ++i, p += 3) hit[i] = tiles.locate(vola::Point{p[0], p[1], p[2]}).rank.has_value();
+    for (py::ssize_t i = 0; i < n; ++i, p += 3) value[i] = answer(tiles.locate(vola::Point{p[0], p[1], p[2]}));
   }
-  if (single_row(input)) return py::bool_(hit[0]);
+  if (single_row(input)) return py::cast(value[0]);
   return std::move(out);
+}
+
+py::object tiles_contain(const vola::tile::TileSet& tiles, const py::handle& input) {
+  return per_point<bool>(tiles, input, [](const vola::tile::TileLookup& hit) { return hit.rank.has_value(); });
 }
 
 // Attribute `name` at each world point's voxel: NaN where no tile has the voxel.
@@ -37,24 +44,12 @@ py::object tiles_values(const vola::tile::TileSet& tiles, const py::handle& inpu
     for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
     throw py::key_error("no attribute '" + name + "' (the tile set has: " + (known.empty() ? "none" : known) + ")");
   }
-  const auto xyz = rows_of_three<double>(input, "points");
-  const auto n = xyz.shape(0);
-  py::array_t<double> out(n);
-  double* value = out.mutable_data();
-  const double* p = xyz.data();
-  {
-    py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i < n; ++i, p += 3) {
-      value[i] = std::numeric_limits<double>::quiet_NaN();
-      const vola::tile::TileLookup hit = tiles.locate(vola::Point{p[0], p[1], p[2]});
-      if (!hit.rank) continue;
-      const vola::AttributeColumn* column = tiles.tree(hit.tile)->attributes().find(name);
-      if (!column) throw vola::FormatError(name, 0, "a tile of the set has no such column, though the index lists it");
-      value[i] = column->get(*hit.rank);
-    }
-  }
-  if (single_row(input)) return py::float_(value[0]);
-  return std::move(out);
+  return per_point<double>(tiles, input, [&](const vola::tile::TileLookup& hit) {
+    if (!hit.rank) return std::numeric_limits<double>::quiet_NaN();
+    const vola::AttributeColumn* column = tiles.tree(hit.tile)->attributes().find(name);
+    if (!column) throw vola::FormatError(name, 0, "a tile of the set has no such column, though the index lists it");
+    return column->get(*hit.rank);
+  });
 }
 
 py::list tile_entries(const vola::tile::TileSet& tiles) {
