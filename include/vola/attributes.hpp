@@ -23,7 +23,16 @@ enum class ValueType : std::uint8_t { u8 = 0, u16, u32, u64, i8, i16, i32, i64, 
 // How several points falling in one voxel become that voxel's value.
 enum class Reduction : std::uint8_t { last = 0, mean, max, min, majority };
 
-std::size_t size_of(ValueType type) noexcept;
+// Bytes of one value (inline: called per value by columns).
+constexpr std::size_t size_of(ValueType type) noexcept {
+  switch (type) {
+    case ValueType::u8: case ValueType::i8: return 1;
+    case ValueType::u16: case ValueType::i16: return 2;
+    case ValueType::u32: case ValueType::i32: case ValueType::f32: return 4;
+    case ValueType::u64: case ValueType::i64: case ValueType::f64: return 8;
+  }
+  return 1;
+}
 // `value` stored at `out` as `type` little-endian bytes: integers rounded to nearest and
 // clamped to the type's range (NaN as 0), as every attribute column stores values.
 void store_value(ValueType type, double value, std::byte* out) noexcept;

@@ -31,15 +31,6 @@ void store(std::byte* p, double value) {
 }
 }  // namespace
 
-std::size_t size_of(ValueType type) noexcept {
-  switch (type) {
-    case ValueType::u8: case ValueType::i8: return 1;
-    case ValueType::u16: case ValueType::i16: return 2;
-    case ValueType::u32: case ValueType::i32: case ValueType::f32: return 4;
-    case ValueType::u64: case ValueType::i64: case ValueType::f64: return 8;
-  }
-  return 1;
-}
 
 std::string_view name_of(ValueType type) noexcept { return kTypeNames[static_cast<int>(type)]; }
 std::string_view name_of(Reduction r) noexcept { return kReductionNames[static_cast<int>(r)]; }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <span>
 
 #include "vola/builder.hpp"
@@ -62,16 +63,17 @@ Tree open_child(const Node& child, const OverviewContext& c) {
 void reduce_children(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c,
                      std::span<const Key> keys, Tree& tree) {
   std::vector<AttributeSpec> specs;
-  {
-    const Tree first = open_child(*children.front(), c);
-    for (const AttributeColumn& column : first.attributes().columns())
-      specs.push_back({column.name(), column.type(), column.reduction()});
-  }
-  if (specs.empty()) return;
-  VoxelReducer reducer(specs, tree.voxel_count());
-  std::vector<double> values(specs.size());
+  std::optional<VoxelReducer> reducer;  // made with the first child's columns
+  std::vector<double> values;
   for (const Node* child : children) {
     const Tree tree_of_child = open_child(*child, c);
+    if (!reducer) {
+      for (const AttributeColumn& column : tree_of_child.attributes().columns())
+        specs.push_back({column.name(), column.type(), column.reduction()});
+      if (specs.empty()) return;
+      reducer.emplace(specs, tree.voxel_count());
+      values.resize(specs.size());
+    }
     std::vector<const AttributeColumn*> columns;
     for (const AttributeSpec& spec : specs) {
       const AttributeColumn* column = tree_of_child.attributes().find(spec.name);
@@ -89,10 +91,10 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
       while (keys[at] < up) ++at;
       for (std::size_t a = 0; a < specs.size(); ++a) values[a] = columns[a]->get(rank);
       ++rank;
-      reducer.add(at, values);
+      reducer->add(at, values);
     });
   }
-  reducer.finish_into(tree);
+  reducer->finish_into(tree);
 }
 
 Tree build_parent(const TileIndex& parent, const std::vector<const Node*>& children, const OverviewContext& c) {

@@ -137,9 +137,16 @@ void merge_records(std::span<const Run> runs, std::span<const SpillFile* const> 
   while (!heap.empty()) {
     const std::size_t i = heap.top().second;
     heap.pop();
+    // Every record of this run below the other runs' next one goes out at once: runs
+    // interleave by whole chunks, not by record, so the heap works once per stretch.
+    const std::uint64_t others = heap.empty() ? ~std::uint64_t{0} : heap.top().first;
     Cursor& c = cursors[i];
-    visit(c.buffer.data() + c.at * words);
-    if (++c.at < c.loaded || refill(c)) heap.emplace(c.buffer[c.at * words + 1], i);
+    bool more = true;
+    do {
+      visit(c.buffer.data() + c.at * words);
+      more = ++c.at < c.loaded || refill(c);
+    } while (more && c.buffer[c.at * words + 1] < others);
+    if (more) heap.emplace(c.buffer[c.at * words + 1], i);
   }
 }
 

@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <unordered_map>
 
 #include "generation.hpp"
 #include "overviews.hpp"
@@ -33,6 +34,7 @@ using detail::SpillFile;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr std::uint64_t kRecordBufferWords = std::uint64_t{8} << 20;  // 64 MiB per worker
 
 struct TileStat {
   std::uint64_t points = 0;
@@ -54,6 +56,13 @@ void sort_unique(std::vector<Key>& keys, int depth) {
   radix_sort(keys, nullptr, 6 * depth);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
+
+struct TileHash {
+  std::size_t operator()(const TileIndex& t) const noexcept {
+    return (static_cast<std::uint32_t>(t.i) * 0x9E3779B1u) ^ (static_cast<std::uint32_t>(t.j) * 0x85EBCA77u) ^
+           (static_cast<std::uint32_t>(t.k) * 0xC2B2AE3Du);
+  }
+};
 
 // Counts what a growing buffer holds room for: `held` grows with its capacity.
 template <class Push>
@@ -153,9 +162,7 @@ class Bucketer {
     TileBuffers* buffers = nullptr;
   };
   Slot& slot_of(const TileIndex& t) {
-    const auto h = (static_cast<std::uint32_t>(t.i) * 0x9E3779B1u) ^ (static_cast<std::uint32_t>(t.j) * 0x85EBCA77u) ^
-                   (static_cast<std::uint32_t>(t.k) * 0xC2B2AE3Du);
-    Slot& slot = cache_[(h >> 24) & (cache_.size() - 1)];
+    Slot& slot = cache_[(TileHash{}(t) >> 24) & (cache_.size() - 1)];
     if (!slot.buffers || slot.tile != t) slot = Slot{t, &tiles_[t]};  // map nodes never move
     return slot;
   }
@@ -185,7 +192,7 @@ class Bucketer {
   std::size_t attributes_;
   std::uint64_t held_ = 0;  // words the buffers have room for
   std::uint64_t outside_ = 0, run_count_ = 0;
-  std::map<TileIndex, TileBuffers> tiles_;
+  std::unordered_map<TileIndex, TileBuffers, TileHash> tiles_;  // nodes never move
   RunMap runs_, value_runs_;
 };
 
@@ -281,7 +288,11 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   const TileGrid& grid = options.grid;
   // Every worker's buffers share 35% of the budget: sorting a buffer needs as much
   // again, and the chunk being read, the maps and the allocator take the rest.
-  const std::uint64_t limit_words = options.memory_budget * 35 / 100 / workers / sizeof(Key);
+  std::uint64_t limit_words = options.memory_budget * 35 / 100 / workers / sizeof(Key);
+  // Attribute records are spilled whole in the end however large the buffers (they are
+  // read back in sequence order, not reduced in memory), so buffers beyond a few tens of
+  // megabytes only save runs; memory is kept for the build.
+  if (!specs.empty()) limit_words = std::min<std::uint64_t>(limit_words, kRecordBufferWords);
   struct SourceChunk {
     const PointSource* source;
     std::uint64_t chunk, global;  // global chunk g -> rank g % ranks
@@ -555,8 +566,8 @@ struct RemovedFolder {
 }  // namespace
 
 std::size_t chunk_points_for(const TileOptions& options) {
-  constexpr std::uint64_t kMost = std::uint64_t{1} << 20, kLeast = 4096, kBytesInFlight = 160;
-  if (!options.attributes) return kMost;
+  constexpr std::uint64_t kMost = std::uint64_t{1} << 18, kLeast = 4096, kBytesInFlight = 160;
+  if (!options.attributes) return std::uint64_t{1} << 20;
   const std::uint64_t workers = resolve_thread_count(options.threads);
   return static_cast<std::size_t>(std::clamp<std::uint64_t>(options.memory_budget / 4 / workers / kBytesInFlight, kLeast, kMost));
 }

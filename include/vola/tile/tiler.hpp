@@ -65,8 +65,8 @@ struct TileSummary {
 };
 
 // Points per work unit (a LAS source's chunk) that suit the options: 2^20 for occupancy;
-// with attributes, fewer when the budget is small, so that the chunks being read (about
-// 160 bytes a point in flight with their decoded fields and values) take at most a
+// with attributes 2^18, or fewer when the budget is small, so that the chunks being read
+// (about 160 bytes a point in flight with their decoded fields and values) take at most a
 // quarter of it. Any chunking gives the same tiles.
 std::size_t chunk_points_for(const TileOptions& options);
 
