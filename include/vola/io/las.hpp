@@ -183,6 +183,10 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
 // chunk (one vector per column, in the same order).
 std::vector<AttributeSpec> las_attributes(const LasHeader& header);
 void las_attribute_values(const LasHeader& header, const LasChunk& chunk, std::vector<std::vector<double>>& values);
+// The same values straight from undecoded point records (LasReader::read_records): those
+// of records[index[j] * record_length] into values[a][j] (resized to index.size()).
+void las_record_attribute_values(const LasHeader& header, const std::uint8_t* records,
+                                 std::span<const std::uint32_t> index, std::vector<std::vector<double>>& values);
 // The reference's payload word per point.
 void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<std::uint64_t>& payloads);
 
