@@ -506,11 +506,14 @@ class RankWalk {
     for (int l = 0; l < depth_; ++l) {
       const Entry* level = level_[l];
       const int shift = 6 * (depth_ - 1 - l);
+      const Entry* below = l + 1 < depth_ ? level_[l + 1] : nullptr;
       for (std::size_t j = 0; j < n; ++j) {
         const Entry& e = level[ranks[j]];
         const unsigned bit = static_cast<unsigned>(keys[j] >> shift) & 63u;
         present &= e.word >> bit;
         ranks[j] = e.before + static_cast<std::uint64_t>(std::popcount(e.word & ((std::uint64_t{1} << bit) - 1)));
+        // The next level's entry, requested now: that level's loop finds it in cache.
+        if (below) __builtin_prefetch(below + ranks[j]);
       }
       if (!(present & 1u)) return false;  // (and later levels would read past a level's words)
     }
