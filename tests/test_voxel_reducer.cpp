@@ -42,27 +42,21 @@ vola::PointCloud random_cloud(std::uint64_t seed, std::size_t n) {
   return cloud;
 }
 
-class VoxelReducerEqualsBuild : public ::testing::TestWithParam<int> {};
-
-TEST_P(VoxelReducerEqualsBuild, BitForBit) {
-  const auto seed = static_cast<std::uint64_t>(GetParam());
-  const vola::PointCloud cloud = random_cloud(seed, 30000);
-  vola::BuildOptions options;
-  options.quantization = vola::Quantization::grid;
-  options.voxel_size = 1.0 + static_cast<double>(seed % 3);  // 1..3: tens to hundreds of points a voxel
+// The reducer over `cloud` (ranks from a tree built on its coordinates, points split
+// into calls of random sizes up to max_call) against vola::build: the same bytes.
+void expect_reducer_equals_build(const vola::PointCloud& cloud, const vola::BuildOptions& options, std::uint64_t seed,
+                                 std::size_t max_call = 2000) {
   const vola::Tree expected = vola::build(cloud, options);
-
-  vola::BuildOptions occupancy = options;
   vola::PointCloud xyz_only;
   xyz_only.xyz = cloud.xyz;
-  vola::Tree got = vola::build(xyz_only, occupancy);
+  vola::Tree got = vola::build(xyz_only, options);
   std::vector<vola::AttributeSpec> specs;
   for (const auto& a : cloud.attributes) specs.push_back({a.name, a.type, a.reduction});
   vola::VoxelReducer reducer(specs, got.voxel_count());
   const vola::Quantizer quantizer = vola::Quantizer::grid(got.frame().origin, got.frame().voxel_size, got.depth());
   std::mt19937_64 rng(seed + 5);
   for (std::size_t at = 0; at < cloud.size();) {
-    const std::size_t n = std::min<std::size_t>(cloud.size() - at, 1 + rng() % 2000);
+    const std::size_t n = std::min<std::size_t>(cloud.size() - at, 1 + rng() % max_call);
     std::vector<std::uint64_t> ranks;
     for (std::size_t i = at; i < at + n; ++i) {
       vola::Voxel v;
@@ -82,8 +76,19 @@ TEST_P(VoxelReducerEqualsBuild, BitForBit) {
     ASSERT_EQ(g.type(), e.type());
     ASSERT_EQ(g.reduction(), e.reduction());
     ASSERT_TRUE(std::equal(g.bytes().begin(), g.bytes().end(), e.bytes().begin(), e.bytes().end()))
-        << "column " << c << " (" << vola::name_of(e.reduction()) << ")";
+        << "column " << c << " " << g.name() << " (" << vola::name_of(e.reduction()) << ")";
   }
+}
+
+class VoxelReducerEqualsBuild : public ::testing::TestWithParam<int> {};
+
+TEST_P(VoxelReducerEqualsBuild, BitForBit) {
+  const auto seed = static_cast<std::uint64_t>(GetParam());
+  const vola::PointCloud cloud = random_cloud(seed, 30000);
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::grid;
+  options.voxel_size = 1.0 + static_cast<double>(seed % 3);  // 1..3: tens to hundreds of points a voxel
+  expect_reducer_equals_build(cloud, options, seed);
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, VoxelReducerEqualsBuild, ::testing::Range(1, 7));
@@ -113,3 +118,88 @@ TEST(VoxelReducer, UnreachedVoxelsAreZero) {
 }
 
 }  // namespace
+
+namespace {
+
+// Integer columns of every reduction whose values fit the narrow slots, the same points
+// in `voxels` voxels of a 2x2x2 grid.
+vola::PointCloud narrow_cloud(std::size_t n, std::uint64_t seed, double value_hi) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coordinate(0.0, 2.0);
+  std::uniform_int_distribution<int> value(0, static_cast<int>(value_hi));
+  vola::PointCloud cloud;
+  const std::vector<std::pair<vola::ValueType, vola::Reduction>> columns = {
+      {vola::ValueType::u16, vola::Reduction::mean},     {vola::ValueType::u8, vola::Reduction::mean},
+      {vola::ValueType::u16, vola::Reduction::max},      {vola::ValueType::u8, vola::Reduction::min},
+      {vola::ValueType::u16, vola::Reduction::last},     {vola::ValueType::u8, vola::Reduction::majority},
+      {vola::ValueType::u16, vola::Reduction::majority}, {vola::ValueType::i32, vola::Reduction::mean}};
+  for (std::size_t c = 0; c < columns.size(); ++c)
+    cloud.attributes.push_back({"n" + std::to_string(c), columns[c].first, columns[c].second, {}});
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
+    for (auto& a : cloud.attributes) {
+      const double hi = a.type == vola::ValueType::u8 ? std::min(value_hi, 255.0) : value_hi;
+      a.values.push_back(std::min<double>(value(rng), hi));
+    }
+  }
+  return cloud;
+}
+
+vola::BuildOptions unit_grid() {
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::grid;
+  options.voxel_size = 1.0;
+  return options;
+}
+
+}  // namespace
+
+// Means of 16-bit values keep 32-bit sums: 70000 points of 65535 in each of 8 voxels
+// carry past 2^32 (the carry table), and the count passes 65536.
+TEST(VoxelReducer, IntegerSumsCarryPastThirtyTwoBits) {
+  vola::PointCloud cloud = narrow_cloud(8 * 70000, 3, 65535);
+  for (auto& a : cloud.attributes)
+    if (a.reduction == vola::Reduction::mean) std::fill(a.values.begin(), a.values.end(), a.type == vola::ValueType::u8 ? 255.0 : 65535.0);
+  cloud.attributes[0].values[12345] = 1.0;  // a mean that is not a whole number
+  expect_reducer_equals_build(cloud, unit_grid(), 3, 50000);
+}
+
+// The same for an f64 mean column of whole numbers (a double sum, no narrow slot) and
+// for a u16 mean whose exact mean is a fraction: only the stored value is rounded.
+TEST(VoxelReducer, IntegerSumEqualsTheDoubleSum) {
+  vola::VoxelReducer narrow({{"m", vola::ValueType::u32, vola::Reduction::mean}}, 1);
+  vola::VoxelReducer wide({{"m", vola::ValueType::f64, vola::Reduction::mean}}, 1);
+  std::vector<std::uint64_t> ranks(70001, 0);
+  std::vector<double> values(70001, 65535.0);
+  values[0] = 2.0;
+  const std::vector<std::span<const double>> columns{values};
+  narrow.add(ranks, columns);
+  wide.add(ranks, columns);
+  const double exact = (70000.0 * 65535.0 + 2.0) / 70001.0;
+  EXPECT_EQ(wide.finish()[0].get(0), exact);
+  EXPECT_EQ(narrow.finish()[0].get(0), std::nearbyint(exact));
+}
+
+// Values that stop fitting the narrow slots part-way (a fraction, a negative number, a
+// value past 255 in a u8 column, NaN): the attribute widens to doubles holding the
+// partials so far, and the result is still build's.
+TEST(VoxelReducer, NarrowSlotsWidenWhenAValueDoesNotFit) {
+  for (const double odd : {2.5, -3.0, 300.0, 70000.0, kNaN}) {
+    SCOPED_TRACE(odd);
+    vola::PointCloud cloud = narrow_cloud(20000, 4, 200);
+    for (auto& a : cloud.attributes) {
+      a.values[9000] = odd;
+      a.values[15000] = odd;
+    }
+    expect_reducer_equals_build(cloud, unit_grid(), 4, 3000);
+  }
+}
+
+// Narrow slots with thousands of points per voxel and many distinct values: majority
+// counts (first value's count derived from the voxel's), max/min/last.
+TEST(VoxelReducer, NarrowSlotsEqualBuild) {
+  for (const double hi : {3.0, 255.0, 65535.0}) {
+    SCOPED_TRACE(hi);
+    expect_reducer_equals_build(narrow_cloud(40000, 5, hi), unit_grid(), 5);
+  }
+}

@@ -44,6 +44,9 @@ std::optional<Reduction> parse_reduction(std::string_view name) noexcept;
 class AttributeColumn {
  public:
   AttributeColumn(std::string name, ValueType type, Reduction reduction, std::size_t count = 0);
+  // A column over values already stored as `type` little-endian bytes (a whole number
+  // of values, else InvalidArgument).
+  AttributeColumn(std::string name, ValueType type, Reduction reduction, std::vector<std::byte> bytes);
 
   const std::string& name() const noexcept { return name_; }
   ValueType type() const noexcept { return type_; }

@@ -1,6 +1,7 @@
 #include "vola/attributes.hpp"
 
 #include "vola/little_endian.hpp"
+#include "store_value.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,18 +17,7 @@ constexpr std::string_view kReductionNames[] = {"last", "mean", "max", "min", "m
 
 template <class T>
 void store(std::byte* p, double value) {
-  T v;
-  if constexpr (std::is_floating_point_v<T>) {
-    v = static_cast<T>(value);
-  } else {
-    // Round to nearest and clamp, so that a mean of integers stays in range.
-    double r = std::isnan(value) ? 0.0 : std::nearbyint(value);
-    r = std::clamp(r, static_cast<double>(std::numeric_limits<T>::lowest()),
-                   static_cast<double>(std::numeric_limits<T>::max()));
-    v = r >= static_cast<double>(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::max()
-                                                                 : static_cast<T>(r);
-  }
-  std::memcpy(p, &v, sizeof(T));
+  detail::store_as<T>(p, value);
 }
 }  // namespace
 
@@ -53,6 +43,14 @@ AttributeColumn::AttributeColumn(std::string name, ValueType type, Reduction red
   if (static_cast<int>(type) > 9) VOLA_THROW(InvalidArgument("attribute " + name_ + ": unknown value type"));
   if (static_cast<int>(reduction) > 4)
     VOLA_THROW(InvalidArgument("attribute " + name_ + ": unknown reduction"));
+}
+
+AttributeColumn::AttributeColumn(std::string name, ValueType type, Reduction reduction, std::vector<std::byte> bytes)
+    : AttributeColumn(std::move(name), type, reduction) {
+  if (bytes.size() % size_of(type) != 0)
+    VOLA_THROW(InvalidArgument("attribute " + name_ + ": " + std::to_string(bytes.size()) + " bytes are not whole " +
+                               std::string(name_of(type)) + " values"));
+  bytes_ = std::move(bytes);
 }
 
 double AttributeColumn::get(std::size_t rank) const {

@@ -1,12 +1,32 @@
+// VoxelReducer: one row of partials per voxel (its point count, then one slot per
+// attribute), so that a point updates one row, usually one cache line: with points in
+// random order, a column per attribute cost a cache miss per attribute and point.
+//
+// Slots are as narrow as exactness allows. A column of integer type whose values are
+// whole numbers in a small range keeps them as such: a mean sums values in [0, 65535]
+// into 32 bits, with a table beside for the rare voxel whose sum carries past 2^32
+// (the sum is exact and below 2^48, so as a double it equals the double sum of
+// vola::build, which is exact too); max, min, last and majority keep a u8 or u16 for
+// u8 and u16 columns whose values fit. Every other slot is a double. The first value
+// that does not fit a narrow slot (a fraction, a negative number, NaN) turns that
+// attribute's slots into doubles for all voxels before it is added, holding the same
+// partials, so results never depend on which slots were narrow.
 #include "vola/voxel_reducer.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <new>
 #include <unordered_map>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 #include "reductions.hpp"
+#include "store_value.hpp"
 #include "vola/error.hpp"
 #include "vola/tree.hpp"
 
@@ -15,51 +35,221 @@ VOLA_INLINE_NAMESPACE_BEGIN
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// How one attribute's partial is kept in a row.
+enum class Slot : std::uint8_t {
+  f64,       // double: the sum (mean), the value (max, min, last), the first value (majority)
+  sum_u32,   // mean of whole numbers in [0, 65535]: the sum's low 32 bits (carries beside)
+  small_u8,  // max, min, last, majority of whole numbers in [0, 255]
+  small_u16  // the same in [0, 65535]
+};
 
-// Majority partials: each voxel's first value and its count in place; the values of a
-// voxel that differ from its first are counted in a table beside, by (rank, value), so
-// that memory follows distinct values per voxel, not points (most voxels hold one).
-struct MajorityPartial {
-  std::vector<double> first;
-  std::vector<std::uint32_t> first_count;
-  struct PairKey {
-    std::uint64_t rank, bits;
-    bool operator==(const PairKey&) const = default;
-  };
-  struct PairHash {
-    std::size_t operator()(const PairKey& k) const noexcept {
-      return static_cast<std::size_t>((k.rank * 0x9E3779B97F4A7C15ull) ^ (k.bits * 0xC2B2AE3D27D4EB4Full));
-    }
-  };
-  std::unordered_map<PairKey, std::uint32_t, PairHash> others;
-
-  static std::uint64_t bits_of(double v) noexcept {
-    return std::isnan(v) ? 0x7FF8000000000000ull : std::bit_cast<std::uint64_t>(v == 0.0 ? 0.0 : v);  // -0 is 0
+std::size_t slot_bytes(Slot s) noexcept {
+  switch (s) {
+    case Slot::f64: return 8;
+    case Slot::sum_u32: return 4;
+    case Slot::small_u16: return 2;
+    default: return 1;
   }
-  void add(std::uint64_t rank, double v) {
-    if (first_count[rank] == 0) {
-      first[rank] = v;
-      first_count[rank] = 1;
-    } else if (detail::same_value(first[rank], v)) {
-      ++first_count[rank];
-    } else {
-      ++others[PairKey{rank, bits_of(v)}];
+}
+
+// The narrow slot an attribute starts with (it may widen to f64 later).
+Slot initial_slot(const AttributeSpec& spec) noexcept {
+  const ValueType t = spec.type;
+  const bool integer = t != ValueType::f32 && t != ValueType::f64;
+  if (spec.reduction == Reduction::mean) return integer ? Slot::sum_u32 : Slot::f64;
+  if (t == ValueType::u8) return Slot::small_u8;
+  if (t == ValueType::u16) return Slot::small_u16;
+  return Slot::f64;
+}
+
+// Whether every value is a whole number in [0, hi] (NaN is not).
+bool all_whole(const double* v, std::size_t n, double hi) noexcept {
+  bool ok = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = v[i];
+    const bool in = x >= 0.0 && x <= hi;
+    ok &= in && static_cast<double>(static_cast<std::uint32_t>(in ? x : 0.0)) == x;
+  }
+  return ok;
+}
+
+bool fits(Slot s, const double* v, std::size_t n) noexcept {
+  switch (s) {
+    case Slot::sum_u32:
+    case Slot::small_u16: return all_whole(v, n, 65535.0);
+    case Slot::small_u8: return all_whole(v, n, 255.0);
+    default: return true;
+  }
+}
+
+template <class T>
+T load(const std::byte* p) noexcept {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <class T>
+void put(std::byte* p, T v) noexcept {
+  std::memcpy(p, &v, sizeof v);
+}
+
+// Zeroed memory for the rows: fresh anonymous pages (zero without being written),
+// advised as transparent huge pages where the system has them (a page fault per 4 KiB
+// of a few hundred megabytes touched at random was a large part of the time, and the
+// random row accesses miss the TLB far less), and released from the front while
+// finish() reads them in order.
+class RowMemory {
+ public:
+  static constexpr std::size_t kHuge = std::size_t{2} << 20;
+  RowMemory() = default;
+  explicit RowMemory(std::size_t bytes) : bytes_((bytes + kHuge - 1) / kHuge * kHuge) {
+    if (bytes_ == 0) return;
+#if defined(__linux__)
+    void* p = ::mmap(nullptr, bytes_ + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    map_ = static_cast<std::byte*>(p);
+    // Start on a huge-page boundary; the pages before it are never touched.
+    data_ = reinterpret_cast<std::byte*>((reinterpret_cast<std::uintptr_t>(map_) + kHuge - 1) / kHuge * kHuge);
+#ifdef MADV_HUGEPAGE
+    ::madvise(data_, bytes_, MADV_HUGEPAGE);
+#endif
+#else
+    map_ = static_cast<std::byte*>(::operator new(bytes_, std::align_val_t{64}));
+    std::memset(map_, 0, bytes_);
+    data_ = map_;
+#endif
+  }
+  ~RowMemory() { reset(); }
+  RowMemory(RowMemory&& o) noexcept { *this = std::move(o); }
+  RowMemory& operator=(RowMemory&& o) noexcept {
+    if (this != &o) {
+      reset();
+      std::swap(map_, o.map_);
+      std::swap(data_, o.data_);
+      std::swap(bytes_, o.bytes_);
+      std::swap(released_, o.released_);
     }
+    return *this;
+  }
+  std::byte* data() const noexcept { return data_; }
+  std::size_t resident_bound() const noexcept { return bytes_ - released_; }
+  // The pages wholly before byte `end` are not read again: give them back.
+  void release_before(std::size_t end) noexcept {
+#if defined(__linux__)
+    const std::size_t upto = end / kHuge * kHuge;
+    if (upto > released_) {
+      ::madvise(data_ + released_, upto - released_, MADV_DONTNEED);
+      released_ = upto;
+    }
+#else
+    (void)end;
+#endif
+  }
+  void reset() noexcept {
+    if (!map_) return;
+#if defined(__linux__)
+    ::munmap(map_, bytes_ + kHuge);
+#else
+    ::operator delete(map_, std::align_val_t{64});
+#endif
+    map_ = data_ = nullptr;
+    bytes_ = released_ = 0;
+  }
+
+ private:
+  std::byte* map_ = nullptr;
+  std::byte* data_ = nullptr;
+  std::size_t bytes_ = 0, released_ = 0;
+};
+
+struct PairKey {
+  std::uint64_t rank, bits;
+  bool operator==(const PairKey&) const = default;
+};
+struct PairHash {
+  std::size_t operator()(const PairKey& k) const noexcept {
+    return static_cast<std::size_t>((k.rank * 0x9E3779B97F4A7C15ull) ^ (k.bits * 0xC2B2AE3D27D4EB4Full));
   }
 };
 
+std::uint64_t bits_of(double v) noexcept {
+  return std::isnan(v) ? 0x7FF8000000000000ull : std::bit_cast<std::uint64_t>(v == 0.0 ? 0.0 : v);  // -0 is 0
+}
+
 }  // namespace
 
+// Row: the voxel's point count (u32) at offset 0, then each attribute's slot at its
+// offset. Majority keeps the voxel's first value in the row and counts the values that
+// differ from it in `others`, by (rank, value): memory follows distinct values per
+// voxel, not points (most voxels hold one); the first value's count is the voxel's
+// points minus the others'.
 struct VoxelReducer::State {
   std::vector<AttributeSpec> specs;
   std::uint64_t voxels = 0;
-  std::vector<std::uint32_t> points;       // per voxel
-  std::vector<std::vector<double>> value;  // per attribute but majority: sum or value per voxel
-  std::vector<MajorityPartial> majority;   // per attribute (used by majority ones only)
+  std::vector<Slot> slot;
+  std::vector<std::size_t> offset;
+  std::size_t stride = 0;
+  RowMemory rows;
+  std::vector<std::unordered_map<std::uint64_t, std::uint32_t>> carries;  // sum_u32: rank -> carries past 2^32
+  std::vector<std::unordered_map<PairKey, std::uint32_t, PairHash>> others;  // majority
   // Points added one at a time, reduced in batches.
   std::vector<std::uint64_t> pending_ranks;
   std::vector<std::vector<double>> pending_values;
+
+  void layout() {
+    // The count at offset 0, then the doubles (unaligned loads cost nothing extra on
+    // x86-64), then the narrow slots, widest first.
+    offset.assign(specs.size(), 0);
+    std::size_t next = 4;
+    for (const std::size_t width : {8, 4, 2, 1})
+      for (std::size_t a = 0; a < specs.size(); ++a)
+        if (slot_bytes(slot[a]) == width) offset[a] = next, next += width;
+    stride = next;
+  }
+
+  double slot_value(const std::byte* row, std::size_t a, std::uint64_t rank) const {
+    switch (slot[a]) {
+      case Slot::f64: return load<double>(row + offset[a]);
+      case Slot::sum_u32: {
+        std::uint64_t sum = load<std::uint32_t>(row + offset[a]);
+        if (!carries[a].empty()) {
+          const auto it = carries[a].find(rank);
+          if (it != carries[a].end()) sum += std::uint64_t{it->second} << 32;
+        }
+        return static_cast<double>(sum);  // below 2^48: exact
+      }
+      case Slot::small_u16: return load<std::uint16_t>(row + offset[a]);
+      default: return static_cast<double>(load<std::uint8_t>(row + offset[a]));
+    }
+  }
+
+  // Attribute a's slots become doubles holding the same partials (voxels without points
+  // keep zero bytes: their slots are written before they are read).
+  void widen(std::size_t a) {
+    State next;
+    next.specs = specs;
+    next.voxels = voxels;
+    next.slot = slot;
+    next.slot[a] = Slot::f64;
+    next.layout();
+    next.rows = RowMemory(next.stride * voxels);
+    for (std::uint64_t v = 0; v < voxels; ++v) {
+      const std::byte* from = rows.data() + v * stride;
+      std::byte* to = next.rows.data() + v * next.stride;
+      const std::uint32_t count = load<std::uint32_t>(from);
+      if (count == 0) continue;
+      put(to, count);
+      for (std::size_t b = 0; b < specs.size(); ++b) {
+        if (b == a) put(to + next.offset[b], slot_value(from, b, v));
+        else std::memcpy(to + next.offset[b], from + offset[b], slot_bytes(slot[b]));
+      }
+    }
+    slot = std::move(next.slot);
+    offset = std::move(next.offset);
+    stride = next.stride;
+    rows = std::move(next.rows);
+    carries[a].clear();
+  }
 };
 
 VoxelReducer::VoxelReducer(std::vector<AttributeSpec> specs, std::uint64_t voxels) : state_(std::make_unique<State>()) {
@@ -67,20 +257,11 @@ VoxelReducer::VoxelReducer(std::vector<AttributeSpec> specs, std::uint64_t voxel
   s.specs = std::move(specs);
   s.voxels = voxels;
   if (s.specs.empty()) return;
-  s.points.assign(voxels, 0);
-  s.value.resize(s.specs.size());
-  s.majority.resize(s.specs.size());
-  for (std::size_t a = 0; a < s.specs.size(); ++a) {
-    switch (s.specs[a].reduction) {
-      case Reduction::majority:
-        s.majority[a].first.assign(voxels, 0.0);
-        s.majority[a].first_count.assign(voxels, 0);
-        break;
-      case Reduction::max:
-      case Reduction::min: s.value[a].assign(voxels, kNaN); break;  // fmax/fmin(NaN, v) = v
-      default: s.value[a].assign(voxels, 0.0); break;
-    }
-  }
+  for (const AttributeSpec& spec : s.specs) s.slot.push_back(initial_slot(spec));
+  s.layout();
+  s.rows = RowMemory(s.stride * voxels);
+  s.carries.resize(s.specs.size());
+  s.others.resize(s.specs.size());
 }
 VoxelReducer::~VoxelReducer() = default;
 VoxelReducer::VoxelReducer(VoxelReducer&&) noexcept = default;
@@ -90,12 +271,50 @@ std::uint64_t VoxelReducer::voxels() const noexcept { return state_->voxels; }
 
 std::size_t VoxelReducer::memory_bytes() const noexcept {
   const State& s = *state_;
-  std::size_t bytes = s.points.capacity() * 4;
-  for (const auto& v : s.value) bytes += v.capacity() * 8;
-  for (const auto& m : s.majority)
-    bytes += m.first.capacity() * 8 + m.first_count.capacity() * 4 + m.others.size() * 40 + m.others.bucket_count() * 8;
+  std::size_t bytes = s.rows.resident_bound();
+  for (const auto& c : s.carries) bytes += c.size() * 32 + c.bucket_count() * 8;
+  for (const auto& m : s.others) bytes += m.size() * 40 + m.bucket_count() * 8;
   return bytes;
 }
+
+namespace {
+
+// One point's update of one slot; `first`: the voxel had no point before.
+template <Reduction R>
+inline void update_f64(std::byte* p, double v, bool first) noexcept {
+  if (first) return put(p, v);
+  put(p, detail::combine<R>(load<double>(p), v));
+}
+
+template <class T, Reduction R>
+inline void update_small(std::byte* p, double v, bool first) noexcept {
+  const T x = static_cast<T>(v);
+  if (first) return put(p, x);
+  const T old = load<T>(p);
+  if constexpr (R == Reduction::max) put(p, std::max(old, x));
+  else if constexpr (R == Reduction::min) put(p, std::min(old, x));
+  else put(p, x);  // last
+}
+
+// What one attribute does per point, resolved once per call.
+enum class Op : std::uint8_t {
+  f64_mean, f64_max, f64_min, f64_last, f64_majority,
+  u32_sum,
+  u8_max, u8_min, u8_last, u8_majority,
+  u16_max, u16_min, u16_last, u16_majority
+};
+
+Op op_of(Slot s, Reduction r) noexcept {
+  const int k = r == Reduction::max ? 1 : r == Reduction::min ? 2 : r == Reduction::last ? 3 : r == Reduction::majority ? 4 : 0;
+  switch (s) {
+    case Slot::f64: return static_cast<Op>(static_cast<int>(Op::f64_mean) + k);
+    case Slot::sum_u32: return Op::u32_sum;
+    case Slot::small_u8: return static_cast<Op>(static_cast<int>(Op::u8_max) + k - 1);
+    default: return static_cast<Op>(static_cast<int>(Op::u16_max) + k - 1);
+  }
+}
+
+}  // namespace
 
 void VoxelReducer::add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values) {
   flush_pending();
@@ -105,7 +324,7 @@ void VoxelReducer::add(std::span<const std::uint64_t> ranks, std::span<const std
 void VoxelReducer::flush_pending() {
   State& s = *state_;
   if (s.pending_ranks.empty()) return;
-  std::vector<std::span<const double>> values(s.pending_values.begin(), s.pending_values.end());
+  const std::vector<std::span<const double>> values(s.pending_values.begin(), s.pending_values.end());
   add_now(s.pending_ranks, values);
   s.pending_ranks.clear();
   for (auto& v : s.pending_values) v.clear();
@@ -120,26 +339,95 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
     if (v.size() != ranks.size())
       VOLA_THROW(InvalidArgument("voxel reducer: an attribute array's length differs from the ranks'"));
   if (s.specs.empty()) return;
-  for (const std::uint64_t r : ranks)
-    if (r >= s.voxels)
-      VOLA_THROW(InvalidArgument("voxel reducer: rank " + std::to_string(r) + " of " + std::to_string(s.voxels) +
-                                 " voxels"));
-  for (const std::uint64_t r : ranks) ++s.points[r];
-  // Attribute by attribute, each a tight loop over the points.
-  for (std::size_t a = 0; a < s.specs.size(); ++a) {
-    const double* in = values[a].data();
-    if (s.specs[a].reduction == Reduction::majority) {
-      for (std::size_t i = 0; i < ranks.size(); ++i) s.majority[a].add(ranks[i], in[i]);
-      continue;
+  std::uint64_t highest = 0;
+  for (const std::uint64_t r : ranks) highest = std::max(highest, r);
+  if (!ranks.empty() && highest >= s.voxels)
+    VOLA_THROW(InvalidArgument("voxel reducer: rank " + std::to_string(highest) + " of " + std::to_string(s.voxels) +
+                               " voxels"));
+  // A value a narrow slot cannot hold widens the attribute first (before any count of
+  // this call is taken, so the widened partials are those of the earlier points).
+  for (std::size_t a = 0; a < s.specs.size(); ++a)
+    if (s.slot[a] != Slot::f64 && !fits(s.slot[a], values[a].data(), ranks.size())) s.widen(a);
+
+  struct Column {
+    Op op;
+    std::uint32_t offset;
+    const double* in;
+  };
+  Column columns[64];
+  std::vector<Column> many;
+  Column* cols = columns;
+  const std::size_t na = s.specs.size();
+  if (na > 64) {
+    many.resize(na);
+    cols = many.data();
+  }
+  for (std::size_t a = 0; a < na; ++a)
+    cols[a] = {op_of(s.slot[a], s.specs[a].reduction), static_cast<std::uint32_t>(s.offset[a]), values[a].data()};
+
+  std::byte* const base = s.rows.data();
+  const std::size_t stride = s.stride, n = ranks.size();
+  constexpr std::size_t kAhead = 12;  // rows requested this many points ahead
+  for (std::size_t i = 0; i < std::min(n, kAhead); ++i) {
+    __builtin_prefetch(base + ranks[i] * stride, 1);
+    __builtin_prefetch(base + ranks[i] * stride + stride - 1, 1);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + kAhead < n) {
+      const std::byte* ahead = base + ranks[i + kAhead] * stride;
+      __builtin_prefetch(ahead, 1);
+      __builtin_prefetch(ahead + stride - 1, 1);
     }
-    double* partial = s.value[a].data();
-    detail::with_reduction(s.specs[a].reduction, [&](auto r) {
-      constexpr Reduction R = decltype(r)::value;
-      for (std::size_t i = 0; i < ranks.size(); ++i) {
-        double& p = partial[ranks[i]];
-        p = detail::combine<R>(p, in[i]);
+    const std::uint64_t rank = ranks[i];
+    std::byte* row = base + rank * stride;
+    const std::uint32_t count = load<std::uint32_t>(row);
+    const bool first = count == 0;
+    for (std::size_t a = 0; a < na; ++a) {
+      const Column& c = cols[a];
+      std::byte* p = row + c.offset;
+      const double v = c.in[i];
+      switch (c.op) {
+        case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
+        case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
+        case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
+        case Op::f64_last: put(p, v); break;
+        case Op::f64_majority: {
+          if (first) put(p, v);
+          else if (const double f = load<double>(p); !detail::same_value(f, v)) ++s.others[a][PairKey{rank, bits_of(v)}];
+          break;
+        }
+        case Op::u32_sum: {
+          const std::uint32_t x = static_cast<std::uint32_t>(v);
+          if (first) {
+            put(p, x);
+          } else {
+            const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
+            put(p, sum);
+            if (sum < old) ++s.carries[a][rank];
+          }
+          break;
+        }
+        case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
+        case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
+        case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
+        case Op::u8_majority: {
+          const auto x = static_cast<std::uint8_t>(v);
+          if (first) put(p, x);
+          else if (load<std::uint8_t>(p) != x) ++s.others[a][PairKey{rank, bits_of(v)}];
+          break;
+        }
+        case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
+        case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
+        case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
+        case Op::u16_majority: {
+          const auto x = static_cast<std::uint16_t>(v);
+          if (first) put(p, x);
+          else if (load<std::uint16_t>(p) != x) ++s.others[a][PairKey{rank, bits_of(v)}];
+          break;
+        }
       }
-    });
+    }
+    put(row, count + 1);
   }
 }
 
@@ -158,39 +446,68 @@ void VoxelReducer::add(std::uint64_t rank, std::span<const double> values) {
 std::vector<AttributeColumn> VoxelReducer::finish() {
   flush_pending();
   State& s = *state_;
-  std::vector<AttributeColumn> columns;
-  for (std::size_t a = 0; a < s.specs.size(); ++a) {
-    const AttributeSpec& spec = s.specs[a];
-    AttributeColumn column(spec.name, spec.type, spec.reduction, s.voxels);
-    if (spec.reduction == Reduction::majority) {
-      MajorityPartial& m = s.majority[a];
-      // The other values per voxel, in rank order, to compare with each first value.
-      std::vector<std::pair<MajorityPartial::PairKey, std::uint32_t>> others(m.others.begin(), m.others.end());
-      m.others = {};
-      std::sort(others.begin(), others.end(), [](const auto& x, const auto& y) { return x.first.rank < y.first.rank; });
-      std::size_t at = 0;
-      for (std::uint64_t v = 0; v < s.voxels; ++v) {
-        double best = m.first[v];
-        std::uint32_t best_count = m.first_count[v];
-        for (; at < others.size() && others[at].first.rank == v; ++at) {
-          const double value = std::bit_cast<double>(others[at].first.bits);
-          const std::uint32_t count = others[at].second;
-          if (count > best_count || (count == best_count && detail::value_before(value, best)))
-            best = value, best_count = count;
-        }
-        column.set(v, detail::canonical_value(best));  // 0 where no point came: first is 0
-      }
-      m = MajorityPartial{};
-    } else {
-      const std::vector<double>& partial = s.value[a];
-      for (std::uint64_t v = 0; v < s.voxels; ++v)
-        column.set(v, s.points[v] == 0 ? 0.0 : detail::finish(spec.reduction, partial[v], s.points[v]));
-      s.value[a] = {};
-    }
-    columns.push_back(std::move(column));
+  const std::size_t na = s.specs.size();
+  // Majority: the other values per voxel, in rank order, to compare with each first value.
+  struct Other {
+    std::uint64_t rank, bits;
+    std::uint32_t count;
+  };
+  std::vector<std::vector<Other>> others(na);
+  for (std::size_t a = 0; a < na; ++a) {
+    others[a].reserve(s.others[a].size());
+    for (const auto& [key, count] : s.others[a]) others[a].push_back({key.rank, key.bits, count});
+    s.others[a] = {};
+    std::sort(others[a].begin(), others[a].end(), [](const Other& x, const Other& y) { return x.rank < y.rank; });
   }
-  s.points = {};
-  s.pending_values = {};
+  // Column bytes grow as the rows are read in order, and the rows read are released:
+  // the partials and the columns are not both whole in memory at once.
+  std::vector<std::vector<std::byte>> bytes(na);
+  std::vector<std::size_t> at(na, 0);
+  constexpr std::uint64_t kBlock = 1 << 16;
+  for (std::uint64_t first = 0; first < s.voxels; first += kBlock) {
+    const std::uint64_t last = std::min(s.voxels, first + kBlock);
+    for (std::size_t a = 0; a < na; ++a) {
+      const AttributeSpec& spec = s.specs[a];
+      std::vector<std::byte>& out = bytes[a];
+      const std::size_t size = size_of(spec.type);
+      if (first == 0) out.reserve(static_cast<std::size_t>(s.voxels) * size);  // address space only
+      out.resize(static_cast<std::size_t>(last) * size);
+      detail::with_value_type(spec.type, [&](auto zero) {
+        using T = decltype(zero);
+        for (std::uint64_t v = first; v < last; ++v) {
+          const std::byte* row = s.rows.data() + v * s.stride;
+          const std::uint32_t count = load<std::uint32_t>(row);
+          double value = 0.0;  // where no point came
+          if (count != 0) {
+            const double partial = s.slot_value(row, a, v);
+            if (spec.reduction == Reduction::majority) {
+              double best = partial;
+              std::uint32_t best_count = count;
+              const std::vector<Other>& o = others[a];
+              std::size_t k = at[a];
+              for (std::size_t j = k; j < o.size() && o[j].rank == v; ++j) best_count -= o[j].count;
+              for (; k < o.size() && o[k].rank == v; ++k) {
+                const double x = std::bit_cast<double>(o[k].bits);
+                if (o[k].count > best_count || (o[k].count == best_count && detail::value_before(x, best)))
+                  best = x, best_count = o[k].count;
+              }
+              at[a] = k;
+              value = detail::canonical_value(best);
+            } else {
+              value = detail::finish(spec.reduction, partial, count);
+            }
+          }
+          detail::store_as<T>(out.data() + v * sizeof(T), value);
+        }
+      });
+    }
+    s.rows.release_before(static_cast<std::size_t>(last) * s.stride);
+  }
+  std::vector<AttributeColumn> columns;
+  for (std::size_t a = 0; a < na; ++a)
+    columns.emplace_back(s.specs[a].name, s.specs[a].type, s.specs[a].reduction, std::move(bytes[a]));
+  s.rows.reset();
+  s.carries.assign(na, {});
   s.voxels = 0;
   return columns;
 }

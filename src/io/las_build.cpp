@@ -1,15 +1,25 @@
 // The streaming LAS conversion (build_las): chunks of records into a StreamBuilder, keys
 // straight from the stored integers where the grid allows, the points' bounds without
-// decoding a coordinate, and one pass instead of two when the header's box can be trusted.
+// decoding a coordinate, and one pass instead of two when the header's box can be
+// trusted. Attribute columns: that occupancy tree first, then one more pass over the
+// records that reduces each point into its voxel's partials in place (VoxelReducer).
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <optional>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "vola/error.hpp"
 #include "vola/io/las.hpp"
 #include "vola/little_endian.hpp"
 #include "vola/stream_builder.hpp"
+#include "vola/voxel_reducer.hpp"
 
 namespace vola::io {
 
@@ -310,7 +320,7 @@ Box decoded_box(const LasHeader& hd, const std::int32_t lo[3], const std::int32_
 std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions& options, BuildReport* report,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                                           std::size_t chunk_points, std::optional<Box>& bounds, std::int32_t lo[3],
-                                          std::int32_t hi[3]) {
+                                          std::int32_t hi[3], std::optional<Quantizer>& used) {
   const LasHeader& hd = reader.header();
   if (reader.points_total() == 0) return std::nullopt;
   const Box header_box{hd.min, hd.max};
@@ -353,6 +363,7 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions&
     bounds = box;
     return std::nullopt;
   }
+  used = quantizer;
   return finish_tree(builder, box, options.epsg, report);
 }
 
@@ -378,8 +389,16 @@ void skip_copc_nodes_outside_the_grid(LasReader& reader, const BuildOptions& req
 
 }  // namespace
 
-Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload, BuildReport* report,
-               const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
+namespace {
+
+// The tree through a StreamBuilder: occupancy (keys from the stored integers where the
+// grid allows), or with attribute columns and payloads reduced per chunk and merged
+// (the path of payloads). `used` gets the grid the keys were made on and stored_lo/hi
+// a range holding every stored integer (the points' own when a pass saw them).
+Tree build_streamed(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload,
+                    BuildReport* report, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                    std::size_t chunk_points, std::optional<Quantizer>& used, std::int32_t stored_lo[3],
+                    std::int32_t stored_hi[3]) {
   BuildOptions options = requested;  // the bbox is filled in from the points when not given
   const LasHeader& hd = reader.header();
   skip_copc_nodes_outside_the_grid(reader, requested);
@@ -388,7 +407,6 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   // Keys are 8 bytes a point; decoded coordinates (the path without key tables) 24.
   const std::size_t decoded_chunk = chunk_points == 0 ? kLasChunkPoints : chunk_points;
   if (chunk_points == 0) chunk_points = occupancy_only ? kLasKeyChunkPoints : kLasChunkPoints;
-  std::int32_t stored_lo[3], stored_hi[3];
   for (int a = 0; a < 3; ++a) {
     stored_lo[a] = std::numeric_limits<std::int32_t>::min();
     stored_hi[a] = std::numeric_limits<std::int32_t>::max();
@@ -396,8 +414,12 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   if (occupancy_only && !options.bbox) {
     std::optional<Box> bounds;
     std::int32_t lo[3], hi[3];
-    if (std::optional<Tree> tree = occupancy_in_one_pass(reader, options, report, progress, chunk_points, bounds, lo, hi))
+    if (std::optional<Tree> tree =
+            occupancy_in_one_pass(reader, options, report, progress, chunk_points, bounds, lo, hi, used)) {
+      std::copy(lo, lo + 3, stored_lo);
+      std::copy(hi, hi + 3, stored_hi);
       return std::move(*tree);
+    }
     if (bounds) {  // the pass above took the points' bounds: only the second pass is left
       options.bbox = bounds;
       std::copy(lo, lo + 3, stored_lo);
@@ -413,6 +435,7 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
     });
   }
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
+  used = quantizer;
   std::vector<AttributeSpec> specs = attributes ? las_attributes(hd) : std::vector<AttributeSpec>{};
   StreamBuilder builder(quantizer, specs, payload);
   if (!occupancy_only) builder.expect_points(reader.points_total());
@@ -451,6 +474,179 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   payloads = {};
   xyz = {};
   return finish_tree(builder, *options.bbox, options.epsg, report);
+}
+
+// Rank of voxel keys in a tree: per level, each word with the number of set bits before
+// it, side by side (one cache line per level and key, not two), on transparent huge
+// pages (a random walk over tens of megabytes of 4 KiB pages missed the TLB at every
+// level). A batch of keys is walked a level at a time: the loads of one level are
+// independent, so their cache misses overlap (the points of a survey come in no
+// spatial order).
+class RankWalk {
+ public:
+  explicit RankWalk(const Tree& tree) : depth_(tree.depth()) {
+    std::size_t total = 0;
+    for (int l = 0; l < depth_; ++l) total += tree.occupancy(l).size();
+    entries_ = Entries(total);
+    Entry* e = entries_.data();
+    for (int l = 0; l < depth_; ++l) {
+      const std::span<const std::uint64_t> words = tree.occupancy(l);
+      level_[l] = e;
+      std::uint64_t count = 0;
+      for (const std::uint64_t w : words) {
+        *e++ = Entry{w, count};
+        count += static_cast<std::uint64_t>(std::popcount(w));
+      }
+    }
+  }
+  // ranks[j]: the rank of keys[j]'s voxel. False when a voxel is not in the tree.
+  bool operator()(const Key* keys, std::size_t n, std::uint64_t* ranks) const noexcept {
+    std::fill(ranks, ranks + n, 0);
+    std::uint64_t present = 1;
+    for (int l = 0; l < depth_; ++l) {
+      const Entry* level = level_[l];
+      const int shift = 6 * (depth_ - 1 - l);
+      const Entry* below = l + 1 < depth_ ? level_[l + 1] : nullptr;
+      for (std::size_t j = 0; j < n; ++j) {
+        const Entry& e = level[ranks[j]];
+        const unsigned bit = static_cast<unsigned>(keys[j] >> shift) & 63u;
+        present &= e.word >> bit;
+        ranks[j] = e.before + static_cast<std::uint64_t>(std::popcount(e.word & ((std::uint64_t{1} << bit) - 1)));
+        // The next level's entry, requested now: that level's loop finds it in cache.
+        if (below) __builtin_prefetch(below + ranks[j]);
+      }
+      if (!(present & 1u)) return false;  // (and later levels would read past a level's words)
+    }
+    return true;
+  }
+
+ private:
+  struct alignas(16) Entry {
+    std::uint64_t word, before;
+  };
+  // Entries on 2 MiB-aligned memory advised as huge pages (Linux).
+  class Entries {
+   public:
+    Entries() = default;
+    explicit Entries(std::size_t n) : bytes_((n * sizeof(Entry) + kHuge - 1) / kHuge * kHuge) {
+      if (n == 0) return;
+      data_ = static_cast<Entry*>(::operator new(bytes_, std::align_val_t{kHuge}));
+#ifdef MADV_HUGEPAGE
+      ::madvise(data_, bytes_, MADV_HUGEPAGE);
+#endif
+    }
+    ~Entries() {
+      if (data_) ::operator delete(data_, std::align_val_t{kHuge});
+    }
+    Entries(const Entries&) = delete;
+    Entries& operator=(Entries&& o) noexcept {
+      std::swap(data_, o.data_);
+      std::swap(bytes_, o.bytes_);
+      return *this;
+    }
+    Entry* data() const noexcept { return data_; }
+
+   private:
+    static constexpr std::size_t kHuge = std::size_t{2} << 20;
+    Entry* data_ = nullptr;
+    std::size_t bytes_ = 0;
+  };
+  int depth_;
+  Entries entries_;
+  std::array<const Entry*, kMaxDepth> level_{};
+};
+
+// The second pass: every record again, its voxel's rank in the tree of the first, and
+// its attribute values straight from the record bytes into a VoxelReducer, which
+// updates each voxel's partials in place. Points fold in input order: the columns are
+// vola::build's over the same points, bit for bit.
+void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std::int32_t stored_lo[3],
+                       const std::int32_t stored_hi[3], Tree& tree,
+                       const std::function<void(std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  VoxelReducer reducer(las_attributes(hd), tree.voxel_count());
+  AxisCells cells[3];
+  bool by_table = reader.points_total() > 0;
+  for (int a = 0; a < 3 && by_table; ++a) by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
+  const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
+  const RankWalk walk(tree);
+  const std::size_t length = hd.record_length, batch = batch_points(hd);
+  // Ranks are walked in groups whose words and counts stay in L1/L2 between levels.
+  constexpr std::size_t kGroup = 512;
+  std::vector<Key> keys;
+  std::vector<std::uint32_t> index;
+  std::vector<std::uint64_t> ranks;
+  std::vector<double> xyz;
+  std::vector<std::vector<double>> values;
+  std::vector<std::span<const double>> views;
+  std::uint64_t reported = 0;
+  reader.rewind();
+  while (true) {
+    const std::span<const std::uint8_t> records = reader.read_records(batch);
+    const std::size_t m = records.size() / length;
+    if (m == 0) break;
+    keys.clear();
+    index.clear();
+    if (by_table) {
+      keys.resize(m);
+      index.resize(m);
+      std::size_t kept = 0;
+      const std::uint8_t* r = records.data();
+      for (std::size_t i = 0; i < m; ++i, r += length) {
+        const Key key = kx(load_le<std::int32_t>(r)) | ky(load_le<std::int32_t>(r + 4)) | kz(load_le<std::int32_t>(r + 8));
+        keys[kept] = key;
+        index[kept] = static_cast<std::uint32_t>(i);
+        kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+      }
+      keys.resize(kept);
+      index.resize(kept);
+    } else {
+      xyz.clear();
+      decode_xyz(hd, records, xyz);
+      quantizer.to_keys(xyz, keys, &index);
+    }
+    const std::size_t kept = keys.size();
+    ranks.resize(kept);
+    for (std::size_t at = 0; at < kept; at += kGroup)
+      if (!walk(keys.data() + at, std::min(kGroup, kept - at), ranks.data() + at))
+        VOLA_THROW(Error("LAS attributes: a point's voxel is not in the tree of the first pass (" + reader.path() + ")"));
+    las_record_attribute_values(hd, records.data(), index, values);
+    views.assign(values.begin(), values.end());
+    reducer.add(ranks, views);
+    if (progress && (reader.points_read() - reported >= kLasChunkPoints || reader.points_read() == reader.points_total())) {
+      reported = reader.points_read();
+      progress(reported);
+    }
+  }
+  reducer.finish_into(tree);
+}
+
+}  // namespace
+
+// Payloads: one streamed pass (or two) through the StreamBuilder, attributes with them.
+// Otherwise occupancy first, then, with attributes, a second pass over the records
+// into the voxels now known (reduce_attributes).
+Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload, BuildReport* report,
+               const std::function<void(std::uint64_t, std::uint64_t)>& progress, std::size_t chunk_points) {
+  std::optional<Quantizer> used;
+  std::int32_t lo[3], hi[3];
+  if (payload || !attributes)
+    return build_streamed(reader, requested, attributes, payload, report, progress, chunk_points, used, lo, hi);
+  // The attribute pass is one more over the points: progress counts it after the others.
+  const std::uint64_t total = reader.points_total();
+  std::uint64_t before = 0;
+  Tree tree = build_streamed(
+      reader, requested, false, false, report,
+      [&](std::uint64_t done, std::uint64_t of) {
+        before = of;
+        if (progress) progress(done, of + total);
+      },
+      chunk_points, used, lo, hi);
+  if (!used) return tree;
+  reduce_attributes(reader, *used, lo, hi, tree, [&](std::uint64_t done) {
+    if (progress) progress(before + done, before + total);
+  });
+  return tree;
 }
 
 }  // namespace vola::io

@@ -3,6 +3,8 @@
 // and a whole file as a PointCloud.
 #include <algorithm>
 
+#include "las_format.hpp"
+
 #include "vola/io/las.hpp"
 
 namespace vola::io {
@@ -67,6 +69,48 @@ void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vecto
   column([&](std::size_t i) { return static_cast<double>(chunk.number_of_returns[i]); });
   for (std::size_t f = 0; f < chunk.extra.size(); ++f)
     if (hd.extra_fields[f].name != "height") column([&](std::size_t i) { return chunk.extra[f][i]; });
+}
+
+void las_record_attribute_values(const LasHeader& hd, const std::uint8_t* records,
+                                 std::span<const std::uint32_t> index, std::vector<std::vector<double>>& values) {
+  // The fields where LasReader::read finds them, decoded the same way.
+  const std::size_t n = index.size(), length = hd.record_length;
+  const bool extended = hd.extended_format();
+  values.resize(las_attributes(hd).size());
+  std::size_t c = 0;
+  auto column = [&](auto&& value_of) {
+    auto& v = values[c++];
+    v.resize(n);
+    double* out = v.data();
+    for (std::size_t j = 0; j < n; ++j) out[j] = value_of(records + std::size_t{index[j]} * length);
+  };
+  if (hd.has_rgb()) {
+    const std::size_t rgb_at = extended ? 30 : (hd.point_format == 2 ? 20 : 28);
+    for (std::size_t k = 0; k < 3; ++k)
+      column([&](const std::uint8_t* r) { return static_cast<double>(load_le<std::uint16_t>(r + rgb_at + 2 * k)); });
+  }
+  column([](const std::uint8_t* r) { return static_cast<double>(load_le<std::uint16_t>(r + 12)); });
+  if (extended) column([](const std::uint8_t* r) { return static_cast<double>(r[16]); });
+  else column([](const std::uint8_t* r) { return static_cast<double>(r[15] & 31u); });
+  const LasExtraField* height = nullptr;
+  for (const auto& f : hd.extra_fields)
+    if (f.name == "height") {
+      height = &f;
+      break;
+    }
+  if (height) {
+    column([&](const std::uint8_t* r) {
+      return las::extra_value(r + height->offset, height->data_type) * height->scale + height->add;
+    });
+  } else {
+    const double scale = hd.scale[2], offset = hd.offset[2];
+    column([&](const std::uint8_t* r) { return static_cast<double>(load_le<std::int32_t>(r + 8)) * scale + offset; });
+  }
+  if (extended) column([](const std::uint8_t* r) { return static_cast<double>(r[14] >> 4); });
+  else column([](const std::uint8_t* r) { return static_cast<double>((r[14] >> 3) & 7u); });
+  for (const auto& f : hd.extra_fields)
+    if (f.name != "height")
+      column([&](const std::uint8_t* r) { return las::extra_value(r + f.offset, f.data_type) * f.scale + f.add; });
 }
 
 void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::uint64_t>& payloads) {

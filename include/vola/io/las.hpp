@@ -186,13 +186,20 @@ PointCloud las_points(LasReader& reader, bool attributes, bool payload,
 // chunk (one vector per column, in the same order).
 std::vector<AttributeSpec> las_attributes(const LasHeader& header);
 void las_attribute_values(const LasHeader& header, const LasChunk& chunk, std::vector<std::vector<double>>& values);
+// The same values straight from undecoded point records (LasReader::read_records): those
+// of records[index[j] * record_length] into values[a][j] (resized to index.size()).
+void las_record_attribute_values(const LasHeader& header, const std::uint8_t* records,
+                                 std::span<const std::uint32_t> index, std::vector<std::vector<double>>& values);
 // The reference's payload word per point.
 void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<std::uint64_t>& payloads);
 
-// The file straight into a tree in memory bounded by the voxels, not the points
-// (vola::StreamBuilder): one pass for the bounds (unless options.bbox is set), one to
-// build. Resolves `options` (depth, voxel size, origin) like vola::build. Memory: the
-// reduced voxels plus a chunk of `chunk_points` points (~100 bytes each).
+// The file straight into a tree in memory bounded by the voxels, not the points: the
+// occupancy through a vola::StreamBuilder, one pass for the bounds (unless options.bbox
+// is set; skipped when the header's box resolves to the same grid), one to build; with
+// attribute columns, one more pass over the records into a vola::VoxelReducer (one row
+// of partials per voxel, columns bit-identical to vola::build's over the same points);
+// with payloads, chunks of `chunk_points` points (~100 bytes each) reduced and merged in
+// the StreamBuilder. Resolves `options` (depth, voxel size, origin) like vola::build.
 // chunk_points 0 (the default): kLasChunkPoints with attributes or payloads,
 // kLasKeyChunkPoints occupancy only (8 bytes a point: 16 + 16 MB of chunk buffers).
 // A larger chunk's sorted blocks repeat less of the runs already built (fewer unions),
