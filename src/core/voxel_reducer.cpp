@@ -101,23 +101,32 @@ void put(std::byte* p, T v) noexcept {
 class RowMemory {
  public:
   static constexpr std::size_t kHuge = std::size_t{2} << 20;
+  static constexpr std::size_t kMapped = std::size_t{32} << 20;  // rows at least this large are mapped
   RowMemory() = default;
-  explicit RowMemory(std::size_t bytes) : bytes_((bytes + kHuge - 1) / kHuge * kHuge) {
-    if (bytes_ == 0) return;
+  explicit RowMemory(std::size_t bytes) {
+    if (bytes == 0) return;
 #if defined(__linux__)
-    void* p = ::mmap(nullptr, bytes_ + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p == MAP_FAILED) throw std::bad_alloc();
-    map_ = static_cast<std::byte*>(p);
-    // Start on a huge-page boundary; the pages before it are never touched.
-    data_ = reinterpret_cast<std::byte*>((reinterpret_cast<std::uintptr_t>(map_) + kHuge - 1) / kHuge * kHuge);
+    if (bytes >= kMapped) {
+      bytes_ = (bytes + kHuge - 1) / kHuge * kHuge;
+      void* p = ::mmap(nullptr, bytes_ + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED)
+        VOLA_THROW(Error("voxel reducer: cannot map " + std::to_string(bytes_ >> 20) + " MiB for the voxels' partials"));
+      map_ = static_cast<std::byte*>(p);
+      mapped_ = true;
+      // Start on a huge-page boundary; the pages before it are never touched.
+      data_ = reinterpret_cast<std::byte*>((reinterpret_cast<std::uintptr_t>(map_) + kHuge - 1) / kHuge * kHuge);
 #ifdef MADV_HUGEPAGE
-    ::madvise(data_, bytes_, MADV_HUGEPAGE);
+      ::madvise(data_, bytes_, MADV_HUGEPAGE);
 #endif
-#else
+      return;
+    }
+#endif
+    // Small rows (a tile's, an overview's): heap memory the allocator hands out again,
+    // zeroed here, costs less than fresh pages faulted in one by one.
+    bytes_ = bytes;
     map_ = static_cast<std::byte*>(::operator new(bytes_, std::align_val_t{64}));
     std::memset(map_, 0, bytes_);
     data_ = map_;
-#endif
   }
   ~RowMemory() { reset(); }
   RowMemory(RowMemory&& o) noexcept { *this = std::move(o); }
@@ -128,6 +137,7 @@ class RowMemory {
       std::swap(data_, o.data_);
       std::swap(bytes_, o.bytes_);
       std::swap(released_, o.released_);
+      std::swap(mapped_, o.mapped_);
     }
     return *this;
   }
@@ -136,6 +146,7 @@ class RowMemory {
   // The pages wholly before byte `end` are not read again: give them back.
   void release_before(std::size_t end) noexcept {
 #if defined(__linux__)
+    if (!mapped_) return;
     const std::size_t upto = end / kHuge * kHuge;
     if (upto > released_) {
       ::madvise(data_ + released_, upto - released_, MADV_DONTNEED);
@@ -148,18 +159,21 @@ class RowMemory {
   void reset() noexcept {
     if (!map_) return;
 #if defined(__linux__)
-    ::munmap(map_, bytes_ + kHuge);
+    if (mapped_) ::munmap(map_, bytes_ + kHuge);
+    else ::operator delete(map_, std::align_val_t{64});
 #else
     ::operator delete(map_, std::align_val_t{64});
 #endif
     map_ = data_ = nullptr;
     bytes_ = released_ = 0;
+    mapped_ = false;
   }
 
  private:
   std::byte* map_ = nullptr;
   std::byte* data_ = nullptr;
   std::size_t bytes_ = 0, released_ = 0;
+  bool mapped_ = false;
 };
 
 struct PairKey {

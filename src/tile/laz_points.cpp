@@ -4,7 +4,7 @@
 #include "laz_points.hpp"
 
 #include "vola/io/las.hpp"
-#include "vola/little_endian.hpp"
+#include "las_records.hpp"
 
 namespace vola::tile {
 
@@ -20,30 +20,21 @@ class LazPoints final : public PointSource {
   std::uint64_t chunk_count() const noexcept override { return reader_->header().laz_chunks.size(); }
   std::uint64_t point_count() const noexcept override { return reader_->header().point_count; }
   void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
-    thread_local std::vector<std::uint8_t> records;
-    reader_->decode_laz_chunk(static_cast<std::size_t>(chunk), records);
-    const io::LasHeader& hd = reader_->header();
-    const std::size_t n = records.size() / hd.record_length;
-    xyz.resize(3 * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t* r = records.data() + i * hd.record_length;
-      for (int a = 0; a < 3; ++a)  // every point format starts with X, Y, Z as int32 (LAS 1.4, 2.6)
-        xyz[3 * i + a] = static_cast<double>(load_le<std::int32_t>(r + 4 * a)) * hd.scale[a] + hd.offset[a];
-    }
+    las_record_xyz(reader_->header(), decoded(chunk), xyz);
   }
   std::vector<AttributeSpec> attributes() const override { return io::las_attributes(reader_->header()); }
   void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
                               std::vector<std::vector<double>>& values) const override {
-    thread_local std::vector<std::uint8_t> records;
-    thread_local io::LasChunk decoded;
-    reader_->decode_laz_chunk(static_cast<std::size_t>(chunk), records);
-    decoded.clear();
-    io::decode_las_records(reader_->header(), records, decoded);
-    io::las_attribute_values(reader_->header(), decoded, values);
-    xyz.swap(decoded.xyz);
+    las_record_points(reader_->header(), decoded(chunk), xyz, values);
   }
 
  private:
+  // Chunk c's records, decoded into a buffer of this thread's (valid until its next call).
+  std::span<const std::uint8_t> decoded(std::uint64_t chunk) const {
+    thread_local std::vector<std::uint8_t> records;
+    reader_->decode_laz_chunk(static_cast<std::size_t>(chunk), records);
+    return records;
+  }
   static std::string path_of(const io::LasReader& reader) { return reader.path(); }
   std::unique_ptr<io::LasReader> reader_;
   std::string name_;

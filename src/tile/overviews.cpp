@@ -64,7 +64,9 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
                      std::span<const Key> keys, Tree& tree) {
   std::vector<AttributeSpec> specs;
   std::optional<VoxelReducer> reducer;  // made with the first child's columns
-  std::vector<double> values;
+  std::vector<std::uint64_t> ranks;      // a child's voxels' parent voxels
+  std::vector<std::vector<double>> values;
+  std::vector<std::span<const double>> views;
   for (const Node* child : children) {
     const Tree tree_of_child = open_child(*child, c);
     if (!reducer) {
@@ -73,6 +75,7 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
       if (specs.empty()) return;
       reducer.emplace(specs, tree.voxel_count());
       values.resize(specs.size());
+      views.resize(specs.size());
     }
     std::vector<const AttributeColumn*> columns;
     for (const AttributeSpec& spec : specs) {
@@ -84,15 +87,20 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
     const auto [ox, oy, oz] = child_offset(parent, *child, c.grid.depth);
     // A child's voxels come in key order, and so do the parent voxels that cover them
     // (the child is an aligned block of the parent): one walk along the parent's keys.
-    std::size_t at = 0, rank = 0;
+    ranks.clear();
+    std::size_t at = 0;
     tree_of_child.for_each_voxel([&](const Voxel& v) {
       const Key up = encode(ox + v.x / 4, oy + v.y / 4, oz + v.z / 4);
-      if (rank == 0) at = static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), up) - keys.begin());
+      if (ranks.empty()) at = static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), up) - keys.begin());
       while (keys[at] < up) ++at;
-      for (std::size_t a = 0; a < specs.size(); ++a) values[a] = columns[a]->get(rank);
-      ++rank;
-      reducer->add(at, values);
+      ranks.push_back(at);
     });
+    for (std::size_t a = 0; a < specs.size(); ++a) {
+      values[a].resize(ranks.size());
+      for (std::size_t r = 0; r < ranks.size(); ++r) values[a][r] = columns[a]->get(r);
+      views[a] = values[a];
+    }
+    reducer->add(ranks, views);
   }
   reducer->finish_into(tree);
 }

@@ -12,6 +12,7 @@
 #include "vola/error.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
+#include "las_records.hpp"
 #include "laz_points.hpp"
 #include "vola/synth/city.hpp"
 
@@ -61,20 +62,7 @@ class LasPoints final : public PointSource {
 
   void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
     const std::span<const std::uint8_t> records = records_of(chunk);
-    const std::size_t n = records.size() / header_.record_length;
-    xyz.resize(3 * n);
-    const auto& s = header_.scale;
-    const auto& o = header_.offset;
-    double* out = xyz.data();
-    // Every point format starts with X, Y, Z as little-endian int32 (ASPRS LAS 1.4, 2.6).
-    for (const std::uint8_t* record = records.data(); record < records.data() + records.size();
-         record += header_.record_length, out += 3) {
-      std::int32_t v[3];
-      std::memcpy(v, record, sizeof v);
-      out[0] = v[0] * s[0] + o[0];
-      out[1] = v[1] * s[1] + o[1];
-      out[2] = v[2] * s[2] + o[2];
-    }
+    las_record_xyz(header_, records, xyz);
     release(records);
   }
 
@@ -83,12 +71,8 @@ class LasPoints final : public PointSource {
   void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
                               std::vector<std::vector<double>>& values) const override {
     const std::span<const std::uint8_t> records = records_of(chunk);
-    thread_local io::LasChunk decoded;
-    decoded.clear();
-    io::decode_las_records(header_, records, decoded);
+    las_record_points(header_, records, xyz, values);
     release(records);
-    io::las_attribute_values(header_, decoded, values);
-    xyz.swap(decoded.xyz);
   }
 
  private:

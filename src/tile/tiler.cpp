@@ -133,7 +133,7 @@ class Bucketer {
       if (records.empty()) continue;
       in_sequence_order(records);
       const std::size_t words = 2 + attributes_;
-      value_runs_[tile].push_back(Run{file_id_, value_file_->append(records), records.size() / words});
+      value_runs_[tile].push_back(detail::append_records(*value_file_, file_id_, records, words));
       std::vector<std::uint64_t>().swap(records);
     }
     held_ = 0;
@@ -261,7 +261,8 @@ struct Tiling {
   }
   std::size_t record_words() const { return 2 + specs.size(); }
   // A tile's attribute records in sequence order, each visited once.
-  void visit_records(const std::vector<Run>& tile_runs, const std::function<void(const std::uint64_t*)>& visit) const {
+  void visit_records(const std::vector<Run>& tile_runs,
+                     const std::function<void(const std::uint64_t*, std::size_t)>& visit) const {
     detail::merge_records(tile_runs, value_file_views, record_words(), merge_buffer(tile_runs.size()) / record_words(),
                           visit);
   }
@@ -401,7 +402,9 @@ void Tiling::exchange() {
         std::vector<std::uint64_t> records;
         if (root != rank) {
           if (const auto it = value_runs.find(tiles[p]); it != value_runs.end()) {
-            visit_records(it->second, [&](const std::uint64_t* r) { records.insert(records.end(), r, r + record_words()); });
+            visit_records(it->second, [&](const std::uint64_t* r, std::size_t n) {
+              records.insert(records.end(), r, r + n * record_words());
+            });
             value_runs.erase(it);
           }
         }
@@ -409,8 +412,8 @@ void Tiling::exchange() {
         if (root == rank)
           for (int r = 0; r < ranks; ++r)
             if (r != rank && !gathered_records[r].empty())
-              value_runs[tiles[p]].push_back(Run{received, value_files[received]->append(gathered_records[r]),
-                                                 gathered_records[r].size() / record_words()});
+              value_runs[tiles[p]].push_back(
+                  detail::append_records(*value_files[received], received, gathered_records[r], record_words()));
       }
       if (root != rank) continue;
       if (talk) options.progress("exchanging tiles", p + 1, tiles.size());
@@ -494,12 +497,23 @@ void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
   if (specs.empty()) return;
   VoxelReducer reducer(specs, tree.voxel_count());
   if (const auto it = value_runs.find(t); it != value_runs.end()) {
-    std::vector<double> values(specs.size());
-    visit_records(it->second, [&](const std::uint64_t* record) {
-      const std::optional<std::uint64_t> r = tree.rank(decode(record[0]));
-      if (!r) throw Error("tile: an attribute record names a voxel the tile does not hold");
-      for (std::size_t a = 0; a < specs.size(); ++a) values[a] = std::bit_cast<double>(record[2 + a]);
-      reducer.add(*r, values);
+    const std::size_t words = record_words();
+    std::vector<std::uint64_t> ranks;
+    std::vector<std::vector<double>> values(specs.size());
+    std::vector<std::span<const double>> views(specs.size());
+    visit_records(it->second, [&](const std::uint64_t* records, std::size_t n) {
+      ranks.resize(n);
+      for (std::size_t r = 0; r < n; ++r) {
+        const std::optional<std::uint64_t> rank = tree.rank(decode(records[r * words]));
+        if (!rank) throw Error("tile: an attribute record names a voxel the tile does not hold");
+        ranks[r] = *rank;
+      }
+      for (std::size_t a = 0; a < specs.size(); ++a) {  // the stretch's values, column by column
+        values[a].resize(n);
+        for (std::size_t r = 0; r < n; ++r) values[a][r] = std::bit_cast<double>(records[r * words + 2 + a]);
+        views[a] = values[a];
+      }
+      reducer.add(ranks, views);
     });
   }
   reducer.finish_into(tree);
