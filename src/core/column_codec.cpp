@@ -19,11 +19,16 @@ constexpr std::uint64_t zigzag(std::uint64_t v) noexcept {
 }
 constexpr std::uint64_t unzigzag(std::uint64_t u) noexcept { return (u >> 1) ^ (std::uint64_t{0} - (u & 1u)); }
 
-// Value i of a column of `width`-byte values, sign-extended from its top bit (so that the
-// differences of small negative and positive values stay small).
+// Value i of a column of `width`-byte values, as an unsigned integer.
 std::uint64_t load(const std::byte* bytes, std::size_t i, unsigned width) noexcept {
   std::uint64_t v = 0;
   std::memcpy(&v, bytes + i * width, width);
+  return v;
+}
+// `v` modulo 2^(8 width), as a signed number of that width, sign-extended: the difference
+// of two width-byte values is then small when they are close (either way round), and
+// zig-zags into `width` bytes.
+std::uint64_t sign_extend(std::uint64_t v, unsigned width) noexcept {
   const unsigned shift = 64 - 8 * width;
   return shift ? static_cast<std::uint64_t>(static_cast<std::int64_t>(v << shift) >> shift) : v;
 }
@@ -212,7 +217,7 @@ std::vector<std::uint8_t> encode_delta_planes(const AttributeColumn& column, int
   std::uint64_t previous = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint64_t v = load(column.bytes().data(), i, width);
-    residuals[i] = zigzag(v - previous);
+    residuals[i] = zigzag(sign_extend(v - previous, width));
     previous = v;
   }
   std::vector<std::uint8_t> raw(n * width);

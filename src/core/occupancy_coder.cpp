@@ -4,9 +4,6 @@
 #include <array>
 #include <bit>
 #include <type_traits>
-#ifdef VOLA_OCC_STATS
-#include <cmath>
-#endif
 
 #include "range_coder.hpp"
 #include "vola/error.hpp"
@@ -82,11 +79,6 @@ class BlockIndex {
   std::size_t mask_ = 0;
 };
 
-#ifdef VOLA_OCC_STATS
-}  // namespace
-double occ_stats[2];
-namespace {
-#endif
 constexpr std::size_t kOctantContexts = 8 * 64 * 4 * 4;
 constexpr std::size_t kCellContexts = 8 * 8 * 8 * 8 * 4 * 3;
 
@@ -161,9 +153,6 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
         farther |= (nb != BlockIndex::kNone ? (octants[nb] >> o) & 1u : 0u) << a;
       }
       BitModel& m = octant_models[o | ctx << 3 | count << 9 | farther << 11];
-#ifdef VOLA_OCC_STATS
-      occ_stats[0] -= std::log2(((actual >> o) & 1u) ? 1 - m.p / 65536.0 : m.p / 65536.0);
-#endif
       if (coder.code(m, (actual >> o) & 1u)) mask |= 1u << o;
     }
     octants[b] = static_cast<std::uint8_t>(mask);
@@ -205,9 +194,6 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
                                   below_cell(b, word, x, y - 1, z - 1) << 2;
         const unsigned farther = below_cell(b, word, x - 2, y, z) | below_cell(b, word, x, y - 2, z) << 1;
         BitModel& m = cell_models[c | below << 3 | beyond << 6 | diagonal << 9 | farther << 12 | std::min(set, 2u) << 14];
-#ifdef VOLA_OCC_STATS
-        occ_stats[1] -= std::log2(((actual >> bit) & 1u) ? 1 - m.p / 65536.0 : m.p / 65536.0);
-#endif
         if (coder.code(m, (actual >> bit) & 1u)) {
           word |= std::uint64_t{1} << bit;
           ++set;
@@ -273,6 +259,8 @@ void OccupancyCoder::decode(std::span<const std::uint8_t> stream, std::span<std:
                                              " words below a level of " + std::to_string(blocks_.size()) + " cells"));
   if (blocks_.size() > 0xFFFFFFFEu)
     VOLA_THROW(FormatError(name, offset, "an occupancy level of 2^32 blocks or more"));
+  if (stream.empty() || stream[0] != 0)  // the encoder's first byte is always 0
+    VOLA_THROW(FormatError(name, offset, "the coded occupancy level is corrupt (it does not start with a 0 byte)"));
   std::fill(words.begin(), words.end(), 0);
   RangeDecoder coder(stream);
   bool empty_root = false;
