@@ -5,7 +5,7 @@
 # (fractions of the LAZ file's size, not recorded sizes).
 #
 # Issue 20 point 5 asks for 1/2 of the LAZ with the default attributes and 1/10 for the
-# occupancy alone; vola reaches 0.79 and 0.112 at 1 ft (docs/BENCHMARKS.md, "Compressed
+# occupancy alone; vola reaches 0.760 and 0.112 at 1 ft (docs/BENCHMARKS.md, "Compressed
 # files"). The bounds below are what is reached, so that it cannot silently get worse;
 # they are not the issue's targets.
 # Usage: cli_compress.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
@@ -41,6 +41,6 @@ for size in 1 2 4; do
   "$vola" info "$tmp/packed$size.vol" | grep -q "version 2" || fail "$size ft: not a compressed file"
 done
 [ "$(wc -l < "$tmp/plain.txt")" -gt 1000 ] || fail "too few voxels compared"
-at_most "$tmp/packed1.vol" 80 100
+at_most "$tmp/packed1.vol" 77 100
 at_most "$tmp/occupancy1.vol" 113 1000
 echo "cli_compress: ok"
