@@ -6,6 +6,7 @@
 #include <type_traits>
 
 #include "range_coder.hpp"
+#include "vola/key.hpp"
 #include "vola/error.hpp"
 
 namespace vola {
@@ -39,44 +40,46 @@ std::uint8_t octants_of(std::uint64_t word) noexcept {
   return m;
 }
 
-// Open-addressing map from a block's coordinates to its index within the level.
+// Finds a block of the level by its coordinates. The blocks are in key order, so their
+// keys are sorted, and a neighbour of block b is usually a few blocks before or after it:
+// an exponential search from b, then a binary one, touches memory near b (a hash table
+// of a few million blocks cost a cache miss per lookup, 1.7 us per voxel at depth 7).
 class BlockIndex {
  public:
-  explicit BlockIndex(std::span<const Cell> blocks) {
-    std::size_t capacity = 16;
-    while (capacity < 2 * blocks.size()) capacity *= 2;
-    keys_.assign(capacity, kEmpty);
-    values_.resize(capacity);
-    mask_ = capacity - 1;
-    for (std::size_t i = 0; i < blocks.size(); ++i) {
-      const std::uint64_t key = pack(blocks[i]);
-      std::size_t at = hash(key);
-      while (keys_[at] != kEmpty) at = (at + 1) & mask_;
-      keys_[at] = key;
-      values_[at] = static_cast<std::uint32_t>(i);
-    }
+  explicit BlockIndex(std::span<const Cell> blocks) : keys_(blocks.size()) {
+    for (std::size_t i = 0; i < blocks.size(); ++i) keys_[i] = encode(blocks[i].x, blocks[i].y, blocks[i].z);
   }
-  // The index of the block at (x, y, z), or kNone.
-  std::uint32_t find(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
-    const std::uint64_t key = pack({x, y, z});
-    for (std::size_t at = hash(key);; at = (at + 1) & mask_) {
-      if (keys_[at] == key) return values_[at];
-      if (keys_[at] == kEmpty) return kNone;
+  // The index of the block at (x, y, z), or kNone; `near` = where to start looking.
+  std::uint32_t find(std::uint32_t x, std::uint32_t y, std::uint32_t z, std::size_t near) const noexcept {
+    if (((x | y | z) >> 20) != 0) return kNone;  // beyond any grid
+    const Key key = encode(x, y, z);
+    const std::size_t n = keys_.size();
+    std::size_t lo, hi;  // the key is in [lo, hi) if anywhere
+    if (keys_[near] < key) {
+      std::size_t step = 1;
+      lo = near + 1;
+      while (lo + step <= n && keys_[lo + step - 1] < key) {
+        lo += step;
+        step *= 2;
+      }
+      hi = std::min(n, lo + step);
+    } else {
+      std::size_t step = 1;
+      hi = near + 1;
+      while (hi > step && keys_[hi - step - 1] >= key) {
+        hi -= step;
+        step *= 2;
+      }
+      lo = hi > step ? hi - step - 1 : 0;
     }
+    const auto it = std::lower_bound(keys_.begin() + static_cast<std::ptrdiff_t>(lo),
+                                     keys_.begin() + static_cast<std::ptrdiff_t>(hi), key);
+    return it != keys_.end() && *it == key ? static_cast<std::uint32_t>(it - keys_.begin()) : kNone;
   }
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
  private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-  static std::uint64_t pack(const Cell& c) noexcept {
-    return std::uint64_t{c.x} | std::uint64_t{c.y} << 21 | std::uint64_t{c.z} << 42;
-  }
-  std::size_t hash(std::uint64_t key) const noexcept {
-    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
-  }
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::uint32_t> values_;
-  std::size_t mask_ = 0;
+  std::vector<Key> keys_;
 };
 
 constexpr std::size_t kOctantContexts = 8 * 64 * 4 * 4;
@@ -96,19 +99,19 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
   std::vector<std::array<std::uint32_t, 8>> lower(n);
   for (std::size_t b = 0; b < n; ++b) {
     const Cell c = blocks[b];
-    near[b][0] = c.x ? index.find(c.x - 1, c.y, c.z) : BlockIndex::kNone;
-    near[b][1] = index.find(c.x + 1, c.y, c.z);
-    near[b][2] = c.y ? index.find(c.x, c.y - 1, c.z) : BlockIndex::kNone;
-    near[b][3] = index.find(c.x, c.y + 1, c.z);
-    near[b][4] = c.z ? index.find(c.x, c.y, c.z - 1) : BlockIndex::kNone;
-    near[b][5] = index.find(c.x, c.y, c.z + 1);
+    near[b][0] = c.x ? index.find(c.x - 1, c.y, c.z, b) : BlockIndex::kNone;
+    near[b][1] = index.find(c.x + 1, c.y, c.z, b);
+    near[b][2] = c.y ? index.find(c.x, c.y - 1, c.z, b) : BlockIndex::kNone;
+    near[b][3] = index.find(c.x, c.y + 1, c.z, b);
+    near[b][4] = c.z ? index.find(c.x, c.y, c.z - 1, b) : BlockIndex::kNone;
+    near[b][5] = index.find(c.x, c.y, c.z + 1, b);
     lower[b][0] = static_cast<std::uint32_t>(b);
     lower[b][1] = near[b][0];
     lower[b][2] = near[b][2];
     lower[b][4] = near[b][4];
     for (unsigned axes : {3u, 5u, 6u, 7u}) {
       const bool ok = (!(axes & 1u) || c.x) && (!(axes & 2u) || c.y) && (!(axes & 4u) || c.z);
-      lower[b][axes] = ok ? index.find(c.x - (axes & 1u), c.y - ((axes >> 1) & 1u), c.z - ((axes >> 2) & 1u))
+      lower[b][axes] = ok ? index.find(c.x - (axes & 1u), c.y - ((axes >> 1) & 1u), c.z - ((axes >> 2) & 1u), b)
                           : BlockIndex::kNone;
     }
   }
