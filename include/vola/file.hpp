@@ -52,7 +52,8 @@ struct FileLayout {
 
 struct WriteOptions {
   Layout layout = Layout::sparse;
-  // zstd-compress the levels (sparse only): a version-2 file only vola reads.
+  // Compress the levels (context-coded occupancy, zstd payload) and attribute columns
+  // (predicted, zstd); sparse only: a version-2 file only vola reads.
   bool compress = false;
   int compression_level = 19;
   // Dense files hold 64^(depth-1) leaf words: refuse beyond this depth.
