@@ -15,7 +15,7 @@ namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 inline constexpr std::size_t kHeaderSize = 80;
-// Version 1: the reference's layout. Version 2 (ours): the levels are zstd-compressed
+// Version 1: the reference's layout. Version 2 (ours): the levels are compressed
 // inside the extension, so no level words follow the header.
 inline constexpr std::uint16_t kVersionPlain = 1;
 inline constexpr std::uint16_t kVersionCompressed = 2;
