@@ -149,7 +149,7 @@ void add_convert(CLI::App& app) {
                   "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean)");
   cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-attributes", args->no_attributes, "LAS: keep occupancy only, no per-voxel attribute columns");
-  cmd->add_flag("--compress", args->options.compress, "zstd-compress the levels and attributes (a file only vola reads)");
+  cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");

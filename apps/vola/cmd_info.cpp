@@ -141,7 +141,7 @@ void run_info(const InfoArgs& a) {
   }
   std::printf("level bytes: %llu%s\n", static_cast<unsigned long long>(layout.level_bytes),
               layout.compressed_levels
-                  ? (" (zstd: " + std::to_string(layout.compressed_level_bytes) + " bytes in the file)").c_str()
+                  ? (" (compressed: " + std::to_string(layout.compressed_level_bytes) + " bytes in the file)").c_str()
                   : "");
   if (layout.extension_bytes) {
     std::printf("extension:   %llu bytes, version %u\n", static_cast<unsigned long long>(layout.extension_bytes),

@@ -15,7 +15,7 @@ namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 inline constexpr std::size_t kHeaderSize = 80;
-// Version 1: the reference's layout. Version 2 (ours): the levels are zstd-compressed
+// Version 1: the reference's layout. Version 2 (ours): the levels are compressed
 // inside the extension, so no level words follow the header.
 inline constexpr std::uint16_t kVersionPlain = 1;
 inline constexpr std::uint16_t kVersionCompressed = 2;
@@ -52,7 +52,8 @@ struct FileLayout {
 
 struct WriteOptions {
   Layout layout = Layout::sparse;
-  // zstd-compress the levels (sparse only): a version-2 file only vola reads.
+  // Compress the levels (context-coded occupancy, zstd payload) and attribute columns
+  // (predicted, zstd); sparse only: a version-2 file only vola reads.
   bool compress = false;
   int compression_level = 19;
   // Dense files hold 64^(depth-1) leaf words: refuse beyond this depth.

@@ -5,6 +5,8 @@
 
 #include "bytes.hpp"
 #include "codec.hpp"
+#include "column_codec.hpp"
+#include "occupancy_coder.hpp"
 #include "crc32c.hpp"
 
 namespace vola {
@@ -17,10 +19,11 @@ namespace {
 // little), so a lying length cannot make us allocate far beyond the file's size.
 constexpr std::uint64_t kMaxRatio = 8192;
 constexpr std::uint64_t kRatioSlack = 1 << 20;
-// Levels record flag: one zstd frame per level part (each level's occupancy words, then
-// its payload words), each in 16-bit lanes. The only layout so far; others would get
-// their own flag.
+// Levels record flags: the layout of the parts (each level's occupancy words, then its
+// payload words). 2: one zstd frame per part, in 16-bit lanes. 3: occupancy parts coded
+// by the context-modelled arithmetic coder (occupancy_coder.hpp), payload parts as in 2.
 constexpr std::uint32_t kLanes16PerPart = 2;
+constexpr std::uint32_t kCodedOccupancy = 3;
 
 void begin_record(ByteWriter& w, RecordTag tag, std::uint32_t flags, std::uint64_t length) {
   w.put(static_cast<std::uint32_t>(tag));
@@ -115,17 +118,18 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
     w.pad_to(8);
   }
 
+  VoxelCorners corners(tree, frame);
   for (const auto& column : tree.attributes().columns()) {
     const auto raw = column.bytes();
-    std::vector<std::uint8_t> packed;
+    EncodedColumn encoded;
     const bool compress = compress_levels && zstd_available();
-    if (compress)
-      packed = zstd_compress({reinterpret_cast<const std::uint8_t*>(raw.data()), raw.size()}, level);
+    if (compress) encoded = encode_column(column, corners, level);
+    const std::vector<std::uint8_t>& packed = encoded.data;
     const std::uint64_t data_size = compress ? packed.size() : raw.size();
     begin_record(w, RecordTag::attribute, 0, 16 + column.name().size() + data_size);
     w.put(static_cast<std::uint8_t>(column.type()));
     w.put(static_cast<std::uint8_t>(column.reduction()));
-    w.put(static_cast<std::uint8_t>(compress ? 1 : 0));
+    w.put(compress ? encoded.encoding : kEncodingRaw);
     w.put(std::uint8_t{0});
     w.put(static_cast<std::uint32_t>(column.name().size()));
     w.put(static_cast<std::uint64_t>(raw.size()));
@@ -150,11 +154,16 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
     }
     std::vector<std::vector<std::uint8_t>> frames;
     std::uint64_t length = 8;
-    for (const auto& part : parts) {
-      frames.push_back(zstd_compress(lanes16_from_words(part), level));
+    OccupancyCoder occupancy;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const bool is_occupancy = !tree.has_payload() || p % 2 == 0;
+      if (is_occupancy)
+        frames.push_back(occupancy.encode(parts[p], p + (tree.has_payload() ? 2 : 1) >= parts.size()));
+      else
+        frames.push_back(zstd_compress(lanes16_from_words(parts[p]), level));
       length += 16 + frames.back().size();
     }
-    begin_record(w, RecordTag::levels, kLanes16PerPart, length);
+    begin_record(w, RecordTag::levels, kCodedOccupancy, length);
     w.put(static_cast<std::uint32_t>(parts.size()));
     w.put(std::uint32_t{0});
     for (std::size_t p = 0; p < parts.size(); ++p) {
@@ -187,7 +196,8 @@ Frame decode_frame(ByteReader& body, std::uint64_t record_offset) {
 }
 
 // An attribute record: one column, zstd-compressed or plain.
-AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, const std::string& name) {
+AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, const std::string& name,
+                                 ExtensionContents& out) {
     const auto type = body.get<std::uint8_t>("attribute type");
     const auto reduction = body.get<std::uint8_t>("attribute reduction");
     const auto encoding = body.get<std::uint8_t>("attribute encoding");
@@ -197,7 +207,8 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
     const auto column_name = body.take(name_length, "attribute name");
     if (type > 9) body.fail_at(record_offset + 16, "unknown attribute value type " + std::to_string(type));
     if (reduction > 4) body.fail_at(record_offset + 17, "unknown attribute reduction " + std::to_string(reduction));
-    if (encoding > 1) body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
+    if (encoding > kEncodingQuantized)
+      body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
     AttributeColumn column(std::string(column_name.begin(), column_name.end()), static_cast<ValueType>(type),
                            static_cast<Reduction>(reduction));
     if (raw_size % size_of(column.type()) != 0)
@@ -205,7 +216,12 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
                                            " is not a whole number of values");
     const auto data = body.take(body.remaining(), "attribute data");
     std::vector<std::uint8_t> raw;
-    if (encoding == 1) {
+    if (encoding >= kEncodingDeltaPlanes) {  // needs the tree: decoded later
+      check_ratio(body, raw_size, data.size());
+      out.pending.push_back({out.attributes.size(), encoding, raw_size, data, record_offset + 32 + name_length});
+      return column;
+    }
+    if (encoding == kEncodingZstd) {
       check_ratio(body, raw_size, data.size());
       raw = zstd_decompress(data, raw_size, name, record_offset + 32 + name_length);
     } else {
@@ -221,8 +237,8 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
 
 // The zstd-compressed levels record: parts of 16-bit lanes, into out.levels.
 void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t flags, const std::string& name,
-                   ExtensionContents& out) {
-    if (flags != kLanes16PerPart)
+                   bool payload, ExtensionContents& out) {
+    if (flags != kLanes16PerPart && flags != kCodedOccupancy)
       body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
     const auto parts = body.get<std::uint32_t>("level part count");
     body.get<std::uint32_t>("reserved");
@@ -242,13 +258,27 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
     if (packed_total != body.remaining())
       body.fail("level parts take " + std::to_string(packed_total) + " bytes, the record holds " +
                 std::to_string(body.remaining()));
+    // Coded occupancy: the parts alternate occupancy and payload when there is payload,
+    // which only the header says; the part count tells (one part per level, or two).
+    const bool coded = flags == kCodedOccupancy;
+    const bool with_payload = coded && payload;
+    if (with_payload && parts % 2 != 0)
+      body.fail_at(record_offset + 16, "levels with payload in an odd number of parts (" + std::to_string(parts) + ")");
     out.levels.resize(raw_total / 8);
     std::size_t at = 0;
-    for (const auto& [raw, packed] : sizes) {
+    OccupancyCoder occupancy;
+    for (std::uint32_t p = 0; p < parts; ++p) {
+      const auto [raw, packed] = sizes[p];
       const std::uint64_t frame_offset = body.offset();
       const auto frame = body.take(packed, "level part");
-      const auto lanes = zstd_decompress(frame, raw, name, frame_offset);
-      words_from_lanes16(lanes, std::span<std::uint64_t>(out.levels).subspan(at, raw / 8));
+      const auto words = std::span<std::uint64_t>(out.levels).subspan(at, raw / 8);
+      if (coded && (!with_payload || p % 2 == 0)) {
+        const bool last = p + (with_payload ? 2 : 1) >= parts;
+        occupancy.decode(frame, words, last, name, frame_offset);
+      } else {
+        const auto lanes = zstd_decompress(frame, raw, name, frame_offset);
+        words_from_lanes16(lanes, words);
+      }
       at += raw / 8;
     }
   out.has_levels = true;
@@ -258,7 +288,7 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
 }  // namespace
 
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   std::uint64_t base) {
+                                   std::uint64_t base, bool payload) {
   ByteReader r(bytes, name, base);
   const auto magic = r.take(8, "extension magic");
   if (std::memcmp(magic.data(), kExtensionMagic, 8) != 0)
@@ -286,7 +316,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         break;
       }
       case RecordTag::attribute: {
-        AttributeColumn column = decode_attribute(body, record_offset, name);
+        AttributeColumn column = decode_attribute(body, record_offset, name, out);
         for (const auto& other : out.attributes)
           if (other.name() == column.name())
             body.fail_at(record_offset, "attribute '" + column.name() + "' appears twice");
@@ -294,7 +324,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         break;
       }
       case RecordTag::levels:
-        decode_levels(body, record_offset, flags, name, out);
+        decode_levels(body, record_offset, flags, name, payload, out);
         break;
       default:
         break;  // a record of a later version: skipped
@@ -304,6 +334,21 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
   if (r.remaining() != 0)
     r.fail(std::to_string(r.remaining()) + " bytes follow the last extension record");
   return out;
+}
+
+void decode_pending_columns(ExtensionContents& ext, const Tree& tree, const std::string& name) {
+  VoxelCorners corners(tree, tree.frame());
+  for (const auto& p : ext.pending) {
+    AttributeColumn& column = ext.attributes[p.index];
+    const std::uint64_t values = p.raw_size / size_of(column.type());
+    if (values != tree.voxel_count())
+      VOLA_THROW(FormatError(name, p.offset,
+                             "attribute '" + column.name() + "' has " + std::to_string(values) + " values for " +
+                                 std::to_string(tree.voxel_count()) + " voxels"));
+    column.resize(values);
+    decode_column(p.encoding, p.data, column, corners, name, p.offset);
+  }
+  ext.pending.clear();
 }
 
 }  // namespace detail

@@ -33,6 +33,16 @@ struct ExtensionContents {
   std::optional<Frame> frame;
   std::string crs_wkt;
   std::vector<AttributeColumn> attributes;
+  // Columns of attribute encodings 2 and 3 (predicted from the voxels), decoded once the
+  // tree is known (decode_pending_columns): attributes[index] is named and typed but empty.
+  struct PendingColumn {
+    std::size_t index;
+    std::uint8_t encoding;
+    std::uint64_t raw_size;
+    std::span<const std::uint8_t> data;  // into the bytes given to decode_extension
+    std::uint64_t offset;
+  };
+  std::vector<PendingColumn> pending;
   bool has_levels = false;
   std::vector<std::uint64_t> levels;  // decompressed level words (version-2 files)
   std::uint64_t compressed_level_bytes = 0;
@@ -65,9 +75,13 @@ bool needs_extension(const Tree& tree) noexcept;
 bool starts_extension(std::span<const std::uint8_t> bytes) noexcept;
 // The tree's columns must outlive `out` (their bytes are borrowed, not copied).
 void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out);
-// `base` = file offset of bytes[0]. Checks every length against what is there.
+// `base` = file offset of bytes[0]; `payload` = the header's nbits > 0 (compressed
+// levels then hold payload parts). Checks every length against what is there.
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   std::uint64_t base);
+                                   std::uint64_t base, bool payload = false);
+// Decodes the pending columns of `ext` for `tree` (its frame set); a column of another
+// length than the tree's voxels is a FormatError.
+void decode_pending_columns(ExtensionContents& ext, const Tree& tree, const std::string& name);
 
 }  // namespace detail
 VOLA_INLINE_NAMESPACE_END

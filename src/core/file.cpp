@@ -93,9 +93,15 @@ std::uint64_t sparse_extent(std::span<const std::uint8_t> bytes, int depth, bool
   return at;
 }
 
-void apply_extension(Tree& tree, detail::ExtensionContents& ext, const std::string& name, std::uint64_t offset) {
+void apply_extension(Tree& tree, const Header& h, detail::ExtensionContents& ext, const std::string& name,
+                     std::uint64_t offset) {
   if (ext.frame) tree.set_frame(*ext.frame);
   tree.georef().crs_wkt = std::move(ext.crs_wkt);
+  if (!ext.pending.empty()) {
+    // Predicted columns need the voxels' places: the frame, or the header's bbox.
+    tree.georef().bbox = h.bbox;
+    detail::decode_pending_columns(ext, tree, name);
+  }
   for (auto& column : ext.attributes) {
     if (column.size() != tree.voxel_count())
       VOLA_THROW(FormatError(name, offset,
@@ -117,7 +123,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   if (h.version == kVersionCompressed) {
     if (h.layout == Layout::dense)
       VOLA_THROW(FormatError(name, 6, "a compressed (version 2) file must be sparse"));
-    auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize);
+    auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize, payload);
     if (!ext.has_levels)
       VOLA_THROW(FormatError(name, kHeaderSize, "a version-2 file must hold its levels in the extension"));
     tree = Tree::from_levels(h.depth, payload, std::move(ext.levels), name + " (compressed levels)");
@@ -127,7 +133,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     info.extension_offset = kHeaderSize;
     info.extension_bytes = bytes.size() - kHeaderSize;
     info.extension_version = ext.version;
-    apply_extension(tree, ext, name, kHeaderSize);
+    apply_extension(tree, h, ext, name, kHeaderSize);
     extension_at = bytes.size();
   } else if (h.layout == Layout::sparse) {
     const std::uint64_t words = sparse_extent(bytes, h.depth, payload, name);
@@ -169,7 +175,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     auto ext = detail::decode_extension(rest, name, extension_at);
     if (ext.has_levels)
       VOLA_THROW(FormatError(name, extension_at, "compressed levels in the extension of a version-1 file"));
-    apply_extension(tree, ext, name, extension_at);
+    apply_extension(tree, h, ext, name, extension_at);
     info.extension_offset = extension_at;
     info.extension_bytes = rest.size();
     info.extension_version = ext.version;

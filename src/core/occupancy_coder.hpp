@@ -1,0 +1,52 @@
+// Internal: context-modelled arithmetic coding of occupancy levels (compressed files,
+// levels record flags 3; docs/FILE_FORMAT.md). Each level is coded with the levels above
+// it known, in two passes over its blocks in file order:
+//   A. per block, which of its eight 2x2x2 octants hold anything (8 bits), each bit in a
+//      context of the neighbouring octants already coded and of which neighbouring blocks
+//      exist (the level above says so);
+//   B. per non-empty octant, its eight cells, each in a context of the three cells below
+//      it along x, y and z (all coded by then, in this block or the previous ones) and of
+//      the octants beyond it along x, y and z (all known after pass A).
+// A block below the root is never empty and an octant of pass B never empty, so their
+// last bit is implied when the others are 0. This is how octree geometry coders of point
+// clouds work (occupancy of a node coded in the context of its neighbours' occupancy);
+// a VOLA block is two octree levels.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vola/version.hpp"
+
+namespace vola {
+VOLA_INLINE_NAMESPACE_BEGIN
+namespace detail {
+
+class OccupancyCoder {
+ public:
+  OccupancyCoder();  // before level 0: one block, at (0, 0, 0)
+
+  // Blocks (words) of the next level.
+  std::uint64_t blocks() const noexcept { return blocks_.size(); }
+  // Codes the next level's words (words.size() == blocks()); `last` = no level follows.
+  std::vector<std::uint8_t> encode(std::span<const std::uint64_t> words, bool last);
+  // Decodes the next level into `words` (words.size() == blocks()); a stream that does
+  // not decode to exactly its own bytes is a FormatError naming `name` and `offset`.
+  void decode(std::span<const std::uint8_t> stream, std::span<std::uint64_t> words, bool last,
+              const std::string& name, std::uint64_t offset);
+
+  struct Cell {
+    std::uint32_t x, y, z;
+  };
+
+ private:
+  void advance(std::span<const std::uint64_t> words, bool last);
+
+  std::vector<Cell> blocks_;  // block coordinates of the next level, in file order
+};
+
+}  // namespace detail
+VOLA_INLINE_NAMESPACE_END
+}  // namespace vola

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Compressed .vol files of a real survey (Autzen, ../shared/data/laz/pdal_autzen_trim.laz)
+# through the CLI: the compressed file holds the same voxels and attribute values as the
+# uncompressed one, at 1, 2 and 4 ft, and is at most a given fraction of the LAZ's bytes
+# (fractions of the LAZ file's size, not recorded sizes).
+#
+# Issue 20 point 5 asks for 1/2 of the LAZ with the default attributes and 1/10 for the
+# occupancy alone; vola reaches 0.760 and 0.112 at 1 ft (docs/BENCHMARKS.md, "Compressed
+# files"). The bounds below are what is reached, so that it cannot silently get worse;
+# they are not the issue's targets.
+# Usage: cli_compress.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
+set -euo pipefail
+vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
+data=${data:-$2}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+laz=$data/laz/pdal_autzen_trim.laz
+[ -f "$laz" ] || skip "no $laz (set VOLA_SHARED)"
+laz_bytes=$(stat -c %s "$laz")
+
+# at_most FILE NUMERATOR DENOMINATOR: FILE's bytes <= LAZ bytes * N / D
+at_most() {
+  local bytes
+  bytes=$(stat -c %s "$1")
+  (( bytes * $3 <= laz_bytes * $2 )) ||
+    fail "$1: $bytes bytes, more than $2/$3 of the LAZ's $laz_bytes"
+  echo "$(basename "$1"): $bytes bytes = $(python3 -c "print(round($bytes / $laz_bytes, 4))") of the LAZ"
+}
+
+for size in 1 2 4; do
+  "$vola" convert "$laz" "$tmp/plain$size.vol" --voxel-size "$size" > /dev/null
+  "$vola" convert "$laz" "$tmp/packed$size.vol" --voxel-size "$size" --compress > /dev/null
+  "$vola" convert "$laz" "$tmp/occupancy$size.vol" --voxel-size "$size" --compress --no-attributes > /dev/null
+  "$vola" voxels --attributes "$tmp/plain$size.vol" > "$tmp/plain.txt"
+  "$vola" voxels --attributes "$tmp/packed$size.vol" > "$tmp/packed.txt"
+  cmp -s "$tmp/plain.txt" "$tmp/packed.txt" || fail "$size ft: the compressed file reads other voxels or values"
+  "$vola" voxels "$tmp/occupancy$size.vol" | cmp -s - <("$vola" voxels "$tmp/plain$size.vol") ||
+    fail "$size ft: the compressed occupancy reads other voxels"
+  "$vola" info "$tmp/packed$size.vol" | grep -q "version 2" || fail "$size ft: not a compressed file"
+done
+[ "$(wc -l < "$tmp/plain.txt")" -gt 1000 ] || fail "too few voxels compared"
+at_most "$tmp/packed1.vol" 77 100
+at_most "$tmp/occupancy1.vol" 113 1000
+echo "cli_compress: ok"
