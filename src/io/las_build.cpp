@@ -673,12 +673,16 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
   const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
   std::optional<RankWalk> walk(std::in_place, tree);
   const std::size_t length = hd.record_length, batch = batch_points(hd);
-  constexpr std::uint64_t kOutside = ~std::uint64_t{0};
   // Records read at once: few enough to cost little memory, enough that the threads
   // meet (twice a group) rarely.
   const std::size_t group = parts.parts == 1 ? batch : std::max<std::size_t>(batch, (std::size_t{8} << 20) / length);
   std::vector<std::uint8_t> copy;                  // a group gathered from several reads (LAZ)
-  std::vector<std::uint64_t> ranks;                // per record of the group: its voxel's rank, or kOutside
+  struct Slice {  // per slice of a group (one a thread): its points of each part
+    std::vector<std::vector<std::uint32_t>> index;  // in the group
+    std::vector<std::vector<std::uint64_t>> ranks;  // local to the part
+  };
+  std::vector<Slice> slices(parts.parts, Slice{std::vector<std::vector<std::uint32_t>>(parts.parts),
+                                               std::vector<std::vector<std::uint64_t>>(parts.parts)});
   struct Scratch {                                 // per thread
     std::vector<Key> keys;
     std::vector<std::uint32_t> index;
@@ -703,7 +707,8 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
       records = copy;
     }
     const std::size_t m = records.size() / length;
-    ranks.resize(m);
+    for (Slice& slice : slices)
+      for (unsigned k = 0; k < parts.parts; ++k) slice.index[k].clear(), slice.ranks[k].clear();
     // The ranks, a slice of records per thread, walked in groups of 512 keys whose words
     // and counts stay in L1/L2 between levels.
     parallel_for(
@@ -740,33 +745,32 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
               if (!(*walk)(s.keys.data() + at, std::min(kGroup, kept - at), s.ranks.data() + at))
                 VOLA_THROW(Error("LAS attributes: a point's voxel is not in the tree of the first pass (" +
                                  reader.path() + ")"));
-            std::uint64_t* out = ranks.data() + from;
-            std::fill(out, out + n, kOutside);
-            for (std::size_t j = 0; j < kept; ++j) out[s.index[j]] = s.ranks[j];
+            // Each point to its part's list, in input order.
+            Slice& slice = slices[c.index];
+            for (std::size_t j = 0; j < kept; ++j) {
+              const std::uint64_t rank = s.ranks[j], g = rank >> RankParts::kBits;
+              const std::uint32_t k = parts.part[g];
+              slice.index[k].push_back(static_cast<std::uint32_t>(from + s.index[j]));
+              slice.ranks[k].push_back(parts.local[g] | (rank & (RankParts::kBlock - 1)));
+            }
           }
         },
         {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.ranks"});
-    // Every part's points of the group, in input order, into its reducer.
+    // Every part's points of the group, slice after slice (input order), into its reducer.
     parallel_for(
         parts.parts,
         [&](const Chunk& c) {
           const auto k = static_cast<std::uint32_t>(c.index);
           Scratch& s = scratch[c.worker];
-          for (std::size_t from = 0; from < m; from += batch) {
-            const std::size_t n = std::min(batch, m - from);
-            s.index.clear();
-            s.ranks.clear();
-            for (std::size_t i = from; i < from + n; ++i) {
-              const std::uint64_t rank = ranks[i];
-              if (rank == kOutside) continue;
-              const std::uint64_t g = rank >> RankParts::kBits;
-              if (parts.part[g] != k) continue;
-              s.index.push_back(static_cast<std::uint32_t>(i - from));
-              s.ranks.push_back(parts.local[g] | (rank & (RankParts::kBlock - 1)));
+          for (const Slice& slice : slices) {
+            const std::vector<std::uint32_t>& index = slice.index[k];
+            const std::vector<std::uint64_t>& local = slice.ranks[k];
+            for (std::size_t from = 0; from < index.size(); from += batch) {
+              const std::size_t n = std::min(batch, index.size() - from);
+              las_record_attribute_values(hd, records.data(), std::span(index).subspan(from, n), s.values);
+              s.views.assign(s.values.begin(), s.values.end());
+              reducers[k].add(std::span(local).subspan(from, n), s.views);
             }
-            las_record_attribute_values(hd, records.data() + from * length, s.index, s.values);
-            s.views.assign(s.values.begin(), s.values.end());
-            reducers[k].add(s.ranks, s.views);
           }
         },
         {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.reduce"});
@@ -777,7 +781,7 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
   }
   walk.reset();
   copy = {};
-  ranks = {};
+  slices = {};
   scratch = {};
   finish_parts(reducers, parts, specs, tree);
 }
