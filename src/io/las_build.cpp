@@ -557,30 +557,32 @@ class RankWalk {
   std::array<const Entry*, kMaxDepth> level_{};
 };
 
-// The voxels dealt to the threads of the second pass: blocks of 2^16 consecutive ranks,
-// block g to part g % parts, each part's blocks side by side in its own VoxelReducer
-// (local ranks). Dealt by blocks, each part gets about as many points and rows as the
-// others wherever the points are dense, and the columns can be written a few blocks of
-// every part at a time (finish_parts).
+// The voxels dealt to the threads of the second pass: blocks of 2^bits consecutive
+// ranks (2^16, fewer for a small tree so that every thread gets some), block g to part
+// g % parts, each part's blocks side by side in its own VoxelReducer (local ranks).
+// Dealt by blocks, each part gets about as many points and rows as the others wherever
+// the points are dense, and the columns can be written a few blocks of every part at a
+// time (finish_parts).
 struct RankParts {
-  static constexpr int kBits = 16;
-  static constexpr std::uint64_t kBlock = std::uint64_t{1} << kBits;
-  std::uint64_t voxels = 0;
+  int bits = 16;
+  std::uint64_t block = 0, voxels = 0;
   unsigned parts = 1;
   std::vector<std::uint32_t> part;   // per block
   std::vector<std::uint64_t> local;  // per block: the local rank of its first voxel
   std::vector<std::uint64_t> size;   // per part: its voxels
 
   RankParts(std::uint64_t voxel_count, unsigned threads) : voxels(voxel_count) {
-    const std::uint64_t blocks = (voxels + kBlock - 1) / kBlock;
+    while (bits > 6 && (voxels >> bits) < std::uint64_t{8} * threads) --bits;
+    block = std::uint64_t{1} << bits;
+    const std::uint64_t blocks = (voxels + block - 1) / block;
     parts = static_cast<unsigned>(std::clamp<std::uint64_t>(blocks, 1, threads));
     part.resize(blocks);
     local.resize(blocks);
     size.assign(parts, 0);
     for (std::uint64_t g = 0; g < blocks; ++g) {
       part[g] = static_cast<std::uint32_t>(g % parts);
-      local[g] = g / parts * kBlock;
-      size[g % parts] += std::min(kBlock, voxels - g * kBlock);
+      local[g] = g / parts * block;
+      size[g % parts] += std::min(block, voxels - g * block);
     }
   }
   std::uint64_t blocks() const noexcept { return part.size(); }
@@ -617,13 +619,15 @@ void finish_parts(std::vector<VoxelReducer>& reducers, const RankParts& parts, c
     size[a] = size_of(specs[a].type);
     bytes[a].reserve(static_cast<std::size_t>(parts.voxels) * size[a]);  // address space only
   }
-  const std::uint64_t round = std::uint64_t{4} * parts.parts;  // blocks per round
+  // Blocks per round: 4 of every part, or more for a large tree (at most ~32 rounds).
+  const std::uint64_t round =
+      std::max<std::uint64_t>(4, (parts.blocks() + 32 * parts.parts - 1) / (32 * parts.parts)) * parts.parts;
   const auto blocks_of = [&](std::uint64_t r, unsigned k, const auto& each) {
     for (std::uint64_t g = r * round + k; g < std::min(parts.blocks(), (r + 1) * round); g += parts.parts)
-      each(g, std::min(parts.voxels, (g + 1) * RankParts::kBlock));
+      each(g, std::min(parts.voxels, (g + 1) * parts.block));
   };
   for (std::uint64_t r = 0; r * round < parts.blocks(); ++r) {
-    const std::uint64_t end = std::min(parts.voxels, (r + 1) * round * RankParts::kBlock);
+    const std::uint64_t end = std::min(parts.voxels, (r + 1) * round * parts.block);
     for (std::size_t a = 0; a < na; ++a) bytes[a].resize(static_cast<std::size_t>(end) * size[a]);
     parallel_for(
         parts.parts,
@@ -631,13 +635,13 @@ void finish_parts(std::vector<VoxelReducer>& reducers, const RankParts& parts, c
           const auto k = static_cast<unsigned>(c.index);
           std::vector<std::byte*> to(na);
           blocks_of(r, k, [&](std::uint64_t g, std::uint64_t last) {
-            const std::uint64_t first = g * RankParts::kBlock;
+            const std::uint64_t first = g * parts.block;
             for (std::size_t a = 0; a < na; ++a) to[a] = bytes[a].data() + first * size[a];
             reducers[k].finish_range(parts.local[g], parts.local[g] + (last - first), to);
           });
           blocks_of(r + 1, k, [&](std::uint64_t g, std::uint64_t last) {
             for (std::size_t a = 0; a < na; ++a)
-              populate(bytes[a].data() + g * RankParts::kBlock * size[a], bytes[a].data() + last * size[a]);
+              populate(bytes[a].data() + g * parts.block * size[a], bytes[a].data() + last * size[a]);
           });
         },
         {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.finish"});
@@ -748,10 +752,10 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
             // Each point to its part's list, in input order.
             Slice& slice = slices[c.index];
             for (std::size_t j = 0; j < kept; ++j) {
-              const std::uint64_t rank = s.ranks[j], g = rank >> RankParts::kBits;
+              const std::uint64_t rank = s.ranks[j], g = rank >> parts.bits;
               const std::uint32_t k = parts.part[g];
               slice.index[k].push_back(static_cast<std::uint32_t>(from + s.index[j]));
-              slice.ranks[k].push_back(parts.local[g] | (rank & (RankParts::kBlock - 1)));
+              slice.ranks[k].push_back(parts.local[g] | (rank & (parts.block - 1)));
             }
           }
         },
