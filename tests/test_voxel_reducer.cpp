@@ -117,6 +117,51 @@ TEST(VoxelReducer, UnreachedVoxelsAreZero) {
   EXPECT_EQ(columns[2].get(1), 3.0);
 }
 
+// finish_range over ranges of random sizes, into the caller's columns, gives finish()'s
+// bytes (majority's other values included); ranges out of order and points added after
+// are refused.
+TEST(VoxelReducer, FinishInRangesEqualsFinish) {
+  const vola::PointCloud cloud = random_cloud(9, 20000);
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::grid;
+  options.voxel_size = 1.0;
+  vola::PointCloud xyz_only;
+  xyz_only.xyz = cloud.xyz;
+  const vola::Tree tree = vola::build(xyz_only, options);
+  const vola::Quantizer quantizer = vola::Quantizer::grid(tree.frame().origin, tree.frame().voxel_size, tree.depth());
+  std::vector<vola::AttributeSpec> specs;
+  for (const auto& a : cloud.attributes) specs.push_back({a.name, a.type, a.reduction});
+  std::vector<std::uint64_t> ranks;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    vola::Voxel v;
+    ASSERT_TRUE(quantizer.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v));
+    ranks.push_back(*tree.rank(v));
+  }
+  std::vector<std::span<const double>> values;
+  for (const auto& a : cloud.attributes) values.emplace_back(a.values);
+  vola::VoxelReducer whole(specs, tree.voxel_count()), ranged(specs, tree.voxel_count());
+  whole.add(ranks, values);
+  ranged.add(ranks, values);
+  const std::vector<vola::AttributeColumn> want = whole.finish();
+  std::vector<std::vector<std::byte>> got(specs.size());
+  for (std::size_t a = 0; a < specs.size(); ++a) got[a].resize(tree.voxel_count() * vola::size_of(specs[a].type));
+  std::mt19937_64 rng(3);
+  std::vector<std::byte*> to(specs.size());
+  for (std::uint64_t first = 0; first < tree.voxel_count();) {
+    const std::uint64_t last = std::min<std::uint64_t>(tree.voxel_count(), first + rng() % 700);
+    for (std::size_t a = 0; a < specs.size(); ++a) to[a] = got[a].data() + first * vola::size_of(specs[a].type);
+    ranged.finish_range(first, last, to);
+    if (first > 0) EXPECT_THROW(ranged.finish_range(first - 1, last, to), vola::InvalidArgument);
+    first = last;
+  }
+  EXPECT_THROW(ranged.add(std::span<const std::uint64_t>(ranks.data(), 1),
+                          std::vector<std::span<const double>>(values.size(), std::span<const double>(values[0].data(), 1))),
+               vola::InvalidArgument);
+  ASSERT_EQ(want.size(), specs.size());
+  for (std::size_t a = 0; a < specs.size(); ++a)
+    EXPECT_TRUE(std::equal(got[a].begin(), got[a].end(), want[a].bytes().begin(), want[a].bytes().end())) << specs[a].name;
+}
+
 }  // namespace
 
 namespace {

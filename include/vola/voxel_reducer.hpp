@@ -39,6 +39,12 @@ class VoxelReducer {
 
   // The columns, in the order of the specs; the reducer is empty afterwards.
   std::vector<AttributeColumn> finish();
+  // The values of voxels [first, last) only, into out[a] (room for last - first values of
+  // attribute a's type, little-endian), and the rows before `last` released: a caller
+  // that fills its own columns a range at a time (ranges in increasing order; voxels
+  // skipped are not written). No point can be added afterwards; finish() completes the
+  // rest. Throws InvalidArgument on a range out of order or out of bounds.
+  void finish_range(std::uint64_t first, std::uint64_t last, std::span<std::byte* const> out);
   // Moves the columns into the tree's attributes (the tree has `voxels` voxels).
   void finish_into(Tree& tree);
 

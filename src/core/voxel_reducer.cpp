@@ -209,6 +209,16 @@ struct VoxelReducer::State {
   // Points added one at a time, reduced in batches.
   std::vector<std::uint64_t> pending_ranks;
   std::vector<std::vector<double>> pending_values;
+  // finish_range(): the voxels finished so far; majority's other values sorted by rank,
+  // and per attribute the first of them not yet used.
+  struct Other {
+    std::uint64_t rank, bits;
+    std::uint32_t count;
+  };
+  bool finishing = false;
+  std::uint64_t finished = 0;
+  std::vector<std::vector<Other>> sorted_others;
+  std::vector<std::size_t> at;
 
   void layout() {
     // The count at offset 0, then the doubles (unaligned loads cost nothing extra on
@@ -353,6 +363,7 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
     if (v.size() != ranks.size())
       VOLA_THROW(InvalidArgument("voxel reducer: an attribute array's length differs from the ranks'"));
   if (s.specs.empty()) return;
+  if (s.finishing) VOLA_THROW(InvalidArgument("voxel reducer: points added after finish_range()"));
   std::uint64_t highest = 0;
   for (const std::uint64_t r : ranks) highest = std::max(highest, r);
   if (!ranks.empty() && highest >= s.voxels)
@@ -457,72 +468,93 @@ void VoxelReducer::add(std::uint64_t rank, std::span<const double> values) {
   if (s.pending_ranks.size() == kBatch) flush_pending();
 }
 
-std::vector<AttributeColumn> VoxelReducer::finish() {
-  flush_pending();
+void VoxelReducer::finish_range(std::uint64_t first, std::uint64_t last, std::span<std::byte* const> out) {
   State& s = *state_;
   const std::size_t na = s.specs.size();
-  // Majority: the other values per voxel, in rank order, to compare with each first value.
-  struct Other {
-    std::uint64_t rank, bits;
-    std::uint32_t count;
-  };
-  std::vector<std::vector<Other>> others(na);
-  for (std::size_t a = 0; a < na; ++a) {
-    others[a].reserve(s.others[a].size());
-    for (const auto& [key, count] : s.others[a]) others[a].push_back({key.rank, key.bits, count});
-    s.others[a] = {};
-    std::sort(others[a].begin(), others[a].end(), [](const Other& x, const Other& y) { return x.rank < y.rank; });
+  if (out.size() != na)
+    VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(out.size()) + " columns for " +
+                               std::to_string(na) + " attributes"));
+  if (first < s.finished || first > last || last > s.voxels)
+    VOLA_THROW(InvalidArgument("voxel reducer: voxels [" + std::to_string(first) + ", " + std::to_string(last) +
+                               ") to finish after " + std::to_string(s.finished) + " of " + std::to_string(s.voxels)));
+  if (!s.finishing) {
+    flush_pending();
+    // Majority: the other values per voxel, in rank order, to compare with each first value.
+    s.sorted_others.assign(na, {});
+    s.at.assign(na, 0);
+    for (std::size_t a = 0; a < na; ++a) {
+      auto& o = s.sorted_others[a];
+      o.reserve(s.others[a].size());
+      for (const auto& [key, count] : s.others[a]) o.push_back({key.rank, key.bits, count});
+      s.others[a] = {};
+      std::sort(o.begin(), o.end(), [](const State::Other& x, const State::Other& y) { return x.rank < y.rank; });
+    }
+    s.finishing = true;
   }
+  for (std::size_t a = 0; a < na; ++a) {
+    const AttributeSpec& spec = s.specs[a];
+    detail::with_value_type(spec.type, [&](auto zero) {
+      using T = decltype(zero);
+      std::byte* const to = out[a];
+      const std::vector<State::Other>& o = s.sorted_others[a];
+      std::size_t k = s.at[a];
+      while (k < o.size() && o[k].rank < first) ++k;  // voxels skipped over
+      for (std::uint64_t v = first; v < last; ++v) {
+        const std::byte* row = s.rows.data() + v * s.stride;
+        const std::uint32_t count = load<std::uint32_t>(row);
+        double value = 0.0;  // where no point came
+        if (count != 0) {
+          const double partial = s.slot_value(row, a, v);
+          if (spec.reduction == Reduction::majority) {
+            double best = partial;
+            std::uint32_t best_count = count;
+            for (std::size_t j = k; j < o.size() && o[j].rank == v; ++j) best_count -= o[j].count;
+            for (; k < o.size() && o[k].rank == v; ++k) {
+              const double x = std::bit_cast<double>(o[k].bits);
+              if (o[k].count > best_count || (o[k].count == best_count && detail::value_before(x, best)))
+                best = x, best_count = o[k].count;
+            }
+            value = detail::canonical_value(best);
+          } else {
+            value = detail::finish(spec.reduction, partial, count);
+          }
+        }
+        detail::store_as<T>(to + (v - first) * sizeof(T), value);
+      }
+      s.at[a] = k;
+    });
+  }
+  s.finished = last;
+  s.rows.release_before(static_cast<std::size_t>(last) * s.stride);
+}
+
+std::vector<AttributeColumn> VoxelReducer::finish() {
+  State& s = *state_;
+  const std::size_t na = s.specs.size();
   // Column bytes grow as the rows are read in order, and the rows read are released:
   // the partials and the columns are not both whole in memory at once.
   std::vector<std::vector<std::byte>> bytes(na);
-  std::vector<std::size_t> at(na, 0);
+  for (std::size_t a = 0; a < na; ++a) bytes[a].reserve(static_cast<std::size_t>(s.voxels) * size_of(s.specs[a].type));  // address space only
+  std::vector<std::byte*> to(na);
   constexpr std::uint64_t kBlock = 1 << 16;
-  for (std::uint64_t first = 0; first < s.voxels; first += kBlock) {
+  for (std::uint64_t first = s.finished; first < s.voxels; first += kBlock) {
     const std::uint64_t last = std::min(s.voxels, first + kBlock);
     for (std::size_t a = 0; a < na; ++a) {
-      const AttributeSpec& spec = s.specs[a];
-      std::vector<std::byte>& out = bytes[a];
-      const std::size_t size = size_of(spec.type);
-      if (first == 0) out.reserve(static_cast<std::size_t>(s.voxels) * size);  // address space only
-      out.resize(static_cast<std::size_t>(last) * size);
-      detail::with_value_type(spec.type, [&](auto zero) {
-        using T = decltype(zero);
-        for (std::uint64_t v = first; v < last; ++v) {
-          const std::byte* row = s.rows.data() + v * s.stride;
-          const std::uint32_t count = load<std::uint32_t>(row);
-          double value = 0.0;  // where no point came
-          if (count != 0) {
-            const double partial = s.slot_value(row, a, v);
-            if (spec.reduction == Reduction::majority) {
-              double best = partial;
-              std::uint32_t best_count = count;
-              const std::vector<Other>& o = others[a];
-              std::size_t k = at[a];
-              for (std::size_t j = k; j < o.size() && o[j].rank == v; ++j) best_count -= o[j].count;
-              for (; k < o.size() && o[k].rank == v; ++k) {
-                const double x = std::bit_cast<double>(o[k].bits);
-                if (o[k].count > best_count || (o[k].count == best_count && detail::value_before(x, best)))
-                  best = x, best_count = o[k].count;
-              }
-              at[a] = k;
-              value = detail::canonical_value(best);
-            } else {
-              value = detail::finish(spec.reduction, partial, count);
-            }
-          }
-          detail::store_as<T>(out.data() + v * sizeof(T), value);
-        }
-      });
+      const std::size_t size = size_of(s.specs[a].type);
+      bytes[a].resize(static_cast<std::size_t>(last) * size);
+      to[a] = bytes[a].data() + first * size;
     }
-    s.rows.release_before(static_cast<std::size_t>(last) * s.stride);
+    finish_range(first, last, to);
   }
   std::vector<AttributeColumn> columns;
   for (std::size_t a = 0; a < na; ++a)
     columns.emplace_back(s.specs[a].name, s.specs[a].type, s.specs[a].reduction, std::move(bytes[a]));
   s.rows.reset();
   s.carries.assign(na, {});
+  s.sorted_others.assign(na, {});
   s.voxels = 0;
+  s.finished = 0;
+  s.finishing = false;
   return columns;
 }
 

@@ -18,6 +18,7 @@
 #include "vola/error.hpp"
 #include "vola/io/las.hpp"
 #include "vola/little_endian.hpp"
+#include "vola/parallel.hpp"
 #include "vola/stream_builder.hpp"
 #include "vola/voxel_reducer.hpp"
 
@@ -556,69 +557,237 @@ class RankWalk {
   std::array<const Entry*, kMaxDepth> level_{};
 };
 
+// The voxels dealt to the threads of the second pass: blocks of 2^bits consecutive
+// ranks (2^16, fewer for a small tree so that every thread gets some), block g to part
+// g % parts, each part's blocks side by side in its own VoxelReducer (local ranks).
+// Dealt by blocks, each part gets about as many points and rows as the others wherever
+// the points are dense, and the columns can be written a few blocks of every part at a
+// time (finish_parts).
+struct RankParts {
+  int bits = 16;
+  std::uint64_t block = 0, voxels = 0;
+  unsigned parts = 1;
+  std::vector<std::uint32_t> part;   // per block
+  std::vector<std::uint64_t> local;  // per block: the local rank of its first voxel
+  std::vector<std::uint64_t> size;   // per part: its voxels
+
+  RankParts(std::uint64_t voxel_count, unsigned threads) : voxels(voxel_count) {
+    while (bits > 6 && (voxels >> bits) < std::uint64_t{8} * threads) --bits;
+    block = std::uint64_t{1} << bits;
+    const std::uint64_t blocks = (voxels + block - 1) / block;
+    parts = static_cast<unsigned>(std::clamp<std::uint64_t>(blocks, 1, threads));
+    part.resize(blocks);
+    local.resize(blocks);
+    size.assign(parts, 0);
+    for (std::uint64_t g = 0; g < blocks; ++g) {
+      part[g] = static_cast<std::uint32_t>(g % parts);
+      local[g] = g / parts * block;
+      size[g % parts] += std::min(block, voxels - g * block);
+    }
+  }
+  std::uint64_t blocks() const noexcept { return part.size(); }
+};
+
+// Ask the kernel for the pages wholly inside [from, to), written (zeroed) now on this
+// thread, so the thread that then writes them does not fault on each (Linux 5.14+; a
+// no-op elsewhere or when refused).
+void populate(std::byte* from, std::byte* to) noexcept {
+#if defined(__linux__)
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23
+#endif
+  constexpr std::uintptr_t kPage = 4096;
+  const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(from) + kPage - 1) / kPage * kPage;
+  const std::uintptr_t b = reinterpret_cast<std::uintptr_t>(to) / kPage * kPage;
+  if (b > a) ::madvise(reinterpret_cast<void*>(a), b - a, MADV_POPULATE_WRITE);
+#else
+  (void)from, (void)to;
+#endif
+}
+
+// The parts' columns into the tree, written in rounds of a few blocks of every part:
+// the columns grow (on this thread) by a round, then every part writes its blocks of it
+// on its own thread and releases the rows it read, so rows and columns are never both
+// whole in memory. Each part also has the kernel supply (zero) the pages of its blocks
+// of the next round, so that first touch is shared by the threads as well.
+void finish_parts(std::vector<VoxelReducer>& reducers, const RankParts& parts, const std::vector<AttributeSpec>& specs,
+                  Tree& tree) {
+  const std::size_t na = specs.size();
+  std::vector<std::vector<std::byte>> bytes(na);
+  std::vector<std::size_t> size(na);
+  for (std::size_t a = 0; a < na; ++a) {
+    size[a] = size_of(specs[a].type);
+    bytes[a].reserve(static_cast<std::size_t>(parts.voxels) * size[a]);  // address space only
+  }
+  // Blocks per round: 4 of every part, or more for a large tree (at most ~32 rounds).
+  const std::uint64_t round =
+      std::max<std::uint64_t>(4, (parts.blocks() + 32 * parts.parts - 1) / (32 * parts.parts)) * parts.parts;
+  const auto blocks_of = [&](std::uint64_t r, unsigned k, const auto& each) {
+    for (std::uint64_t g = r * round + k; g < std::min(parts.blocks(), (r + 1) * round); g += parts.parts)
+      each(g, std::min(parts.voxels, (g + 1) * parts.block));
+  };
+  for (std::uint64_t r = 0; r * round < parts.blocks(); ++r) {
+    const std::uint64_t end = std::min(parts.voxels, (r + 1) * round * parts.block);
+    for (std::size_t a = 0; a < na; ++a) bytes[a].resize(static_cast<std::size_t>(end) * size[a]);
+    parallel_for(
+        parts.parts,
+        [&](const Chunk& c) {
+          const auto k = static_cast<unsigned>(c.index);
+          std::vector<std::byte*> to(na);
+          blocks_of(r, k, [&](std::uint64_t g, std::uint64_t last) {
+            const std::uint64_t first = g * parts.block;
+            for (std::size_t a = 0; a < na; ++a) to[a] = bytes[a].data() + first * size[a];
+            reducers[k].finish_range(parts.local[g], parts.local[g] + (last - first), to);
+          });
+          blocks_of(r + 1, k, [&](std::uint64_t g, std::uint64_t last) {
+            for (std::size_t a = 0; a < na; ++a)
+              populate(bytes[a].data() + g * parts.block * size[a], bytes[a].data() + last * size[a]);
+          });
+        },
+        {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.finish"});
+  }
+  reducers.clear();
+  for (std::size_t a = 0; a < na; ++a)
+    tree.attributes().add(AttributeColumn(specs[a].name, specs[a].type, specs[a].reduction, std::move(bytes[a])));
+}
+
 // The second pass: every record again, its voxel's rank in the tree of the first, and
 // its attribute values straight from the record bytes into a VoxelReducer, which
 // updates each voxel's partials in place. Points fold in input order: the columns are
 // vola::build's over the same points, bit for bit.
+//
+// On T threads (vola::thread_count()) the voxels are dealt to T parts (RankParts), one
+// VoxelReducer each. The records come in groups read once (a LAZ chunk is decoded
+// once); the threads first find the group's ranks, a slice each, then every thread
+// takes the group's points whose voxel is in its part, in input order. Each voxel's
+// points still fold in input order in one reducer, so the columns are the same bytes
+// whatever the threads; the fresh rows' first touch, the row updates and the finish are
+// shared by the threads.
 void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std::int32_t stored_lo[3],
                        const std::int32_t stored_hi[3], Tree& tree,
                        const std::function<void(std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
-  VoxelReducer reducer(las_attributes(hd), tree.voxel_count());
+  const std::vector<AttributeSpec> specs = las_attributes(hd);
+  const RankParts parts(tree.voxel_count(), thread_count());
+  std::vector<VoxelReducer> reducers;
+  for (unsigned k = 0; k < parts.parts; ++k) reducers.emplace_back(specs, parts.size[k]);
   AxisCells cells[3];
   bool by_table = reader.points_total() > 0;
   for (int a = 0; a < 3 && by_table; ++a) by_table = cells[a].build(hd, quantizer, a, stored_lo[a], stored_hi[a]);
   const AxisCells::Lookup kx = cells[0].lookup(), ky = cells[1].lookup(), kz = cells[2].lookup();
-  const RankWalk walk(tree);
+  std::optional<RankWalk> walk(std::in_place, tree);
   const std::size_t length = hd.record_length, batch = batch_points(hd);
-  // Ranks are walked in groups whose words and counts stay in L1/L2 between levels.
-  constexpr std::size_t kGroup = 512;
-  std::vector<Key> keys;
-  std::vector<std::uint32_t> index;
-  std::vector<std::uint64_t> ranks;
-  std::vector<double> xyz;
-  std::vector<std::vector<double>> values;
-  std::vector<std::span<const double>> views;
+  // Records read at once: few enough to cost little memory, enough that the threads
+  // meet (twice a group) rarely.
+  const std::size_t group = parts.parts == 1 ? batch : std::max<std::size_t>(batch, (std::size_t{8} << 20) / length);
+  std::vector<std::uint8_t> copy;                  // a group gathered from several reads (LAZ)
+  struct Slice {  // per slice of a group (one a thread): its points of each part
+    std::vector<std::vector<std::uint32_t>> index;  // in the group
+    std::vector<std::vector<std::uint64_t>> ranks;  // local to the part
+  };
+  std::vector<Slice> slices(parts.parts, Slice{std::vector<std::vector<std::uint32_t>>(parts.parts),
+                                               std::vector<std::vector<std::uint64_t>>(parts.parts)});
+  struct Scratch {                                 // per thread
+    std::vector<Key> keys;
+    std::vector<std::uint32_t> index;
+    std::vector<std::uint64_t> ranks;
+    std::vector<double> xyz;
+    std::vector<std::vector<double>> values;
+    std::vector<std::span<const double>> views;
+  };
+  std::vector<Scratch> scratch(parts.parts);
   std::uint64_t reported = 0;
   reader.rewind();
   while (true) {
-    const std::span<const std::uint8_t> records = reader.read_records(batch);
-    const std::size_t m = records.size() / length;
-    if (m == 0) break;
-    keys.clear();
-    index.clear();
-    if (by_table) {
-      keys.resize(m);
-      index.resize(m);
-      std::size_t kept = 0;
-      const std::uint8_t* r = records.data();
-      for (std::size_t i = 0; i < m; ++i, r += length) {
-        const Key key = kx(load_le<std::int32_t>(r)) | ky(load_le<std::int32_t>(r + 4)) | kz(load_le<std::int32_t>(r + 8));
-        keys[kept] = key;
-        index[kept] = static_cast<std::uint32_t>(i);
-        kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+    std::span<const std::uint8_t> records = reader.read_records(group);
+    if (records.empty()) break;
+    if (records.size() < group * length && reader.points_read() < reader.points_total()) {
+      copy.assign(records.begin(), records.end());
+      while (copy.size() < group * length) {
+        const std::span<const std::uint8_t> more = reader.read_records(group - copy.size() / length);
+        if (more.empty()) break;
+        copy.insert(copy.end(), more.begin(), more.end());
       }
-      keys.resize(kept);
-      index.resize(kept);
-    } else {
-      xyz.clear();
-      decode_xyz(hd, records, xyz);
-      quantizer.to_keys(xyz, keys, &index);
+      records = copy;
     }
-    const std::size_t kept = keys.size();
-    ranks.resize(kept);
-    for (std::size_t at = 0; at < kept; at += kGroup)
-      if (!walk(keys.data() + at, std::min(kGroup, kept - at), ranks.data() + at))
-        VOLA_THROW(Error("LAS attributes: a point's voxel is not in the tree of the first pass (" + reader.path() + ")"));
-    las_record_attribute_values(hd, records.data(), index, values);
-    views.assign(values.begin(), values.end());
-    reducer.add(ranks, views);
+    const std::size_t m = records.size() / length;
+    for (Slice& slice : slices)
+      for (unsigned k = 0; k < parts.parts; ++k) slice.index[k].clear(), slice.ranks[k].clear();
+    // The ranks, a slice of records per thread, walked in groups of 512 keys whose words
+    // and counts stay in L1/L2 between levels.
+    parallel_for(
+        m,
+        [&](const Chunk& c) {
+          Scratch& s = scratch[c.worker];
+          constexpr std::size_t kGroup = 512;
+          for (std::size_t from = c.begin; from < c.end; from += batch) {
+            const std::size_t n = std::min(batch, c.end - from);
+            const std::uint8_t* r = records.data() + from * length;
+            s.keys.clear();
+            s.index.clear();
+            if (by_table) {
+              s.keys.resize(n);
+              s.index.resize(n);
+              std::size_t kept = 0;
+              for (std::size_t i = 0; i < n; ++i, r += length) {
+                const Key key =
+                    kx(load_le<std::int32_t>(r)) | ky(load_le<std::int32_t>(r + 4)) | kz(load_le<std::int32_t>(r + 8));
+                s.keys[kept] = key;
+                s.index[kept] = static_cast<std::uint32_t>(i);
+                kept += (key >> 63) ^ 1;  // AxisCells::kOutside: the point is outside the grid
+              }
+              s.keys.resize(kept);
+              s.index.resize(kept);
+            } else {
+              s.xyz.clear();
+              decode_xyz(hd, records.subspan(from * length, n * length), s.xyz);
+              quantizer.to_keys(s.xyz, s.keys, &s.index);
+            }
+            const std::size_t kept = s.keys.size();
+            s.ranks.resize(kept);
+            for (std::size_t at = 0; at < kept; at += kGroup)
+              if (!(*walk)(s.keys.data() + at, std::min(kGroup, kept - at), s.ranks.data() + at))
+                VOLA_THROW(Error("LAS attributes: a point's voxel is not in the tree of the first pass (" +
+                                 reader.path() + ")"));
+            // Each point to its part's list, in input order.
+            Slice& slice = slices[c.index];
+            for (std::size_t j = 0; j < kept; ++j) {
+              const std::uint64_t rank = s.ranks[j], g = rank >> parts.bits;
+              const std::uint32_t k = parts.part[g];
+              slice.index[k].push_back(static_cast<std::uint32_t>(from + s.index[j]));
+              slice.ranks[k].push_back(parts.local[g] | (rank & (parts.block - 1)));
+            }
+          }
+        },
+        {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.ranks"});
+    // Every part's points of the group, slice after slice (input order), into its reducer.
+    parallel_for(
+        parts.parts,
+        [&](const Chunk& c) {
+          const auto k = static_cast<std::uint32_t>(c.index);
+          Scratch& s = scratch[c.worker];
+          for (const Slice& slice : slices) {
+            const std::vector<std::uint32_t>& index = slice.index[k];
+            const std::vector<std::uint64_t>& local = slice.ranks[k];
+            for (std::size_t from = 0; from < index.size(); from += batch) {
+              const std::size_t n = std::min(batch, index.size() - from);
+              las_record_attribute_values(hd, records.data(), std::span(index).subspan(from, n), s.values);
+              s.views.assign(s.values.begin(), s.values.end());
+              reducers[k].add(std::span(local).subspan(from, n), s.views);
+            }
+          }
+        },
+        {.threads = parts.parts, .chunks = parts.parts, .name = "las.attributes.reduce"});
     if (progress && (reader.points_read() - reported >= kLasChunkPoints || reader.points_read() == reader.points_total())) {
       reported = reader.points_read();
       progress(reported);
     }
   }
-  reducer.finish_into(tree);
+  walk.reset();
+  copy = {};
+  slices = {};
+  scratch = {};
+  finish_parts(reducers, parts, specs, tree);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "vola/file.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/las.hpp"
+#include "vola/parallel.hpp"
 
 namespace {
 
@@ -175,6 +176,49 @@ TEST(LasStream, SharedLazFilesBuildAsTheWholeCloudDoes) {
     SCOPED_TRACE(file.string());
     check_file([&] { return vola::io::LasReader(file.string()); }, 997);
   }
+}
+
+// The attribute pass on 1, 2 or 3 threads (the voxels dealt to as many parts, each
+// reducing its own points in input order): the same bytes every time.
+void check_threads(const std::function<vola::io::LasReader()>& open) {
+  struct Restore {
+    ~Restore() { vola::set_thread_count(0); }
+  } restore;
+  for (const Case& c : kCases) {
+    if (!c.attributes || c.payload) continue;
+    SCOPED_TRACE(c.name);
+    std::vector<std::uint8_t> one;
+    for (const unsigned threads : {1u, 2u, 3u}) {
+      SCOPED_TRACE("threads " + std::to_string(threads));
+      vola::set_thread_count(threads);
+      vola::io::LasReader reader = open();
+      const vola::Tree tree = vola::io::build_las(reader, options_for(c, reader.header()), true, false, nullptr, {});
+      const std::vector<std::uint8_t> bytes = vola::serialize(tree);
+      if (threads == 1) one = bytes;
+      else EXPECT_TRUE(bytes == one);
+    }
+  }
+}
+
+TEST(LasStream, SharedFilesGiveTheSameBytesOnAnyThreads) {
+  VOLA_REQUIRE_DATA(data);
+  std::vector<std::filesystem::path> files = vola_io_test::files_ending(data / "las", ".las");
+  const auto laz = vola_io_test::files_ending(data / "laz", ".laz");
+  ASSERT_GE(files.size(), 20u);
+  ASSERT_GE(laz.size(), 5u);
+  files.insert(files.end(), laz.begin(), laz.end());
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.string());
+    check_threads([&] { return vola::io::LasReader(file.string()); });
+  }
+}
+
+TEST(LasStream, GeneratedFileGivesTheSameBytesOnAnyThreads) {
+  const Bytes bytes = generated_las(300000, 23);
+  const vola_test::TempDir dir;
+  const auto path = dir.path() / "generated.las";
+  vola_test::write_bytes(path, bytes);
+  check_threads([&] { return vola::io::LasReader(path.string()); });
 }
 
 TEST(LasStream, GeneratedFileInManyChunksBuildsAsTheWholeCloudDoes) {

@@ -197,7 +197,8 @@ void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<st
 // occupancy through a vola::StreamBuilder, one pass for the bounds (unless options.bbox
 // is set; skipped when the header's box resolves to the same grid), one to build; with
 // attribute columns, one more pass over the records into a vola::VoxelReducer (one row
-// of partials per voxel, columns bit-identical to vola::build's over the same points);
+// of partials per voxel, columns bit-identical to vola::build's over the same points;
+// on vola::thread_count() threads, each reducing the voxels of its part of the ranks);
 // with payloads, chunks of `chunk_points` points (~100 bytes each) reduced and merged in
 // the StreamBuilder. Resolves `options` (depth, voxel size, origin) like vola::build.
 // chunk_points 0 (the default): kLasChunkPoints with attributes or payloads,
