@@ -197,7 +197,7 @@ void add_tile(CLI::App& app) {
       "  vola tile --generate-survey 1000000000 --tile-size 2000 --depth 6 --crs 32633 -o big/ --memory 2G\n"
       "  mpirun -np 3 vola tile *.las --tile-size 1000 --depth 6 -o tiles/\n"
       "  vola get tiles/index.geojson 636250 849217 435       vola render tiles/index.geojson -o view.png");
-  cmd->add_option("inputs", args->inputs, "Point files: LAS (streamed from a memory map), or any point format vola convert reads");
+  cmd->add_option("inputs", args->inputs, "Point files: LAS/LAZ/COPC (streamed in chunks), or any point format vola convert reads");
   cmd->add_option("-o,--output", args->output, "Output folder")->required();
   cmd->add_option("--tile-size", args->tile_size, "Tile edge in the CRS's units (metres, feet, ...)")->required()
       ->check(CLI::PositiveNumber);

@@ -1,7 +1,6 @@
 #include "vola/tile/point_source.hpp"
 
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -20,6 +19,10 @@ namespace vola::tile {
 
 namespace {
 
+// Records are read with pread into a buffer of the reading thread's, never mapped: a
+// file cut while it is tiled is then a short read (an IoError naming it), not SIGBUS,
+// and the page cache keeps the file's pages out of the process (as LasReader does; a
+// map also cost a TLB miss and a page fault every few pages).
 class LasPoints final : public PointSource {
  public:
   LasPoints(const std::string& path, std::size_t chunk_points) : name_(path), chunk_points_(chunk_points) {
@@ -27,29 +30,11 @@ class LasPoints final : public PointSource {
     header_ = reader.header();
     epsg = header_.epsg;
     wkt = header_.wkt;
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw IoError(path + ": cannot open (" + std::strerror(errno) + ")");
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) {
-      ::close(fd);
-      throw IoError(path + ": cannot stat");
-    }
-    size_ = static_cast<std::size_t>(st.st_size);
-    if (size_ > 0) {
-      void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
-      ::close(fd);
-      if (map == MAP_FAILED) throw IoError(path + ": cannot map (" + std::strerror(errno) + ")");
-      data_ = static_cast<const std::uint8_t*>(map);
-      ::madvise(map, size_, MADV_SEQUENTIAL);
-    } else {
-      ::close(fd);
-    }
-    const std::uint64_t end = header_.offset_to_points + header_.point_count * std::uint64_t{header_.record_length};
-    if (end > size_)  // the reader checked this already; kept so that decoding can never read past the map
-      throw FormatError(path, header_.offset_to_points, "point records run past the end of the file");
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) throw IoError(path + ": cannot open (" + std::strerror(errno) + ")");
   }
   ~LasPoints() override {
-    if (data_) ::munmap(const_cast<std::uint8_t*>(data_), size_);
+    if (fd_ >= 0) ::close(fd_);
   }
   LasPoints(const LasPoints&) = delete;
   LasPoints& operator=(const LasPoints&) = delete;
@@ -61,42 +46,54 @@ class LasPoints final : public PointSource {
   std::uint64_t point_count() const noexcept override { return header_.point_count; }
 
   void read_chunk(std::uint64_t chunk, std::vector<double>& xyz) const override {
-    const std::span<const std::uint8_t> records = records_of(chunk);
-    las_record_xyz(header_, records, xyz);
-    release(records);
+    // In batches that stay in cache, so that the buffer stays small however large the chunk.
+    const auto [first, n] = range_of(chunk);
+    const std::uint64_t batch = std::max<std::uint64_t>(1, io::kLasRecordBatchBytes / header_.record_length);
+    xyz.clear();
+    thread_local std::vector<double> part;
+    for (std::uint64_t done = 0; done < n; done += batch) {
+      las_record_xyz(header_, records(first + done, std::min(batch, n - done)), part);
+      xyz.insert(xyz.end(), part.begin(), part.end());
+    }
   }
 
   std::vector<AttributeSpec> attributes() const override { return io::las_attributes(header_); }
 
   void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
                               std::vector<std::vector<double>>& values) const override {
-    const std::span<const std::uint8_t> records = records_of(chunk);
-    las_record_points(header_, records, xyz, values);
-    release(records);
+    const auto [first, n] = range_of(chunk);
+    las_record_points(header_, records(first, n), xyz, values);
   }
 
  private:
-  // Chunk c's records, straight from the map.
-  std::span<const std::uint8_t> records_of(std::uint64_t chunk) const {
+  // Chunk c's first point and number of points.
+  std::pair<std::uint64_t, std::uint64_t> range_of(std::uint64_t chunk) const {
     const std::uint64_t first = chunk * chunk_points_;
-    const std::uint64_t n = first < header_.point_count ? std::min<std::uint64_t>(chunk_points_, header_.point_count - first) : 0;
-    return {data_ + header_.offset_to_points + first * header_.record_length, n * header_.record_length};
+    return {first, first < header_.point_count ? std::min<std::uint64_t>(chunk_points_, header_.point_count - first) : 0};
   }
-  // Done with these pages: drop them from this process (the page cache keeps them), so
-  // that resident memory stays within the budget however large the file. A page shared
-  // with a neighbouring chunk is simply read back in from the cache if still needed.
-  static void release(std::span<const std::uint8_t> records) {
-    const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    const auto begin = reinterpret_cast<std::uintptr_t>(records.data()) & ~(page - 1);
-    const auto end = reinterpret_cast<std::uintptr_t>(records.data() + records.size()) & ~(page - 1);
-    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+  // Records [first, first + n), read into this thread's buffer (valid until its next call).
+  std::span<const std::uint8_t> records(std::uint64_t first, std::uint64_t n) const {
+    thread_local std::vector<std::uint8_t> buffer;
+    const std::size_t bytes = static_cast<std::size_t>(n * header_.record_length);
+    if (buffer.size() < bytes) buffer.resize(bytes);
+    std::uint64_t offset = header_.offset_to_points + first * header_.record_length;
+    for (std::size_t done = 0; done < bytes;) {
+      const ssize_t got = ::pread(fd_, buffer.data() + done, bytes - done, static_cast<off_t>(offset));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0)
+        throw IoError(name_ + ": byte " + std::to_string(offset) + ": cannot read the point records (" +
+                      (got < 0 ? std::string(std::strerror(errno)) : "the file is shorter than its header says: cut while tiled?") +
+                      ")");
+      done += static_cast<std::size_t>(got);
+      offset += static_cast<std::uint64_t>(got);
+    }
+    return {buffer.data(), bytes};
   }
 
   std::string name_;
   std::size_t chunk_points_;
   io::LasHeader header_;
-  const std::uint8_t* data_ = nullptr;
-  std::size_t size_ = 0;
+  int fd_ = -1;
 };
 
 class WholeFilePoints final : public PointSource {

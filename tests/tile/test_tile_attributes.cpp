@@ -226,4 +226,29 @@ TEST(TileAttributes, ColumnsNotEveryInputHasAreLeftOutWithAWarning) {
   EXPECT_TRUE(read((dir / "bare" / index.tiles.front().file).string()).attributes().empty());
 }
 
+// A LAS file cut after the source opened it: reading its chunks is an IoError naming
+// the file (the records are read, not mapped: never SIGBUS).
+TEST(TileSources, ALasFileCutWhileTiledIsAnError) {
+  VOLA_REQUIRE_DATA(data);
+  vola_test::TempDir dir;
+  const fs::path copy = dir / "cut.las";
+  fs::copy_file(data / "las" / "pdal_autzen_trim.las", copy);
+  const auto source = tile::open_las_points(copy.string(), 4096);
+  fs::resize_file(copy, fs::file_size(copy) / 2);
+  std::vector<double> xyz;
+  std::vector<std::vector<double>> values;
+  bool failed = false;
+  for (std::uint64_t c = 0; c < source->chunk_count(); ++c) {
+    try {
+      if (c % 2) source->read_chunk(c, xyz);
+      else source->read_chunk_with_values(c, xyz, values);
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("cut.las"), std::string::npos) << e.what();
+      failed = true;
+      break;
+    }
+  }
+  EXPECT_TRUE(failed) << "reading past the cut succeeded";
+}
+
 }  // namespace

@@ -41,8 +41,8 @@ class PointSource {
   std::string wkt;
 };
 
-// A LAS file (1.0-1.4, any point format), memory-mapped: chunk c is records
-// [c * chunk_points, (c + 1) * chunk_points), decoded straight from the map. A LAZ or
+// A LAS file (1.0-1.4, any point format), read with pread: chunk c is records
+// [c * chunk_points, (c + 1) * chunk_points) (a file cut meanwhile: an IoError). A LAZ or
 // COPC file: chunk c is the file's own LAZ chunk c (chunk_points unused).
 std::unique_ptr<PointSource> open_las_points(const std::string& path, std::size_t chunk_points = std::size_t{1} << 20);
 // Any other point format `vola convert` reads, read whole (one chunk), with the
