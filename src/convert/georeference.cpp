@@ -33,6 +33,16 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
   return out;
 }
 
+void reproject_heights(const geo::Reprojection& reprojection, PointCloud& cloud) {
+  for (auto& column : cloud.attributes) {
+    if (column.name != "height" || column.values.size() != cloud.size()) continue;
+    std::vector<double> at(cloud.xyz);  // (x, y, height): the height moves as a z there would
+    for (std::size_t i = 0; i < cloud.size(); ++i) at[3 * i + 2] = column.values[i];
+    reprojection.transform(at);
+    for (std::size_t i = 0; i < cloud.size(); ++i) column.values[i] = at[3 * i + 2];
+  }
+}
+
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
 
 std::string crs_definition_of(const std::string& given) {
@@ -48,7 +58,9 @@ ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io
     throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `epsg`");
   const std::string from = source.wkt.empty() ? "EPSG:" + std::to_string(*source.epsg) : source.wkt;
   const std::string to = crs_definition_of(options.target_crs);
-  geo::Reprojection(from, to).transform(input.cloud.xyz);
+  geo::Reprojection reprojection(from, to);
+  reproject_heights(reprojection, input.cloud);
+  reprojection.transform(input.cloud.xyz);
   ResolvedCrs target;
   target.wkt = geo::crs_wkt(to);
   target.epsg = geo::epsg_from_wkt(target.wkt);

@@ -31,6 +31,12 @@ std::string crs_definition_of(const std::string& given);
 std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
                                       const ResolvedCrs& crs);
 
+// Before the points are reprojected: a `height` column (each point's z, or a LAS
+// extra-bytes height, a z too) is reprojected as the z of its point's x and y, so that
+// it ends in the target's vertical unit like the voxels (Autzen's feet became metres,
+// its heights did not).
+void reproject_heights(const geo::Reprojection& reprojection, PointCloud& cloud);
+
 // The code the VOLA header carries: the known one, else the reference's default (2000).
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known);
 

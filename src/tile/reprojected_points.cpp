@@ -4,6 +4,7 @@
 // small pool (as many as workers ever read at once), made the first time one is short.
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "vola/geo/crs.hpp"
@@ -20,6 +21,9 @@ class ReprojectedPoints final : public PointSource {
     idle_.push_back(std::make_unique<geo::Reprojection>(from_, to_, 1));  // fails now for a CRS PROJ cannot do
     wkt = geo::crs_wkt(to_);
     epsg = geo::epsg_from_wkt(wkt);
+    const std::vector<AttributeSpec> columns = source_->attributes();
+    for (std::size_t a = 0; a < columns.size(); ++a)
+      if (columns[a].name == "height") height_ = a;
   }
   const std::string& name() const noexcept override { return source_->name(); }
   std::uint64_t chunk_count() const noexcept override { return source_->chunk_count(); }
@@ -32,6 +36,13 @@ class ReprojectedPoints final : public PointSource {
   void read_chunk_with_values(std::uint64_t chunk, std::vector<double>& xyz,
                               std::vector<std::vector<double>>& values) const override {
     source_->read_chunk_with_values(chunk, xyz, values);
+    if (height_ && *height_ < values.size()) {  // the height moves as its point's z would
+      thread_local std::vector<double> at;
+      at = xyz;
+      for (std::size_t i = 0; i < values[*height_].size(); ++i) at[3 * i + 2] = values[*height_][i];
+      transform(at);
+      for (std::size_t i = 0; i < values[*height_].size(); ++i) values[*height_][i] = at[3 * i + 2];
+    }
     transform(xyz);
   }
 
@@ -65,6 +76,7 @@ class ReprojectedPoints final : public PointSource {
 
   std::unique_ptr<PointSource> source_;
   std::string from_, to_;
+  std::optional<std::size_t> height_;  // the source's `height` column
   mutable std::mutex mutex_;
   mutable std::vector<std::unique_ptr<geo::Reprojection>> idle_;
 };

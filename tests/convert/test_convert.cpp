@@ -211,6 +211,26 @@ TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {
   }
 }
 
+// Reprojected into metres, the height column is in metres too: each voxel's mean height
+// lies inside the voxel's own vertical extent (Autzen in feet kept heights in feet).
+TEST(Convert, ReprojectedHeightsAreInTheTargetsUnits) {
+  VOLA_REQUIRE_DATA(data);
+  vola::ConvertOptions options;
+  options.target_crs = "EPSG:32610";
+  options.voxel_size = 2.0;
+  const vola::Tree tree = vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options);
+  const vola::AttributeColumn* height = tree.attributes().find("height");
+  ASSERT_NE(height, nullptr);
+  const vola::Frame frame = tree.frame();
+  std::uint64_t rank = 0, outside = 0;
+  tree.for_each_voxel([&](const vola::Voxel& v) {
+    const double bottom = frame.origin[2] + v.z * frame.voxel_size;
+    const double h = height->get(rank++);
+    if (!(h >= bottom - 1e-3 && h <= bottom + frame.voxel_size + 1e-3)) ++outside;
+  });
+  EXPECT_EQ(outside, 0u) << "of " << tree.voxel_count() << " voxels";
+}
+
 TEST(Convert, VoxelGridsMapCellForCellAndPointsNeedAGrid) {
   VOLA_REQUIRE_DATA(data);
   const vola::Tree chair = vola::convert((data / "binvox" / "trimesh_chair_model.binvox").string(), {});

@@ -226,6 +226,37 @@ TEST(TileAttributes, ColumnsNotEveryInputHasAreLeftOutWithAWarning) {
   EXPECT_TRUE(read((dir / "bare" / index.tiles.front().file).string()).attributes().empty());
 }
 
+// Tiles of a reprojected survey: heights move with the points (feet to metres), so each
+// voxel's mean height lies in the voxel's own vertical extent.
+TEST(TileAttributes, ReprojectedHeightsAreInTheTargetsUnits) {
+  VOLA_REQUIRE_DATA(data);
+  vola_test::TempDir dir;
+  tile::TileOptions o = autzen_grid(dir / "t");
+  o.grid.tile_size = 256.0;  // metres now
+  o.grid.depth = 5;          // voxels of 0.25 m
+  auto las = tile::open_las_points((data / "las" / "pdal_autzen_trim.las").string(), 5000);
+  const std::string from = las->wkt;
+  const auto source = tile::reprojected(std::move(las), from, "EPSG:32610");
+  auto comm = tile::single_process();
+  tile::make_tiles({source.get()}, o, *comm);
+  const tile::TileIndexFile index = tile::read_tile_index((dir / "t" / "index.geojson").string());
+  std::uint64_t voxels = 0, outside = 0;
+  for (const tile::TileEntry& e : index.tiles) {
+    const Tree tree = read((dir / "t" / e.file).string());
+    const AttributeColumn* height = tree.attributes().find("height");
+    ASSERT_NE(height, nullptr) << e.file;
+    std::uint64_t rank = 0;
+    tree.for_each_voxel([&](const Voxel& v) {
+      const double bottom = tree.frame().origin[2] + v.z * tree.frame().voxel_size;
+      const double h = height->get(rank++);
+      if (!(h >= bottom - 1e-3 && h <= bottom + tree.frame().voxel_size + 1e-3)) ++outside;
+    });
+    voxels += tree.voxel_count();
+  }
+  EXPECT_GT(voxels, 0u);
+  EXPECT_EQ(outside, 0u) << "of " << voxels << " voxels";
+}
+
 // A LAS file cut after the source opened it: reading its chunks is an IoError naming
 // the file (the records are read, not mapped: never SIGBUS).
 TEST(TileSources, ALasFileCutWhileTiledIsAnError) {
