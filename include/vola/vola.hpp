@@ -12,3 +12,4 @@
 #include "vola/stream_builder.hpp"
 #include "vola/tree.hpp"
 #include "vola/version.hpp"
+#include "vola/voxel_reducer.hpp"
