@@ -10,8 +10,9 @@
 # classification) and from the LAS points (`vola translate` to XYZ): CRS, geotransform,
 # nodata, cropping, COG layout, and every cell's value, for dsm, dtm, intensity,
 # density and count, cells of the voxel size and of two voxels, a grid tree without
-# attributes (voxel faces) and a toolkit tree (bbox frame). A --map PNG's world file
-# must place every voxel column on its pixel as GDAL reads it.
+# attributes (voxel faces), a toolkit tree (bbox frame) and a reference file with an
+# EPSG code for its CRS. A --map PNG's world file must place every voxel column on its
+# pixel as GDAL reads it.
 # Exit status: 0 all good, 1 failures, 77 data or GDAL's Python missing (outside CI).
 set -uo pipefail
 
@@ -23,6 +24,7 @@ vola=$1
 shared=${VOLA_SHARED:-$2}
 python=${3:-/usr/bin/python3}
 las=$shared/data/las/pdal_autzen_trim.las
+golden=$shared/golden/crs29902_sparse/crs29902_sparse.vol  # a reference file: EPSG code only
 missing() {
   if [[ -n ${CI:-} ]]; then
     echo "FAIL: $1 (CI is set)" >&2
@@ -31,7 +33,7 @@ missing() {
   echo "SKIP: $1" >&2
   exit 77
 }
-[[ -f $las ]] || missing "$las is missing"
+[[ -f $las && -f $golden ]] || missing "$las or $golden is missing"
 "$python" -c 'import numpy; from osgeo import gdal, osr' 2>/dev/null || missing "$python has no numpy or osgeo.gdal"
 
 tmp=$(mktemp -d)
@@ -71,9 +73,12 @@ for product in dsm dtm intensity density count; do
 done
 run "$vola" export "$tmp/a.vol" "$tmp/a_dsm6.tif" --raster dsm --resolution 6 -q
 run "$vola" export "$tmp/a.vol" "$tmp/a_count6.tif" --raster count --resolution 6 -q
+run "$vola" export "$tmp/a.vol" "$tmp/a_intensity6.tif" --raster intensity --resolution 6 -q
 run "$vola" export "$tmp/b.vol" "$tmp/b_dsm.tif" --raster dsm -q
 run "$vola" export "$tmp/b.vol" "$tmp/b_dtm.tif" --raster dtm -q
 run "$vola" export "$tmp/t.vol" "$tmp/t_dsm.tif" --raster dsm -q
+run "$vola" export "$golden" "$tmp/g_count.tif" --raster count -q
+run "$vola" export "$golden" "$tmp/g.xyz" -q
 run "$vola" export "$tmp/a.vol" "$tmp/h.png" --map -q
 [[ -f $tmp/h.pgw ]] || fail "--map wrote no h.pgw world file"
 run "$vola" export "$tmp/a.vol" "$tmp/slices" --slices --depth 3 -q
@@ -243,14 +248,16 @@ check(np.all(dsm[valid] <= top_z[valid] + 1e-3) and np.all(dsm[valid] > top_z[va
 
 # Cells of two voxels: voxel column i goes to cell floor((i + 0.5) * 3 / 6) = i // 2.
 cols6, rows6, shape6 = grid_of(i // 2, j // 2)
+intensity6 = per_cell(cols6[top], rows6[top], a[top, col["intensity"]], mean, shape6)
 for product, want in (("dsm6", per_cell(cols6, rows6, height, vmax, shape6)),
-                      ("count6", per_cell(cols6, rows6, np.ones_like(x), vsum, shape6))):
+                      ("count6", per_cell(cols6, rows6, np.ones_like(x), vsum, shape6)),
+                      ("intensity6", intensity6)):
     name = f"a_{product}.tif"
     ds, band, got = read(name)
     check_file(name, ds, band, wkt)
     expect_grid(name, ds, 6.0, origin[0] + (i // 2).min() * 6, origin[1] + ((j // 2).max() + 1) * 6,
                 shape6[1], shape6[0])
-    expect_values(name, got, want)
+    expect_values(name, got, want, 1e-6 if product == "intensity6" else 0.0)
 
 # Without attributes: voxel faces.
 _, b = columns(f"{tmp}/b.xyz")
@@ -284,6 +291,17 @@ want = per_cell(tc, tr, t[:, 2] + step / 2, vmax, (ds.RasterYSize, ds.RasterXSiz
 valid = ~np.isnan(want)
 check(np.array_equal(got != NODATA, valid) and np.allclose(got[valid], want[valid], rtol=0, atol=1e-4),
       "t_dsm.tif: values are not the columns' top faces")
+
+# A reference file: toolkit grid from the header bbox, CRS as an EPSG code only.
+_, g = columns(f"{tmp}/g.xyz")
+ds, band, got = read("g_count.tif")
+srs = ds.GetSpatialRef()
+check(srs is not None and srs.GetAuthorityCode(None) == "29902", "g_count.tif: CRS is not EPSG:29902")
+gt = ds.GetGeoTransform()
+gc = np.floor((g[:, 0] - gt[0]) / gt[1]).astype(np.int64)
+gr = np.floor((g[:, 1] - gt[3]) / gt[5]).astype(np.int64)
+want = per_cell(gc, gr, np.ones(len(g)), vsum, (ds.RasterYSize, ds.RasterXSize))
+expect_values("g_count.tif", got, want)
 
 # --map: the world file places voxel column (i, j) on the pixel GDAL computes for its
 # centre, whose value is the column's highest k + 1.
