@@ -46,11 +46,13 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
   if (cell < voxel * (1.0 - 1e-9))
     throw InvalidArgument("raster resolution " + number(cell) + " is finer than the voxels (" + number(voxel) +
                           "): give the voxel size or more");
-  const bool one_to_one = cell == voxel;
-  // The cell holding voxel column i's centre, origin + (i + 0.5) * voxel.
+  // The cell holding voxel column i's centre, origin + (i + 0.5) * voxel, counted in
+  // voxels: exact for the ratios users give (R = 2.5 voxels puts the centre of column 2
+  // on the border of cells 0 and 1, and in cell 1).
+  const double ratio = cell / voxel;
   auto cell_of = [&](std::uint32_t i) -> std::uint64_t {
-    if (one_to_one) return i;
-    return static_cast<std::uint64_t>(std::floor((static_cast<double>(i) + 0.5) * voxel / cell));
+    if (ratio == 1.0) return i;
+    return static_cast<std::uint64_t>(std::floor((static_cast<double>(i) + 0.5) / ratio));
   };
 
   std::uint64_t u_min = std::numeric_limits<std::uint64_t>::max(), v_min = u_min, u_max = 0, v_max = 0;
