@@ -67,6 +67,7 @@ fails_keeping "generate" g.xyz "$vola" generate city out/g.xyz --points 5000
 fails_keeping "export binvox" e.binvox "$vola" export city.vol out/e.binvox -q
 fails_keeping "export ply" e.ply "$vola" export city.vol out/e.ply -q
 fails_keeping "export png map" e.png "$vola" export city.vol out/e.png --map -q
+fails_keeping "export tif raster" e.tif "$vola" export city.vol out/e.tif --raster dsm -q
 fails_keeping "render png" r.png "$vola" render city.vol -o out/r.png --size 64x48 -q
 fails_keeping "plan csv" p.csv "$vola" plan room.vol --from 1 1 1 --to 5 3 2 -o out/p.csv -q
 fails_keeping "sonify wav" s.wav "$vola" sonify room.vol --source 2 1.5 1.25 --listener 4 3 2 --in "$dry" \

@@ -1,5 +1,5 @@
-// vola export: a .vol file back out as PLY, XYZ, LAS, binvox, a dense NPY grid or PNG
-// images.
+// vola export: a .vol file back out as PLY, XYZ, LAS, binvox, a dense NPY grid, PNG
+// images or GeoTIFF rasters.
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -24,30 +24,57 @@ struct ExportArgs {
   int bits = 16;
   std::uint32_t above = 0;
   bool above_given = false;
+  std::string raster;       // dsm, dtm, ... (empty: no raster)
+  double resolution = 0.0;  // 0: the voxel size
+  bool resolution_given = false;
 };
 
-std::string format_from_extension(const std::string& path) {
+std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string format_from_extension(const std::string& path) {
+  const std::string ext = lower_extension(path);
   if (ext == ".ply") return "ply";
   if (ext == ".xyz" || ext == ".txt") return "xyz";
   if (ext == ".las" || ext == ".laz") return "las";
   if (ext == ".binvox") return "binvox";
   if (ext == ".npy") return "npy";
   if (ext == ".png") return "png";
+  if (ext == ".tif" || ext == ".tiff") return "tif";
   throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext +
-                        "'; say --format (ply, xyz, las, binvox, npy, png)");
+                        "'; say --format (ply, xyz, las, binvox, npy, png, tif)");
 }
 
 // The format, after checking that the options given apply to it.
 std::string resolve_format(const ExportArgs& a) {
   const int images = int{a.slices} + int{a.map} + int{a.above_given};
+  const bool raster = !a.raster.empty();
   if (images > 1) throw InvalidArgument("--slices, --map and --occupancy-above are different images: give one");
+  if (images && raster)
+    throw InvalidArgument("--raster writes a GeoTIFF, --slices, --map and --occupancy-above PNG images: give one");
   std::string format = a.format;
-  if (format == "auto") format = images ? "png" : format_from_extension(a.output);
+  if (format == "auto") format = images ? "png" : raster ? "tif" : format_from_extension(a.output);
   if (images && format != "png") throw InvalidArgument("--slices, --map and --occupancy-above write PNG, not " + format);
+  if (raster && format != "tif") throw InvalidArgument("--raster writes a GeoTIFF, not " + format);
+  // A map is a PNG of voxel units: under another name (a.tif) it would pass for what it
+  // is not.
+  if ((a.map || a.above_given) && a.format == "auto" && lower_extension(a.output) != ".png")
+    throw InvalidArgument(a.output + ": --map and --occupancy-above write PNG images (voxel units, with a .pgw world "
+                          "file): name OUT .png" +
+                          std::string(lower_extension(a.output) == ".tif" || lower_extension(a.output) == ".tiff"
+                                          ? "; for a GeoTIFF of elevations use --raster dsm (or dtm, intensity, "
+                                            "density, count)"
+                                          : ""));
+  if (raster && a.format == "auto" && lower_extension(a.output) != ".tif" && lower_extension(a.output) != ".tiff")
+    throw InvalidArgument(a.output + ": --raster writes a GeoTIFF: name OUT .tif");
   if (format == "png" && !images)
     throw InvalidArgument("PNG export needs --slices (OUT is a directory), --map or --occupancy-above Z");
+  if (format == "tif" && !raster)
+    throw InvalidArgument("GeoTIFF export needs --raster dsm, dtm, intensity, density or count");
+  if (a.resolution_given && !raster) throw InvalidArgument("--resolution applies to --raster");
   if ((a.ascii || a.cubes) && format != "ply") throw InvalidArgument("--ascii and --cubes apply to PLY export");
   if (a.bits != 16 && !a.map) throw InvalidArgument("--bits applies to --map");
   return format;
@@ -100,16 +127,32 @@ void run_export(const ExportArgs& a) {
   } else if (format == "npy") {
     io::write_npy_grid(tree, a.output);
     say("NPY uint8 grid of " + std::to_string(tree.side()) + "^3 cells, " + std::to_string(voxels) + " occupied");
+  } else if (format == "tif") {
+    io::RasterOptions options;
+    options.product = *io::raster_product(a.raster);
+    options.resolution = a.resolution;
+    const io::RasterReport r = io::write_geotiff(tree, a.output, options);
+    char cell[64];
+    std::snprintf(cell, sizeof cell, "%.17g", r.resolution);
+    say("GeoTIFF " + a.raster + " (Float32, COG, nodata " + std::to_string(static_cast<int>(io::kRasterNodata)) +
+        "): " + std::to_string(r.width) + " x " + std::to_string(r.height) + " cells of " + cell + ", " +
+        std::to_string(r.cells_with_data) + " with a value (" + r.rule + "), CRS " +
+        (r.has_crs ? "the file's" : "none (the file has no CRS)"));
   } else if (a.slices) {
-    const std::uint32_t images = io::write_png_slices(tree, a.output);
-    say(std::to_string(images) + " PNG slices of " + std::to_string(tree.side()) + "^2 pixels");
+    const std::uint32_t images = io::write_png_slices(tree, a.output, true);
+    say(std::to_string(images) + " PNG slices of " + std::to_string(tree.side()) +
+        "^2 pixels, each with a .pgw world file");
   } else if (a.map) {
     io::write_png_height_map(tree, a.output, a.bits);
-    say(std::to_string(a.bits) + "-bit PNG height map of " + std::to_string(tree.side()) + "^2 pixels");
+    const std::string world = io::write_world_file(tree, a.output);
+    say(std::to_string(a.bits) + "-bit PNG height map of " + std::to_string(tree.side()) +
+        "^2 pixels in voxel units (" + (a.bits == 16 ? "z index + 1" : "z scaled to 1..255") +
+        ", 0 empty; --raster dsm for elevations), world file " + world);
   } else {
     io::write_png_occupancy_above(tree, a.output, a.above);
+    const std::string world = io::write_world_file(tree, a.output);
     say("PNG occupancy map of voxels at z >= " + std::to_string(a.above) + ", " + std::to_string(tree.side()) +
-        "^2 pixels");
+        "^2 pixels, world file " + world);
   }
 }
 
@@ -117,7 +160,8 @@ void run_export(const ExportArgs& a) {
 
 void add_export(CLI::App& app) {
   auto args = std::make_shared<ExportArgs>();
-  auto* cmd = app.add_subcommand("export", "Write a .vol file as PLY, XYZ, LAS, binvox, a dense NPY grid or PNG images");
+  auto* cmd = app.add_subcommand(
+      "export", "Write a .vol file as PLY, XYZ, LAS, binvox, a dense NPY grid, PNG images or GeoTIFF rasters");
   cmd->footer(
       "Formats (from OUT's extension unless --format says):\n"
       "  .ply     voxel centres with every attribute as a vertex property (binary; --ascii),\n"
@@ -128,14 +172,25 @@ void add_export(CLI::App& app) {
       "  .laz     the same, LASzip-compressed (vola's own LAZ codec)\n"
       "  .binvox  binvox voxel grid\n"
       "  .npy     uint8 0/1 array of shape (S, S, S), index [x, y, z] (depth <= 5)\n"
-      "  .png     images, with one of:\n"
+      "  .png     images in voxel units (pixel = voxel column, values voxel indices, not\n"
+      "           elevations), each with a .pgw world file placing its pixels; one of:\n"
       "             --slices               OUT is a directory: one image per z slice, occupied\n"
       "                                    white, named depth<D>-<z>.png (depth <= 5)\n"
-      "             --map                  height map: highest occupied z + 1 per column, 0 if\n"
-      "                                    empty (16-bit; --bits 8 scales to 1..255)\n"
+      "             --map                  height map: highest occupied z index + 1 per column,\n"
+      "                                    0 if empty (16-bit; --bits 8 scales to 1..255)\n"
       "             --occupancy-above Z    black where a column has a voxel at z >= Z, else\n"
       "                                    white (the reference reader's --map)\n"
       "           Images show x to the right and y up (north up); maps stop at depth 7.\n"
+      "  .tif     --raster PRODUCT: a Float32 cloud-optimised GeoTIFF (DEFLATE) in the\n"
+      "           file's units and CRS, north up, nodata -9999, cropped to the occupied\n"
+      "           cells; cells of --resolution R units (default the voxel size; a voxel\n"
+      "           column goes to the cell holding its centre). PRODUCT per cell:\n"
+      "             dsm        max of the height column (mean point z per voxel, LAS) over\n"
+      "                        the voxels; without it, the highest voxel's top face\n"
+      "             dtm        min of height (else the lowest voxel's bottom face) over the\n"
+      "                        ground voxels (classification 2) if any, else all voxels\n"
+      "             intensity  mean intensity of each voxel column's top voxel\n"
+      "             density    occupied voxels per square unit; count: occupied voxels\n"
       "Positions are voxel centres in the file's coordinates. --depth K exports the coarser\n"
       "grid of the first K levels (4^K voxels per axis), e.g. to fit a dense format.\n"
       "Examples:\n"
@@ -144,24 +199,31 @@ void add_export(CLI::App& app) {
       "  vola export city.vol city.las\n"
       "  vola export city.vol grid.npy --depth 4\n"
       "  vola export city.vol slices --slices --depth 4\n"
-      "  vola export city.vol height.png --map\n"
+      "  vola export city.vol height.png --map                 # and height.pgw\n"
+      "  vola export autzen.vol dsm.tif --raster dsm\n"
+      "  vola export autzen.vol dtm.tif --raster dtm --resolution 6\n"
       "  vola export city.vol obstacles.png --occupancy-above 3");
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
-  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png")
-      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png"}))
+  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif")
+      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif"}))
       ->capture_default_str();
   cmd->add_flag("--ascii", args->ascii, "PLY: ascii instead of binary little-endian");
   cmd->add_flag("--cubes", args->cubes, "PLY: the voxels' outer surface as a quad mesh instead of centre points");
   cmd->add_option("--depth", args->depth, "Export the level-of-detail grid of this depth (1..file depth)")
       ->check(CLI::Range(1, 10));
   cmd->add_flag("--slices", args->slices, "PNG: one image per z slice into the directory OUT");
-  cmd->add_flag("--map", args->map, "PNG: top-down height map");
+  cmd->add_flag("--map", args->map, "PNG: top-down height map in voxel units (z index + 1)");
   cmd->add_option("--bits", args->bits, "--map: 16 (exact z + 1) or 8 (scaled)")
       ->check(CLI::IsMember({8, 16}))
       ->capture_default_str();
   cmd->add_option("--occupancy-above", args->above, "PNG: top-down occupancy map of the voxels at z >= Z (voxel units)")
       ->each([args](const std::string&) { args->above_given = true; });
+  cmd->add_option("--raster", args->raster, "GeoTIFF: dsm, dtm, intensity, density or count per cell")
+      ->check(CLI::IsMember({"dsm", "dtm", "intensity", "density", "count"}));
+  cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
+      ->check(CLI::PositiveNumber)
+      ->each([args](const std::string&) { args->resolution_given = true; });
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_export(*args); });
 }

@@ -1,12 +1,16 @@
-// Top-down images: a height map, and the reference reader's occupancy map (--map).
+// Top-down images: a height map, and the reference reader's occupancy map (--map); the
+// world files that place them.
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "vola/io/png_image.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola::io {
 
@@ -71,6 +75,30 @@ void write_png_occupancy_above(const Tree& tree, const std::string& path, std::u
     const unsigned top = tops[x + side * y];
     return top && top - 1 >= min_z ? 0 : 255;
   });
+}
+
+std::string world_file_path(const std::string& image_path) {
+  return std::filesystem::path(image_path).replace_extension(".pgw").string();
+}
+
+std::string write_world_file(const Tree& tree, const std::string& image_path) {
+  const Frame frame = tree.frame();
+  const double size = frame.voxel_size;
+  const double side = static_cast<double>(tree.side());
+  // The centre of the top-left pixel: voxel column (0, S - 1).
+  const double values[6] = {size, 0.0, 0.0, -size, frame.origin[0] + 0.5 * size, frame.origin[1] + (side - 0.5) * size};
+  std::string text;
+  for (const double value : values) {
+    char digits[32];
+    const auto result = std::to_chars(digits, digits + sizeof digits, value);  // shortest exact text
+    text.append(digits, result.ptr);
+    text += '\n';
+  }
+  const std::string path = world_file_path(image_path);
+  OutputFile out(path);
+  out.write(text);
+  out.commit();
+  return path;
 }
 
 }  // namespace vola::io

@@ -10,7 +10,7 @@
 
 namespace vola::io {
 
-std::uint32_t write_png_slices(const Tree& tree, const std::string& directory) {
+std::uint32_t write_png_slices(const Tree& tree, const std::string& directory, bool world_files) {
   if (tree.depth() > kMaxSliceDepth)
     throw InvalidArgument("slices of depth " + std::to_string(tree.depth()) + " would be " + std::to_string(tree.side()) +
                           " images of " + std::to_string(tree.side()) + "^2 pixels; slices stop at depth " +
@@ -44,6 +44,7 @@ std::uint32_t write_png_slices(const Tree& tree, const std::string& directory) {
       image.write_row(row.data());
     }
     image.finish();
+    if (world_files) write_world_file(tree, file.string());
   }
   return static_cast<std::uint32_t>(side);
 }

@@ -1,6 +1,6 @@
-// The entry points of the reader plugins libvola_gdal.so (elevation rasters through
-// GDAL) and libvola_assimp.so (meshes through Assimp); see src/plugin/plugin.hpp for why
-// they are plugins.
+// The entry points of the plugins libvola_gdal.so (elevation rasters read, GeoTIFF
+// rasters written, through GDAL) and libvola_assimp.so (meshes through Assimp); see
+// src/plugin/plugin.hpp for why they are plugins.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +10,7 @@
 
 #include "../plugin/plugin.hpp"
 #include "vola/io/dem.hpp"
+#include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::io {
@@ -22,7 +23,12 @@ namespace plugin {
 using ReadDemEntry = void (*)(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                               DemRaster& out, PluginFailure& failure);
 using ReadMeshEntry = void (*)(const std::string& path, std::vector<Triangle>& out, PluginFailure& failure);
+// The raster as a cloud-optimised GeoTIFF's bytes (write_geotiff in vola/io/export.hpp);
+// the CRS from `wkt`, else EPSG `epsg`, none when wkt is empty and epsg 0.
+using WriteGeotiffEntry = void (*)(const Raster& raster, const std::string& wkt, std::uint32_t epsg,
+                                   std::vector<std::uint8_t>& out, PluginFailure& failure);
 inline constexpr const char* kReadDemSymbol = "vola_plugin_read_dem";
+inline constexpr const char* kWriteGeotiffSymbol = "vola_plugin_write_geotiff";
 inline constexpr const char* kReadMeshSymbol = "vola_plugin_read_mesh";
 
 }  // namespace plugin

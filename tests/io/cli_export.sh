@@ -110,7 +110,8 @@ same_voxels "$tmp/binvox.vol" "binvox round trip"
 is_png() { [[ $(head -c 8 "$1" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]]; }
 png_size() { od -An -tu1 -j16 -N8 "$1" | awk '{ print $1*16777216 + $2*65536 + $3*256 + $4, $5*16777216 + $6*65536 + $7*256 + $8 }'; }
 "$vola" export "$tmp/a.vol" "$tmp/slices" --slices --depth 2 -q || fail "export --slices"
-[[ $(ls "$tmp/slices" | wc -l) -eq 16 ]] || fail "--slices --depth 2 wrote $(ls "$tmp/slices" | wc -l) images, not 16"
+[[ $(ls "$tmp/slices" | grep -c '\.png$') -eq 16 ]] || fail "--slices --depth 2 wrote $(ls "$tmp/slices" | grep -c '\.png$') images, not 16"
+[[ $(ls "$tmp/slices" | grep -c '\.pgw$') -eq 16 ]] || fail "--slices --depth 2: not one .pgw world file per image"
 is_png "$tmp/slices/depth2-015.png" || fail "depth2-015.png is not a PNG"
 [[ $(png_size "$tmp/slices/depth2-000.png") == "16 16" ]] || fail "slices are not 16x16"
 "$vola" export "$tmp/a.vol" "$tmp/h.png" --map -q || fail "export --map"

@@ -4,7 +4,6 @@
 #include <gdal_priv.h>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <ogr_spatialref.h>
 #include <string>
 #include <vector>
@@ -18,24 +17,6 @@
 namespace vola::io {
 
 namespace {
-
-// GDAL reports through a global handler that prints; the library never prints, so
-// errors are kept quiet while we read and taken from CPLGetLastErrorMsg.
-class QuietGdalErrors {
- public:
-  QuietGdalErrors() {
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    CPLErrorReset();
-  }
-  ~QuietGdalErrors() { CPLPopErrorHandler(); }
-  QuietGdalErrors(const QuietGdalErrors&) = delete;
-  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-};
-
-std::string gdal_message(const char* what) {
-  const char* message = CPLGetLastErrorMsg();
-  return std::string(what) + (message && *message ? std::string(": ") + message : std::string());
-}
 
 void crs_of(const GDALDataset& dataset, DemRaster& dem) {
   const OGRSpatialReference* srs = dataset.GetSpatialRef();
@@ -59,8 +40,7 @@ void crs_of(const GDALDataset& dataset, DemRaster& dem) {
 
 DemRaster read_dem_with_gdal(const std::string& path,
                              const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
-  static std::once_flag registered;
-  std::call_once(registered, [] { GDALAllRegister(); });
+  register_gdal_drivers();
   QuietGdalErrors quiet;
   const ConfinedGdalConfig confined;  // gdal_confined.hpp: one local file, nothing else
   const Dataset dataset = open_confined_raster(path);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <mutex>
 
 #include "vola/error.hpp"
 
@@ -55,6 +56,16 @@ void check_reads_only(GDALDataset& dataset, const std::string& path) {
 }
 
 }  // namespace
+
+void register_gdal_drivers() {
+  static std::once_flag registered;
+  std::call_once(registered, [] { GDALAllRegister(); });
+}
+
+std::string gdal_message(const char* what) {
+  const char* message = CPLGetLastErrorMsg();
+  return std::string(what) + (message && *message ? std::string(": ") + message : std::string());
+}
 
 ConfinedGdalConfig::ConfinedGdalConfig() {
   for (const auto& [key, value] : kConfinement) {

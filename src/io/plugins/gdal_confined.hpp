@@ -35,6 +35,25 @@ inline constexpr std::uint64_t kDemCellsPerByte = 256;
 inline constexpr std::uint64_t kDemBlockAllowance = std::uint64_t{64} << 20;
 inline constexpr std::uint64_t kDemBlockBytesPerByte = 256;
 
+// GDALAllRegister, once per process (thread safe).
+void register_gdal_drivers();
+
+// GDAL reports through a global handler that prints; the library never prints, so
+// errors are kept quiet while GDAL works and taken from CPLGetLastErrorMsg.
+class QuietGdalErrors {
+ public:
+  QuietGdalErrors() {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdalErrors() { CPLPopErrorHandler(); }
+  QuietGdalErrors(const QuietGdalErrors&) = delete;
+  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
+};
+
+// `what`, then ": " and GDAL's last error message when it has one.
+std::string gdal_message(const char* what);
+
 struct DatasetCloser {
   void operator()(GDALDataset* d) const { GDALClose(d); }
 };

@@ -1,5 +1,6 @@
-// The readers inside the plugins, as plain functions: what the plugins' entry points
-// run, and what the fuzz targets call directly (linked with GDAL or Assimp themselves).
+// The readers (and the GeoTIFF writer) inside the plugins, as plain functions: what the
+// plugins' entry points run, and what the fuzz targets call directly (linked with GDAL
+// or Assimp themselves).
 #pragma once
 
 #include <cstdint>
@@ -8,12 +9,16 @@
 #include <vector>
 
 #include "vola/io/dem.hpp"
+#include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::io {
 
 // As read_dem (vola/io/dem.hpp), through GDAL in this process.
 DemRaster read_dem_with_gdal(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress);
+// The GeoTIFF bytes of write_geotiff (vola/io/export.hpp), through GDAL in this process:
+// the CRS from `wkt`, else EPSG `epsg`, none when wkt is empty and epsg 0.
+std::vector<std::uint8_t> geotiff_with_gdal(const Raster& raster, const std::string& wkt, std::uint32_t epsg);
 // As read_mesh_triangles (vola/io/mesh.hpp), through Assimp in this process.
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path);
 
