@@ -68,6 +68,12 @@ MaterialTable parse_material_table(std::string_view text, const std::string& nam
     const auto at = what.find("at line");
     throw FormatError(name, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
                       "invalid JSON " + (at == std::string::npos ? what : what.substr(at)));
+  } catch (const nlohmann::json::exception& e) {
+    // A number beyond the range of doubles ("1e999") is nlohmann's out_of_range, not a
+    // parse_error: "[json.exception.out_of_range.406] number overflow parsing '1e999'".
+    const std::string what = e.what();
+    const auto at = what.find("] ");
+    throw FormatError(name, std::nullopt, "invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
   }
   if (!doc.is_object()) throw FormatError(name, std::nullopt, "the material table must be a JSON object");
   MaterialTable t;
