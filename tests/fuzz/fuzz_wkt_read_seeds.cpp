@@ -2,7 +2,8 @@
 // data folder's LAS files (beside golden/), the EPSG codes data/EXPECTED.txt names for
 // them, and definitions written here: WKT1 with TOWGS84 (a bound CRS), WKT2 with an ID,
 // a compound CRS with a vertical part, an engineering CRS, a PROJ string, a pipeline.
-// Linked into fuzz_wkt_read_replay in place of fuzz_seeds.cpp.
+// Each definition is a seed for every entry point (its selector byte first,
+// fuzz_wkt_read.cpp). Linked into fuzz_wkt_read_replay in place of fuzz_seeds.cpp.
 #include <algorithm>
 #include <cstring>
 #include <fstream>
@@ -20,6 +21,18 @@ namespace fs = std::filesystem;
 using Bytes = std::vector<std::uint8_t>;
 
 Seed text(const std::string& name, const std::string& s) { return {name, Bytes(s.begin(), s.end())}; }
+
+// The definitions, once for each of the six entry points.
+std::vector<Seed> for_each_entry_point(const std::vector<Seed>& definitions) {
+  std::vector<Seed> seeds;
+  for (std::uint8_t entry = 0; entry < 6; ++entry)
+    for (const Seed& d : definitions) {
+      Seed s{std::to_string(entry) + "_" + d.name, {entry}};
+      s.bytes.insert(s.bytes.end(), d.bytes.begin(), d.bytes.end());
+      seeds.push_back(std::move(s));
+    }
+  return seeds;
+}
 
 template <class T>
 T get(const Bytes& b, std::size_t at) {
@@ -48,7 +61,7 @@ std::vector<std::string> wkt_records(const Bytes& las) {
 }  // namespace
 
 std::vector<Seed> synthetic_seeds() {
-  return {
+  return for_each_entry_point({
       text("wkt1_bound.wkt",
            "PROJCS[\"NAD83 / UTM zone 15N\",GEOGCS[\"NAD83\",DATUM[\"North_American_Datum_1983\",SPHEROID[\"GRS 1980\","
            "6378137,298.257222101],TOWGS84[0,0,0,0,0,0,0]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],"
@@ -72,7 +85,7 @@ std::vector<Seed> synthetic_seeds() {
       text("pipeline.txt", "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=merc"),
       text("epsg_2056.txt", "EPSG:2056"),
       text("empty.txt", ""),
-  };
+  });
 }
 
 // WKT records of every LAS file in data/las and data/laz, and the EPSG codes of EXPECTED.txt.
@@ -101,7 +114,7 @@ std::vector<Seed> golden_seeds(const fs::path& golden) {
       if (seen.insert(code).second) seeds.push_back(text("code_" + (*it)[1].str(), code));
     }
   std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) { return a.name < b.name; });
-  return seeds;
+  return for_each_entry_point(seeds);
 }
 
 }  // namespace vola_fuzz
