@@ -93,8 +93,8 @@ std::vector<Seed> synthetic_seeds() {
 // the archive itself too.
 std::vector<Seed> golden_seeds(const fs::path& golden) {
   std::vector<Seed> seeds;
-  const auto folder = golden.parent_path() / "data" / "modelnet";
-  if (!fs::is_directory(folder)) return seeds;
+  const auto folder = shared_data(golden, "modelnet");
+  if (folder.empty()) return seeds;
   for (const auto& entry : fs::directory_iterator(folder)) {
     if (!entry.is_regular_file() || entry.path().extension() != ".npz") continue;
     const std::string path = entry.path().string(), stem = entry.path().stem().string();

@@ -118,8 +118,8 @@ std::vector<Seed> synthetic_seeds() {
 std::vector<Seed> golden_seeds(const fs::path& golden) {
   std::vector<Seed> seeds;
   const auto data = golden.parent_path() / "data";
-  const auto folder = data / "rgbd";
-  if (!fs::is_directory(folder)) return seeds;
+  const auto folder = shared_data(golden, "rgbd");
+  if (folder.empty()) return seeds;
   for (const auto& entry : fs::recursive_directory_iterator(folder)) {
     if (!entry.is_regular_file()) continue;
     const fs::path& p = entry.path();

@@ -83,8 +83,8 @@ std::vector<Seed> synthetic_seeds() {
 // Every .wav of the shared data folder's audio/, whole and shortened.
 std::vector<Seed> golden_seeds(const std::filesystem::path& golden) {
   std::vector<Seed> seeds;
-  const auto folder = golden.parent_path() / "data" / "audio";
-  if (!std::filesystem::is_directory(folder)) return seeds;
+  const auto folder = shared_data(golden, "audio");
+  if (folder.empty()) return seeds;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (!entry.is_regular_file() || entry.path().extension() != ".wav") continue;
     Bytes whole = read_all(entry.path());

@@ -93,8 +93,8 @@ std::vector<Seed> golden_seeds(const fs::path& golden) {
   std::vector<Seed> seeds;
   std::set<std::string> seen;
   for (const char* sub : {"las", "laz"}) {
-    const auto folder = golden.parent_path() / "data" / sub;
-    if (!fs::is_directory(folder)) continue;
+    const auto folder = shared_data(golden, sub);
+    if (folder.empty()) continue;
     for (const auto& entry : fs::directory_iterator(folder)) {
       if (!entry.is_regular_file()) continue;
       std::ifstream in(entry.path(), std::ios::binary);
