@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -67,6 +68,12 @@ MaterialTable parse_material_table(std::string_view text, const std::string& nam
     const auto at = what.find("at line");
     throw FormatError(name, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
                       "invalid JSON " + (at == std::string::npos ? what : what.substr(at)));
+  } catch (const nlohmann::json::exception& e) {
+    // A number beyond the range of doubles ("1e999") is nlohmann's out_of_range, not a
+    // parse_error: "[json.exception.out_of_range.406] number overflow parsing '1e999'".
+    const std::string what = e.what();
+    const auto at = what.find("] ");
+    throw FormatError(name, std::nullopt, "invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
   }
   if (!doc.is_object()) throw FormatError(name, std::nullopt, "the material table must be a JSON object");
   MaterialTable t;
@@ -85,12 +92,19 @@ MaterialTable parse_material_table(std::string_view text, const std::string& nam
   }
   if (!doc.contains("materials") || !doc["materials"].is_object())
     throw FormatError(name, std::nullopt, "missing \"materials\": an object mapping material ids to coefficients");
+  // JSON keeps one member per key, but "2" and "02" (or "0" and "-0") are different keys
+  // for the same id: each id may be listed once.
+  std::map<std::int64_t, std::string> keys;
   for (const auto& [key, value] : doc["materials"].items()) {
     const std::string where = "materials.\"" + key + "\"";
     std::int64_t id = 0;
     const auto [end, ec] = std::from_chars(key.data(), key.data() + key.size(), id);
     if (ec != std::errc() || end != key.data() + key.size())
       throw FormatError(name, std::nullopt, where + ": a material id must be an integer");
+    const auto [previous, added] = keys.emplace(id, key);
+    if (!added)
+      throw FormatError(name, std::nullopt,
+                        where + ": material id " + std::to_string(id) + " is already listed as \"" + previous->second + "\"");
     t.materials.emplace_back(id, parse_material(value, name, where));
   }
   if (t.source == MaterialSource::scene && !t.materials.empty())

@@ -83,13 +83,16 @@ Sound read_sound(const std::string& path) {
   s.sample_rate = info.samplerate;
   const auto channels = static_cast<std::size_t>(info.channels);
   s.channels.resize(channels);
-  std::vector<double> chunk(static_cast<std::size_t>(kChunkFrames) * channels);
+  // 64K samples a read whatever the header's channel count: a header claiming 256
+  // channels costs no more buffer than a mono one (it took 128 MiB before any sample).
+  const sf_count_t chunk_frames = std::max<sf_count_t>(1, kChunkFrames / static_cast<sf_count_t>(channels));
+  std::vector<double> chunk(static_cast<std::size_t>(chunk_frames) * channels);
   for (;;) {
-    const sf_count_t got = sf_readf_double(file.get(), chunk.data(), kChunkFrames);
+    const sf_count_t got = sf_readf_double(file.get(), chunk.data(), chunk_frames);
     if (got < 0) throw IoError(path + ": " + sf_strerror(file.get()));
     for (sf_count_t f = 0; f < got; ++f)
       for (std::size_t c = 0; c < channels; ++c) s.channels[c].push_back(chunk[static_cast<std::size_t>(f) * channels + c]);
-    if (got < kChunkFrames) break;
+    if (got < chunk_frames) break;
   }
   if (sf_error(file.get()) != SF_ERR_NO_ERROR) throw IoError(path + ": " + sf_strerror(file.get()));
   return s;

@@ -135,12 +135,14 @@ VoxelGrid parse_binvox(std::span<const std::uint8_t> bytes, const std::string& n
                                     std::to_string(bytes.size()) + " bytes (kBinvoxVoxelAllowance + " +
                                     std::to_string(kBinvoxVoxelsPerByte) + " per byte)");
   grid.voxels.reserve(static_cast<std::size_t>(occupied));
+  // Copies: clang 14 cannot capture structured bindings in a lambda.
+  const std::uint64_t bc = b * c, c_side = c;
   walk_runs(bytes, at, cells, name, [&](std::uint8_t value, std::uint64_t first, std::uint64_t count) {
     if (!value) return;
     for (std::uint64_t i = first; i < first + count; ++i) {
-      const std::uint64_t x = i / (b * c), zy = i % (b * c);
-      grid.voxels.push_back(
-          {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(zy % c), static_cast<std::uint32_t>(zy / c)});
+      const std::uint64_t x = i / bc, zy = i % bc;
+      grid.voxels.push_back({static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(zy % c_side),
+                             static_cast<std::uint32_t>(zy / c_side)});
     }
   });
   return grid;

@@ -1,9 +1,12 @@
 #include "network.hpp"
 
 #include <unistd.h>
+#include <zip.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <new>
+#include <vector>
 
 #include "vola/error.hpp"
 #include "vola/learn/occupancy.hpp"
@@ -68,7 +71,12 @@ struct SmallNet : Network {
   }
 };
 
-std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+// The first line of libtorch's message that says something (some begin with a newline).
+std::string first_line(const std::string& text) {
+  const auto begin = text.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return "(libtorch gave no reason)";
+  return text.substr(begin, text.find('\n', begin) - begin);
+}
 
 }  // namespace
 
@@ -110,17 +118,68 @@ Architecture read_architecture(torch::serialize::InputArchive& archive, const st
     if (value != static_cast<std::int64_t>(Architecture::paper) && value != static_cast<std::int64_t>(Architecture::small))
       throw FormatError(path, std::nullopt, "unknown network architecture " + std::to_string(value));
     return static_cast<Architecture>(value);
-  } catch (const c10::Error& error) {
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& error) {  // c10::Error, and libtorch's std::runtime_errors
     throw FormatError(path, std::nullopt, "not a vola model (no architecture record): " + first_line(error.what()));
+  }
+}
+
+// libtorch (1.13) reads a model's zip without checking its records' CRC-32s or that the
+// local headers agree with the central directory, then compiles the TorchScript and
+// unpickles what the records hold; on damaged records it has freed invalid pointers
+// (docs/SECURITY.md). So the archive is checked first with libzip: consistent headers,
+// every record read through to the end (libzip compares its CRC there), no record
+// stating more bytes than the file holds. A damaged model is then a FormatError before
+// libtorch sees it; a deliberately crafted one (valid CRCs) still reaches libtorch.
+void check_model_archive(const std::string& path) {
+  std::error_code error;
+  const std::uint64_t file_bytes = std::filesystem::file_size(path, error);
+  if (error) throw IoError("cannot open model " + path + ": " + error.message());
+  int code = 0;
+  std::unique_ptr<zip_t, void (*)(zip_t*)> archive(zip_open(path.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &code),
+                                                   [](zip_t* z) { zip_discard(z); });
+  if (!archive) {
+    zip_error_t reason;
+    zip_error_init_with_code(&reason, code);
+    const std::string message = zip_error_strerror(&reason);
+    zip_error_fini(&reason);
+    throw FormatError(path, std::nullopt, "not a torch model archive (zip): " + message);
+  }
+  const zip_int64_t count = zip_get_num_entries(archive.get(), 0);
+  std::vector<char> sink(64 * 1024);
+  for (zip_int64_t i = 0; i < count; ++i) {
+    zip_stat_t stat;
+    zip_stat_init(&stat);
+    if (zip_stat_index(archive.get(), static_cast<zip_uint64_t>(i), 0, &stat) != 0)
+      throw FormatError(path, std::nullopt, "zip record " + std::to_string(i) + ": " + zip_strerror(archive.get()));
+    const std::string name = stat.valid & ZIP_STAT_NAME ? stat.name : "record " + std::to_string(i);
+    if ((stat.valid & ZIP_STAT_COMP_SIZE) && stat.comp_size > file_bytes)
+      throw FormatError(path, std::nullopt, name + ": states " + std::to_string(stat.comp_size) +
+                                                " stored bytes, more than the file's " + std::to_string(file_bytes));
+    std::unique_ptr<zip_file_t, int (*)(zip_file_t*)> member(zip_fopen_index(archive.get(), static_cast<zip_uint64_t>(i), 0),
+                                                             zip_fclose);
+    if (!member) throw FormatError(path, std::nullopt, name + ": " + zip_strerror(archive.get()));
+    zip_int64_t got = 0;
+    while ((got = zip_fread(member.get(), sink.data(), sink.size())) > 0) {
+    }
+    if (got < 0) throw FormatError(path, std::nullopt, name + ": " + zip_file_strerror(member.get()));
   }
 }
 
 void load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) throw IoError("cannot open model " + path + ": no such file");
+  check_model_archive(path);
   try {
     archive.load_from(path);
-  } catch (const c10::Error& failure) {
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& failure) {
+    // c10::Error, and what libtorch's TorchScript and pickle readers throw as plain
+    // std::runtime_error ("expected a valid token but found ''").
     throw FormatError(path, std::nullopt, "not a torch archive: " + first_line(failure.what()));
   }
 }
@@ -130,7 +189,11 @@ void read_weights(torch::serialize::InputArchive& archive, Network& network, con
     torch::serialize::InputArchive weights;
     if (!archive.try_read("model", weights)) throw FormatError(path, std::nullopt, "no network weights ('model')");
     network.load(weights);
-  } catch (const c10::Error& failure) {
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& failure) {  // c10::Error, and libtorch's std::runtime_errors
     throw FormatError(path, std::nullopt, "weights do not fit the network: " + first_line(failure.what()));
   }
 }

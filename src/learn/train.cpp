@@ -1,6 +1,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <new>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -69,7 +70,11 @@ int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectur
     optimizer.load(optimizer_state);
     archive.read("epochs_done", epochs_done);
     return static_cast<int>(epochs_done.item<std::int64_t>());
-  } catch (const c10::Error& failure) {
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& failure) {  // c10::Error, and libtorch's std::runtime_errors
     const std::string what = failure.what();
     throw FormatError(path, std::nullopt, "damaged checkpoint: " + what.substr(0, what.find('\n')));
   }

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 
 #include "vola/error.hpp"
@@ -152,10 +153,14 @@ DepthImage read_pgm_depth(const std::string& path, const std::vector<std::uint8_
     throw FormatError(path, std::nullopt, "PGM: depth needs 16-bit samples (maxval 256..65535), found maxval " +
                                               std::to_string(maxval));
   if (width == 0 || height == 0) throw FormatError(path, std::nullopt, "PGM: empty image");
-  const std::uint64_t need = width * height * 2;
-  if (bytes.size() - at < need)
+  // Sizes of up to ten digits each: width * height * 2 could wrap around 64 bits, so the
+  // samples the file holds are compared by division.
+  const std::uint64_t samples = (bytes.size() - at) / 2;
+  if (width > std::numeric_limits<std::uint32_t>::max() || height > std::numeric_limits<std::uint32_t>::max() ||
+      height > samples / width)
     throw FormatError(path, bytes.size(), "PGM: truncated: " + std::to_string(width) + " x " + std::to_string(height) +
-                                              " 16-bit samples need " + std::to_string(need) + " bytes after the header");
+                                              " 16-bit samples need more than the " + std::to_string(bytes.size() - at) +
+                                              " bytes after the header");
   DepthImage image;
   image.width = static_cast<std::uint32_t>(width);
   image.height = static_cast<std::uint32_t>(height);

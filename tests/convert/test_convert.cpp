@@ -180,6 +180,21 @@ TEST(DescribeCrs, NamesWhatProjFindsAndInventsNoCode) {
   EXPECT_THROW(vola::geo::describe_crs("not a crs"), vola::Error);
 }
 
+// A CRS read from a file (a LAS WKT record, a tile index) may not make PROJ read other
+// local files: "+init=FILE:id" is refused, not read. (Grid files named by path, as in
+// "+nadgrids=FILE", are not opened either; PROJ treats a grid it cannot open as absent.)
+TEST(DescribeCrs, DefinitionsCannotReadOtherLocalFiles) {
+  vola_test::TempDir dir;
+  const std::string init = (dir / "init").string();
+  const std::string line = "<site> +proj=utm +zone=33 +datum=WGS84 +units=m +no_defs <>\n";
+  vola_test::write_bytes(dir / "init", std::vector<std::uint8_t>(line.begin(), line.end()));
+  EXPECT_THROW(vola::geo::describe_crs("+init=" + init + ":site +type=crs"), vola::Error);
+  EXPECT_THROW(vola::geo::crs_wkt1("+init=" + init + ":site"), vola::Error);
+  // PROJ's own definitions and grids are still found.
+  EXPECT_EQ(vola::geo::describe_crs("+proj=utm +zone=33 +datum=WGS84 +units=m +no_defs +type=crs").kind, "projected");
+  EXPECT_EQ(vola::geo::epsg_from_wkt(vola::geo::crs_wkt(32633)), 32633u);
+}
+
 TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {
   VOLA_REQUIRE_DATA(data);
   const std::string las = (data / "las" / "pdal_autzen_trim.las").string();

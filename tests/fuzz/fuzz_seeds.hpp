@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,5 +30,14 @@ std::vector<Seed> synthetic_seeds();
 // Every .vol / .dvol / .dvol.gz below `golden` (gunzipped with gzip -dc). Throws
 // std::runtime_error when a file cannot be read.
 std::vector<Seed> golden_seeds(const std::filesystem::path& golden);
+
+// `golden`'s sibling data/<sub> (the shared data folder's files), or an empty path when it
+// is missing; with CI set a missing folder throws std::runtime_error instead.
+inline std::filesystem::path shared_data(const std::filesystem::path& golden, const std::string& sub) {
+  const auto path = golden.parent_path() / "data" / sub;
+  if (std::filesystem::exists(path)) return path;
+  if (std::getenv("CI")) throw std::runtime_error("shared data " + path.string() + " is missing (CI is set; set VOLA_SHARED)");
+  return {};
+}
 
 }  // namespace vola_fuzz

@@ -9,7 +9,8 @@
 // --regressions: a folder of inputs that once failed (tests/fuzz/regressions), replayed
 // and mutated like the other seeds.
 //
-// With FILEs (e.g. libFuzzer crash artifacts) only those are replayed. The golden
+// With FILEs (e.g. libFuzzer crash artifacts) only those are replayed. With
+// VOLA_FUZZ_LAST_INPUT=FILE each input is first written to FILE (the one a crash ends on). The golden
 // folder defaults to $VOLA_SHARED/golden; when it is missing the run is skipped
 // (exit 77), or fails when the environment variable CI is set.
 #include <chrono>
@@ -122,7 +123,16 @@ void mutate_once(Bytes& b, std::mt19937_64& rng) {
   }
 }
 
-void run(const Bytes& b) { LLVMFuzzerTestOneInput(b.data(), b.size()); }
+// VOLA_FUZZ_LAST_INPUT=FILE: each input is written to FILE before it runs, so that the
+// one a crash (an abort, a heap error in a library) ended on is left there.
+void run(const Bytes& b) {
+  static const char* last = std::getenv("VOLA_FUZZ_LAST_INPUT");
+  if (last && *last) {
+    std::ofstream out(last, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  }
+  LLVMFuzzerTestOneInput(b.data(), b.size());
+}
 
 bool write_file(const fs::path& path, const Bytes& bytes) {
   std::ofstream out(path, std::ios::binary);

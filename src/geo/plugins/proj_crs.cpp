@@ -2,9 +2,14 @@
 // proj_plugin.hpp (vola/geo/crs.hpp documents what each does).
 #include <proj.h>
 
+#include <sys/types.h>
+
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "../proj_plugin.hpp"
 #include "vola/error.hpp"
@@ -22,10 +27,87 @@ struct PjDeleter {
 using Context = std::unique_ptr<PJ_CONTEXT, ContextDeleter>;
 using Pj = std::unique_ptr<PJ, PjDeleter>;
 
+// PROJ opens files a definition names: "+init=/any/file:id", grids ("+nadgrids=/any/file",
+// a WKT PARAMETERFILE), and bare names in the current directory after its own. A
+// definition read from a file (a LAS WKT record, a tile index's crs_wkt) may not make
+// vola read other local files (docs/SECURITY.md, "no escapes"), so every context opens
+// files through this API, which allows only paths inside PROJ's own data directories
+// (proj_info().searchpath: PROJ_DATA, the user's PROJ folder, the installed data), after
+// resolving "..", and symbolic links.
+const std::vector<std::string>& proj_data_directories() {
+  static const std::vector<std::string> directories = [] {
+    std::vector<std::string> out;
+    const char* searchpath = proj_info().searchpath;
+    const std::string all = searchpath ? searchpath : "";
+    for (std::size_t start = 0; start <= all.size();) {
+      std::size_t end = all.find(':', start);
+      if (end == std::string::npos) end = all.size();
+      std::error_code error;
+      const auto directory = std::filesystem::weakly_canonical(all.substr(start, end - start), error);
+      if (end > start && !error) out.push_back(directory.string());
+      start = end + 1;
+    }
+    return out;
+  }();
+  return directories;
+}
+
+bool inside_proj_data(const char* name) {
+  if (!name || !*name) return false;
+  std::error_code error;
+  const std::string path = std::filesystem::weakly_canonical(std::filesystem::absolute(name, error), error).string();
+  if (error) return false;
+  for (const auto& d : proj_data_directories())
+    if (path.size() > d.size() && path.compare(0, d.size(), d) == 0 && path[d.size()] == '/') return true;
+  return false;
+}
+
+std::FILE* file_of(PROJ_FILE_HANDLE* handle) { return reinterpret_cast<std::FILE*>(handle); }
+
+const PROJ_FILE_API kConfinedFiles{
+    1,
+    [](PJ_CONTEXT*, const char* name, PROJ_OPEN_ACCESS access, void*) -> PROJ_FILE_HANDLE* {
+      if (!inside_proj_data(name)) return nullptr;
+      const char* mode = access == PROJ_OPEN_ACCESS_READ_ONLY     ? "rb"
+                         : access == PROJ_OPEN_ACCESS_READ_UPDATE ? "r+b"
+                                                                  : "w+b";
+      return reinterpret_cast<PROJ_FILE_HANDLE*>(std::fopen(name, mode));
+    },
+    [](PJ_CONTEXT*, PROJ_FILE_HANDLE* f, void* buffer, std::size_t bytes, void*) {
+      return std::fread(buffer, 1, bytes, file_of(f));
+    },
+    [](PJ_CONTEXT*, PROJ_FILE_HANDLE* f, const void* buffer, std::size_t bytes, void*) {
+      return std::fwrite(buffer, 1, bytes, file_of(f));
+    },
+    [](PJ_CONTEXT*, PROJ_FILE_HANDLE* f, long long offset, int whence, void*) -> int {
+      return ::fseeko(file_of(f), static_cast<off_t>(offset), whence) == 0;
+    },
+    [](PJ_CONTEXT*, PROJ_FILE_HANDLE* f, void*) -> unsigned long long {
+      const off_t at = ::ftello(file_of(f));
+      return at < 0 ? 0 : static_cast<unsigned long long>(at);
+    },
+    [](PJ_CONTEXT*, PROJ_FILE_HANDLE* f, void*) { std::fclose(file_of(f)); },
+    [](PJ_CONTEXT*, const char* name, void*) -> int {
+      std::error_code error;
+      return inside_proj_data(name) && std::filesystem::exists(name, error);
+    },
+    [](PJ_CONTEXT*, const char* name, void*) -> int {
+      std::error_code error;
+      if (!inside_proj_data(name)) return false;
+      std::filesystem::create_directories(name, error);
+      return std::filesystem::is_directory(name, error);
+    },
+    [](PJ_CONTEXT*, const char* name, void*) -> int { return inside_proj_data(name) && std::remove(name) == 0; },
+    [](PJ_CONTEXT*, const char* from, const char* to, void*) -> int {
+      return inside_proj_data(from) && inside_proj_data(to) && std::rename(from, to) == 0;
+    },
+};
+
 Context make_context() {
   Context ctx(proj_context_create());
   if (!ctx) throw Error("PROJ: cannot create a context");
   proj_log_level(ctx.get(), PJ_LOG_NONE);
+  if (!proj_context_set_fileapi(ctx.get(), &kConfinedFiles, nullptr)) throw Error("PROJ: cannot confine its file access");
   return ctx;
 }
 

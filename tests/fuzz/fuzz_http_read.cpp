@@ -1,0 +1,83 @@
+// Fuzz entry point of vola view's request handling: the input is what one client sends
+// on a connection before closing its side, answered by Server::respond (the same
+// request stream, limits, cpp-httplib parser, Host and UTF-8 guards and routes as a
+// socket) by a server showing a small tree with attributes, served as 127.0.0.1:8080.
+// Nothing may crash or throw; every answer starts with an HTTP/1.1 status line of
+// 100..599, never 500 (an exception escaping a route).
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <unistd.h>
+
+#include "fuzz_seeds.hpp"
+#include "vola/error.hpp"
+#include "vola/file.hpp"
+#include "vola/viewer/server.hpp"
+#include "vola/vola.hpp"
+
+namespace vola_fuzz {
+Stats& stats() {
+  static Stats s;
+  return s;
+}
+}  // namespace vola_fuzz
+
+namespace {
+
+void check(bool invariant) {
+  if (!invariant) std::abort();
+}
+
+vola::viewer::Server& server() {
+  static const std::unique_ptr<vola::viewer::Server> s = [] {
+    vola::PointCloud cloud;
+    vola::PointAttribute intensity{"intensity", vola::ValueType::u16, vola::Reduction::max, {}};
+    for (int i = 0; i < 200; ++i) {
+      cloud.xyz.insert(cloud.xyz.end(), {0.37 * i, 10.0 + (i * 7) % 23, 0.5 * (i % 11)});
+      cloud.payload.push_back(static_cast<std::uint64_t>(i));
+      intensity.values.push_back(i * 100);
+    }
+    cloud.attributes.push_back(intensity);
+    vola::BuildOptions options;
+    options.depth = 4;
+    options.payload = true;
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("vola_fuzz_http_" + std::to_string(::getpid()) + ".vol")).string();
+    vola::write(vola::build(cloud, options), path);
+    std::vector<std::unique_ptr<vola::viewer::ViewedFile>> files;
+    files.push_back(std::make_unique<vola::viewer::ViewedFile>(path));
+    std::filesystem::remove(path);
+    vola::viewer::ServerOptions server_options;
+    server_options.port = 8080;
+    return std::make_unique<vola::viewer::Server>(std::move(files), server_options);
+  }();
+  return *s;
+}
+
+// The status of every answer in `out` (pipelined requests get several).
+bool statuses_ok(std::string_view out, bool& any_ok) {
+  std::size_t at = 0;
+  while ((at = out.find("HTTP/1.1 ", at)) != std::string_view::npos) {
+    if (at + 12 > out.size()) return false;
+    const int code = std::atoi(std::string(out.substr(at + 9, 3)).c_str());
+    if (code < 100 || code > 599 || code == 500) return false;
+    any_ok |= code == 200;
+    at += 12;
+  }
+  return true;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string answer = server().respond(std::string_view(reinterpret_cast<const char*>(data), size));
+  check(answer.empty() || answer.starts_with("HTTP/1.1 "));
+  bool any_ok = false;
+  check(statuses_ok(answer, any_ok));
+  ++(any_ok ? vola_fuzz::stats().parsed : vola_fuzz::stats().refused);
+  return 0;
+}
