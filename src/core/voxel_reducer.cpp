@@ -320,6 +320,15 @@ inline void update_small(std::byte* p, double v, bool first) noexcept {
   else put(p, x);  // last
 }
 
+// A narrow majority slot holds the voxel's first value; a point with another value is
+// counted in `others` by (rank, value).
+template <class T, class Others>
+inline void update_majority(std::byte* p, double v, bool first, Others& others, std::uint64_t rank) {
+  const T x = static_cast<T>(v);
+  if (first) put(p, x);
+  else if (load<T>(p) != x) ++others[PairKey{rank, bits_of(v)}];
+}
+
 // What one attribute does per point, resolved once per call.
 enum class Op : std::uint8_t {
   f64_mean, f64_max, f64_min, f64_last, f64_majority,
@@ -435,21 +444,11 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
         case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
         case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
         case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
-        case Op::u8_majority: {
-          const auto x = static_cast<std::uint8_t>(v);
-          if (first) put(p, x);
-          else if (load<std::uint8_t>(p) != x) ++s.others[a][PairKey{rank, bits_of(v)}];
-          break;
-        }
+        case Op::u8_majority: update_majority<std::uint8_t>(p, v, first, s.others[a], rank); break;
         case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
         case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
         case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
-        case Op::u16_majority: {
-          const auto x = static_cast<std::uint16_t>(v);
-          if (first) put(p, x);
-          else if (load<std::uint16_t>(p) != x) ++s.others[a][PairKey{rank, bits_of(v)}];
-          break;
-        }
+        case Op::u16_majority: update_majority<std::uint16_t>(p, v, first, s.others[a], rank); break;
       }
     }
     put(row, count + 1);

@@ -25,17 +25,11 @@
 #include "readers.hpp"  // src/io/plugins: the reader itself, not its plugin
 
 namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
 const char* const kDemExtensions[2] = {"tif", "asc"};
 }  // namespace vola_fuzz
 
 namespace {
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 bool small_enough(const std::string& path) {
   static std::once_flag registered;

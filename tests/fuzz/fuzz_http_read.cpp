@@ -19,18 +19,9 @@
 #include "vola/viewer/server.hpp"
 #include "vola/vola.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 vola::viewer::Server& server() {
   static const std::unique_ptr<vola::viewer::Server> s = [] {

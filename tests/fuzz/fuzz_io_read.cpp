@@ -23,18 +23,9 @@
 #include "vola/io/ply.hpp"
 #include "vola/vola.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 void check_cloud(const vola::PointCloud& cloud) {
   check(cloud.xyz.size() % 3 == 0);

@@ -13,13 +13,6 @@
 #include "vola/error.hpp"
 #include "vola/io/laz.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
 namespace laz = vola::io::laz;
@@ -28,9 +21,7 @@ namespace laz = vola::io::laz;
 constexpr std::uint64_t kMaxRecordBytes = std::uint64_t{32} << 20;
 constexpr std::uint16_t kMaxRecordLength = 512;
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 template <class T>
 bool get(std::span<const std::uint8_t> b, std::size_t at, T& v) {

@@ -16,18 +16,9 @@
 #include "vola/error.hpp"
 #include "vola/vola.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 void check_material(const vola::audio::Material& m) {
   check(m.bands.size() == 1 || m.bands.size() == vola::audio::kOctaveBands.size());

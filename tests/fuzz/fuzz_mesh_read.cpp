@@ -15,10 +15,6 @@
 #include "vola/io/mesh.hpp"
 
 namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
 // The extension of each selector value (fuzz_mesh_read_seeds.cpp writes seeds with it).
 extern const char* const kMeshExtensions[5];
 const char* const kMeshExtensions[5] = {"stl", "obj", "off", "dae", "gltf"};

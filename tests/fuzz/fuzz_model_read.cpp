@@ -18,13 +18,6 @@
 #include "vola/error.hpp"
 #include "vola/learn/classifier.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = vola_fuzz::scratch_file("model", "pt", std::span(data, size));
   try {

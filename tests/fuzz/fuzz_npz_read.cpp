@@ -15,18 +15,9 @@
 #include "vola/error.hpp"
 #include "vola/learn/npz.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 }  // namespace
 

@@ -10,18 +10,9 @@
 #include "fuzz_seeds.hpp"
 #include "vola/vola.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 void exercise(const vola::Tree& tree) {
   // Walk every voxel; the first few are queried one by one.

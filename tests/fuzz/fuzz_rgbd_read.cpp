@@ -19,18 +19,9 @@
 #include "vola/slam/image.hpp"
 #include "vola/slam/sequence.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 void check_poses(const std::vector<vola::slam::StampedPose>& poses) {
   for (const auto& p : poses) {

@@ -23,7 +23,16 @@ struct Stats {
   std::uint64_t parsed = 0;
   std::uint64_t refused = 0;
 };
-Stats& stats();
+// One counter per program (inline: every target and its replay share it).
+inline Stats& stats() {
+  static Stats s;
+  return s;
+}
+
+// A broken invariant of what a reader returned: abort, so that libFuzzer keeps the input.
+inline void check(bool invariant) {
+  if (!invariant) std::abort();
+}
 
 // Files written by the library.
 std::vector<Seed> synthetic_seeds();

@@ -16,18 +16,9 @@
 #include "vola/error.hpp"
 #include "vola/tile/tile_index.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 void check_file(const std::string& file) {
   check(!file.empty() && file.front() != '/' && file.find("..") == std::string::npos);

@@ -14,18 +14,9 @@
 #include "vola/audio/wav.hpp"
 #include "vola/error.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 }  // namespace
 

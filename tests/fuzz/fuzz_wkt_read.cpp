@@ -17,18 +17,9 @@
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 
-namespace vola_fuzz {
-Stats& stats() {
-  static Stats s;
-  return s;
-}
-}  // namespace vola_fuzz
-
 namespace {
 
-void check(bool invariant) {
-  if (!invariant) std::abort();
-}
+using vola_fuzz::check;
 
 template <class F>
 bool accepted(F&& f) {
