@@ -12,7 +12,7 @@ set -euo pipefail
 vola=$1 out=$2 points=${3:-1000000000} memory=${4:-2G} threads=${5:-0}
 rm -rf "$out"
 baseline=$(/usr/bin/time -f '%M' "$vola" --version 2>&1 > /dev/null | tail -1)
-/usr/bin/time -v "$vola" tile --generate-survey "$points" --tile-size 1024 --depth 6 --crs 32633 \
+/usr/bin/time -v "$vola" tile --generate-survey "$points" --tile-size 1024 --depth 6 --assign-crs 32633 \
   --memory "$memory" --threads "$threads" -o "$out" 2> "$out.time" | tee "$out.summary"
 peak=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$out.time")
 wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$out.time")

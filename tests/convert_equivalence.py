@@ -36,7 +36,8 @@ GENERIC_PATTERNS = [
 ]
 GENERIC_OPTIONS = [
     {"quantize": "toolkit", "depth": 4},
-    {"quantize": "grid", "depth": 5},
+    # Some inputs are in degrees (EPSG:4326), refused as grid voxels unless allowed.
+    {"quantize": "grid", "depth": 5, "allow_geographic": True},
 ]
 # Options beyond the basics, each on a real file that exercises it.
 SPECIFIC_CASES = [
@@ -48,7 +49,8 @@ SPECIFIC_CASES = [
     ("data/las/pdal_autzen_trim.las",
      {"quantize": "toolkit", "depth": 6, "bbox": [636500.0, 849000.0, 400.0, 638000.0, 851000.0, 600.0]}),
     ("data/las/pdal_1.2-with-color.las", {"voxel_size": 50.0, "epsg": 32615}),
-    ("data/las/pdal_epsg_4326.las", {"voxel_size": 0.001}),
+    ("data/las/pdal_1.2-with-color.las", {"voxel_size": 50.0, "assign_crs": "EPSG:32615"}),
+    ("data/las/pdal_epsg_4326.las", {"voxel_size": 0.001, "allow_geographic": True}),
     ("data/las/pdal_autzen_trim.las", {"voxel_size": 5.0, "target_crs": "EPSG:32610"}),
     ("data/las/pdal_epsg_4326.las", {"voxel_size": 1.0, "target_crs": "32615", "attributes": False}),
     ("data/las/pdal_extrabytes.las", {"voxel_size": 1.0}),
@@ -60,7 +62,7 @@ SPECIFIC_CASES = [
     ("data/binvox/trimesh_chair_model.binvox", {}),
     ("data/dem/pdal_gdal_int16_epsg26711.tif", {"voxel_size": 60.0, "dem_base": 0.0}),
     ("data/dem/pdal_gdal_int16_epsg26711.tif", {"voxel_size": 60.0, "dem_surface_only": True}),
-    ("data/dem/pysheds_dem_int16_tiled_epsg4326.tif", {"voxel_size": 0.005}),
+    ("data/dem/pysheds_dem_int16_tiled_epsg4326.tif", {"voxel_size": 0.005, "allow_geographic": True}),
     ("data/bench/surface_points_1e6.npy", {"quantize": "toolkit", "depth": 5, "compress": True}),
     ("golden/d2_sparse_n1/input.txt", {"quantize": "toolkit", "depth": 2, "nbits": 1}),
     ("golden/d2_dense_n1/input.txt", {"quantize": "toolkit", "depth": 2, "nbits": 1, "dense": True}),
@@ -115,7 +117,7 @@ def cli_flags(options):
             for spec in value:
                 flags += ["--attribute", spec]
         elif key == "epsg":
-            flags += ["--crs", str(value)]
+            flags += ["--assign-crs", str(value)]
         elif isinstance(value, bool):
             if value:
                 flags.append("--" + key.replace("_", "-"))

@@ -125,7 +125,7 @@ while IFS=$'\t' read -r case_name depth mode nbits crs _npoints _nvoxels vol_fil
   dir=$golden/$case_name
   ours=$tmp/$case_name.out
 
-  args=(convert "$dir/input.txt" "$ours" --quantize toolkit --depth "$depth" --crs "$crs")
+  args=(convert "$dir/input.txt" "$ours" --quantize toolkit --depth "$depth" --assign-crs "$crs")
   [[ $mode == 1 ]] && args+=(--dense)
   [[ $nbits != 0 ]] && args+=(--nbits 1)
   # A bbox that is not the points' own min/max (fixed_bbox_clip) must be passed.

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "crs_flags.hpp"
 #include "option_flags.hpp"
 #include "progress.hpp"
 #include "vola/convert.hpp"
@@ -21,8 +22,7 @@ struct ConvertArgs {
   std::string input, output, quantize;
   ConvertOptions options;
   std::vector<double> origin, bbox;
-  std::uint32_t crs = 2000;
-  bool crs_given = false, no_attributes = false, quiet = false;
+  bool no_attributes = false, quiet = false;
   std::vector<int> columns{1, 2, 3};
 };
 
@@ -32,7 +32,6 @@ ConvertOptions options_of(ConvertArgs& a) {
     options.quantization = a.quantize == "grid" ? Quantization::grid : Quantization::toolkit;
   if (!a.origin.empty()) options.origin = Point{a.origin[0], a.origin[1], a.origin[2]};
   if (!a.bbox.empty()) options.bbox = Box{{a.bbox[0], a.bbox[1], a.bbox[2]}, {a.bbox[3], a.bbox[4], a.bbox[5]}};
-  if (a.crs_given) options.epsg = a.crs;
   options.attributes = !a.no_attributes;
   std::copy(a.columns.begin(), a.columns.end(), options.columns.begin());
   return options;
@@ -112,7 +111,7 @@ void add_convert(CLI::App& app) {
       "  toolkit  the reference toolkit's rounding against the longest bbox side; with the same\n"
       "           input and options the output is byte-identical to the reference's.\n"
       "Examples:\n"
-      "  vola convert city.xyz city.vol --voxel-size 0.5 --crs 32633\n"
+      "  vola convert city.xyz city.vol --voxel-size 0.5 --assign-crs 32633\n"
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
       "  vola convert scan.csv scan.vol --voxel-size 0.1 --attribute intensity=4:u16:mean\n"
       "  vola convert points.npy points.vol --depth 5 --compress\n"
@@ -132,11 +131,7 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--nbits", args->options.nbits, "Payload words per block: 0 = occupancy only, 1 = one 64-bit payload word per block")
       ->check(CLI::Range(0, 64))->capture_default_str();
   cmd->add_flag("--dense", args->options.dense, "Write the reference's dense layout (depth <= 5)");
-  cmd->add_option("--crs", args->crs, "EPSG code of the input coordinates (header lat/lon from it)")
-      ->each([args](const std::string&) { args->crs_given = true; })->capture_default_str();
-  cmd->add_option("--target-crs", args->options.target_crs,
-                  "Reproject the points into this CRS (EPSG code, WKT or PROJ string) before voxelising; "
-                  "--voxel-size, --origin and --bbox are then in its units");
+  add_crs_options(*cmd, args->options.assign_crs, args->options.target_crs, args->options.allow_geographic);
   cmd->add_option("--level", args->options.level,
                   "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")

@@ -10,8 +10,10 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "crs_flags.hpp"
 #include "progress.hpp"
 #include "vola/crs_rules.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/error.hpp"
 #include "vola/tile/tiler.hpp"
 
@@ -25,8 +27,8 @@ struct TileArgs {
   double tile_size = 0.0;
   int depth = 0;
   std::vector<double> origin;
-  std::optional<std::uint32_t> crs;
-  std::string target_crs;
+  std::string assign_crs, target_crs;
+  bool allow_geographic = false;
   unsigned threads = 0;
   bool no_overviews = false, no_attributes = false, quiet = false;
   std::uint64_t generate = 0;
@@ -66,29 +68,49 @@ std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::siz
   return tile::open_file_points(path, attributes);
 }
 
-// With --target-crs, every input moved from its own CRS (--crs, else what it says) into
-// the target as it is read: inputs in different CRSs then tile together.
+// With --target-crs, every input moved from its own CRS (--assign-crs, else what it says)
+// into the target as it is read: inputs in different CRSs then tile together.
 void reproject_sources(const TileArgs& a, std::vector<std::unique_ptr<tile::PointSource>>& sources) {
   if (a.target_crs.empty()) return;
-  const bool digits = a.target_crs.find_first_not_of("0123456789") == std::string::npos;
-  const std::string to = digits ? "EPSG:" + a.target_crs : a.target_crs;
+  const std::string to = crs_definition_of(a.target_crs);
   for (auto& s : sources) {
-    std::string from = a.crs ? "EPSG:" + std::to_string(*a.crs) : !s->wkt.empty() ? s->wkt : "";
+    std::string from = !a.assign_crs.empty() ? crs_definition_of(a.assign_crs) : !s->wkt.empty() ? s->wkt : "";
     if (from.empty() && s->epsg) from = "EPSG:" + std::to_string(*s->epsg);
     if (from.empty())
-      throw InvalidArgument(s->name() + " states no CRS to reproject from; name it with --crs");
+      throw InvalidArgument(s->name() + " states no CRS to reproject from; name it with --assign-crs");
     s = tile::reprojected(std::move(s), from, to);
   }
 }
 
-// The CRS every tile carries: --crs, else what the inputs say (they must agree).
+// The CRS every tile carries: --assign-crs, else what the inputs say (they must agree).
+// Tiles of a geographic CRS (voxels of degrees by units of height) only when forced.
 void resolve_tile_crs(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources,
                       tile::TileOptions& options) {
   std::vector<StatedCrs> stated;
   for (const auto& s : sources) stated.push_back({s->name(), s->epsg, s->wkt});
-  const ResolvedCrs crs = resolve_crs(stated, a.crs);
+  const ResolvedCrs crs = resolve_crs(stated, a.assign_crs);
+  if (!a.allow_geographic && !crs.wkt.empty() && is_geographic_crs(crs.wkt))
+    throw OptionError("target_crs", "the inputs are in a geographic CRS: tiles and voxels would be degrees of "
+                                    "longitude and latitude by units of height, not cubes; give --target-crs (a "
+                                    "projected CRS such as UTM), or --allow-geographic to tile in degrees anyway");
   options.epsg = crs.epsg;
   options.crs_wkt = crs.wkt;
+}
+
+// --assign-crs on an input that says another CRS relabels its coordinates: say so.
+void warn_relabelled(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources) {
+  if (a.assign_crs.empty() || !a.target_crs.empty()) return;
+  for (const auto& s : sources) {
+    const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
+    try {
+      if (!said.empty() && !geo::same_crs(said, crs_definition_of(a.assign_crs)))
+        std::fprintf(stderr, "vola: warning: %s states %s; --assign-crs %s relabels its coordinates without moving "
+                     "them (to move them, give --target-crs)\n", s->name().c_str(),
+                     geo::crs_summary(geo::describe_crs(said)).c_str(), a.assign_crs.substr(0, 60).c_str());
+    } catch (const Error&) {
+      // A CRS PROJ cannot read: resolve_tile_crs reports what matters.
+    }
+  }
 }
 
 void run_tile(const TileArgs& a) {
@@ -97,7 +119,7 @@ void run_tile(const TileArgs& a) {
   const bool talk = comm->rank() == 0 && !a.quiet;
   try {
     if (a.inputs.empty() && a.generate == 0) throw InvalidArgument("no input: give point files or --generate-survey N");
-    if (a.crs) resolve_crs({}, a.crs);  // an unknown code fails before any work
+    if (!a.assign_crs.empty()) resolve_crs({}, a.assign_crs);  // an unknown CRS fails before any work
     tile::TileOptions options;
     options.memory_budget = parse_bytes(a.memory);
     options.threads = a.threads;
@@ -118,9 +140,15 @@ void run_tile(const TileArgs& a) {
     options.output_dir = a.output;
     options.spill_dir = a.spill_dir;
     options.overviews = !a.no_overviews;
+    if (talk) warn_relabelled(a, sources);
     reproject_sources(a, sources);
-    if (a.target_crs.empty()) resolve_tile_crs(a, sources, options);
-    else resolve_tile_crs(TileArgs{}, sources, options);  // every source now states the target
+    if (a.target_crs.empty()) {
+      resolve_tile_crs(a, sources, options);
+    } else {
+      TileArgs moved;  // every source now states the target
+      moved.allow_geographic = a.allow_geographic;
+      resolve_tile_crs(moved, sources, options);
+    }
     std::unique_ptr<Progress> progress;
     std::string stage;
     if (talk)
@@ -194,7 +222,7 @@ void add_tile(CLI::App& app) {
       "Examples:\n"
       "  vola tile flight1.las flight2.las --tile-size 512 --depth 6 -o tiles/    (voxels of 512/4^6 = 0.125 m)\n"
       "  vola tile survey.las --tile-size 1024 --depth 7 -o tiles/ --memory 1G      (voxels of 6.25 cm)\n"
-      "  vola tile --generate-survey 1000000000 --tile-size 2000 --depth 6 --crs 32633 -o big/ --memory 2G\n"
+      "  vola tile --generate-survey 1000000000 --tile-size 2000 --depth 6 --assign-crs 32633 -o big/ --memory 2G\n"
       "  mpirun -np 3 vola tile *.las --tile-size 1000 --depth 6 -o tiles/\n"
       "  vola get tiles/index.geojson 636250 849217 435       vola render tiles/index.geojson -o view.png");
   cmd->add_option("inputs", args->inputs, "Point files: LAS/LAZ/COPC (streamed in chunks), or any point format vola convert reads");
@@ -204,10 +232,7 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--depth", args->depth, "Levels per tile: 4^DEPTH voxels per tile edge (1..10)")->required()
       ->check(CLI::Range(1, 10));
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
-  cmd->add_option("--crs", args->crs, "EPSG code of the coordinates (default: what the inputs say)");
-  cmd->add_option("--target-crs", args->target_crs,
-                  "Reproject every input into this CRS (EPSG code, WKT or PROJ string) as it is read; inputs in "
-                  "different CRSs then tile together. --tile-size and --origin are in its units");
+  add_crs_options(*cmd, args->assign_crs, args->target_crs, args->allow_geographic);
   cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
       ->capture_default_str();
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");

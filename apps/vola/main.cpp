@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
       " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
       "one word per 4x4x4 block, one bit per voxel, children found by counting bits.\n\n"
       "Examples:\n"
-      "  vola convert scan.xyz scan.vol --voxel-size 0.25 --crs 29902   # GIS grid, 25 cm voxels\n"
+      "  vola convert scan.xyz scan.vol --voxel-size 0.25 --assign-crs 29902   # GIS grid, 25 cm voxels\n"
       "  vola convert pts.txt pts.vol --quantize toolkit --depth 5         # as the reference toolkit\n"
       "  vola info scan.vol\n"
       "  vola get scan.vol 10 20 3\n"

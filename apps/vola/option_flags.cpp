@@ -7,7 +7,7 @@ namespace vola::cli {
 std::string flag_of(const std::string& option) {
   // Members whose flag is not simply --member-name.
   static const std::map<std::string, std::string> renamed = {
-      {"quantization", "--quantize"},     {"epsg", "--crs"},           {"text_attributes", "--attribute"},
+      {"quantization", "--quantize"},     {"epsg", "--assign-crs"},          {"text_attributes", "--attribute"},
       {"attributes", "--no-attributes"},  {"memory_budget", "--memory"}, {"bin_width_db", "--bin-width"},
       {"floor_db", "--floor"},            {"architecture", "--arch"},  {"output_dir", "-o"}};
   if (const auto it = renamed.find(option); it != renamed.end()) return it->second;

@@ -9,7 +9,7 @@
 
 namespace vola::cli {
 
-// "voxel_size" -> "--voxel-size", "epsg" -> "--crs", ...
+// "voxel_size" -> "--voxel-size", "epsg" -> "--assign-crs", ...
 std::string flag_of(const std::string& option);
 
 // "voxel_size: grid quantization needs a `voxel_size` or a `depth`" ->

@@ -37,13 +37,20 @@ struct ConvertOptions {
   int nbits = 0;                // payload words per block: 0 occupancy only, 1 the reference's
 
   // ---- what the input is ----
-  // The input's CRS as an EPSG code; wins over what the input says.
+  // The input's CRS, relabelled: any definition PROJ reads ("EPSG:2994", "2994", WKT, a
+  // PROJ string). It wins over what the input says, without moving a point (a warning
+  // says so when the input states another CRS); to move the points, give target_crs.
+  std::string assign_crs;
+  // The same as an EPSG code (the Python and C front ends' `epsg`); not with assign_crs.
   std::optional<std::uint32_t> epsg;
   // Reproject the points into this CRS before voxelising ("EPSG:32610", "32610", WKT or
   // a PROJ string); the grid options (voxel_size, origin, bbox) are then in its units.
   // Point input only; the input's CRS (stated, or `epsg`) is the source. The points are
   // read whole for it (not streamed).
   std::string target_crs;
+  // Grid voxels in a geographic CRS (degrees of longitude and latitude by metres of
+  // height, not cubes) are refused unless forced here or target_crs reprojects them.
+  bool allow_geographic = false;
   // COPC input: read only the octree's levels 0..level (0 = the root's points), a
   // coarser sample of the cloud from a small part of the file. With a grid bbox, nodes
   // outside the grid are skipped whatever the level.
@@ -81,7 +88,7 @@ struct ConvertReport {
   // file's --level or a grid bbox, less than the file.
   std::optional<std::uint64_t> bytes_read;
   // What a careful user should know about the result (a CRS relabelled, voxels in
-  // degrees): one sentence each, for the front end to show.
+  // degrees allowed or quantized by the toolkit): one sentence each, for the front end.
   std::vector<std::string> warnings;
 };
 

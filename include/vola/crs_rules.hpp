@@ -29,10 +29,22 @@ struct ResolvedCrs {
   bool stated = false;     // the inputs said something
 };
 
-// `given` wins over what the inputs say (and fails for a code PROJ does not know, before
-// any work); without it, the inputs must agree by meaning (the same code, or WKTs PROJ
-// finds equivalent however they are spelled, or all
-// nothing), else InvalidArgument names the first two that differ.
-ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::uint32_t> given);
+// A CRS as a user may name it: "32610" means "EPSG:32610"; anything else (EPSG:n, WKT,
+// a PROJ string) is kept as it is.
+std::string crs_definition_of(const std::string& given);
+
+// The EPSG code a definition names directly ("32610", "EPSG:32610"), else none.
+std::optional<std::uint32_t> epsg_code_of(const std::string& given);
+
+// `given` (a definition as crs_definition_of reads it; empty: none) wins over what the
+// inputs say, relabelling them (and fails for a CRS PROJ does not know, before any work);
+// without it, the inputs must agree by meaning (the same code, or WKTs PROJ finds
+// equivalent however they are spelled, or all nothing), else InvalidArgument names the
+// first two that differ.
+ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, const std::string& given = {});
+
+// Whether a CRS (WKT or any definition) is geographic: x and y in degrees. False for
+// what PROJ cannot read.
+bool is_geographic_crs(const std::string& definition);
 
 }  // namespace vola

@@ -177,6 +177,8 @@ typedef struct vola_convert_options {
   int write_flags;                     /* vola_convert_file: a vola_write_flags value */
   vola_progress_callback progress;     /* may be NULL; called now and then during long reads */
   void *progress_user;
+  const char *assign_crs;              /* NULL, or the input's CRS as any definition (not with epsg) */
+  int allow_geographic;                /* voxelise in a geographic CRS's degrees anyway (default 0: refused) */
 } vola_convert_options;
 
 typedef struct vola_convert_report {

@@ -133,7 +133,8 @@ Tree convert(const std::filesystem::path& path, int depth,
              std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
              int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
-             const std::string& target_crs, std::optional<int> level) {
+             const std::string& target_crs, std::optional<int> level, const std::string& assign_crs,
+             bool allow_geographic) {
   vola::ConvertOptions options;
   options.format = format;
   if (!quantize.empty()) options.quantization = parse_quantization(quantize);
@@ -143,7 +144,9 @@ Tree convert(const std::filesystem::path& path, int depth,
   if (bbox) options.bbox = vola::Box{{(*bbox)[0], (*bbox)[1], (*bbox)[2]}, {(*bbox)[3], (*bbox)[4], (*bbox)[5]}};
   options.nbits = nbits;
   options.epsg = epsg;
+  options.assign_crs = assign_crs;
   options.target_crs = target_crs;
+  options.allow_geographic = allow_geographic;
   options.level = level;
   options.attributes = attributes;
   options.columns = columns;
@@ -200,6 +203,7 @@ void bind_building(py::module_& m) {
         py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
         py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
+        py::arg("assign_crs") = "", py::arg("allow_geographic") = false,
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
         "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
@@ -207,7 +211,8 @@ void bind_building(py::module_& m) {
         "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
         "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
-        "first (grid options then in its units); level=L reads a COPC file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for.");
+        "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
+        "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for.");
   m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output) {
         py::gil_scoped_release release;
         with_python_names([&] { vola::io::translate_points(input.string(), output.string()); });

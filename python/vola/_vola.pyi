@@ -147,6 +147,10 @@ def convert(
     dense: bool = False,
     compress: bool = False,
     output: Optional[PathLike] = None,
+    target_crs: str = "",
+    level: Optional[int] = None,
+    assign_crs: str = "",
+    allow_geographic: bool = False,
 ) -> Tree: ...
 def input_formats() -> List[Tuple[str, List[str]]]: ...
 def compression_available() -> bool: ...

@@ -25,7 +25,9 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   if (c.has_bbox) o.bbox = vola::Box{{c.bbox[0], c.bbox[1], c.bbox[2]}, {c.bbox[3], c.bbox[4], c.bbox[5]}};
   o.nbits = c.nbits;
   if (c.epsg) o.epsg = c.epsg;
+  if (c.assign_crs) o.assign_crs = c.assign_crs;
   if (c.target_crs) o.target_crs = c.target_crs;
+  o.allow_geographic = c.allow_geographic != 0;
   if (c.level >= 0) o.level = c.level;
   o.attributes = c.attributes != 0;
   for (int i = 0; i < 3; ++i) o.columns[static_cast<std::size_t>(i)] = c.columns[i];

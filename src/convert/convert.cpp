@@ -84,13 +84,14 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
              ConvertReport* report_out) {
   options.check();
   // A CRS PROJ does not know fails before gigabytes are read.
-  if (options.epsg) resolve_crs({}, options.epsg);
+  if (const std::string given = given_crs(options); !given.empty()) resolve_crs({}, given);
   if (!options.target_crs.empty()) check_target_crs(options.target_crs);
   const io::InputFormat& format = io::find_input_format(path, options.format);
   io::Input input = read(path, format, options, progress);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));
+  refuse_geographic_grid(path, options, input, crs, build.quantization);
 
   CentreLatLon centre(crs.epsg, crs.wkt.empty() ? input.wkt : crs.wkt);  // PROJ gets ready while the tree is built
   ConvertReport report;

@@ -40,12 +40,28 @@ bool same_meaning(const StatedCrs& a, const std::optional<std::uint32_t>& a_epsg
 
 }  // namespace
 
-ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::uint32_t> given) {
+std::string crs_definition_of(const std::string& given) {
+  const bool digits = !given.empty() && given.find_first_not_of("0123456789") == std::string::npos;
+  return digits ? "EPSG:" + given : given;
+}
+
+std::optional<std::uint32_t> epsg_code_of(const std::string& given) {
+  std::string digits = given;
+  if (digits.size() > 5 && (digits.compare(0, 5, "EPSG:") == 0 || digits.compare(0, 5, "epsg:") == 0))
+    digits = digits.substr(5);
+  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+    return std::nullopt;
+  return static_cast<std::uint32_t>(std::stoul(digits));
+}
+
+ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, const std::string& given) {
   ResolvedCrs out;
   for (const StatedCrs& s : inputs) out.stated = out.stated || s.epsg || !s.wkt.empty();
-  if (given) {
-    out.epsg = given;
-    out.wkt = geo::crs_wkt(*given);  // throws for a code PROJ does not know
+  if (!given.empty()) {
+    // Both throw for a CRS PROJ does not know. A code keeps the WKT its code gives.
+    out.epsg = epsg_code_of(given);
+    out.wkt = out.epsg ? geo::crs_wkt(*out.epsg) : geo::crs_wkt(crs_definition_of(given));
+    if (!out.epsg) out.epsg = geo::epsg_from_wkt(out.wkt);
     out.given = true;
     return out;
   }
@@ -68,6 +84,16 @@ ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, std::optional<std::ui
   out.epsg = first_epsg;
   out.wkt = !first->wkt.empty() ? first->wkt : (first_epsg ? geo::crs_wkt(*first_epsg) : std::string());
   return out;
+}
+
+bool is_geographic_crs(const std::string& definition) {
+  try {
+    // The horizontal unit catches a compound CRS on a geographic one (EPSG:4326+5703).
+    const geo::CrsDescription d = geo::describe_crs(definition);
+    return d.kind.rfind("geographic", 0) == 0 || d.horizontal_unit.find("degree") != std::string::npos;
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 }  // namespace vola

@@ -5,28 +5,61 @@
 
 namespace vola::convert_detail {
 
+namespace {
+
+// The CRS of the result as PROJ reads it (empty when none is known).
+std::string result_definition(const ResolvedCrs& crs) {
+  return !crs.wkt.empty() ? crs.wkt : crs.epsg ? "EPSG:" + std::to_string(*crs.epsg) : "";
+}
+
+// Points voxelised in the CRS's own x and y (not voxel grids or meshes, which keep theirs).
+bool voxelises_points(const io::Input& input) { return !input.grid && !input.is_mesh(); }
+
+std::string geographic_name(const std::string& definition) {
+  try {
+    return geo::describe_crs(definition).name;
+  } catch (const Error&) {
+    return definition.substr(0, 60);
+  }
+}
+
+}  // namespace
+
+std::string given_crs(const ConvertOptions& options) {
+  return options.epsg ? std::to_string(*options.epsg) : options.assign_crs;
+}
+
 ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, const io::Input& input) {
   const StatedCrs stated{path, input.epsg, input.wkt};
-  return resolve_crs(std::span(&stated, 1), options.epsg);
+  return resolve_crs(std::span(&stated, 1), given_crs(options));
+}
+
+void refuse_geographic_grid(const std::string& path, const ConvertOptions& options, const io::Input& input,
+                            const ResolvedCrs& crs, Quantization quantization) {
+  if (options.allow_geographic || quantization != Quantization::grid || !voxelises_points(input)) return;
+  const std::string result = result_definition(crs);
+  if (result.empty() || !is_geographic_crs(result)) return;
+  throw OptionError("target_crs", path + " is in " + geographic_name(result) +
+                                      ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
+                                      "units of height, not cubes; give `target_crs` (a projected CRS such as UTM), " +
+                                      "or `allow_geographic` to voxelise in degrees anyway");
 }
 
 std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
                                       const ResolvedCrs& crs) {
   std::vector<std::string> out;
+  const std::string given = given_crs(options);
   try {
     const std::string stated = !input.wkt.empty() ? input.wkt : input.epsg ? "EPSG:" + std::to_string(*input.epsg) : "";
-    if (options.epsg && options.target_crs.empty() && !stated.empty() &&
-        !geo::same_crs(stated, "EPSG:" + std::to_string(*options.epsg)))
-      out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `epsg` " +
-                    std::to_string(*options.epsg) + " relabels its coordinates without moving them (to move them, " +
+    if (!given.empty() && options.target_crs.empty() && !stated.empty() &&
+        !geo::same_crs(stated, crs_definition_of(given)))
+      out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `assign_crs` " +
+                    given.substr(0, 60) + " relabels its coordinates without moving them (to move them, " +
                     "give `target_crs`)");
-    const std::string result = !crs.wkt.empty() ? crs.wkt : crs.epsg ? "EPSG:" + std::to_string(*crs.epsg) : "";
-    if (!result.empty() && !input.grid && !input.is_mesh()) {
-      const geo::CrsDescription d = geo::describe_crs(result);
-      if (d.kind.rfind("geographic", 0) == 0)
-        out.push_back("the CRS (" + d.name + ") is geographic: voxels are degrees of longitude and latitude by " +
-                      "units of height, not cubes; give `target_crs` (a projected CRS such as UTM) for cubes");
-    }
+    const std::string result = result_definition(crs);
+    if (!result.empty() && voxelises_points(input) && is_geographic_crs(result))
+      out.push_back("the CRS (" + geographic_name(result) + ") is geographic: voxels are degrees of longitude and " +
+                    "latitude by units of height, not cubes; give `target_crs` (a projected CRS such as UTM) for cubes");
   } catch (const Error&) {
     // A CRS PROJ cannot read draws no warning here; the conversion reports it if it matters.
   }
@@ -45,17 +78,12 @@ void reproject_heights(const geo::Reprojection& reprojection, PointCloud& cloud)
 
 std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return known.value_or(2000); }
 
-std::string crs_definition_of(const std::string& given) {
-  const bool digits = !given.empty() && given.find_first_not_of("0123456789") == std::string::npos;
-  return digits ? "EPSG:" + given : given;
-}
-
 ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io::Input& input) {
   if (input.is_mesh() || input.grid || input.terrain)
     throw OptionError("target_crs", "reprojects points; " + path + " is " + input.format + " input");
   const ResolvedCrs source = input_crs(path, options, input);
   if (!source.epsg && source.wkt.empty())
-    throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `epsg`");
+    throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `assign_crs`");
   const std::string from = source.wkt.empty() ? "EPSG:" + std::to_string(*source.epsg) : source.wkt;
   const std::string to = crs_definition_of(options.target_crs);
   geo::Reprojection reprojection(from, to);

@@ -14,7 +14,10 @@
 
 namespace vola::convert_detail {
 
-// The input's CRS under the rules of vola/crs_rules.hpp (the code given wins).
+// The CRS the user assigned (`assign_crs`, or `epsg` as digits); empty when none.
+std::string given_crs(const ConvertOptions& options);
+
+// The input's CRS under the rules of vola/crs_rules.hpp (the CRS given wins).
 ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, const io::Input& input);
 
 // The points of `input` moved into options.target_crs from the input's CRS; the CRS
@@ -22,12 +25,15 @@ ResolvedCrs input_crs(const std::string& path, const ConvertOptions& options, co
 // is not points or states no CRS, and for a target PROJ cannot read.
 ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io::Input& input);
 
-// A CRS as the user may give it: "32610" means "EPSG:32610"; anything else as it is.
-std::string crs_definition_of(const std::string& given);
+// Throws OptionError for grid voxels of points in a geographic CRS (x and y in degrees, z
+// in metres or feet: not cubes) unless options.allow_geographic; toolkit quantization,
+// which fits any box, is only warned about.
+void refuse_geographic_grid(const std::string& path, const ConvertOptions& options, const io::Input& input,
+                            const ResolvedCrs& crs, Quantization quantization);
 
-// Warnings about the CRS of a conversion: `epsg` given for an input that states another
-// CRS (the coordinates are relabelled, not moved), and a geographic CRS (voxels whose x
-// and y are degrees while z is in metres or feet).
+// Warnings about the CRS of a conversion: a CRS assigned to an input that states another
+// (the coordinates are relabelled, not moved), and a geographic CRS (voxels whose x and y
+// are degrees while z is in metres or feet).
 std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
                                       const ResolvedCrs& crs);
 

@@ -100,6 +100,8 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
 }  // namespace convert_detail
 
 void ConvertOptions::check() const {
+  if (epsg && !assign_crs.empty())
+    throw OptionError("assign_crs", "give the input's CRS once (`assign_crs` or `epsg`, not both)");
   if (nbits < 0 || nbits > 64) throw OptionError("nbits", std::to_string(nbits) + " is outside 0..64");
   if (dense && compress) throw OptionError("compress", "compressed files are sparse (dense and compress together)");
   for (int c : columns)

@@ -61,8 +61,12 @@ int main(int argc, char **argv) {
       options.nbits = atoi(value);
     } else if (strcmp(key, "epsg") == 0) {
       options.epsg = (uint32_t)strtoul(value, NULL, 10);
+    } else if (strcmp(key, "assign_crs") == 0) {
+      options.assign_crs = value;
     } else if (strcmp(key, "target_crs") == 0) {
       options.target_crs = value;
+    } else if (strcmp(key, "allow_geographic") == 0) {
+      options.allow_geographic = atoi(value);
     } else if (strcmp(key, "level") == 0) {
       options.level = atoi(value);
     } else if (strcmp(key, "attributes") == 0) {

@@ -81,7 +81,7 @@ def main():
             run([a.vola, "convert", las, ours, "--target-crs", target, "--voxel-size", str(voxel), "--no-attributes", "-q"])
             # The source CRS as vola states it (the input's WKT, or its code's).
             plain = tmp / ("%s.plain.vol" % name)
-            run([a.vola, "convert", las, plain, "--voxel-size", "1", "--no-attributes", "-q"])
+            run([a.vola, "convert", las, plain, "--voxel-size", "1", "--no-attributes", "--allow-geographic", "-q"])
             source = json.loads(run([a.vola, "info", "--json", plain]))["crs_wkt"]
             target_crs = pyproj.CRS.from_user_input(int(target) if target.isdigit() else target)
             transformer = pyproj.Transformer.from_crs(pyproj.CRS.from_wkt(source), target_crs, always_xy=True)

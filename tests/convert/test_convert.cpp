@@ -88,31 +88,31 @@ TEST(ResolveQuantizer, LeavesItsOptionsAlone) {
 
 TEST(ResolveCrs, TheGivenCodeWinsAndInputsMustAgree) {
   const std::vector<vola::StatedCrs> agree{{"a.las", 32610, ""}, {"b.las", 32610, ""}};
-  const vola::ResolvedCrs crs = vola::resolve_crs(agree, std::nullopt);
+  const vola::ResolvedCrs crs = vola::resolve_crs(agree);
   EXPECT_EQ(crs.epsg, 32610u);
   EXPECT_NE(crs.wkt.find("32610"), std::string::npos);
   EXPECT_FALSE(crs.given);
 
   const std::vector<vola::StatedCrs> nothing{{"a.xyz", std::nullopt, ""}, {"b.xyz", std::nullopt, ""}};
-  const vola::ResolvedCrs none = vola::resolve_crs(nothing, std::nullopt);
+  const vola::ResolvedCrs none = vola::resolve_crs(nothing);
   EXPECT_FALSE(none.epsg.has_value());
   EXPECT_TRUE(none.wkt.empty());
   EXPECT_FALSE(none.stated);
 
   const std::vector<vola::StatedCrs> differ{{"a.las", 32610, ""}, {"b.las", std::nullopt, ""}};
   try {
-    vola::resolve_crs(differ, std::nullopt);
+    vola::resolve_crs(differ);
     FAIL() << "inputs with and without a CRS were accepted";
   } catch (const vola::InvalidArgument& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("a.las says EPSG:32610"), std::string::npos) << what;
     EXPECT_NE(what.find("b.las says nothing"), std::string::npos) << what;
   }
-  const vola::ResolvedCrs given = vola::resolve_crs(differ, 4326u);
+  const vola::ResolvedCrs given = vola::resolve_crs(differ, "4326");
   EXPECT_EQ(given.epsg, 4326u);
   EXPECT_TRUE(given.given);
   EXPECT_TRUE(given.stated);
-  EXPECT_THROW(vola::resolve_crs({}, 999999u), vola::Error);
+  EXPECT_THROW(vola::resolve_crs({}, "999999"), vola::Error);
 }
 
 // What a LAS file says its CRS is, as convert and tile state it.
@@ -132,11 +132,11 @@ TEST(ResolveCrs, InputsAgreeByMeaningNotBySpelling) {
   ASSERT_EQ(pf1.epsg, 2994u);
   EXPECT_NE(trim.wkt, vola::geo::crs_wkt(2994));
   const std::vector<vola::StatedCrs> same{trim, pf1};
-  EXPECT_NO_THROW(vola::resolve_crs(same, std::nullopt));
+  EXPECT_NO_THROW(vola::resolve_crs(same));
 
   const std::vector<vola::StatedCrs> differ{trim, bmx};
   try {
-    vola::resolve_crs(differ, std::nullopt);
+    vola::resolve_crs(differ);
     FAIL() << "a foot CRS and a metre CRS were taken as one";
   } catch (const vola::InvalidArgument& e) {
     const std::string what = e.what();
@@ -154,7 +154,7 @@ TEST(ResolveCrs, InputsAgreeByMeaningNotBySpelling) {
     respelled.replace(at, from.size(), to);
   }
   const std::vector<vola::StatedCrs> spelled{bmx, {"respelled.las", std::nullopt, respelled}};
-  EXPECT_NO_THROW(vola::resolve_crs(spelled, std::nullopt));
+  EXPECT_NO_THROW(vola::resolve_crs(spelled));
 }
 
 // vola info's naming of a CRS: PROJ's name, a code only when PROJ identifies one, the units.
@@ -260,3 +260,79 @@ TEST(Convert, VoxelGridsMapCellForCellAndPointsNeedAGrid) {
 }
 
 }  // namespace
+
+// --assign-crs relabels with any definition (a WKT with no code too) and says so when the
+// input states another CRS; the points do not move.
+TEST(Convert, AssignCrsRelabelsAnyDefinitionWithAWarning) {
+  VOLA_REQUIRE_DATA(data);
+  const std::string las = (data / "las" / "pdal_autzen_trim.las").string();
+  vola::ConvertOptions plain;
+  plain.voxel_size = 10.0;
+  const vola::Tree stated = vola::convert(las, plain);
+
+  vola::ConvertOptions utm = plain;
+  utm.assign_crs = "EPSG:32610";
+  vola::ConvertReport report;
+  const vola::Tree relabelled = vola::convert(las, utm, {}, &report);
+  EXPECT_EQ(report.epsg, 32610u);
+  EXPECT_EQ(relabelled.georef().epsg, 32610u);
+  EXPECT_EQ(relabelled.frame().origin, stated.frame().origin);  // nothing moved
+  EXPECT_EQ(relabelled.voxel_count(), stated.voxel_count());
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("relabels its coordinates without moving them"), std::string::npos);
+
+  // A custom WKT (no EPSG code) is kept as the file's CRS; the same CRS draws no warning.
+  vola::ConvertOptions same = plain;
+  same.assign_crs = stated.georef().crs_wkt;
+  vola::ConvertReport same_report;
+  const vola::Tree kept = vola::convert(las, same, {}, &same_report);
+  EXPECT_TRUE(same_report.warnings.empty());
+  EXPECT_TRUE(vola::geo::same_crs(kept.georef().crs_wkt, stated.georef().crs_wkt));
+
+  vola::ConvertOptions both = utm;
+  both.epsg = 32610;
+  EXPECT_EQ(refused_option([&] { vola::convert(las, both); }), "assign_crs");
+  vola::ConvertOptions unknown = plain;
+  unknown.assign_crs = "EPSG:999999";
+  EXPECT_THROW(vola::convert(las, unknown), vola::Error);
+}
+
+// Grid voxels in degrees are refused unless reprojected or allowed; the toolkit's
+// quantization (which fits any box) only warns.
+TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
+  VOLA_REQUIRE_DATA(data);
+  const std::string las = (data / "las" / "pdal_epsg_4326.las").string();
+  vola::ConvertOptions grid;
+  grid.voxel_size = 0.001;
+  EXPECT_EQ(refused_option([&] { vola::convert(las, grid); }), "target_crs");
+
+  vola::ConvertOptions allowed = grid;
+  allowed.allow_geographic = true;
+  vola::ConvertReport report;
+  EXPECT_GT(vola::convert(las, allowed, {}, &report).voxel_count(), 0u);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("geographic"), std::string::npos);
+
+  vola::ConvertOptions moved = grid;
+  moved.voxel_size = 1.0;
+  moved.target_crs = "32615";
+  vola::ConvertReport moved_report;
+  EXPECT_GT(vola::convert(las, moved, {}, &moved_report).voxel_count(), 0u);
+  EXPECT_TRUE(moved_report.warnings.empty());
+
+  vola::ConvertOptions toolkit;
+  toolkit.quantization = vola::Quantization::toolkit;
+  toolkit.depth = 4;
+  vola::ConvertReport toolkit_report;
+  EXPECT_NO_THROW(vola::convert(las, toolkit, {}, &toolkit_report));
+  EXPECT_EQ(toolkit_report.warnings.size(), 1u);
+
+  // A projected file assigned a geographic CRS is refused the same way.
+  vola::ConvertOptions relabelled;
+  relabelled.voxel_size = 10.0;
+  relabelled.assign_crs = "4326";
+  EXPECT_EQ(refused_option([&] { vola::convert((data / "las" / "pdal_autzen_trim.las").string(), relabelled); }),
+            "target_crs");
+  EXPECT_TRUE(vola::is_geographic_crs("EPSG:4979"));
+  EXPECT_FALSE(vola::is_geographic_crs("EPSG:32610"));
+}

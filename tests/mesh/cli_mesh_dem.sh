@@ -88,9 +88,10 @@ solid=$(info_field "$tmp/cube_solid.vol" voxels)
 # tests cover nodata), the EPSG code in the header, and a toolkit conversion.
 dem_case() {
   local file=$1 size=$2 epsg=$3 cells=$4
+  local extra=("${@:5}")
   local name
   name=$(basename "$file")
-  "$vola" convert "$file" "$tmp/$name.surface.vol" --voxel-size "$size" --dem-surface-only -q || {
+  "$vola" convert "$file" "$tmp/$name.surface.vol" --voxel-size "$size" --dem-surface-only -q "${extra[@]}" || {
     fail "$name: surface conversion failed"
     return
   }
@@ -101,7 +102,12 @@ dem_case() {
   [[ $(info_field "$tmp/$name.toolkit.vol" crs) == "$epsg" ]] || fail "$name: toolkit header EPSG is not $epsg"
 }
 dem_case "$data/dem/pdal_gdal_int16_epsg26711.tif" 60 26711 $((20 * 20))
-dem_case "$data/dem/pysheds_dem_int16_tiled_epsg4326.tif" 0.000833333333333 4326 $((367 * 359))
+dem_case "$data/dem/pysheds_dem_int16_tiled_epsg4326.tif" 0.000833333333333 4326 $((367 * 359)) --allow-geographic
+# Without --allow-geographic, cells of degrees under heights of metres are refused, naming the way out.
+"$vola" convert "$data/dem/pysheds_dem_int16_tiled_epsg4326.tif" "$tmp/degrees.vol" --voxel-size 0.000833333333333 \
+  2> "$tmp/degrees.err" && fail "a DEM in degrees became grid voxels without --allow-geographic"
+grep -q -- "geographic CRS.*--target-crs.*--allow-geographic" "$tmp/degrees.err" || fail "degrees: $(cat "$tmp/degrees.err")"
+[[ -e "$tmp/degrees.vol" ]] && fail "a refused conversion wrote its output"
 
 # Full columns: as many columns as cells, and more voxels than cells.
 pdal=$data/dem/pdal_gdal_int16_epsg26711.tif

@@ -88,6 +88,20 @@ python3 -c "import json, sys; v = json.load(open(sys.argv[1]))['vola']; assert v
 "$vola" tile "$data/las/pdal_1.2-with-color.las" --target-crs 32610 --tile-size 200 --depth 4 -o "$tmp/nocrs" \
   2> "$tmp/err.txt" && fail "an input with no CRS was reprojected"
 grep -q "states no CRS to reproject from" "$tmp/err.txt" || fail "no-CRS message: $(cat "$tmp/err.txt")"
+# Degrees: tiles in a geographic CRS are refused unless reprojected or forced.
+geo=$data/las/pdal_epsg_4326.las
+"$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" 2> "$tmp/err.txt" && fail "tiles in degrees accepted"
+grep -q "geographic CRS.*--allow-geographic" "$tmp/err.txt" || fail "degrees message: $(cat "$tmp/err.txt")"
+"$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" --allow-geographic -q || fail "--allow-geographic refused"
+"$vola" tile "$geo" --tile-size 200 --depth 4 -o "$tmp/degrees_utm" --target-crs 32615 -q || fail "degrees to UTM refused"
+# --assign-crs relabels (a warning says the file stated another CRS); --crs is its old name.
+"$vola" tile "$las" --assign-crs 2994 --tile-size 256 --depth 4 -o "$tmp/assigned" > /dev/null 2> "$tmp/err.txt" ||
+  fail "--assign-crs of the same CRS refused: $(cat "$tmp/err.txt")"
+[ -s "$tmp/err.txt" ] && fail "--assign-crs of the file's own CRS warned: $(cat "$tmp/err.txt")"
+"$vola" tile "$las" --assign-crs 32610 --tile-size 256 --depth 4 -o "$tmp/relabelled" > /dev/null 2> "$tmp/err.txt"
+grep -q "relabels its coordinates without moving them" "$tmp/err.txt" || fail "relabel warning: $(cat "$tmp/err.txt")"
+"$vola" tile "$las" --crs 32610 --tile-size 256 --depth 4 -o "$tmp/old_flag" -q 2> "$tmp/err.txt"
+grep -q -- "--crs is now --assign-crs" "$tmp/err.txt" || fail "old --crs note: $(cat "$tmp/err.txt")"
 # The same CRS spelled by two writers (PDAL's WKT with no code, GeoKeys EPSG:2994) tiles together.
 "$vola" tile "$las" "$data/las/pdal_autzen_pf1.las" --tile-size 256 --depth 4 -o "$tmp/spelled" -q 2> "$tmp/err.txt" ||
   fail "one CRS in two spellings refused: $(cat "$tmp/err.txt")"
