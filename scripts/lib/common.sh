@@ -24,8 +24,9 @@ VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
 # The occupancy map's tests compare with OctoMap cell by cell (a test-only dependency).
 VOLA_BUILD_PACKAGES+=(liboctomap-dev)
 
-# vola export --raster's test reads the GeoTIFFs back with GDAL's Python bindings.
-VOLA_BUILD_PACKAGES+=(python3-gdal)
+# vola export --raster's test reads the GeoTIFFs back with GDAL's Python bindings; the tile test
+# opens the tile index with ogrinfo, as a GIS user would.
+VOLA_BUILD_PACKAGES+=(python3-gdal gdal-bin)
 
 # vola tile under mpirun: Open MPI (the tests run 3 ranks on one machine).
 VOLA_BUILD_PACKAGES+=(libopenmpi-dev openmpi-bin)

@@ -1,5 +1,5 @@
 // The entry points of the plugins libvola_gdal.so (elevation rasters read, GeoTIFF
-// rasters written, through GDAL) and libvola_assimp.so (meshes through Assimp); see
+// rasters and footprint layers written, through GDAL/OGR) and libvola_assimp.so (meshes through Assimp); see
 // src/plugin/plugin.hpp for why they are plugins.
 #pragma once
 
@@ -11,6 +11,7 @@
 #include "../plugin/plugin.hpp"
 #include "vola/io/dem.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/footprints.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::io {
@@ -27,6 +28,13 @@ using ReadMeshEntry = void (*)(const std::string& path, std::vector<Triangle>& o
 // the CRS from `wkt`, else EPSG `epsg`, none when wkt is empty and epsg 0.
 using WriteGeotiffEntry = void (*)(const Raster& raster, const std::string& wkt, std::uint32_t epsg,
                                    std::vector<std::uint8_t>& out, PluginFailure& failure);
+// Footprint layers as GeoJSON or GeoPackage bytes (vola/io/footprints.hpp).
+using FootprintsGeojsonEntry = void (*)(const FootprintLayer& layer, const std::string& collection_members_json,
+                                        std::vector<std::uint8_t>& out, PluginFailure& failure);
+using FootprintsGeopackageEntry = void (*)(const FootprintLayer& layer, std::vector<std::uint8_t>& out,
+                                           PluginFailure& failure);
+inline constexpr const char* kFootprintsGeojsonSymbol = "vola_plugin_footprints_geojson";
+inline constexpr const char* kFootprintsGeopackageSymbol = "vola_plugin_footprints_geopackage";
 inline constexpr const char* kReadDemSymbol = "vola_plugin_read_dem";
 inline constexpr const char* kWriteGeotiffSymbol = "vola_plugin_write_geotiff";
 inline constexpr const char* kReadMeshSymbol = "vola_plugin_read_mesh";

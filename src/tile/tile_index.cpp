@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "vola/error.hpp"
-#include "vola/output_stream.hpp"
+#include "vola/geo/crs.hpp"
+#include "vola/io/footprints.hpp"
+#include "vola/output_file.hpp"
 
 namespace vola::tile {
 
@@ -17,19 +20,90 @@ namespace {
 using nlohmann::json;
 using nlohmann::ordered_json;
 
-ordered_json tile_array(const TileIndex& t) { return ordered_json::array({t.i, t.j, t.k}); }
+using io::FootprintField;
+using FieldType = io::FootprintField::Type;
 
-ordered_json footprint(const Box& b) {
-  const double x0 = b.min[0], y0 = b.min[1], x1 = b.max[0], y1 = b.max[1];
-  return {{"type", "Polygon"},
-          {"coordinates", ordered_json::array({ordered_json::array(
-                              {ordered_json::array({x0, y0}), ordered_json::array({x1, y0}),
-                               ordered_json::array({x1, y1}), ordered_json::array({x0, y1}),
-                               ordered_json::array({x0, y0})})})}};
+std::vector<std::int64_t> tile_list(const TileIndex& t) { return {t.i, t.j, t.k}; }
+std::vector<double> box_list(const Box& b) { return {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]}; }
+std::int64_t count(std::uint64_t n) { return static_cast<std::int64_t>(n); }
+
+// The index's CRS as WKT: its own, else its code's, else none.
+std::string index_crs_wkt(const TileIndexFile& index) {
+  if (!index.crs_wkt.empty() || !index.epsg) return index.crs_wkt;
+  return geo::crs_wkt(*index.epsg);
 }
 
-ordered_json box_array(const Box& b) {
-  return ordered_json::array({b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
+// What vola reads back: per tile, `file`, `tile` [i, j, k], the counts and the points'
+// `bbox` [min x y z, max x y z].
+io::FootprintLayer geojson_layer(const TileIndexFile& index, const std::string& wkt) {
+  io::FootprintLayer layer{"tiles", wkt,
+                           {{"file", FieldType::text},
+                            {"tile", FieldType::integer_list},
+                            {"points", FieldType::integer},
+                            {"voxels", FieldType::integer},
+                            {"bytes", FieldType::integer},
+                            {"bbox", FieldType::real_list}},
+                           {}};
+  for (const TileEntry& t : index.tiles) {
+    const Box box = index.grid.tile_box(t.tile);
+    layer.features.push_back({box.min[0], box.min[1], box.max[0], box.max[1],
+                              {t.file, tile_list(t.tile), count(t.points), count(t.voxels), count(t.bytes),
+                               box_list(t.bbox)}});
+  }
+  return layer;
+}
+
+// What a desktop GIS shows best: one scalar column per value.
+io::FootprintLayer geopackage_layer(const TileIndexFile& index, const std::string& wkt) {
+  io::FootprintLayer layer{"tiles", wkt, {{"file", FieldType::text}}, {}};
+  for (const char* name : {"tile_i", "tile_j", "tile_k", "points", "voxels", "bytes"})
+    layer.fields.push_back({name, FieldType::integer});
+  for (const char* name : {"min_x", "min_y", "min_z", "max_x", "max_y", "max_z"})
+    layer.fields.push_back({name, FieldType::real});
+  for (const TileEntry& t : index.tiles) {
+    const Box box = index.grid.tile_box(t.tile);
+    io::Footprint f{box.min[0], box.min[1], box.max[0], box.max[1], {t.file}};
+    for (const std::int64_t v : {std::int64_t{t.tile.i}, std::int64_t{t.tile.j}, std::int64_t{t.tile.k}, count(t.points),
+                                 count(t.voxels), count(t.bytes)})
+      f.values.emplace_back(v);
+    for (const double v : box_list(t.bbox)) f.values.emplace_back(v);
+    layer.features.push_back(std::move(f));
+  }
+  return layer;
+}
+
+ordered_json vola_member(const TileIndexFile& index) {
+  ordered_json vola;
+  vola["format"] = "vola-tile-index";
+  vola["version"] = 1;
+  vola["origin"] = ordered_json::array({index.grid.origin[0], index.grid.origin[1], index.grid.origin[2]});
+  vola["tile_size"] = index.grid.tile_size;
+  vola["depth"] = index.grid.depth;
+  vola["voxel_size"] = index.grid.voxel_size();
+  if (index.epsg) vola["epsg"] = *index.epsg;
+  else vola["epsg"] = nullptr;
+  vola["crs_wkt"] = index.crs_wkt;
+  vola["points_in"] = index.points_in;
+  vola["points_outside"] = index.points_outside;
+  std::uint64_t voxels = 0;
+  for (const TileEntry& t : index.tiles) voxels += t.voxels;
+  vola["tiles"] = index.tiles.size();
+  vola["voxels"] = voxels;
+  vola["attributes"] = index.attributes;
+  ordered_json overviews = ordered_json::array();
+  for (const OverviewEntry& o : index.overviews)
+    overviews.push_back({{"level", o.level},
+                         {"tile", ordered_json::array({o.tile.i, o.tile.j, o.tile.k})},
+                         {"file", o.file},
+                         {"voxels", o.voxels}});
+  vola["overviews"] = std::move(overviews);
+  return vola;
+}
+
+void write_whole(const std::vector<std::uint8_t>& bytes, const std::string& path) {
+  OutputFile out(path);
+  out.write(bytes.data(), bytes.size());
+  out.commit();
 }
 
 [[noreturn]] void bad(const std::string& path, const std::string& what) {
@@ -78,47 +152,12 @@ std::string relative_file(const json& j, const std::string& path, const std::str
 }  // namespace
 
 void write_tile_index(const TileIndexFile& index, const std::string& path) {
-  ordered_json root;
-  root["type"] = "FeatureCollection";
-  root["name"] = "vola tiles";
-  if (index.epsg)
-    root["crs"] = {{"type", "name"},
-                   {"properties", {{"name", "urn:ogc:def:crs:EPSG::" + std::to_string(*index.epsg)}}}};
-  ordered_json vola;
-  vola["format"] = "vola-tile-index";
-  vola["version"] = 1;
-  vola["origin"] = ordered_json::array({index.grid.origin[0], index.grid.origin[1], index.grid.origin[2]});
-  vola["tile_size"] = index.grid.tile_size;
-  vola["depth"] = index.grid.depth;
-  vola["voxel_size"] = index.grid.voxel_size();
-  if (index.epsg) vola["epsg"] = *index.epsg;
-  else vola["epsg"] = nullptr;
-  vola["crs_wkt"] = index.crs_wkt;
-  vola["points_in"] = index.points_in;
-  vola["points_outside"] = index.points_outside;
-  std::uint64_t voxels = 0;
-  for (const TileEntry& t : index.tiles) voxels += t.voxels;
-  vola["tiles"] = index.tiles.size();
-  vola["voxels"] = voxels;
-  vola["attributes"] = index.attributes;
-  ordered_json overviews = ordered_json::array();
-  for (const OverviewEntry& o : index.overviews)
-    overviews.push_back({{"level", o.level}, {"tile", tile_array(o.tile)}, {"file", o.file}, {"voxels", o.voxels}});
-  vola["overviews"] = std::move(overviews);
-  root["vola"] = std::move(vola);
-  ordered_json features = ordered_json::array();
-  for (const TileEntry& t : index.tiles) {
-    ordered_json f;
-    f["type"] = "Feature";
-    f["geometry"] = footprint(index.grid.tile_box(t.tile));
-    f["properties"] = {{"file", t.file},     {"tile", tile_array(t.tile)}, {"points", t.points},
-                       {"voxels", t.voxels}, {"bytes", t.bytes},           {"bbox", box_array(t.bbox)}};
-    features.push_back(std::move(f));
-  }
-  root["features"] = std::move(features);
-  OutputStream out(path);
-  out << root.dump(1) << '\n';
-  out.commit();
+  const std::string wkt = index_crs_wkt(index);
+  // The GeoPackage first: the GeoJSON index, renamed into place last, is the switch.
+  write_whole(io::footprints_geopackage(geopackage_layer(index, wkt)),
+              std::filesystem::path(path).replace_extension(".gpkg").string());
+  const ordered_json members = {{"vola", vola_member(index)}};
+  write_whole(io::footprints_geojson(geojson_layer(index, wkt), members.dump()), path);
 }
 
 TileIndexFile read_tile_index(const std::string& path) {

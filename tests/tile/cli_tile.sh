@@ -39,11 +39,45 @@ assert v["tiles"] == len(index["features"]) > 4, v["tiles"]
 assert v["points_in"] == 110000 and v["points_outside"] == 0, v
 assert sum(f["properties"]["points"] for f in index["features"]) == 110000
 assert v["crs_wkt"], "the survey's WKT travels into the index"
+assert "crs" not in index, "RFC 7946: no crs member, coordinates are WGS84"
 for f in index["features"]:
     ring = f["geometry"]["coordinates"][0]
-    assert len(ring) == 5 and ring[0] == ring[4]
-    assert abs(ring[1][0] - ring[0][0] - 256) < 1e-9
+    assert ring[0] == ring[-1] and len(ring) > 5, "a closed ring, edges densified"
+    for lon, lat in ring:  # Autzen, Oregon
+        assert -123.2 < lon < -122.9 and 43.9 < lat < 44.2, (lon, lat)
 assert len(v["overviews"]) >= 2 and v["overviews"][-1]["level"] >= 1
+PY
+# As QGIS opens them, through OGR: the GeoJSON in WGS84, the GeoPackage in the survey's
+# own CRS (a WKT with no EPSG code), both with the tiles' extent.
+command -v ogrinfo > /dev/null || skip "ogrinfo not installed (apt-get install gdal-bin)"
+ogrinfo -ro -so -al "$index" > "$tmp/ogr_json.txt" || fail "ogrinfo cannot open the index"
+ogrinfo -ro -so -al "$tmp/one/index.gpkg" > "$tmp/ogr_gpkg.txt" || fail "ogrinfo cannot open index.gpkg"
+"${VOLA_PYTHON:-python3}" - "$index" "$tmp/ogr_json.txt" "$tmp/ogr_gpkg.txt" <<'PY' || fail "ogrinfo CRS and extent"
+import json, re, sys
+import pyproj
+index = json.load(open(sys.argv[1]))
+v, ogr_json, ogr_gpkg = index["vola"], open(sys.argv[2]).read(), open(sys.argv[3]).read()
+def extent(text):
+    m = re.search(r"Extent: \(([-\d.]+), ([-\d.]+)\) - \(([-\d.]+), ([-\d.]+)\)", text)
+    return [float(g) for g in m.groups()]
+def count(text):
+    return int(re.search(r"Feature Count: (\d+)", text).group(1))
+assert count(ogr_json) == count(ogr_gpkg) == v["tiles"], (count(ogr_json), count(ogr_gpkg))
+assert 'GEOGCRS["WGS 84"' in ogr_json, ogr_json
+assert 'PROJCRS["NAD_1983_HARN_Lambert_Conformal_Conic"' in ogr_gpkg, ogr_gpkg
+size, (ox, oy, _) = v["tile_size"], v["origin"]
+tiles = [f["properties"]["tile"] for f in index["features"]]
+want = [ox + min(t[0] for t in tiles) * size, oy + min(t[1] for t in tiles) * size,
+        ox + (max(t[0] for t in tiles) + 1) * size, oy + (max(t[1] for t in tiles) + 1) * size]
+got = extent(ogr_gpkg)
+assert all(abs(a - b) < 1e-6 for a, b in zip(got, want)), (got, want)
+# The WGS84 extent holds the native extent's corners as pyproj moves them.
+to_wgs84 = pyproj.Transformer.from_crs(pyproj.CRS.from_wkt(v["crs_wkt"]), "EPSG:4326", always_xy=True)
+lon0, lat0, lon1, lat1 = extent(ogr_json)
+for x in (want[0], want[2]):
+    for y in (want[1], want[3]):
+        lon, lat = to_wgs84.transform(x, y)
+        assert lon0 - 1e-6 <= lon <= lon1 + 1e-6 and lat0 - 1e-6 <= lat <= lat1 + 1e-6, (lon, lat, extent(ogr_json))
 PY
 ls "$tmp/one/.generation-1/overviews/L1/"*.vol > /dev/null || fail "no overview files"
 

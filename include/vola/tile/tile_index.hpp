@@ -1,9 +1,14 @@
-// The tile index `vola tile` writes beside its tiles: a GeoJSON FeatureCollection with
-// one Polygon feature per tile (its footprint in the CRS's units; properties: file,
-// tile index, points, voxels, bytes, the points' bbox) and a "vola" member holding the
-// grid (origin, tile size, depth, voxel size), the CRS and the overview pyramid.
-// Desktop GIS opens it as a footprint layer; vola get / render / plan and the Python
-// module open it as one scene whose tiles are mapped only when a query needs them.
+// The tile index `vola tile` writes beside its tiles, through OGR (GDAL's GeoJSON and
+// GPKG drivers, vola/io/footprints.hpp):
+//  - index.geojson, an RFC 7946 FeatureCollection: one Polygon per tile, its footprint in
+//    WGS84 longitude/latitude (null when the CRS is unknown or cannot reach WGS84), with
+//    properties file, tile [i, j, k], points, voxels, bytes and the points' bbox in the
+//    CRS's units; and a "vola" member holding the grid (origin, tile size, depth, voxel
+//    size), the CRS (EPSG code, WKT) and the overview pyramid. vola get / render / plan
+//    and the Python module open it as one scene whose tiles are mapped only when a query
+//    needs them.
+//  - index.gpkg, a GeoPackage of the same footprints in the survey's own CRS (one column
+//    per value), for desktop GIS.
 #pragma once
 
 #include <cstdint>
@@ -45,7 +50,8 @@ struct TileIndexFile {
 
 inline constexpr const char* kIndexFileName = "index.geojson";
 
-// Deterministic bytes for the same contents.
+// Writes index.gpkg beside `path` (its extension replaced), then `path`, each whole
+// through a temporary renamed into place. Deterministic bytes for the same contents.
 void write_tile_index(const TileIndexFile& index, const std::string& path);
 // Throws FormatError naming the file and what is wrong or missing.
 TileIndexFile read_tile_index(const std::string& path);

@@ -7,55 +7,16 @@
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 
-#include <atomic>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "../reader_plugin.hpp"
 #include "gdal_confined.hpp"
+#include "gdal_memory.hpp"
 #include "readers.hpp"
 #include "vola/error.hpp"
 
 namespace vola::io {
-
-namespace {
-
-class Options {
- public:
-  Options& set(const char* key, const char* value) {
-    list_ = CSLSetNameValue(list_, key, value);
-    return *this;
-  }
-  char** get() const noexcept { return list_; }
-  Options() = default;
-  Options(const Options&) = delete;
-  Options& operator=(const Options&) = delete;
-  ~Options() { CSLDestroy(list_); }
-
- private:
-  char** list_ = nullptr;
-};
-
-// A folder of /vsimem/ for one write, removed with what GDAL left in it.
-class MemoryFolder {
- public:
-  MemoryFolder() {
-    static std::atomic<unsigned long long> next{0};
-    path_ = "/vsimem/vola_geotiff_" + std::to_string(static_cast<long long>(::getpid())) + "_" +
-            std::to_string(next.fetch_add(1));
-    VSIMkdir(path_.c_str(), 0700);
-  }
-  ~MemoryFolder() { VSIRmdirRecursive(path_.c_str()); }
-  MemoryFolder(const MemoryFolder&) = delete;
-  MemoryFolder& operator=(const MemoryFolder&) = delete;
-  const std::string& path() const noexcept { return path_; }
-
- private:
-  std::string path_;
-};
-
-}  // namespace
 
 std::vector<std::uint8_t> geotiff_with_gdal(const Raster& raster, const std::string& wkt, std::uint32_t epsg) {
   if (raster.width == 0 || raster.height == 0 || raster.values.size() != raster.width * raster.height ||

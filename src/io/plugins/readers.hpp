@@ -10,6 +10,7 @@
 
 #include "vola/io/dem.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/footprints.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::io {
@@ -19,6 +20,11 @@ DemRaster read_dem_with_gdal(const std::string& path, const std::function<void(s
 // The GeoTIFF bytes of write_geotiff (vola/io/export.hpp), through GDAL in this process:
 // the CRS from `wkt`, else EPSG `epsg`, none when wkt is empty and epsg 0.
 std::vector<std::uint8_t> geotiff_with_gdal(const Raster& raster, const std::string& wkt, std::uint32_t epsg);
+// The bytes of footprints_geojson / footprints_geopackage (vola/io/footprints.hpp),
+// through OGR in this process.
+std::vector<std::uint8_t> footprints_geojson_with_ogr(const FootprintLayer& layer,
+                                                      const std::string& collection_members_json);
+std::vector<std::uint8_t> footprints_geopackage_with_ogr(const FootprintLayer& layer);
 // As read_mesh_triangles (vola/io/mesh.hpp), through Assimp in this process.
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path);
 
