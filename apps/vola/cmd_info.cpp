@@ -77,9 +77,8 @@ std::string json_crs(const NamedCrs& crs) {
 
 void run_info(const InfoArgs& a) {
   if (is_point_file(a.file) || !is_vol_file(a.file)) {
-    if (a.json) throw InvalidArgument(a.file + ": --json describes .vol files; this is a point file");
-    if (is_point_file(a.file)) print_point_file_info(a.file, a.summary);
-    else print_point_cloud_info(a.file, a.summary);
+    if (is_point_file(a.file)) print_point_file_info(a.file, a.summary, a.json);
+    else print_point_cloud_info(a.file, a.summary, a.json);
     return;
   }
   if (a.summary) throw InvalidArgument("--summary reads the points of a point file; " + a.file + " is a .vol file");
@@ -164,7 +163,7 @@ void add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree");
   cmd->add_option("file", args->file, ".vol file, or a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()->check(CLI::ExistingFile);
-  cmd->add_flag("--json", args->json, "Print JSON instead of a table (.vol files)");
+  cmd->add_flag("--json", args->json, "Print JSON instead of a table (.vol and point files)");
   cmd->add_flag("--summary", args->summary,
                 "Point files: read every point for their own bounds, column ranges and points per class (like pdal "
                 "info --summary)");

@@ -1,10 +1,13 @@
-// vola info on a LAS, LAZ or COPC file: what the header, the (E)VLRs, the compression and
-// the COPC octree say, read without decoding a point.
+// vola info on point files: a LAS, LAZ or COPC file's header, (E)VLRs, compression and
+// COPC octree, read without decoding a point; any other point file's count, CRS and
+// columns; with --summary every point read; with --json the same as one JSON object.
 #include "info_points.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "vola/error.hpp"
@@ -17,14 +20,58 @@ namespace vola::cli {
 
 namespace {
 
-std::string crs_of(const io::LasHeader& hd) {
-  const std::string definition = !hd.wkt.empty() ? hd.wkt : hd.epsg ? "EPSG:" + std::to_string(*hd.epsg) : "";
+using nlohmann::ordered_json;
+
+std::string crs_definition(const std::string& wkt, const std::optional<std::uint32_t>& epsg) {
+  return !wkt.empty() ? wkt : epsg ? "EPSG:" + std::to_string(*epsg) : "";
+}
+
+std::string crs_text(const std::string& definition) {
   if (definition.empty()) return "none stated";
   try {
     return geo::crs_summary(geo::describe_crs(definition));
   } catch (const Error& e) {
     return "not readable by PROJ (" + std::string(e.what()) + ")";
   }
+}
+
+// The CRS as PROJ names it (null when none is stated; "problem" when PROJ cannot read it).
+ordered_json crs_json(const std::string& wkt, const std::optional<std::uint32_t>& epsg) {
+  const std::string definition = crs_definition(wkt, epsg);
+  if (definition.empty()) return nullptr;
+  ordered_json out;
+  try {
+    const geo::CrsDescription d = geo::describe_crs(definition);
+    out["name"] = d.name;
+    out["kind"] = d.kind;
+    out["epsg"] = d.epsg ? ordered_json(*d.epsg) : ordered_json(nullptr);
+    out["unit"] = d.horizontal_unit;
+    out["vertical"] = d.vertical_name.empty() ? ordered_json(nullptr) : ordered_json(d.vertical_name);
+    out["vertical_unit"] = d.vertical_unit.empty() ? ordered_json(nullptr) : ordered_json(d.vertical_unit);
+  } catch (const Error& e) {
+    out["problem"] = e.what();
+  }
+  out["wkt"] = wkt;
+  return out;
+}
+
+ordered_json xyz(const double* v) { return ordered_json::array({v[0], v[1], v[2]}); }
+
+// Coordinates at the file's precision: a LAS coordinate is offset + scale * integer, and a
+// header's doubles carry the binary noise of that sum (848935.2000000001 for 848935.20 at
+// scale 0.01); rounded to the scale's decimals they print as the file means them.
+ordered_json xyz_at(const double* v, const double* scale) {
+  ordered_json out = ordered_json::array();
+  for (int i = 0; i < 3; ++i) {
+    const double decimals = scale[i] > 0 ? std::ceil(-std::log10(scale[i]) - 1e-9) : 0.0;
+    if (decimals < 0 || decimals > 12 || !std::isfinite(v[i])) {
+      out.push_back(v[i]);
+      continue;
+    }
+    const double unit = std::pow(10.0, decimals);
+    out.push_back(std::round(v[i] * unit) / unit);
+  }
+  return out;
 }
 
 void print_compression(const io::LasHeader& hd) {
@@ -58,6 +105,23 @@ void print_copc(const io::CopcHierarchy& copc) {
                 static_cast<unsigned long long>(per_level[l]), i.spacing / static_cast<double>(std::uint64_t{1} << l));
 }
 
+ordered_json copc_json(const io::CopcHierarchy& copc) {
+  ordered_json levels = ordered_json::array();
+  std::vector<std::uint64_t> per_level(static_cast<std::size_t>(copc.levels), 0);
+  std::vector<std::size_t> nodes_per_level(static_cast<std::size_t>(copc.levels), 0);
+  for (const auto& n : copc.nodes) {
+    per_level[static_cast<std::size_t>(n.level)] += n.point_count;
+    ++nodes_per_level[static_cast<std::size_t>(n.level)];
+  }
+  for (std::size_t l = 0; l < per_level.size(); ++l)
+    levels.push_back({{"level", l}, {"nodes", nodes_per_level[l]}, {"points", per_level[l]},
+                      {"spacing", copc.info.spacing / static_cast<double>(std::uint64_t{1} << l)}});
+  return {{"levels", copc.levels},       {"nodes", copc.nodes.size()},
+          {"pages", copc.pages},         {"center", xyz(copc.info.center.data())},
+          {"halfsize", copc.info.halfsize}, {"spacing", copc.info.spacing},
+          {"per_level", std::move(levels)}};
+}
+
 // The column named `name`, or nullptr.
 const PointAttribute* column_named(const PointCloud& cloud, const std::string& name) {
   for (const auto& a : cloud.attributes)
@@ -87,27 +151,55 @@ void print_summary(const PointCloud& cloud) {
   }
 }
 
+// print_summary's figures as JSON (pdal info --summary's content, vola's names).
+// `scale`: a LAS file's, for coordinates at its precision (null: as read).
+ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr) {
+  const Box box = cloud.bounds();
+  const auto coordinates = [scale](const Point& p) { return scale ? xyz_at(p.data(), scale) : xyz(p.data()); };
+  ordered_json out = {{"points_read", cloud.size()},
+                      {"bounds", {{"min", coordinates(box.min)}, {"max", coordinates(box.max)}}}};
+  ordered_json columns = ordered_json::object();
+  for (const auto& a : cloud.attributes) {
+    if (a.values.empty()) continue;
+    const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
+    columns[a.name] = {{"min", *lo}, {"max", *hi}};
+  }
+  out["columns"] = std::move(columns);
+  if (const PointAttribute* classes = column_named(cloud, "classification")) {
+    std::map<int, std::uint64_t> counts;
+    for (const double c : classes->values) ++counts[static_cast<int>(c)];
+    ordered_json list = ordered_json::array();
+    for (const auto& [code, n] : counts)
+      list.push_back({{"code", code}, {"name", std::string(analysis::asprs_class_name(code))}, {"points", n}});
+    out["classes"] = std::move(list);
+  }
+  return out;
+}
+
+void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2).c_str()); }
+
 }  // namespace
 
-void print_point_cloud_info(const std::string& path, bool summary) {
+void print_point_cloud_info(const std::string& path, bool summary, bool json) {
   io::InputOptions options;
   options.attributes = true;
   const io::Input in = io::read_input(path, "auto", options);
   if (in.is_mesh() || in.grid || in.terrain)
     throw InvalidArgument(path + ": vola info describes .vol and point files; this is " + in.format +
                           " input (convert it with vola convert, then vola info the .vol)");
+  if (json) {
+    ordered_json doc = {{"file", path}, {"format", in.format}, {"points", in.cloud.size()},
+                        {"crs", crs_json(in.wkt, in.epsg)}};
+    ordered_json dimensions = ordered_json::array();
+    for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
+    doc["dimensions"] = std::move(dimensions);
+    if (summary) doc["summary"] = summary_json(in.cloud);
+    print_json(doc);
+    return;
+  }
   std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
   std::printf("points:      %zu\n", in.cloud.size());
-  const std::string definition = !in.wkt.empty() ? in.wkt : in.epsg ? "EPSG:" + std::to_string(*in.epsg) : "";
-  std::string crs = "none stated";
-  if (!definition.empty()) {
-    try {
-      crs = geo::crs_summary(geo::describe_crs(definition));
-    } catch (const Error& e) {
-      crs = "not readable by PROJ (" + std::string(e.what()) + ")";
-    }
-  }
-  std::printf("crs:         %s\n", crs.c_str());
+  std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());
   std::printf("columns:    ");
   for (const auto& a : in.cloud.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
   std::printf("%s\n", in.cloud.attributes.empty() ? " none" : "");
@@ -123,8 +215,53 @@ bool is_point_file(const std::string& path) {
   return las;
 }
 
-void print_point_file_info(const std::string& path, bool summary) {
+namespace {
+
+void print_las_json(io::LasReader& reader, const std::string& path, bool summary) {
+  const io::LasHeader& hd = reader.header();
+  ordered_json doc = {{"file", path},
+                      {"format", hd.copc ? "COPC" : hd.compressed() ? "LAZ" : "LAS"},
+                      {"version", hd.version()},
+                      {"software", hd.generating_software},
+                      {"system", hd.system_identifier},
+                      {"points", hd.point_count},
+                      {"point_format", hd.point_format},
+                      {"record_length", hd.record_length},
+                      {"crs", crs_json(hd.wkt, hd.epsg)},
+                      {"scale", xyz(hd.scale.data())},
+                      {"offset", xyz(hd.offset.data())},
+                      {"bounds",
+                       {{"min", xyz_at(hd.min.data(), hd.scale.data())},
+                        {"max", xyz_at(hd.max.data(), hd.scale.data())},
+                        {"source", "header"}}}};
+  ordered_json dimensions = ordered_json::array();
+  for (const auto& spec : io::las_attributes(hd)) dimensions.push_back({{"name", spec.name}, {"type", name_of(spec.type)}});
+  doc["dimensions"] = std::move(dimensions);
+  ordered_json vlrs = ordered_json::array();
+  for (const auto& v : hd.vlrs)
+    vlrs.push_back({{"user_id", v.user_id}, {"record_id", v.record_id}, {"bytes", v.length},
+                    {"extended", v.extended}, {"description", v.description}});
+  doc["vlrs"] = std::move(vlrs);
+  if (hd.compressed()) {
+    const auto& z = *hd.laszip;
+    ordered_json items = ordered_json::array();
+    for (const auto& item : z.items) items.push_back(io::laz::describe_item(item));
+    doc["laz"] = {{"compressor", z.compressor},
+                  {"chunk_size", z.chunk_size == io::laz::kVariableChunkSize ? ordered_json("variable")
+                                                                             : ordered_json(z.chunk_size)},
+                  {"chunks", hd.laz_chunks.size()},
+                  {"items", std::move(items)}};
+  }
+  if (hd.copc) doc["copc"] = copc_json(*hd.copc);
+  if (summary) doc["summary"] = summary_json(io::las_points(reader, true, false), hd.scale.data());
+  print_json(doc);
+}
+
+}  // namespace
+
+void print_point_file_info(const std::string& path, bool summary, bool json) {
   io::LasReader reader(path);
+  if (json) return print_las_json(reader, path, summary);
   const io::LasHeader& hd = reader.header();
   std::printf("file:        %s (%s %s)\n", path.c_str(), hd.copc ? "COPC" : hd.compressed() ? "LAZ" : "LAS",
               hd.version().c_str());
@@ -132,7 +269,7 @@ void print_point_file_info(const std::string& path, bool summary) {
               hd.system_identifier.c_str());
   std::printf("points:      %llu, point format %u, %u bytes a record\n", static_cast<unsigned long long>(hd.point_count),
               hd.point_format, hd.record_length);
-  std::printf("crs:         %s\n", crs_of(hd).c_str());
+  std::printf("crs:         %s\n", crs_text(crs_definition(hd.wkt, hd.epsg)).c_str());
   std::printf("scale:       %.9g %.9g %.9g, offset %.9g %.9g %.9g\n", hd.scale[0], hd.scale[1], hd.scale[2], hd.offset[0],
               hd.offset[1], hd.offset[2]);
   std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the header's)\n", hd.min[0],
