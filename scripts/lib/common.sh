@@ -12,6 +12,8 @@ VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-da
 
 # The Python module (pybind11, numpy) and its tests (pytest, matplotlib for the example).
 VOLA_BUILD_PACKAGES+=(python3-dev pybind11-dev python3-pytest python3-matplotlib python3-pyproj)
+# pip install . and python3 -m build --wheel (pyproject.toml), tested in a venv.
+VOLA_BUILD_PACKAGES+=(python3-venv python3-pip python3-setuptools python3-wheel python3-build)
 
 # vola view: cpp-httplib, chromium for its browser test, and node/npm to build the page
 # (three.js, esbuild from the npm registry); a machine with its own node keeps it.
