@@ -72,6 +72,19 @@ printf '1 2 3
 "$vola" get "$tmp/map.vol" --world --points "$tmp/bad_points.txt" 2> "$tmp/err" && fail "a bad point line was accepted"
 grep -q 'bad_points.txt: line 2: expected three finite numbers' "$tmp/err" || fail "message: $(cat "$tmp/err")"
 
+# plan on the state map: unknown space is an obstacle by default. Along x the known free
+# voxels lead from the sensor's voxel to (0.875, 0.125); (0.375, 0.375) was never seen.
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.875 0.125 0.125 -o "$tmp/path.csv" -q \
+  || fail "plan along known free voxels"
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 -o "$tmp/path.csv" 2> "$tmp/err" \
+  && fail "a goal in unknown space was accepted"
+grep -q 'goal .* is inside an obstacle or unknown space' "$tmp/err" || fail "message: $(cat "$tmp/err")"
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 -o "$tmp/path.csv" -q --unknown free \
+  || fail "plan with --unknown free"
+"$vola" plan "$tmp/map.free.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 --unknown occupied \
+  -o "$tmp/path.csv" 2> "$tmp/err" && fail "--unknown occupied on a plain .vol was accepted"
+grep -q 'is not a state map' "$tmp/err" || fail "message: $(cat "$tmp/err")"
+
 # Errors name the line; no output file appears.
 printf 'scans/ahead.xyz 0 0 0 0 0 0 1\nscans/ahead.xyz 0 0 zero 0 0 0 1\n' > "$tmp/bad.txt"
 "$vola" map "$tmp/bad.txt" -o "$tmp/bad.vol" --voxel-size 0.25 2> "$tmp/err" && fail "a bad pose was accepted"
