@@ -66,7 +66,9 @@ void bind_map(py::module_& m) {
              if (!(max_range >= 0.0)) throw InvalidArgument("max_range must be >= 0 (0: no limit)");
              return PyMap{OccupancyMap(voxel_size), max_range};
            }),
-           py::arg("voxel_size"), py::arg("max_range") = 0.0)
+           py::arg("voxel_size"), py::arg("max_range") = 0.0,
+           "An empty map of voxels of edge voxel_size (voxel (i,j,k) covers [i*R, (i+1)*R)); points farther than\n"
+           "max_range (> 0) from the sensor mark their ray free up to it and hit nothing.")
       .def_property_readonly("voxel_size", [](const PyMap& self) { return self.map.voxel_size(); })
       .def_property_readonly("max_range", [](const PyMap& self) { return self.max_range; })
       .def("__len__", [](const PyMap& self) { return self.map.size(); })
@@ -82,14 +84,16 @@ void bind_map(py::module_& m) {
             }
             return report_dict(report);
           },
-          py::arg("points"), py::arg("origin"))
+          py::arg("points"), py::arg("origin"),
+          "One scan: points (N, 3) in world coordinates, each a ray from origin (the sensor). Returns the counts\n"
+          "of `vola map`'s summary (points, not_finite, outside, cut, hit_voxels, free_voxels).")
       .def("state",
            [](const PyMap& self, const py::handle& points) {
              return per_point<std::int8_t>(points, [&](const Point& p) {
                return static_cast<std::int8_t>(map_state(self.map, p));
              });
            },
-           py::arg("points"))
+           py::arg("points"), "(N,) int8 per world point: vola.UNKNOWN 0, vola.FREE 1, vola.OCCUPIED 2.")
       .def("probability",
            [](const PyMap& self, const py::handle& points) {
              return per_point<double>(points, [&](const Point& p) {
@@ -98,15 +102,16 @@ void bind_map(py::module_& m) {
                return value ? map::occupancy_probability(*value) : std::numeric_limits<double>::quiet_NaN();
              });
            },
-           py::arg("points"))
-      .def("tree", [](const PyMap& self) { return map::freeze(self.map); })
+           py::arg("points"), "(N,) float64 occupancy probability per world point, NaN where unknown.")
+      .def("tree", [](const PyMap& self) { return map::freeze(self.map); },
+           "The map as a state map tree (Tree.is_state_map), as save() writes it.")
       .def(
           "save",
           [](const PyMap& self, const std::filesystem::path& path) {
             py::gil_scoped_release release;
             write(map::freeze(self.map), path.string());
           },
-          py::arg("path"));
+          py::arg("path"), "Writes the state map: the bytes `vola map` writes for the same scans.");
 
   m.def(
       "state",
@@ -116,7 +121,9 @@ void bind_map(py::module_& m) {
         check_mapped(tree);
         return out;
       },
-      py::arg("tree"), py::arg("points"));
+      py::arg("tree"), py::arg("points"),
+      "(N,) int8 state per world point of a loaded tree: a state map's UNKNOWN/FREE/OCCUPIED; any other tree's\n"
+      "voxels are OCCUPIED and the rest FREE.");
   m.def(
       "probability",
       [](const Tree& tree, const py::handle& points) {
@@ -128,9 +135,11 @@ void bind_map(py::module_& m) {
         check_mapped(tree);
         return out;
       },
-      py::arg("tree"), py::arg("points"));
-  m.def("occupied_tree", &map::occupied_tree, py::arg("tree"));
-  m.def("free_tree", &map::free_tree, py::arg("tree"));
+      py::arg("tree"), py::arg("points"),
+      "(N,) float64 occupancy probability per world point from the tree's log_odds column, NaN where there is none.");
+  m.def("occupied_tree", &map::occupied_tree, py::arg("tree"),
+        "A state map's occupied voxels as a plain tree (columns kept); any other tree as it is.");
+  m.def("free_tree", &map::free_tree, py::arg("tree"), "A state map's free voxels as a plain tree (columns kept).");
 }
 
 }  // namespace vola::python
