@@ -1,7 +1,10 @@
 // vola census FILE: per level blocks and cells, per attribute histograms (classification
 // counts with ASPRS names), volume and footprint, voxel counts inside boxes or polygons.
+// A state map (vola map) is counted as its occupied voxels, after its occupied, free and
+// unknown counts.
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -10,6 +13,7 @@
 #include "vola/analysis/census.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::cli {
 
@@ -78,8 +82,20 @@ void print_histogram(const analysis::Histogram& h) {
                 static_cast<unsigned long long>(h.counts[i]));
 }
 
+void print_states(const map::StateCounts& s) {
+  std::printf("  state map: %llu occupied, %llu free, %llu unknown in the known voxels' box (%u..%u, %u..%u, "
+              "%u..%u); the counts below are of the occupied voxels\n",
+              static_cast<unsigned long long>(s.occupied), static_cast<unsigned long long>(s.free),
+              static_cast<unsigned long long>(s.unknown_in_bounds), s.min.x, s.max.x, s.min.y, s.max.y, s.min.z,
+              s.max.z);
+}
+
 void run_census(const CensusArgs& a) {
-  const Tree tree = open_mapped(a.file);
+  const Tree file = open_mapped(a.file);
+  std::optional<map::StateCounts> states;
+  if (map::is_state_map(file)) states = map::state_counts(file);
+  const Tree tree = map::occupied_tree(file);
+  check_mapped(file);
   analysis::CensusOptions options;
   options.bins = a.bins;
   options.regions = parse_regions(a);
@@ -90,6 +106,11 @@ void run_census(const CensusArgs& a) {
     j["file"] = a.file;
     j["depth"] = c.depth;
     j["voxels"] = c.voxels;
+    if (states)
+      j["states"] = {{"occupied", states->occupied}, {"free", states->free},
+                     {"unknown_in_bounds", states->unknown_in_bounds},
+                     {"bounds", {{"min", {states->min.x, states->min.y, states->min.z}},
+                                 {"max", {states->max.x, states->max.y, states->max.z}}}}};
     for (std::size_t l = 0; l < c.levels.size(); ++l)
       j["levels"].push_back({{"level", l}, {"blocks", c.levels[l].blocks}, {"cells", c.levels[l].cells},
                              {"fill", c.levels[l].fill}});
@@ -116,6 +137,7 @@ void run_census(const CensusArgs& a) {
   }
 
   std::printf("%s: depth %d, %llu voxels\n", a.file.c_str(), c.depth, static_cast<unsigned long long>(c.voxels));
+  if (states) print_states(*states);
   std::printf("  level %12s %14s %8s\n", "blocks", "cells", "fill");
   for (std::size_t l = 0; l < c.levels.size(); ++l)
     std::printf("  %5zu %12llu %14llu %8.4f\n", l, static_cast<unsigned long long>(c.levels[l].blocks),
@@ -151,6 +173,8 @@ void add_census(CLI::App& app) {
   cmd->footer(
       "Regions are in world coordinates; a voxel counts when its centre is inside.\n"
       "Volume and footprint area need a GIS grid (vola convert --voxel-size).\n"
+      "A state map (vola map) counts its occupied voxels, after a line (JSON: \"states\") with its\n"
+      "occupied, free and unknown voxel counts (unknown: within the box of the known voxels).\n"
       "Example: vola census autzen.vol --box 636000,849000,400,637000,850000,500 --json");
   cmd->add_option("file", args->file, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", args->json, "Print JSON instead of a table");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/raycast/collision.hpp"
@@ -48,7 +49,7 @@ void print_segment_hit(const CollideArgs& a, const Point& from, const Point& to,
 int run_collide(const CollideArgs& a) {
   const int queries = !a.segment.empty() + !a.sphere.empty() + !a.box.empty();
   if (queries != 1) throw InvalidArgument("give exactly one of --segment, --sphere or --box");
-  const Tree tree = open_mapped(a.input);
+  const Tree tree = open_voxels(a.input);
   const Frame frame = tree.frame();
   const raycast::Collider collider(tree);
   auto to_grid = [&](double x, double y, double z) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/analysis/components.hpp"
 #include "vola/builder.hpp"
@@ -89,7 +90,7 @@ void per_class(const Tree& tree, const ComponentsArgs& a, analysis::Connectivity
 }
 
 void run_components(const ComponentsArgs& a) {
-  const Tree tree = open_mapped(a.file);
+  const Tree tree = open_voxels(a.file);
   const analysis::Connectivity c = analysis::parse_connectivity(a.connectivity);
   if (a.per_class) return per_class(tree, a, c);
   const analysis::ComponentLabels r = analysis::label_components(tree, c);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
@@ -82,7 +83,7 @@ std::string resolve_format(const ExportArgs& a) {
 
 void run_export(const ExportArgs& a) {
   const std::string format = resolve_format(a);
-  Tree tree = open_mapped(a.input);
+  Tree tree = open_voxels(a.input);
   if (a.depth > tree.depth())
     throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
                           std::to_string(tree.depth()));

@@ -9,6 +9,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::cli {
 
@@ -90,6 +91,8 @@ void run_info(const InfoArgs& a) {
   const double bits = voxels > 0 ? 8.0 * static_cast<double>(layout.file_size) / voxels : 0.0;
   const char* mode = h.layout == Layout::dense ? "dense" : "sparse";
   const NamedCrs crs = name_crs(tree);
+  std::optional<map::StateCounts> states;
+  if (map::is_state_map(tree)) states = map::state_counts(tree);
   if (a.json) {
     std::printf("{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
                 "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %.17g,\n"
@@ -111,7 +114,12 @@ void run_info(const InfoArgs& a) {
       std::printf("%s\n    {\"name\": %s, \"type\": \"%s\", \"reduction\": \"%s\"}", i ? "," : "",
                   quoted(columns[i].name()).c_str(), std::string(name_of(columns[i].type())).c_str(),
                   std::string(name_of(columns[i].reduction())).c_str());
-    std::printf("\n  ],\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
+    std::printf("\n  ]");
+    if (states)
+      std::printf(",\n  \"state_map\": {\"occupied\": %llu, \"free\": %llu, \"unknown_in_bounds\": %llu}",
+                  static_cast<unsigned long long>(states->occupied), static_cast<unsigned long long>(states->free),
+                  static_cast<unsigned long long>(states->unknown_in_bounds));
+    std::printf(",\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
                 "  \"crs_named\": %s\n}\n",
                 layout.compressed_levels ? "true" : "false", static_cast<unsigned long long>(layout.extension_bytes),
                 quoted(tree.georef().crs_wkt).c_str(), json_crs(crs).c_str());
@@ -129,8 +137,15 @@ void run_info(const InfoArgs& a) {
   std::printf("grid:        %s quantization, voxel size %s, origin (%s)%s\n",
               frame.quantization == Quantization::grid ? "grid" : "toolkit", shortest(frame.voxel_size).c_str(),
               triple(frame.origin).c_str(), tree.stored_frame() ? "" : " (from the header bbox)");
-  std::printf("voxels:      %llu occupied, %.2f bits per occupied voxel (whole file)\n",
-              static_cast<unsigned long long>(tree.voxel_count()), bits);
+  if (states)
+    std::printf("voxels:      state map (vola map): %llu known, %.2f bits per known voxel (whole file): %llu "
+                "occupied, %llu free, %llu unknown in the known voxels' box; the payload words hold the states\n",
+                static_cast<unsigned long long>(tree.voxel_count()), bits,
+                static_cast<unsigned long long>(states->occupied), static_cast<unsigned long long>(states->free),
+                static_cast<unsigned long long>(states->unknown_in_bounds));
+  else
+    std::printf("voxels:      %llu occupied, %.2f bits per occupied voxel (whole file)\n",
+                static_cast<unsigned long long>(tree.voxel_count()), bits);
   std::printf("levels:      level  blocks      occupied cells  bytes\n");
   for (int l = 0; l < tree.depth(); ++l) {
     const std::size_t blocks = h.layout == Layout::dense ? (std::size_t{1} << (6 * l)) : tree.occupancy(l).size();

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 
@@ -17,7 +18,7 @@ struct LodArgs {
 };
 
 void run_lod(const LodArgs& a) {
-  const Tree tree = open_mapped(a.input);
+  const Tree tree = open_voxels(a.input);
   if (a.depth > tree.depth())
     throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
                           std::to_string(tree.depth()));

@@ -1,6 +1,7 @@
 // vola map SCANLIST -o MAP.vol --voxel-size R: range scans with poses into a probabilistic
-// occupancy map (OctoMap's insertion model), written as the occupied voxels with their
-// log-odds, and the free voxels too with --free.
+// occupancy map (OctoMap's insertion model), written as one state map (occupied, free and
+// unknown, vola/map/state_map.hpp) with every known voxel's log-odds; --free also writes
+// the free voxels as a plain tree, as before the state map.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "vola/io/input.hpp"
 #include "vola/map/occupancy_map.hpp"
 #include "vola/map/scan_list.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::cli {
 
@@ -59,14 +61,14 @@ void add_up(map::ScanReport& total, const map::ScanReport& r) {
 }
 
 void print_summary(const MapArgs& a, const map::OccupancyMap& m, const map::ScanReport& total, std::size_t scans,
-                   const Tree& occupied, double seconds, double insert_seconds) {
+                   const map::StateCounts& states, double seconds, double insert_seconds) {
   std::printf("scans:   %zu, %llu points (%llu not finite, %llu outside the index range skipped; %llu beyond "
               "--max-range, free up to it)\n",
               scans, static_cast<unsigned long long>(total.points), static_cast<unsigned long long>(total.not_finite),
               static_cast<unsigned long long>(total.outside), static_cast<unsigned long long>(total.cut));
   std::printf("voxels:  %zu known, %llu occupied, %llu free (voxel size %.9g)\n", m.size(),
-              static_cast<unsigned long long>(occupied.voxel_count()),
-              static_cast<unsigned long long>(m.size() - occupied.voxel_count()), a.voxel_size);
+              static_cast<unsigned long long>(states.occupied), static_cast<unsigned long long>(states.free),
+              a.voxel_size);
   std::printf("file:    %s%s\n", a.output.c_str(), a.free ? (" and " + free_path(a.output)).c_str() : "");
   std::printf("time:    %.3f s (ray insertion %.3f s, %.0f points/s)\n", seconds, insert_seconds,
               insert_seconds > 0 ? static_cast<double>(total.points) / insert_seconds : 0.0);
@@ -93,16 +95,16 @@ void run_map(const MapArgs& a) {
   }
   if (progress) progress->finish();
   // Both trees are built before either file is written, so a failure leaves neither.
-  const Tree occupied = map::freeze(m, map::VoxelState::occupied);
+  const Tree states = map::freeze(m);
   if (a.free) {
-    const Tree free = map::freeze(m, map::VoxelState::free);
-    write(occupied, a.output);
+    const Tree free = map::free_tree(states);
+    write(states, a.output);
     write(free, free_path(a.output));
   } else {
-    write(occupied, a.output);
+    write(states, a.output);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!a.quiet) print_summary(a, m, total, scans.size(), occupied, seconds, insert_seconds);
+  if (!a.quiet) print_summary(a, m, total, scans.size(), map::state_counts(states), seconds, insert_seconds);
 }
 
 }  // namespace
@@ -120,19 +122,23 @@ void add_map(CLI::App& app) {
       "above); one scan updates each voxel once, a hit winning over a miss. Voxel (i,j,k) covers\n"
       "[i*R, (i+1)*R) per axis. Points farther than --max-range mark the ray free up to it, no hit;\n"
       "NaN and infinite points are skipped and counted.\n"
-      "MAP.vol holds the occupied voxels with their log-odds (attribute log_odds, f32); --free also\n"
-      "writes the free voxels to MAP.free.vol.\n"
+      "MAP.vol is a state map: every known voxel, occupied or free, with its log-odds (attribute\n"
+      "log_odds, f32), and a state word per block (nbits 1: bit set = occupied); unknown space is not\n"
+      "in the tree. Every vola command reads it as its occupied voxels; vola get --points prints\n"
+      "occupied/free/unknown and the probability, vola info and vola census count the states, vola\n"
+      "view --free shows the free voxels. --free also writes the free voxels to MAP.free.vol as a\n"
+      "plain tree (as vola map did before the state map).\n"
       "Example:\n"
       "  printf 'velodyne/000000.bin 0 0 0 0 0 0 1\\n' > scans.txt\n"
       "  vola map scans.txt -o map.vol --voxel-size 0.2 --max-range 40 --free");
   cmd->add_option("scanlist", args->list, "Text file: FILE tx ty tz qx qy qz qw per line")->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->output, "Output .vol (occupied voxels)")->required();
+  cmd->add_option("-o,--output", args->output, "Output .vol (state map: occupied and free voxels)")->required();
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge R in the points' unit")->required()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-range", args->max_range, "Longest ray; farther points mark free space only (0: no limit)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol");
+  cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol as a plain tree");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_map(*args); });
 }

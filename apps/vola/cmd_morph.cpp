@@ -6,6 +6,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/analysis/crop.hpp"
 #include "vola/analysis/downsample.hpp"
 #include "vola/analysis/fill.hpp"
@@ -63,7 +64,7 @@ void add_morph(CLI::App& app) {
     cmd->footer(std::string("Example: vola dilate obstacles.vol --radius 3 inflated.vol\n") + kDropped);
     add_radius(cmd, args);
     cmd->callback([args] {
-      const Tree in = open_mapped(args->input);
+      const Tree in = open_voxels(args->input);
       finish(*args, "dilate", in, analysis::dilate(in, args->radius, element_of(args->element)));
     });
   }
@@ -73,7 +74,7 @@ void add_morph(CLI::App& app) {
     cmd->footer(std::string("Cells outside the grid count as empty.\n") + kDropped);
     add_radius(cmd, args);
     cmd->callback([args] {
-      const Tree in = open_mapped(args->input);
+      const Tree in = open_voxels(args->input);
       finish(*args, "erode", in, analysis::erode(in, args->radius, element_of(args->element)));
     });
   }
@@ -82,7 +83,7 @@ void add_morph(CLI::App& app) {
     auto* cmd = add_io(app, "fill", "Fill enclosed cavities (empty cells the outside cannot reach face to face)", args);
     cmd->footer(std::string("Works in the voxels' bounding box, refused beyond 2^33 cells (crop first).\n") + kDropped);
     cmd->callback([args] {
-      const Tree in = open_mapped(args->input);
+      const Tree in = open_voxels(args->input);
       analysis::FillReport report;
       const Tree out = analysis::fill_cavities(in, &report);
       finish(*args, "fill", in, out, " (" + std::to_string(report.filled) + " cavity cells filled)");
@@ -95,7 +96,7 @@ void add_morph(CLI::App& app) {
     cmd->add_option("--min", args->min, "x,y,z of the first voxel (inclusive)")->required()->delimiter(',')->expected(3);
     cmd->add_option("--max", args->max, "x,y,z of the last voxel (inclusive)")->required()->delimiter(',')->expected(3);
     cmd->callback([args] {
-      const Tree in = open_mapped(args->input);
+      const Tree in = open_voxels(args->input);
       const auto& lo = args->min;
       const auto& hi = args->max;
       finish(*args, "crop", in, analysis::crop(in, {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}));
@@ -109,7 +110,7 @@ void add_morph(CLI::App& app) {
     cmd->add_option("--depth", args->depth, "Depth of the result")->required()->check(CLI::Range(1, 10));
     cmd->add_option("--min-voxels", args->min_voxels, "Voxels a coarse cell needs to be kept")->check(CLI::PositiveNumber);
     cmd->callback([args] {
-      const Tree in = open_mapped(args->input);
+      const Tree in = open_voxels(args->input);
       finish(*args, "downsample", in, analysis::downsample(in, args->depth, args->min_voxels));
     });
   }

@@ -1,7 +1,9 @@
 // vola plan: a collision-free path between two points (A* over free voxels), as CSV and PLY;
-// with --avoid, the trajectory of a reactive agent that only looks along a fan of rays.
+// with --avoid, the trajectory of a reactive agent that only looks along a fan of rays. On a
+// state map (vola map) unknown space is an obstacle unless --unknown free.
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -9,6 +11,7 @@
 #include "commands.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/output_file.hpp"
 #include "vola/raycast/avoidance.hpp"
 #include "vola/raycast/path_planner.hpp"
@@ -36,6 +39,14 @@ struct PlanArgs {
   bool avoid = false;
   double speed = 0.0, look_ahead = 0.0;  // 0: one voxel, 24 voxels
   std::size_t max_steps = 100000;
+  std::string unknown;  // "occupied" or "free"; empty: occupied for a state map
+};
+
+// What the search plans in: the obstacles (a state map's occupied voxels) and, when
+// unknown space counts as an obstacle, the state map's known voxels.
+struct Scene {
+  Tree obstacles;
+  std::optional<Tree> known;
 };
 
 // The agent's positions (grid coordinates) from `from` towards `to`, step by step; throws
@@ -52,10 +63,30 @@ raycast::Flight fly_to(const PlanArgs& a, const Tree& tree, const Point& from, c
   return raycast::fly(avoider, from, to, a.max_steps, std::max(0.5, options.speed));
 }
 
+// A .vol file: a state map's occupied voxels, its known ones too unless --unknown free;
+// any other file as it is (empty space free, so --unknown occupied has nothing to mean).
+Scene load_file(const PlanArgs& a) {
+  Tree file = open_mapped(a.input);
+  if (!map::is_state_map(file)) {
+    if (a.unknown == "occupied")
+      throw InvalidArgument("--unknown occupied: " + a.input + " is not a state map (vola map writes one): its "
+                            "empty space is free, it has no unknown space");
+    return {std::move(file), std::nullopt};
+  }
+  Tree occupied = map::occupied_tree(file);
+  check_mapped(file);
+  if (a.unknown == "free") return {std::move(occupied), std::nullopt};
+  if (a.avoid)
+    throw InvalidArgument("--avoid sees occupied voxels only, not unknown space: give --unknown free to fly " + a.input +
+                          " optimistically");
+  return {std::move(occupied), std::move(file)};
+}
+
 // The scene to plan in: the file, or for a tile index one grid over the tiles that meet
 // the from-to box grown by --margin (only those tiles are opened).
-Tree load_scene(const PlanArgs& a) {
-  if (!tile::is_tile_index_path(a.input)) return open_mapped(a.input);
+Scene load_scene(const PlanArgs& a) {
+  if (!tile::is_tile_index_path(a.input)) return load_file(a);
+  if (a.unknown == "occupied") throw InvalidArgument("--unknown occupied: a tile set has no unknown space");
   if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
   const tile::TileSet tiles(a.input);
   const double margin = a.margin > 0.0 ? a.margin : tiles.grid().tile_size;
@@ -68,11 +99,12 @@ Tree load_scene(const PlanArgs& a) {
   if (!a.quiet)
     std::printf("planning over %zu of %zu tiles (the from-to box and %.6g around it)\n", tiles.tiles_opened(),
                 tiles.index().tiles.size(), margin);
-  return scene;
+  return {std::move(scene), std::nullopt};
 }
 
 void run_plan(const PlanArgs& a) {
-  const Tree tree = load_scene(a);
+  const Scene scene = load_scene(a);
+  const Tree& tree = scene.obstacles;
   const Frame frame = tree.frame();
   Point from{a.from[0], a.from[1], a.from[2]}, to{a.to[0], a.to[1], a.to[2]};
   raycast::PlanOptions options;
@@ -80,6 +112,7 @@ void run_plan(const PlanArgs& a) {
   options.level = a.level;
   options.hierarchical = a.hierarchical;
   options.smooth = !a.no_smooth;
+  if (scene.known) options.known = &*scene.known;
   if (!a.grid) {
     from = raycast::world_to_grid(frame, from);
     to = raycast::world_to_grid(frame, to);
@@ -135,17 +168,23 @@ void add_plan(CLI::App& app) {
       "of its centre. A* moves to the 26 neighbours at Euclidean cost, so the cost is optimal on the\n"
       "planning grid; smoothing then replaces runs by straight segments the sphere can sweep clear.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
+      "On a state map (vola map) unknown space is an obstacle too (--unknown occupied, the default\n"
+      "there): a voxel is free only when it is known free and no unknown voxel is within the radius;\n"
+      "--unknown free plans optimistically through unknown space. A .vol made from points has no\n"
+      "unknown space: what is not a voxel is free.\n"
       "Coordinates are world coordinates (the file's frame) unless --grid is given.\n"
       "INPUT may be a tile index (index.geojson from vola tile): the search then runs over the tiles\n"
       "that meet the box around --from and --to grown by --margin, and opens no others.\n"
       "--avoid flies a reactive agent instead of planning: each step it casts a fan of rays around\n"
       "the goal direction (--look-ahead long, as thick as the agent), takes the open direction\n"
       "closest to the goal and its current heading, and moves --speed only if the swept sphere is\n"
-      "clear, so it never collides; without a map search it can get stuck (then exit status 1).\n"
+      "clear, so it never collides; without a map search it can get stuck (then exit status 1). It\n"
+      "sees occupied voxels only: on a state map it needs --unknown free.\n"
       "Examples:\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 -o path.csv --ply path.ply\n"
       "  vola plan site.vol --grid --from 0.5 0.5 0.5 --to 900 900 30 --hierarchical\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 --avoid --speed 0.25\n"
+      "  vola plan map.vol --from 0 0 1 --to 20 5 1 --radius 0.3 --unknown free\n"
       "  vola plan tiles/index.geojson --from 500100 5000100 105 --to 501900 5001200 110 --radius 1");
   cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--from", args->from, "Start X Y Z")->required()->expected(3);
@@ -165,6 +204,9 @@ void add_plan(CLI::App& app) {
   cmd->add_option("--margin", args->margin, "Tile index: how far around the from-to box to search (default: one tile)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--grid", args->grid, "Points and radius are in voxel-grid coordinates");
+  cmd->add_option("--unknown", args->unknown,
+                  "State maps: is unknown space occupied (the default there) or free (optimistic)?")
+      ->check(CLI::IsMember({"occupied", "free"}));
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_plan(*args); });
 }

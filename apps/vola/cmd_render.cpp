@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "png_writer.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -167,7 +168,7 @@ void run_render(const RenderArgs& a) {
         });
     return;
   }
-  const Tree tree = open_mapped(a.input);
+  const Tree tree = open_voxels(a.input);
   if (a.camera.empty()) camera = default_camera(tree);
   else if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   const raycast::RayCaster caster(tree);

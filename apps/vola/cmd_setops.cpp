@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "vola/analysis/change.hpp"
 #include "vola/file.hpp"
 #include "vola/setops.hpp"
@@ -33,8 +34,8 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args, op, name] {
-    const Tree a = open_mapped(args->a);
-    const Tree b = open_mapped(args->b);
+    const Tree a = open_voxels(args->a);
+    const Tree b = open_voxels(args->b);
     const Tree result = op(a, b, args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal);
     write(result, args->output);
     if (!args->quiet)
@@ -60,8 +61,8 @@ void add_diff(CLI::App& app) {
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] {
-    const Tree a = open_mapped(args->a);
-    const Tree b = open_mapped(args->b);
+    const Tree a = open_voxels(args->a);
+    const Tree b = open_voxels(args->b);
     const FrameCheck check = args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal;
     const Tree removed = subtract(a, b, check);  // also checks depths and frames
     if (!args->output.empty()) write(removed, args->output);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "ir_plot.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/materials.hpp"
@@ -107,7 +108,7 @@ void run_sonify(SonifyArgs& a) {
   audio::MaterialTable table = audio::scene_material(a.reflection);
   if (!a.materials.empty()) table = audio::read_material_table(a.materials);
   if (a.payload_coefficients) table.source = audio::MaterialSource::payload_value;
-  const Tree tree = open_mapped(a.scene);
+  const Tree tree = open_voxels(a.scene);
   const audio::AcousticScene scene(tree, table);
   const Point listener{a.listener[0], a.listener[1], a.listener[2]};
 

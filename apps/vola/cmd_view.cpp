@@ -14,6 +14,7 @@ namespace {
 
 struct ViewArgs {
   std::vector<std::string> files;
+  bool free = false;
   viewer::ServerOptions server;
 };
 
@@ -25,10 +26,15 @@ void run_view(const ViewArgs& a) {
   for (const auto& path : a.files) {
     files.push_back(std::make_unique<viewer::ViewedFile>(path));
     voxels += files.back()->tree().voxel_count();
+    // A state map's free voxels as a layer of their own, with its own toggle on the page.
+    if (a.free && files.back()->is_state_map()) {
+      files.push_back(std::make_unique<viewer::ViewedFile>(path, viewer::MapPart::free));
+      voxels += files.back()->tree().voxel_count();
+    }
   }
   viewer::Server server(std::move(files), a.server);
   const int port = server.bind();
-  std::printf("vola view: %zu file%s, %llu voxels\n", a.files.size(), a.files.size() == 1 ? "" : "s",
+  std::printf("vola view: %zu file%s, %llu voxels shown\n", a.files.size(), a.files.size() == 1 ? "" : "s",
               static_cast<unsigned long long>(voxels));
   std::printf("open http://%s:%d/ in a browser (Ctrl-C stops)\n", url_host(a.server.host).c_str(), port);
   std::fflush(stdout);
@@ -46,12 +52,16 @@ void add_view(CLI::App& app) {
       "colour by height, ASPRS classification, stored RGB or file; a slicing plane hides\n"
       "what lies above it; a click reports the voxel (grid and CRS coordinates, attributes).\n"
       "Several files share one scene in world coordinates (two surveys: change at a glance).\n"
+      "A state map (vola map) shows its occupied voxels; --free adds its free voxels as a second\n"
+      "layer, \"NAME (free)\", with a toggle of its own.\n"
       "The page needs no network: three.js is compiled into this binary.\n\n"
       "Examples:\n"
       "  vola view scan.vol\n"
       "  vola view survey2019.vol survey2024.vol --port 8080\n"
+      "  vola view map.vol --free\n"
       "  vola view scan.vol --host 0.0.0.0 --port 8080 --allow-host mybox.local");
   cmd->add_option("files", args->files, ".vol files to show")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--free", args->free, "Also show the free voxels of state maps (vola map), as a layer of their own");
   cmd->add_option("--port", args->server.port, "Port to listen on (default 0: a free one, printed)")
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--host", args->server.host,

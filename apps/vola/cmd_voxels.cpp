@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "open_voxels.hpp"
 #include "text_output.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -54,7 +55,7 @@ void print_tail(TextOutput& out, const Tree& tree, const VoxelsArgs& a, std::uin
 }
 
 void run_voxels(const VoxelsArgs& a) {
-  const Tree tree = open_mapped(a.file);
+  const Tree tree = open_voxels(a.file);
   TextOutput out;
   print_header(out, tree, a);
   each_voxel(tree, [&](const Voxel& v, std::uint64_t rank, std::size_t block) {
@@ -75,7 +76,7 @@ std::string source_crs(const Tree& tree, const VoxelsArgs& a) {
 }
 
 void run_coords(const VoxelsArgs& a) {
-  const Tree tree = open_mapped(a.file);
+  const Tree tree = open_voxels(a.file);
   const Quantizer q = tree.quantizer();
   std::optional<geo::ToWgs84> to_wgs84;
   if (a.wgs84) to_wgs84.emplace(source_crs(tree, a));

@@ -64,8 +64,9 @@ struct WriteOptions {
 bool compression_available() noexcept;
 
 // The file's bytes. The extension is written only when the tree carries something the
-// reference header cannot say (a grid frame, a CRS in WKT, attribute columns) or when
-// compressing, so a toolkit-mode tree serializes exactly as the reference writes it.
+// reference header cannot say (a grid frame, a CRS in WKT, attribute columns, a state
+// map's payload meaning) or when compressing, so a toolkit-mode tree serializes exactly
+// as the reference writes it.
 std::vector<std::uint8_t> serialize(const Tree& tree, const WriteOptions& options = {});
 // Writes through a temporary file and a rename: no half-written file on failure.
 void write(const Tree& tree, const std::string& path, const WriteOptions& options = {});

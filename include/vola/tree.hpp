@@ -65,6 +65,16 @@ class RankDirectory {
   unsigned shift_ = 3;
 };
 
+// What a tree's payload words mean.
+//  reference:       the reference toolkit's: one word per block, the row of the block's
+//                   lexicographically greatest voxel (FORMAT.md section 8), or none.
+//  occupancy_state: a state map (vola/map/state_map.hpp): the tree holds every KNOWN voxel
+//                   and bit b of a leaf block's payload word is 1 iff voxel b is occupied,
+//                   0 iff free; at coarser levels bit b is 1 iff cell b holds any occupied
+//                   voxel. Unknown space is outside the tree. Written in the extension
+//                   (record 5, docs/FILE_FORMAT.md); a reference reader sees the known voxels.
+enum class PayloadMeaning : std::uint8_t { reference = 0, occupancy_state = 1 };
+
 class Tree {
  public:
   // An empty tree of depth 1 (one zero root word).
@@ -182,6 +192,9 @@ class Tree {
   Quantizer quantizer() const;
   Attributes& attributes() noexcept { return attributes_; }
   const Attributes& attributes() const noexcept { return attributes_; }
+  PayloadMeaning payload_meaning() const noexcept { return payload_meaning_; }
+  // occupancy_state needs payload words (InvalidArgument otherwise).
+  void set_payload_meaning(PayloadMeaning meaning);
   std::span<const std::uint64_t> voxel_payloads() const noexcept { return voxel_payloads_; }
   // One payload per voxel in rank order (size voxel_count()).
   void set_voxel_payloads(std::vector<std::uint64_t> payloads);
@@ -326,6 +339,7 @@ class Tree {
   std::optional<Frame> frame_;
   Attributes attributes_;
   std::vector<std::uint64_t> voxel_payloads_;
+  PayloadMeaning payload_meaning_ = PayloadMeaning::reference;
 };
 
 VOLA_INLINE_NAMESPACE_END

@@ -1,5 +1,5 @@
 // The vola Python module (vola._vola): the error family and the parts, each in its own
-// file (building.cpp, tree.cpp, tree_analysis.cpp, tiles.cpp).
+// file (building.cpp, tree.cpp, tree_analysis.cpp, tiles.cpp, map.cpp).
 #include "python_support.hpp"
 
 PYBIND11_MODULE(_vola, m) {
@@ -30,4 +30,5 @@ PYBIND11_MODULE(_vola, m) {
   bind_tree_analysis(tree);
   bind_building(m);
   bind_tiles(m);
+  bind_map(m);
 }

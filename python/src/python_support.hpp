@@ -121,5 +121,6 @@ void bind_building(py::module_& m);
 py::class_<Tree> bind_tree(py::module_& m);
 void bind_tree_analysis(py::class_<Tree>& tree);
 void bind_tiles(py::module_& m);
+void bind_map(py::module_& m);
 
 }  // namespace vola::python

@@ -201,6 +201,9 @@ py::class_<Tree> bind_tree(py::module_& m) {
       .def("__len__", [](const Tree& t) { return t.voxel_count(); })
       .def("__repr__", &repr)
       .def_property_readonly("is_mapped", &Tree::is_mapped, "True when the level words live in a file mapping.")
+      .def_property_readonly(
+          "is_state_map", [](const Tree& t) { return t.payload_meaning() == vola::PayloadMeaning::occupancy_state; },
+          "True for a state map (vola map, vola.Map.save): known voxels, payload bit set = occupied.")
       .def_property_readonly("memory_bytes", &Tree::memory_bytes, "Bytes held in memory (mapped words not counted).")
       .def("node_count", &Tree::node_count, py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
       .def_property_readonly("quantization", [](const Tree& t) { return t.frame().quantization == vola::Quantization::grid ? "grid" : "toolkit"; },

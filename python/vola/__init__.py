@@ -15,6 +15,22 @@ Coordinates: voxel (i, j, k) covers [origin + i*voxel_size, origin + (i+1)*voxel
 per axis. Arrays of voxels are (N, 3) in key order, which is also the row order of
 attribute columns (a voxel's rank). Errors raise vola.Error subclasses: FormatError
 (bad bytes: names the file and byte offset), IoError, InvalidArgument.
+
+Robot maps: vola.Map(voxel_size, max_range=0) takes range scans as `vola map` does
+(OctoMap's model: each point is a ray from the sensor origin, its end voxel hit, the voxels
+it passes free):
+
+    >>> m = vola.Map(0.2, max_range=40.0)
+    >>> m.insert(points_in_world, origin=(x, y, z))         # one scan
+    >>> m.state(queries)          # (N,) int8: vola.UNKNOWN 0, vola.FREE 1, vola.OCCUPIED 2
+    >>> m.probability(queries)    # (N,) float64, NaN where unknown
+    >>> m.save("map.vol")         # a state map, the bytes `vola map` writes
+
+A state map file (tree.is_state_map) holds every known voxel with a state bit (occupied
+or free) and a "log_odds" column; vola.state(tree, points) and vola.probability(tree,
+points) query it in world coordinates, vola.occupied_tree(tree) and vola.free_tree(tree)
+give plain trees of either part (the analysis methods count every voxel of the tree they
+are called on: take occupied_tree(tree) for the obstacles).
 """
 
 from __future__ import annotations
@@ -23,10 +39,14 @@ import os
 from typing import Union
 
 from ._vola import (
+    FREE,
+    OCCUPIED,
+    UNKNOWN,
     Error,
     FormatError,
     InvalidArgument,
     IoError,
+    Map,
     TileSet,
     Tree,
     __version__,
@@ -35,20 +55,28 @@ from ._vola import (
     compression_available,
     convert,
     export_las,
+    free_tree,
     from_dense,
     input_formats,
+    occupied_tree,
     open_mapped,
     open_tiles,
     parse,
+    probability,
     read,
+    state,
     translate,
 )
 
 __all__ = [
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
     "Error",
     "FormatError",
     "InvalidArgument",
     "IoError",
+    "Map",
     "TileSet",
     "Tree",
     "__version__",
@@ -57,13 +85,17 @@ __all__ = [
     "compression_available",
     "convert",
     "export_las",
+    "free_tree",
     "from_dense",
     "input_formats",
+    "occupied_tree",
     "open",
     "open_mapped",
     "open_tiles",
     "parse",
+    "probability",
     "read",
+    "state",
     "translate",
 ]
 

@@ -82,7 +82,7 @@ void check_trailer(ByteReader& r, std::span<const std::uint8_t> bytes, std::uint
 bool needs_extension(const Tree& tree) noexcept {
   const auto& frame = tree.stored_frame();
   return (frame && frame->quantization == Quantization::grid) || !tree.georef().crs_wkt.empty() ||
-         !tree.attributes().empty();
+         !tree.attributes().empty() || tree.payload_meaning() != PayloadMeaning::reference;
 }
 
 bool starts_extension(std::span<const std::uint8_t> bytes) noexcept {
@@ -100,7 +100,8 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
   std::uint64_t borrowed_bytes = 0;  // so far: the file offset is own.size() + this
   w.put_bytes(kExtensionMagic);
   w.put(kExtensionVersion);
-  const std::uint32_t records = 1 + (tree.georef().crs_wkt.empty() ? 0 : 1) +
+  const bool meaning = tree.payload_meaning() != PayloadMeaning::reference;
+  const std::uint32_t records = 1 + (tree.georef().crs_wkt.empty() ? 0 : 1) + (meaning ? 1 : 0) +
                                 static_cast<std::uint32_t>(tree.attributes().size()) + (compress_levels ? 1 : 0);
   w.put(records);
 
@@ -116,6 +117,13 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
     begin_record(w, RecordTag::crs_wkt, 0, wkt.size());
     w.put_bytes(as_bytes(wkt));
     w.pad_to(8);
+  }
+
+  if (meaning) {
+    // Before the attributes: a reader knows what the payload means before any column.
+    begin_record(w, RecordTag::payload_meaning, 0, 8);
+    w.put(static_cast<std::uint8_t>(tree.payload_meaning()));
+    for (int i = 0; i < 7; ++i) w.put(std::uint8_t{0});
   }
 
   VoxelCorners corners(tree, frame);
@@ -326,6 +334,15 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
       case RecordTag::levels:
         decode_levels(body, record_offset, flags, name, payload, out);
         break;
+      case RecordTag::payload_meaning: {
+        const auto meaning = body.get<std::uint8_t>("payload meaning");
+        if (meaning > static_cast<std::uint8_t>(PayloadMeaning::occupancy_state))
+          body.fail_at(record_offset + 16, "unknown payload meaning " + std::to_string(meaning) +
+                                               " (this vola knows 0 reference, 1 occupancy state)");
+        out.payload_meaning = static_cast<PayloadMeaning>(meaning);
+        out.payload_meaning_offset = record_offset;
+        break;
+      }
       default:
         break;  // a record of a later version: skipped
     }

@@ -26,12 +26,14 @@ inline constexpr std::uint32_t kExtensionVersion = 2;
 inline constexpr std::uint32_t kFirstVersionWithTrailer = 2;
 inline constexpr std::uint64_t kTrailerSize = 16;
 
-enum class RecordTag : std::uint32_t { frame = 1, crs_wkt = 2, attribute = 3, levels = 4 };
+enum class RecordTag : std::uint32_t { frame = 1, crs_wkt = 2, attribute = 3, levels = 4, payload_meaning = 5 };
 
 struct ExtensionContents {
   std::uint32_t version = 0;
   std::optional<Frame> frame;
   std::string crs_wkt;
+  PayloadMeaning payload_meaning = PayloadMeaning::reference;
+  std::uint64_t payload_meaning_offset = 0;  // of its record, for errors
   std::vector<AttributeColumn> attributes;
   // Columns of attribute encodings 2 and 3 (predicted from the voxels), decoded once the
   // tree is known (decode_pending_columns): attributes[index] is named and typed but empty.

@@ -37,6 +37,10 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
   h.lon = tree.georef().lon;
   h.bbox = tree.georef().bbox;
   if (options.layout == Layout::dense) {
+    // Dense files keep one payload per voxel run, by the reference's rule: state bits
+    // would not survive.
+    if (tree.payload_meaning() != PayloadMeaning::reference)
+      VOLA_THROW(InvalidArgument("an occupancy-state map is written sparse only"));
     if (options.compress) VOLA_THROW(InvalidArgument("compression applies to sparse files only"));
     if (tree.depth() > options.max_dense_depth)
       VOLA_THROW(InvalidArgument("a dense file of depth " + std::to_string(tree.depth()) + " holds " +
@@ -96,6 +100,12 @@ std::uint64_t sparse_extent(std::span<const std::uint8_t> bytes, int depth, bool
 void apply_extension(Tree& tree, const Header& h, detail::ExtensionContents& ext, const std::string& name,
                      std::uint64_t offset) {
   if (ext.frame) tree.set_frame(*ext.frame);
+  if (ext.payload_meaning != PayloadMeaning::reference) {
+    if (!tree.has_payload())
+      VOLA_THROW(FormatError(name, ext.payload_meaning_offset,
+                             "the extension says the payload holds occupancy states, but the header has nbits 0"));
+    tree.set_payload_meaning(ext.payload_meaning);
+  }
   tree.georef().crs_wkt = std::move(ext.crs_wkt);
   if (!ext.pending.empty()) {
     // Predicted columns need the voxels' places: the frame, or the header's bbox.

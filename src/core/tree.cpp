@@ -279,6 +279,12 @@ void Tree::set_voxel_payloads(std::vector<std::uint64_t> payloads) {
   voxel_payloads_ = std::move(payloads);
 }
 
+void Tree::set_payload_meaning(PayloadMeaning meaning) {
+  if (meaning == PayloadMeaning::occupancy_state && !has_payload_)
+    VOLA_THROW(InvalidArgument("an occupancy-state tree needs payload words (one per block)"));
+  payload_meaning_ = meaning;
+}
+
 std::vector<Key> Tree::keys() const {
   std::vector<Key> out;
   out.reserve(voxel_count());
@@ -297,6 +303,9 @@ Tree Tree::level_of_detail(int depth) const {
   coarse.mapped_ = mapped_;
   coarse.nbits_ = nbits_;
   coarse.georef_ = georef_;
+  // A state map's coarser payload bits already say "any occupied voxel in this cell", so
+  // the coarse tree is a state map of the coarser cells.
+  coarse.payload_meaning_ = payload_meaning_;
   Frame f = frame();
   f.voxel_size *= static_cast<double>(std::uint64_t{1} << (2 * (depth_ - depth)));
   f.quantization = Quantization::grid;

@@ -1,33 +1,108 @@
-// The map's voxels of one state as a VOLA tree: the builder's grid quantization puts each
-// voxel centre back into its own voxel, so indices, attributes and the file's frame come
-// from the one road every tree takes.
+// The map frozen into a state map (vola/map/state_map.hpp): the known voxels' keys are
+// radix-sorted once, the occupancy levels come from the bulk builder, and every level's
+// state words from one pass over the sorted keys.
 #include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/error.hpp"
 #include "vola/map/occupancy_map.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::map {
 
-Tree freeze(const OccupancyMap& map, VoxelState state) {
-  const double size = map.voxel_size();
-  PointCloud cloud;
-  PointAttribute column{"log_odds", ValueType::f32, Reduction::last, {}};
-  VoxelIndex lowest{kIndexLimit, kIndexLimit, kIndexLimit};
-  for (const auto& [v, value] : map.voxels()) {
-    if (map.occupied(value) != (state == VoxelState::occupied)) continue;
-    // Centres, not corners: a corner can round to the voxel below in (x - origin) / R.
-    cloud.xyz.insert(cloud.xyz.end(), {(v.i + 0.5) * size, (v.j + 0.5) * size, (v.k + 0.5) * size});
-    column.values.push_back(value);
-    lowest = {std::min(lowest.i, v.i), std::min(lowest.j, v.j), std::min(lowest.k, v.k)};
+namespace {
+
+struct Bounds {
+  VoxelIndex lo{kIndexLimit, kIndexLimit, kIndexLimit};
+  VoxelIndex hi{-kIndexLimit, -kIndexLimit, -kIndexLimit};
+};
+
+// The smallest depth whose grid holds `span` voxels per axis.
+int depth_for(std::int64_t span) {
+  for (int depth = kMinDepth; depth <= kMaxDepth; ++depth)
+    if (span <= std::int64_t{side_of(depth)}) return depth;
+  throw InvalidArgument("the map's known voxels span " + std::to_string(span) + " voxels on an axis; a VOLA tree holds " +
+                        std::to_string(side_of(kMaxDepth)) + " at most (depth " + std::to_string(kMaxDepth) + ")");
+}
+
+// State words for every level, block for block with the occupancy words: bit b of a
+// block's word is set when cell b holds an occupied voxel. Blocks of a level are stored in
+// key order, so a block index advances whenever the key's prefix above that level changes.
+std::vector<std::vector<std::uint64_t>> state_words(const Tree& occupancy, std::span<const Key> keys,
+                                                    std::span<const std::uint8_t> occupied) {
+  const int depth = occupancy.depth();
+  std::vector<std::vector<std::uint64_t>> words(static_cast<std::size_t>(depth));
+  for (int l = 0; l < depth; ++l) words[l].assign(occupancy.occupancy(l).size(), 0);
+  std::array<std::size_t, kMaxDepth> block{};
+  std::array<Key, kMaxDepth> prefix{};
+  for (std::size_t n = 0; n < keys.size(); ++n) {
+    for (int l = 0; l < depth; ++l) {
+      const Key p = keys[n] >> (6 * (depth - l));
+      if (n > 0 && p != prefix[l]) ++block[l];
+      prefix[l] = p;
+      if (occupied[n]) words[l][block[l]] |= std::uint64_t{1} << ((keys[n] >> (6 * (depth - 1 - l))) & 63u);
+    }
   }
-  if (cloud.size() == 0) lowest = {0, 0, 0};
-  cloud.attributes.push_back(std::move(column));
-  BuildOptions options;
-  options.quantization = Quantization::grid;
-  options.voxel_size = size;
+  return words;
+}
+
+}  // namespace
+
+Tree freeze(const OccupancyMap& map) {
+  const double size = map.voxel_size();
+  Bounds b;
+  map.for_each([&](const VoxelIndex& v, float) {
+    b.lo = {std::min(b.lo.i, v.i), std::min(b.lo.j, v.j), std::min(b.lo.k, v.k)};
+    b.hi = {std::max(b.hi.i, v.i), std::max(b.hi.j, v.j), std::max(b.hi.k, v.k)};
+  });
+  if (map.size() == 0) b = {{0, 0, 0}, {0, 0, 0}};
+  const int depth = depth_for(std::int64_t{1} + std::max({std::int64_t{b.hi.i} - b.lo.i,
+                                                          std::int64_t{b.hi.j} - b.lo.j,
+                                                          std::int64_t{b.hi.k} - b.lo.k}));
+  std::vector<Key> keys;
+  std::vector<float> values;
+  keys.reserve(map.size());
+  values.reserve(map.size());
+  map.for_each([&](const VoxelIndex& v, float value) {
+    keys.push_back(encode(static_cast<std::uint32_t>(v.i - b.lo.i), static_cast<std::uint32_t>(v.j - b.lo.j),
+                          static_cast<std::uint32_t>(v.k - b.lo.k)));
+    values.push_back(value);
+  });
+  std::vector<std::uint32_t> order(keys.size());
+  for (std::size_t n = 0; n < order.size(); ++n) order[n] = static_cast<std::uint32_t>(n);
+  radix_sort(keys, &order, 6 * depth);
+
+  std::vector<std::uint8_t> occupied(keys.size());
+  AttributeColumn column("log_odds", ValueType::f32, Reduction::last, keys.size());
+  for (std::size_t n = 0; n < keys.size(); ++n) {
+    const float value = values[order[n]];
+    occupied[n] = map.occupied(value) ? 1 : 0;
+    column.set(n, value);  // a float through double: exact
+  }
+  values = {};
+  order = {};
+
+  const Tree occupancy = build_from_sorted_keys(keys, depth);
+  const auto states = state_words(occupancy, keys, occupied);
+  std::vector<std::uint64_t> words;
+  words.reserve(2 * occupancy.words().size());
+  for (int l = 0; l < depth; ++l) {
+    const auto level = occupancy.occupancy(l);
+    words.insert(words.end(), level.begin(), level.end());
+    words.insert(words.end(), states[l].begin(), states[l].end());
+  }
+  Tree tree = Tree::from_levels(depth, true, std::move(words));
+  tree.set_nbits(1);
+  tree.set_payload_meaning(PayloadMeaning::occupancy_state);
   // A multiple of R: the tree's voxel (0,0,0) is the map's lowest voxel.
-  options.origin = Point{lowest.i * size, lowest.j * size, lowest.k * size};
-  return build(cloud, options);
+  const Point origin{b.lo.i * size, b.lo.j * size, b.lo.k * size};
+  tree.set_frame(Frame{Quantization::grid, origin, size});
+  tree.georef().bbox = Box{origin, {(b.hi.i + 1) * size, (b.hi.j + 1) * size, (b.hi.k + 1) * size}};
+  tree.attributes().add(std::move(column));
+  return tree;
 }
 
 }  // namespace vola::map

@@ -1,6 +1,7 @@
 #include "vola/raycast/path_planner.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <queue>
@@ -25,10 +26,36 @@ double distance(const Point& a, const Point& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-// One planning grid: a tree (maybe a level of detail) and the inflation radius in its cells.
+// Is every voxel of `known` whose cell comes within `radius` of `p` (grid units) there?
+// Cells off the grid are unknown. (2r + 2)^3 lookups at most: for a robot a few voxels wide.
+bool known_around(const Tree& known, const Point& p, double radius) {
+  std::array<std::int64_t, 3> lo{}, hi{};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = static_cast<std::int64_t>(std::floor(p[a] - radius));
+    hi[a] = static_cast<std::int64_t>(std::floor(p[a] + radius));
+    if (lo[a] < 0 || hi[a] >= static_cast<std::int64_t>(known.side())) return false;
+  }
+  const auto gap = [](double x, std::int64_t cell) {  // distance from x to [cell, cell + 1] on one axis
+    const double c = static_cast<double>(cell);
+    return x < c ? c - x : x > c + 1.0 ? x - (c + 1.0) : 0.0;
+  };
+  for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+    for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const double dx = gap(p[0], x), dy = gap(p[1], y), dz = gap(p[2], z);
+        if (dx * dx + dy * dy + dz * dz > radius * radius) continue;
+        if (!known.contains(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)))
+          return false;
+      }
+  return true;
+}
+
+// One planning grid: a tree (maybe a level of detail) and the inflation radius in its
+// cells; with `known`, unknown space counts as an obstacle too.
 class Grid {
  public:
-  Grid(const Tree& tree, double radius) : collider_(tree), radius_(radius), side_(tree.side()) {}
+  Grid(const Tree& tree, double radius, const Tree* known)
+      : collider_(tree), radius_(radius), side_(tree.side()), known_(known) {}
   bool inside(const Cell& c) const {
     return c[0] >= 0 && c[1] >= 0 && c[2] >= 0 && c[0] < side_ && c[1] < side_ && c[2] < side_;
   }
@@ -37,7 +64,7 @@ class Grid {
                            static_cast<std::uint32_t>(c[2]));
     const auto found = free_.find(key);
     if (found != free_.end()) return found->second;
-    const bool f = !collider_.sphere(centre(c), radius_);
+    const bool f = !collider_.sphere(centre(c), radius_) && (!known_ || known_around(*known_, centre(c), radius_));
     free_.emplace(key, f);
     return f;
   }
@@ -54,6 +81,7 @@ class Grid {
       const double f = steps ? static_cast<double>(i) / static_cast<double>(steps) : 0.0;
       const Point p{a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])};
       if (collider_.sphere(p, radius_ + h / 2)) return false;
+      if (known_ && !known_around(*known_, p, radius_ + h / 2)) return false;
     }
     return true;
   }
@@ -63,6 +91,7 @@ class Grid {
   Collider collider_;
   double radius_;
   std::int64_t side_;
+  const Tree* known_;
   std::unordered_map<Key, bool> free_;
 };
 
@@ -135,9 +164,14 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
   if (level >= tree.depth())
     throw InvalidArgument("plan: level " + std::to_string(level) + " is finer than the tree (levels 0.." +
                           std::to_string(tree.depth() - 1) + ")");
+  if (options.known && options.known->depth() != tree.depth())
+    throw InvalidArgument("plan: the known voxels' tree has depth " + std::to_string(options.known->depth()) +
+                          ", the obstacles' " + std::to_string(tree.depth()) + ": they must share one grid");
   const Tree planning = level == tree.depth() - 1 ? tree : tree.level_of_detail(level + 1);
+  std::optional<Tree> known_planning;
+  if (options.known) known_planning = level == tree.depth() - 1 ? *options.known : options.known->level_of_detail(level + 1);
   const double cell_size = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
-  Grid grid(planning, options.radius / cell_size);
+  Grid grid(planning, options.radius / cell_size, known_planning ? &*known_planning : nullptr);
   const Cell from = cell_of(start, cell_size), to = cell_of(goal, cell_size);
   const auto side = static_cast<double>(tree.side());
   for (const auto& [name, p, c] : {std::tuple{"start", start, from}, std::tuple{"goal", goal, to}}) {
@@ -146,6 +180,7 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
                             std::to_string(static_cast<long long>(side)) + ")^3 (grid coordinates)");
     if (!grid.free(c))
       throw InvalidArgument(std::string("plan: the ") + name + " " + show(p) + " is inside an obstacle" +
+                            (options.known ? " or unknown space" : "") +
                             (options.radius > 0 ? " or closer than the radius to one" : ""));
   }
 

@@ -8,6 +8,7 @@
 
 #include "vola/analysis/census.hpp"
 #include "vola/error.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/raycast/ray_caster.hpp"
 
 namespace vola::viewer {
@@ -32,12 +33,27 @@ void put_u64(std::string& out, std::size_t at, std::uint64_t v) {
 
 nlohmann::json json_point(const Point& p) { return nlohmann::json::array({p[0], p[1], p[2]}); }
 
+// The voxels shown: a state map's occupied or free part (copied out of the mapping,
+// which is checked after), any other file as mapped.
+Tree shown_tree(const std::string& path, FileLayout& layout, MapPart part, bool& state_map) {
+  const Tree file = open_mapped(path, &layout);
+  state_map = map::is_state_map(file);
+  if (!state_map) {
+    if (part == MapPart::free)
+      throw InvalidArgument(path + ": not a state map (vola map writes one): it has no free voxels to show");
+    return file;
+  }
+  Tree shown = part == MapPart::free ? map::free_tree(file) : map::occupied_tree(file);
+  check_mapped(file);
+  return shown;
+}
+
 }  // namespace
 
-ViewedFile::ViewedFile(const std::string& path)
+ViewedFile::ViewedFile(const std::string& path, MapPart part)
     : path_(path),
-      name_(std::filesystem::path(path).filename().string()),
-      tree_(open_mapped(path, &layout_)),
+      name_(std::filesystem::path(path).filename().string() + (part == MapPart::free ? " (free)" : "")),
+      tree_(shown_tree(path, layout_, part, state_map_)),
       index_(tree_),
       levels_(static_cast<std::size_t>(tree_.depth())) {
   classes_ = find_column(tree_, "classification");
@@ -105,7 +121,8 @@ nlohmann::json ViewedFile::metadata() const {
           {"attributes", attributes},
           {"has_classes", classes_ != nullptr},
           {"has_colours", rgb_[0] != nullptr},
-          {"classes", classes}};
+          {"classes", classes},
+          {"state_map", state_map_}};
 }
 
 std::string ViewedFile::cell_batch(int level, std::uint64_t first, std::uint64_t count) const {

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# vola map end to end: two scans with poses (one turned a quarter about z) give the hit
-# voxels in MAP.vol and the passed ones in MAP.free.vol at the expected world places; bad
-# list lines and missing files are errors naming the line, and nothing is written then.
+# vola map end to end: two scans with poses (one turned a quarter about z) give a state
+# map whose occupied voxels are the hit ones (what every command reads of it) and the
+# passed ones in MAP.free.vol at the expected world places; info, census and get --points
+# report the states; bad list lines and missing files are errors naming the line, and
+# nothing is written then.
 # Usage: cli_map.sh VOLA
 set -euo pipefail
 vola=$1
@@ -23,6 +25,65 @@ grep -q '^scans:   2, 2 points' "$tmp/out" || fail "summary: $(cat "$tmp/out")"
 "$vola" coords "$tmp/map.vol" | sort > "$tmp/occupied"
 printf '0.125 1.125 0.125\n1.125 0.125 0.125\n' | diff - "$tmp/occupied" || fail "occupied voxels differ"
 [ "$("$vola" coords "$tmp/map.free.vol" | wc -l)" -eq 7 ] || fail "expected 7 free voxels: $("$vola" coords "$tmp/map.free.vol")"
+
+# The state map: 9 known voxels; commands see the 2 occupied ones.
+"$vola" info "$tmp/map.vol" > "$tmp/info"
+grep -q 'state map (vola map): 9 known, .* 2 occupied, 7 free' "$tmp/info" || fail "info: $(cat "$tmp/info")"
+"$vola" census "$tmp/map.vol" --json > "$tmp/census.json"
+python3 - "$tmp/census.json" <<'PY' || fail "census: $(cat "$tmp/census.json")"
+import json, sys
+c = json.load(open(sys.argv[1]))
+assert c["voxels"] == 2 and c["states"]["occupied"] == 2 and c["states"]["free"] == 7, c
+# the known voxels span 5 x 5 x 1 cells: 25 - 9 unknown
+assert c["states"]["unknown_in_bounds"] == 16, c
+PY
+[ "$("$vola" voxels "$tmp/map.vol" | wc -l)" -eq 2 ] || fail "voxels: $("$vola" voxels "$tmp/map.vol")"
+"$vola" union "$tmp/map.vol" "$tmp/map.free.vol" "$tmp/union.vol" > /dev/null
+[ "$("$vola" coords "$tmp/union.vol" | wc -l)" -eq 9 ] || fail "union of occupied and free: $("$vola" coords "$tmp/union.vol")"
+"$vola" get "$tmp/map.vol" 4 0 0 | grep -q '^voxel 4 0 0: occupied' || fail "get of an occupied voxel"
+"$vola" get "$tmp/map.vol" 2 0 0 | grep -q '^voxel 2 0 0: free' || fail "get of a free voxel"
+
+# get --points: one line per point; P from the log-odds (one hit: 0.7; one miss: 0.4;
+# the sensor's voxel, passed by both scans: 1 / (1 + 1.5^2)).
+printf '1.1 0.1 0.1
+0.6 0.1 0.1
+
+0.1 0.1 0.1
+5 5 5
+-1 0 0
+' > "$tmp/points.txt"
+"$vola" get "$tmp/map.vol" --world --points "$tmp/points.txt" > "$tmp/states"
+printf 'occupied 0.7000
+free 0.4000
+free 0.3077
+unknown
+unknown
+' | diff - "$tmp/states" || fail "get --points"
+"$vola" get "$tmp/map.free.vol" --world --points "$tmp/points.txt" > "$tmp/plain"
+printf 'free
+occupied
+occupied
+free
+free
+' | diff - "$tmp/plain" || fail "get --points on a plain tree"
+printf '1 2 3
+1 2
+' > "$tmp/bad_points.txt"
+"$vola" get "$tmp/map.vol" --world --points "$tmp/bad_points.txt" 2> "$tmp/err" && fail "a bad point line was accepted"
+grep -q 'bad_points.txt: line 2: expected three finite numbers' "$tmp/err" || fail "message: $(cat "$tmp/err")"
+
+# plan on the state map: unknown space is an obstacle by default. Along x the known free
+# voxels lead from the sensor's voxel to (0.875, 0.125); (0.375, 0.375) was never seen.
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.875 0.125 0.125 -o "$tmp/path.csv" -q \
+  || fail "plan along known free voxels"
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 -o "$tmp/path.csv" 2> "$tmp/err" \
+  && fail "a goal in unknown space was accepted"
+grep -q 'goal .* is inside an obstacle or unknown space' "$tmp/err" || fail "message: $(cat "$tmp/err")"
+"$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 -o "$tmp/path.csv" -q --unknown free \
+  || fail "plan with --unknown free"
+"$vola" plan "$tmp/map.free.vol" --from 0.125 0.125 0.125 --to 0.375 0.375 0.125 --unknown occupied \
+  -o "$tmp/path.csv" 2> "$tmp/err" && fail "--unknown occupied on a plain .vol was accepted"
+grep -q 'is not a state map' "$tmp/err" || fail "message: $(cat "$tmp/err")"
 
 # Errors name the line; no output file appears.
 printf 'scans/ahead.xyz 0 0 0 0 0 0 1\nscans/ahead.xyz 0 0 zero 0 0 0 1\n' > "$tmp/bad.txt"

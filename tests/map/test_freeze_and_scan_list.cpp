@@ -1,7 +1,8 @@
-// Freezing a map into VOLA trees (voxels line up with the map's, log-odds kept exactly)
-// and the scan list's format and errors.
+// Freezing a map into a state map and its occupied and free trees (voxels line up with the
+// map's, log-odds kept exactly), and the scan list's format and errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -9,6 +10,7 @@
 #include "vola/file.hpp"
 #include "vola/map/occupancy_map.hpp"
 #include "vola/map/scan_list.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace {
 
@@ -25,7 +27,10 @@ OccupancyMap small_map() {
 }
 
 void expect_frozen(const OccupancyMap& map, VoxelState state) {
-  const vola::Tree tree = vola::map::freeze(map, state);
+  const vola::Tree all = vola::map::freeze(map);
+  const vola::Tree tree = state == VoxelState::occupied ? vola::map::occupied_tree(all) : vola::map::free_tree(all);
+  EXPECT_FALSE(vola::map::is_state_map(tree));
+  EXPECT_FALSE(tree.has_payload());
   const vola::AttributeColumn* column = tree.attributes().find("log_odds");
   ASSERT_NE(column, nullptr);
   EXPECT_EQ(column->type(), vola::ValueType::f32);
@@ -58,13 +63,15 @@ TEST(MapFreeze, OccupiedAndFreeTreesHoldTheMapsVoxelsAndLogOdds) {
 
 TEST(MapFreeze, SurvivesAFileRoundTrip) {
   const OccupancyMap map = small_map();
-  const vola::Tree tree = vola::map::freeze(map, VoxelState::occupied);
+  const vola::Tree tree = vola::map::freeze(map);
   const auto path = std::filesystem::temp_directory_path() / "vola_map_freeze_test.vol";
   vola::write(tree, path.string());
   const vola::Tree back = vola::read(path.string());
   std::filesystem::remove(path);
-  EXPECT_EQ(back.voxel_count(), tree.voxel_count());
+  EXPECT_TRUE(vola::map::is_state_map(back));
+  EXPECT_EQ(back.voxel_count(), map.size());
   EXPECT_EQ(back.frame(), tree.frame());
+  EXPECT_TRUE(std::ranges::equal(back.words(), tree.words()));
   ASSERT_NE(back.attributes().find("log_odds"), nullptr);
   const auto a = tree.attributes().find("log_odds")->bytes();
   const auto b = back.attributes().find("log_odds")->bytes();

@@ -152,6 +152,107 @@ TEST(PathPlanner, CostEqualsDijkstraOnSmallGrids) {
   EXPECT_GT(unreachable + compared, 90);
 }
 
+// With `known`, a cell is free only when besides no voxel within the radius is unknown
+// (cells off the grid are unknown): the brute force over the dense arrays.
+std::vector<char> brute_known_free(const vola::Tree& known, const std::vector<char>& free, double radius) {
+  const std::int64_t side = known.side();
+  std::vector<char> out = free;
+  for (std::int64_t z = 0; z < side; ++z)
+    for (std::int64_t y = 0; y < side; ++y)
+      for (std::int64_t x = 0; x < side; ++x)
+        for (std::int64_t oz = z - 2; oz <= z + 2; ++oz)
+          for (std::int64_t oy = y - 2; oy <= y + 2; ++oy)
+            for (std::int64_t ox = x - 2; ox <= x + 2; ++ox) {
+              const double c[3] = {double(x) + 0.5, double(y) + 0.5, double(z) + 0.5};
+              const double o[3] = {double(ox), double(oy), double(oz)};
+              double d2 = 0;
+              for (int a = 0; a < 3; ++a) {
+                const double n = std::clamp(c[a], o[a], o[a] + 1);
+                d2 += (c[a] - n) * (c[a] - n);
+              }
+              if (d2 > radius * radius) continue;
+              const bool inside = ox >= 0 && oy >= 0 && oz >= 0 && ox < side && oy < side && oz < side;
+              if (!inside || !known.contains(vola::Voxel{static_cast<std::uint32_t>(ox), static_cast<std::uint32_t>(oy),
+                                                         static_cast<std::uint32_t>(oz)}))
+                out[static_cast<std::size_t>((z * side + y) * side + x)] = 0;
+            }
+  return out;
+}
+
+TEST(PathPlanner, UnknownSpaceIsAnObstacleWithKnown) {
+  int compared = 0, unreachable = 0, longer = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const vola::Tree tree = maze(seed, 2);
+    const std::int64_t side = tree.side();
+    // Known: everything but a few random boxes of unknown space.
+    std::mt19937_64 rng(seed * 77);
+    std::vector<std::array<std::int64_t, 6>> holes;
+    for (int h = 0; h < 3; ++h) {
+      std::array<std::int64_t, 6> b{};
+      for (int a = 0; a < 3; ++a) {
+        b[a] = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(side - 3));
+        b[a + 3] = b[a] + 2 + static_cast<std::int64_t>(rng() % 6);
+      }
+      holes.push_back(b);
+    }
+    std::vector<vola::Voxel> known_voxels;
+    for (std::uint32_t z = 0; z < side; ++z)
+      for (std::uint32_t y = 0; y < side; ++y)
+        for (std::uint32_t x = 0; x < side; ++x) {
+          bool hole = false;
+          for (const auto& b : holes)
+            hole = hole || (x >= b[0] && x < b[3] && y >= b[1] && y < b[4] && z >= b[2] && z < b[5]);
+          if (!hole || tree.contains(vola::Voxel{x, y, z})) known_voxels.push_back({x, y, z});
+        }
+    const vola::Tree known = vola::build_from_voxels(known_voxels, 2);
+    for (const double radius : {0.0, 0.9}) {
+      const auto free = brute_free(tree, radius);
+      const auto known_free = brute_known_free(known, free, radius);
+      for (int trial = 0; trial < 8; ++trial) {
+        std::array<std::int64_t, 3> s{}, g{};
+        auto random_free = [&](std::array<std::int64_t, 3>& c) {
+          do {
+            for (auto& x : c) x = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(side));
+          } while (!known_free[static_cast<std::size_t>((c[2] * side + c[1]) * side + c[0])]);
+        };
+        random_free(s);
+        random_free(g);
+        const double expected = dijkstra(known_free, side, s, g);
+        const Point from{double(s[0]) + 0.5, double(s[1]) + 0.5, double(s[2]) + 0.5},
+            to{double(g[0]) + 0.5, double(g[1]) + 0.5, double(g[2]) + 0.5};
+        PlanOptions options;
+        options.radius = radius;
+        options.known = &known;
+        if (std::isinf(expected)) {
+          EXPECT_THROW(plan_path(tree, from, to, options), vola::InvalidArgument);
+          ++unreachable;
+          continue;
+        }
+        const auto path = plan_path(tree, from, to, options);
+        EXPECT_NEAR(path.cost, expected, 1e-9) << "seed " << seed << " radius " << radius;
+        longer += expected > dijkstra(free, side, s, g) + 1e-9;
+        ++compared;
+      }
+    }
+    // A start in unknown space is refused by name.
+    const auto& b = holes[0];
+    const Point in_hole{double(b[0]) + 0.5, double(b[1]) + 0.5, double(b[2]) + 0.5};
+    if (!tree.contains(vola::Voxel{static_cast<std::uint32_t>(b[0]), static_cast<std::uint32_t>(b[1]),
+                                   static_cast<std::uint32_t>(b[2])})) {
+      PlanOptions options;
+      options.known = &known;
+      try {
+        plan_path(tree, in_hole, in_hole, options);
+        ADD_FAILURE() << "a start in unknown space was accepted";
+      } catch (const vola::InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("unknown space"), std::string::npos) << e.what();
+      }
+    }
+  }
+  EXPECT_GT(compared, 40);
+  EXPECT_GT(longer, 0);  // unknown space did make some paths go round
+}
+
 TEST(PathPlanner, CoarseAndHierarchicalPlans) {
   const vola::Tree tree = maze(5, 3);
   const Point from{0.5, 0.5, 0.5}, to{63.5, 63.5, 63.5};

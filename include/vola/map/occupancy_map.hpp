@@ -1,5 +1,5 @@
 // A mutable probabilistic occupancy map that takes range scans the way OctoMap does and
-// freezes into VOLA trees.
+// freezes into a VOLA state map (state_map.hpp).
 //
 // Voxel (i, j, k) covers [i*R, (i+1)*R) on each axis, i = floor(x / R), so voxel indices
 // line up cell for cell with OctoMap's keys (key = i + 32768) when R is a power of two
@@ -95,6 +95,11 @@ class OccupancyMap {
   bool occupied(float value) const noexcept { return value >= model_.occupied_at; }
   // Every known voxel with its log-odds, sorted by index.
   std::vector<std::pair<VoxelIndex, float>> voxels() const;
+  // Visits every known voxel, in no particular order: f(const VoxelIndex&, float log_odds).
+  template <class F>
+  void for_each(F&& f) const {
+    for (const auto& [key, value] : cells_) f(unpack(key), value);
+  }
 
   // Packing used by the hash map and the per-scan sets (exposed for the tests).
   static std::uint64_t pack(const VoxelIndex& v) noexcept;
@@ -106,12 +111,7 @@ class OccupancyMap {
   std::unordered_map<std::uint64_t, float> cells_;
 };
 
-// Which voxels a frozen tree holds.
-enum class VoxelState { occupied, free };
-
-// The voxels of one state as a VOLA tree in grid quantization (voxel size R, origin a
-// multiple of R so that the tree's voxels are the map's), with the attribute column
-// "log_odds" (f32). An empty state gives an empty tree.
-Tree freeze(const OccupancyMap& map, VoxelState state);
+// freeze(map) (state_map.hpp) stores the map as one VOLA tree of its known voxels with
+// their occupied/free states and log-odds.
 
 }  // namespace vola::map

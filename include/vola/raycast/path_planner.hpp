@@ -13,6 +13,11 @@
 // corridor has no path (its cost is then not guaranteed optimal).
 // Smoothing replaces runs of the path by straight segments when a sphere of `radius`
 // swept along the segment stays clear (checked conservatively at quarter-cell steps).
+// `known` (a state map's tree of known voxels, on the planned tree's grid) makes unknown
+// space an obstacle as well: a cell is free only when, besides, every voxel within
+// `radius` of its centre (its own voxel at radius 0) is known, and smoothing keeps the
+// swept sphere inside known space too. At a coarser level a cell is known when any voxel
+// in it is (the fine search, when given, is exact).
 #pragma once
 
 #include <cstdint>
@@ -28,6 +33,7 @@ struct PlanOptions {
   bool smooth = true;
   bool hierarchical = false;
   std::uint64_t max_expansions = 20'000'000;  // then the goal counts as unreachable
+  const Tree* known = nullptr;   // not owned; null: space outside the tree's voxels is free
 };
 
 struct PlannedPath {
@@ -39,7 +45,7 @@ struct PlannedPath {
 
 // start and goal are points in grid coordinates (voxels). Throws InvalidArgument naming
 // the problem: a point outside the volume, inside an obstacle (or closer than the
-// radius to one), or a goal that cannot be reached.
+// radius to one, or to unknown space with `known`), or a goal that cannot be reached.
 PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, const PlanOptions& options = {});
 
 }  // namespace vola::raycast

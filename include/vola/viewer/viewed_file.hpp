@@ -36,10 +36,16 @@ inline constexpr std::size_t kBatchHeaderBytes = 32;
 // The most cells one batch may ask for (48 MiB of 32-bit coordinates).
 inline constexpr std::uint64_t kMaxBatchCells = std::uint64_t{1} << 22;
 
+// Which voxels of a state map (vola map) a ViewedFile shows; any other file shows all
+// its voxels whatever is asked.
+enum class MapPart { occupied, free };
+
 class ViewedFile {
  public:
-  // Maps the file (FormatError / IoError for a bad one) and scans its colour columns.
-  explicit ViewedFile(const std::string& path);
+  // Maps the file (FormatError / IoError for a bad one) and scans its colour columns. A
+  // state map shows its occupied voxels, or with MapPart::free its free ones (named
+  // "NAME (free)"); InvalidArgument for MapPart::free on a file that is not a state map.
+  explicit ViewedFile(const std::string& path, MapPart part = MapPart::occupied);
   ~ViewedFile();
   ViewedFile(const ViewedFile&) = delete;
   ViewedFile& operator=(const ViewedFile&) = delete;
@@ -49,6 +55,7 @@ class ViewedFile {
   // which may say where the user keeps their files).
   const std::string& name() const noexcept { return name_; }
   const Tree& tree() const noexcept { return tree_; }
+  bool is_state_map() const noexcept { return state_map_; }
   const CellIndex& cells() const noexcept { return index_; }
 
   // Name (base name only), counts per level, grid frame, CRS, attributes, the classes present with their
@@ -75,6 +82,7 @@ class ViewedFile {
   std::string path_;
   std::string name_;
   FileLayout layout_;
+  bool state_map_ = false;
   Tree tree_;
   CellIndex index_;
   const AttributeColumn* classes_ = nullptr;

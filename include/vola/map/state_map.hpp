@@ -1,0 +1,87 @@
+// A state map: occupied, free and unknown space in one VOLA tree, the paper's "two bits
+// per voxel" (each 64-bit occupancy word mirrored by a 64-bit state word).
+//
+// The tree holds every KNOWN voxel; its payload word per block (nbits 1) says which of
+// them are occupied: at the leaf level bit b is 1 iff voxel b is occupied, 0 iff free; at
+// coarser levels bit b is 1 iff cell b holds any occupied voxel, so a walk down the
+// payload words answers "any obstacle here?" at every level. Unknown space is outside the
+// tree. The tree says it is one with PayloadMeaning::occupancy_state (tree.hpp), stored
+// in the file's extension. The attribute column "log_odds" (f32) covers every known voxel.
+//
+// Costs: state_at is one rank walk (O(depth), no allocation); occupied_tree, free_tree
+// and state_counts visit the leaf blocks once.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <optional>
+
+#include "vola/frame.hpp"
+#include "vola/tree.hpp"
+
+namespace vola::map {
+
+class OccupancyMap;
+
+// Values as numpy gets them from the Python module (vola.UNKNOWN, vola.FREE, vola.OCCUPIED).
+enum class VoxelState : std::int8_t { unknown = 0, free = 1, occupied = 2 };
+
+const char* name_of(VoxelState state) noexcept;
+
+inline bool is_state_map(const Tree& tree) noexcept {
+  return tree.payload_meaning() == PayloadMeaning::occupancy_state;
+}
+
+// A voxel's state. A state map: occupied, free, or unknown (not in the tree). Any other
+// tree keeps the old meaning: its voxels are occupied and everything else is free.
+VoxelState state_at(const Tree& tree, const Voxel& v) noexcept;
+
+// The state of the voxel holding a world point (the tree's frame), with its log-odds
+// when the tree has a "log_odds" column and knows the voxel. Outside the grid: unknown
+// for a state map, free for any other tree. Made once per tree (the quantizer and the
+// column are looked up once), then one rank walk per point; the tree must outlive it.
+struct WorldState {
+  VoxelState state = VoxelState::unknown;
+  std::optional<float> log_odds;
+};
+class StateLookup {
+ public:
+  explicit StateLookup(const Tree& tree);
+  WorldState at(const Point& p) const noexcept;
+
+ private:
+  const Tree& tree_;
+  Quantizer quantizer_;
+  const AttributeColumn* log_odds_;
+};
+
+// OctoMap's probability of a log-odds value: 1 / (1 + exp(-l)).
+inline double occupancy_probability(float log_odds) noexcept {
+  return 1.0 / (1.0 + std::exp(-static_cast<double>(log_odds)));
+}
+
+// The occupied (or free) voxels of a state map as a plain tree: same depth, frame and
+// georeferencing, no payload, the attribute columns restricted to those voxels. A tree
+// that is not a state map is returned as it is by occupied_tree; free_tree refuses it
+// (InvalidArgument: its free space is everything outside it).
+Tree occupied_tree(const Tree& state_map);
+Tree free_tree(const Tree& state_map);
+
+struct StateCounts {
+  std::uint64_t occupied = 0;
+  std::uint64_t free = 0;
+  // Cells of the box spanned by the known voxels (grid bounds, inclusive) that are not
+  // known; 0 for an empty map.
+  std::uint64_t unknown_in_bounds = 0;
+  Voxel min{0, 0, 0}, max{0, 0, 0};  // the known voxels' bounds
+};
+// Counts of a state map (InvalidArgument for another tree).
+StateCounts state_counts(const Tree& state_map);
+
+// The map frozen into a state map: grid quantization, voxel size R, origin the map's
+// lowest voxel corner (a multiple of R, so tree voxels are map voxels shifted by whole
+// cells), the smallest depth that holds every known voxel, "log_odds" for every known
+// voxel. Throws InvalidArgument when the known voxels span more than 4^10 per axis.
+Tree freeze(const OccupancyMap& map);
+
+}  // namespace vola::map

@@ -1,0 +1,145 @@
+// vola.Map (an occupancy map from range scans, as vola map builds it) and the state of
+// points in a loaded state map (vola.state, vola.probability).
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "python_support.hpp"
+#include "vola/file.hpp"
+#include "vola/map/occupancy_map.hpp"
+#include "vola/map/state_map.hpp"
+
+namespace vola::python {
+
+namespace {
+
+using map::OccupancyMap;
+using map::VoxelState;
+
+// One scan's report as a dict of counts.
+py::dict report_dict(const map::ScanReport& r) {
+  py::dict d;
+  d["points"] = r.points;
+  d["not_finite"] = r.not_finite;
+  d["outside"] = r.outside;
+  d["cut"] = r.cut;
+  d["hit_voxels"] = r.hit_voxels;
+  d["free_voxels"] = r.free_voxels;
+  return d;
+}
+
+// f(point) for each row of `points`, without the GIL, into an (N,) array of T.
+template <class T, class F>
+py::array_t<T> per_point(const py::handle& points, F&& f) {
+  const auto xyz = rows_of_three<double>(points, "points");
+  const auto n = static_cast<std::size_t>(xyz.shape(0));
+  std::vector<T> out(n);
+  const double* p = xyz.data();
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < n; ++i) out[i] = f(Point{p[3 * i], p[3 * i + 1], p[3 * i + 2]});
+  }
+  return owning_array(std::move(out), {static_cast<py::ssize_t>(n)});
+}
+
+struct PyMap {
+  OccupancyMap map;
+  double max_range;
+};
+
+VoxelState map_state(const OccupancyMap& m, const Point& p) {
+  const auto v = m.voxel_of(p);
+  const auto value = v ? m.log_odds(*v) : std::nullopt;
+  if (!value) return VoxelState::unknown;
+  return m.occupied(*value) ? VoxelState::occupied : VoxelState::free;
+}
+
+}  // namespace
+
+void bind_map(py::module_& m) {
+  m.attr("UNKNOWN") = static_cast<int>(VoxelState::unknown);
+  m.attr("FREE") = static_cast<int>(VoxelState::free);
+  m.attr("OCCUPIED") = static_cast<int>(VoxelState::occupied);
+
+  py::class_<PyMap>(m, "Map", "A probabilistic occupancy map from range scans, as `vola map` builds it.")
+      .def(py::init([](double voxel_size, double max_range) {
+             if (!(max_range >= 0.0)) throw InvalidArgument("max_range must be >= 0 (0: no limit)");
+             return PyMap{OccupancyMap(voxel_size), max_range};
+           }),
+           py::arg("voxel_size"), py::arg("max_range") = 0.0,
+           "An empty map of voxels of edge voxel_size (voxel (i,j,k) covers [i*R, (i+1)*R)); points farther than\n"
+           "max_range (> 0) from the sensor mark their ray free up to it and hit nothing.")
+      .def_property_readonly("voxel_size", [](const PyMap& self) { return self.map.voxel_size(); })
+      .def_property_readonly("max_range", [](const PyMap& self) { return self.max_range; })
+      .def("__len__", [](const PyMap& self) { return self.map.size(); })
+      .def(
+          "insert",
+          [](PyMap& self, const py::handle& points, const std::array<double, 3>& origin) {
+            const auto xyz = rows_of_three<double>(points, "points");
+            const std::span<const double> values(xyz.data(), static_cast<std::size_t>(xyz.size()));
+            map::ScanReport report;
+            {
+              py::gil_scoped_release release;
+              report = self.map.insert_scan(values, to_point(origin), self.max_range);
+            }
+            return report_dict(report);
+          },
+          py::arg("points"), py::arg("origin"),
+          "One scan: points (N, 3) in world coordinates, each a ray from origin (the sensor). Returns the counts\n"
+          "of `vola map`'s summary (points, not_finite, outside, cut, hit_voxels, free_voxels).")
+      .def("state",
+           [](const PyMap& self, const py::handle& points) {
+             return per_point<std::int8_t>(points, [&](const Point& p) {
+               return static_cast<std::int8_t>(map_state(self.map, p));
+             });
+           },
+           py::arg("points"), "(N,) int8 per world point: vola.UNKNOWN 0, vola.FREE 1, vola.OCCUPIED 2.")
+      .def("probability",
+           [](const PyMap& self, const py::handle& points) {
+             return per_point<double>(points, [&](const Point& p) {
+               const auto v = self.map.voxel_of(p);
+               const auto value = v ? self.map.log_odds(*v) : std::nullopt;
+               return value ? map::occupancy_probability(*value) : std::numeric_limits<double>::quiet_NaN();
+             });
+           },
+           py::arg("points"), "(N,) float64 occupancy probability per world point, NaN where unknown.")
+      .def("tree", [](const PyMap& self) { return map::freeze(self.map); },
+           "The map as a state map tree (Tree.is_state_map), as save() writes it.")
+      .def(
+          "save",
+          [](const PyMap& self, const std::filesystem::path& path) {
+            py::gil_scoped_release release;
+            write(map::freeze(self.map), path.string());
+          },
+          py::arg("path"), "Writes the state map: the bytes `vola map` writes for the same scans.");
+
+  m.def(
+      "state",
+      [](const Tree& tree, const py::handle& points) {
+        const map::StateLookup lookup(tree);
+        auto out = per_point<std::int8_t>(points, [&](const Point& p) { return static_cast<std::int8_t>(lookup.at(p).state); });
+        check_mapped(tree);
+        return out;
+      },
+      py::arg("tree"), py::arg("points"),
+      "(N,) int8 state per world point of a loaded tree: a state map's UNKNOWN/FREE/OCCUPIED; any other tree's\n"
+      "voxels are OCCUPIED and the rest FREE.");
+  m.def(
+      "probability",
+      [](const Tree& tree, const py::handle& points) {
+        const map::StateLookup lookup(tree);
+        auto out = per_point<double>(points, [&](const Point& p) {
+          const auto s = lookup.at(p);
+          return s.log_odds ? map::occupancy_probability(*s.log_odds) : std::numeric_limits<double>::quiet_NaN();
+        });
+        check_mapped(tree);
+        return out;
+      },
+      py::arg("tree"), py::arg("points"),
+      "(N,) float64 occupancy probability per world point from the tree's log_odds column, NaN where there is none.");
+  m.def("occupied_tree", &map::occupied_tree, py::arg("tree"),
+        "A state map's occupied voxels as a plain tree (columns kept); any other tree as it is.");
+  m.def("free_tree", &map::free_tree, py::arg("tree"), "A state map's free voxels as a plain tree (columns kept).");
+}
+
+}  // namespace vola::python

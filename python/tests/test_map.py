@@ -1,0 +1,76 @@
+"""vola.Map: scans in, states out; its saved state map equals `vola map`'s bytes for the
+same scans, and vola.state on the loaded file gives the map's own decisions."""
+
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import vola
+
+
+def _scans(seed: int):
+    """Two scans of rays from two origins: known voxels of both states, unknown elsewhere."""
+    rng = np.random.default_rng(seed)
+    return [(rng.uniform(-3, 3, size=(400, 3)), np.array([0.05, 0.1, 0.15])),
+            (rng.uniform(-3, 3, size=(400, 3)), np.array([1.05, -0.4, 0.3]))]
+
+
+def _centres(m: vola.Map, lo: int, hi: int) -> np.ndarray:
+    axis = (np.arange(lo, hi) + 0.5) * m.voxel_size
+    return np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def test_constants_and_states_of_a_hand_made_scan():
+    assert (vola.UNKNOWN, vola.FREE, vola.OCCUPIED) == (0, 1, 2)
+    m = vola.Map(0.5)
+    report = m.insert(np.array([[2.2, 0.3, 0.3]]), origin=(0.1, 0.1, 0.1))
+    assert report["points"] == 1 and report["hit_voxels"] == 1 and report["free_voxels"] == 4
+    states = m.state(np.array([[2.2, 0.3, 0.3], [0.2, 0.2, 0.2], [1.2, 0.2, 0.2], [9.0, 9.0, 9.0]]))
+    assert states.dtype == np.int8
+    assert states.tolist() == [vola.OCCUPIED, vola.FREE, vola.FREE, vola.UNKNOWN]
+    p = m.probability(np.array([[2.2, 0.3, 0.3], [0.2, 0.2, 0.2], [9.0, 9.0, 9.0]]))
+    assert p[0] == pytest.approx(0.7) and p[1] == pytest.approx(0.4) and np.isnan(p[2])
+    with pytest.raises(vola.InvalidArgument):
+        vola.Map(0.0)
+    with pytest.raises(ValueError):
+        m.insert(np.zeros((2, 2)), origin=(0, 0, 0))
+
+
+def test_a_saved_map_answers_as_the_map(tmp_path: pathlib.Path):
+    m = vola.Map(0.25, max_range=2.5)
+    for points, origin in _scans(3):
+        m.insert(points, origin)
+    path = tmp_path / "map.vol"
+    m.save(path)
+    tree = vola.open(path)
+    assert tree.is_state_map and len(tree) == len(m)
+    queries = _centres(m, -14, 14)
+    want = m.state(queries)
+    assert set(np.unique(want).tolist()) == {vola.UNKNOWN, vola.FREE, vola.OCCUPIED}
+    np.testing.assert_array_equal(vola.state(tree, queries), want)
+    np.testing.assert_array_equal(vola.probability(tree, queries), m.probability(queries))
+    occupied, free = vola.occupied_tree(tree), vola.free_tree(tree)
+    assert not occupied.is_state_map
+    assert len(occupied) == int((want == vola.OCCUPIED).sum())
+    assert len(occupied) + len(free) == len(tree)
+    # A plain tree: its voxels are occupied, the rest free.
+    plain = vola.state(occupied, queries)
+    np.testing.assert_array_equal(plain, np.where(want == vola.OCCUPIED, vola.OCCUPIED, vola.FREE))
+
+
+def test_save_writes_the_bytes_vola_map_writes(tmp_path: pathlib.Path, vola_cli: str):
+    lines = []
+    m = vola.Map(0.25, max_range=2.5)
+    for n, (points, origin) in enumerate(_scans(5)):
+        # The CLI takes sensor-frame points and a pose; an identity rotation adds the
+        # translation exactly, so both routes see the same world points.
+        np.savetxt(tmp_path / f"scan{n}.xyz", points - origin, fmt="%.17g")
+        lines.append(f"scan{n}.xyz {origin[0]!r} {origin[1]!r} {origin[2]!r} 0 0 0 1")
+        m.insert((points - origin) + origin, origin)
+    (tmp_path / "scans.txt").write_text("\n".join(lines) + "\n")
+    subprocess.run([vola_cli, "map", str(tmp_path / "scans.txt"), "-o", str(tmp_path / "cli.vol"),
+                    "--voxel-size", "0.25", "--max-range", "2.5", "-q"], check=True)
+    m.save(tmp_path / "python.vol")
+    assert (tmp_path / "python.vol").read_bytes() == (tmp_path / "cli.vol").read_bytes()
