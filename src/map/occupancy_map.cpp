@@ -6,7 +6,6 @@
 #include "ray_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/parallel.hpp"
-#include "voxel_set.hpp"
 
 namespace vola::map {
 
@@ -25,17 +24,71 @@ VoxelIndex index_of(const detail::Cell& c) noexcept {
   return {static_cast<std::int32_t>(c[0]), static_cast<std::int32_t>(c[1]), static_cast<std::int32_t>(c[2])};
 }
 
-// What one worker collects from its rays of a scan.
-struct WorkerSets {
-  detail::VoxelSet hit, passed;
+// Blocks of 4x4x4 voxels: block (i >> 2, j >> 2, k >> 2), bit (i & 3) + 4 (j & 3) + 16 (k & 3)
+// (the VOLA order), keys of 19 bits per axis.
+constexpr int kBlockBits = kIndexBits - 2;
+constexpr std::int64_t kBlockOffset = std::int64_t{1} << (kBlockBits - 1);
+constexpr std::uint64_t kBlockMask = (std::uint64_t{1} << kBlockBits) - 1;
+
+std::uint64_t block_key(const detail::Cell& c) noexcept {
+  const auto field = [](std::int64_t v) { return static_cast<std::uint64_t>((v >> 2) + kBlockOffset) & kBlockMask; };
+  return field(c[0]) | field(c[1]) << kBlockBits | field(c[2]) << (2 * kBlockBits);
+}
+
+std::uint64_t bit_of(const detail::Cell& c) noexcept {
+  return std::uint64_t{1} << ((c[0] & 3) | (c[1] & 3) << 2 | (c[2] & 3) << 4);
+}
+
+// What one worker's rays of a scan pass and hit, as bits in block masks. Consecutive
+// voxels of a ray mostly share a block, so the last block is remembered.
+class ScanBlocks {
+ public:
+  struct Masks {
+    std::uint64_t passed = 0, hit = 0;
+  };
+
+  void pass(const detail::Cell& c) { masks_of(block_key(c)).passed |= bit_of(c); }
+  void hit(const detail::Cell& c) { masks_of(block_key(c)).hit |= bit_of(c); }
+  // Adds another worker's bits.
+  void add(const ScanBlocks& other) {
+    for (std::size_t b = 0; b < other.keys_.size(); ++b) {
+      Masks& m = masks_of(other.keys_[b]);
+      m.passed |= other.masks_[b].passed;
+      m.hit |= other.masks_[b].hit;
+    }
+  }
+  std::size_t size() const noexcept { return keys_.size(); }
+  std::uint64_t key(std::size_t b) const noexcept { return keys_[b]; }
+  const Masks& masks(std::size_t b) const noexcept { return masks_[b]; }
+
   ScanReport report;
+
+ private:
+  Masks& masks_of(std::uint64_t key) {
+    if (key != last_key_) {
+      bool added = false;
+      last_ = index_.find_or_add(key, added);
+      if (added) {
+        keys_.push_back(key);
+        masks_.emplace_back();
+      }
+      last_key_ = key;
+    }
+    return masks_[last_];
+  }
+
+  detail::BlockIndex index_;
+  std::vector<std::uint64_t> keys_;
+  std::vector<Masks> masks_;
+  std::uint64_t last_key_ = detail::BlockIndex::kEmpty;
+  std::uint32_t last_ = 0;
 };
 
-// One ray into a worker's sets. Cells are in range: both ends are, and the walk stays
+// One ray into a worker's masks. Cells are in range: both ends are, and the walk stays
 // inside their box.
 // Grid units by division, as voxel_of: floor(x * (1 / R)) would differ from floor(x / R)
 // where x / R rounds across an integer.
-void cast(const Point& origin, const Point& point, double size, double max_range, WorkerSets& out) {
+void cast(const Point& origin, const Point& point, double size, double max_range, ScanBlocks& out) {
   const detail::GridPoint o{origin[0] / size, origin[1] / size, origin[2] / size};
   Point end = point;
   bool hit = true;
@@ -50,27 +103,8 @@ void cast(const Point& origin, const Point& point, double size, double max_range
     }
   }
   const detail::GridPoint e{end[0] / size, end[1] / size, end[2] / size};
-  detail::walk_ray(o, e, [&](const detail::Cell& c) { out.passed.insert(OccupancyMap::pack(index_of(c))); });
-  if (hit) out.hit.insert(OccupancyMap::pack(index_of(detail::cell_of(e))));
-}
-
-// The scan's updates, whatever worker found them: hits win over passes (OctoMap's
-// computeUpdate), so `passed` ends up holding only the voxels that get a miss.
-WorkerSets merge(std::vector<WorkerSets>& sets) {
-  WorkerSets all = std::move(sets[0]);
-  for (std::size_t w = 1; w < sets.size(); ++w) {
-    sets[w].hit.for_each([&](std::uint64_t key) { all.hit.insert(key); });
-    sets[w].passed.for_each([&](std::uint64_t key) { all.passed.insert(key); });
-    all.report.not_finite += sets[w].report.not_finite;
-    all.report.outside += sets[w].report.outside;
-    all.report.cut += sets[w].report.cut;
-  }
-  detail::VoxelSet free;
-  all.passed.for_each([&](std::uint64_t key) {
-    if (!all.hit.contains(key)) free.insert(key);
-  });
-  all.passed = std::move(free);
-  return all;
+  detail::walk_ray(o, e, [&](const detail::Cell& c) { out.pass(c); });
+  if (hit) out.hit(detail::cell_of(e));
 }
 
 }  // namespace
@@ -116,18 +150,35 @@ std::optional<VoxelIndex> OccupancyMap::voxel_of(const Point& p) const noexcept 
   return index_of(c);
 }
 
+VoxelIndex OccupancyMap::voxel_at(std::size_t block, int bit) const noexcept {
+  const std::uint64_t key = block_keys_[block];
+  const auto axis = [&](int field, int low) {
+    const std::int64_t b = static_cast<std::int64_t>((key >> (field * kBlockBits)) & kBlockMask) - kBlockOffset;
+    return static_cast<std::int32_t>(b * 4 + low);
+  };
+  return {axis(0, bit & 3), axis(1, (bit >> 2) & 3), axis(2, (bit >> 4) & 3)};
+}
+
 std::optional<float> OccupancyMap::log_odds(const VoxelIndex& v) const {
-  const auto it = cells_.find(pack(v));
-  if (it == cells_.end()) return std::nullopt;
-  return it->second;
+  const detail::Cell c{v.i, v.j, v.k};
+  const std::int64_t block = index_.find(block_key(c));
+  if (block < 0) return std::nullopt;
+  const Block& b = blocks_[static_cast<std::size_t>(block)];
+  const std::uint64_t bit = bit_of(c);
+  if (!(b.known & bit)) return std::nullopt;
+  return b.log_odds[static_cast<std::size_t>(__builtin_ctzll(bit))];
 }
 
 std::vector<std::pair<VoxelIndex, float>> OccupancyMap::voxels() const {
   std::vector<std::pair<VoxelIndex, float>> out;
-  out.reserve(cells_.size());
-  for (const auto& [key, value] : cells_) out.emplace_back(unpack(key), value);
+  out.reserve(known_);
+  for_each([&](const VoxelIndex& v, float value) { out.emplace_back(v, value); });
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return out;
+}
+
+std::size_t OccupancyMap::memory_bytes() const noexcept {
+  return index_.memory_bytes() + block_keys_.capacity() * sizeof(std::uint64_t) + blocks_.capacity() * sizeof(Block);
 }
 
 ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& origin, double max_range,
@@ -139,11 +190,11 @@ ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& o
   if (xyz.size() % 3 != 0) throw InvalidArgument("xyz must hold 3 coordinates per point");
   const std::size_t count = xyz.size() / 3;
   const unsigned workers = resolve_thread_count(threads);
-  std::vector<WorkerSets> sets(workers);
+  std::vector<ScanBlocks> scans(workers);
   parallel_for(
       count,
       [&](const Chunk& chunk) {
-        WorkerSets& mine = sets[chunk.worker];
+        ScanBlocks& mine = scans[chunk.worker];
         for (std::size_t n = chunk.begin; n < chunk.end; ++n) {
           const Point p{xyz[3 * n], xyz[3 * n + 1], xyz[3 * n + 2]};
           if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
@@ -158,18 +209,42 @@ ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& o
         }
       },
       ParallelOptions{.threads = workers, .grain = 2048, .name = "map.insert_scan"});
-  WorkerSets scan = merge(sets);
+  ScanBlocks& scan = scans[0];
+  for (std::size_t w = 1; w < scans.size(); ++w) {
+    scan.add(scans[w]);
+    scan.report.not_finite += scans[w].report.not_finite;
+    scan.report.outside += scans[w].report.outside;
+    scan.report.cut += scans[w].report.cut;
+  }
   // One update per voxel, as OctoMap's updateNode: add, then clamp (a voxel already at
-  // the bound stays there, which is what OctoMap's early abort amounts to).
-  const auto update = [&](std::uint64_t key, float change) {
-    float& value = cells_.try_emplace(key, 0.0f).first->second;
-    value = std::clamp(value + change, model_.clamp_min, model_.clamp_max);
+  // the bound stays there, which is what OctoMap's early abort amounts to). A voxel both
+  // hit and passed counts as hit (OctoMap's computeUpdate).
+  const auto update = [&](Block& block, std::uint64_t bits, float change) {
+    for (; bits; bits &= bits - 1) {
+      float& value = block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bits))];
+      value = std::clamp(value + change, model_.clamp_min, model_.clamp_max);
+    }
   };
-  scan.passed.for_each([&](std::uint64_t key) { update(key, model_.miss); });
-  scan.hit.for_each([&](std::uint64_t key) { update(key, model_.hit); });
+  for (std::size_t b = 0; b < scan.size(); ++b) {
+    const ScanBlocks::Masks& m = scan.masks(b);
+    const std::uint64_t free = m.passed & ~m.hit;
+    bool added = false;
+    const std::uint32_t at = index_.find_or_add(scan.key(b), added);
+    if (added) {
+      block_keys_.push_back(scan.key(b));
+      blocks_.emplace_back();
+    }
+    Block& block = blocks_[at];
+    const std::uint64_t fresh = (free | m.hit) & ~block.known;
+    for (std::uint64_t bits = fresh; bits; bits &= bits - 1) block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bits))] = 0.0f;
+    block.known |= fresh;
+    known_ += static_cast<std::size_t>(__builtin_popcountll(fresh));
+    update(block, free, model_.miss);
+    update(block, m.hit, model_.hit);
+    scan.report.hit_voxels += static_cast<std::uint64_t>(__builtin_popcountll(m.hit));
+    scan.report.free_voxels += static_cast<std::uint64_t>(__builtin_popcountll(free));
+  }
   scan.report.points = count;
-  scan.report.hit_voxels = scan.hit.size();
-  scan.report.free_voxels = scan.passed.size();
   return scan.report;
 }
 

@@ -20,18 +20,26 @@
 //    cut point passes voxels as above (the cut point's voxel excluded) and nothing is hit;
 //  - an update adds the hit or miss log-odds (float) and clamps to [clamp_min, clamp_max].
 //
-// Costs: a scan of n rays of m voxels each is O(n m) hash operations, run in parallel with
-// vola::parallel_for (per-worker voxel sets merged before the map changes).
+// Storage, as VOLA's own: 4x4x4 blocks, each a 64-bit word of known voxels (bit
+// x + 4y + 16z) and 64 floats, found through one hash of block keys. A scan marks the
+// voxels its rays pass and hit as bits in per-worker block masks (a hash probe only when
+// a ray enters another block, not per voxel), merged, then applied block by block: a scan
+// touches only the blocks it changes, and memory follows the map (its blocks), never the
+// scans already inserted.
+//
+// Costs: a scan of n rays of m voxels each is O(n m) bit operations plus one probe per
+// block a ray enters, run in parallel with vola::parallel_for.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include "vola/frame.hpp"
+#include "vola/map/detail/block_index.hpp"
 #include "vola/tree.hpp"
 
 namespace vola::map {
@@ -86,7 +94,7 @@ class OccupancyMap {
 
   double voxel_size() const noexcept { return voxel_size_; }
   const SensorModel& model() const noexcept { return model_; }
-  std::size_t size() const noexcept { return cells_.size(); }
+  std::size_t size() const noexcept { return known_; }
   // The voxel holding a world point (floor(x / R) per axis); nullopt when not finite or
   // outside the index range.
   std::optional<VoxelIndex> voxel_of(const Point& p) const noexcept;
@@ -98,17 +106,35 @@ class OccupancyMap {
   // Visits every known voxel, in no particular order: f(const VoxelIndex&, float log_odds).
   template <class F>
   void for_each(F&& f) const {
-    for (const auto& [key, value] : cells_) f(unpack(key), value);
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      for (std::uint64_t bits = blocks_[b].known; bits; bits &= bits - 1) {
+        const int bit = __builtin_ctzll(bits);
+        f(voxel_at(b, bit), blocks_[b].log_odds[static_cast<std::size_t>(bit)]);
+      }
   }
 
-  // Packing used by the hash map and the per-scan sets (exposed for the tests).
+  // Packing of indices into one 63-bit key (exposed for the tests).
   static std::uint64_t pack(const VoxelIndex& v) noexcept;
   static VoxelIndex unpack(std::uint64_t key) noexcept;
 
+  // Bytes the map holds (blocks and their index), for memory reports.
+  std::size_t memory_bytes() const noexcept;
+  std::size_t block_count() const noexcept { return blocks_.size(); }
+
  private:
+  struct Block {
+    std::uint64_t known = 0;            // bit x + 4y + 16z: the voxel was updated
+    std::array<float, 64> log_odds{};   // meaningful where known
+  };
+
   double voxel_size_;
   SensorModel model_;
-  std::unordered_map<std::uint64_t, float> cells_;
+  detail::BlockIndex index_;             // block key -> position in blocks_
+  std::vector<std::uint64_t> block_keys_;
+  std::vector<Block> blocks_;
+  std::size_t known_ = 0;
+
+  VoxelIndex voxel_at(std::size_t block, int bit) const noexcept;
 };
 
 // freeze(map) (state_map.hpp) stores the map as one VOLA tree of its known voxels with
