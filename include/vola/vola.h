@@ -163,6 +163,7 @@ typedef struct vola_convert_options {
   uint32_t epsg;                       /* the input's CRS as an EPSG code; 0 = what the input says */
   const char *target_crs;              /* NULL, or reproject points into this CRS (EPSG code, WKT, PROJ string) */
   int level;                           /* COPC: read octree levels 0..level only; -1 (default) = all */
+  const char *grid;                    /* OpenVDB: the grid to read; NULL = the file's first */
   int attributes;                      /* keep the format's per-point attributes (default 1) */
   int columns[3];                      /* text: x y z columns (default 1 2 3) */
   const int *payload_columns;          /* text, nbits 1: payload byte columns (default: all after x y z) */

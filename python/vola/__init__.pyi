@@ -13,6 +13,7 @@ from ._vola import (
     build_from_voxels as build_from_voxels,
     compression_available as compression_available,
     convert as convert,
+    export_map as export_map,
     from_dense as from_dense,
     input_formats as input_formats,
     open_mapped as open_mapped,
