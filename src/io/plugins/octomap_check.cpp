@@ -135,8 +135,10 @@ OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& pat
   layout.data_offset = data < 0 ? bytes.size() : static_cast<std::size_t>(data);
   if (layout.id.empty()) throw FormatError(path, std::nullopt, "the header names no tree type ('id')");
   if (layout.id == "1") layout.id = "OcTree";  // liboctomap's fix for an old id
-  if (!(std::isfinite(layout.resolution) && layout.resolution > 0.0))
-    throw FormatError(path, std::nullopt, "the resolution ('res') is not a finite number > 0");
+  // The 65536 cells of an axis and the keys' scale (1 / res) must be finite numbers too.
+  if (!(std::isfinite(layout.resolution) && layout.resolution > 0.0 && std::isfinite(layout.resolution * 65536.0) &&
+        std::isfinite(1.0 / layout.resolution)))
+    throw FormatError(path, std::nullopt, "the resolution ('res') is not a finite number > 0 whose 65536 cells are finite");
   if (!layout.binary && layout.id != "OcTree")
     throw FormatError(path, std::nullopt,
                       "an .ot file of a " + layout.id + ": vola reads OcTree maps (occupancy log-odds per node)");

@@ -27,10 +27,11 @@ struct OctomapLayout {
 inline constexpr int kOctomapDepth = 16;
 
 // Throws FormatError naming `path` and the byte offset: an unknown first line (old binary
-// files without it included), no `data` line, a resolution that is not finite and > 0, an
-// .ot tree type other than OcTree (its nodes hold other data), a node stream cut short or
-// deeper than 16 levels, a non-finite log-odds, a .bt node count that differs from the
-// header's size (liboctomap refuses it too), or more than `max_cells` occupied cells.
+// files without it included), no `data` line, a resolution that is not finite and > 0 (or
+// whose 65536 cells or inverse are not), an .ot tree type other than OcTree (its nodes
+// hold other data), a node stream cut short or deeper than 16 levels, a non-finite
+// log-odds, a .bt node count that differs from the header's size (liboctomap refuses it
+// too), or more than `max_cells` occupied cells.
 OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& path, std::uint64_t max_cells);
 
 }  // namespace vola::io

@@ -94,7 +94,8 @@ std::pair<double, openvdb::Vec3d> uniform_frame(const openvdb::GridBase& grid, c
   // The linear part alone (the Jacobian), so that a large translation costs no precision.
   const auto map = transform.baseMap();
   const double size = map->applyJacobian(openvdb::Vec3d(1, 0, 0))[0];
-  if (!(std::isfinite(size) && size > 0.0)) throw refuse("its voxel size along x is not a finite number > 0");
+  if (!(std::isfinite(size) && size > 0.0 && std::isfinite(1.0 / size) && std::isfinite(size * 4294967296.0)))
+    throw refuse("its voxel size is not a finite number > 0 whose 2^32 voxels are finite");
   for (int a = 0; a < 3; ++a) {
     openvdb::Vec3d unit(0, 0, 0);
     unit[a] = 1.0;
@@ -187,6 +188,8 @@ VoxelGrid read_vdb_with_openvdb(const std::string& path, const std::string& name
       const double corner = (zero[a] - 0.5 * size) / size + box.min()[a];
       const double lattice = std::round(corner);
       out.origin[a] = (std::fabs(corner - lattice) < 1e-9 * std::max(1.0, std::fabs(lattice)) ? lattice : corner) * size;
+      if (!std::isfinite(out.origin[a]))
+        throw FormatError(path, std::nullopt, "grid '" + chosen + "': its voxels lie beyond finite coordinates");
     }
     out.voxel_size = size;
     return out;
