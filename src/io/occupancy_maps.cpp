@@ -116,6 +116,10 @@ void MapVoxels::check() const {
                             " log-odds for " + std::to_string(voxels.size()) + " voxels");
     for (float value : log_odds)
       if (!std::isfinite(value)) throw InvalidArgument(std::string("a log-odds of the ") + state + " voxels is not finite");
+    for (const Voxel& v : voxels)
+      if (std::max({v.x, v.y, v.z}) >= side_of(kMaxDepth))
+        throw InvalidArgument(std::string("a voxel of the ") + state + " voxels lies beyond a depth-10 grid (" +
+                              std::to_string(side_of(kMaxDepth)) + " voxels per axis)");
   };
   check_list("occupied", occupied, occupied_log_odds);
   check_list("free", free, free_log_odds);

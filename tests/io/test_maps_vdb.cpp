@@ -106,6 +106,24 @@ TEST(VdbExport, LogOddsAndFreeVoxelsGoToFloatGrids) {
   for (const auto& [cell, value] : map.free) EXPECT_EQ(miss_cells.at(cell), value);
 }
 
+// Voxels one per 128^3 block: each costs OpenVDB an internal node of 33 KiB, 4.7 GB in all.
+TEST(VdbExport, ThinlyScatteredVoxelsAreRefusedBeforeOpenvdbBuildsThem) {
+  vola_test::TempDir dir;
+  vola::io::MapVoxels voxels;
+  for (std::uint32_t i = 0; i < 60; ++i)
+    for (std::uint32_t j = 0; j < 60; ++j)
+      for (std::uint32_t k = 0; k < 40; ++k) voxels.occupied.push_back({128 * i, 128 * j, 128 * k});
+  try {
+    vola::io::write_vdb(voxels, (dir / "thin.vdb").string());
+    ADD_FAILURE() << "a 4.7 GB OpenVDB tree was built";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("OpenVDB would need about 4."), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(vola_test::fs::exists(dir / "thin.vdb"));
+  voxels.occupied.resize(20000);  // 0.6 GB: written
+  EXPECT_EQ(vola::io::write_vdb(voxels, (dir / "thin.vdb").string()).occupied, 20000u);
+}
+
 TEST(VdbImport, RoundTripGivesTheSameVoxelsValuesAndFrame) {
   vola_test::TempDir dir;
   for (std::uint64_t seed = 20; seed < 24; ++seed) {

@@ -36,7 +36,8 @@ struct MapVoxels {
   std::vector<float> free_log_odds;
 
   // Throws InvalidArgument when a log-odds list is neither empty nor one per voxel, a
-  // log-odds is not finite, or the voxel size is not finite and > 0.
+  // log-odds is not finite, a voxel lies beyond a depth-10 grid (2^20 per axis), or the
+  // voxel size is not finite and > 0.
   void check() const;
 };
 
@@ -76,7 +77,7 @@ inline constexpr std::int64_t kOctomapKeyCentre = 32768;
 //    are millions of voxels from 0): the map moves by -origin, so that the grid's corner
 //    is OctoMap's 0 (shift in the report, a warning); voxels 32768 or more from the
 //    grid's corner are then refused (InvalidArgument: crop or coarsen first).
-// A voxel both occupied and free is refused.
+// A voxel both occupied and free is refused; so is a tree above kMaxMapLibraryBytes.
 MapExportReport write_octomap(const MapVoxels& voxels, const std::string& path);
 
 // An OpenVDB file of grids in the map's frame: the first "occupied" (BoolGrid, the
@@ -86,8 +87,15 @@ MapExportReport write_octomap(const MapVoxels& voxels, const std::string& path);
 // (i, j, k)'s voxel centre (OpenVDB's convention: centres at integer indices) on the
 // world centre of vola voxel (i - n_x, j - n_y, k - n_z), n = round(origin / R): grids of
 // one voxel size share an index space whatever their origins. Trees pruned, Blosc or zip
-// compression as OpenVDB defaults.
+// compression as OpenVDB defaults. Grids above kMaxMapLibraryBytes are refused.
 MapExportReport write_vdb(const MapVoxels& voxels, const std::string& path);
+
+// The library's own tree for a map is refused above this many bytes, estimated from its
+// node sizes and the voxels' node counts before it is built (InvalidArgument naming the
+// estimate): OpenVDB's internal nodes take 33 KiB and 264 KiB each, so voxels scattered
+// thinly over a wide grid cost far more there than in vola (10^6 uniform voxels at depth
+// 10: about 40 GB). 4 GiB.
+inline constexpr std::uint64_t kMaxMapLibraryBytes = std::uint64_t{4} << 30;
 
 // Readers, as the format table calls them. Maps are refused above this many occupied
 // voxels once pruned nodes are expanded (a lying header or a solid octant of a huge map):

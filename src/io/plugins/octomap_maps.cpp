@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "../reader_plugin.hpp"
+#include "node_census.hpp"
 #include "octomap_check.hpp"
 #include "readers.hpp"
 #include "view_buffer.hpp"
@@ -80,6 +81,29 @@ std::unique_ptr<octomap::OcTree> parse(const std::string& bytes, const OctomapLa
   return std::unique_ptr<octomap::OcTree>(static_cast<octomap::OcTree*>(tree.release()));
 }
 
+std::string gib_text(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / (1u << 30));
+  return text;
+}
+
+// liboctomap's nodes for these keys: a node per distinct cell of every depth 0..16, each
+// an OcTreeNode and, above the leaves, an array of 8 child pointers (plus an allocation's
+// overhead for each).
+std::uint64_t octree_bytes(const std::vector<octomap::OcTreeKey>& keys) {
+  std::vector<std::uint64_t> codes;
+  codes.reserve(keys.size());
+  for (const auto& k : keys) codes.push_back(morton_code(k[0], k[1], k[2]));
+  std::vector<int> shifts(kOctomapDepth);
+  for (int s = 0; s < kOctomapDepth; ++s) shifts[s] = s;
+  const std::vector<std::uint64_t> cells = cells_per_shift(codes, shifts);
+  constexpr std::uint64_t kOverhead = 16, kNode = sizeof(octomap::OcTreeNode) + kOverhead,
+                          kChildren = 8 * sizeof(void*) + kOverhead;
+  std::uint64_t bytes = kNode + kChildren;  // the root
+  for (int s = 0; s < kOctomapDepth; ++s) bytes += cells[s] * (kNode + (s > 0 ? kChildren : 0));
+  return bytes;
+}
+
 }  // namespace
 
 VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes) {
@@ -135,22 +159,31 @@ void write_octomap_with_liboctomap(const MapVoxels& voxels, bool binary, const P
   octomap::OcTree tree(size);
   // OctoMap's own rule, coordToKey of the voxel's centre: half a voxel from every face,
   // so no rounding moves it to a neighbour.
-  const auto key_of = [&](const Voxel& v) {
-    octomap::OcTreeKey key;
-    for (int a = 0; a < 3; ++a) {
-      const double centre = voxels.frame.origin[a] + (coordinate(v, a) + 0.5) * size + shift[a];
-      if (!tree.coordToKeyChecked(centre, key[a]))
-        throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
-                              ") lies beyond OctoMap's keys");
+  std::vector<octomap::OcTreeKey> keys;
+  keys.reserve(voxels.occupied.size() + voxels.free.size());
+  for (const auto* list : {&voxels.occupied, &voxels.free})
+    for (const Voxel& v : *list) {
+      octomap::OcTreeKey key;
+      for (int a = 0; a < 3; ++a) {
+        const double centre = voxels.frame.origin[a] + (coordinate(v, a) + 0.5) * size + shift[a];
+        if (!tree.coordToKeyChecked(centre, key[a]))
+          throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " +
+                                std::to_string(v.z) + ") lies beyond OctoMap's keys");
+      }
+      keys.push_back(key);
     }
-    return key;
-  };
-  for (std::size_t n = 0; n < voxels.occupied.size(); ++n) {
+  if (const std::uint64_t bytes = octree_bytes(keys); bytes > kMaxMapLibraryBytes)
+    throw InvalidArgument("liboctomap would need about " + gib_text(bytes) + " GiB for the tree of these " +
+                          std::to_string(keys.size()) + " voxels, more than vola's " + gib_text(kMaxMapLibraryBytes) +
+                          " GiB: crop the map or export a coarser --depth");
+
+  const std::size_t occupied = voxels.occupied.size();
+  for (std::size_t n = 0; n < occupied; ++n) {
     const float value = voxels.occupied_log_odds.empty() ? tree.getClampingThresMaxLog() : voxels.occupied_log_odds[n];
-    tree.setNodeValue(key_of(voxels.occupied[n]), value, true);
+    tree.setNodeValue(keys[n], value, true);
   }
   for (std::size_t n = 0; n < voxels.free.size(); ++n) {
-    const octomap::OcTreeKey key = key_of(voxels.free[n]);
+    const octomap::OcTreeKey& key = keys[occupied + n];
     if (tree.search(key)) {
       const Voxel& v = voxels.free[n];
       throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +

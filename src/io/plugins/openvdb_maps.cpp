@@ -4,11 +4,14 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <type_traits>
 
 #include "../reader_plugin.hpp"
+#include "node_census.hpp"
 #include "readers.hpp"
 #include "vola/error.hpp"
 
@@ -71,6 +74,34 @@ typename GridT::Ptr make_grid(const std::string& name, const std::vector<Voxel>&
   }
   openvdb::tools::prune(grid->tree());  // uniform leaves become tiles
   return grid;
+}
+
+std::string gib_text(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / (1u << 30));
+  return text;
+}
+
+// OpenVDB's nodes for one grid of these voxels: leaves of 8^3 voxels, internal nodes of
+// 128^3 and 4096^3 (node boundaries at multiples of those in index space, hence the
+// offset modulo 4096), each with an allocation's overhead; a non-bool leaf's values sit
+// in a buffer of their own.
+template <class GridT>
+std::uint64_t grid_bytes(const std::vector<Voxel>& voxels, const Placement& placement) {
+  using Tree = typename GridT::TreeType;
+  using Upper = typename Tree::RootNodeType::ChildNodeType;
+  using Lower = typename Upper::ChildNodeType;
+  using Leaf = typename Tree::LeafNodeType;
+  std::array<std::uint32_t, 3> phase{};
+  for (int a = 0; a < 3; ++a) phase[a] = static_cast<std::uint32_t>(((placement.offset[a] % 4096) + 4096) % 4096);
+  std::vector<std::uint64_t> codes;
+  codes.reserve(voxels.size());
+  for (const Voxel& v : voxels) codes.push_back(morton_code(v.x + phase[0], v.y + phase[1], v.z + phase[2]));
+  const std::vector<std::uint64_t> cells = cells_per_shift(codes, {Leaf::TOTAL, Lower::TOTAL, Upper::TOTAL});
+  constexpr std::uint64_t kOverhead = 16;
+  const std::uint64_t buffer = std::is_same_v<typename GridT::ValueType, bool> ? 0 : Leaf::SIZE * sizeof(typename GridT::ValueType) + kOverhead;
+  return cells[0] * (sizeof(Leaf) + kOverhead + buffer) + cells[1] * (sizeof(Lower) + kOverhead) +
+         cells[2] * (sizeof(Upper) + kOverhead);
 }
 
 // One state's grid: BoolGrid of true voxels, or FloatGrid of their log-odds (background 0:
@@ -201,6 +232,16 @@ VoxelGrid read_vdb_with_openvdb(const std::string& path, const std::string& name
 void write_vdb_with_openvdb(const MapVoxels& voxels, const std::string& temporary, MapExportReport& report) {
   initialise_openvdb();
   const Placement placement = placement_of(voxels.frame);
+  const auto bytes_of = [&](const std::vector<Voxel>& list, const std::vector<float>& log_odds) {
+    return log_odds.empty() ? grid_bytes<openvdb::BoolGrid>(list, placement) : grid_bytes<openvdb::FloatGrid>(list, placement);
+  };
+  const std::uint64_t bytes =
+      bytes_of(voxels.occupied, voxels.occupied_log_odds) + bytes_of(voxels.free, voxels.free_log_odds);
+  if (bytes > kMaxMapLibraryBytes)
+    throw InvalidArgument("OpenVDB would need about " + gib_text(bytes) + " GiB for the grids of these " +
+                          std::to_string(voxels.occupied.size() + voxels.free.size()) +
+                          " voxels (scattered thinly: OpenVDB's internal nodes cover 128^3 and 4096^3 voxels each), "
+                          "more than vola's " + gib_text(kMaxMapLibraryBytes) + " GiB: crop the map or export a coarser --depth");
   openvdb::GridPtrVec grids;
   grids.push_back(state_grid("occupied", voxels.occupied, voxels.occupied_log_odds, placement));
   if (!voxels.free.empty()) grids.push_back(state_grid("free", voxels.free, voxels.free_log_odds, placement));
