@@ -7,8 +7,9 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 namespace vola::io {
@@ -35,6 +36,13 @@ inline std::vector<std::uint64_t> cells_per_shift(std::vector<std::uint64_t>& co
       if (differ >> (3 * shifts[s])) ++counts[s];
   }
   return counts;
+}
+
+// Bytes as GiB with one decimal, for the refusals.
+inline std::string gib_text(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / (1u << 30));
+  return text;
 }
 
 }  // namespace vola::io

@@ -81,12 +81,6 @@ std::unique_ptr<octomap::OcTree> parse(const std::string& bytes, const OctomapLa
   return std::unique_ptr<octomap::OcTree>(static_cast<octomap::OcTree*>(tree.release()));
 }
 
-std::string gib_text(std::uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / (1u << 30));
-  return text;
-}
-
 // liboctomap's nodes for these keys: a node per distinct cell of every depth 0..16, each
 // an OcTreeNode and, above the leaves, an array of 8 child pointers (plus an allocation's
 // overhead for each).

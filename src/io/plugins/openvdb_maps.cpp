@@ -76,12 +76,6 @@ typename GridT::Ptr make_grid(const std::string& name, const std::vector<Voxel>&
   return grid;
 }
 
-std::string gib_text(std::uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f", static_cast<double>(bytes) / (1u << 30));
-  return text;
-}
-
 // OpenVDB's nodes for one grid of these voxels: leaves of 8^3 voxels, internal nodes of
 // 128^3 and 4096^3 (node boundaries at multiples of those in index space, hence the
 // offset modulo 4096), each with an allocation's overhead; a non-bool leaf's values sit
