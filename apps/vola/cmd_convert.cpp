@@ -110,6 +110,12 @@ void add_convert(CLI::App& app) {
       "           size line up. Default when --voxel-size or --origin is given.\n"
       "  toolkit  the reference toolkit's rounding against the longest bbox side; with the same\n"
       "           input and options the output is byte-identical to the reference's.\n"
+      "Maps (OctoMap .bt/.ot through liboctomap, OpenVDB .vdb through OpenVDB):\n"
+      "  the occupied cells (.bt/.ot: occupied leaves, pruned nodes expanded; .vdb: the active\n"
+      "  voxels of the first grid or --grid NAME) become voxels cell for cell at the file's own\n"
+      "  voxel size (--voxel-size must equal it), the grid origin on the file's cells; .ot\n"
+      "  log-odds and .vdb float/double/int32 values become a column (log_odds, or the grid's\n"
+      "  name). Rotated, sheared or non-uniform .vdb transforms are refused.\n"
       "Examples:\n"
       "  vola convert city.xyz city.vol --voxel-size 0.5 --assign-crs 32633\n"
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
@@ -117,7 +123,9 @@ void add_convert(CLI::App& app) {
       "  vola convert points.npy points.vol --depth 5 --compress\n"
       "  vola convert autzen.las autzen_utm.vol --target-crs EPSG:32610 --voxel-size 1\n"
       "  vola convert part.stl part.vol --quantize toolkit --depth 5 --solid\n"
-      "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0");
+      "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0\n"
+      "  vola convert map.bt map.vol\n"
+      "  vola convert fields.vdb density.vol --grid density");
   cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file")->required();
   cmd->add_option("--format", args->options.format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
@@ -134,6 +142,7 @@ void add_convert(CLI::App& app) {
   add_crs_options(*cmd, args->options.assign_crs, args->options.target_crs, args->options.allow_geographic);
   cmd->add_option("--level", args->options.level,
                   "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
+  cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the file's first)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1")->expected(3)->capture_default_str();
@@ -143,7 +152,7 @@ void add_convert(CLI::App& app) {
                   "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "
                   "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean)");
   cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--no-attributes", args->no_attributes, "LAS: keep occupancy only, no per-voxel attribute columns");
+  cmd->add_flag("--no-attributes", args->no_attributes, "Keep occupancy only, no per-voxel attribute columns (LAS, PLY, PCD, .ot log-odds, .vdb values)");
   cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");

@@ -1,5 +1,5 @@
 // vola export: a .vol file back out as PLY, XYZ, LAS, binvox, a dense NPY grid, PNG
-// images or GeoTIFF rasters.
+// images, GeoTIFF rasters or occupancy maps (OctoMap, OpenVDB).
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -13,6 +13,7 @@
 #include "vola/geo/crs.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/occupancy_maps.hpp"
 
 namespace vola::cli {
 
@@ -28,6 +29,7 @@ struct ExportArgs {
   std::string raster;       // dsm, dtm, ... (empty: no raster)
   double resolution = 0.0;  // 0: the voxel size
   bool resolution_given = false;
+  std::string free;  // maps: a .vol of the free voxels (`vola map --free`)
 };
 
 std::string lower_extension(const std::string& path) {
@@ -45,8 +47,10 @@ std::string format_from_extension(const std::string& path) {
   if (ext == ".npy") return "npy";
   if (ext == ".png") return "png";
   if (ext == ".tif" || ext == ".tiff") return "tif";
+  if (ext == ".bt" || ext == ".ot") return "octomap";
+  if (ext == ".vdb") return "vdb";
   throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext +
-                        "'; say --format (ply, xyz, las, binvox, npy, png, tif)");
+                        "'; say --format (ply, xyz, las, binvox, npy, png, tif, octomap, vdb)");
 }
 
 // The format, after checking that the options given apply to it.
@@ -78,7 +82,33 @@ std::string resolve_format(const ExportArgs& a) {
   if (a.resolution_given && !raster) throw InvalidArgument("--resolution applies to --raster");
   if ((a.ascii || a.cubes) && format != "ply") throw InvalidArgument("--ascii and --cubes apply to PLY export");
   if (a.bits != 16 && !a.map) throw InvalidArgument("--bits applies to --map");
+  if (!a.free.empty() && format != "octomap" && format != "vdb") throw InvalidArgument("--free applies to .bt, .ot and .vdb maps");
   return format;
+}
+
+void export_map(const ExportArgs& a, const Tree& tree, const std::string& format) {
+  std::optional<Tree> free;
+  if (!a.free.empty()) {
+    free = open_mapped(a.free);
+    if (a.depth > 0 && a.depth < free->depth()) free = free->level_of_detail(a.depth);
+  }
+  const io::MapVoxels voxels = io::map_voxels(tree, free ? &*free : nullptr);
+  const io::MapExportReport r = format == "vdb" ? io::write_vdb(voxels, a.output) : io::write_octomap(voxels, a.output);
+  for (const auto& warning : r.warnings) std::fprintf(stderr, "vola: warning: %s\n", warning.c_str());  // even with -q
+  if (a.quiet) return;
+  const std::string probabilities = r.log_odds ? "log-odds from the log_odds columns" : "occupancy only";
+  std::string what;
+  if (format == "vdb") {
+    what = "OpenVDB grids";
+    for (const auto& name : r.grids) what += " " + name;
+  } else {
+    const bool binary = lower_extension(a.output) == ".bt";
+    what = std::string("OctoMap OcTree ") + (binary ? "(.bt, maximum likelihood)" : "(.ot, " + probabilities + ")") +
+           " of " + std::to_string(r.nodes) + " nodes";
+  }
+  std::printf("%s: %llu occupied and %llu free voxels of %.17g -> %s\n", what.c_str(),
+              static_cast<unsigned long long>(r.occupied), static_cast<unsigned long long>(r.free),
+              voxels.frame.voxel_size, a.output.c_str());
 }
 
 void run_export(const ExportArgs& a) {
@@ -139,6 +169,8 @@ void run_export(const ExportArgs& a) {
         "): " + std::to_string(r.width) + " x " + std::to_string(r.height) + " cells of " + cell + ", " +
         std::to_string(r.cells_with_data) + " with a value (" + r.rule + "), CRS " +
         (r.has_crs ? "the file's" : "none (the file has no CRS)"));
+  } else if (format == "octomap" || format == "vdb") {
+    export_map(a, tree, format);
   } else if (a.slices) {
     const std::uint32_t images = io::write_png_slices(tree, a.output, true);
     say(std::to_string(images) + " PNG slices of " + std::to_string(tree.side()) +
@@ -192,6 +224,17 @@ void add_export(CLI::App& app) {
       "                        ground voxels (classification 2) if any, else all voxels\n"
       "             intensity  mean intensity of each voxel column's top voxel\n"
       "             density    occupied voxels per square unit; count: occupied voxels\n"
+      "  .bt      OctoMap OcTree, binary (liboctomap): every voxel an occupied leaf of\n"
+      "           resolution = the voxel size (free leaves from --free FREE.vol), pruned\n"
+      "  .ot      OctoMap OcTree with probabilities: log-odds from a log_odds column (as\n"
+      "           vola map writes), else OctoMap's clamping values (0.971 / 0.1192)\n"
+      "           OctoMap's cells are floor(x / R): a grid origin that is not a multiple of\n"
+      "           the voxel size moves the map under half a voxel onto them, and a map beyond\n"
+      "           OctoMap's 32768 cells from 0 (UTM, state plane) moves so that its grid corner\n"
+      "           is OctoMap's 0; both with a warning giving the shift.\n"
+      "  .vdb     OpenVDB: grid \"occupied\" (BoolGrid) or \"log_odds\" (FloatGrid) with a\n"
+      "           log_odds column, and \"free\"/\"free_log_odds\" with --free; transform = voxel\n"
+      "           size and the grid origin (index centres on the voxel centres)\n"
       "Positions are voxel centres in the file's coordinates. --depth K exports the coarser\n"
       "grid of the first K levels (4^K voxels per axis), e.g. to fit a dense format.\n"
       "Examples:\n"
@@ -203,11 +246,14 @@ void add_export(CLI::App& app) {
       "  vola export city.vol height.png --map                 # and height.pgw\n"
       "  vola export autzen.vol dsm.tif --raster dsm\n"
       "  vola export autzen.vol dtm.tif --raster dtm --resolution 6\n"
-      "  vola export city.vol obstacles.png --occupancy-above 3");
+      "  vola export city.vol obstacles.png --occupancy-above 3\n"
+      "  vola map scans.txt -o map.vol --voxel-size 0.2 --free\n"
+      "  vola export map.vol map.bt --free map.free.vol\n"
+      "  vola export map.vol map.vdb");
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
-  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif")
-      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif"}))
+  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif, octomap, vdb")
+      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif", "octomap", "vdb"}))
       ->capture_default_str();
   cmd->add_flag("--ascii", args->ascii, "PLY: ascii instead of binary little-endian");
   cmd->add_flag("--cubes", args->cubes, "PLY: the voxels' outer surface as a quad mesh instead of centre points");
@@ -225,6 +271,8 @@ void add_export(CLI::App& app) {
   cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
       ->check(CLI::PositiveNumber)
       ->each([args](const std::string&) { args->resolution_given = true; });
+  cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb): a .vol of the free voxels on the same grid (vola map --free)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_export(*args); });
 }

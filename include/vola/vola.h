@@ -179,6 +179,7 @@ typedef struct vola_convert_options {
   void *progress_user;
   const char *assign_crs;              /* NULL, or the input's CRS as any definition (not with epsg) */
   int allow_geographic;                /* voxelise in a geographic CRS's degrees anyway (default 0: refused) */
+  const char *grid;                    /* OpenVDB: the grid to read; NULL = the file's first */
 } vola_convert_options;
 
 typedef struct vola_convert_report {

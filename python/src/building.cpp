@@ -2,6 +2,7 @@
 #include "python_support.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "vola/file.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/occupancy_maps.hpp"
 #include "vola/io/translate.hpp"
 
 namespace vola::python {
@@ -134,7 +136,7 @@ Tree convert(const std::filesystem::path& path, int depth,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
              int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
              const std::string& target_crs, std::optional<int> level, const std::string& assign_crs,
-             bool allow_geographic) {
+             bool allow_geographic, const std::string& grid) {
   vola::ConvertOptions options;
   options.format = format;
   if (!quantize.empty()) options.quantization = parse_quantization(quantize);
@@ -148,6 +150,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   options.target_crs = target_crs;
   options.allow_geographic = allow_geographic;
   options.level = level;
+  options.grid = grid;
   options.attributes = attributes;
   options.columns = columns;
   options.payload_columns = std::move(payload_columns);
@@ -203,8 +206,9 @@ void bind_building(py::module_& m) {
         py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
         py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
-        py::arg("assign_crs") = "", py::arg("allow_geographic") = false,
-        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM) and builds its\n"
+        py::arg("assign_crs") = "", py::arg("allow_geographic") = false, py::arg("grid") = "",
+        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
+        "OpenVDB .vdb) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
         "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
         "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
@@ -212,7 +216,9 @@ void bind_building(py::module_& m) {
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
         "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
         "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
-        "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for.");
+        "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
+        "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
+        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid.");
   m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output) {
         py::gil_scoped_release release;
         with_python_names([&] { vola::io::translate_points(input.string(), output.string()); });
@@ -226,6 +232,33 @@ void bind_building(py::module_& m) {
       "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
       "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"
       "ending in .laz is LASzip-compressed.");
+  m.def("export_map", [](const Tree& tree, const std::filesystem::path& path, const Tree* free) {
+        vola::io::MapExportReport r;
+        {
+          py::gil_scoped_release release;
+          r = with_python_names([&] {
+            const vola::io::MapVoxels voxels = vola::io::map_voxels(tree, free);
+            std::string ext = path.extension().string();
+            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+            return ext == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
+          });
+        }
+        py::dict report;
+        report["occupied"] = r.occupied;
+        report["free"] = r.free;
+        report["log_odds"] = r.log_odds;
+        report["shift"] = py::make_tuple(r.shift[0], r.shift[1], r.shift[2]);
+        report["nodes"] = r.nodes;
+        report["grids"] = r.grids;
+        report["warnings"] = r.warnings;
+        return report;
+      }, py::arg("tree"), py::arg("path"), py::arg("free") = py::none(),
+      "The tree as an occupancy map (`vola export TREE OUT.bt|.ot|.vdb [--free FREE]`): OctoMap .bt (binary,\n"
+      "maximum likelihood) or .ot (log-odds from a log_odds column, else the clamping maximum) through\n"
+      "liboctomap, or OpenVDB .vdb (grid 'occupied', or 'log_odds'; 'free'/'free_log_odds' with free=)\n"
+      "through OpenVDB; free= is a tree of free voxels on the same grid (vola map --free). Returns a dict:\n"
+      "occupied, free, log_odds, shift (added to coordinates when OctoMap's cells needed it), nodes, grids,\n"
+      "warnings.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

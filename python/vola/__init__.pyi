@@ -18,6 +18,7 @@ from ._vola import (
     compression_available as compression_available,
     convert as convert,
     free_tree as free_tree,
+    export_map as export_map,
     from_dense as from_dense,
     input_formats as input_formats,
     occupied_tree as occupied_tree,

@@ -23,8 +23,11 @@ command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
 # 3D CNN classification (vola_learn): libtorch (CPU) and libzip for .npz, found through pkg-config.
 VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
 
-# The occupancy map's tests compare with OctoMap cell by cell (a test-only dependency).
-VOLA_BUILD_PACKAGES+=(liboctomap-dev)
+# Occupancy maps in and out: OctoMap .bt/.ot through liboctomap (the octomap plugin; the
+# map tests also compare with OctoMap cell by cell) and .vdb through OpenVDB (the openvdb
+# plugin; libopenvdb-dev brings TBB and Blosc, but not the Boost.Iostreams headers that
+# OpenVDB's headers and FindOpenVDB.cmake need).
+VOLA_BUILD_PACKAGES+=(liboctomap-dev libopenvdb-dev libboost-iostreams-dev)
 
 # vola export --raster's test reads the GeoTIFFs back with GDAL's Python bindings; the tile test
 # opens the tile index with ogrinfo, as a GIS user would.

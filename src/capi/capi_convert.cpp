@@ -29,6 +29,7 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   if (c.target_crs) o.target_crs = c.target_crs;
   o.allow_geographic = c.allow_geographic != 0;
   if (c.level >= 0) o.level = c.level;
+  if (c.grid) o.grid = c.grid;
   o.attributes = c.attributes != 0;
   for (int i = 0; i < 3; ++i) o.columns[static_cast<std::size_t>(i)] = c.columns[i];
   o.payload_columns.assign(c.payload_columns, c.payload_columns + c.payload_column_count);

@@ -1,6 +1,9 @@
 // The conversion pipeline: reader -> points, voxels or triangles -> builder -> tree.
 #include "vola/convert.hpp"
 
+#include <cmath>
+#include <cstdio>
+
 #include "georeference.hpp"
 #include "options.hpp"
 #include "shapes.hpp"
@@ -32,6 +35,9 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (options.level && format.name != "las")
     throw OptionError("level", "applies to COPC input only (" + path + " is " + format.name + ")");
   input.copc_level = options.level;
+  if (!options.grid.empty() && format.name != "vdb")
+    throw OptionError("grid", "applies to OpenVDB input only (" + path + " is " + format.name + ")");
+  input.grid = options.grid;
   input.progress = progress;
   io::Input loaded = format.read(path, input);
   if (options.solid && !loaded.is_mesh())
@@ -40,9 +46,24 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
 }
 
 // Voxel-grid inputs map one cell to one voxel unless the options ask for another grid:
-// then their cell centres are quantized like points.
-bool maps_cell_for_cell(const io::Input& input, const ConvertOptions& options) {
-  return input.grid && !options.quantization && options.voxel_size <= 0.0 && !options.origin && !options.bbox;
+// then their cell centres are quantized like points. A map's cells are its own: another
+// voxel size is refused (resampling occupancy would invent or lose obstacles), and its
+// own size given explicitly still maps cell for cell.
+std::string size_text(double size) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.15g", size);
+  return text;
+}
+
+bool maps_cell_for_cell(const std::string& path, const io::Input& input, const ConvertOptions& options) {
+  if (!input.grid) return false;
+  const double size = input.grid->voxel_size;
+  const bool own_size = options.voxel_size > 0.0 && std::fabs(options.voxel_size - size) <= 1e-9 * size;
+  if (input.grid->fixed_voxel_size && options.voxel_size > 0.0 && !own_size)
+    throw OptionError("voxel_size", "is " + size_text(options.voxel_size) + ", but " + path + " is a map of " +
+                                        size_text(size) + " cells: give its own size or leave it out");
+  return !options.quantization && (options.voxel_size <= 0.0 || (input.grid->fixed_voxel_size && own_size)) &&
+         !options.origin && !options.bbox;
 }
 
 void check_target_crs(const std::string& target) {
@@ -60,7 +81,7 @@ const char* unit_of(const io::Input& input) {
 
 Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions& options, const BuildOptions& build,
                 BuildReport& report) {
-  if (maps_cell_for_cell(input, options)) return tree_from_grid_cells(*input.grid, options.depth, report);
+  if (maps_cell_for_cell(path, input, options)) return tree_from_grid_cells(*input.grid, options.depth, report);
   if (!options.quantization && options.depth == 0 && options.voxel_size <= 0.0)
     throw OptionError("voxel_size",
                       "how fine should the voxels be? Give `voxel_size` (grid quantization: the voxel edge in the "

@@ -113,11 +113,11 @@ void ConvertOptions::check() const {
   if (level && (*level < 0 || *level > 30)) throw OptionError("level", std::to_string(*level) + " is outside 0..30");
   if (dem_base && !std::isfinite(*dem_base)) throw OptionError("dem_base", "must be finite");
   for (const auto& spec : text_attributes) convert_detail::parse_text_attribute(spec);
-  BuildOptions grid = convert_detail::build_options(*this, 2000);
+  BuildOptions build = convert_detail::build_options(*this, 2000);
   // Whether the voxels are given a size at all is decided once the input is known: a
   // voxel-grid input maps cell for cell without either.
-  if (grid.depth == 0 && grid.voxel_size <= 0.0) grid.depth = kMaxDepth;
-  grid.check();
+  if (build.depth == 0 && build.voxel_size <= 0.0) build.depth = kMaxDepth;
+  build.check();
 }
 
 }  // namespace vola

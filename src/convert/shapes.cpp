@@ -18,8 +18,20 @@ Tree tree_from_grid_cells(const io::VoxelGrid& grid, int requested_depth, BuildR
   if (side_of(depth) < largest)
     throw OptionError("depth", "a " + std::to_string(largest) + "-cell grid does not fit depth " + std::to_string(depth) +
                                    " (" + std::to_string(side_of(depth)) + " voxels per axis)");
-  Tree tree = build_from_voxels(grid.voxels, depth);
-  tree.set_frame(Frame{Quantization::grid, grid.origin, grid.voxel_size});
+  Tree tree;
+  if (grid.attributes.empty()) {
+    tree = build_from_voxels(grid.voxels, depth);
+    tree.set_frame(Frame{Quantization::grid, grid.origin, grid.voxel_size});
+  } else {
+    // Columns ride with the cell centres through the builder's grid quantization, which
+    // puts each centre back into its own cell (half a cell from every face).
+    BuildOptions options;
+    options.quantization = Quantization::grid;
+    options.depth = depth;
+    options.voxel_size = grid.voxel_size;
+    options.origin = grid.origin;
+    tree = build(grid_cell_centres(grid), options);
+  }
   Box box{grid.origin, grid.origin};
   for (int i = 0; i < 3; ++i) box.max[i] += grid.voxel_size * grid.dims[i];
   tree.georef().bbox = box;
@@ -36,6 +48,7 @@ PointCloud grid_cell_centres(const io::VoxelGrid& grid) {
     cloud.xyz.push_back(grid.origin[1] + (v.y + 0.5) * grid.voxel_size);
     cloud.xyz.push_back(grid.origin[2] + (v.z + 0.5) * grid.voxel_size);
   }
+  cloud.attributes = grid.attributes;
   return cloud;
 }
 

@@ -6,9 +6,11 @@
 
 namespace vola::convert_detail {
 
-// A voxel-grid input (binvox, NPY occupancy) cell for cell; depth 0 = the smallest that holds it.
+// A voxel-grid input (binvox, NPY occupancy, maps) cell for cell, its per-cell values as
+// columns; depth 0 = the smallest that holds it.
 Tree tree_from_grid_cells(const io::VoxelGrid& grid, int depth, BuildReport& report);
-// The cell centres of a voxel-grid input, as points (to quantize on another grid).
+// The cell centres of a voxel-grid input, as points with its per-cell values (to quantize
+// on another grid).
 PointCloud grid_cell_centres(const io::VoxelGrid& grid);
 // Triangles -> surface voxels (and the inside when solid). Toolkit mode frames the
 // vertices' bbox, as a point cloud's bbox frames its points.

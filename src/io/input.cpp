@@ -12,6 +12,7 @@
 #include "vola/io/las.hpp"
 #include "vola/io/mesh.hpp"
 #include "vola/io/npy.hpp"
+#include "vola/io/occupancy_maps.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
 
@@ -89,6 +90,20 @@ Input read_dem_input(const std::string& path, const InputOptions& options) {
   return in;
 }
 
+Input read_octomap_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "octomap";
+  in.grid = read_octomap(path, options);
+  return in;
+}
+
+Input read_vdb_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "vdb";
+  in.grid = read_vdb(path, options);
+  return in;
+}
+
 std::vector<InputFormat> make_formats() {
   return {
       {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10, and LAZ (compressed LAS, COPC)", read_las_input},
@@ -102,6 +117,9 @@ std::vector<InputFormat> make_formats() {
        "meshes through Assimp: STL, OBJ, OFF, glTF, COLLADA, 3DS", read_mesh_input},
       {"dem", {".tif", ".tiff", ".dem", ".img"}, "elevation rasters through GDAL (GeoTIFF, ...): cells as columns",
        read_dem_input},
+      {"octomap", {".bt", ".ot"}, "OctoMap occupancy maps through liboctomap: occupied cells (.ot: with log-odds)",
+       read_octomap_input},
+      {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
   };
 }
 

@@ -1,6 +1,7 @@
 // The entry points of the plugins libvola_gdal.so (elevation rasters read, GeoTIFF
-// rasters and footprint layers written, through GDAL/OGR) and libvola_assimp.so (meshes through Assimp); see
-// src/plugin/plugin.hpp for why they are plugins.
+// rasters and footprint layers written, through GDAL/OGR), libvola_assimp.so (meshes
+// through Assimp), libvola_octomap.so (OctoMap .bt/.ot through liboctomap) and
+// libvola_openvdb.so (.vdb through OpenVDB); see src/plugin/plugin.hpp for why they are plugins.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/footprints.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/occupancy_maps.hpp"
 
 namespace vola::io {
 
@@ -38,6 +40,21 @@ inline constexpr const char* kFootprintsGeopackageSymbol = "vola_plugin_footprin
 inline constexpr const char* kReadDemSymbol = "vola_plugin_read_dem";
 inline constexpr const char* kWriteGeotiffSymbol = "vola_plugin_write_geotiff";
 inline constexpr const char* kReadMeshSymbol = "vola_plugin_read_mesh";
+
+// Maps (vola/io/occupancy_maps.hpp). The writers write the file at `temporary` (an
+// OutputFile's temporary, which the caller commits); `shift` is added to every world
+// coordinate before OctoMap's coordToKey.
+using ReadOctomapEntry = void (*)(const std::string& path, bool attributes, VoxelGrid& out, PluginFailure& failure);
+using WriteOctomapEntry = void (*)(const MapVoxels& voxels, bool binary, const Point& shift,
+                                   const std::string& temporary, MapExportReport& report, PluginFailure& failure);
+using ReadVdbEntry = void (*)(const std::string& path, const std::string& grid, bool attributes, VoxelGrid& out,
+                              PluginFailure& failure);
+using WriteVdbEntry = void (*)(const MapVoxels& voxels, const std::string& temporary, MapExportReport& report,
+                               PluginFailure& failure);
+inline constexpr const char* kReadOctomapSymbol = "vola_plugin_read_octomap";
+inline constexpr const char* kWriteOctomapSymbol = "vola_plugin_write_octomap";
+inline constexpr const char* kReadVdbSymbol = "vola_plugin_read_vdb";
+inline constexpr const char* kWriteVdbSymbol = "vola_plugin_write_vdb";
 
 }  // namespace plugin
 }  // namespace vola::io

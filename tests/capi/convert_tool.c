@@ -69,6 +69,8 @@ int main(int argc, char **argv) {
       options.allow_geographic = atoi(value);
     } else if (strcmp(key, "level") == 0) {
       options.level = atoi(value);
+    } else if (strcmp(key, "grid") == 0) {
+      options.grid = value;
     } else if (strcmp(key, "attributes") == 0) {
       options.attributes = atoi(value);
     } else if (strcmp(key, "columns") == 0) {

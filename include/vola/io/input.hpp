@@ -26,6 +26,7 @@ struct InputOptions {
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
   std::optional<int> copc_level;   // COPC: only the octree's levels 0..copc_level
+  std::string grid;                // OpenVDB: the grid to read (empty: the file's first)
 };
 
 // Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).
@@ -34,6 +35,11 @@ struct VoxelGrid {
   Point origin{0, 0, 0};                       // world position of cell (0,0,0)'s corner
   double voxel_size = 1.0;                     // world size of one cell
   std::vector<Voxel> voxels;                   // occupied cells, any order
+  // Per-cell values (one per voxel, in the order of `voxels`), kept as attribute columns.
+  std::vector<PointAttribute> attributes;
+  // Maps (OctoMap, OpenVDB): the cells are the map's own; a conversion to another voxel
+  // size is refused rather than resampled.
+  bool fixed_voxel_size = false;
 };
 
 using Triangle = std::array<Point, 3>;

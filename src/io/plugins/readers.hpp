@@ -1,4 +1,4 @@
-// The readers (and the GeoTIFF writer) inside the plugins, as plain functions: what the
+// The readers (and the GeoTIFF and map writers) inside the plugins, as plain functions: what the
 // plugins' entry points run, and what the fuzz targets call directly (linked with GDAL
 // or Assimp themselves).
 #pragma once
@@ -12,6 +12,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/footprints.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/occupancy_maps.hpp"
 
 namespace vola::io {
 
@@ -27,5 +28,13 @@ std::vector<std::uint8_t> footprints_geojson_with_ogr(const FootprintLayer& laye
 std::vector<std::uint8_t> footprints_geopackage_with_ogr(const FootprintLayer& layer);
 // As read_mesh_triangles (vola/io/mesh.hpp), through Assimp in this process.
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path);
+// As read_octomap and write_octomap (vola/io/occupancy_maps.hpp), through liboctomap in
+// this process: the file written at `temporary`, every world coordinate moved by `shift`.
+VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes);
+void write_octomap_with_liboctomap(const MapVoxels& voxels, bool binary, const Point& shift, const std::string& temporary,
+                                   MapExportReport& report);
+// As read_vdb and write_vdb, through OpenVDB in this process.
+VoxelGrid read_vdb_with_openvdb(const std::string& path, const std::string& grid, bool attributes);
+void write_vdb_with_openvdb(const MapVoxels& voxels, const std::string& temporary, MapExportReport& report);
 
 }  // namespace vola::io

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# `vola export` to OctoMap (.bt, .ot) and OpenVDB (.vdb) and `vola convert` back, end to end.
+#
+#   cli_maps.sh VOLA_BINARY SHARED_DIR      ($VOLA_SHARED overrides SHARED_DIR)
+#
+# A real survey (pdal_autzen-utm.las, UTM metres) at 2 m goes vol -> .bt/.ot/.vdb -> vol
+# and must give the same voxels (.bt/.ot: moved to OctoMap's 0 with a warning, since UTM
+# coordinates lie beyond OctoMap's keys; .vdb: the same world centres); a `vola map` with
+# --free exports occupied and free voxels with their log-odds; wrong voxel sizes, damaged
+# files and misplaced options fail with a message.
+# Exit status: 0 all good, 1 failures, 77 shared folder missing (outside CI).
+set -uo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 VOLA_BINARY SHARED_DIR" >&2
+  exit 2
+fi
+vola=$1
+shared=${VOLA_SHARED:-$2}
+las=$shared/data/las/pdal_autzen-utm.las
+if [[ ! -f $las ]]; then
+  if [[ -n ${CI:-} ]]; then
+    echo "FAIL: $las is missing (CI is set)" >&2
+    exit 1
+  fi
+  echo "SKIP: $las is missing" >&2
+  exit 77
+fi
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+# expect_error MESSAGE_PART COMMAND...: the command fails and says MESSAGE_PART.
+expect_error() {
+  local part=$1
+  shift
+  if "$@" >"$tmp/out" 2>"$tmp/err"; then
+    fail "'$*' succeeded, expected an error saying '$part'"
+  elif ! grep -q -- "$part" "$tmp/err"; then
+    fail "'$*' failed without saying '$part': $(cat "$tmp/err")"
+  fi
+}
+
+"$vola" convert "$las" "$tmp/a.vol" --voxel-size 2 -q || fail "convert $las"
+"$vola" voxels "$tmp/a.vol" | sort >"$tmp/a.voxels"
+"$vola" coords "$tmp/a.vol" | sort >"$tmp/a.coords"
+[[ $(wc -l <"$tmp/a.voxels") -gt 1000 ]] || fail "the survey gave too few voxels"
+
+for ext in bt ot; do
+  "$vola" export "$tmp/a.vol" "$tmp/a.$ext" >"$tmp/out" 2>"$tmp/err" || fail "export .$ext: $(cat "$tmp/err")"
+  grep -q "lies beyond OctoMap's 32768 cells of 2 around 0, so it moved by" "$tmp/err" ||
+    fail ".$ext export did not warn about the shift: $(cat "$tmp/err")"
+  grep -q "^OctoMap OcTree (.$ext" "$tmp/out" || fail ".$ext summary: $(cat "$tmp/out")"
+  "$vola" convert "$tmp/a.$ext" "$tmp/$ext.vol" -q || fail "convert .$ext"
+  "$vola" voxels "$tmp/$ext.vol" | sort | cmp -s - "$tmp/a.voxels" || fail ".$ext round trip: the voxels differ"
+  "$vola" info "$tmp/$ext.vol" | grep -q "voxel size 2, origin (0, 0, 0)" || fail ".$ext round trip: not the map's grid"
+done
+
+"$vola" export "$tmp/a.vol" "$tmp/a.vdb" >"$tmp/out" 2>"$tmp/err" || fail "export .vdb: $(cat "$tmp/err")"
+[[ ! -s $tmp/err ]] || fail ".vdb export warned: $(cat "$tmp/err")"
+grep -q "^OpenVDB grids occupied:" "$tmp/out" || fail ".vdb summary: $(cat "$tmp/out")"
+"$vola" convert "$tmp/a.vdb" "$tmp/vdb.vol" -q || fail "convert .vdb"
+"$vola" coords "$tmp/vdb.vol" | sort | cmp -s - "$tmp/a.coords" || fail ".vdb round trip: the voxel centres differ"
+
+# An occupancy map with free space and log-odds (the scans of tests/map/cli_map.sh).
+mkdir "$tmp/scans"
+printf '1.0 0 0\n' >"$tmp/scans/ahead.xyz"
+printf 'scans/ahead.xyz 0.1 0.1 0.1 0 0 0 1\nscans/ahead.xyz 0.1 0.1 0.1 0 0 0.70710678 0.70710678\n' >"$tmp/list.txt"
+"$vola" map "$tmp/list.txt" -o "$tmp/map.vol" --voxel-size 0.25 --free -q || fail "vola map"
+"$vola" export "$tmp/map.vol" "$tmp/map.ot" --free "$tmp/map.free.vol" >"$tmp/out" 2>"$tmp/err" || fail "export map.ot: $(cat "$tmp/err")"
+grep -q "(.ot, log-odds from the log_odds columns) of .* nodes: 2 occupied and 7 free voxels of 0.25" "$tmp/out" ||
+  fail "map.ot summary: $(cat "$tmp/out")"
+[[ ! -s $tmp/err ]] || fail "a vola map export warned: $(cat "$tmp/err")"
+"$vola" convert "$tmp/map.ot" "$tmp/map_back.vol" -q || fail "convert map.ot"
+"$vola" coords "$tmp/map_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.vol" | sort) ||
+  fail "map.ot round trip: the occupied voxels differ"
+"$vola" voxels "$tmp/map_back.vol" --attributes --header | head -1 | grep -q "log_odds" || fail "map.ot lost the log-odds"
+"$vola" export "$tmp/map.vol" "$tmp/map.vdb" --free "$tmp/map.free.vol" >"$tmp/out" || fail "export map.vdb"
+grep -q "^OpenVDB grids log_odds free_log_odds: 2 occupied and 7 free" "$tmp/out" || fail "map.vdb summary: $(cat "$tmp/out")"
+"$vola" convert "$tmp/map.vdb" "$tmp/free_back.vol" --grid free_log_odds -q || fail "convert map.vdb --grid free_log_odds"
+"$vola" coords "$tmp/free_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.free.vol" | sort) ||
+  fail "map.vdb: the free voxels differ"
+
+# Errors.
+expect_error "is a map of 2 cells" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --voxel-size 3
+expect_error "its grids: 'occupied'" "$vola" convert "$tmp/a.vdb" "$tmp/x.vol" --grid density
+expect_error "applies to OpenVDB input only" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --grid occupied
+expect_error "--free applies to .bt, .ot and .vdb maps" "$vola" export "$tmp/a.vol" "$tmp/x.ply" --free "$tmp/map.free.vol"
+head -c 300 "$tmp/a.bt" >"$tmp/cut.bt"
+expect_error "$tmp/cut.bt.*the node stream ends inside a node" "$vola" convert "$tmp/cut.bt" "$tmp/x.vol"
+head -c 2000 "$tmp/a.vdb" >"$tmp/cut.vdb"
+expect_error "$tmp/cut.vdb" "$vola" convert "$tmp/cut.vdb" "$tmp/x.vol"
+[[ ! -e $tmp/x.vol ]] || fail "a failed conversion wrote its output"
+
+if [[ $failures -ne 0 ]]; then
+  echo "cli_maps: $failures failure(s)" >&2
+  exit 1
+fi
+echo "cli_maps: ok"
