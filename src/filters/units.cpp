@@ -17,9 +17,19 @@ std::optional<double> metres_per_unit(const std::string& unit) {
   return std::nullopt;
 }
 
-Units units_of_crs(const std::optional<std::uint32_t>& epsg, const std::string& wkt) {
+Units units_of_crs(const std::optional<std::uint32_t>& epsg, const std::string& wkt_given) {
+  // An empty WKT record (some writers leave one) says nothing.
+  const bool blank = wkt_given.find_first_not_of(std::string(" \t\r\n\0", 5)) == std::string::npos;
+  const std::string wkt = blank ? std::string() : wkt_given;
   if (wkt.empty() && !epsg) return {};
-  const geo::CrsDescription crs = geo::describe_crs(wkt.empty() ? "EPSG:" + std::to_string(*epsg) : wkt);
+  geo::CrsDescription crs;
+  try {
+    crs = geo::describe_crs(wkt.empty() ? "EPSG:" + std::to_string(*epsg) : wkt);
+  } catch (const Error&) {
+    // A WKT record PROJ cannot read (pdal_warsaw_small.las holds "''") states no CRS.
+    if (!epsg || wkt.empty()) return {};
+    crs = geo::describe_crs("EPSG:" + std::to_string(*epsg));
+  }
   const auto horizontal = metres_per_unit(crs.horizontal_unit);
   if (!horizontal)
     throw InvalidArgument("the points' CRS (" + crs.name + ") has coordinates in " +
