@@ -1,6 +1,7 @@
 #include "vola/filters/stages.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numeric>
@@ -97,8 +98,11 @@ Stage parse_stage(const std::string& spec) {
         refuse(spec, "a minimum is above its maximum");
     } else if (name == "polygon" || name == "croppolygon") {
       s.kind = Stage::Kind::polygon;
-      if (args.empty()) refuse(spec, "polygon needs a file: polygon:FILE (GeoJSON or WKT)");
-      s.polygons = read_polygons(args);
+      if (args.empty()) refuse(spec, "polygon needs a file: polygon:FILE (GeoJSON or WKT), or the WKT itself");
+      std::string head = args.substr(0, 12);
+      for (char& ch : head) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      const bool inline_text = args[0] == '{' || head.rfind("POLYGON", 0) == 0 || head.rfind("MULTIPOLYGON", 0) == 0;
+      s.polygons = inline_text ? parse_polygons(args, "polygon") : read_polygons(args);
     } else {
       refuse(spec, "no filter '" + spec.substr(0, colon) +
                        "' (where:EXPR, smrf, hag, outlier, voxel:R, poisson:R, crop:..., polygon:FILE)");
