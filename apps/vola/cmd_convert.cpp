@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "crs_flags.hpp"
+#include "filter_flags.hpp"
 #include "option_flags.hpp"
 #include "progress.hpp"
 #include "vola/convert.hpp"
@@ -66,6 +67,7 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
   if (build.voxels)
     std::printf("bits per voxel: %.2f (occupied voxels)\n",
                 8.0 * static_cast<double>(out_bytes) / static_cast<double>(build.voxels));
+  for (const auto& line : report.filters) std::printf("filter:         %s\n", line.c_str());
   std::printf("time:           %.3f s\n", seconds);
 }
 
@@ -125,7 +127,10 @@ void add_convert(CLI::App& app) {
       "  vola convert part.stl part.vol --quantize toolkit --depth 5 --solid\n"
       "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0\n"
       "  vola convert map.bt map.vol\n"
-      "  vola convert fields.vdb density.vol --grid density");
+      "  vola convert fields.vdb density.vol --grid density\n"
+      "  vola convert autzen.laz ground.vol --voxel-size 3 --where \"Classification == 2\"\n"
+      "  vola convert autzen.laz trees.vol --voxel-size 3 --filter smrf --filter hag --where \"HeightAboveGround > 6\"\n" +
+      std::string(kFilterHelp));
   cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file")->required();
   cmd->add_option("--format", args->options.format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
@@ -157,6 +162,7 @@ void add_convert(CLI::App& app) {
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");
+  add_filter_options(*cmd, args->options.filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_convert(*args); });
 }

@@ -7,8 +7,10 @@
 #include <string>
 
 #include "commands.hpp"
+#include "filter_flags.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
+#include "vola/filters/stages.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/translate.hpp"
 
@@ -18,6 +20,7 @@ namespace {
 
 struct TranslateArgs {
   std::string input, output;
+  std::vector<std::string> filters;
   bool quiet = false;
 };
 
@@ -31,11 +34,29 @@ void run_translate(const TranslateArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<Progress> progress;
   if (!a.quiet) progress = std::make_unique<Progress>("translating points");
-  io::translate_points(a.input, a.output, [&](std::uint64_t done, std::uint64_t total) {
-    if (progress) progress->update(done, total);
-  });
+  const std::vector<filters::Stage> stages = filters::parse_stages(a.filters);
+  std::vector<filters::StageReport> reports;
+  io::PointEdit edit;
+  if (!stages.empty())
+    edit = [&](io::PointTable& table) {
+      filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
+      reports = std::move(result.stages);
+      return std::move(result.kept);
+    };
+  io::translate_points(
+      a.input, a.output,
+      [&](std::uint64_t done, std::uint64_t total) {
+        if (progress) progress->update(done, total);
+      },
+      edit);
   if (!progress) return;
   progress->finish();
+  for (const auto& r : reports) {
+    std::printf("filter:  %s: %llu -> %llu points", r.spec.c_str(), static_cast<unsigned long long>(r.points_in),
+                static_cast<unsigned long long>(r.points_out));
+    if (r.spec.rfind("smrf", 0) == 0) std::printf(", %llu ground", static_cast<unsigned long long>(r.ground));
+    std::printf("\n");
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (lower_extension(a.output) == ".las" || lower_extension(a.output) == ".laz") {
     const io::LasReader written(a.output);
@@ -65,10 +86,17 @@ void add_translate(CLI::App& app) {
       "  vola translate survey.laz survey.las     # decompress\n"
       "  vola translate survey.las survey.laz     # compress\n"
       "  vola translate cloud.copc.laz cloud.las  # a COPC file's points, in its chunk order\n"
-      "  vola translate survey.laz survey.ply     # for tools that read PLY, every field kept");
+      "  vola translate survey.laz survey.ply     # for tools that read PLY, every field kept\n"
+      "  vola translate autzen.laz ground.laz --filter smrf             # class 2 ground, 1 the rest\n"
+      "  vola translate autzen.laz veg.ply --filter smrf --filter hag --where \"HeightAboveGround > 2\"\n"
+      "With filters, a LAS/LAZ output keeps the records of the points left, every field as it was\n"
+      "but the classification, and the header's counts and bounds follow; a new dimension\n"
+      "(height_above_ground) is written to .ply and .xyz outputs.\n" +
+      std::string(kFilterHelp));
   cmd->add_option("input", args->input, "Input point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .las, .laz, .ply or .xyz")->required();
+  add_filter_options(*cmd, args->filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_translate(*args); });
 }

@@ -29,6 +29,7 @@ void add_classify(CLI::App& app);  // classify and evaluate
 void add_collide(CLI::App& app);
 void add_tile(CLI::App& app);
 void add_translate(CLI::App& app);
+void add_pipeline(CLI::App& app);
 void add_map(CLI::App& app);
 
 // One-line summaries of the subcommands that run in companion executables, shared by the

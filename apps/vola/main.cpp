@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   vola::cli::add_collide(app);
   vola::cli::add_tile(app);
   vola::cli::add_translate(app);
+  vola::cli::add_pipeline(app);
   vola::cli::add_map(app);
   return vola::cli::run_app(app, argc, argv);
 }

@@ -9,7 +9,8 @@ std::string flag_of(const std::string& option) {
   static const std::map<std::string, std::string> renamed = {
       {"quantization", "--quantize"},     {"epsg", "--assign-crs"},          {"text_attributes", "--attribute"},
       {"attributes", "--no-attributes"},  {"memory_budget", "--memory"}, {"bin_width_db", "--bin-width"},
-      {"floor_db", "--floor"},            {"architecture", "--arch"},  {"output_dir", "-o"}};
+      {"floor_db", "--floor"},            {"architecture", "--arch"},  {"output_dir", "-o"},
+      {"filters", "--filter"}};
   if (const auto it = renamed.find(option); it != renamed.end()) return it->second;
   std::string flag = "--" + option;
   for (char& c : flag)

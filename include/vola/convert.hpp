@@ -70,6 +70,14 @@ struct ConvertOptions {
   std::optional<double> dem_base;   // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;    // DEM: one voxel per cell at its height
 
+  // ---- point filters, run in order on the points before they become voxels ----
+  // One string per stage, as include/vola/filters/stages.hpp writes them: "where:EXPR",
+  // "smrf", "hag", "outlier", "voxel:R", "poisson:R", "crop:MINX,MINY,MAXX,MAXY",
+  // "polygon:FILE". Point input only. Filters that need every point (smrf, hag,
+  // outlier, voxel, poisson) read the input whole; per-point ones (where, crop,
+  // polygon) alone leave LAS/LAZ streaming, chunk by chunk.
+  std::vector<std::string> filters;
+
   // ---- the file convert_file writes ----
   bool dense = false;     // the reference's dense layout (depth <= 5)
   bool compress = false;  // zstd levels and attributes (a file only vola reads)
@@ -93,6 +101,8 @@ struct ConvertReport {
   // What a careful user should know about the result (a CRS relabelled, voxels in
   // degrees allowed or quantized by the toolkit): one sentence each, for the front end.
   std::vector<std::string> warnings;
+  // Points each filter stage took in and left ("smrf: 110000 -> 110000, 26411 ground").
+  std::vector<std::string> filters;
 };
 
 // (done, total) in any unit, now and then during long reads.

@@ -10,6 +10,7 @@
 
 #include "vola/builder.hpp"
 #include "vola/convert.hpp"
+#include "vola/filters/stages.hpp"
 #include "vola/file.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
@@ -136,8 +137,9 @@ Tree convert(const std::filesystem::path& path, int depth,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
              int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
              const std::string& target_crs, std::optional<int> level, const std::string& assign_crs,
-             bool allow_geographic, const std::string& grid) {
+             bool allow_geographic, const std::string& grid, std::vector<std::string> filters) {
   vola::ConvertOptions options;
+  options.filters = std::move(filters);
   options.format = format;
   if (!quantize.empty()) options.quantization = parse_quantization(quantize);
   options.depth = depth;
@@ -207,6 +209,7 @@ void bind_building(py::module_& m) {
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
         py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
         py::arg("assign_crs") = "", py::arg("allow_geographic") = false, py::arg("grid") = "",
+        py::arg("filters") = std::vector<std::string>{},
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
         "OpenVDB .vdb) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
@@ -218,13 +221,26 @@ void bind_building(py::module_& m) {
         "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
         "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
         "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
-        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid.");
-  m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output) {
+        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid.\n"
+        "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
+        "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).");
+  m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output,
+                        const std::vector<std::string>& filters) {
         py::gil_scoped_release release;
-        with_python_names([&] { vola::io::translate_points(input.string(), output.string()); });
-      }, py::arg("input"), py::arg("output"),
+        with_python_names([&] {
+          const auto stages = vola::filters::parse_stages(filters);
+          vola::io::PointEdit edit;
+          if (!stages.empty())
+            edit = [&](vola::io::PointTable& table) {
+              return vola::filters::run_stages(stages, table.cloud, table.epsg, table.wkt).kept;
+            };
+          vola::io::translate_points(input.string(), output.string(), {}, edit);
+        });
+      }, py::arg("input"), py::arg("output"), py::arg("filters") = std::vector<std::string>{},
       "Point file to point file, point by point, no voxels (`vola translate`): LAS, LAZ, COPC, PLY, PCD, XYZ,\n"
-      "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.");
+      "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.\n"
+      "filters=['smrf'] etc. as `vola translate --filter` (docs/FILTERS.md): LAS/LAZ out keeps the records left,\n"
+      "classification updated.");
   m.def("export_las", [](const Tree& tree, const std::filesystem::path& path) {
         py::gil_scoped_release release;
         with_python_names([&] { vola::io::write_las(tree, path.string()); });

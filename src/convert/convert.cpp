@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "filtering.hpp"
 #include "georeference.hpp"
 #include "options.hpp"
 #include "shapes.hpp"
@@ -19,7 +20,7 @@ namespace {
 using namespace convert_detail;
 
 io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
-               const ConvertProgress& progress) {
+               const ConvertProgress& progress, std::vector<std::string>& filter_report) {
   if (format.name != "text" && !options.text_attributes.empty())
     throw OptionError("text_attributes", "apply to text input only (" + path + " is " + format.name + ")");
   if (format.name != "dem" && (options.dem_base || options.dem_surface_only))
@@ -39,7 +40,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
     throw OptionError("grid", "applies to OpenVDB input only (" + path + " is " + format.name + ")");
   input.grid = options.grid;
   input.progress = progress;
-  io::Input loaded = format.read(path, input);
+  io::Input loaded = options.filters.empty() ? format.read(path, input) : read_filtered(path, format, options, progress, filter_report);
   if (options.solid && !loaded.is_mesh())
     throw OptionError("solid", "applies to mesh input (triangles); " + path + " holds none");
   return loaded;
@@ -108,7 +109,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   if (const std::string given = given_crs(options); !given.empty()) resolve_crs({}, given);
   if (!options.target_crs.empty()) check_target_crs(options.target_crs);
   const io::InputFormat& format = io::find_input_format(path, options.format);
-  io::Input input = read(path, format, options, progress);
+  std::vector<std::string> filter_report;
+  io::Input input = read(path, format, options, progress, filter_report);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));
@@ -126,6 +128,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
     if (input.bytes_read) report.bytes_read = input.bytes_read();
     report.warnings = crs_warnings(path, options, input, crs);
+    report.filters = std::move(filter_report);
     *report_out = std::move(report);
   }
   return tree;

@@ -7,6 +7,7 @@
 
 #include "vola/attributes.hpp"
 #include "vola/error.hpp"
+#include "vola/filters/stages.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -118,6 +119,11 @@ void ConvertOptions::check() const {
   // voxel-grid input maps cell for cell without either.
   if (build.depth == 0 && build.voxel_size <= 0.0) build.depth = kMaxDepth;
   build.check();
+  if (!filters.empty()) {
+    filters::parse_stages(filters);  // throws OptionError("filters", ...) naming the stage
+    if (nbits > 0) throw OptionError("filters", "cannot be combined with payload words (nbits); keep attributes instead");
+    if (level) throw OptionError("filters", "cannot be combined with a COPC level yet");
+  }
 }
 
 }  // namespace vola

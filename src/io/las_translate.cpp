@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <span>
 
 #include "las_format.hpp"
 #include "vola/output_file.hpp"
@@ -47,9 +48,84 @@ void append_vlr(std::vector<std::uint8_t>& out, const std::string& user, std::ui
   out.insert(out.end(), data.begin(), data.end());
 }
 
+// The records to write, in order: every record of the reader, or with edits only the
+// kept ones, their classification set from the edited column.
+class RecordSource {
+ public:
+  RecordSource(LasReader& reader, const std::optional<LasRecordEdits>& edits) : reader_(reader), edits_(edits) {
+    if (edits_) {
+      const auto column = std::find_if(edits_->points.attributes.begin(), edits_->points.attributes.end(),
+                                       [](const PointAttribute& a) { return a.name == "classification"; });
+      if (column != edits_->points.attributes.end()) classes_ = &column->values;
+    }
+  }
+  // Up to max_points records (fewer at the end; empty when there are no more).
+  std::span<const std::uint8_t> next(std::size_t max_points) {
+    if (!edits_) return reader_.read_records(max_points);
+    const std::size_t length = reader_.header().record_length;
+    buffer_.clear();
+    while (buffer_.empty()) {
+      const std::uint64_t first = reader_.points_read();
+      const auto records = reader_.read_records(max_points);
+      if (records.empty()) break;
+      for (std::size_t j = 0; j < records.size() / length; ++j) {
+        if (kept_at_ >= edits_->kept.size() || edits_->kept[kept_at_] != first + j) continue;
+        const std::size_t at = buffer_.size();
+        buffer_.insert(buffer_.end(), records.begin() + static_cast<std::ptrdiff_t>(j * length),
+                       records.begin() + static_cast<std::ptrdiff_t>((j + 1) * length));
+        if (classes_) set_class(buffer_.data() + at, (*classes_)[kept_at_]);
+        ++kept_at_;
+      }
+    }
+    return buffer_;
+  }
+
+ private:
+  void set_class(std::uint8_t* record, double value) const {
+    const auto c = static_cast<unsigned>(value);
+    if (reader_.header().extended_format()) {
+      record[16] = static_cast<std::uint8_t>(c);
+    } else {
+      if (c > 31)
+        throw InvalidArgument("classification " + std::to_string(c) + " does not fit point format " +
+                              std::to_string(reader_.header().point_format) + " (0..31)");
+      record[15] = static_cast<std::uint8_t>((record[15] & 0xE0u) | c);
+    }
+  }
+  LasReader& reader_;
+  const std::optional<LasRecordEdits>& edits_;
+  const std::vector<double>* classes_ = nullptr;
+  std::size_t kept_at_ = 0;
+  std::vector<std::uint8_t> buffer_;
+};
+
+// The header fields that describe the points, for the points left after edits: counts,
+// counts by return, bounds.
+void rewrite_point_fields(std::vector<std::uint8_t>& head, const LasHeader& hd, const PointCloud& points) {
+  const std::size_t n = points.size();
+  const Box box = points.bounds();
+  const auto returns = std::find_if(points.attributes.begin(), points.attributes.end(),
+                                    [](const PointAttribute& a) { return a.name == "return_number"; });
+  std::uint64_t by_return[15] = {};
+  if (returns != points.attributes.end())
+    for (const double r : returns->values)
+      if (r >= 1 && r <= 15) ++by_return[static_cast<int>(r) - 1];
+  const bool legacy_counts_fit = n <= 0xFFFFFFFFu && hd.point_format < 6;
+  store(head, 107, static_cast<std::uint32_t>(legacy_counts_fit ? n : 0));
+  for (int r = 0; r < 5; ++r)
+    store(head, 111 + 4 * static_cast<std::size_t>(r),
+          static_cast<std::uint32_t>(legacy_counts_fit ? by_return[r] : 0));
+  const double bounds[6] = {box.max[0], box.min[0], box.max[1], box.min[1], box.max[2], box.min[2]};
+  for (int k = 0; k < 6; ++k) store(head, 179 + 8 * static_cast<std::size_t>(k), n ? bounds[k] : 0.0);
+  if (hd.version_minor >= 4 && head.size() >= 375) {
+    store(head, 247, static_cast<std::uint64_t>(n));
+    for (int r = 0; r < 15; ++r) store(head, 255 + 8 * static_cast<std::size_t>(r), by_return[r]);
+  }
+}
+
 // The records, compressed into chunks of kLazChunkPoints after an 8-byte placeholder for
 // the chunk table's offset, then the chunk table; returns the bytes written.
-std::uint64_t write_laz_points(LasReader& reader, const laz::LaszipInfo& info, OutputFile& out, std::uint64_t points_at,
+std::uint64_t write_laz_points(LasReader& reader, RecordSource& source, const laz::LaszipInfo& info, OutputFile& out, std::uint64_t points_at,
                                const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   const std::int64_t placeholder = -1;
@@ -60,7 +136,7 @@ std::uint64_t write_laz_points(LasReader& reader, const laz::LaszipInfo& info, O
   for (;;) {
     records.clear();
     while (records.size() < kLazChunkPoints * hd.record_length) {
-      const auto r = reader.read_records(kLazChunkPoints - records.size() / hd.record_length);
+      const auto r = source.next(kLazChunkPoints - records.size() / hd.record_length);
       if (r.empty()) break;
       records.insert(records.end(), r.begin(), r.end());
     }
@@ -81,13 +157,13 @@ std::uint64_t write_laz_points(LasReader& reader, const laz::LaszipInfo& info, O
   return at + table.size() - points_at;
 }
 
-std::uint64_t write_las_points(LasReader& reader, OutputFile& out,
+std::uint64_t write_las_points(LasReader& reader, RecordSource& source, OutputFile& out,
                                const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   const std::size_t batch = std::max<std::size_t>(1, kLasRecordBatchBytes / hd.record_length);
   std::uint64_t bytes = 0;
   for (;;) {
-    const auto r = reader.read_records(batch);
+    const auto r = source.next(batch);
     if (r.empty()) break;
     out.write(r.data(), r.size());
     bytes += r.size();
@@ -99,7 +175,8 @@ std::uint64_t write_las_points(LasReader& reader, OutputFile& out,
 }  // namespace
 
 void translate_las(const std::string& input, const std::string& output,
-                   const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+                   const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                   const std::optional<LasRecordEdits>& edits) {
   LasReader reader(input);
   const LasHeader& hd = reader.header();
   const bool laz_out = las::laz_path(output);
@@ -125,12 +202,14 @@ void translate_las(const std::string& input, const std::string& output,
   head[104] = static_cast<std::uint8_t>(hd.point_format | (laz_out ? 0x80 : 0));
   store(head, 96, static_cast<std::uint32_t>(points_at));
   store(head, 100, vlr_count);
+  if (edits) rewrite_point_fields(head, hd, edits->points);
 
   OutputFile out(output);
   out.write(head.data(), head.size());
   out.write(vlrs.data(), vlrs.size());
-  const std::uint64_t point_bytes =
-      laz_out ? write_laz_points(reader, info, out, points_at, progress) : write_las_points(reader, out, progress);
+  RecordSource source(reader, edits);
+  const std::uint64_t point_bytes = laz_out ? write_laz_points(reader, source, info, out, points_at, progress)
+                                            : write_las_points(reader, source, out, progress);
   if (reader.points_read() != hd.point_count)
     throw FormatError(input, hd.offset_to_points, "holds " + std::to_string(reader.points_read()) + " points, not the " +
                                                       std::to_string(hd.point_count) + " its header says");

@@ -21,14 +21,17 @@ namespace vola::io {
 namespace {
 
 // The columns of a LAS file's records, in record order.
-PointCloud las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
-                           int& coordinate_digits) {
+PointTable las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   LasReader reader(path);
   const LasHeader& hd = reader.header();
+  PointTable table;
+  table.format = "las";
+  table.epsg = hd.epsg;
+  table.wkt = hd.wkt;
   // Coordinates at the file's own precision: as many decimals as the finest scale needs.
   const double finest = std::min({hd.scale[0], hd.scale[1], hd.scale[2]});
-  coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
-  PointCloud cloud;
+  table.coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
+  PointCloud& cloud = table.cloud;
   const auto add = [&](const char* name, ValueType type) { cloud.attributes.push_back({name, type, Reduction::last, {}}); };
   add("intensity", ValueType::u16);
   add("return_number", ValueType::u8);
@@ -66,7 +69,7 @@ PointCloud las_point_table(const std::string& path, const std::function<void(std
     for (const auto& e : chunk.extra) append(e);
     if (progress) progress(reader.points_read(), reader.points_total());
   }
-  return cloud;
+  return table;
 }
 
 std::vector<std::string> column_names(const PointCloud& cloud) {
@@ -145,29 +148,39 @@ std::string extension_of(const std::string& path) {
 
 }  // namespace
 
+PointTable read_point_table(const std::string& input, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                            const std::string& format) {
+  if (find_input_format(input, format).name == "las") return las_point_table(input, progress);
+  InputOptions options;
+  options.attributes = true;
+  options.progress = progress;
+  Input in = read_input(input, format, options);
+  if (in.is_mesh() || in.grid || in.terrain)
+    throw InvalidArgument(input + ": point filters and vola translate take point files; this is " + in.format + " input");
+  PointTable table;
+  table.format = in.format;
+  table.cloud = std::move(in.cloud);
+  table.epsg = in.epsg;
+  table.wkt = std::move(in.wkt);
+  return table;
+}
+
 void translate_points(const std::string& input, const std::string& output,
-                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress, const PointEdit& edit) {
   const std::string out_ext = extension_of(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
-  if ((out_ext == ".las" || out_ext == ".laz") && las_in) return translate_las(input, output, progress);
-  if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt" && out_ext != ".las" && out_ext != ".laz")
+  const bool las_out = out_ext == ".las" || out_ext == ".laz";
+  if (!las_out && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
     throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply and .xyz (or .txt)");
-  int digits = -1;  // shortest round trip, unless the input has a precision
-  PointCloud cloud;
-  Input in;
-  if (las_in) {
-    cloud = las_point_table(input, progress, digits);
-  } else {
-    InputOptions options;
-    options.attributes = true;
-    in = read_input(input, "auto", options);
-    if (in.is_mesh() || in.grid || in.terrain)
-      throw InvalidArgument(input + ": vola translate takes point files; this is " + in.format + " input");
-    cloud = std::move(in.cloud);
+  if (las_out && las_in && !edit) return translate_las(input, output, progress);
+  PointTable table = read_point_table(input, progress);
+  if (edit) {
+    const std::vector<std::uint64_t> kept = edit(table);
+    if (las_out && las_in) return translate_las(input, output, progress, LasRecordEdits{kept, table.cloud});
   }
-  if (out_ext == ".ply") write_ply_points(cloud, output);
-  else if (out_ext == ".las" || out_ext == ".laz") write_las(cloud, output, in.epsg, in.wkt);
-  else write_xyz_points(cloud, output, digits);
+  if (out_ext == ".ply") write_ply_points(table.cloud, output);
+  else if (las_out) write_las(table.cloud, output, table.epsg, table.wkt);
+  else write_xyz_points(table.cloud, output, table.coordinate_digits);
 }
 
 }  // namespace vola::io

@@ -166,8 +166,17 @@ class LasReader {
 // extra bytes, GPS times and returns all carry over. The output's kind follows its
 // extension; it is written under a temporary name and renamed when complete.
 // progress(done, total) counts points.
+// With `edits`, only the records kept[i] (input indices, increasing) are written, with
+// the classification of points.attributes' "classification" column (point i of
+// `points` is record kept[i]), and the header's point counts, counts by return and
+// bounds follow them.
+struct LasRecordEdits {
+  const std::vector<std::uint64_t>& kept;
+  const PointCloud& points;
+};
 void translate_las(const std::string& input, const std::string& output,
-                   const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+                   const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+                   const std::optional<LasRecordEdits>& edits = std::nullopt);
 
 // Bytes of records worth reading at once: a batch that stays in L2 while its keys or
 // fields are decoded (a pread() of it from the page cache is a copy through the

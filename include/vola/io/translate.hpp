@@ -3,9 +3,33 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
+#include <vector>
+
+#include "vola/builder.hpp"
 
 namespace vola::io {
+
+// Every point of a point file with every field it has as a named column (Reduction::last
+// for LAS fields), in file order, and the CRS the file states.
+struct PointTable {
+  std::string format;  // the reader's name
+  PointCloud cloud;
+  std::optional<std::uint32_t> epsg;
+  std::string wkt;
+  int coordinate_digits = -1;  // LAS: decimals of the finest scale; -1 elsewhere
+};
+// LAS/LAZ/COPC input gives intensity, return_number, number_of_returns, classification,
+// user_data, point_source_id, gps_time, red/green/blue and extra bytes by name; other
+// point files what their reader keeps. Throws InvalidArgument for a mesh, grid or DEM.
+// `format`: "auto" (from the extension) or a name from input_formats().
+PointTable read_point_table(const std::string& input, const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+                            const std::string& format = "auto");
+
+// What happens to the points between reading and writing (point filters): may change
+// columns, add some and drop points; returns, for each point left, its index in the input.
+using PointEdit = std::function<std::vector<std::uint64_t>(PointTable&)>;
 
 // `input` (any point format vola reads: LAS, LAZ, COPC, PLY, PCD, XYZ/TXT/CSV, NPY,
 // KITTI) into `output`, by its extension:
@@ -19,7 +43,12 @@ namespace vola::io {
 // gps_time, red/green/blue, and extra bytes by name. Points keep their input order; the
 // output is written under a temporary name and renamed when complete. Throws
 // InvalidArgument for an output kind it does not write, FormatError for bad input.
+// With `edit`, the points are read whole, edited, then written: LAS/LAZ to LAS/LAZ keeps
+// the records of the points left, byte for byte but their classification (taken from the
+// column) and the header's counts and bounds; columns the record has no field for (a
+// new one such as height_above_ground) go to PLY and XYZ outputs only.
 void translate_points(const std::string& input, const std::string& output,
-                      const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+                      const PointEdit& edit = {});
 
 }  // namespace vola::io

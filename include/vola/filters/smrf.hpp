@@ -1,0 +1,58 @@
+// Ground classification by the Simple Morphological Filter (SMRF: Pingel, Clarke and
+// McBride, "An improved simple morphological filter for the terrain classification of
+// airborne LIDAR data", ISPRS J. Photogramm. 77, 2013), written from the paper:
+//
+//  1. the minimum surface: the lowest candidate point of each cell (cell size `cell`);
+//  2. low outliers: cells whose minimum is a pit far below its neighbours (the same
+//     progressive opening run on the negated surface, window kLowOutlierWindow, slope
+//     kLowOutlierSlope) are emptied, so that a stray point below the ground cannot drag
+//     the surface down;
+//  3. empty cells filled (inpainting: a push-pull pyramid, then Laplace smoothing);
+//  4. progressive morphological opening with a disk of radius 1, 2, ... up to
+//     window / cell cells: a cell is an object when one opening lowers it by more than
+//     slope x radius x cell;
+//  5. the provisional ground surface: the minimum surface without empty, outlier and
+//     object cells, filled again; its slope (gradient magnitude) per cell;
+//  6. a point is ground when |z - surface(x, y)| <= threshold + scalar x slope, with the
+//     surface interpolated bilinearly at the point.
+//
+// As PDAL's filters.smrf does by default, only last returns (and single ones) can be
+// ground, and points classified noise (7 low, 18 high) are left out of the surface and
+// never ground. Parameters are metres whatever the data's units (Units converts).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "vola/builder.hpp"
+#include "vola/filters/units.hpp"
+
+namespace vola::filters {
+
+struct SmrfOptions {
+  double cell = 1.0;        // metres
+  double slope = 0.15;      // rise over run
+  double window = 18.0;     // metres: the largest opening's radius
+  double threshold = 0.5;   // metres
+  double scalar = 1.25;     // metres per unit of slope
+  bool last_returns_only = true;
+  // Throws OptionError naming the member out of range.
+  void check() const;
+};
+
+// The low-outlier pass's window (metres) and slope: pits deeper than 5 m per metre of
+// radius within 5 m are not terrain (real ditches and banks are far gentler).
+inline constexpr double kLowOutlierWindow = 5.0;
+inline constexpr double kLowOutlierSlope = 5.0;
+
+// Ground flags for points xyz (x y z triples); candidate[i] false leaves point i out of
+// the surface and not ground. Throws InvalidArgument when the grid would pass 2^28 cells
+// (a larger cell or a crop first).
+std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<bool>& candidate,
+                              const SmrfOptions& options, const Units& units);
+
+// On a cloud: classification 2 on ground points, 1 on the others (the column is added
+// when missing), noise (7, 18) kept. Returns the number of ground points.
+std::size_t classify_ground(PointCloud& cloud, const SmrfOptions& options, const Units& units);
+
+}  // namespace vola::filters

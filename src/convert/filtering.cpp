@@ -1,0 +1,82 @@
+#include "filtering.hpp"
+
+#include <algorithm>
+
+#include "vola/error.hpp"
+#include "vola/filters/dimensions.hpp"
+#include "vola/filters/stages.hpp"
+#include "vola/io/translate.hpp"
+
+namespace vola::convert_detail {
+
+namespace {
+
+// LAS record fields vola convert does not keep per voxel (io::las_attributes).
+bool dropped_las_field(const std::string& name) {
+  return name == "return_number" || name == "user_data" || name == "point_source_id" || name == "gps_time";
+}
+
+// The table of every LAS field (Reduction::last) as the columns io::las_attributes
+// lists, in its order and with its types and reductions, then the filters' own columns.
+PointCloud las_voxel_columns(PointCloud&& table) {
+  PointCloud cloud;
+  cloud.xyz = std::move(table.xyz);
+  std::vector<PointAttribute> columns = std::move(table.attributes);
+  const auto take = [&](const std::string& name, ValueType type, Reduction reduction) {
+    const auto it = std::find_if(columns.begin(), columns.end(), [&](const PointAttribute& a) { return a.name == name; });
+    if (it == columns.end()) return false;
+    cloud.attributes.push_back({name, type, reduction, std::move(it->values)});
+    columns.erase(it);
+    return true;
+  };
+  if (std::any_of(columns.begin(), columns.end(), [](const PointAttribute& a) { return a.name == "red"; })) {
+    take("red", ValueType::u16, Reduction::mean);
+    take("green", ValueType::u16, Reduction::mean);
+    take("blue", ValueType::u16, Reduction::mean);
+  }
+  take("intensity", ValueType::u16, Reduction::mean);
+  take("classification", ValueType::u8, Reduction::majority);
+  if (!take("height", ValueType::f32, Reduction::mean)) {  // an extra-bytes "height" is the height
+    std::vector<double> z(cloud.size());
+    for (std::size_t i = 0; i < z.size(); ++i) z[i] = cloud.xyz[3 * i + 2];
+    cloud.attributes.push_back({"height", ValueType::f32, Reduction::mean, std::move(z)});
+  }
+  take("number_of_returns", ValueType::u8, Reduction::max);
+  for (auto& column : columns) {
+    if (dropped_las_field(column.name)) continue;
+    column.type = ValueType::f64;
+    column.reduction = Reduction::mean;
+    cloud.attributes.push_back(std::move(column));
+  }
+  return cloud;
+}
+
+}  // namespace
+
+std::string describe(const filters::StageReport& stage) {
+  std::string line = stage.spec + ": " + std::to_string(stage.points_in) + " -> " + std::to_string(stage.points_out) + " points";
+  if (stage.spec.rfind("smrf", 0) == 0) line += ", " + std::to_string(stage.ground) + " ground";
+  return line;
+}
+
+io::Input read_filtered(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
+                        const ConvertProgress& progress, std::vector<std::string>& report) {
+  const std::vector<filters::Stage> stages = filters::parse_stages(options.filters);
+  io::PointTable table;
+  try {
+    table = io::read_point_table(path, progress, format.name);
+  } catch (const InvalidArgument& e) {
+    throw OptionError("filters", std::string("apply to point input only: ") + e.what());
+  }
+  const filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
+  for (const auto& stage : result.stages) report.push_back(describe(stage));
+  io::Input input;
+  input.format = table.format;
+  input.epsg = table.epsg;
+  input.wkt = std::move(table.wkt);
+  input.cloud = table.format == "las" ? las_voxel_columns(std::move(table.cloud)) : std::move(table.cloud);
+  if (!options.attributes) input.cloud.attributes.clear();
+  return input;
+}
+
+}  // namespace vola::convert_detail

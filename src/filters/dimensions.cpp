@@ -1,0 +1,51 @@
+#include "vola/filters/dimensions.hpp"
+
+#include <cctype>
+
+namespace vola::filters {
+
+std::string dimension_key(const std::string& name) {
+  std::string key;
+  for (const char c : name)
+    if (c != '_') key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return key;
+}
+
+std::optional<Dimension> find_dimension(const PointCloud& cloud, const std::string& name) {
+  const std::string key = dimension_key(name);
+  for (std::size_t c = 0; c < cloud.attributes.size(); ++c)
+    if (dimension_key(cloud.attributes[c].name) == key) return Dimension{-1, c};
+  if (key == "x") return Dimension{0, 0};
+  if (key == "y") return Dimension{1, 0};
+  if (key == "z") return Dimension{2, 0};
+  return std::nullopt;
+}
+
+std::string dimension_list(const PointCloud& cloud) {
+  std::string list = "x, y, z";
+  for (const auto& a : cloud.attributes) list += ", " + a.name;
+  return list;
+}
+
+std::size_t ensure_column(PointCloud& cloud, const std::string& name, ValueType type, Reduction reduction) {
+  if (const auto d = find_dimension(cloud, name); d && d->axis < 0) return d->column;
+  cloud.attributes.push_back({name, type, reduction, std::vector<double>(cloud.size(), 0.0)});
+  return cloud.attributes.size() - 1;
+}
+
+void keep_points(PointCloud& cloud, const std::vector<bool>& keep) {
+  std::size_t out = 0;
+  const std::size_t n = cloud.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!keep[i]) continue;
+    for (int a = 0; a < 3; ++a) cloud.xyz[3 * out + a] = cloud.xyz[3 * i + a];
+    if (!cloud.payload.empty()) cloud.payload[out] = cloud.payload[i];
+    for (auto& column : cloud.attributes) column.values[out] = column.values[i];
+    ++out;
+  }
+  cloud.xyz.resize(3 * out);
+  if (!cloud.payload.empty()) cloud.payload.resize(out);
+  for (auto& column : cloud.attributes) column.values.resize(out);
+}
+
+}  // namespace vola::filters

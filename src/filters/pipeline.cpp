@@ -1,0 +1,261 @@
+#include "vola/filters/pipeline.hpp"
+
+#include <cctype>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "vola/error.hpp"
+#include "vola/filters/dimensions.hpp"
+#include "vola/filters/stages.hpp"
+
+namespace vola::filters {
+
+namespace {
+
+using nlohmann::json;
+
+std::string lower_extension(const std::string& path) {
+  const auto dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string number_text(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+// A stage's numeric option: a JSON number or a string holding one (PDAL takes both).
+double numeric(const json& value, const std::string& where) {
+  if (value.is_number()) return value.get<double>();
+  if (value.is_string()) {
+    const std::string text = value.get<std::string>();
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (!text.empty() && *end == '\0') return v;
+  }
+  throw InvalidArgument(where + " must be a number, not " + value.dump());
+}
+
+class StageReader {
+ public:
+  StageReader(const json& stage, std::size_t index) : stage_(stage) {
+    type_ = stage.value("type", "");
+    prefix_ = "pipeline stage " + std::to_string(index) + (type_.empty() ? "" : " (" + type_ + ")") + ": ";
+  }
+  const std::string& type() const { return type_; }
+  [[noreturn]] void fail(const std::string& what) const { throw InvalidArgument(prefix_ + what); }
+  bool has(const char* key) const { return stage_.contains(key); }
+  double number(const char* key) const {
+    try {
+      return numeric(stage_.at(key), std::string("\"") + key + "\"");
+    } catch (const InvalidArgument& e) {
+      fail(e.what());
+    }
+  }
+  std::string text(const char* key) const {
+    if (!stage_.contains(key) || !stage_.at(key).is_string()) fail(std::string("needs \"") + key + "\" as a string");
+    return stage_.at(key).get<std::string>();
+  }
+  // Every key must be one of `known` (and type, tag).
+  void only(std::initializer_list<const char*> known) const {
+    for (const auto& [key, value] : stage_.items()) {
+      if (key == "type" || key == "tag") continue;
+      bool ok = false;
+      std::string list;
+      for (const char* k : known) {
+        ok = ok || key == k;
+        list += std::string(list.empty() ? "" : ", ") + k;
+      }
+      if (!ok) fail("no option \"" + key + "\"" + (list.empty() ? " (it takes none)" : " (it takes " + list + ")"));
+    }
+  }
+  // The stage string of a filter, checked by parse_stage.
+  std::string filter() const {
+    std::string spec;
+    if (type_ == "filters.smrf") {
+      only({"cell", "slope", "window", "threshold", "scalar"});
+      spec = "smrf";
+      std::string params;
+      for (const char* key : {"cell", "slope", "window", "threshold", "scalar"})
+        if (has(key)) params += std::string(params.empty() ? "" : ",") + key + "=" + number_text(number(key));
+      if (!params.empty()) spec += ":" + params;
+    } else if (type_ == "filters.range") {
+      only({"limits"});
+      try {
+        spec = "where:" + range_expression(text("limits"));
+      } catch (const InvalidArgument& e) {
+        fail(e.what());
+      }
+    } else if (type_ == "filters.expression") {
+      only({"expression"});
+      spec = "where:" + text("expression");
+    } else if (type_ == "filters.hag_nn" || type_ == "filters.hag") {
+      only({"count"});
+      if (has("count") && number("count") != 1) fail("vola's height above ground uses the nearest ground point (count 1)");
+      spec = "hag";
+    } else if (type_ == "filters.outlier") {
+      only({"method", "mean_k", "multiplier"});
+      if (has("method") && text("method") != "statistical") fail("only the \"statistical\" method is implemented");
+      spec = "outlier";
+      std::string params;
+      if (has("mean_k")) params += "k=" + number_text(number("mean_k"));
+      if (has("multiplier")) params += std::string(params.empty() ? "" : ",") + "multiplier=" + number_text(number("multiplier"));
+      if (!params.empty()) spec += ":" + params;
+    } else if (type_ == "filters.crop") {
+      only({"bounds", "polygon"});
+      if (has("bounds") == has("polygon")) fail("give \"bounds\" or \"polygon\" (one of them)");
+      spec = has("bounds") ? crop_bounds(text("bounds")) : "polygon:" + text("polygon");
+    } else if (type_ == "filters.sample") {
+      only({"radius"});
+      spec = "poisson:" + number_text(number("radius"));
+    } else if (type_ == "filters.voxelcenternearestneighbor") {
+      only({"cell"});
+      spec = "voxel:" + number_text(number("cell"));
+    } else {
+      fail("unknown stage type (vola runs readers.*, filters.smrf, filters.range, filters.expression, filters.hag_nn, "
+           "filters.outlier, filters.crop, filters.sample, filters.voxelcenternearestneighbor, writers.las, writers.ply, "
+           "writers.text, writers.vola)");
+    }
+    try {
+      parse_stage(spec);
+    } catch (const Error& e) {
+      fail(e.what());
+    }
+    return spec;
+  }
+
+ private:
+  // PDAL's "([minx, maxx], [miny, maxy])" or with "[minz, maxz]".
+  std::string crop_bounds(const std::string& bounds) const {
+    std::vector<double> v;
+    std::string digits;
+    for (const char c : bounds + ",") {
+      if (std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E') {
+        digits += c;
+      } else if (!digits.empty()) {
+        v.push_back(numeric(json(digits), "a bound"));
+        digits.clear();
+      }
+    }
+    if (v.size() == 4) return "crop:" + number_text(v[0]) + "," + number_text(v[2]) + "," + number_text(v[1]) + "," + number_text(v[3]);
+    if (v.size() == 6)
+      return "crop:" + number_text(v[0]) + "," + number_text(v[2]) + "," + number_text(v[4]) + "," + number_text(v[1]) +
+             "," + number_text(v[3]) + "," + number_text(v[5]);
+    fail("\"bounds\" must be \"([minx, maxx], [miny, maxy])\" or with \"[minz, maxz]\"");
+  }
+  const json& stage_;
+  std::string type_, prefix_;
+};
+
+}  // namespace
+
+bool PipelineWriter::voxels() const { return lower_extension(filename) == ".vol"; }
+
+std::string range_expression(const std::string& limits) {
+  // Per dimension (in order of first appearance), its ranges joined by ||.
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;
+  std::size_t i = 0;
+  const auto fail = [&](const std::string& what) {
+    throw InvalidArgument("limits \"" + limits + "\": at character " + std::to_string(i + 1) + ": " + what);
+  };
+  while (i < limits.size()) {
+    while (i < limits.size() && (limits[i] == ',' || std::isspace(static_cast<unsigned char>(limits[i])))) ++i;
+    if (i >= limits.size()) break;
+    std::string name;
+    while (i < limits.size() && (std::isalnum(static_cast<unsigned char>(limits[i])) || limits[i] == '_')) name += limits[i++];
+    if (name.empty()) fail("expected a dimension name");
+    const bool negate = i < limits.size() && limits[i] == '!';
+    if (negate) ++i;
+    if (i >= limits.size() || (limits[i] != '[' && limits[i] != '(')) fail("expected [ or ( after " + name);
+    const bool open_low = limits[i++] == '(';
+    const auto colon = limits.find(':', i);
+    if (colon == std::string::npos) fail("expected MIN:MAX");
+    const auto close = limits.find_first_of("])", colon);
+    if (close == std::string::npos) fail("expected ] or )");
+    const std::string low = limits.substr(i, colon - i), high = limits.substr(colon + 1, close - colon - 1);
+    const bool open_high = limits[close] == ')';
+    std::string range;
+    const auto bound = [&](const std::string& text, const char* closed_op, const char* open_op, bool open) {
+      if (text.find_first_not_of(' ') == std::string::npos) return;
+      const double v = numeric(json(text), "a limit");
+      range += std::string(range.empty() ? "" : " && ") + name + " " + (open ? open_op : closed_op) + " " + number_text(v);
+    };
+    bound(low, ">=", ">", open_low);
+    bound(high, "<=", "<", open_high);
+    if (range.empty()) range = name + " == " + name;  // [:] : any value (NaN aside)
+    range = "(" + range + ")";
+    if (negate) range = "!" + range;
+    i = close + 1;
+    auto group = std::find_if(groups.begin(), groups.end(),
+                              [&](const auto& g) { return dimension_key(g.first) == dimension_key(name); });
+    if (group == groups.end()) groups.push_back({name, {range}});
+    else group->second.push_back(range);
+  }
+  if (groups.empty()) fail("no range");
+  std::string expression;
+  for (const auto& [name, ranges] : groups) {
+    std::string joined;
+    for (const auto& r : ranges) joined += (joined.empty() ? "" : " || ") + r;
+    expression += std::string(expression.empty() ? "" : " && ") + (ranges.size() > 1 ? "(" + joined + ")" : joined);
+  }
+  return expression;
+}
+
+Pipeline parse_pipeline(const std::string& text, const std::string& name) {
+  json document;
+  try {
+    document = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InvalidArgument(name + ": not JSON: " + e.what());
+  }
+  if (document.is_object() && document.contains("pipeline")) document = document["pipeline"];
+  if (!document.is_array() || document.empty())
+    throw InvalidArgument(name + ": a pipeline is a JSON array of stages (or {\"pipeline\": [...]})");
+  Pipeline pipeline;
+  for (std::size_t index = 0; index < document.size(); ++index) {
+    const json& element = document[index];
+    const std::string prefix = "pipeline stage " + std::to_string(index) + ": ";
+    if (element.is_string()) {
+      const std::string file = element.get<std::string>();
+      if (pipeline.input.empty() && index == 0) pipeline.input = file;
+      else pipeline.writers.push_back({file, {}});
+      continue;
+    }
+    if (!element.is_object()) throw InvalidArgument(prefix + "a stage is a file name or an object with \"type\"");
+    const StageReader stage(element, index);
+    const std::string& type = stage.type();
+    if (type.empty() && element.contains("filename")) {  // PDAL infers the kind from the position
+      if (index == 0) pipeline.input = stage.text("filename");
+      else pipeline.writers.push_back({stage.text("filename"), {}});
+    } else if (type.rfind("readers.", 0) == 0) {
+      if (index != 0) stage.fail("a reader must come first (vola pipelines read one input)");
+      stage.only({"filename"});
+      pipeline.input = stage.text("filename");
+    } else if (type.rfind("writers.", 0) == 0) {
+      PipelineWriter writer;
+      writer.filename = stage.text("filename");
+      if (type == "writers.vola" || writer.voxels()) {
+        stage.only({"filename", "voxel_size", "depth", "compress", "dense", "attributes"});
+        for (const auto& [key, value] : element.items())
+          if (key != "type" && key != "tag" && key != "filename") writer.options[key] = value.dump();
+      } else if (type == "writers.las" || type == "writers.ply" || type == "writers.text") {
+        stage.only({"filename"});
+      } else {
+        stage.fail("unknown writer (writers.las for .las/.laz, writers.ply, writers.text, writers.vola for .vol)");
+      }
+      pipeline.writers.push_back(std::move(writer));
+    } else {
+      if (!pipeline.writers.empty()) stage.fail("a filter after a writer (vola runs the filters, then every writer)");
+      pipeline.stages.push_back(stage.filter());
+    }
+  }
+  if (pipeline.input.empty()) throw InvalidArgument(name + ": the pipeline has no reader (a file name first)");
+  if (pipeline.writers.empty()) throw InvalidArgument(name + ": the pipeline has no writer (a file name last)");
+  return pipeline;
+}
+
+}  // namespace vola::filters

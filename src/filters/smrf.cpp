@@ -1,0 +1,152 @@
+#include "vola/filters/smrf.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "elevation_grid.hpp"
+#include "vola/error.hpp"
+#include "vola/filters/dimensions.hpp"
+
+namespace vola::filters {
+
+using detail::ElevationGrid;
+
+void SmrfOptions::check() const {
+  const auto positive = [](const char* name, double v) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw OptionError(name, "must be a positive number (metres), not " + std::to_string(v));
+  };
+  positive("cell", cell);
+  positive("window", window);
+  if (!(slope >= 0.0) || !std::isfinite(slope)) throw OptionError("slope", "must be 0 or more");
+  if (!(threshold >= 0.0) || !std::isfinite(threshold)) throw OptionError("threshold", "must be 0 or more");
+  if (!(scalar >= 0.0) || !std::isfinite(scalar)) throw OptionError("scalar", "must be 0 or more");
+}
+
+namespace {
+
+constexpr double kMaxCells = double(1u << 28);
+
+// Cells an opening lowers by more than slope x radius x cell, for radius 1..max_radius
+// (each opening of the previous surface: openings by growing disks, the progressive filter).
+std::vector<bool> progressive_objects(const ElevationGrid& surface, int max_radius, double slope) {
+  std::vector<bool> object(surface.cells(), false);
+  ElevationGrid previous = surface, opened;
+  for (int r = 1; r <= max_radius; ++r) {
+    detail::open_disk(previous, opened, r);
+    const double limit = slope * r * surface.cell;
+    for (std::size_t i = 0; i < surface.cells(); ++i)
+      if (previous.z[i] - opened.z[i] > limit) object[i] = true;
+    std::swap(previous, opened);
+  }
+  return object;
+}
+
+// Gradient magnitude (rise over run) of a filled grid, central differences inside.
+std::vector<float> slope_of(const ElevationGrid& g) {
+  std::vector<float> s(g.cells());
+  for (std::size_t j = 0; j < g.rows; ++j)
+    for (std::size_t i = 0; i < g.cols; ++i) {
+      const std::size_t il = i > 0 ? i - 1 : i, ir = i + 1 < g.cols ? i + 1 : i;
+      const std::size_t jl = j > 0 ? j - 1 : j, jr = j + 1 < g.rows ? j + 1 : j;
+      const double gx = ir > il ? (g.at(ir, j) - g.at(il, j)) / (static_cast<double>(ir - il) * g.cell) : 0.0;
+      const double gy = jr > jl ? (g.at(i, jr) - g.at(i, jl)) / (static_cast<double>(jr - jl) * g.cell) : 0.0;
+      s[j * g.cols + i] = static_cast<float>(std::sqrt(gx * gx + gy * gy));
+    }
+  return s;
+}
+
+}  // namespace
+
+std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<bool>& candidate,
+                              const SmrfOptions& options, const Units& units) {
+  options.check();
+  const std::size_t n = xyz.size() / 3;
+  std::vector<bool> ground(n, false);
+  // Everything below is in metres.
+  const double h = units.horizontal, v = units.vertical;
+  double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
+  std::size_t candidates = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!candidate[i] || !std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
+      continue;
+    minx = std::min(minx, xyz[3 * i] * h), maxx = std::max(maxx, xyz[3 * i] * h);
+    miny = std::min(miny, xyz[3 * i + 1] * h), maxy = std::max(maxy, xyz[3 * i + 1] * h);
+    ++candidates;
+  }
+  if (candidates == 0) return ground;
+  const double c = options.cell;
+  const double cols_d = std::floor((maxx - minx) / c) + 1, rows_d = std::floor((maxy - miny) / c) + 1;
+  if (cols_d * rows_d > kMaxCells)
+    throw InvalidArgument("smrf: a grid of " + std::to_string(cols_d) + " x " + std::to_string(rows_d) +
+                          " cells of " + std::to_string(c) + " m is too large; give a larger cell or crop first");
+  ElevationGrid zmin(static_cast<std::size_t>(cols_d), static_cast<std::size_t>(rows_d), minx, miny, c);
+  const auto cell_of = [&](std::size_t i) {
+    const auto col = std::min(zmin.cols - 1, static_cast<std::size_t>((xyz[3 * i] * h - minx) / c));
+    const auto row = std::min(zmin.rows - 1, static_cast<std::size_t>((xyz[3 * i + 1] * h - miny) / c));
+    return row * zmin.cols + col;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!candidate[i] || !std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
+      continue;
+    float& cell = zmin.z[cell_of(i)];
+    const auto z = static_cast<float>(xyz[3 * i + 2] * v);
+    if (std::isnan(cell) || z < cell) cell = z;
+  }
+
+  // Low outliers: pits of the minimum surface, found as peaks of its negation.
+  ElevationGrid negated = zmin;
+  for (float& z : negated.z) z = -z;
+  detail::inpaint(negated);
+  const int low_radius = std::max(1, static_cast<int>(std::ceil(kLowOutlierWindow / c)));
+  const std::vector<bool> pit = progressive_objects(negated, low_radius, kLowOutlierSlope);
+  for (std::size_t k = 0; k < zmin.cells(); ++k)
+    if (pit[k]) zmin.z[k] = NAN;
+
+  ElevationGrid filled = zmin;
+  detail::inpaint(filled);
+  const int max_radius = std::max(1, static_cast<int>(std::ceil(options.window / c)));
+  const std::vector<bool> object = progressive_objects(filled, max_radius, options.slope);
+
+  ElevationGrid surface = zmin;
+  for (std::size_t k = 0; k < surface.cells(); ++k)
+    if (object[k]) surface.z[k] = NAN;
+  detail::inpaint(surface);
+  const std::vector<float> slope = slope_of(surface);
+
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!candidate[i] || !std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
+      continue;
+    const double ground_z = detail::interpolate(surface, xyz[3 * i] * h, xyz[3 * i + 1] * h);
+    const double limit = options.threshold + options.scalar * slope[cell_of(i)];
+    ground[i] = std::abs(xyz[3 * i + 2] * v - ground_z) <= limit;
+  }
+  return ground;
+}
+
+std::size_t classify_ground(PointCloud& cloud, const SmrfOptions& options, const Units& units) {
+  const std::size_t n = cloud.size();
+  const std::size_t cls = ensure_column(cloud, "classification", ValueType::u8, Reduction::majority);
+  const auto returns = find_dimension(cloud, "return_number");
+  const auto count = find_dimension(cloud, "number_of_returns");
+  std::vector<bool> candidate(n, true);
+  const auto& classes = cloud.attributes[cls].values;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (classes[i] == 7 || classes[i] == 18) candidate[i] = false;
+    // Last or only returns (files without return numbers, or with 0, count as single).
+    if (options.last_returns_only && returns && count && returns->axis < 0 && count->axis < 0) {
+      const double r = value_of(cloud, *returns, i), m = value_of(cloud, *count, i);
+      if (m > 0 && r < m) candidate[i] = false;
+    }
+  }
+  const std::vector<bool> ground = smrf_ground(cloud.xyz, candidate, options, units);
+  auto& values = cloud.attributes[cls].values;
+  std::size_t found = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (values[i] == 7 || values[i] == 18) continue;
+    values[i] = ground[i] ? 2.0 : 1.0;
+    found += ground[i];
+  }
+  return found;
+}
+
+}  // namespace vola::filters

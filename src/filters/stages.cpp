@@ -1,0 +1,178 @@
+#include "vola/filters/stages.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <numeric>
+
+#include "vola/error.hpp"
+#include "vola/filters/dimensions.hpp"
+
+namespace vola::filters {
+
+namespace {
+
+[[noreturn]] void refuse(const std::string& spec, const std::string& cause) {
+  throw OptionError("filters", "'" + spec + "': " + cause);
+}
+
+double number(const std::string& spec, const std::string& text) {
+  double v = 0.0;
+  const char* end = text.data() + text.size();
+  const auto r = std::from_chars(text.data(), end, v);
+  if (r.ec != std::errc() || r.ptr != end || !std::isfinite(v)) refuse(spec, "'" + text + "' is not a number");
+  return v;
+}
+
+std::vector<std::string> split(const std::string& text, char by) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    const auto at = text.find(by, start);
+    parts.push_back(text.substr(start, at - start));
+    if (at == std::string::npos) return parts;
+    start = at + 1;
+  }
+}
+
+// "name=value,name=value" into the named members.
+template <class Set>
+void parameters(const std::string& spec, const std::string& args, Set&& set) {
+  if (args.empty()) return;
+  for (const auto& item : split(args, ',')) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos) refuse(spec, "'" + item + "' is not NAME=VALUE");
+    set(item.substr(0, eq), number(spec, item.substr(eq + 1)));
+  }
+}
+
+}  // namespace
+
+Stage parse_stage(const std::string& spec) {
+  Stage s;
+  s.spec = spec;
+  const auto colon = spec.find(':');
+  const std::string name = dimension_key(spec.substr(0, colon));
+  const std::string args = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  try {
+    if (name == "where") {
+      s.kind = Stage::Kind::where;
+      s.expression.emplace(args);
+    } else if (name == "smrf") {
+      s.kind = Stage::Kind::smrf;
+      parameters(spec, args, [&](const std::string& key, double v) {
+        if (key == "cell") s.smrf.cell = v;
+        else if (key == "slope") s.smrf.slope = v;
+        else if (key == "window") s.smrf.window = v;
+        else if (key == "threshold") s.smrf.threshold = v;
+        else if (key == "scalar") s.smrf.scalar = v;
+        else refuse(spec, "smrf has no parameter '" + key + "' (cell, slope, window, threshold, scalar)");
+      });
+      s.smrf.check();
+    } else if (name == "hag") {
+      s.kind = Stage::Kind::hag;
+      if (!args.empty()) refuse(spec, "hag takes no parameters");
+    } else if (name == "outlier") {
+      s.kind = Stage::Kind::outlier;
+      parameters(spec, args, [&](const std::string& key, double v) {
+        if (key == "k" || key == "mean_k") s.outlier.neighbours = static_cast<int>(v);
+        else if (key == "multiplier") s.outlier.multiplier = v;
+        else refuse(spec, "outlier has no parameter '" + key + "' (k, multiplier)");
+      });
+      s.outlier.check();
+    } else if (name == "voxel" || name == "poisson") {
+      s.kind = name == "voxel" ? Stage::Kind::voxel : Stage::Kind::poisson;
+      if (args.empty()) refuse(spec, name + " needs a size: " + name + ":R");
+      s.size = number(spec, args);
+      if (!(s.size > 0)) refuse(spec, "the size must be positive");
+    } else if (name == "crop") {
+      s.kind = Stage::Kind::crop;
+      const auto parts = split(args, ',');
+      std::vector<double> v;
+      for (const auto& p : parts) v.push_back(number(spec, p));
+      if (v.size() == 4) s.box = {v[0], v[1], v[2], v[3], std::nullopt, std::nullopt};
+      else if (v.size() == 6) s.box = {v[0], v[1], v[3], v[4], v[2], v[5]};
+      else refuse(spec, "crop takes MINX,MINY,MAXX,MAXY or MINX,MINY,MINZ,MAXX,MAXY,MAXZ");
+      if (s.box.min_x > s.box.max_x || s.box.min_y > s.box.max_y || (s.box.min_z && *s.box.min_z > *s.box.max_z))
+        refuse(spec, "a minimum is above its maximum");
+    } else if (name == "polygon" || name == "croppolygon") {
+      s.kind = Stage::Kind::polygon;
+      if (args.empty()) refuse(spec, "polygon needs a file: polygon:FILE (GeoJSON or WKT), or the WKT itself");
+      std::string head = args.substr(0, 12);
+      for (char& ch : head) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      const bool inline_text = args[0] == '{' || head.rfind("POLYGON", 0) == 0 || head.rfind("MULTIPOLYGON", 0) == 0;
+      s.polygons = inline_text ? parse_polygons(args, "polygon") : read_polygons(args);
+    } else {
+      refuse(spec, "no filter '" + spec.substr(0, colon) +
+                       "' (where:EXPR, smrf, hag, outlier, voxel:R, poisson:R, crop:..., polygon:FILE)");
+    }
+  } catch (const OptionError&) {
+    throw;
+  } catch (const Error& e) {
+    refuse(spec, e.what());
+  }
+  return s;
+}
+
+std::vector<Stage> parse_stages(const std::vector<std::string>& specs) {
+  std::vector<Stage> stages;
+  for (const auto& spec : specs) stages.push_back(parse_stage(spec));
+  return stages;
+}
+
+std::vector<bool> per_point_mask(const std::vector<Stage>& stages, const PointCloud& cloud) {
+  std::vector<bool> keep(cloud.size(), true);
+  for (const Stage& s : stages) {
+    std::vector<bool> mask;
+    switch (s.kind) {
+      case Stage::Kind::where: mask = s.expression->evaluate(cloud); break;
+      case Stage::Kind::crop: mask = inside_box(cloud.xyz, s.box); break;
+      case Stage::Kind::polygon: mask = inside_polygons(cloud.xyz, s.polygons); break;
+      default: throw InvalidArgument("filter '" + s.spec + "' needs all the points at once");
+    }
+    for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = keep[i] && mask[i];
+  }
+  return keep;
+}
+
+FilterResult run_stages(const std::vector<Stage>& stages, PointCloud& cloud, const std::optional<std::uint32_t>& epsg,
+                        const std::string& wkt, std::uint64_t first_index) {
+  FilterResult result;
+  result.kept.resize(cloud.size());
+  std::iota(result.kept.begin(), result.kept.end(), first_index);
+  std::optional<Units> units;
+  for (const Stage& s : stages) {
+    StageReport report{s.spec, cloud.size(), 0, 0};
+    std::vector<bool> keep;
+    switch (s.kind) {
+      case Stage::Kind::where:
+      case Stage::Kind::crop:
+      case Stage::Kind::polygon: keep = per_point_mask({s}, cloud); break;
+      case Stage::Kind::smrf:
+        if (!units) units = units_of_crs(epsg, wkt);
+        report.ground = classify_ground(cloud, s.smrf, *units);
+        break;
+      case Stage::Kind::hag: add_height_above_ground(cloud); break;
+      case Stage::Kind::outlier: {
+        keep = statistical_outliers(cloud.xyz, s.outlier);
+        keep.flip();
+        break;
+      }
+      case Stage::Kind::voxel: keep = voxel_decimation(cloud.xyz, s.size); break;
+      case Stage::Kind::poisson: keep = poisson_decimation(cloud.xyz, s.size); break;
+    }
+    if (!keep.empty()) {
+      keep_points(cloud, keep);
+      std::size_t out = 0;
+      for (std::size_t i = 0; i < keep.size(); ++i)
+        if (keep[i]) result.kept[out++] = result.kept[i];
+      result.kept.resize(out);
+    }
+    report.points_out = cloud.size();
+    result.stages.push_back(report);
+  }
+  return result;
+}
+
+}  // namespace vola::filters

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Point filters end to end through the CLI on the Autzen survey:
+#  - translate --filter smrf writes classes 1 and 2 only, as many ground points as it
+#    reports, and every other byte of every record as it was;
+#  - convert --where gives the bytes of converting the points translate --where kept;
+#  - a JSON pipeline gives the files of the same flags;
+#  - unknown dimensions and filters fail with a message that names them.
+# Usage: cli_filters.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
+set -euo pipefail
+vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
+data=${data:-$2}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+autzen=$data/las/pdal_autzen_trim.las
+[ -f "$autzen" ] || skip "no $autzen (set VOLA_SHARED)"
+
+# translate --filter smrf: classes, counts, and the records but their class bits.
+"$vola" translate "$autzen" "$tmp/smrf.las" --filter smrf > "$tmp/smrf.txt"
+ground=$(sed -n 's/.*smrf: 110000 -> 110000 points, \([0-9]*\) ground/\1/p' "$tmp/smrf.txt")
+[ -n "$ground" ] || fail "translate did not report the ground count: $(cat "$tmp/smrf.txt")"
+"$vola" info "$tmp/smrf.las" --summary > "$tmp/info.txt"
+grep -Eq "^class: +2 Ground +$ground$" "$tmp/info.txt" || fail "info does not count $ground ground points: $(grep class "$tmp/info.txt")"
+others=$(awk '/^class:/ && $2 != 1 && $2 != 2 {print}' "$tmp/info.txt")
+[ -z "$others" ] || fail "classes other than 1 and 2 after smrf: $others"
+python3 - "$autzen" "$tmp/smrf.las" <<'PY' || fail "records differ beyond the classification"
+import struct, sys
+a, b = (open(p, "rb").read() for p in sys.argv[1:3])
+oa, ob = struct.unpack_from("<I", a, 96)[0], struct.unpack_from("<I", b, 96)[0]
+n, length = struct.unpack_from("<I", a, 107)[0], struct.unpack_from("<H", a, 105)[0]
+assert struct.unpack_from("<I", b, 107)[0] == n
+for i in range(n):
+    ra, rb = bytearray(a[oa + i * length:oa + (i + 1) * length]), bytearray(b[ob + i * length:ob + (i + 1) * length])
+    assert rb[15] & 31 in (1, 2), i
+    ra[15] &= 0xE0; rb[15] &= 0xE0
+    assert ra == rb, i
+PY
+# The same to LAZ: the same records once decoded.
+"$vola" translate "$autzen" "$tmp/smrf.laz" --filter smrf -q
+"$vola" translate "$tmp/smrf.laz" "$tmp/smrf_back.las" -q
+python3 - "$tmp/smrf.las" "$tmp/smrf_back.las" <<'PY' || fail "LAZ output decodes to other records"
+import struct, sys
+a, b = (open(p, "rb").read() for p in sys.argv[1:3])
+oa, ob = struct.unpack_from("<I", a, 96)[0], struct.unpack_from("<I", b, 96)[0]
+assert a[oa:] == b[ob:ob + len(a) - oa]
+PY
+
+# convert --where equals converting the points translate --where kept.
+where="Classification == 2 && Z < 450"
+"$vola" translate "$autzen" "$tmp/kept.las" --where "$where" -q
+"$vola" convert "$tmp/kept.las" "$tmp/kept.vol" --voxel-size 3 -q
+"$vola" convert "$autzen" "$tmp/where.vol" --voxel-size 3 --where "$where" -q
+cmp "$tmp/kept.vol" "$tmp/where.vol" || fail "convert --where differs from converting the kept points"
+"$vola" info "$tmp/kept.las" --summary | grep -Eq "^class: +2 Ground" || fail "no ground left by --where"
+
+# A pipeline gives the files of the same flags.
+cat > "$tmp/p.json" <<JSON
+["$autzen", {"type": "filters.smrf"}, {"type": "filters.range", "limits": "Classification[2:2]"},
+ "$tmp/pipe.las", {"type": "writers.vola", "filename": "$tmp/pipe.vol", "voxel_size": 3}]
+JSON
+"$vola" pipeline "$tmp/p.json" -q
+"$vola" translate "$autzen" "$tmp/flags.las" --filter smrf --where "Classification == 2" -q
+"$vola" convert "$autzen" "$tmp/flags.vol" --voxel-size 3 --filter smrf --where "Classification == 2" -q
+cmp "$tmp/pipe.las" "$tmp/flags.las" || fail "pipeline LAS differs from the flags'"
+cmp "$tmp/pipe.vol" "$tmp/flags.vol" || fail "pipeline .vol differs from the flags'"
+
+# Height above ground as a dimension for --where, to PLY.
+"$vola" translate "$autzen" "$tmp/high.xyz" --filter smrf --filter hag --where "HeightAboveGround > 2" -q
+head -1 "$tmp/high.xyz" | grep -q "height_above_ground" || fail "no height_above_ground column"
+awk 'NR > 1 && $NF <= 2 {bad = 1} END {exit bad}' "$tmp/high.xyz" || fail "a point at 2 or less above ground passed"
+
+# Errors name what is wrong.
+if "$vola" convert "$autzen" "$tmp/x.vol" --voxel-size 3 --where "Clasification == 2" 2> "$tmp/err.txt"; then fail "a misspelt dimension was accepted"; fi
+grep -q "no dimension 'Clasification'" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+if "$vola" translate "$autzen" "$tmp/x.las" --filter ground 2> "$tmp/err.txt"; then fail "an unknown filter was accepted"; fi
+grep -q "no filter 'ground'" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+echo '["a.las", {"type": "filters.smrf", "cells": 2}, "b.las"]' > "$tmp/bad.json"
+if "$vola" pipeline "$tmp/bad.json" 2> "$tmp/err.txt"; then fail "a misspelt stage option was accepted"; fi
+grep -q 'pipeline stage 1 (filters.smrf): no option "cells"' "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

@@ -1,0 +1,280 @@
+// Each filter on small synthetic clouds against a slow reference written here: k nearest
+// neighbours and outliers by O(n^2) distances, decimation by its invariants, crops by
+// direct tests, height above ground by a scan of every ground point, SMRF on a scene
+// whose ground is known.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <map>
+#include <random>
+
+#include "vola/error.hpp"
+#include "vola/filters/crop.hpp"
+#include "vola/filters/dimensions.hpp"
+#include "vola/filters/kd_tree.hpp"
+#include "vola/filters/neighbours.hpp"
+#include "vola/filters/smrf.hpp"
+#include "vola/filters/stages.hpp"
+
+namespace {
+
+using namespace vola::filters;
+
+std::vector<double> random_points(std::size_t n, std::uint64_t seed, double extent = 50.0) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, extent);
+  std::vector<double> xyz(3 * n);
+  for (double& v : xyz) v = u(rng);
+  // Some exact duplicates and points on a lattice: ties the tree must break by index.
+  for (std::size_t i = 0; i + 1 < n / 10; ++i)
+    for (int a = 0; a < 3; ++a) xyz[3 * (n - 1 - i) + a] = std::round(xyz[3 * i + a]);
+  return xyz;
+}
+
+double distance2(const std::vector<double>& xyz, std::size_t i, const double* q, int dims) {
+  double d2 = 0.0;
+  for (int a = 0; a < dims; ++a) d2 += (xyz[3 * i + a] - q[a]) * (xyz[3 * i + a] - q[a]);
+  return d2;
+}
+
+TEST(KdTree, NearestEqualsBruteForceIn2dAnd3d) {
+  const auto xyz = random_points(2000, 1);
+  const KdTree<3> tree3(xyz, 3);
+  const KdTree<2> tree2(xyz, 3);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-5.0, 55.0);
+  for (int q = 0; q < 200; ++q) {
+    const double p[3] = {u(rng), u(rng), u(rng)};
+    for (int dims : {2, 3}) {
+      std::vector<std::pair<double, std::uint32_t>> all;
+      for (std::size_t i = 0; i < xyz.size() / 3; ++i)
+        all.push_back({distance2(xyz, i, p, dims), static_cast<std::uint32_t>(i)});
+      std::sort(all.begin(), all.end());
+      for (std::size_t k : {1u, 8u, 9u}) {
+        const auto got = dims == 3 ? tree3.nearest({p[0], p[1], p[2]}, k) : tree2.nearest({p[0], p[1]}, k);
+        ASSERT_EQ(got.size(), k);
+        for (std::size_t j = 0; j < k; ++j) ASSERT_EQ(got[j], all[j]) << "query " << q << " dims " << dims << " k " << k;
+      }
+    }
+  }
+}
+
+TEST(Outliers, EqualBruteForceStatistics) {
+  auto xyz = random_points(800, 3, 20.0);
+  for (int far = 0; far < 6; ++far)  // a few points far from everything
+    for (int a = 0; a < 3; ++a) xyz.push_back(200.0 + 37.0 * far + a);
+  const std::size_t n = xyz.size() / 3;
+  std::vector<double> mean(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<double> d;
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != i) d.push_back(std::sqrt(distance2(xyz, j, &xyz[3 * i], 3)));
+    std::sort(d.begin(), d.end());
+    mean[i] = std::accumulate(d.begin(), d.begin() + 8, 0.0) / 8.0;
+  }
+  const double average = std::accumulate(mean.begin(), mean.end(), 0.0) / static_cast<double>(n);
+  double squares = 0.0;
+  for (double m : mean) squares += (m - average) * (m - average);
+  const double limit = average + 2.0 * std::sqrt(squares / static_cast<double>(n));
+  const std::vector<bool> got = statistical_outliers(xyz, OutlierOptions{});
+  std::size_t outliers = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(got[i], mean[i] > limit) << i;
+    outliers += got[i];
+  }
+  EXPECT_GE(outliers, 6u);  // the far points at least
+  for (std::size_t i = n - 6; i < n; ++i) EXPECT_TRUE(got[i]);
+}
+
+TEST(Decimation, VoxelKeepsTheNearestToEachCentreOncePerCube) {
+  const auto xyz = random_points(3000, 4, 10.0);
+  const double size = 1.5;
+  const std::vector<bool> keep = voxel_decimation(xyz, size);
+  const std::size_t n = xyz.size() / 3;
+  double lo[3] = {INFINITY, INFINITY, INFINITY};
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], xyz[3 * i + a]);
+  // Brute force: per cube, the first point at the smallest distance to its centre.
+  std::map<std::array<long, 3>, std::pair<double, std::size_t>> best;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::array<long, 3> c{};
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      c[a] = static_cast<long>(std::floor((xyz[3 * i + a] - lo[a]) / size));
+      const double centre = lo[a] + (static_cast<double>(c[a]) + 0.5) * size;
+      d2 += (xyz[3 * i + a] - centre) * (xyz[3 * i + a] - centre);
+    }
+    auto [it, added] = best.try_emplace(c, d2, i);
+    if (!added && d2 < it->second.first - 1e-12) it->second = {d2, i};
+  }
+  std::vector<bool> expected(n, false);
+  for (const auto& [c, chosen] : best) expected[chosen.second] = true;
+  EXPECT_EQ(keep, expected);
+  EXPECT_LT(std::count(keep.begin(), keep.end(), true), static_cast<long>(n));
+}
+
+TEST(Decimation, PoissonKeepsNoTwoCloseAndCoversEveryDroppedPoint) {
+  const auto xyz = random_points(3000, 5, 10.0);
+  const double r = 0.8;
+  const std::vector<bool> keep = poisson_decimation(xyz, r);
+  const std::size_t n = xyz.size() / 3;
+  for (std::size_t i = 0; i < n; ++i) {
+    // A dropped point has a kept point before it within r; kept points are r apart.
+    bool covered = false;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i || !keep[j]) continue;
+      const double d2 = distance2(xyz, j, &xyz[3 * i], 3);
+      if (keep[i]) ASSERT_GE(d2, r * r) << i << " and " << j;
+      else if (j < i && d2 < r * r) covered = true;
+    }
+    if (!keep[i]) {
+      ASSERT_TRUE(covered) << i;
+    }
+  }
+  EXPECT_TRUE(keep[0]);
+}
+
+TEST(Crop, BoxAndPolygonsWithHolesAgainstDirectTests) {
+  const auto xyz = random_points(2000, 6, 10.0);
+  CropBox box{2, 3, 7, 8, std::nullopt, std::nullopt};
+  const auto in2 = inside_box(xyz, box);
+  box.min_z = 1;
+  box.max_z = 4;
+  const auto in3 = inside_box(xyz, box);
+  // A square 1..9 with a square hole 4..6, as WKT and as GeoJSON.
+  const PolygonSet wkt = parse_polygons("POLYGON ((1 1, 9 1, 9 9, 1 9, 1 1), (4 4, 6 4, 6 6, 4 6, 4 4))", "wkt");
+  const PolygonSet json = parse_polygons(
+      R"({"type":"Feature","geometry":{"type":"MultiPolygon","coordinates":[[[[1,1],[9,1],[9,9],[1,9],[1,1]],[[4,4],[6,4],[6,6],[4,6],[4,4]]]]}})",
+      "json");
+  const auto in_wkt = inside_polygons(xyz, wkt), in_json = inside_polygons(xyz, json);
+  std::size_t counts[4] = {};
+  for (std::size_t i = 0; i < xyz.size() / 3; ++i) {
+    const double x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+    const bool b2 = x >= 2 && x <= 7 && y >= 3 && y <= 8;
+    ASSERT_EQ(in2[i], b2);
+    ASSERT_EQ(in3[i], b2 && z >= 1 && z <= 4);
+    const bool ring = x > 1 && x < 9 && y > 1 && y < 9 && !(x > 4 && x < 6 && y > 4 && y < 6);
+    const auto on_edge = [](double v) { return v == 1 || v == 4 || v == 6 || v == 9; };
+    if (on_edge(x) || on_edge(y)) continue;  // which side an edge point lies on is the test's own choice
+    ASSERT_EQ(in_wkt[i], ring) << x << " " << y;
+    ASSERT_EQ(in_json[i], ring);
+    counts[0] += b2, counts[1] += in3[i], counts[2] += ring, counts[3] += !ring;
+  }
+  for (auto c : counts) EXPECT_GT(c, 0u);
+  EXPECT_THROW(parse_polygons("LINESTRING (0 0, 1 1)", "line"), vola::InvalidArgument);
+  EXPECT_THROW(parse_polygons(R"({"type":"Point","coordinates":[1,2]})", "point"), vola::InvalidArgument);
+}
+
+TEST(HeightAboveGround, EqualsZMinusTheNearestGroundPointByBruteForce) {
+  vola::PointCloud cloud;
+  cloud.xyz = random_points(1500, 7, 30.0);
+  cloud.attributes.push_back({"classification", vola::ValueType::u8, vola::Reduction::majority, {}});
+  for (std::size_t i = 0; i < cloud.size(); ++i) cloud.attributes[0].values.push_back(i % 4 == 0 ? 2 : 1);
+  add_height_above_ground(cloud);
+  const auto hag = find_dimension(cloud, "HeightAboveGround");
+  ASSERT_TRUE(hag && hag->axis < 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    double best = INFINITY;
+    std::size_t nearest = 0;
+    for (std::size_t j = 0; j < cloud.size(); j += 4) {
+      const double d2 = distance2(cloud.xyz, j, &cloud.xyz[3 * i], 2);
+      if (d2 < best) best = d2, nearest = j;
+    }
+    ASSERT_EQ(value_of(cloud, *hag, i), cloud.xyz[3 * i + 2] - cloud.xyz[3 * nearest + 2]) << i;
+  }
+  vola::PointCloud no_ground;
+  no_ground.xyz = {0, 0, 0};
+  EXPECT_THROW(add_height_above_ground(no_ground), vola::InvalidArgument);
+}
+
+// A sloping field (5%) with a low outlier, a 20 x 30 m building 8 m high and a few
+// trees, 2 points per square metre with 5 cm noise: SMRF finds the field and not the
+// roof, tree tops or outlier.
+TEST(Smrf, SeparatesGroundFromABuildingTreesAndALowOutlier) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0.0, 100.0);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  vola::PointCloud cloud;
+  std::vector<int> truth;  // 2 ground, 6 building, 5 tree, 7 outlier
+  const auto ground_z = [](double x, double y) { return 100.0 + 0.05 * x + 0.02 * y; };
+  for (int i = 0; i < 20000; ++i) {
+    const double x = u(rng), y = u(rng);
+    double z = ground_z(x, y) + noise(rng);
+    int kind = 2;
+    if (x > 40 && x < 60 && y > 30 && y < 60) z += 8.0, kind = 6;
+    else if (std::hypot(x - 20, y - 80) < 3 && i % 2) z += 6.0 + noise(rng), kind = 5;
+    cloud.xyz.insert(cloud.xyz.end(), {x, y, z});
+    truth.push_back(kind);
+  }
+  cloud.xyz.insert(cloud.xyz.end(), {70.0, 70.0, ground_z(70, 70) - 30.0});
+  truth.push_back(7);
+  classify_ground(cloud, SmrfOptions{}, Units{});
+  const auto& cls = cloud.attributes[0].values;
+  std::size_t ground = 0, found = 0, wrong = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    ground += truth[i] == 2;
+    found += truth[i] == 2 && cls[i] == 2;
+    wrong += truth[i] != 2 && cls[i] == 2;
+  }
+  EXPECT_GE(static_cast<double>(found), 0.99 * static_cast<double>(ground));
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_EQ(cls.back(), 1.0);  // the outlier is not ground
+}
+
+// The same scene in US survey feet gives the same answer as in metres.
+TEST(Smrf, ParametersAreMetresWhateverTheUnits) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 60.0);
+  std::vector<double> metres;
+  for (int i = 0; i < 6000; ++i) {
+    const double x = u(rng), y = u(rng);
+    const bool roof = x > 20 && x < 35 && y > 20 && y < 40;
+    metres.insert(metres.end(), {x, y, 50.0 + 0.1 * x + (roof ? 3.0 : 0.0)});
+  }
+  const double foot = 1200.0 / 3937.0;
+  std::vector<double> feet = metres;
+  for (double& v : feet) v /= foot;
+  const std::vector<bool> all(metres.size() / 3, true);
+  const auto in_metres = smrf_ground(metres, all, SmrfOptions{}, Units{});
+  const auto in_feet = smrf_ground(feet, all, SmrfOptions{}, Units{foot, foot});
+  EXPECT_EQ(in_metres, in_feet);
+  EXPECT_GT(std::count(in_metres.begin(), in_metres.end(), false), 400);  // the roof, 3 m up (~500 points)
+  EXPECT_EQ(*metres_per_unit("US survey foot"), foot);
+}
+
+TEST(Stages, ParseTheirStringsAndRefuseUnknownOnes) {
+  EXPECT_EQ(parse_stage("smrf:cell=2,window=30").smrf.window, 30.0);
+  EXPECT_EQ(parse_stage("voxel:0.5").size, 0.5);
+  EXPECT_EQ(parse_stage("crop:1,2,3,4,5,6").box.max_x, 4.0);
+  EXPECT_EQ(parse_stage("outlier:k=12").outlier.neighbours, 12);
+  const auto message = [](const std::string& spec) {
+    try {
+      parse_stage(spec);
+    } catch (const vola::OptionError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message("ground"), "filters: 'ground': no filter 'ground' (where:EXPR, smrf, hag, outlier, voxel:R, "
+                               "poisson:R, crop:..., polygon:FILE)");
+  EXPECT_EQ(message("smrf:cells=2"), "filters: 'smrf:cells=2': smrf has no parameter 'cells' (cell, slope, window, threshold, scalar)");
+  EXPECT_EQ(message("where:z >"), "filters: 'where:z >': where: at character 4: expected a dimension name or a number, found the end");
+  EXPECT_EQ(message("crop:1,2,3"), "filters: 'crop:1,2,3': crop takes MINX,MINY,MAXX,MAXY or MINX,MINY,MINZ,MAXX,MAXY,MAXZ");
+}
+
+TEST(Stages, RunInOrderAndReportTheInputIndexOfEveryPointLeft) {
+  vola::PointCloud cloud;
+  for (int i = 0; i < 10; ++i) cloud.xyz.insert(cloud.xyz.end(), {double(i), 0.0, double(i % 3)});
+  cloud.attributes.push_back({"classification", vola::ValueType::u8, vola::Reduction::majority,
+                              {2, 1, 2, 1, 2, 1, 2, 1, 2, 1}});
+  const auto result = run_stages(parse_stages({"where:z > 0", "crop:2,-1,9,1", "where:Classification==2"}), cloud, {}, "");
+  EXPECT_EQ(result.kept, (std::vector<std::uint64_t>{2, 4, 8}));
+  EXPECT_EQ(cloud.xyz, (std::vector<double>{2, 0, 2, 4, 0, 1, 8, 0, 2}));
+  ASSERT_EQ(result.stages.size(), 3u);
+  EXPECT_EQ(result.stages[0].points_out, 6u);
+  EXPECT_EQ(result.stages[1].points_out, 5u);
+}
+
+}  // namespace
