@@ -19,12 +19,13 @@ las_path, png_path = sys.argv[1], sys.argv[2]
 # 1. Convert: any input `vola convert` reads. 2 m voxels on a grid in the survey's CRS.
 tree = vola.convert(las_path, voxel_size=2.0)
 print(tree)
-crs = tree.crs_wkt.split('"')[1] if tree.crs_wkt else "unknown"  # the WKT's name
-print(f"CRS {crs} (header EPSG:{tree.epsg}), origin {tree.origin}, {tree.side}^3 grid")
+crs = vola.describe_crs(tree.crs_wkt) if tree.crs_wkt else {"name": "unknown", "unit": "unit"}
+unit = {"metre": "m", "foot": "ft", "US survey foot": "ftUS"}.get(crs["unit"], crs["unit"])  # Autzen: feet
+print(f"CRS {crs['name']} ({crs['unit']}), origin {tree.origin}, {tree.side}^3 grid")
 
 # 2. Census: per-level blocks, volume, footprint and ASPRS classes.
 census = tree.census()
-print(f"voxels {census['voxels']}, volume {census['volume']:.0f} m^3, footprint {census['footprint_area']:.0f} m^2")
+print(f"voxels {census['voxels']}, volume {census['volume']:.0f} {unit}^3, footprint {census['footprint_area']:.0f} {unit}^2")
 for level, row in enumerate(census["levels"]):
     print(f"  level {level}: {row['blocks']:6d} blocks  {row['cells']:7d} cells  fill {row['fill']:.2f}")
 for attribute in census["attributes"]:
@@ -35,7 +36,7 @@ for attribute in census["attributes"]:
 voxels = tree.voxels()                           # (N, 3) uint32
 centres = tree.centers()                         # (N, 3) float64, CRS coordinates
 intensity = tree.attribute("intensity")          # read-only view, no copy
-print(f"mean intensity {intensity.mean():.1f}; highest voxel centre z = {centres[:, 2].max():.1f} m")
+print(f"mean intensity {intensity.mean():.1f}; highest voxel centre z = {centres[:, 2].max():.1f} {unit}")
 
 # 4. A horizontal slice through the middle of the occupied heights, as a dense image.
 z = int(np.median(voxels[:, 2]))
@@ -47,7 +48,7 @@ extent = (tree.origin[0], tree.origin[0] + image.shape[1] * tree.voxel_size,
           tree.origin[1], tree.origin[1] + image.shape[0] * tree.voxel_size)
 shown = axes.imshow(image, origin="lower", extent=extent, cmap="viridis", interpolation="nearest")
 figure.colorbar(shown, ax=axes, label="intensity (voxel mean)")
-axes.set_title(f"voxels at z = {tree.origin[2] + (z + 0.5) * tree.voxel_size:.1f} m ({in_slice.sum()} voxels)")
+axes.set_title(f"voxels at z = {tree.origin[2] + (z + 0.5) * tree.voxel_size:.1f} {unit} ({in_slice.sum()} voxels)")
 axes.set_xlabel("easting")
 axes.set_ylabel("northing")
 figure.tight_layout()

@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "open_voxels.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
@@ -86,12 +87,23 @@ std::string resolve_format(const ExportArgs& a) {
   return format;
 }
 
-void export_map(const ExportArgs& a, const Tree& tree, const std::string& format) {
+// The free voxels: a state map's own (vola map), else --free's plain tree, else none.
+std::optional<Tree> free_voxels(const ExportArgs& a) {
   std::optional<Tree> free;
-  if (!a.free.empty()) {
+  const Tree input = open_mapped(a.input);
+  if (map::is_state_map(input)) {
+    if (!a.free.empty())
+      throw InvalidArgument(a.input + " is a state map and holds its free voxels; --free is for plain trees");
+    free = map::free_tree(input);
+  } else if (!a.free.empty()) {
     free = open_mapped(a.free);
-    if (a.depth > 0 && a.depth < free->depth()) free = free->level_of_detail(a.depth);
   }
+  if (free && a.depth > 0 && a.depth < free->depth()) free = free->level_of_detail(a.depth);
+  return free;
+}
+
+void export_map(const ExportArgs& a, const Tree& tree, const std::string& format) {
+  const std::optional<Tree> free = free_voxels(a);
   const io::MapVoxels voxels = io::map_voxels(tree, free ? &*free : nullptr);
   const io::MapExportReport r = format == "vdb" ? io::write_vdb(voxels, a.output) : io::write_octomap(voxels, a.output);
   for (const auto& warning : r.warnings) std::fprintf(stderr, "vola: warning: %s\n", warning.c_str());  // even with -q
@@ -225,7 +237,7 @@ void add_export(CLI::App& app) {
       "             intensity  mean intensity of each voxel column's top voxel\n"
       "             density    occupied voxels per square unit; count: occupied voxels\n"
       "  .bt      OctoMap OcTree, binary (liboctomap): every voxel an occupied leaf of\n"
-      "           resolution = the voxel size (free leaves from --free FREE.vol), pruned\n"
+      "           resolution = the voxel size (free leaves: a state map's own, or --free), pruned\n"
       "  .ot      OctoMap OcTree with probabilities: log-odds from a log_odds column (as\n"
       "           vola map writes), else OctoMap's clamping values (0.971 / 0.1192)\n"
       "           OctoMap's cells are floor(x / R): a grid origin that is not a multiple of\n"
@@ -247,8 +259,8 @@ void add_export(CLI::App& app) {
       "  vola export autzen.vol dsm.tif --raster dsm\n"
       "  vola export autzen.vol dtm.tif --raster dtm --resolution 6\n"
       "  vola export city.vol obstacles.png --occupancy-above 3\n"
-      "  vola map scans.txt -o map.vol --voxel-size 0.2 --free\n"
-      "  vola export map.vol map.bt --free map.free.vol\n"
+      "  vola map scans.txt -o map.vol --voxel-size 0.2 && vola export map.vol map.ot   # occupied, free, log-odds\n"
+      "  vola export occupied.vol map.bt --free free.vol    # plain trees: free voxels from another file\n"
       "  vola export map.vol map.vdb");
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
@@ -271,7 +283,7 @@ void add_export(CLI::App& app) {
   cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
       ->check(CLI::PositiveNumber)
       ->each([args](const std::string&) { args->resolution_given = true; });
-  cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb): a .vol of the free voxels on the same grid (vola map --free)")
+  cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb) from a plain tree: a .vol of the free voxels on the same grid (a state map from vola map holds its own)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_export(*args); });

@@ -11,6 +11,7 @@
 #include "vola/builder.hpp"
 #include "vola/convert.hpp"
 #include "vola/filters/stages.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/file.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
@@ -180,6 +181,20 @@ Tree convert(const std::filesystem::path& path, int depth,
 }  // namespace
 
 void bind_building(py::module_& m) {
+  m.def("describe_crs", [](const std::string& definition) {
+        const vola::geo::CrsDescription d = with_python_names([&] { return vola::geo::describe_crs(definition); });
+        py::dict out;
+        out["name"] = d.name;
+        out["kind"] = d.kind;
+        out["epsg"] = d.epsg ? py::object(py::int_(*d.epsg)) : py::object(py::none());
+        out["unit"] = d.horizontal_unit;
+        out["vertical"] = d.vertical_name.empty() ? py::object(py::none()) : py::object(py::str(d.vertical_name));
+        out["vertical_unit"] = d.vertical_unit.empty() ? py::object(py::none()) : py::object(py::str(d.vertical_unit));
+        return out;
+      }, py::arg("definition"),
+      "What PROJ says a CRS is (as `vola info` prints it): {'name', 'kind', 'epsg' (None unless PROJ identifies\n"
+      "one with confidence), 'unit' (horizontal: 'metre', 'foot', 'US survey foot', 'degree', ...), 'vertical',\n"
+      "'vertical_unit'}. definition: WKT (tree.crs_wkt), 'EPSG:n' or a PROJ string.");
   m.def("build", &build_points, py::arg("points"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0,
         py::arg("quantize") = "grid", py::arg("origin") = py::none(), py::arg("attributes") = py::dict(),
         py::arg("reductions") = py::dict(), py::arg("epsg") = 2000u, py::arg("crs_wkt") = "",

@@ -21,6 +21,7 @@ def test_example_prints_a_census_and_plots_a_slice(shared_data, tmp_path):
                          capture_output=True, text=True, check=True)
     tree = vola.convert(las, voxel_size=2.0)
     assert f"voxels {len(tree)}," in run.stdout
+    assert "ft^3, footprint" in run.stdout and "(foot)" in run.stdout  # Autzen is in feet, not metres
     assert "Ground" in run.stdout and f"level {tree.depth - 1}:" in run.stdout
     image = pytest.importorskip("matplotlib.image").imread(png)
     assert image.shape[0] > 100 and image.shape[1] > 100

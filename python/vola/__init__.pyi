@@ -17,6 +17,7 @@ from ._vola import (
     build_from_voxels as build_from_voxels,
     compression_available as compression_available,
     convert as convert,
+    describe_crs as describe_crs,
     free_tree as free_tree,
     export_map as export_map,
     from_dense as from_dense,

@@ -11,6 +11,8 @@ cmake --build "$work/build" >/dev/null
 "$work/build/consumer" "$work/points.vol"
 "$work/build/consumer_convert" "$work"
 "$work/build/consumer_modules"
+"$work/build/consumer_io" "$work"
+"$work/build/consumer_geo"
 "$work/build/consumer_tile" "$work"
 for component in viewer slam audio learn; do "$work/build/consumer_$component"; done
 # The same consumer against the build tree, no install.
@@ -19,4 +21,6 @@ cmake --build "$work/from_build" >/dev/null
 "$work/from_build/consumer" "$work/points_build.vol"
 "$work/from_build/consumer_convert" "$work"
 "$work/from_build/consumer_modules"
+"$work/from_build/consumer_io" "$work"
+"$work/from_build/consumer_geo"
 for component in viewer slam audio learn; do "$work/from_build/consumer_$component"; done

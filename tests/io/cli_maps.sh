@@ -6,7 +6,7 @@
 # A real survey (pdal_autzen-utm.las, UTM metres) at 2 m goes vol -> .bt/.ot/.vdb -> vol
 # and must give the same voxels (.bt/.ot: moved to OctoMap's 0 with a warning, since UTM
 # coordinates lie beyond OctoMap's keys; .vdb: the same world centres); a `vola map` with
-# --free exports occupied and free voxels with their log-odds; wrong voxel sizes, damaged
+# a state map exports occupied and free voxels with their log-odds (plain trees: --free); wrong voxel sizes, damaged
 # files and misplaced options fail with a message.
 # Exit status: 0 all good, 1 failures, 77 shared folder missing (outside CI).
 set -uo pipefail
@@ -71,7 +71,8 @@ mkdir "$tmp/scans"
 printf '1.0 0 0\n' >"$tmp/scans/ahead.xyz"
 printf 'scans/ahead.xyz 0.1 0.1 0.1 0 0 0 1\nscans/ahead.xyz 0.1 0.1 0.1 0 0 0.70710678 0.70710678\n' >"$tmp/list.txt"
 "$vola" map "$tmp/list.txt" -o "$tmp/map.vol" --voxel-size 0.25 --free -q || fail "vola map"
-"$vola" export "$tmp/map.vol" "$tmp/map.ot" --free "$tmp/map.free.vol" >"$tmp/out" 2>"$tmp/err" || fail "export map.ot: $(cat "$tmp/err")"
+# A state map (what vola map writes) holds its free voxels: they go out with it.
+"$vola" export "$tmp/map.vol" "$tmp/map.ot" >"$tmp/out" 2>"$tmp/err" || fail "export map.ot: $(cat "$tmp/err")"
 grep -q "(.ot, log-odds from the log_odds columns) of .* nodes: 2 occupied and 7 free voxels of 0.25" "$tmp/out" ||
   fail "map.ot summary: $(cat "$tmp/out")"
 [[ ! -s $tmp/err ]] || fail "a vola map export warned: $(cat "$tmp/err")"
@@ -79,13 +80,23 @@ grep -q "(.ot, log-odds from the log_odds columns) of .* nodes: 2 occupied and 7
 "$vola" coords "$tmp/map_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.vol" | sort) ||
   fail "map.ot round trip: the occupied voxels differ"
 "$vola" voxels "$tmp/map_back.vol" --attributes --header | head -1 | grep -q "log_odds" || fail "map.ot lost the log-odds"
-"$vola" export "$tmp/map.vol" "$tmp/map.vdb" --free "$tmp/map.free.vol" >"$tmp/out" || fail "export map.vdb"
+"$vola" export "$tmp/map.vol" "$tmp/map.vdb" >"$tmp/out" || fail "export map.vdb"
 grep -q "^OpenVDB grids log_odds free_log_odds: 2 occupied and 7 free" "$tmp/out" || fail "map.vdb summary: $(cat "$tmp/out")"
 "$vola" convert "$tmp/map.vdb" "$tmp/free_back.vol" --grid free_log_odds -q || fail "convert map.vdb --grid free_log_odds"
 "$vola" coords "$tmp/free_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.free.vol" | sort) ||
   fail "map.vdb: the free voxels differ"
 
+# Plain trees take their free voxels from --free (here the state map's two halves; the
+# union keeps no log-odds, so the occupied leaves get OctoMap's clamping maximum).
+"$vola" union "$tmp/map.vol" "$tmp/map.vol" "$tmp/occupied.vol" -q || fail "union: the occupied voxels as a plain tree"
+"$vola" export "$tmp/occupied.vol" "$tmp/plain.ot" --free "$tmp/map.free.vol" >"$tmp/out" || fail "export --free"
+grep -q ": 2 occupied and 7 free voxels of 0.25" "$tmp/out" || fail "plain.ot summary: $(cat "$tmp/out")"
+"$vola" convert "$tmp/plain.ot" "$tmp/plain_back.vol" -q || fail "convert plain.ot"
+"$vola" coords "$tmp/plain_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.vol" | sort) ||
+  fail "plain.ot: the occupied voxels differ from the state map's"
+
 # Errors.
+expect_error "is a state map and holds its free voxels" "$vola" export "$tmp/map.vol" "$tmp/x.ot" --free "$tmp/map.free.vol"
 expect_error "is a map of 2 cells" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --voxel-size 3
 expect_error "its grids: 'occupied'" "$vola" convert "$tmp/a.vdb" "$tmp/x.vol" --grid density
 expect_error "applies to OpenVDB input only" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --grid occupied
