@@ -29,18 +29,23 @@ void walk_ray(const GridPoint& origin, const GridPoint& end, Visit&& visit) {
   const Cell first = cell_of(origin), last = cell_of(end);
   if (first == last) return;
   visit(first);
-  std::array<double, 3> delta{}, next{};
+  std::array<double, 3> delta{}, next{}, after{};
   std::array<int, 3> step{};
   Cell cell{};
+  // The crossing time of the plane `k` planes ahead of the cell on axis a.
+  const auto crossing = [&](int a, std::int64_t k) {
+    const double plane = static_cast<double>(step[a] > 0 ? cell[a] + k : cell[a] - k + 1);
+    return (plane - origin[a]) / delta[a];
+  };
   for (int a = 0; a < 3; ++a) {
     delta[a] = end[a] - origin[a];
     step[a] = delta[a] > 0.0 ? 1 : (delta[a] < 0.0 ? -1 : 0);
     // The cell the segment is in just after t = 0: on a plane moving down, the one below.
     cell[a] = step[a] < 0 ? static_cast<std::int64_t>(std::ceil(origin[a])) - 1 : first[a];
-    next[a] = std::numeric_limits<double>::infinity();
+    next[a] = after[a] = std::numeric_limits<double>::infinity();
     if (step[a] != 0) {
-      const double plane = static_cast<double>(step[a] > 0 ? cell[a] + 1 : cell[a]);
-      next[a] = (plane - origin[a]) / delta[a];
+      next[a] = crossing(a, 1);
+      after[a] = crossing(a, 2);
     }
   }
   // Each step moves an axis towards `last`, so this bounds the walk whatever the
@@ -52,11 +57,14 @@ void walk_ray(const GridPoint& origin, const GridPoint& end, Visit&& visit) {
     const double t = std::min(next[0], std::min(next[1], next[2]));
     // The segment ends (t = 1 is the end point) before it leaves this cell.
     if (!(t < 1.0)) return;
+    // The next crossing of a stepping axis was computed one step early (`after`), so the
+    // division of the one after it is off the loop's critical path; each is still
+    // computed from its own plane.
     for (int a = 0; a < 3; ++a) {
       if (next[a] != t) continue;
       cell[a] += step[a];
-      const double plane = static_cast<double>(step[a] > 0 ? cell[a] + 1 : cell[a]);
-      next[a] = (plane - origin[a]) / delta[a];
+      next[a] = after[a];
+      after[a] = crossing(a, 2);
     }
   }
 }
