@@ -42,6 +42,9 @@ GENERIC_OPTIONS = [
 # Options beyond the basics, each on a real file that exercises it.
 SPECIFIC_CASES = [
     ("data/las/pdal_autzen_trim.las", {"voxel_size": 10.0}),
+    ("data/las/pdal_autzen_trim.las",
+     {"voxel_size": 10.0, "filters": ["where:Classification == 2 && z < 450", "crop:636100,848950,637000,849400"]}),
+    ("data/las/pdal_autzen_trim.las", {"voxel_size": 5.0, "filters": ["smrf", "hag", "where:HeightAboveGround > 2"]}),
     ("data/las/pdal_autzen_trim.las", {"voxel_size": 10.0, "attributes": False, "compress": True}),
     ("data/las/pdal_autzen_trim.las", {"voxel_size": 20.0, "origin": [636000.0, 848000.0, 400.0]}),
     ("data/las/pdal_autzen_trim.las", {"quantize": "toolkit", "depth": 4, "nbits": 1}),
@@ -118,6 +121,9 @@ def cli_flags(options):
                 flags += ["--attribute", spec]
         elif key == "epsg":
             flags += ["--assign-crs", str(value)]
+        elif key == "filters":
+            for stage in value:
+                flags += ["--filter", stage]
         elif isinstance(value, bool):
             if value:
                 flags.append("--" + key.replace("_", "-"))
@@ -134,7 +140,9 @@ def c_arguments(options):
     for key, value in options.items():
         if isinstance(value, bool):
             value = int(value)
-        if isinstance(value, list):
+        if key == "filters":  # stages hold commas
+            value = ";".join(value)
+        elif isinstance(value, list):
             value = ",".join(repr(v) if isinstance(v, float) else str(v) for v in value)
         elif isinstance(value, float):
             value = repr(value)

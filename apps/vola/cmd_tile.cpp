@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "crs_flags.hpp"
+#include "filter_flags.hpp"
 #include "progress.hpp"
 #include "vola/crs_rules.hpp"
 #include "vola/geo/crs.hpp"
@@ -29,6 +30,7 @@ struct TileArgs {
   std::vector<double> origin;
   std::string assign_crs, target_crs;
   bool allow_geographic = false;
+  std::vector<std::string> filters;  // per-point stages (vola/filters/stages.hpp)
   unsigned threads = 0;
   bool no_overviews = false, no_attributes = false, quiet = false;
   std::uint64_t generate = 0;
@@ -140,6 +142,9 @@ void run_tile(const TileArgs& a) {
     options.output_dir = a.output;
     options.spill_dir = a.spill_dir;
     options.overviews = !a.no_overviews;
+    // Filters see the points in their own CRS, before any reprojection (as in convert).
+    if (!a.filters.empty())
+      for (auto& s : sources) s = tile::filtered(std::move(s), a.filters);
     if (talk) warn_relabelled(a, sources);
     reproject_sources(a, sources);
     if (a.target_crs.empty()) {
@@ -210,9 +215,13 @@ void add_tile(CLI::App& app) {
   cmd->footer(
       "Tile (i, j, k) covers ORIGIN + [i, i+1) * TILE-SIZE on each axis and holds 4^DEPTH voxels per\n"
       "axis (voxel = TILE-SIZE / 4^DEPTH), so tiles of one tile size and depth line up voxel for\n"
-      "voxel, across runs too. OUTDIR gets tile_I_J_K.vol files, index.geojson (footprints, files,\n"
-      "counts, CRS: open it in a GIS, or pass it to vola get / render / plan) and overviews/L1, L2, ...\n"
+      "voxel, across runs too. OUTDIR gets tile_I_J_K.vol files, index.geojson (RFC 7946 footprints in\n"
+      "WGS84 with files and counts, plus the grid and CRS: pass it to vola get / render / plan / view),\n"
+      "index.gpkg (the footprints in the survey's own CRS, for a GIS) and overviews/L1, L2, ...\n"
       "(each level 4x coarser, covering 4x4x4 tiles of the level below).\n"
+      "Filters: --where, --crop and --crop-polygon (as in vola convert) drop points chunk by chunk, in\n"
+      "the inputs' own CRS, before any reprojection; filters that need neighbours (smrf, hag, outlier,\n"
+      "decimation) are refused: run them with vola translate first.\n"
       "Memory: voxel keys are bucketed per tile and spilled to disk as sorted runs whenever the\n"
       "--memory budget is reached, so inputs far larger than memory tile within it; a single tile's\n"
       "voxel keys (8 bytes each) must fit the budget; with attributes every point's values are spilled\n"
@@ -233,6 +242,7 @@ void add_tile(CLI::App& app) {
       ->check(CLI::Range(1, 10));
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
   add_crs_options(*cmd, args->assign_crs, args->target_crs, args->allow_geographic);
+  add_filter_options(*cmd, args->filters);
   cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
       ->capture_default_str();
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");

@@ -37,6 +37,11 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
     vola::capi::require(c.text_attributes[i] != nullptr, "text_attributes holds a NULL");
     o.text_attributes.emplace_back(c.text_attributes[i]);
   }
+  vola::capi::require(c.filters != nullptr || c.filter_count == 0, "filters is NULL");
+  for (std::size_t i = 0; i < c.filter_count; ++i) {
+    vola::capi::require(c.filters[i] != nullptr, "filters holds a NULL");
+    o.filters.emplace_back(c.filters[i]);
+  }
   o.skip_lines = c.skip_lines;
   o.solid = c.solid != 0;
   if (c.has_dem_base) o.dem_base = c.dem_base;

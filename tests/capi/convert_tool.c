@@ -1,6 +1,7 @@
 /* convert_tool INPUT OUTPUT [key=value ...]: vola_convert_file from C, for
  * tests/convert_equivalence.py. Keys are vola_convert_options' members (Python's keyword
- * names); lists are comma-separated: bbox=0,0,0,15,15,15 text_attributes=a=4:u8,b=5. */
+ * names); lists are comma-separated: bbox=0,0,0,15,15,15 text_attributes=a=4:u8,b=5, but
+ * filters, whose stages hold commas, are separated by semicolons: filters=smrf;hag. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,10 +21,10 @@ static int split_doubles(const char *text, double *out, int capacity) {
   return n;
 }
 
-/* Text attribute specs hold no commas, so a comma separates them. */
-static size_t split_strings(char *text, char **out, size_t capacity) {
+/* Text attribute specs hold no commas, so a comma separates them; filter stages do. */
+static size_t split_strings(char *text, const char *separator, char **out, size_t capacity) {
   size_t n = 0;
-  for (char *item = strtok(text, ","); item && n < capacity; item = strtok(NULL, ",")) out[n++] = item;
+  for (char *item = strtok(text, separator); item && n < capacity; item = strtok(NULL, separator)) out[n++] = item;
   return n;
 }
 
@@ -36,6 +37,7 @@ int main(int argc, char **argv) {
   vola_convert_options_init(&options);
   int payload_columns[kMaxItems];
   char *text_attributes[kMaxItems];
+  char *filters[kMaxItems];
   double values[kMaxItems];
   for (int i = 3; i < argc; ++i) {
     char *eq = strchr(argv[i], '=');
@@ -81,8 +83,11 @@ int main(int argc, char **argv) {
       for (int c = 0; c < n; ++c) payload_columns[c] = (int)values[c];
       options.payload_columns = payload_columns;
       options.payload_column_count = (size_t)n;
+    } else if (strcmp(key, "filters") == 0) {
+      options.filter_count = split_strings(eq + 1, ";", filters, kMaxItems);
+      options.filters = (const char *const *)filters;
     } else if (strcmp(key, "text_attributes") == 0) {
-      options.text_attribute_count = split_strings(eq + 1, text_attributes, kMaxItems);
+      options.text_attribute_count = split_strings(eq + 1, ",", text_attributes, kMaxItems);
       options.text_attributes = (const char *const *)text_attributes;
     } else if (strcmp(key, "skip_lines") == 0) {
       options.skip_lines = atoi(value);

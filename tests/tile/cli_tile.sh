@@ -122,6 +122,15 @@ python3 -c "import json, sys; v = json.load(open(sys.argv[1]))['vola']; assert v
 "$vola" tile "$data/las/pdal_1.2-with-color.las" --target-crs 32610 --tile-size 200 --depth 4 -o "$tmp/nocrs" \
   2> "$tmp/err.txt" && fail "an input with no CRS was reprojected"
 grep -q "states no CRS to reproject from" "$tmp/err.txt" || fail "no-CRS message: $(cat "$tmp/err.txt")"
+# Per-point filters chunk by chunk: the ground tiles hold exactly the voxels of converting
+# the ground points on the same grid; neighbourhood filters are refused with the way out.
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/ground" --where "Classification == 2" --chunk-points 7000 -q
+"$vola" convert "$las" "$tmp/ground.vol" --voxel-size 1 --origin 0 0 0 --where "Classification == 2" -q
+for t in "$tmp"/ground/.generation-1/tile_*.vol; do "$vola" coords "$t"; done | grep -v '^#' | sort > "$tmp/tiled.txt"
+"$vola" coords "$tmp/ground.vol" | grep -v '^#' | sort > "$tmp/converted.txt"
+[ -s "$tmp/tiled.txt" ] && cmp -s "$tmp/tiled.txt" "$tmp/converted.txt" || fail "--where: tiles differ from convert --where"
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/smrf" --filter smrf 2> "$tmp/err.txt" && fail "smrf in tile accepted"
+grep -q "needs each point's neighbours.*vola translate" "$tmp/err.txt" || fail "smrf message: $(cat "$tmp/err.txt")"
 # Degrees: tiles in a geographic CRS are refused unless reprojected or forced.
 geo=$data/las/pdal_epsg_4326.las
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" 2> "$tmp/err.txt" && fail "tiles in degrees accepted"

@@ -55,6 +55,12 @@ std::unique_ptr<PointSource> open_file_points(const std::string& path, bool attr
 std::unique_ptr<PointSource> reprojected(std::unique_ptr<PointSource> source, const std::string& from,
                                          const std::string& to);
 
+// `source`'s points that the per-point filter stages keep (where, crop, polygon in
+// vola/filters/stages.hpp's spelling), chunk by chunk; the stages' dimensions are x, y, z
+// and the source's attribute columns. Throws OptionError("filters") for a stage that
+// needs each point's neighbours (smrf, hag, outlier, decimation).
+std::unique_ptr<PointSource> filtered(std::unique_ptr<PointSource> source, const std::vector<std::string>& stages);
+
 // A survey the project generates: square city blocks (vola::synth::generate_city, 200 m)
 // side by side in rows, each block one chunk with its own seed, so that any worker can
 // generate any block and the whole is never stored. `density` points per square metre
