@@ -40,7 +40,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
     throw OptionError("grid", "applies to OpenVDB input only (" + path + " is " + format.name + ")");
   input.grid = options.grid;
   input.progress = progress;
-  io::Input loaded = options.filters.empty() ? format.read(path, input) : read_filtered(path, format, options, progress, filter_report);
+  io::Input loaded = options.filters.empty() ? format.read(path, input) : read_filtered(path, format, options, input, filter_report);
   if (options.solid && !loaded.is_mesh())
     throw OptionError("solid", "applies to mesh input (triangles); " + path + " holds none");
   return loaded;

@@ -60,8 +60,17 @@ std::string describe(const filters::StageReport& stage) {
 }
 
 io::Input read_filtered(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
-                        const ConvertProgress& progress, std::vector<std::string>& report) {
+                        const io::InputOptions& input_options, std::vector<std::string>& report) {
   const std::vector<filters::Stage> stages = filters::parse_stages(options.filters);
+  if (format.name == "text") {
+    io::InputOptions whole = input_options;
+    whole.stream = false;
+    io::Input text = format.read(path, whole);
+    const filters::FilterResult result = filters::run_stages(stages, text.cloud, text.epsg, text.wkt);
+    for (const auto& stage : result.stages) report.push_back(describe(stage));
+    return text;
+  }
+  const ConvertProgress& progress = input_options.progress;
   io::PointTable table;
   try {
     table = io::read_point_table(path, progress, format.name);

@@ -70,6 +70,16 @@ cmp "$tmp/pipe.vol" "$tmp/flags.vol" || fail "pipeline .vol differs from the fla
 head -1 "$tmp/high.xyz" | grep -q "height_above_ground" || fail "no height_above_ground column"
 awk 'NR > 1 && $NF <= 2 {bad = 1} END {exit bad}' "$tmp/high.xyz" || fail "a point at 2 or less above ground passed"
 
+# Text input: --where sees the --attribute columns by name and keeps them; the same bytes
+# as converting the points an awk filter kept.
+printf '0.1 0.1 0.1 7 2\n1.2 0.1 0.1 9 5\n2.3 0.1 0.1 8 2\n3.4 2.1 0.1 3 2\n' > "$tmp/pts.xyz"
+awk '$5 == 2' "$tmp/pts.xyz" > "$tmp/ground_pts.xyz"
+"$vola" convert "$tmp/pts.xyz" "$tmp/text_where.vol" --voxel-size 0.5 --attribute class=5:u8:majority \
+  --attribute intensity=4 --where "class == 2" -q
+"$vola" convert "$tmp/ground_pts.xyz" "$tmp/text_awk.vol" --voxel-size 0.5 --attribute class=5:u8:majority \
+  --attribute intensity=4 -q
+cmp "$tmp/text_where.vol" "$tmp/text_awk.vol" || fail "text --where differs from awk's selection"
+
 # Errors name what is wrong.
 if "$vola" convert "$autzen" "$tmp/x.vol" --voxel-size 3 --where "Clasification == 2" 2> "$tmp/err.txt"; then fail "a misspelt dimension was accepted"; fi
 grep -q "no dimension 'Clasification'" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
