@@ -22,7 +22,7 @@ namespace vola::cli {
 namespace {
 
 struct MapArgs {
-  std::string list, output;
+  std::string list, output, from;
   double voxel_size = 0.0;
   double max_range = 0.0;
   bool free = false;
@@ -74,10 +74,26 @@ void print_summary(const MapArgs& a, const map::OccupancyMap& m, const map::Scan
               insert_seconds > 0 ? static_cast<double>(total.points) / insert_seconds : 0.0);
 }
 
+// --from: the saved map the scans go on updating, at the same voxel size.
+map::OccupancyMap resumed_map(const MapArgs& a) {
+  const Tree saved = open_mapped(a.from);
+  map::OccupancyMap m = [&] {
+    try {
+      return map::thaw(saved);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(a.from + ": " + e.what());
+    }
+  }();
+  if (m.voxel_size() != a.voxel_size)
+    throw OptionError("voxel_size", std::to_string(a.voxel_size) + " differs from " + a.from + "'s voxel size " +
+                                        std::to_string(m.voxel_size()));
+  return m;
+}
+
 void run_map(const MapArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<map::ScanEntry> scans = map::read_scan_list(a.list);
-  map::OccupancyMap m(a.voxel_size);
+  map::OccupancyMap m = a.from.empty() ? map::OccupancyMap(a.voxel_size) : resumed_map(a);
   std::unique_ptr<Progress> progress;
   if (!a.quiet) progress = std::make_unique<Progress>("inserting scans");
   map::ScanReport total;
@@ -128,14 +144,21 @@ void add_map(CLI::App& app) {
       "occupied/free/unknown and the probability, vola info and vola census count the states, vola\n"
       "view --free shows the free voxels. --free also writes the free voxels to MAP.free.vol as a\n"
       "plain tree (as vola map did before the state map).\n"
+      "--from MAP.vol continues a saved map: only the blocks the new scans touch change, and the file\n"
+      "equals the one all the scans would give at once.\n"
       "Example:\n"
       "  printf 'velodyne/000000.bin 0 0 0 0 0 0 1\\n' > scans.txt\n"
-      "  vola map scans.txt -o map.vol --voxel-size 0.2 --max-range 40 --free");
+      "  vola map scans.txt -o map.vol --voxel-size 0.2 --max-range 40 --free\n"
+      "  vola map more_scans.txt --from map.vol -o map.vol --voxel-size 0.2 --max-range 40");
   cmd->add_option("scanlist", args->list, "Text file: FILE tx ty tz qx qy qz qw per line")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "Output .vol (state map: occupied and free voxels)")->required();
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge R in the points' unit")->required()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--from", args->from,
+                  "Insert into this saved map (a state map from vola map, same --voxel-size) instead of an empty "
+                  "one; -o may name the same file. The result equals inserting every scan at once")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--max-range", args->max_range, "Longest ray; farther points mark free space only (0: no limit)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol as a plain tree");

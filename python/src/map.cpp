@@ -69,6 +69,15 @@ void bind_map(py::module_& m) {
            py::arg("voxel_size"), py::arg("max_range") = 0.0,
            "An empty map of voxels of edge voxel_size (voxel (i,j,k) covers [i*R, (i+1)*R)); points farther than\n"
            "max_range (> 0) from the sensor mark their ray free up to it and hit nothing.")
+      .def_static(
+          "from_tree",
+          [](const Tree& state_map, double max_range) {
+            if (!(max_range >= 0.0)) throw InvalidArgument("max_range must be >= 0 (0: no limit)");
+            return PyMap{map::thaw(state_map), max_range};
+          },
+          py::arg("tree"), py::arg("max_range") = 0.0,
+          "The map a state map was saved from (vola.read('map.vol')), to insert more scans into: saving it\n"
+          "again gives the bytes of inserting every scan at once.")
       .def_property_readonly("voxel_size", [](const PyMap& self) { return self.map.voxel_size(); })
       .def_property_readonly("max_range", [](const PyMap& self) { return self.max_range; })
       .def("__len__", [](const PyMap& self) { return self.map.size(); })

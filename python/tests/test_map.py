@@ -74,3 +74,39 @@ def test_save_writes_the_bytes_vola_map_writes(tmp_path: pathlib.Path, vola_cli:
                     "--voxel-size", "0.25", "--max-range", "2.5", "-q"], check=True)
     m.save(tmp_path / "python.vol")
     assert (tmp_path / "python.vol").read_bytes() == (tmp_path / "cli.vol").read_bytes()
+
+
+def test_a_saved_map_takes_more_scans_as_vola_map_from_does(tmp_path: pathlib.Path, vola_cli: str):
+    """Incremental equals batch: Map.from_tree and `vola map --from` continue a saved map
+    to the bytes of inserting every scan at once."""
+    scans = _scans(7) + _scans(8)
+    lists = {"all": [], "first": [], "rest": []}
+    for n, (points, origin) in enumerate(scans):
+        np.savetxt(tmp_path / f"scan{n}.xyz", points - origin, fmt="%.17g")
+        line = f"scan{n}.xyz {origin[0]!r} {origin[1]!r} {origin[2]!r} 0 0 0 1"
+        lists["all"].append(line)
+        lists["first" if n < 2 else "rest"].append(line)
+    for name, lines in lists.items():
+        (tmp_path / f"{name}.txt").write_text("\n".join(lines) + "\n")
+    run = lambda *args: subprocess.run([vola_cli, "map", *map(str, args), "--voxel-size", "0.25", "-q"], check=True)
+    run(tmp_path / "all.txt", "-o", tmp_path / "all.vol")
+    run(tmp_path / "first.txt", "-o", tmp_path / "resumed.vol")
+    run(tmp_path / "rest.txt", "--from", tmp_path / "resumed.vol", "-o", tmp_path / "resumed.vol")
+    assert (tmp_path / "resumed.vol").read_bytes() == (tmp_path / "all.vol").read_bytes()
+
+    m = vola.Map.from_tree(vola.read(tmp_path / "resumed.vol"))
+    assert len(m) == len(vola.Map.from_tree(vola.read(tmp_path / "all.vol")))
+    first = vola.Map(0.25)
+    for points, origin in scans[:2]:
+        first.insert(points, origin)
+    first.save(tmp_path / "first_py.vol")
+    again = vola.Map.from_tree(vola.read(tmp_path / "first_py.vol"))
+    for points, origin in scans[2:]:
+        again.insert(points, origin)
+    again.save(tmp_path / "again.vol")
+    assert (tmp_path / "again.vol").read_bytes() == (tmp_path / "all.vol").read_bytes()
+    with pytest.raises(vola.InvalidArgument):
+        vola.Map.from_tree(vola.build_from_voxels(np.array([[1, 2, 3]]), 2))
+    subprocess.run([vola_cli, "map", str(tmp_path / "rest.txt"), "--from", str(tmp_path / "all.vol"), "-o",
+                    str(tmp_path / "x.vol"), "--voxel-size", "0.5", "-q"], check=False)
+    assert not (tmp_path / "x.vol").exists(), "a voxel size other than the saved map's was accepted"

@@ -177,6 +177,24 @@ std::vector<std::pair<VoxelIndex, float>> OccupancyMap::voxels() const {
   return out;
 }
 
+void OccupancyMap::restore(const VoxelIndex& v, float log_odds) {
+  if (!(log_odds >= model_.clamp_min && log_odds <= model_.clamp_max))
+    throw InvalidArgument("log-odds " + std::to_string(log_odds) + " is outside the map's clamping range");
+  const detail::Cell c{v.i, v.j, v.k};
+  if (!in_range(c)) throw InvalidArgument("voxel outside the map's index range");
+  bool added = false;
+  const std::uint32_t at = index_.find_or_add(block_key(c), added);
+  if (added) {
+    block_keys_.push_back(block_key(c));
+    blocks_.emplace_back();
+  }
+  Block& block = blocks_[at];
+  const std::uint64_t bit = bit_of(c);
+  if (!(block.known & bit)) ++known_;
+  block.known |= bit;
+  block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bit))] = log_odds;
+}
+
 std::size_t OccupancyMap::memory_bytes() const noexcept {
   return index_.memory_bytes() + block_keys_.capacity() * sizeof(std::uint64_t) + blocks_.capacity() * sizeof(Block);
 }

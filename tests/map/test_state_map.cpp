@@ -13,6 +13,7 @@
 
 #include "test_support.hpp"
 #include "vola/builder.hpp"
+#include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/map/occupancy_map.hpp"
 #include "vola/map/state_map.hpp"
@@ -213,3 +214,34 @@ TEST(StateMap, TheMarkerIsCheckedOnReadingAndDenseFilesAreRefused) {
 }
 
 }  // namespace
+
+// Incremental equals batch: scans inserted into a map thawed from a saved state map (read
+// back from a file) give the bytes of inserting every scan into one map.
+TEST(StateMap, InsertingIntoAThawedMapEqualsInsertingAllAtOnce) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> coord(-4.0, 4.0);
+  std::vector<std::pair<vola::Point, std::vector<double>>> scans;
+  for (int scan = 0; scan < 6; ++scan) {
+    const vola::Point origin{coord(rng) / 4, coord(rng) / 4, coord(rng) / 4};
+    std::vector<double> xyz;
+    for (int n = 0; n < 300; ++n) xyz.insert(xyz.end(), {coord(rng), coord(rng), coord(rng)});
+    scans.emplace_back(origin, std::move(xyz));
+  }
+  OccupancyMap batch(0.25), first(0.25);
+  for (std::size_t s = 0; s < scans.size(); ++s) {
+    batch.insert_scan(scans[s].second, scans[s].first, 3.0, 2);
+    if (s < 3) first.insert_scan(scans[s].second, scans[s].first, 3.0, 1);
+  }
+  const vola::Tree saved = round_trip(vola::map::freeze(first), {}, "vola_thaw.vol");
+  OccupancyMap resumed = vola::map::thaw(saved);
+  EXPECT_EQ(vola::serialize(vola::map::freeze(resumed)), vola::serialize(vola::map::freeze(first)));
+  for (std::size_t s = 3; s < scans.size(); ++s) resumed.insert_scan(scans[s].second, scans[s].first, 3.0, 1);
+  EXPECT_EQ(resumed.size(), batch.size());
+  EXPECT_EQ(vola::serialize(vola::map::freeze(resumed)), vola::serialize(vola::map::freeze(batch)));
+
+  const std::vector<vola::Voxel> one{{1, 2, 3}};
+  EXPECT_THROW(vola::map::thaw(vola::build_from_voxels(one, 2)), vola::InvalidArgument);
+  vola::Tree no_column = vola::map::freeze(first);
+  no_column.attributes().clear();
+  EXPECT_THROW(vola::map::thaw(no_column), vola::InvalidArgument);
+}

@@ -92,6 +92,10 @@ class OccupancyMap {
   ScanReport insert_scan(std::span<const double> xyz, const Point& origin, double max_range = 0.0,
                          unsigned threads = 0);
 
+  // Sets a voxel's log-odds as a saved map had it (thaw, state_map.hpp): the voxel becomes
+  // known. Throws InvalidArgument for a value outside [clamp_min, clamp_max] or NaN.
+  void restore(const VoxelIndex& v, float log_odds);
+
   double voxel_size() const noexcept { return voxel_size_; }
   const SensorModel& model() const noexcept { return model_; }
   std::size_t size() const noexcept { return known_; }

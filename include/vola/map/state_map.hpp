@@ -84,4 +84,11 @@ StateCounts state_counts(const Tree& state_map);
 // voxel. Throws InvalidArgument when the known voxels span more than 4^10 per axis.
 Tree freeze(const OccupancyMap& map);
 
+// The map a state map was frozen from (every known voxel with its log-odds), so that more
+// scans can be inserted and frozen again: freeze(thaw(freeze(m))) == freeze(m), and
+// inserting scans into a thawed map gives the bytes of inserting them all at once.
+// Throws InvalidArgument unless `tree` is a state map in grid quantization with a
+// "log_odds" column whose origin is a whole number of voxels (what freeze writes).
+OccupancyMap thaw(const Tree& state_map);
+
 }  // namespace vola::map
