@@ -6,6 +6,7 @@
 
 #include "python_support.hpp"
 #include "vola/file.hpp"
+#include "vola/map/distance_field.hpp"
 #include "vola/map/occupancy_map.hpp"
 #include "vola/map/state_map.hpp"
 
@@ -146,6 +147,56 @@ void bind_map(py::module_& m) {
       },
       py::arg("tree"), py::arg("points"),
       "(N,) float64 occupancy probability per world point from the tree's log_odds column, NaN where there is none.");
+  const auto box_of = [](const py::handle& lo, const py::handle& hi) {
+    const auto l = lo.cast<std::array<std::int64_t, 3>>(), h = hi.cast<std::array<std::int64_t, 3>>();
+    return map::GridBox{l, h};
+  };
+  py::class_<map::DistanceField>(m, "DistanceField",
+                                 "Exact Euclidean distances (world units) from voxel centres to the nearest obstacle voxel's\n"
+                                 "centre, capped at max_distance (vola/map/distance_field.hpp): the ESDF planners use.")
+      .def(py::init([box_of](const Tree& tree, double max_distance, const py::object& lo, const py::object& hi) {
+             if (lo.is_none() != hi.is_none()) throw InvalidArgument("give both lo and hi, or neither");
+             const std::optional<map::GridBox> box = lo.is_none() ? std::nullopt : std::optional(box_of(lo, hi));
+             py::gil_scoped_release release;
+             return box ? std::make_unique<map::DistanceField>(tree, *box, max_distance)
+                        : std::make_unique<map::DistanceField>(tree, max_distance);
+           }),
+           py::arg("tree"), py::arg("max_distance"), py::arg("lo") = py::none(), py::arg("hi") = py::none(),
+           "The field of the tree's voxels (a state map's occupied ones) over grid voxels lo..hi-1 (default: the\n"
+           "voxels' box grown by max_distance).")
+      .def("distance",
+           [](const map::DistanceField& self, const py::handle& points) {
+             return per_point<double>(points, [&](const Point& p) { return self.distance(p); });
+           },
+           py::arg("points"), "(N,) distance at each world point (its voxel's value; max_distance outside the box).")
+      .def("gradient",
+           [](const map::DistanceField& self, const py::handle& points) {
+             const auto xyz = rows_of_three<double>(points, "points");
+             const auto n = static_cast<std::size_t>(xyz.shape(0));
+             std::vector<double> out(3 * n);
+             const double* p = xyz.data();
+             {
+               py::gil_scoped_release release;
+               for (std::size_t i = 0; i < n; ++i) {
+                 const Point g = self.gradient(Point{p[3 * i], p[3 * i + 1], p[3 * i + 2]});
+                 std::copy(g.begin(), g.end(), out.begin() + static_cast<std::ptrdiff_t>(3 * i));
+               }
+             }
+             return owning_array(std::move(out), {static_cast<py::ssize_t>(n), 3});
+           },
+           py::arg("points"), "(N, 3) gradient of the distance at each world point (away from the nearest obstacle).")
+      .def("update",
+           [box_of](map::DistanceField& self, const Tree& tree, const py::handle& lo, const py::handle& hi) {
+             const map::GridBox box = box_of(lo, hi);
+             py::gil_scoped_release release;
+             self.update(tree, box);
+           },
+           py::arg("tree"), py::arg("lo"), py::arg("hi"),
+           "Recomputes the cells near grid voxels lo..hi-1, where `tree` (same grid) changed.")
+      .def_property_readonly("box", [](const map::DistanceField& self) {
+        return py::make_tuple(self.box().lo, self.box().hi);
+      })
+      .def_property_readonly("max_distance", &map::DistanceField::max_distance);
   m.def("occupied_tree", &map::occupied_tree, py::arg("tree"),
         "A state map's occupied voxels as a plain tree (columns kept); any other tree as it is.");
   m.def("free_tree", &map::free_tree, py::arg("tree"), "A state map's free voxels as a plain tree (columns kept).");

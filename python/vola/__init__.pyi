@@ -15,6 +15,7 @@ from ._vola import (
     __version__ as __version__,
     build as build,
     build_from_voxels as build_from_voxels,
+    DistanceField as DistanceField,
     compression_available as compression_available,
     convert as convert,
     describe_crs as describe_crs,
