@@ -2,9 +2,9 @@
 
 #include <cctype>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "vola/error.hpp"
 
@@ -120,11 +120,20 @@ PolygonSet parse_polygons(const std::string& text, const std::string& name) {
 }
 
 PolygonSet read_polygons(const std::string& path) {
-  std::ifstream in(path);
+  // A regular file of bounded size: a device or a FIFO named here (/dev/zero) would
+  // never end, and a polygon file is text a person wrote or exported.
+  constexpr std::uintmax_t kMaxPolygonFileBytes = std::uintmax_t{256} << 20;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    throw InvalidArgument(path + ": not a regular file (a polygon file is GeoJSON or WKT text)");
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error || size > kMaxPolygonFileBytes)
+    throw InvalidArgument(path + ": " + (error ? "cannot read its size" : "more than 256 MiB of polygon text"));
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_polygons(text.str(), path);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!in.read(text.data(), static_cast<std::streamsize>(size))) throw IoError(path + ": cannot read");
+  return parse_polygons(text, path);
 }
 
 std::vector<bool> inside_box(std::span<const double> xyz, const CropBox& box) {
