@@ -43,8 +43,10 @@ double numeric(const json& value, const std::string& where) {
 class StageReader {
  public:
   StageReader(const json& stage, std::size_t index) : stage_(stage) {
+    prefix_ = "pipeline stage " + std::to_string(index) + ": ";
+    if (stage.contains("type") && !stage["type"].is_string()) fail("\"type\" must be a string, not " + stage["type"].dump());
     type_ = stage.value("type", "");
-    prefix_ = "pipeline stage " + std::to_string(index) + (type_.empty() ? "" : " (" + type_ + ")") + ": ";
+    if (!type_.empty()) prefix_ = "pipeline stage " + std::to_string(index) + " (" + type_ + "): ";
   }
   const std::string& type() const { return type_; }
   [[noreturn]] void fail(const std::string& what) const { throw InvalidArgument(prefix_ + what); }
@@ -151,6 +153,36 @@ class StageReader {
   std::string type_, prefix_;
 };
 
+// One object stage into `pipeline`: a reader, a writer or a filter.
+void read_stage(const json& element, std::size_t index, Pipeline& pipeline) {
+  const StageReader stage(element, index);
+  const std::string& type = stage.type();
+  if (type.empty() && element.contains("filename")) {  // PDAL infers the kind from the position
+    if (index == 0) pipeline.input = stage.text("filename");
+    else pipeline.writers.push_back({stage.text("filename"), {}});
+  } else if (type.rfind("readers.", 0) == 0) {
+    if (index != 0) stage.fail("a reader must come first (vola pipelines read one input)");
+    stage.only({"filename"});
+    pipeline.input = stage.text("filename");
+  } else if (type.rfind("writers.", 0) == 0) {
+    PipelineWriter writer;
+    writer.filename = stage.text("filename");
+    if (type == "writers.vola" || writer.voxels()) {
+      stage.only({"filename", "voxel_size", "depth", "compress", "dense", "attributes"});
+      for (const auto& [key, value] : element.items())
+        if (key != "type" && key != "tag" && key != "filename") writer.options[key] = value.dump();
+    } else if (type == "writers.las" || type == "writers.ply" || type == "writers.text") {
+      stage.only({"filename"});
+    } else {
+      stage.fail("unknown writer (writers.las for .las/.laz, writers.ply, writers.text, writers.vola for .vol)");
+    }
+    pipeline.writers.push_back(std::move(writer));
+  } else {
+    if (!pipeline.writers.empty()) stage.fail("a filter after a writer (vola runs the filters, then every writer)");
+    pipeline.stages.push_back(stage.filter());
+  }
+}
+
 }  // namespace
 
 bool PipelineWriter::voxels() const { return lower_extension(filename) == ".vol"; }
@@ -226,31 +258,10 @@ Pipeline parse_pipeline(const std::string& text, const std::string& name) {
       continue;
     }
     if (!element.is_object()) throw InvalidArgument(prefix + "a stage is a file name or an object with \"type\"");
-    const StageReader stage(element, index);
-    const std::string& type = stage.type();
-    if (type.empty() && element.contains("filename")) {  // PDAL infers the kind from the position
-      if (index == 0) pipeline.input = stage.text("filename");
-      else pipeline.writers.push_back({stage.text("filename"), {}});
-    } else if (type.rfind("readers.", 0) == 0) {
-      if (index != 0) stage.fail("a reader must come first (vola pipelines read one input)");
-      stage.only({"filename"});
-      pipeline.input = stage.text("filename");
-    } else if (type.rfind("writers.", 0) == 0) {
-      PipelineWriter writer;
-      writer.filename = stage.text("filename");
-      if (type == "writers.vola" || writer.voxels()) {
-        stage.only({"filename", "voxel_size", "depth", "compress", "dense", "attributes"});
-        for (const auto& [key, value] : element.items())
-          if (key != "type" && key != "tag" && key != "filename") writer.options[key] = value.dump();
-      } else if (type == "writers.las" || type == "writers.ply" || type == "writers.text") {
-        stage.only({"filename"});
-      } else {
-        stage.fail("unknown writer (writers.las for .las/.laz, writers.ply, writers.text, writers.vola for .vol)");
-      }
-      pipeline.writers.push_back(std::move(writer));
-    } else {
-      if (!pipeline.writers.empty()) stage.fail("a filter after a writer (vola runs the filters, then every writer)");
-      pipeline.stages.push_back(stage.filter());
+    try {
+      read_stage(element, index, pipeline);
+    } catch (const json::exception& e) {  // a member of an unexpected JSON type
+      throw InvalidArgument(prefix + e.what());
     }
   }
   if (pipeline.input.empty()) throw InvalidArgument(name + ": the pipeline has no reader (a file name first)");
