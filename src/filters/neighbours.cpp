@@ -90,16 +90,32 @@ void check_size(const char* option, double size) {
   if (!(size > 0.0) || !std::isfinite(size)) throw OptionError(option, "must be a positive length, not " + std::to_string(size));
 }
 
+// Cell indices are int64: refuse a size so small that |coordinate| / size passes 2^52.
+void check_cells(const char* option, std::span<const double> xyz, double size) {
+  double reach = 0.0;
+  for (const double v : xyz)
+    if (std::isfinite(v)) reach = std::max(reach, std::abs(v));
+  if (reach / size > 4.5e15)
+    throw OptionError(option, std::to_string(size) + " is too small for coordinates reaching " + std::to_string(reach));
+}
+
 }  // namespace
 
 std::vector<bool> voxel_decimation(std::span<const double> xyz, double size) {
   check_size("voxel", size);
+  check_cells("voxel", xyz, size);
   const std::size_t n = xyz.size() / 3;
+  // Points with a NaN or infinite coordinate are in no cell: never kept.
+  const auto finite = [&](std::size_t i) {
+    return std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]);
+  };
   double lo[3] = {INFINITY, INFINITY, INFINITY};
   for (std::size_t i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], xyz[3 * i + a]);
+    if (finite(i))
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], xyz[3 * i + a]);
   std::unordered_map<CellKey, std::pair<double, std::size_t>, CellHash> best;  // cell -> (distance^2, point)
   for (std::size_t i = 0; i < n; ++i) {
+    if (!finite(i)) continue;
     std::int64_t c[3];
     double d2 = 0.0;
     for (int a = 0; a < 3; ++a) {
@@ -118,12 +134,14 @@ std::vector<bool> voxel_decimation(std::span<const double> xyz, double size) {
 
 std::vector<bool> poisson_decimation(std::span<const double> xyz, double radius) {
   check_size("poisson", radius);
+  check_cells("poisson", xyz, radius);
   const std::size_t n = xyz.size() / 3;
   std::unordered_map<CellKey, std::vector<std::size_t>, CellHash> kept_in;  // cells of side radius
   std::vector<bool> keep(n, false);
   const double r2 = radius * radius;
   for (std::size_t i = 0; i < n; ++i) {
     const double* p = &xyz[3 * i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;  // in no cell: dropped
     const CellKey c{static_cast<std::int64_t>(std::floor(p[0] / radius)), static_cast<std::int64_t>(std::floor(p[1] / radius)),
                     static_cast<std::int64_t>(std::floor(p[2] / radius))};
     bool near = false;

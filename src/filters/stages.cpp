@@ -76,7 +76,11 @@ Stage parse_stage(const std::string& spec) {
     } else if (name == "outlier") {
       s.kind = Stage::Kind::outlier;
       parameters(spec, args, [&](const std::string& key, double v) {
-        if (key == "k" || key == "mean_k") s.outlier.neighbours = static_cast<int>(v);
+        if (key == "k" || key == "mean_k") {
+          // A count: whole and small enough for an int (a k near the point count is already absurd).
+          if (!(v >= 1.0 && v <= 1e6) || v != std::floor(v)) refuse(spec, "k must be a whole number from 1 to 1000000");
+          s.outlier.neighbours = static_cast<int>(v);
+        }
         else if (key == "multiplier") s.outlier.multiplier = v;
         else refuse(spec, "outlier has no parameter '" + key + "' (k, multiplier)");
       });

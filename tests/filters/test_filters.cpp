@@ -278,3 +278,18 @@ TEST(Stages, RunInOrderAndReportTheInputIndexOfEveryPointLeft) {
 }
 
 }  // namespace
+
+// Points with a NaN or infinite coordinate are in no cell (never kept, no undefined
+// conversion of NaN to an integer), and sizes too small for the coordinates are refused.
+TEST(Decimation, NonFinitePointsAreDroppedAndTinySizesRefused) {
+  const std::vector<double> xyz{0.1, 0.1, 0.1, NAN, 0, 0, 0.2, INFINITY, 0, 5, 5, 5};
+  const std::vector<bool> voxel = vola::filters::voxel_decimation(xyz, 1.0);
+  const std::vector<bool> poisson = vola::filters::poisson_decimation(xyz, 1.0);
+  EXPECT_EQ(voxel, (std::vector<bool>{true, false, false, true}));
+  EXPECT_EQ(poisson, (std::vector<bool>{true, false, false, true}));
+  const std::vector<double> far{1e300, 0, 0};
+  EXPECT_THROW(vola::filters::voxel_decimation(far, 1e-300), vola::OptionError);
+  EXPECT_THROW(vola::filters::poisson_decimation(far, 1e-300), vola::OptionError);
+  EXPECT_THROW(vola::filters::parse_stage("outlier:k=1e200"), vola::OptionError);
+  EXPECT_THROW(vola::filters::parse_stage("smrf:cell=1e-9"), vola::OptionError);
+}
