@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "crs_units.hpp"
@@ -34,6 +35,22 @@ bool inside(const fs::path& folder, const fs::path& path) {
 
 nlohmann::json json_point(const Point& p) { return nlohmann::json::array({p[0], p[1], p[2]}); }
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr Box kEmpty{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+
+void grow(Box& box, const Box& by) {
+  for (int a = 0; a < 3; ++a) {
+    box.min[a] = std::min(box.min[a], by.min[a]);
+    box.max[a] = std::max(box.max[a], by.max[a]);
+  }
+}
+
+// The tile's index on the grid of overview level `level` (floor division by 4^level).
+tile::TileIndex overview_tile(const tile::TileIndex& t, int level) {
+  const int shift = 2 * level;
+  return {t.i >> shift, t.j >> shift, t.k >> shift};
+}
+
 }  // namespace
 
 ViewedTileSet::ViewedTileSet(const std::string& index_path, std::size_t max_open)
@@ -44,9 +61,17 @@ ViewedTileSet::ViewedTileSet(const std::string& index_path, std::size_t max_open
   folder_ = folder.string();
   name_ = folder.filename().string();
   for (const auto& t : index_.tiles)
-    pieces_.push_back({0, t.tile, t.file, t.voxels, piece_box(index_.grid, 0, t.tile)});
+    pieces_.push_back({0, t.tile, t.file, t.voxels, piece_box(index_.grid, 0, t.tile), t.bbox});
+  // An overview's points are those of the tiles it covers (the page measures distances
+  // to them: the overview's own box is mostly empty).
+  std::map<std::pair<int, tile::TileIndex>, Box> covered;
+  for (const auto& o : index_.overviews) covered.emplace(std::pair{o.level, o.tile}, kEmpty);
+  for (const auto& t : index_.tiles)
+    for (auto& [key, box] : covered)
+      if (overview_tile(t.tile, key.first) == key.second) grow(box, t.bbox);
   for (const auto& o : index_.overviews)
-    pieces_.push_back({o.level, o.tile, o.file, o.voxels, piece_box(index_.grid, o.level, o.tile)});
+    pieces_.push_back({o.level, o.tile, o.file, o.voxels, piece_box(index_.grid, o.level, o.tile),
+                       covered.at(std::pair{o.level, o.tile})});
 }
 
 ViewedTileSet::~ViewedTileSet() = default;
@@ -56,13 +81,8 @@ nlohmann::json ViewedTileSet::metadata() const {
   const tile::TileGrid& grid = index_.grid;
   // The points' bounds (each tile's bbox), which the camera frames; the tiles' boxes
   // are whole grid cells and may be mostly empty.
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Box points{{inf, inf, inf}, {-inf, -inf, -inf}};
-  for (const auto& t : index_.tiles)
-    for (int a = 0; a < 3; ++a) {
-      points.min[a] = std::min(points.min[a], t.bbox.min[a]);
-      points.max[a] = std::max(points.max[a], t.bbox.max[a]);
-    }
+  Box points = kEmpty;
+  for (const auto& t : index_.tiles) grow(points, t.bbox);
   int levels = 0;
   json list = json::array();
   for (std::size_t id = 0; id < pieces_.size(); ++id) {
@@ -75,6 +95,8 @@ nlohmann::json ViewedTileSet::metadata() const {
                     {"voxels", p.voxels},
                     {"min", json_point(p.box.min)},
                     {"max", json_point(p.box.max)},
+                    {"points_min", json_point(p.points.min)},
+                    {"points_max", json_point(p.points.max)},
                     {"origin", json_point(p.box.min)},
                     {"voxel_size", grid.voxel_size() * std::pow(4.0, p.level)}});
   }

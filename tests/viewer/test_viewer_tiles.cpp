@@ -75,7 +75,8 @@ struct TileFolder {
                           {"points", v.size()},
                           {"voxels", v.size()},
                           {"bytes", 0},
-                          {"bbox", {b.min[0] + 1, b.min[1] + 2, b.min[2] + 3, b.max[0] - 1, b.max[1] - 2, b.max[2] - 3}}}}});
+                          {"bbox",
+                           {b.min[0] + 1, b.min[1] + 2, b.min[2] + 3, b.max[0] - 1, b.max[1] - 2, b.max[2] - 3}}}}});
   }
   void write_index(std::optional<std::uint32_t> epsg = std::nullopt) const {
     const json vola_member = {{"format", "vola-tile-index"},
@@ -166,7 +167,11 @@ TEST(ViewerTiles, TheListingIsTheIndex) {
   EXPECT_EQ(pieces[1]["min"], json({164.0, 200.0, 10.0}));
   EXPECT_EQ(pieces[1]["max"], json({228.0, 264.0, 74.0}));
   EXPECT_EQ(pieces[1]["voxel_size"], 4.0);
+  EXPECT_EQ(pieces[1]["points_min"], json({165.0, 202.0, 13.0}));
+  EXPECT_EQ(pieces[1]["points_max"], json({227.0, 262.0, 71.0}));
   EXPECT_EQ(pieces[2]["max"], json({356.0, 456.0, 266.0}));  // 4 tiles a side
+  EXPECT_EQ(pieces[2]["points_min"], s["points_min"]);      // the points of both tiles
+  EXPECT_EQ(pieces[2]["points_max"], s["points_max"]);
   EXPECT_EQ(pieces[2]["voxel_size"], 16.0);
 }
 

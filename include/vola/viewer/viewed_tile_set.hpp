@@ -34,6 +34,7 @@ struct TilePiece {
   std::string file;      // relative to the index's folder
   std::uint64_t voxels = 0;
   Box box;               // the world box the piece's grid covers
+  Box points;            // the box of its points: the tile's bbox, an overview's tiles' together
 };
 
 class ViewedTileSet {
@@ -53,9 +54,9 @@ class ViewedTileSet {
   // Tiles first, in the index's order, then overviews by level.
   const std::vector<TilePiece>& pieces() const noexcept { return pieces_; }
 
-  // Grid, CRS and its units, attributes, the points' bounds, the overview levels and
-  // every piece (id = position in pieces(), level, tile, file, voxels, box, origin and
-  // voxel size of its grid): what the page needs to choose pieces.
+  // Grid, CRS and its unit, attributes, the points' bounds, the overview levels and
+  // every piece (id = position in pieces(), level, tile, file, voxels, box, its points'
+  // box, origin and voxel size of its grid): what the page needs to choose pieces.
   nlohmann::json metadata() const;
   // Piece `id`, opened if it is not (InvalidArgument for an id out of range; IoError
   // for a file outside the index's folder; FormatError / IoError for a bad file).
