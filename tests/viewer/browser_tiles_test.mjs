@@ -2,8 +2,9 @@
 // serves its index.geojson, and checks that the page lists every piece the index has;
 // that from the first camera (the whole survey in view) only overviews load; that
 // looking down at the survey's middle from close by loads tiles there, and not the
-// whole set; that cells held stay within the page's cache; that the scale bar is in the
-// CRS's feet with a north arrow; and that the screenshot it writes is not blank.
+// whole set; that with a small cache (the page's ?budget=&cache=) the tiles left behind
+// are freed when the camera moves on; that the scale bar is in the CRS's feet with a
+// north arrow; and that the screenshot it writes is not blank.
 // Usage: node browser_tiles_test.mjs VOLA DATA_DIR NODE_MODULES CHROMIUM OUT.png
 // Exit 77 (skip) when the data is missing and CI is not set.
 import { execFileSync } from 'node:child_process';
@@ -70,6 +71,24 @@ try {
   // The screenshot: the whole survey again, some tiles still held.
   await page.evaluate(async () => { window.volaView.frameAll(); await window.volaView.whenIdle(); });
   await screenshotNotBlank(page, screenshotPath);
+
+  // A small cache: looking down at the west end, then the east end, frees the west's tiles.
+  const small = await openPage(browser, url);
+  // The west end's tiles in view hold 42,772 cells, the east end's more than 20,000.
+  await small.page.goto(`${url}?budget=60000&cache=60000`);
+  const visit = (p) => small.page.evaluate(async (q) => {
+    window.volaView.lookDownAt(q, 150);
+    await window.volaView.whenIdle();
+    return window.volaView.tileCounts()[0];
+  }, p);
+  await small.page.evaluate(async () => { await window.volaView.ready; await window.volaView.whenIdle(); });
+  const west = await visit([bounds.min[0] + 0.1 * (bounds.max[0] - bounds.min[0]), middle[1], middle[2]]);
+  const east = await visit([bounds.max[0] - 0.1 * (bounds.max[0] - bounds.min[0]), middle[1], middle[2]]);
+  console.log(`west: ${JSON.stringify(west)}\neast: ${JSON.stringify(east)}`);
+  check(west.tilesLoaded > 0 && east.tilesLoaded > 0, 'no tiles loaded at the ends');
+  check(east.cells <= east.cache, `${east.cells} cells held, the cache is ${east.cache}`);
+  check(west.loadedTiles.some((id) => !east.loadedTiles.includes(id)), 'the west end\'s tiles were not freed');
+  check(small.foreign.length === 0 && small.problems.length === 0, [...small.foreign, ...small.problems].join('\n'));
 
   check(foreign.length === 0, `the page asked for other hosts: ${foreign.join(', ')}`);
   check(problems.length === 0, problems.join('\n'));

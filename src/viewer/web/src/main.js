@@ -9,7 +9,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { fetchCells, fetchFiles, fetchPick, fetchTileSets } from './api.js';
 import { VoxelLayer } from './layer.js';
 import { unitLabel, updateNorthArrow, updateScaleBar } from './overlay.js';
-import { TileStreamer } from './tiles.js';
+import { CELL_BUDGET, CELL_CACHE, TileStreamer } from './tiles.js';
 import { classColour, fileColour, rampColour } from './palette.js';
 
 const BATCH_CELLS = 1 << 20;
@@ -426,8 +426,10 @@ async function main() {
   state.units = [...state.files, ...state.tileSets].map((f) => f.units).find((u) => u.unit !== 'units') ||
     state.units;
   buildFileList();
+  const query = new URLSearchParams(window.location.search);
+  const limits = { budget: Number(query.get('budget')) || CELL_BUDGET, cache: Number(query.get('cache')) || CELL_CACHE };
   state.streamers = state.tileSets.map((set) => new TileStreamer(set, state.sceneOrigin, slice, scene, colourOf,
-    () => { reportTiles(); render(); }, (e) => setStatus(e.message, true)));
+    () => { reportTiles(); render(); }, (e) => setStatus(e.message, true), limits));
   $('detail-section').hidden = !state.files.length;
   const maxDepth = Math.max(1, ...state.files.map((f) => f.depth));
   $('detail').max = maxDepth;

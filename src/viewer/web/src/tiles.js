@@ -12,8 +12,10 @@ import { fetchPieceCells } from './api.js';
 import { VoxelLayer } from './layer.js';
 
 const BATCH_CELLS = 1 << 18;
-const CELL_BUDGET = 2_000_000;  // cells of the cut
-const CELL_CACHE = 4_000_000;   // cells held, cut or not
+// Cells of the cut, and cells held (cut or not), unless the page's URL says otherwise
+// (?budget=N&cache=N: a weaker machine, or a test that wants to see pieces freed).
+export const CELL_BUDGET = 2_000_000;
+export const CELL_CACHE = 4_000_000;
 // A piece whose voxels span at most this many pixels is fine enough: its cubes already
 // merge into surfaces on screen.
 const REFINE_PIXELS = 3;
@@ -22,8 +24,9 @@ const LOADS_AT_ONCE = 2;
 export class TileStreamer {
   // set: /api/tilesets metadata; sceneOrigin: the world point at the scene's 0;
   // slice: shared uniforms (layer.js); colourOf(layer, i); changed(): called when what is
-  // drawn or loaded changes; failed(error): a piece could not be loaded.
-  constructor(set, sceneOrigin, slice, scene, colourOf, changed, failed) {
+  // drawn or loaded changes; failed(error): a piece could not be loaded; limits:
+  // { budget, cache } in cells.
+  constructor(set, sceneOrigin, slice, scene, colourOf, changed, failed, limits) {
     this.set = set;
     this.sceneOrigin = sceneOrigin;
     this.slice = slice;
@@ -31,6 +34,8 @@ export class TileStreamer {
     this.colourOf = colourOf;
     this.changed = changed;
     this.failed = failed;
+    this.budget = limits.budget;
+    this.cache = limits.cache;
     this.nodes = set.pieces.map((p) => ({
       piece: p,
       children: [],
@@ -74,7 +79,7 @@ export class TileStreamer {
       const n = queue.shift();
       const children = n.children.filter((c) => c.inView);
       const more = children.reduce((sum, c) => sum + c.piece.voxels, 0) - n.piece.voxels;
-      if (children.length && n.inView && n.priority > REFINE_PIXELS && cells + more <= CELL_BUDGET) {
+      if (children.length && n.inView && n.priority > REFINE_PIXELS && cells + more <= this.budget) {
         cells += more;
         queue.push(...children);
       } else {
@@ -104,17 +109,18 @@ export class TileStreamer {
   // cells held fit the cache.
   evict() {
     let held = this.cellsHeld();
-    if (held <= CELL_CACHE) return;
+    if (held <= this.cache) return;
     const keep = new Set(this.cut);
     const spare = this.nodes.filter((n) => n.loaded && !keep.has(n) && !n.layer.mesh.visible)
       .sort((a, b) => a.priority - b.priority);
     for (const n of spare) {
-      if (held <= CELL_CACHE) break;
+      if (held <= this.cache) break;
       held -= n.layer.total;
       n.layer.dispose();
       n.layer = null;
       n.loaded = false;
     }
+    this.changed();
   }
 
   pump() {
@@ -145,6 +151,7 @@ export class TileStreamer {
       }
       n.loaded = true;
       this.show();
+      this.evict();
     } finally {
       --this.loading;
       this.pump();
@@ -173,7 +180,9 @@ export class TileStreamer {
       overviewsLoaded: loaded.filter((n) => n.piece.level > 0).length,
       shown: this.nodes.filter((n) => n.layer && n.layer.mesh.visible).length,
       cells: this.cellsHeld(),
-      budget: CELL_BUDGET,
+      loadedTiles: loaded.filter((n) => n.piece.level === 0).map((n) => n.piece.id),
+      budget: this.budget,
+      cache: this.cache,
     };
   }
 
