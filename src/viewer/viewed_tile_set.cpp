@@ -65,10 +65,19 @@ ViewedTileSet::ViewedTileSet(const std::string& index_path, std::size_t max_open
   // An overview's points are those of the tiles it covers (the page measures distances
   // to them: the overview's own box is mostly empty).
   std::map<std::pair<int, tile::TileIndex>, Box> covered;
-  for (const auto& o : index_.overviews) covered.emplace(std::pair{o.level, o.tile}, kEmpty);
+  int levels = 0;
+  for (const auto& o : index_.overviews) {
+    // 32-bit tile indexes: from level 16 up every tile has one overview (4^16 = 2^32).
+    if (o.level < 1 || o.level > 16)
+      throw FormatError(index_path, 0, o.file + ": overview level " + std::to_string(o.level) + " is outside 1..16");
+    covered.emplace(std::pair{o.level, o.tile}, kEmpty);
+    levels = std::max(levels, o.level);
+  }
   for (const auto& t : index_.tiles)
-    for (auto& [key, box] : covered)
-      if (overview_tile(t.tile, key.first) == key.second) grow(box, t.bbox);
+    for (int level = 1; level <= levels; ++level) {
+      const auto it = covered.find(std::pair{level, overview_tile(t.tile, level)});
+      if (it != covered.end()) grow(it->second, t.bbox);
+    }
   for (const auto& o : index_.overviews)
     pieces_.push_back({o.level, o.tile, o.file, o.voxels, piece_box(index_.grid, o.level, o.tile),
                        covered.at(std::pair{o.level, o.tile})});

@@ -228,6 +228,11 @@ TEST(ViewerTiles, NoFileOutsideTheIndexsFolderIsOpened) {
   folder.features[1]["properties"]["file"] = "/etc/passwd";
   folder.write_index();
   EXPECT_THROW(ViewedTileSet(folder.index.string()), vola::FormatError);
+  folder.features[1]["properties"]["file"] = "tile_1_0_0.vol";
+  folder.overviews[0]["level"] = 1000;  // 4^1000: no grid
+  folder.write_index();
+  EXPECT_THROW(ViewedTileSet(folder.index.string()), vola::FormatError);
+  folder.overviews[0]["level"] = 1;
 
   // A tile that is a symbolic link to a file outside: served never, named only as the index names it.
   write_piece(folder.dir / "outside.vol", folder.voxels[1], 0, {1, 0, 0});
