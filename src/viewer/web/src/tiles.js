@@ -42,7 +42,8 @@ export class TileStreamer {
       parent: null,
       layer: null,    // a VoxelLayer once loading starts
       loaded: false,
-      priority: 0,
+      priority: 0,    // how large its voxels look on screen, in pixels
+      inView: false,  // whether its points' box meets the camera's frustum
       // Distances are to the piece's points, not to its grid's box (mostly empty air).
       box: new THREE.Box3(new THREE.Vector3(...p.points_min.map((v, a) => v - sceneOrigin[a])),
         new THREE.Vector3(...p.points_max.map((v, a) => v - sceneOrigin[a]))),
