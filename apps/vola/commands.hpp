@@ -38,7 +38,7 @@ inline constexpr const char* kDatasetSummary = "Make a 3D classification dataset
 inline constexpr const char* kTrainSummary = "Train a 3D CNN classifier on a `vola dataset` folder";
 inline constexpr const char* kClassifySummary = "Classify .vol objects with a 3D CNN (ModelNet10 classes)";
 inline constexpr const char* kEvaluateSummary = "Accuracy of a 3D CNN on a labelled dataset folder";
-inline constexpr const char* kViewSummary = "Show .vol files in 3D in a web browser (a local page on 127.0.0.1)";
+inline constexpr const char* kViewSummary = "Show .vol files and tile sets in 3D in a web browser (a local page on 127.0.0.1)";
 inline constexpr const char* kSonifySummary = "Hear a scene: pass a dry recording through the scene's acoustics";
 
 // vola-learn, vola-view and vola-sonify hold the subcommands above (companions.cpp): vola

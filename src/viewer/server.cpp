@@ -58,12 +58,14 @@ double real_param(const httplib::Request& req, const char* name) {
 }  // namespace
 
 struct Server::Impl {
-  Impl(std::vector<std::unique_ptr<ViewedFile>> f, ServerOptions o)
-      : files(std::move(f)), options(std::move(o)), names(names_of(options)), http(options.limits) {
+  Impl(std::vector<std::unique_ptr<ViewedFile>> f, std::vector<std::unique_ptr<ViewedTileSet>> t, ServerOptions o)
+      : files(std::move(f)), tile_sets(std::move(t)), options(std::move(o)), names(names_of(options)),
+        http(options.limits) {
     names.set_port(options.port);
   }
 
   std::vector<std::unique_ptr<ViewedFile>> files;
+  std::vector<std::unique_ptr<ViewedTileSet>> tile_sets;
   ServerOptions options;
   HostNames names;
   BoundedHttpServer http;
@@ -81,6 +83,22 @@ struct Server::Impl {
     if (ec != std::errc{} || end != text.data() + text.size() || i >= files.size())
       throw NotFound("no file " + text + " (this viewer serves files 0.." + std::to_string(files.size() - 1) + ")");
     return *files[i];
+  }
+
+  // Piece req.matches[2] of tile set req.matches[1].
+  std::shared_ptr<const ViewedFile> piece(const httplib::Request& req) const {
+    const std::string& set_text = req.matches[1];
+    const std::string& piece_text = req.matches[2];
+    std::size_t s = 0, p = 0;
+    const auto [set_end, set_ec] = std::from_chars(set_text.data(), set_text.data() + set_text.size(), s);
+    if (set_ec != std::errc{} || set_end != set_text.data() + set_text.size() || s >= tile_sets.size())
+      throw NotFound("no tile set " + set_text + " (this viewer serves " + std::to_string(tile_sets.size()) + ")");
+    const ViewedTileSet& set = *tile_sets[s];
+    const auto [piece_end, piece_ec] = std::from_chars(piece_text.data(), piece_text.data() + piece_text.size(), p);
+    if (piece_ec != std::errc{} || piece_end != piece_text.data() + piece_text.size() || p >= set.pieces().size())
+      throw NotFound("no piece " + piece_text + " in tile set " + set_text + " (it has pieces 0.." +
+                     std::to_string(set.pieces().size() - 1) + ")");
+    return set.piece(p);
   }
 
   // Runs a handler, turning vola errors into 400/404 with a JSON message.
@@ -137,6 +155,23 @@ struct Server::Impl {
       const auto count = integer_param<std::uint64_t>(req, "count", 0, kMaxBatchCells);
       res.set_content(f.cell_batch(level, first, count), "application/octet-stream");
     }));
+    http.Get("/api/tilesets", [this](const httplib::Request&, httplib::Response& res) {
+      nlohmann::json list = nlohmann::json::array();
+      for (std::size_t i = 0; i < tile_sets.size(); ++i) {
+        list.push_back(tile_sets[i]->metadata());
+        list.back()["index"] = i;
+      }
+      send_json(res, 200, list);
+    });
+    http.Get(R"(/api/tilesets/(\d+)/pieces/(\d+)/cells)",
+             guarded([this](const httplib::Request& req, httplib::Response& res) {
+               const auto f = piece(req);
+               const int level = integer_param<int>(req, "level", 0, f->tree().depth() - 1);
+               const auto first =
+                   integer_param<std::uint64_t>(req, "first", 0, std::numeric_limits<std::uint64_t>::max());
+               const auto count = integer_param<std::uint64_t>(req, "count", 0, kMaxBatchCells);
+               res.set_content(f->cell_batch(level, first, count), "application/octet-stream");
+             }));
     http.Get(R"(/api/files/(\d+)/cell)", guarded([this](const httplib::Request& req, httplib::Response& res) {
       const ViewedFile& f = file(req);
       const int level = integer_param<int>(req, "level", 0, f.tree().depth() - 1);
@@ -180,7 +215,11 @@ struct Server::Impl {
 };
 
 Server::Server(std::vector<std::unique_ptr<ViewedFile>> files, ServerOptions options)
-    : impl_(std::make_unique<Impl>(std::move(files), std::move(options))) {
+    : Server(std::move(files), {}, std::move(options)) {}
+
+Server::Server(std::vector<std::unique_ptr<ViewedFile>> files, std::vector<std::unique_ptr<ViewedTileSet>> tile_sets,
+               ServerOptions options)
+    : impl_(std::make_unique<Impl>(std::move(files), std::move(tile_sets), std::move(options))) {
   impl_->guards();
   impl_->routes();
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "crs_units.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/error.hpp"
 #include "vola/map/state_map.hpp"
@@ -118,6 +119,7 @@ nlohmann::json ViewedFile::metadata() const {
           {"voxel_size", frame.voxel_size},
           {"epsg", layout_.header.epsg},
           {"crs_wkt", tree_.georef().crs_wkt},
+          {"units", crs_units(tree_.georef())},
           {"attributes", attributes},
           {"has_classes", classes_ != nullptr},
           {"has_colours", rgb_[0] != nullptr},

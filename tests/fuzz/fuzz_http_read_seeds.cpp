@@ -1,5 +1,5 @@
 // Seeds for fuzz_http_read: the requests vola view's page sends (the page, its script,
-// the file list, cell batches, one cell, picks), pipelined, with a body, chunked, with a
+// the file list, cell batches, one cell, picks, the tile sets and a tile's cells), pipelined, with a body, chunked, with a
 // foreign Host, percent-escapes that are not UTF-8; and, from the shared golden folder,
 // requests carrying each small golden .vol file as their body (the API takes no bodies:
 // the server must read past or refuse them). Linked into fuzz_http_read_replay in place
@@ -31,6 +31,10 @@ std::vector<Seed> synthetic_seeds() {
       text("files", get("/api/files")),
       text("cells", get("/api/files/0/cells?level=2&first=0&count=100")),
       text("cell", get("/api/files/0/cell?level=3&x=1&y=2&z=0")),
+      text("tilesets", get("/api/tilesets")),
+      text("tile_cells", get("/api/tilesets/0/pieces/0/cells?level=3&first=0&count=100")),
+      text("tile_bad", get("/api/tilesets/0/pieces/1/cells?level=0&first=0&count=1") +
+                           get("/api/tilesets/3/pieces/0/cells?level=0&first=0&count=1")),
       text("pick", get("/api/files/0/pick?level=3&ox=-1&oy=0.5&oz=0.5&dx=1&dy=0&dz=0&tmax=100")),
       text("pipelined", get("/api/files") + get("/api/files/0/cell?level=0&x=0&y=0&z=0") + get("/api/files/9/cells?level=1&first=0&count=1")),
       text("foreign_host", "GET /api/files HTTP/1.1\r\nHost: evil.example:8080\r\n\r\n"),

@@ -1,33 +1,23 @@
 // vola view end to end in headless Chromium (Debian's, driven by playwright-core):
 // converts a real LAS survey, serves it beside a coarser conversion of the same survey,
-// and checks that the page shows the voxel counts `vola info` reports, that clicks pick
+// and checks that the page shows the voxel counts and levels `vola info` reports, that clicks pick
 // the voxel the camera's ray meets first (computed here from `vola voxels`, with and
 // without the slicing plane), that the page needs nothing but the loopback server, that
-// bad API requests get clear errors without stopping the server, and that the
-// screenshot it writes is not blank.
+// bad API requests get clear errors without stopping the server, that the first camera
+// has the whole survey in view, with a scale bar in feet and a north arrow (the survey's
+// CRS is in feet), and that the screenshot it writes is not blank.
 // Usage: node browser_test.mjs VOLA DATA_DIR NODE_MODULES CHROMIUM OUT.png ($VOLA_SHARED/data if set)
 // Exit 77 (skip) when the data is missing and CI is not set.
-import { spawn, execFileSync } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
-import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { existsSync } from 'node:fs';
+import {
+  autzenOrSkip, check, dataInView, launchChromium, openPage, screenshotNotBlank, startView,
+} from './browser_support.mjs';
 
 const [vola, defaultDataDir, nodeModules, chromiumPath, screenshotPath] = process.argv.slice(2);
-// VOLA_SHARED in the environment overrides the configured data folder, as for every test.
-const dataDir = process.env.VOLA_SHARED ? path.join(process.env.VOLA_SHARED, 'data') : defaultDataDir;
-const las = path.join(dataDir, 'las', 'pdal_autzen_trim.las');
-if (!existsSync(las)) {
-  if (process.env.CI) { console.error(`FAIL: ${las} is missing (CI is set)`); process.exit(1); }
-  console.log(`SKIP: ${las} is missing; set VOLA_SHARED`);
-  process.exit(77);
-}
-const { chromium } = createRequire(path.join(nodeModules, 'noop.js'))('playwright-core');
-
-function check(condition, message) {
-  if (!condition) throw new Error(message);
-}
+const las = autzenOrSkip(defaultDataDir);
 const run = (...args) => execFileSync(vola, args, { encoding: 'utf8', maxBuffer: 1 << 28 });
 
 const tmp = mkdtempSync(path.join(tmpdir(), 'vola-view-'));
@@ -69,37 +59,10 @@ try {
   const size = info.voxel_size;
   const centreOf = (v) => v.map((c, a) => info.origin[a] + (c + 0.5) * size);
 
-  server = spawn(vola, ['view', fine, coarse], { stdio: ['ignore', 'pipe', 'inherit'] });
-  const url = await new Promise((resolve, reject) => {
-    let out = '';
-    server.stdout.on('data', (chunk) => {
-      out += chunk;
-      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve(m[0]);
-    });
-    server.on('exit', (code) => reject(new Error(`vola view exited (${code}): ${out}`)));
-  });
-  console.log(`vola view serves ${url}`);
-
-  browser = await chromium.launch({
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--no-sandbox', '--headless', '--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync', '--disable-default-apps',
-      '--disable-domain-reliability', '--no-first-run', '--metrics-recording-only', '--no-pings'],
-  });
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
-  // The page must need nothing but the loopback server.
-  const foreign = [];
-  await page.route('**/*', (route) => {
-    const u = route.request().url();
-    if (u.startsWith(url)) return route.continue();
-    foreign.push(u);
-    return route.abort();
-  });
+  let url;
+  ({ server, url } = await startView(vola, [fine, coarse]));
+  browser = await launchChromium(nodeModules, chromiumPath);
+  const { page, problems, foreign } = await openPage(browser, url);
 
   const started = Date.now();
   await page.goto(url);
@@ -111,6 +74,13 @@ try {
     const shown = await page.textContent(`[data-testid=voxel-count-${i}]`);
     check(Number(shown.replace(/,/g, '')) === expected, `file ${i}: the page shows ${shown} voxels, vola info ${expected}`);
   }
+  // The first camera has every voxel's box in view.
+  const bounds = await page.evaluate(() => window.volaView.state.bounds);
+  check(await dataInView(page, bounds), `the first camera crops the survey (${JSON.stringify(bounds)})`);
+  // Feet, as the survey's CRS (EPSG:2994) says, and north shown.
+  check(await page.getAttribute('#scale', 'data-unit') === 'foot', 'the scale bar is not in feet');
+  check(/^\d+ ft$/.test(await page.textContent('#scale-label')), `scale: ${await page.textContent('#scale-label')}`);
+  check(await page.isVisible('#north'), 'no north arrow');
 
   // Hide the coarse survey with its toggle, show the finest level, look down the column.
   await page.click('[data-testid=visible-1]');
@@ -124,6 +94,10 @@ try {
     await window.volaView.setDetail(depth);
     window.volaView.lookDownAt(target, 300);
   }, [info.depth, centreOf(top)]);
+  // Levels as vola info counts them: the finest is depth - 1.
+  const label = await page.textContent('#detail-label');
+  check(label.includes(`fine.vol: level ${info.depth - 1} (levels 0-${info.depth - 1}, depth ${info.depth})`) &&
+    info.levels.length === info.depth, `the detail label reads: ${label}`);
   let pick = await pickAtCentre();
   check(pick && pick.file === 0, `the click picked nothing in the fine survey: ${JSON.stringify(pick)}`);
   check(pick.voxel.join(' ') === top.join(' '), `picked voxel ${pick.voxel}, expected the column's top ${top}`);
@@ -159,30 +133,7 @@ try {
 
   // The screenshot: the whole survey, coloured by height; not blank.
   await page.evaluate(() => window.volaView.frameAll());
-  const png = await page.screenshot({ path: screenshotPath });
-  const stats = await page.evaluate(async (b64) => {
-    const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-    const image = await createImageBitmap(new Blob([bytes], { type: 'image/png' }));
-    const canvas = new OffscreenCanvas(image.width, image.height);
-    const context = canvas.getContext('2d');
-    context.drawImage(image, 0, 0);
-    const data = context.getImageData(0, 0, image.width, image.height).data;
-    let sum = 0, sum2 = 0, away = 0;
-    const colours = new Set();
-    const n = data.length / 4;
-    for (let i = 0; i < data.length; i += 4) {
-      const l = 0.299 * data[i] + 0.587 * data[i + 1] + 0.114 * data[i + 2];
-      sum += l; sum2 += l * l;
-      // Pixels unlike the background (#15181d).
-      if (Math.abs(data[i] - 0x15) + Math.abs(data[i + 1] - 0x18) + Math.abs(data[i + 2] - 0x1d) > 30) ++away;
-      colours.add((data[i] << 16) | (data[i + 1] << 8) | data[i + 2]);
-    }
-    const mean = sum / n;
-    return { variance: sum2 / n - mean * mean, drawn: away / n, colours: colours.size };
-  }, png.toString('base64'));
-  console.log(`screenshot ${screenshotPath}: luminance variance ${stats.variance.toFixed(1)}, ` +
-    `${(100 * stats.drawn).toFixed(1)}% of pixels drawn, ${stats.colours} colours`);
-  check(stats.variance > 100 && stats.drawn > 0.1 && stats.colours > 200, 'the screenshot is (nearly) blank');
+  await screenshotNotBlank(page, screenshotPath);
 
   check(foreign.length === 0, `the page asked for other hosts: ${foreign.join(', ')}`);
   check(problems.length === 0, problems.join('\n'));

@@ -8,6 +8,8 @@
 //   GET /api/files/F/cell?level=L&x=X&y=Y&z=Z        JSON: one cell (ViewedFile::cell_info)
 //   GET /api/files/F/pick?level=L&ox=..&oy=..&oz=..&dx=..&dy=..&dz=..[&tmax=T]
 //                                            JSON: the first cell along a ray in cell units
+//   GET /api/tilesets                        JSON: every tile set's pieces (ViewedTileSet::metadata)
+//   GET /api/tilesets/S/pieces/P/cells?level=L&first=I&count=N   a batch of piece P's cells
 // Bad requests get status 400 (404 for an unknown file or path) and {"error": "..."}.
 //
 // Any web page the user opens can make the browser send requests here, and any local
@@ -20,8 +22,9 @@
 //   not received within receive_timeout 408; a connection over the waiting limit gets 503;
 //   an error answer closes its connection;
 // - a path or query that is not UTF-8 gets 400, an unknown path 404; it serves the
-//   compiled-in page and the files it was given (by index), nothing from the file system,
-//   and names those files by their base names only.
+//   compiled-in page, the files it was given and the pieces their tile indexes list (by
+//   index; viewed_tile_set.hpp keeps them inside the index's folder), nothing else from
+//   the file system, and names files by their base names (pieces by their names in the index).
 #pragma once
 
 #include <chrono>
@@ -32,6 +35,7 @@
 #include <vector>
 
 #include "vola/viewer/viewed_file.hpp"
+#include "vola/viewer/viewed_tile_set.hpp"
 
 namespace vola::viewer {
 
@@ -61,6 +65,8 @@ struct ServerOptions {
 class Server {
  public:
   Server(std::vector<std::unique_ptr<ViewedFile>> files, ServerOptions options = {});
+  Server(std::vector<std::unique_ptr<ViewedFile>> files, std::vector<std::unique_ptr<ViewedTileSet>> tile_sets,
+         ServerOptions options = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

@@ -58,8 +58,9 @@ class ViewedFile {
   bool is_state_map() const noexcept { return state_map_; }
   const CellIndex& cells() const noexcept { return index_; }
 
-  // Name (base name only), counts per level, grid frame, CRS, attributes, the classes present with their
-  // ASPRS names: what the page needs before asking for cells.
+  // Name (base name only), counts per level, grid frame, CRS and its unit (crs_units.hpp),
+  // attributes, the classes present with their ASPRS names: what the page needs before
+  // asking for cells.
   nlohmann::json metadata() const;
   // Cells [first, first + count) of `level` as a binary batch (format above); count is
   // clipped to the cells there are. InvalidArgument for a bad level or count.

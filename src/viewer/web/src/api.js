@@ -12,6 +12,10 @@ export function fetchFiles() {
   return getJson('/api/files');
 }
 
+export function fetchTileSets() {
+  return getJson('/api/tilesets');
+}
+
 // A ray in the level's cell units: origin o, direction d, optional tMax.
 export function fetchPick(file, level, o, d, tMax) {
   const q = new URLSearchParams({ level, ox: o[0], oy: o[1], oz: o[2], dx: d[0], dy: d[1], dz: d[2] });
@@ -24,8 +28,16 @@ const FLAG_COLOURS = 2;
 const HEADER_BYTES = 32;
 
 // Cells [first, first + count) of a level: { first, count, coords, classes, colours }.
-export async function fetchCells(file, level, first, count) {
-  const url = `/api/files/${file}/cells?level=${level}&first=${first}&count=${count}`;
+export function fetchCells(file, level, first, count) {
+  return fetchBatch(`/api/files/${file}/cells?level=${level}&first=${first}&count=${count}`);
+}
+
+// The same from piece `piece` of tile set `set`.
+export function fetchPieceCells(set, piece, level, first, count) {
+  return fetchBatch(`/api/tilesets/${set}/pieces/${piece}/cells?level=${level}&first=${first}&count=${count}`);
+}
+
+async function fetchBatch(url) {
   const response = await fetch(url);
   if (!response.ok) throw new Error((await response.json()).error || `${url}: HTTP ${response.status}`);
   const buffer = await response.arrayBuffer();

@@ -80,9 +80,10 @@ export class VoxelLayer {
       geometry.setDrawRange(0, 0);
     } else {
       geometry = new THREE.InstancedBufferGeometry();
-      geometry.index = unitCube.index;
-      geometry.setAttribute('position', unitCube.getAttribute('position'));
-      geometry.setAttribute('normal', unitCube.getAttribute('normal'));
+      // Copies (24 vertices): disposing a layer frees its buffers, which others must not share.
+      geometry.index = unitCube.index.clone();
+      geometry.setAttribute('position', unitCube.getAttribute('position').clone());
+      geometry.setAttribute('normal', unitCube.getAttribute('normal').clone());
       this.cellAttribute = new THREE.InstancedBufferAttribute(this.cells, 3);
       this.colourAttribute = new THREE.InstancedBufferAttribute(this.colours, 3, true);
       geometry.setAttribute('cell', this.cellAttribute);
@@ -122,6 +123,13 @@ export class VoxelLayer {
   recolour(colourOf, from = 0, to = this.loaded) {
     for (let i = from; i < to; ++i) this.colours.set(colourOf(this, i), 3 * i);
     this.colourAttribute.needsUpdate = true;
+  }
+
+  // Frees the GPU buffers; the layer is not drawn again.
+  dispose() {
+    this.mesh.removeFromParent();
+    this.mesh.geometry.dispose();
+    this.material.dispose();
   }
 
   // The world z of cell i's centre, relative to the file's origin.

@@ -1,11 +1,15 @@
 // vola view: the page. Loads every file's metadata, streams levels coarse to fine as
-// binary batches, and answers clicks by casting the click's ray on the server at the
-// level shown. window.volaView exposes the state and a few actions for scripts (the
-// browser test drives the page through it and through real clicks).
+// binary batches, streams tile sets by distance from the camera (tiles.js), and answers
+// clicks on files by casting the click's ray on the server at the level shown. A scale
+// bar in the CRS's unit and a north arrow follow the camera (overlay.js).
+// window.volaView exposes the state and a few actions for scripts (the browser tests
+// drive the page through it and through real clicks).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { fetchCells, fetchFiles, fetchPick } from './api.js';
+import { fetchCells, fetchFiles, fetchPick, fetchTileSets } from './api.js';
 import { VoxelLayer } from './layer.js';
+import { unitLabel, updateNorthArrow, updateScaleBar } from './overlay.js';
+import { CELL_BUDGET, CELL_CACHE, TileStreamer } from './tiles.js';
 import { classColour, fileColour, rampColour } from './palette.js';
 
 const BATCH_CELLS = 1 << 20;
@@ -22,7 +26,7 @@ const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(45, 1, 0.1, 1e7);
 camera.up.set(0, 0, 1);
 const controls = new OrbitControls(camera, canvas);
-controls.addEventListener('change', render);
+controls.addEventListener('change', () => { render(); cutTileSets(); });
 
 // Uniforms every layer shares: the slicing plane, and pixels per unit of size at unit
 // distance (for layers drawn as points).
@@ -40,6 +44,9 @@ scene.add(highlight);
 
 const state = {
   files: [],
+  tileSets: [],
+  streamers: [],           // one TileStreamer per tile set
+  units: { unit: 'units', north: false },  // of the first file or set that states a CRS
   sceneOrigin: [0, 0, 0],  // world point at the scene's 0 (float32 on the GPU needs small numbers)
   bounds: null,            // world box of every file's voxels: { min, max }
   detail: 1,
@@ -58,7 +65,38 @@ function render() {
   requestAnimationFrame(() => {
     frameRequested = false;
     renderer.render(scene, camera);
+    updateScaleBar($('scale'), camera, controls.target, cssPixelsPerUnit(), state.units.unit);
+    updateNorthArrow($('north'), camera, controls.target, state.units.north);
   });
+}
+
+// Screen (CSS) pixels one unit spans at unit distance from the camera.
+function cssPixelsPerUnit() {
+  return window.innerHeight / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2));
+}
+
+// Cuts every tile set's tree again for the camera, once per frame however many moves.
+let cutRequested = false;
+function cutTileSets() {
+  if (cutRequested || !state.streamers.length) return;
+  cutRequested = true;
+  requestAnimationFrame(() => {
+    cutRequested = false;
+    for (const streamer of state.streamers) streamer.update(camera, cssPixelsPerUnit());
+  });
+}
+
+function reportTiles() {
+  for (const [i, streamer] of state.streamers.entries()) {
+    const c = streamer.counts();
+    const row = $(`tiles-${i}`);
+    const number = (n) => n.toLocaleString('en-US');
+    row.textContent = `${c.loaded} of ${c.pieces} pieces loaded (${c.tilesLoaded} tiles, ${c.overviewsLoaded} ` +
+      `overviews), ${c.shown} drawn, ${number(c.cells)} cells (budget ${number(c.budget)})`;
+    row.dataset.tilesLoaded = String(c.tilesLoaded);
+    row.dataset.overviewsLoaded = String(c.overviewsLoaded);
+    row.dataset.cells = String(c.cells);
+  }
 }
 
 function resize() {
@@ -132,10 +170,12 @@ function updateVisibility() {
 function setDetail(d) {
   state.detail = d;
   $('detail').value = d;
+  // Levels as vola info counts them: 0 (the root's 4x4x4 cells) to depth - 1 (the voxels).
   $('detail-label').textContent = state.files.map((f) => {
     const level = levelOf(f);
-    return `${f.name}: level ${level} of ${f.depth - 1}, ${f.levels[level].cells.toLocaleString()} cells` +
-      ` of ${f.levels[level].cell_size} units`;
+    const { cells, cell_size: size } = f.levels[level];
+    return `${f.name}: level ${level} (levels 0-${f.depth - 1}, depth ${f.depth}), ` +
+      `${cells.toLocaleString()} cells of ${size} ${unitLabel(f.units.unit)}`;
   }).join('\n');
   updateVisibility();
   state.loading = state.loading.then(async () => {
@@ -154,6 +194,7 @@ function setDetail(d) {
 
 function recolourAll() {
   for (const layer of state.layers.values()) layer.recolour(colourOf);
+  for (const streamer of state.streamers) streamer.recolour();
   renderLegend();
   render();
 }
@@ -183,6 +224,7 @@ function renderLegend() {
     row(rampColour(1), `${state.bounds.max[2].toFixed(2)} (highest)`);
   } else if (state.colourMode === 'file') {
     for (const f of state.files) row(fileColour(f.index), f.name);
+    for (const t of state.tileSets) row(fileColour(t.index), `${t.name} (tile set)`);
   } else if (!state.files.some((f) => f.has_colours)) {
     legend.append('no file has red/green/blue columns');
   }
@@ -282,18 +324,24 @@ function showPick(pick) {
   render();
 }
 
-// Frames the whole scene from above and to the south.
+// Frames the whole scene from above and to the south: the camera backs off until the
+// sphere around the data's box fits the narrower of the two fields of view.
 function frameAll() {
   const { min, max } = state.bounds;
   const centre = min.map((m, a) => (m + max[a]) / 2 - state.sceneOrigin[a]);
   const radius = Math.max(Math.hypot(max[0] - min[0], max[1] - min[1], max[2] - min[2]) / 2, 1);
+  const halfHeight = THREE.MathUtils.degToRad(camera.fov) / 2;
+  const halfWidth = Math.atan(Math.tan(halfHeight) * camera.aspect);
+  const distance = radius / Math.sin(Math.min(halfHeight, halfWidth));
+  const direction = new THREE.Vector3(0, -1.15, 0.9).normalize();
   controls.target.set(...centre);
-  camera.position.set(centre[0], centre[1] - 1.15 * radius, centre[2] + 0.9 * radius);
+  camera.position.set(...centre).addScaledVector(direction, distance);
   camera.near = radius / 1000;
-  camera.far = radius * 100;
+  camera.far = (distance + radius) * 100;
   camera.updateProjectionMatrix();
   controls.update();
   render();
+  cutTileSets();
 }
 
 // Looks straight down at world point p from `height` above it: the canvas centre's ray
@@ -304,6 +352,7 @@ function lookDownAt(p, height) {
   camera.position.set(target[0], target[1], target[2] + height);
   controls.update();
   render();
+  cutTileSets();
 }
 
 function buildFileList() {
@@ -327,19 +376,40 @@ function buildFileList() {
     n.dataset.testid = `voxel-count-${file.index}`;
     n.dataset.voxels = String(file.voxels);
     n.textContent = file.voxels.toLocaleString('en-US');
-    count.append(n, ` voxels, depth ${file.depth}, voxel ${file.voxel_size} units` +
+    const unit = unitLabel(file.units.unit);
+    count.append(n, ` voxels, depth ${file.depth}, voxel ${file.voxel_size} ${unit}` +
       (file.epsg !== 2000 ? `, EPSG:${file.epsg}` : file.crs_wkt ? ', CRS from WKT' : ''));
     row.append(label, count);
+    list.append(row);
+  }
+  for (const set of state.tileSets) {
+    const row = document.createElement('div');
+    row.className = 'file';
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = `rgb(${fileColour(set.index).join(',')})`;
+    const title = document.createElement('div');
+    title.append(swatch, `${set.name} (tile set)`);
+    const about = document.createElement('div');
+    const unit = unitLabel(set.units.unit);
+    const overviews = set.overview_levels ? `overview levels 1-${set.overview_levels}` : 'no overviews';
+    about.textContent = `${set.tiles} tiles of ${set.tile_size} ${unit}, depth ${set.depth}, voxel ` +
+      `${set.voxel_size} ${unit}, ${overviews}` +
+      (set.epsg !== null ? `, EPSG:${set.epsg}` : set.crs_wkt ? ', CRS from WKT' : '');
+    const status = document.createElement('div');
+    status.className = 'count';
+    status.id = `tiles-${set.index}`;
+    row.append(title, about, status);
     list.append(row);
   }
 }
 
 async function main() {
-  state.files = await fetchFiles();
+  [state.files, state.tileSets] = await Promise.all([fetchFiles(), fetchTileSets()]);
   state.visible = state.files.map(() => true);
   const nonEmpty = state.files.filter((f) => f.voxels > 0);
-  if (!nonEmpty.length) throw new Error('every file is empty');
-  state.sceneOrigin = [...nonEmpty[0].origin];
+  if (!nonEmpty.length && !state.tileSets.length) throw new Error('every file is empty');
+  state.sceneOrigin = nonEmpty.length ? [...nonEmpty[0].origin] : [...state.tileSets[0].points_min];
   const min = [Infinity, Infinity, Infinity];
   const max = [-Infinity, -Infinity, -Infinity];
   for (const f of nonEmpty)
@@ -347,9 +417,21 @@ async function main() {
       min[a] = Math.min(min[a], f.origin[a] + f.voxels_min[a] * f.voxel_size);
       max[a] = Math.max(max[a], f.origin[a] + (f.voxels_max[a] + 1) * f.voxel_size);
     }
+  for (const t of state.tileSets)
+    for (let a = 0; a < 3; ++a) {
+      min[a] = Math.min(min[a], t.points_min[a]);
+      max[a] = Math.max(max[a], t.points_max[a]);
+    }
   state.bounds = { min, max };
+  state.units = [...state.files, ...state.tileSets].map((f) => f.units).find((u) => u.unit !== 'units') ||
+    state.units;
   buildFileList();
-  const maxDepth = Math.max(...state.files.map((f) => f.depth));
+  const query = new URLSearchParams(window.location.search);
+  const limits = { budget: Number(query.get('budget')) || CELL_BUDGET, cache: Number(query.get('cache')) || CELL_CACHE };
+  state.streamers = state.tileSets.map((set) => new TileStreamer(set, state.sceneOrigin, slice, scene, colourOf,
+    () => { reportTiles(); render(); }, (e) => setStatus(e.message, true), limits));
+  $('detail-section').hidden = !state.files.length;
+  const maxDepth = Math.max(1, ...state.files.map((f) => f.depth));
   $('detail').max = maxDepth;
   let d = 1;
   while (d < maxDepth && state.files.reduce((sum, f) => sum + f.levels[Math.min(d + 1, f.depth) - 1].cells, 0) <=
@@ -391,9 +473,17 @@ function setSlice(on, axis = 2, at = 0) {
 
 window.volaView = {
   state,
+  camera,
   setSlice,
   ready: main().catch((e) => { setStatus(e.message, true); throw e; }),
-  whenIdle: () => state.loading,
+  // Files and tile sets loaded as far as the detail and the camera ask.
+  whenIdle: async () => {
+    await state.loading;
+    // A cut for the camera as it is now, not as the next frame will find it.
+    for (const streamer of state.streamers) streamer.update(camera, cssPixelsPerUnit());
+    await Promise.all(state.streamers.map((s) => s.idle()));
+  },
+  tileCounts: () => state.streamers.map((s) => s.counts()),
   setDetail,
   pickAt,
   lookDownAt,
