@@ -103,6 +103,8 @@ class ExpressionParser {
     return false;
   }
   std::size_t add(Expression::Node node) {
+    // A chain of && or || makes a tree as deep as it is long: evaluation recurses it.
+    if (e_.nodes_.size() >= 4096) fail(peek().position, "more than 4096 comparisons and operators");
     e_.nodes_.push_back(std::move(node));
     return e_.nodes_.size() - 1;
   }
@@ -128,17 +130,28 @@ class ExpressionParser {
     }
     return left;
   }
+  // Nesting (! and parentheses) recurses, and so does evaluation over the tree: bounded,
+  // as no filter a person writes nests this deep ("!!!!..." overflowed the stack).
+  static constexpr int kMaxNesting = 256;
+  void nest(std::size_t position) {
+    if (++depth_ > kMaxNesting) fail(position, "nested more than " + std::to_string(kMaxNesting) + " deep");
+  }
   std::size_t parse_unary() {
-    if (accept_op("!")) {
+    if (peek().type == Token::op && peek().text == "!") {
+      nest(peek().position);
+      ++at_;
       Expression::Node n;
       n.kind = Expression::Kind::not_;
       n.left = parse_unary();
+      --depth_;
       return add(std::move(n));
     }
     if (peek().type == Token::lparen) {
       const std::size_t open = peek().position;
+      nest(open);
       ++at_;
       const std::size_t inner = parse_or();
+      --depth_;
       if (peek().type != Token::rparen)
         fail(peek().position, "expected ')' to close the '(' at character " + std::to_string(open) + ", found " +
                                   describe(peek()));
@@ -188,6 +201,7 @@ class ExpressionParser {
   Expression& e_;
   std::vector<Token> tokens_;
   std::size_t at_ = 0;
+  int depth_ = 0;  // ! and ( being parsed
 };
 
 Expression::Expression(std::string text) : text_(std::move(text)) {

@@ -110,3 +110,15 @@ TEST(Expression, ListsItsDimensionsOnceInOrder) {
 }
 
 }  // namespace
+
+// Parsing and evaluation recurse: nesting and length are bounded with an error, where
+// "!!!!..." used to overflow the stack (fuzz_filters_read).
+TEST(Expression, DeepNestingAndEndlessChainsAreRefused) {
+  EXPECT_THROW(vola::filters::Expression(std::string(300, '!') + "x == 1"), vola::InvalidArgument);
+  EXPECT_THROW(vola::filters::Expression(std::string(300, '(') + "x == 1" + std::string(300, ')')),
+               vola::InvalidArgument);
+  std::string chain = "x == 1";
+  for (int i = 0; i < 5000; ++i) chain += " && x == 1";
+  EXPECT_THROW(vola::filters::Expression{chain}, vola::InvalidArgument);
+  EXPECT_NO_THROW(vola::filters::Expression(std::string(200, '!') + "x == 1"));
+}
