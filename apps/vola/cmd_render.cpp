@@ -49,28 +49,6 @@ std::array<std::uint32_t, 2> parse_size(const std::string& text) {
   throw InvalidArgument("--size must be WIDTHxHEIGHT with each 1..16384, e.g. 640x480 (got '" + text + "')");
 }
 
-// The default view: from above one corner of the occupied bounding box, looking at its centre.
-raycast::PinholeCamera default_camera(const Tree& tree) {
-  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  const int level = std::min(tree.depth() - 1, 3);
-  const double cell = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
-  tree.for_each_node(level, [&](const Voxel& c) {
-    const double p[3] = {c.x * cell, c.y * cell, c.z * cell};
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a] + cell);
-    }
-  });
-  raycast::PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (lo[a] + hi[a]);
-    extent = std::max(extent, hi[a] - lo[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
-}
-
 std::string with_suffix(const std::string& path, const std::string& suffix) {
   const auto dot = path.rfind('.');
   const auto slash = path.find_last_of('/');
@@ -92,7 +70,7 @@ std::vector<std::uint16_t> depth_image(const raycast::Rendering& r) {
   return out;
 }
 
-// The default view of a tile set: the same placement as default_camera, over the
+// The default view of a tile set: the same placement as raycast::overview_camera, over the
 // points' bounding box of every tile (read from the index, no tile opened).
 raycast::PinholeCamera default_camera(const tile::TileSet& tiles) {
   Box box = tiles.index().tiles.front().bbox;
@@ -169,7 +147,7 @@ void run_render(const RenderArgs& a) {
     return;
   }
   const Tree tree = open_voxels(a.input);
-  if (a.camera.empty()) camera = default_camera(tree);
+  if (a.camera.empty()) camera = raycast::overview_camera(tree);
   else if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   const raycast::RayCaster caster(tree);
   render_frames(a, camera, width, height,
