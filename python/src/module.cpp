@@ -1,5 +1,6 @@
-// The vola Python module (vola._vola): the error family and the parts, each in its own
-// file (building.cpp, tree.cpp, tree_analysis.cpp, tiles.cpp, map.cpp).
+// The vola Python module (vola._vola): the error family and the parts, each in its own file
+// (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, tiles.cpp,
+// map.cpp).
 #include "python_support.hpp"
 
 PYBIND11_MODULE(_vola, m) {
@@ -28,6 +29,8 @@ PYBIND11_MODULE(_vola, m) {
   using namespace vola::python;
   py::class_<Tree> tree = bind_tree(m);
   bind_tree_analysis(tree);
+  bind_setops(m, tree);
+  bind_morphology(tree);
   bind_building(m);
   bind_tiles(m);
   bind_map(m);

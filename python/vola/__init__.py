@@ -55,11 +55,13 @@ from ._vola import (
     compression_available,
     convert,
     describe_crs,
+    difference,
     export_las,
-    free_tree,
     export_map,
+    free_tree,
     from_dense,
     input_formats,
+    intersect,
     occupied_tree,
     open_mapped,
     open_tiles,
@@ -68,6 +70,7 @@ from ._vola import (
     read,
     state,
     translate,
+    union,
 )
 
 __all__ = [
@@ -87,11 +90,13 @@ __all__ = [
     "compression_available",
     "convert",
     "describe_crs",
+    "difference",
     "export_las",
-    "free_tree",
     "export_map",
+    "free_tree",
     "from_dense",
     "input_formats",
+    "intersect",
     "occupied_tree",
     "open",
     "open_mapped",
@@ -101,6 +106,7 @@ __all__ = [
     "read",
     "state",
     "translate",
+    "union",
 ]
 
 
