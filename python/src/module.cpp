@@ -1,6 +1,6 @@
 // The vola Python module (vola._vola): the error family and the parts, each in its own file
-// (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, tiles.cpp,
-// map.cpp).
+// (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, render.cpp,
+// collide.cpp, tiles.cpp, map.cpp).
 #include "python_support.hpp"
 
 PYBIND11_MODULE(_vola, m) {
@@ -31,6 +31,8 @@ PYBIND11_MODULE(_vola, m) {
   bind_tree_analysis(tree);
   bind_setops(m, tree);
   bind_morphology(tree);
+  bind_render(tree);
+  bind_collide(tree);
   bind_building(m);
   bind_tiles(m);
   bind_map(m);

@@ -130,5 +130,7 @@ void bind_tiles(py::module_& m);
 void bind_map(py::module_& m);
 void bind_setops(py::module_& m, py::class_<Tree>& tree);
 void bind_morphology(py::class_<Tree>& tree);
+void bind_render(py::class_<Tree>& tree);
+void bind_collide(py::class_<Tree>& tree);
 
 }  // namespace vola::python
