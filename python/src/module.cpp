@@ -1,6 +1,6 @@
-// The vola Python module (vola._vola): the error family and the parts, each in its own file
-// (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, render.cpp,
-// collide.cpp, export.cpp, filters.cpp, tiles.cpp, map.cpp).
+// The vola Python module (vola._vola): the error family and the parts, each in its own
+// file (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, render.cpp,
+// collide.cpp, export.cpp, filters.cpp, tiling.cpp, tiles.cpp, map.cpp).
 #include "python_support.hpp"
 
 PYBIND11_MODULE(_vola, m) {
@@ -36,6 +36,7 @@ PYBIND11_MODULE(_vola, m) {
   bind_building(m);
   bind_export(m, tree);
   bind_filters(m);
+  bind_tiling(m);
   bind_tiles(m);
   bind_map(m);
 }

@@ -134,5 +134,6 @@ void bind_render(py::class_<Tree>& tree);
 void bind_collide(py::class_<Tree>& tree);
 void bind_export(py::module_& m, py::class_<Tree>& tree);
 void bind_filters(py::module_& m);
+void bind_tiling(py::module_& m);
 
 }  // namespace vola::python

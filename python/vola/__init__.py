@@ -31,6 +31,18 @@ or free) and a "log_odds" column; vola.state(tree, points) and vola.probability(
 points) query it in world coordinates, vola.occupied_tree(tree) and vola.free_tree(tree)
 give plain trees of either part (the analysis methods count every voxel of the tree they
 are called on: take occupied_tree(tree) for the obstacles).
+
+Every CLI subcommand that works on voxels is a call here, through the same library
+function and with the same errors:
+
+    >>> both = vola.union(a, b); shell = a - a.erode(1)        # vola union / diff / erode
+    >>> inflated = tree.dilate(3, "sphere"); solid, n = tree.fill()
+    >>> view = tree.render(eye, look_at, size=(640, 480))        # {'image', 'depth', 'hits'}
+    >>> tree.collide_sphere(centres, 2.5)                         # (N,) bool, world units
+    >>> dsm, geotransform = tree.raster("dsm", resolution=1.0)   # the GeoTIFF's grid
+    >>> vola.export_raster(tree, "dsm.tif", "dsm"); vola.export_ply(tree, "v.ply")
+    >>> vola.tile(["a.las", "b.las"], "tiles", tile_size=512, depth=6)
+    >>> kept = vola.filter_points(xyz, {"classification": c}, ["smrf", "hag"], crs="EPSG:32610")
 """
 
 from __future__ import annotations
@@ -79,6 +91,7 @@ from ._vola import (
     probability,
     read,
     state,
+    tile,
     translate,
     union,
 )
@@ -125,6 +138,7 @@ __all__ = [
     "probability",
     "read",
     "state",
+    "tile",
     "translate",
     "union",
 ]
