@@ -24,12 +24,13 @@ def test_point_and_grid_files_match_the_cli(autzen, vola_cli, tmp_path):
     coarse = autzen.level_of_detail(4)  # dense formats: 256**3 cells
     runs = (
         ("a.ply", [], autzen, lambda t, p: vola.export_ply(t, p)),
-        ("b.ply", ["--ascii", "--cubes", "--depth", "4"], coarse, lambda t, p: vola.export_ply(t, p, ascii=True, cubes=True)),
+        ("b.ply", ["--ascii", "--cubes", "--depth", "4"], autzen,
+         lambda t, p: vola.export_ply(t, p, ascii=True, cubes=True, depth=4)),
         ("c.xyz", [], autzen, vola.export_xyz),
         ("d.las", [], autzen, vola.export_las),
         ("e.laz", [], autzen, vola.export_las),
         ("f.binvox", ["--depth", "4"], coarse, vola.export_binvox),
-        ("g.npy", ["--depth", "4"], coarse, vola.export_npy),
+        ("g.npy", ["--depth", "4"], autzen, lambda t, p: vola.export_npy(t, p, depth=4)),
         ("h.png", ["--map", "--bits", "8"], autzen, lambda t, p: vola.export_height_map(t, p, bits=8)),
         ("i.png", ["--occupancy-above", "20"], autzen, lambda t, p: vola.export_occupancy_above(t, p, 20)),
     )
@@ -47,6 +48,16 @@ def test_point_and_grid_files_match_the_cli(autzen, vola_cli, tmp_path):
     assert report["has_crs"] and report["point_format"] in (6, 7)
     grid = np.load(tmp_path / "py" / "g.npy")
     np.testing.assert_array_equal(grid.astype(bool), coarse.to_dense())
+    # Refusals name the keyword, as the CLI names its flag.
+    deep = vola.build_from_voxels(np.array([[0, 0, 0], [1, 2, 3]]), depth=6)
+    deep.write(tmp_path / "deep.vol")
+    with pytest.raises(vola.InvalidArgument, match=r"^depth: a dense grid of depth 6 .*coarser copy \(depth K\)"):
+        vola.export_npy(deep, tmp_path / "big.npy")
+    refused = subprocess.run([vola_cli, "export", str(tmp_path / "deep.vol"), str(tmp_path / "big.npy")], capture_output=True,
+                             text=True)
+    assert refused.returncode == 1 and "coarser copy (--depth K)" in refused.stderr
+    with pytest.raises(vola.InvalidArgument, match="^depth: depth 7 is not one of the tree's depths 1..6"):
+        vola.export_xyz(deep, tmp_path / "x.xyz", depth=7)
 
 
 def test_slices_match_the_cli(autzen, vola_cli, tmp_path):

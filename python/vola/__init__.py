@@ -40,9 +40,12 @@ function and with the same errors:
     >>> view = tree.render(eye, look_at, size=(640, 480))        # {'image', 'depth', 'hits'}
     >>> tree.collide_sphere(centres, 2.5)                         # (N,) bool, world units
     >>> dsm, geotransform = tree.raster("dsm", resolution=1.0)   # the GeoTIFF's grid
-    >>> vola.export_raster(tree, "dsm.tif", "dsm"); vola.export_ply(tree, "v.ply")
+    >>> vola.export_raster(tree, "dsm.tif", "dsm"); vola.export_ply(tree, "v.ply", depth=6)
     >>> vola.tile(["a.las", "b.las"], "tiles", tile_size=512, depth=6)
     >>> kept = vola.filter_points(xyz, {"classification": c}, ["smrf", "hag"], crs="EPSG:32610")
+
+The export_* functions take the CLI's `vola export --depth K` as depth=K (the grid of the
+tree's first K levels); a format that refuses a deep tree says so naming `depth`.
 """
 
 from __future__ import annotations
