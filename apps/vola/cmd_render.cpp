@@ -70,25 +70,6 @@ std::vector<std::uint16_t> depth_image(const raycast::Rendering& r) {
   return out;
 }
 
-// The default view of a tile set: the same placement as raycast::overview_camera, over the
-// points' bounding box of every tile (read from the index, no tile opened).
-raycast::PinholeCamera default_camera(const tile::TileSet& tiles) {
-  Box box = tiles.index().tiles.front().bbox;
-  for (const auto& t : tiles.index().tiles)
-    for (int a = 0; a < 3; ++a) {
-      box.min[a] = std::min(box.min[a], t.bbox.min[a]);
-      box.max[a] = std::max(box.max[a], t.bbox.max[a]);
-    }
-  raycast::PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (box.min[a] + box.max[a]);
-    extent = std::max(extent, box.max[a] - box.min[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
-}
-
 void write_images(const RenderArgs& a, const raycast::Rendering& image, const std::string& shaded, std::uint32_t width,
                   std::uint32_t height) {
   const std::string depth = with_suffix(shaded, "_depth");
@@ -137,7 +118,7 @@ void run_render(const RenderArgs& a) {
   if (tile::is_tile_index_path(a.input)) {  // world coordinates; a tile opens when a ray first reaches it
     if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
     const tile::TileSet tiles(a.input);
-    if (a.camera.empty()) camera = default_camera(tiles);
+    if (a.camera.empty()) camera = tile::overview_camera(tiles);
     render_frames(
         a, camera, width, height, [&](const raycast::PinholeCamera& cam) { return tile::render(tiles, cam, a.threads); },
         [&] {
