@@ -31,12 +31,12 @@ PYBIND11_MODULE(_vola, m) {
   bind_tree_analysis(tree);
   bind_setops(m, tree);
   bind_morphology(tree);
-  bind_render(tree);
   bind_collide(tree);
   bind_building(m);
   bind_export(m, tree);
   bind_filters(m);
   bind_tiling(m);
   bind_tiles(m);
+  bind_render(tree, m);
   bind_map(m);
 }

@@ -130,7 +130,8 @@ void bind_tiles(py::module_& m);
 void bind_map(py::module_& m);
 void bind_setops(py::module_& m, py::class_<Tree>& tree);
 void bind_morphology(py::class_<Tree>& tree);
-void bind_render(py::class_<Tree>& tree);
+// After bind_tiles: it adds TileSet.render.
+void bind_render(py::class_<Tree>& tree, py::module_& m);
 void bind_collide(py::class_<Tree>& tree);
 void bind_export(py::module_& m, py::class_<Tree>& tree);
 void bind_filters(py::module_& m);

@@ -64,3 +64,19 @@ def test_depth_straight_down_onto_a_slab():
         tree.render(eye=eye)
     with pytest.raises(vola.InvalidArgument, match="1..16384"):
         tree.render(size=(0, 10))
+
+
+def test_tile_set_images_as_the_cli(autzen_trim, vola_cli, tmp_path):
+    summary = vola.tile([autzen_trim], tmp_path / "tiles", tile_size=500.0, depth=4, overviews=False)
+    tiles = vola.open_tiles(summary["index"])
+    out = tmp_path / "tiles.png"
+    subprocess.run([vola_cli, "render", summary["index"], "-o", str(out), "--size", "64x48", "-q"], check=True)
+    ours = tiles.render(size=(64, 48))
+    np.testing.assert_array_equal(ours["image"], np.asarray(Image.open(out)))
+    np.testing.assert_array_equal(depth_png(ours["depth"]), np.asarray(Image.open(tmp_path / "tiles_depth.png")))
+    assert ours["hits"] > 300 and tiles.tiles_opened > 1
+    # The same place seen through the tiles and through one tree of the whole survey on their grid.
+    tree = vola.convert(autzen_trim, voxel_size=summary["voxel_size"], origin=(0.0, 0.0, 0.0), attributes=False)
+    (x0, y0, z0), (x1, y1, z1) = tree.bbox
+    view = {"eye": (x0 - 100.0, y0 - 80.0, z1 + 200.0), "look_at": ((x0 + x1) / 2, (y0 + y1) / 2, z0), "size": (40, 30)}
+    np.testing.assert_allclose(tiles.render(**view)["depth"], tree.render(**view)["depth"], rtol=1e-9)

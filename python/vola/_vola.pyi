@@ -142,6 +142,16 @@ class TileSet:
     def tile(self, i: int, j: int, k: int) -> Optional[Tree]: ...
     @property
     def attributes(self) -> List[str]: ...
+    def render(
+        self,
+        eye: Optional[Vec3] = None,
+        look_at: Optional[Vec3] = None,
+        up: Vec3 = (0.0, 0.0, 1.0),
+        fov: float = 60.0,
+        size: Tuple[int, int] = (512, 512),
+        orbit: Optional[Tuple[int, int]] = None,
+        threads: int = 0,
+    ) -> Dict[str, Any]: ...
     @overload
     def values(self, points: Sequence[float], name: str) -> float: ...
     @overload
