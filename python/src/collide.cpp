@@ -13,14 +13,15 @@ namespace vola::python {
 
 namespace {
 
-// Runs query(i) for every row without the GIL; an InvalidArgument names the row when
-// there are several.
+// Runs query(collider, i) for every row, the collider built and the rows answered without
+// the GIL; an InvalidArgument names the row when there are several.
 template <class Query>
-void each_query(py::ssize_t n, const char* what, Query&& query) {
+void each_query(const Tree& tree, py::ssize_t n, const char* what, Query&& query) {
   py::gil_scoped_release release;
+  const vola::raycast::Collider collider(tree);
   for (py::ssize_t i = 0; i < n; ++i) {
     try {
-      query(i);
+      query(collider, i);
     } catch (const vola::InvalidArgument& e) {
       if (n == 1) throw;
       throw vola::InvalidArgument(std::string(what) + " " + std::to_string(i) + ": " + e.what());
@@ -49,8 +50,7 @@ py::dict collide_segment(const Tree& tree, const py::handle& starts_in, const py
   auto nn = normal.mutable_unchecked<2>();
   const double* a = starts.data();
   const double* b = ends.data();
-  const vola::raycast::Collider collider(tree);
-  each_query(n, "segment", [&](py::ssize_t i) {
+  each_query(tree, n, "segment", [&](const vola::raycast::Collider& collider, py::ssize_t i) {
     const vola::Point from{a[3 * i], a[3 * i + 1], a[3 * i + 2]}, to{b[3 * i], b[3 * i + 1], b[3 * i + 2]};
     const auto found = world ? collider.segment(vola::raycast::world_to_grid(frame, from), vola::raycast::world_to_grid(frame, to))
                              : collider.segment(from, to);
@@ -87,8 +87,7 @@ py::object collide_sphere(const Tree& tree, const py::handle& centres_in, const 
   bool* out = hit.mutable_data();
   const double* c = centres.data();
   const double* r = radii.data();
-  const vola::raycast::Collider collider(tree);
-  each_query(n, "sphere", [&](py::ssize_t i) {
+  each_query(tree, n, "sphere", [&](const vola::raycast::Collider& collider, py::ssize_t i) {
     const vola::Point centre{c[3 * i], c[3 * i + 1], c[3 * i + 2]};
     const double radius = r[one_radius ? 0 : i];
     out[i] = world ? collider.sphere(vola::raycast::world_to_grid(frame, centre), radius / frame.voxel_size)
@@ -108,8 +107,7 @@ py::object collide_box(const Tree& tree, const py::handle& boxes_in, bool world)
   py::array_t<bool> hit(n);
   bool* out = hit.mutable_data();
   const double* b = boxes.data();
-  const vola::raycast::Collider collider(tree);
-  each_query(n, "box", [&](py::ssize_t i) {
+  each_query(tree, n, "box", [&](const vola::raycast::Collider& collider, py::ssize_t i) {
     vola::Box box{{b[6 * i], b[6 * i + 1], b[6 * i + 2]}, {b[6 * i + 3], b[6 * i + 4], b[6 * i + 5]}};
     if (world) box = vola::Box{vola::raycast::world_to_grid(frame, box.min), vola::raycast::world_to_grid(frame, box.max)};
     out[i] = collider.box(box);
