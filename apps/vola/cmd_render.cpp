@@ -49,28 +49,6 @@ std::array<std::uint32_t, 2> parse_size(const std::string& text) {
   throw InvalidArgument("--size must be WIDTHxHEIGHT with each 1..16384, e.g. 640x480 (got '" + text + "')");
 }
 
-// The default view: from above one corner of the occupied bounding box, looking at its centre.
-raycast::PinholeCamera default_camera(const Tree& tree) {
-  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  const int level = std::min(tree.depth() - 1, 3);
-  const double cell = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
-  tree.for_each_node(level, [&](const Voxel& c) {
-    const double p[3] = {c.x * cell, c.y * cell, c.z * cell};
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a] + cell);
-    }
-  });
-  raycast::PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (lo[a] + hi[a]);
-    extent = std::max(extent, hi[a] - lo[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
-}
-
 std::string with_suffix(const std::string& path, const std::string& suffix) {
   const auto dot = path.rfind('.');
   const auto slash = path.find_last_of('/');
@@ -90,25 +68,6 @@ std::vector<std::uint16_t> depth_image(const raycast::Rendering& r) {
   for (std::size_t i = 0; i < out.size(); ++i)
     if (std::isfinite(r.depth[i])) out[i] = static_cast<std::uint16_t>(65535.0 - 60000.0 * (r.depth[i] - near) / span);
   return out;
-}
-
-// The default view of a tile set: the same placement as default_camera, over the
-// points' bounding box of every tile (read from the index, no tile opened).
-raycast::PinholeCamera default_camera(const tile::TileSet& tiles) {
-  Box box = tiles.index().tiles.front().bbox;
-  for (const auto& t : tiles.index().tiles)
-    for (int a = 0; a < 3; ++a) {
-      box.min[a] = std::min(box.min[a], t.bbox.min[a]);
-      box.max[a] = std::max(box.max[a], t.bbox.max[a]);
-    }
-  raycast::PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (box.min[a] + box.max[a]);
-    extent = std::max(extent, box.max[a] - box.min[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
 }
 
 void write_images(const RenderArgs& a, const raycast::Rendering& image, const std::string& shaded, std::uint32_t width,
@@ -159,7 +118,7 @@ void run_render(const RenderArgs& a) {
   if (tile::is_tile_index_path(a.input)) {  // world coordinates; a tile opens when a ray first reaches it
     if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
     const tile::TileSet tiles(a.input);
-    if (a.camera.empty()) camera = default_camera(tiles);
+    if (a.camera.empty()) camera = tile::overview_camera(tiles);
     render_frames(
         a, camera, width, height, [&](const raycast::PinholeCamera& cam) { return tile::render(tiles, cam, a.threads); },
         [&] {
@@ -169,7 +128,7 @@ void run_render(const RenderArgs& a) {
     return;
   }
   const Tree tree = open_voxels(a.input);
-  if (a.camera.empty()) camera = default_camera(tree);
+  if (a.camera.empty()) camera = raycast::overview_camera(tree);
   else if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   const raycast::RayCaster caster(tree);
   render_frames(a, camera, width, height,

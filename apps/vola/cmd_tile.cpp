@@ -3,7 +3,6 @@
 // budget, on all cores, and on many processes under mpirun.
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -12,10 +11,10 @@
 #include "commands.hpp"
 #include "crs_flags.hpp"
 #include "filter_flags.hpp"
+#include "option_flags.hpp"
 #include "progress.hpp"
-#include "vola/crs_rules.hpp"
-#include "vola/geo/crs.hpp"
 #include "vola/error.hpp"
+#include "vola/tile/tile_inputs.hpp"
 #include "vola/tile/tiler.hpp"
 
 namespace vola::cli {
@@ -59,101 +58,34 @@ std::uint64_t parse_bytes(const std::string& text) {
   return static_cast<std::uint64_t>(value * scale);
 }
 
-std::unique_ptr<tile::PointSource> open_source(const std::string& path, std::size_t chunk_points, bool attributes) {
-  // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error))
-    throw InvalidArgument(path + ": not a regular file (inputs are point files on this machine)");
-  std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".las" || ext == ".laz") return tile::open_las_points(path, chunk_points);
-  return tile::open_file_points(path, attributes);
-}
-
-// With --target-crs, every input moved from its own CRS (--assign-crs, else what it says)
-// into the target as it is read: inputs in different CRSs then tile together.
-void reproject_sources(const TileArgs& a, std::vector<std::unique_ptr<tile::PointSource>>& sources) {
-  if (a.target_crs.empty()) return;
-  const std::string to = crs_definition_of(a.target_crs);
-  for (auto& s : sources) {
-    std::string from = !a.assign_crs.empty() ? crs_definition_of(a.assign_crs) : !s->wkt.empty() ? s->wkt : "";
-    if (from.empty() && s->epsg) from = "EPSG:" + std::to_string(*s->epsg);
-    if (from.empty())
-      throw InvalidArgument(s->name() + " states no CRS to reproject from; name it with --assign-crs");
-    s = tile::reprojected(std::move(s), from, to);
-  }
-}
-
-// The CRS every tile carries: --assign-crs, else what the inputs say (they must agree).
-// Tiles of a geographic CRS (voxels of degrees by units of height) only when forced.
-void resolve_tile_crs(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources,
-                      tile::TileOptions& options) {
-  std::vector<StatedCrs> stated;
-  for (const auto& s : sources) stated.push_back({s->name(), s->epsg, s->wkt});
-  const ResolvedCrs crs = resolve_crs(stated, a.assign_crs);
-  if (!a.allow_geographic && !crs.wkt.empty() && is_geographic_crs(crs.wkt))
-    throw OptionError("target_crs", "the inputs are in a geographic CRS: tiles and voxels would be degrees of "
-                                    "longitude and latitude by units of height, not cubes; give --target-crs (a "
-                                    "projected CRS such as UTM), or --allow-geographic to tile in degrees anyway");
-  options.epsg = crs.epsg;
-  options.crs_wkt = crs.wkt;
-}
-
-// --assign-crs on an input that says another CRS relabels its coordinates: say so.
-void warn_relabelled(const TileArgs& a, const std::vector<std::unique_ptr<tile::PointSource>>& sources) {
-  if (a.assign_crs.empty() || !a.target_crs.empty()) return;
-  for (const auto& s : sources) {
-    const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
-    try {
-      if (!said.empty() && !geo::same_crs(said, crs_definition_of(a.assign_crs)))
-        std::fprintf(stderr, "vola: warning: %s states %s; --assign-crs %s relabels its coordinates without moving "
-                     "them (to move them, give --target-crs)\n", s->name().c_str(),
-                     geo::crs_summary(geo::describe_crs(said)).c_str(), a.assign_crs.substr(0, 60).c_str());
-    } catch (const Error&) {
-      // A CRS PROJ cannot read: resolve_tile_crs reports what matters.
-    }
-  }
-}
-
 void run_tile(const TileArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<tile::Communicator> comm = tile::world();
   const bool talk = comm->rank() == 0 && !a.quiet;
   try {
-    if (a.inputs.empty() && a.generate == 0) throw InvalidArgument("no input: give point files or --generate-survey N");
-    if (!a.assign_crs.empty()) resolve_crs({}, a.assign_crs);  // an unknown CRS fails before any work
     tile::TileOptions options;
     options.memory_budget = parse_bytes(a.memory);
     options.threads = a.threads;
     options.attributes = !a.no_attributes;
-    const std::size_t chunk_points = a.chunk_points ? a.chunk_points : tile::chunk_points_for(options);
-    std::vector<std::unique_ptr<tile::PointSource>> sources;
-    for (const std::string& path : a.inputs) sources.push_back(open_source(path, chunk_points, options.attributes));
-    if (a.generate) {
-      tile::SurveyOptions survey;
-      survey.points = a.generate;
-      survey.density = a.density;
-      survey.seed = a.seed;
-      sources.push_back(tile::generated_survey(survey));
-    }
     options.grid.tile_size = a.tile_size;
     options.grid.depth = a.depth;
     if (!a.origin.empty()) options.grid.origin = {a.origin[0], a.origin[1], a.origin[2]};
     options.output_dir = a.output;
     options.spill_dir = a.spill_dir;
     options.overviews = !a.no_overviews;
-    // Filters see the points in their own CRS, before any reprojection (as in convert).
-    if (!a.filters.empty())
-      for (auto& s : sources) s = tile::filtered(std::move(s), a.filters);
-    if (talk) warn_relabelled(a, sources);
-    reproject_sources(a, sources);
-    if (a.target_crs.empty()) {
-      resolve_tile_crs(a, sources, options);
-    } else {
-      TileArgs moved;  // every source now states the target
-      moved.allow_geographic = a.allow_geographic;
-      resolve_tile_crs(moved, sources, options);
-    }
+    tile::TileInputs inputs;
+    inputs.inputs = a.inputs;
+    inputs.generate_survey = a.generate;
+    inputs.survey.density = a.density;
+    inputs.survey.seed = a.seed;
+    inputs.assign_crs = a.assign_crs;
+    inputs.target_crs = a.target_crs;
+    inputs.allow_geographic = a.allow_geographic;
+    inputs.chunk_points = a.chunk_points;
+    inputs.filters = a.filters;
+    const tile::OpenedInputs opened = tile::open_inputs(inputs, options);
+    if (talk)
+      for (const std::string& w : opened.warnings) std::fprintf(stderr, "vola: warning: %s\n", with_flags(w).c_str());
     std::unique_ptr<Progress> progress;
     std::string stage;
     if (talk)
@@ -165,18 +97,12 @@ void run_tile(const TileArgs& a) {
         }
         progress->update(done, total);
       };
-    std::vector<const tile::PointSource*> views;
-    std::uint64_t points = 0;
-    for (const auto& s : sources) {
-      views.push_back(s.get());
-      points += s->point_count();
-    }
-    const tile::TileSummary summary = tile::make_tiles(views, options, *comm);
+    const tile::TileSummary summary = tile::make_tiles(opened.views(), options, *comm);
     if (progress) progress->finish();
     if (!talk) return;
     for (const std::string& w : summary.warnings) std::fprintf(stderr, "vola: warning: %s\n", w.c_str());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("inputs:         %zu (%llu points)\n", sources.size(), static_cast<unsigned long long>(points));
+    std::printf("inputs:         %zu (%llu points)\n", opened.sources.size(), static_cast<unsigned long long>(opened.points));
     std::printf("crs:            %s\n", options.epsg ? ("EPSG:" + std::to_string(*options.epsg)).c_str()
                                                      : (options.crs_wkt.empty() ? "none known" : "WKT from the input"));
     std::printf("grid:           tiles of %.6g at depth %d (%u^3 voxels of %.6g), origin %.6g %.6g %.6g\n",

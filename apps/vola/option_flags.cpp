@@ -10,7 +10,7 @@ std::string flag_of(const std::string& option) {
       {"quantization", "--quantize"},     {"epsg", "--assign-crs"},          {"text_attributes", "--attribute"},
       {"attributes", "--no-attributes"},  {"memory_budget", "--memory"}, {"bin_width_db", "--bin-width"},
       {"floor_db", "--floor"},            {"architecture", "--arch"},  {"output_dir", "-o"},
-      {"filters", "--filter"}};
+      {"filters", "--filter"},            {"inputs", "inputs"}};
   if (const auto it = renamed.find(option); it != renamed.end()) return it->second;
   std::string flag = "--" + option;
   for (char& c : flag)

@@ -2,7 +2,6 @@
 #include "python_support.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -13,9 +12,7 @@
 #include "vola/filters/stages.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/file.hpp"
-#include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
-#include "vola/io/occupancy_maps.hpp"
 #include "vola/io/translate.hpp"
 
 namespace vola::python {
@@ -256,40 +253,6 @@ void bind_building(py::module_& m) {
       "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.\n"
       "filters=['smrf'] etc. as `vola translate --filter` (docs/FILTERS.md): LAS/LAZ out keeps the records left,\n"
       "classification updated.");
-  m.def("export_las", [](const Tree& tree, const std::filesystem::path& path) {
-        py::gil_scoped_release release;
-        with_python_names([&] { vola::io::write_las(tree, path.string()); });
-      }, py::arg("tree"), py::arg("path"),
-      "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
-      "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"
-      "ending in .laz is LASzip-compressed.");
-  m.def("export_map", [](const Tree& tree, const std::filesystem::path& path, const Tree* free) {
-        vola::io::MapExportReport r;
-        {
-          py::gil_scoped_release release;
-          r = with_python_names([&] {
-            const vola::io::MapVoxels voxels = vola::io::map_voxels(tree, free);
-            std::string ext = path.extension().string();
-            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-            return ext == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
-          });
-        }
-        py::dict report;
-        report["occupied"] = r.occupied;
-        report["free"] = r.free;
-        report["log_odds"] = r.log_odds;
-        report["shift"] = py::make_tuple(r.shift[0], r.shift[1], r.shift[2]);
-        report["nodes"] = r.nodes;
-        report["grids"] = r.grids;
-        report["warnings"] = r.warnings;
-        return report;
-      }, py::arg("tree"), py::arg("path"), py::arg("free") = py::none(),
-      "The tree as an occupancy map (`vola export TREE OUT.bt|.ot|.vdb [--free FREE]`): OctoMap .bt (binary,\n"
-      "maximum likelihood) or .ot (log-odds from a log_odds column, else the clamping maximum) through\n"
-      "liboctomap, or OpenVDB .vdb (grid 'occupied', or 'log_odds'; 'free'/'free_log_odds' with free=)\n"
-      "through OpenVDB; free= is a tree of free voxels on the same grid (vola map --free). Returns a dict:\n"
-      "occupied, free, log_odds, shift (added to coordinates when OctoMap's cells needed it), nodes, grids,\n"
-      "warnings.");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

@@ -1,5 +1,6 @@
 // The vola Python module (vola._vola): the error family and the parts, each in its own
-// file (building.cpp, tree.cpp, tree_analysis.cpp, tiles.cpp, map.cpp).
+// file (building.cpp, tree.cpp, tree_analysis.cpp, setops.cpp, morphology.cpp, render.cpp,
+// collide.cpp, export.cpp, filters.cpp, tiling.cpp, tiles.cpp, map.cpp).
 #include "python_support.hpp"
 
 PYBIND11_MODULE(_vola, m) {
@@ -28,7 +29,14 @@ PYBIND11_MODULE(_vola, m) {
   using namespace vola::python;
   py::class_<Tree> tree = bind_tree(m);
   bind_tree_analysis(tree);
+  bind_setops(m, tree);
+  bind_morphology(tree);
+  bind_collide(tree);
   bind_building(m);
+  bind_export(m, tree);
+  bind_filters(m);
+  bind_tiling(m);
   bind_tiles(m);
+  bind_render(tree, m);
   bind_map(m);
 }

@@ -96,22 +96,28 @@ inline vola::Quantization parse_quantization(const std::string& name) {
 inline vola::Point to_point(const std::array<double, 3>& p) { return vola::Point{p[0], p[1], p[2]}; }
 
 // The library names options as its structs do; Python's keywords are the same names but
-// for quantize. Runs `body`, rethrowing an OptionError in the keywords' words.
+// for quantize.
+inline std::string python_keyword(const std::string& option) { return option == "quantization" ? std::string("quantize") : option; }
+
+// A library message (a cause, a warning) with each `member` named as its keyword.
+inline std::string python_words(std::string text) {
+  for (auto open = text.find('`'); open != std::string::npos; open = text.find('`', open)) {
+    const auto close = text.find('`', open + 1);
+    if (close == std::string::npos) break;
+    const std::string name = python_keyword(text.substr(open + 1, close - open - 1));
+    text.replace(open, close - open + 1, name);
+    open += name.size();
+  }
+  return text;
+}
+
+// Runs `body`, rethrowing an OptionError in the keywords' words.
 template <class Body>
 auto with_python_names(Body&& body) {
-  const auto keyword = [](const std::string& option) { return option == "quantization" ? std::string("quantize") : option; };
   try {
     return body();
   } catch (const vola::OptionError& e) {
-    std::string cause = e.cause();
-    for (auto open = cause.find('`'); open != std::string::npos; open = cause.find('`', open)) {
-      const auto close = cause.find('`', open + 1);
-      if (close == std::string::npos) break;
-      const std::string name = keyword(cause.substr(open + 1, close - open - 1));
-      cause.replace(open, close - open + 1, name);
-      open += name.size();
-    }
-    throw vola::InvalidArgument(keyword(e.option()) + ": " + cause);
+    throw vola::InvalidArgument(python_keyword(e.option()) + ": " + python_words(e.cause()));
   }
 }
 
@@ -122,5 +128,13 @@ py::class_<Tree> bind_tree(py::module_& m);
 void bind_tree_analysis(py::class_<Tree>& tree);
 void bind_tiles(py::module_& m);
 void bind_map(py::module_& m);
+void bind_setops(py::module_& m, py::class_<Tree>& tree);
+void bind_morphology(py::class_<Tree>& tree);
+// After bind_tiles: it adds TileSet.render.
+void bind_render(py::class_<Tree>& tree, py::module_& m);
+void bind_collide(py::class_<Tree>& tree);
+void bind_export(py::module_& m, py::class_<Tree>& tree);
+void bind_filters(py::module_& m);
+void bind_tiling(py::module_& m);
 
 }  // namespace vola::python

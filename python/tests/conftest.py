@@ -36,3 +36,9 @@ def vola_cli() -> str:
             pytest.fail("VOLA_CLI is not set to the vola executable and CI is set")
         pytest.skip("VOLA_CLI is not set to the vola executable")
     return cli
+
+
+@pytest.fixture(scope="session")
+def autzen_trim(shared_data: pathlib.Path) -> pathlib.Path:
+    """A dense survey (110 000 points, Oregon feet) where las_file is a sparse one."""
+    return _require(shared_data / "las" / "pdal_autzen_trim.las", "LAS survey")

@@ -31,6 +31,21 @@ or free) and a "log_odds" column; vola.state(tree, points) and vola.probability(
 points) query it in world coordinates, vola.occupied_tree(tree) and vola.free_tree(tree)
 give plain trees of either part (the analysis methods count every voxel of the tree they
 are called on: take occupied_tree(tree) for the obstacles).
+
+Every CLI subcommand that works on voxels is a call here, through the same library
+function and with the same errors:
+
+    >>> both = vola.union(a, b); shell = a - a.erode(1)        # vola union / diff / erode
+    >>> inflated = tree.dilate(3, "sphere"); solid, n = tree.fill()
+    >>> view = tree.render(eye, look_at, size=(640, 480))        # {'image', 'depth', 'hits'}
+    >>> tree.collide_sphere(centres, 2.5)                         # (N,) bool, world units
+    >>> dsm, geotransform = tree.raster("dsm", resolution=1.0)   # the GeoTIFF's grid
+    >>> vola.export_raster(tree, "dsm.tif", "dsm"); vola.export_ply(tree, "v.ply", depth=6)
+    >>> vola.tile(["a.las", "b.las"], "tiles", tile_size=512, depth=6)
+    >>> kept = vola.filter_points(xyz, {"classification": c}, ["smrf", "hag"], crs="EPSG:32610")
+
+The export_* functions take the CLI's `vola export --depth K` as depth=K (the grid of the
+tree's first K levels); a format that refuses a deep tree says so naming `depth`.
 """
 
 from __future__ import annotations
@@ -41,6 +56,7 @@ from typing import Union
 from ._vola import (
     FREE,
     OCCUPIED,
+    RASTER_NODATA,
     UNKNOWN,
     Error,
     FormatError,
@@ -56,11 +72,22 @@ from ._vola import (
     compression_available,
     convert,
     describe_crs,
+    difference,
+    export_binvox,
+    export_height_map,
     export_las,
-    free_tree,
     export_map,
+    export_npy,
+    export_occupancy_above,
+    export_ply,
+    export_raster,
+    export_slices,
+    export_xyz,
+    filter_points,
+    free_tree,
     from_dense,
     input_formats,
+    intersect,
     occupied_tree,
     open_mapped,
     open_tiles,
@@ -68,12 +95,15 @@ from ._vola import (
     probability,
     read,
     state,
+    tile,
     translate,
+    union,
 )
 
 __all__ = [
     "FREE",
     "OCCUPIED",
+    "RASTER_NODATA",
     "UNKNOWN",
     "Error",
     "FormatError",
@@ -89,11 +119,22 @@ __all__ = [
     "compression_available",
     "convert",
     "describe_crs",
+    "difference",
+    "export_binvox",
+    "export_height_map",
     "export_las",
-    "free_tree",
     "export_map",
+    "export_npy",
+    "export_occupancy_above",
+    "export_ply",
+    "export_raster",
+    "export_slices",
+    "export_xyz",
+    "filter_points",
+    "free_tree",
     "from_dense",
     "input_formats",
+    "intersect",
     "occupied_tree",
     "open",
     "open_mapped",
@@ -102,7 +143,9 @@ __all__ = [
     "probability",
     "read",
     "state",
+    "tile",
     "translate",
+    "union",
 ]
 
 

@@ -28,8 +28,8 @@ Tree combine(const Tree& a, const Tree& b, FrameCheck check, const char* what, M
   if (check == FrameCheck::require_equal && !same_frame(a.frame(), b.frame()))
     VOLA_THROW(InvalidArgument(std::string(what) +
                           ": the trees' grids differ (origin or voxel size), so equal voxel indices are "
-                          "different places; convert both with the same --quantize grid --voxel-size and "
-                          "--origin"));
+                          "different places; convert both with grid quantization and the same voxel size "
+                          "and origin"));
   const auto ka = a.keys();
   const auto kb = b.keys();
   std::vector<Key> out;

@@ -28,9 +28,9 @@ std::string npy_header(std::uint64_t side) {
 
 void write_npy_grid(const Tree& tree, const std::string& path) {
   if (tree.depth() > kMaxNpyDepth)
-    throw InvalidArgument("a dense grid of depth " + std::to_string(tree.depth()) + " has " +
-                          std::to_string(tree.side()) + "^3 cells; NPY export stops at depth " +
-                          std::to_string(kMaxNpyDepth) + " (1 GiB): export a coarser copy (--depth K, or vola lod)");
+    throw OptionError("depth", "a dense grid of depth " + std::to_string(tree.depth()) + " has " +
+                                   std::to_string(tree.side()) + "^3 cells; NPY export stops at depth " +
+                                   std::to_string(kMaxNpyDepth) + " (1 GiB): export a coarser copy (`depth` K)");
   const std::uint64_t side = tree.side();
   // One bit per cell in the array's own order, then expanded a run of z at a time:
   // S^3 / 8 bytes of memory rather than S^3.

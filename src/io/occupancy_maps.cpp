@@ -88,9 +88,10 @@ Point octomap_shift(const MapVoxels& voxels, const std::string& path, std::vecto
   if (beyond) {
     for (int a = 0; a < 3; ++a)
       if (high[a] >= kOctomapKeyCentre)
-        throw InvalidArgument(path + ": the map reaches " + std::to_string(high[a]) + " voxels from its grid's corner along " +
-                              "xyz"[a] + ", and lies beyond OctoMap's 65536 cells from 0; OctoMap keeps 32768 cells on " +
-                              "each side of 0: crop it or export a coarser --depth");
+        throw OptionError("depth", path + ": the map reaches " + std::to_string(high[a]) +
+                                       " voxels from its grid's corner along " + "xyz"[a] +
+                                       ", and lies beyond OctoMap's 65536 cells from 0; OctoMap keeps 32768 cells on " +
+                                       "each side of 0: crop it or export a coarser `depth`");
     for (int a = 0; a < 3; ++a) shift[a] = -origin[a];
     warnings.push_back(path + ": the map lies beyond OctoMap's 32768 cells of " + number_text(size) +
                        " around 0, so it moved by " + point_text(shift) + ": the grid's corner " + point_text(origin) +

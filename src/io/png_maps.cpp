@@ -18,9 +18,9 @@ namespace {
 
 void check_map_size(const Tree& tree) {
   if (tree.depth() > kMaxMapDepth)
-    throw InvalidArgument("a map of depth " + std::to_string(tree.depth()) + " would be " + std::to_string(tree.side()) +
-                          "^2 pixels; maps stop at depth " + std::to_string(kMaxMapDepth) +
-                          ": export a coarser copy (--depth K)");
+    throw OptionError("depth", "a map of depth " + std::to_string(tree.depth()) + " would be " +
+                                   std::to_string(tree.side()) + "^2 pixels; maps stop at depth " +
+                                   std::to_string(kMaxMapDepth) + ": export a coarser copy (`depth` K)");
 }
 
 // Per (x, y) column, 1 + the highest occupied z, 0 for an empty column; index x + S*y.

@@ -12,9 +12,10 @@ namespace vola::io {
 
 std::uint32_t write_png_slices(const Tree& tree, const std::string& directory, bool world_files) {
   if (tree.depth() > kMaxSliceDepth)
-    throw InvalidArgument("slices of depth " + std::to_string(tree.depth()) + " would be " + std::to_string(tree.side()) +
-                          " images of " + std::to_string(tree.side()) + "^2 pixels; slices stop at depth " +
-                          std::to_string(kMaxSliceDepth) + ": export a coarser copy (--depth K)");
+    throw OptionError("depth", "slices of depth " + std::to_string(tree.depth()) + " would be " +
+                                   std::to_string(tree.side()) + " images of " + std::to_string(tree.side()) +
+                                   "^2 pixels; slices stop at depth " + std::to_string(kMaxSliceDepth) +
+                                   ": export a coarser copy (`depth` K)");
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) throw IoError(directory + ": cannot create the directory: " + error.message());

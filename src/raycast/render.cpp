@@ -81,4 +81,25 @@ Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned 
   return out;
 }
 
+PinholeCamera overview_camera(const Tree& tree) {
+  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  const int level = std::min(tree.depth() - 1, 3);
+  const double cell = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
+  tree.for_each_node(level, [&](const Voxel& c) {
+    const double p[3] = {c.x * cell, c.y * cell, c.z * cell};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a] + cell);
+    }
+  });
+  PinholeCamera cam;
+  double extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    cam.look_at[a] = 0.5 * (lo[a] + hi[a]);
+    extent = std::max(extent, hi[a] - lo[a]);
+  }
+  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
+  return cam;
+}
+
 }  // namespace vola::raycast

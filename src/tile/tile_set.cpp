@@ -207,4 +207,21 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
   return out;
 }
 
+raycast::PinholeCamera overview_camera(const TileSet& tiles) {
+  Box box = tiles.index().tiles.front().bbox;
+  for (const auto& t : tiles.index().tiles)
+    for (int a = 0; a < 3; ++a) {
+      box.min[a] = std::min(box.min[a], t.bbox.min[a]);
+      box.max[a] = std::max(box.max[a], t.bbox.max[a]);
+    }
+  raycast::PinholeCamera cam;
+  double extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    cam.look_at[a] = 0.5 * (box.min[a] + box.max[a]);
+    extent = std::max(extent, box.max[a] - box.min[a]);
+  }
+  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
+  return cam;
+}
+
 }  // namespace vola::tile

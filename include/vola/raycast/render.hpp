@@ -25,4 +25,9 @@ double lambert(const std::array<int, 3>& normal);
 
 Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads = 0);
 
+// The default view of a tree (grid coordinates, the rest of the camera as constructed):
+// from above one corner of its occupied bounding box (at level min(depth - 1, 3)),
+// looking at the box's centre.
+PinholeCamera overview_camera(const Tree& tree);
+
 }  // namespace vola::raycast

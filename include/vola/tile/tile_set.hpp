@@ -72,4 +72,9 @@ class TileSet {
 // in world units), shaded like raycast::render.
 raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& world_camera, unsigned threads = 0);
 
+// The default view of a tile set (world coordinates), placed as raycast::overview_camera
+// places a tree's, over the points' bounding box of every tile (from the index: no tile
+// is opened).
+raycast::PinholeCamera overview_camera(const TileSet& tiles);
+
 }  // namespace vola::tile

@@ -1,0 +1,191 @@
+// vola.export_*: every format `vola export` writes, each through the library writer the
+// CLI calls (include/vola/io/export.hpp, binvox.hpp, occupancy_maps.hpp); Tree.raster gives
+// the GeoTIFF's grid as a numpy array. depth=K is the CLI's --depth K: the grid of the
+// tree's first K levels.
+#include "python_support.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "vola/io/binvox.hpp"
+#include "vola/io/export.hpp"
+#include "vola/io/occupancy_maps.hpp"
+
+namespace vola::python {
+
+namespace {
+
+// Runs a writer without the GIL, its OptionErrors in Python's words.
+template <class Write>
+auto write_released(Write&& write) {
+  py::gil_scoped_release release;
+  return with_python_names(std::forward<Write>(write));
+}
+
+// write(tree) on the tree's first `depth` levels (0: the tree itself), as `vola export
+// --depth` does.
+template <class Write>
+auto at_depth(const Tree& tree, int depth, Write&& write) {
+  if (depth < 0 || depth > tree.depth())
+    throw vola::OptionError("depth", "`depth` " + std::to_string(depth) + " is not one of the tree's depths 1.." +
+                                         std::to_string(tree.depth()) + " (0: the tree's own)");
+  if (depth == 0 || depth == tree.depth()) return write(tree);
+  return write(tree.level_of_detail(depth));
+}
+
+vola::io::RasterOptions raster_options(const std::string& product, double resolution) {
+  const auto kind = vola::io::raster_product(product);
+  if (!kind) throw vola::InvalidArgument("product '" + product + "': expected 'dsm', 'dtm', 'intensity', 'density' or 'count'");
+  vola::io::RasterOptions options;
+  options.product = *kind;
+  options.resolution = resolution;
+  return options;
+}
+
+py::tuple raster(const Tree& tree, const std::string& product, double resolution, int depth) {
+  const auto options = raster_options(product, resolution);
+  vola::io::Raster r = write_released([&] {
+    return at_depth(tree, depth, [&](const Tree& t) { return vola::io::make_raster(t, options); });
+  });
+  const auto h = static_cast<py::ssize_t>(r.height), w = static_cast<py::ssize_t>(r.width);
+  const auto& g = r.geotransform;
+  return py::make_tuple(owning_array(std::move(r.values), {h, w}), py::make_tuple(g[0], g[1], g[2], g[3], g[4], g[5]));
+}
+
+py::dict export_raster(const Tree& tree, const std::filesystem::path& path, const std::string& product, double resolution,
+                       int depth) {
+  const auto options = raster_options(product, resolution);
+  const vola::io::RasterReport r = write_released([&] {
+    return at_depth(tree, depth, [&](const Tree& t) { return vola::io::write_geotiff(t, path.string(), options); });
+  });
+  py::dict out;
+  out["width"] = r.width;
+  out["height"] = r.height;
+  out["resolution"] = r.resolution;
+  out["cells_with_data"] = r.cells_with_data;
+  out["rule"] = r.rule;
+  out["has_crs"] = r.has_crs;
+  return out;
+}
+
+py::dict export_las(const Tree& tree, const std::filesystem::path& path, int depth) {
+  const vola::io::LasReport r = write_released([&] {
+    return at_depth(tree, depth, [&](const Tree& t) { return vola::io::write_las(t, path.string()); });
+  });
+  py::dict out;
+  out["point_format"] = r.point_format;
+  out["scale"] = r.scale;
+  out["has_crs"] = r.has_crs;
+  out["extra_bytes"] = r.extra_bytes;
+  out["clamped_intensities"] = r.clamped_intensities;
+  return out;
+}
+
+py::dict export_map(const Tree& tree, const std::filesystem::path& path, const Tree* free, int depth) {
+  const vola::io::MapExportReport r = write_released([&] {
+    const std::optional<Tree> coarse_free =
+        free && depth > 0 && depth < free->depth() ? std::optional<Tree>(free->level_of_detail(depth)) : std::nullopt;
+    const vola::io::MapVoxels voxels = at_depth(tree, depth, [&](const Tree& t) {
+      return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free);
+    });
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
+  });
+  py::dict report;
+  report["occupied"] = r.occupied;
+  report["free"] = r.free;
+  report["log_odds"] = r.log_odds;
+  report["shift"] = py::make_tuple(r.shift[0], r.shift[1], r.shift[2]);
+  report["nodes"] = r.nodes;
+  report["grids"] = r.grids;
+  report["warnings"] = r.warnings;
+  return report;
+}
+
+}  // namespace
+
+void bind_export(py::module_& m, py::class_<Tree>& tree) {
+  m.attr("RASTER_NODATA") = vola::io::kRasterNodata;
+  tree.def("raster", &raster, py::arg("product") = "dsm", py::arg("resolution") = 0.0, py::arg("depth") = 0,
+           "The grid `vola export --raster PRODUCT` writes, in memory: (values (H, W) float32, row 0 the\n"
+           "northernmost, vola.RASTER_NODATA where a cell has no voxel; geotransform: GDAL's six numbers, cell\n"
+           "(c, r) has its top-left corner at (gt[0] + c*gt[1], gt[3] + r*gt[5])). product: 'dsm' (max height\n"
+           "column, else top face), 'dtm' (min over ground voxels), 'intensity', 'density', 'count'; resolution:\n"
+           "cell edge in the CRS's units (0: the voxel size, not finer). Cropped to the occupied cells.");
+  m.def("export_raster", &export_raster, py::arg("tree"), py::arg("path"), py::arg("product") = "dsm",
+        py::arg("resolution") = 0.0, py::arg("depth") = 0,
+        "tree.raster(product, resolution) as a Float32 cloud-optimised GeoTIFF through GDAL (`vola export TREE\n"
+        "OUT.tif --raster PRODUCT [--resolution R]`): the tree's CRS, nodata vola.RASTER_NODATA. Returns {width,\n"
+        "height, resolution, cells_with_data, rule, has_crs}.");
+  m.def("export_ply", [](const Tree& tree, const std::filesystem::path& path, bool ascii, bool cubes, int depth) {
+        vola::io::PlyOptions options;
+        options.ascii = ascii;
+        options.cubes = cubes;
+        const vola::io::PlyReport r = write_released([&] {
+          return at_depth(tree, depth, [&](const Tree& t) { return vola::io::write_ply(t, path.string(), options); });
+        });
+        py::dict out;
+        out["vertices"] = r.vertices;
+        out["faces"] = r.faces;
+        return out;
+      }, py::arg("tree"), py::arg("path"), py::arg("ascii") = false, py::arg("cubes") = false, py::arg("depth") = 0,
+      "PLY (`vola export TREE OUT.ply [--ascii] [--cubes]`): voxel centres with every attribute as a vertex\n"
+      "property, or with cubes=True the voxels' outer surface as quads. Returns {vertices, faces}.");
+  m.def("export_xyz", [](const Tree& tree, const std::filesystem::path& path, int depth) {
+        write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_xyz(t, path.string()); }); });
+      }, py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
+      "'x y z [attributes]' text per voxel centre, full double precision (`vola export TREE OUT.xyz`).");
+  m.def("export_las", &export_las, py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
+        "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
+        "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"
+        "ending in .laz is LASzip-compressed. Returns {point_format, scale, has_crs, extra_bytes,\n"
+        "clamped_intensities}.");
+  m.def("export_binvox", [](const Tree& tree, const std::filesystem::path& path, int depth) {
+        write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_binvox(t, path.string()); }); });
+      }, py::arg("tree"), py::arg("path"), py::arg("depth") = 0, "A binvox voxel grid (`vola export TREE OUT.binvox`), side <= 4096.");
+  m.def("export_npy", [](const Tree& tree, const std::filesystem::path& path, int depth) {
+        write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_npy_grid(t, path.string()); }); });
+      }, py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
+      "A uint8 0/1 array of shape (S, S, S), index [x, y, z] (`vola export TREE OUT.npy`), depth <= 5.");
+  m.def("export_slices", [](const Tree& tree, const std::filesystem::path& directory, bool world_files, int depth) {
+        return write_released([&] {
+          return at_depth(tree, depth, [&](const Tree& t) { return vola::io::write_png_slices(t, directory.string(), world_files); });
+        });
+      }, py::arg("tree"), py::arg("directory"), py::arg("world_files") = true, py::arg("depth") = 0,
+      "One 8-bit PNG per z slice, occupied white, named depth<D>-<z>.png, each with a .pgw world file\n"
+      "(`vola export TREE DIR --slices`), depth <= 5. Returns the number of images.");
+  m.def("export_height_map", [](const Tree& tree, const std::filesystem::path& path, int bits, int depth) {
+        return write_released([&] {
+          return at_depth(tree, depth, [&](const Tree& t) {
+            vola::io::write_png_height_map(t, path.string(), bits);
+            return vola::io::write_world_file(t, path.string());
+          });
+        });
+      }, py::arg("tree"), py::arg("path"), py::arg("bits") = 16, py::arg("depth") = 0,
+      "Top-down PNG height map in voxel units (`vola export TREE OUT.png --map [--bits 8]`): highest z index\n"
+      "+ 1 per column, 0 empty (bits=8 scales to 1..255), and its .pgw world file, whose path is returned.\n"
+      "For elevations, tree.raster('dsm').");
+  m.def("export_occupancy_above", [](const Tree& tree, const std::filesystem::path& path, std::uint32_t min_z, int depth) {
+        return write_released([&] {
+          return at_depth(tree, depth, [&](const Tree& t) {
+            vola::io::write_png_occupancy_above(t, path.string(), min_z);
+            return vola::io::write_world_file(t, path.string());
+          });
+        });
+      }, py::arg("tree"), py::arg("path"), py::arg("min_z"), py::arg("depth") = 0,
+      "Top-down PNG occupancy map (`vola export TREE OUT.png --occupancy-above Z`): black where a column has a\n"
+      "voxel at z index >= min_z, else white; and its .pgw world file, whose path is returned.");
+  m.def("export_map", &export_map, py::arg("tree"), py::arg("path"), py::arg("free") = py::none(), py::arg("depth") = 0,
+        "The tree as an occupancy map (`vola export TREE OUT.bt|.ot|.vdb [--free FREE]`): OctoMap .bt (binary,\n"
+        "maximum likelihood) or .ot (log-odds from a log_odds column, else the clamping maximum) through\n"
+        "liboctomap, or OpenVDB .vdb (grid 'occupied', or 'log_odds'; 'free'/'free_log_odds' with free=)\n"
+        "through OpenVDB; free= is a tree of free voxels on the same grid (vola map --free). Returns a dict:\n"
+        "occupied, free, log_odds, shift (added to coordinates when OctoMap's cells needed it), nodes, grids,\n"
+        "warnings.");
+}
+
+}  // namespace vola::python

@@ -1,0 +1,76 @@
+// vola.filter_points: the point filters of `vola convert/translate/tile --filter` (and
+// `vola pipeline`) on arrays, through filters::run_stages as those commands call it.
+#include "python_support.hpp"
+
+#include <cstdint>
+#include <optional>
+
+#include "vola/crs_rules.hpp"
+#include "vola/filters/stages.hpp"
+
+namespace vola::python {
+
+namespace {
+
+py::dict filter_points(const py::handle& points, const py::dict& attributes, const std::vector<std::string>& filters,
+                       const std::string& crs) {
+  const auto xyz = rows_of_three<double>(points, "points");
+  const auto n = static_cast<std::size_t>(xyz.shape(0));
+  vola::PointCloud cloud;
+  cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
+  for (const auto& [key, value] : attributes) {
+    vola::PointAttribute a;
+    a.name = py::cast<std::string>(key);
+    const py::array raw = py::array::ensure(value);
+    if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
+    a.type = value_type_of(raw.dtype());
+    const auto column = CArray<double>::ensure(raw);
+    if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
+      throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
+                                  "), got shape " + std::string(py::str(raw.attr("shape"))));
+    a.values.assign(column.data(), column.data() + n);
+    cloud.attributes.push_back(std::move(a));
+  }
+  const std::optional<std::uint32_t> epsg = crs.empty() ? std::nullopt : vola::epsg_code_of(crs);
+  const std::string wkt = epsg ? std::string() : crs;
+  vola::filters::FilterResult result;
+  {
+    py::gil_scoped_release release;
+    result = with_python_names([&] {
+      const auto stages = vola::filters::parse_stages(filters);
+      return vola::filters::run_stages(stages, cloud, epsg, wkt);
+    });
+  }
+  const auto k = static_cast<py::ssize_t>(cloud.size());
+  py::dict columns;
+  for (auto& a : cloud.attributes) {
+    const py::array values = owning_array(std::move(a.values), {k});
+    columns[py::str(a.name)] = values.attr("astype")(dtype_of(a.type));
+  }
+  py::list stages;
+  for (const auto& s : result.stages)
+    stages.append(py::dict(py::arg("spec") = s.spec, py::arg("points_in") = s.points_in, py::arg("points_out") = s.points_out,
+                           py::arg("ground") = s.ground));
+  py::dict out;
+  out["points"] = owning_array(std::move(cloud.xyz), {k, py::ssize_t{3}});
+  out["attributes"] = columns;
+  out["kept"] = owning_array(std::move(result.kept), {k});
+  out["stages"] = stages;
+  return out;
+}
+
+}  // namespace
+
+void bind_filters(py::module_& m) {
+  m.def("filter_points", &filter_points, py::arg("points"), py::arg("attributes") = py::dict(),
+        py::arg("filters") = std::vector<std::string>{}, py::arg("crs") = "",
+        "Runs point filters in order on (N, 3) points and their columns, as `vola translate --filter/--where/--crop`\n"
+        "does (docs/FILTERS.md): 'where:EXPR', 'smrf[:cell=1,...]' (classification 2 ground, 1 the rest), 'hag'\n"
+        "(adds height_above_ground), 'outlier[:k=8,multiplier=2]', 'voxel:R', 'poisson:R', 'crop:X0,Y0,X1,Y1',\n"
+        "'polygon:FILE'. attributes: {name: (N,) array} (e.g. classification, intensity; the dtype is kept).\n"
+        "crs: the points' CRS ('EPSG:2992', '2992' or WKT) for smrf's metre parameters (none: metres).\n"
+        "Returns {'points': (K, 3), 'attributes': {name: (K,)} with any new columns, 'kept': (K,) uint64 input row\n"
+        "of each point left, 'stages': [{spec, points_in, points_out, ground}]}.");
+}
+
+}  // namespace vola::python

@@ -1,0 +1,102 @@
+#include "vola/tile/tile_inputs.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include "vola/crs_rules.hpp"
+#include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
+
+namespace vola::tile {
+
+namespace {
+
+std::unique_ptr<PointSource> open_source(const std::string& path, std::size_t chunk_points, bool attributes) {
+  // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    throw InvalidArgument(path + ": not a regular file (inputs are point files on this machine)");
+  std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".las" || ext == ".laz") return open_las_points(path, chunk_points);
+  return open_file_points(path, attributes);
+}
+
+// With a target CRS, every input moved from its own CRS (assign_crs, else what it says)
+// into the target as it is read: inputs in different CRSs then tile together.
+void reproject_sources(const TileInputs& in, std::vector<std::unique_ptr<PointSource>>& sources) {
+  if (in.target_crs.empty()) return;
+  const std::string to = crs_definition_of(in.target_crs);
+  for (auto& s : sources) {
+    std::string from = !in.assign_crs.empty() ? crs_definition_of(in.assign_crs) : !s->wkt.empty() ? s->wkt : "";
+    if (from.empty() && s->epsg) from = "EPSG:" + std::to_string(*s->epsg);
+    if (from.empty()) throw OptionError("assign_crs", s->name() + " states no CRS to reproject from; name it with `assign_crs`");
+    s = reprojected(std::move(s), from, to);
+  }
+}
+
+// The CRS every tile carries: `assign` (empty: what the inputs say; they must agree).
+// Tiles of a geographic CRS (voxels of degrees by units of height) only when allowed.
+void resolve_tile_crs(const std::string& assign, bool allow_geographic,
+                      const std::vector<std::unique_ptr<PointSource>>& sources, TileOptions& options) {
+  std::vector<StatedCrs> stated;
+  for (const auto& s : sources) stated.push_back({s->name(), s->epsg, s->wkt});
+  const ResolvedCrs crs = resolve_crs(stated, assign);
+  if (!allow_geographic && !crs.wkt.empty() && is_geographic_crs(crs.wkt))
+    throw OptionError("target_crs", "the inputs are in a geographic CRS: tiles and voxels would be degrees of "
+                                    "longitude and latitude by units of height, not cubes; give `target_crs` (a "
+                                    "projected CRS such as UTM), or `allow_geographic` to tile in degrees anyway");
+  options.epsg = crs.epsg;
+  options.crs_wkt = crs.wkt;
+}
+
+// assign_crs on an input that says another CRS relabels its coordinates: say so.
+std::vector<std::string> relabel_warnings(const TileInputs& in, const std::vector<std::unique_ptr<PointSource>>& sources) {
+  std::vector<std::string> warnings;
+  if (in.assign_crs.empty() || !in.target_crs.empty()) return warnings;
+  for (const auto& s : sources) {
+    const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
+    try {
+      if (!said.empty() && !geo::same_crs(said, crs_definition_of(in.assign_crs)))
+        warnings.push_back(s->name() + " states " + geo::crs_summary(geo::describe_crs(said)) + "; `assign_crs` " +
+                           in.assign_crs.substr(0, 60) +
+                           " relabels its coordinates without moving them (to move them, give `target_crs`)");
+    } catch (const Error&) {
+      // A CRS PROJ cannot read: resolve_tile_crs reports what matters.
+    }
+  }
+  return warnings;
+}
+
+}  // namespace
+
+std::vector<const PointSource*> OpenedInputs::views() const {
+  std::vector<const PointSource*> out;
+  for (const auto& s : sources) out.push_back(s.get());
+  return out;
+}
+
+OpenedInputs open_inputs(const TileInputs& in, TileOptions& options) {
+  if (in.inputs.empty() && in.generate_survey == 0)
+    throw OptionError("inputs", "no input: give point files or `generate_survey` N");
+  if (!in.assign_crs.empty()) resolve_crs({}, in.assign_crs);  // an unknown CRS fails before any work
+  OpenedInputs out;
+  const std::size_t chunk_points = in.chunk_points ? in.chunk_points : chunk_points_for(options);
+  for (const std::string& path : in.inputs) out.sources.push_back(open_source(path, chunk_points, options.attributes));
+  if (in.generate_survey) {
+    SurveyOptions survey = in.survey;
+    survey.points = in.generate_survey;
+    out.sources.push_back(generated_survey(survey));
+  }
+  if (!in.filters.empty())
+    for (auto& s : out.sources) s = filtered(std::move(s), in.filters);
+  out.warnings = relabel_warnings(in, out.sources);
+  reproject_sources(in, out.sources);
+  // After a reprojection every source states the target.
+  resolve_tile_crs(in.target_crs.empty() ? in.assign_crs : std::string(), in.allow_geographic, out.sources, options);
+  for (const auto& s : out.sources) out.points += s->point_count();
+  return out;
+}
+
+}  // namespace vola::tile
