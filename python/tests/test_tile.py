@@ -57,3 +57,14 @@ def test_refusals_and_warnings_in_python_words(autzen, shared_data, tmp_path):
                         assign_crs="EPSG:32633")
     assert summary["points_in"] == 20000 and summary["tiles"] > 0 and summary["epsg"] == 32633
     assert np.isclose(summary["voxel_size"], 400.0 / 64)
+
+
+def test_per_point_filters_as_the_cli(autzen, vola_cli, tmp_path):
+    """filters= runs vola tile's --where chunk by chunk: the same files as the CLI's."""
+    vola.tile([autzen], tmp_path / "py", tile_size=1000.0, depth=4, threads=1, chunk_points=7000,
+              filters=["where:Classification == 2"])
+    subprocess.run([vola_cli, "tile", str(autzen), "-o", str(tmp_path / "cli"), "--tile-size", "1000", "--depth", "4",
+                    "--threads", "1", "--where", "Classification == 2", "-q"], check=True)
+    assert files(tmp_path / "py") == files(tmp_path / "cli")
+    with pytest.raises(vola.InvalidArgument, match="neighbours"):
+        vola.tile([autzen], tmp_path / "smrf", tile_size=1000.0, depth=4, filters=["smrf"])

@@ -97,8 +97,10 @@ TEST(NpyExport, RefusesGridsBeyondTheLimit) {
   try {
     vola::io::write_npy_grid(deep, file.string());
     FAIL() << "a 4096^3 grid was not refused";
-  } catch (const vola::InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("--depth"), std::string::npos) << e.what();
+  } catch (const vola::OptionError& e) {
+    // The option to give, as each front end spells it (--depth, depth=).
+    EXPECT_EQ(e.option(), "depth") << e.what();
+    EXPECT_NE(e.cause().find("coarser"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(vola_test::fs::exists(file));
 }
