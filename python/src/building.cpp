@@ -24,29 +24,13 @@ namespace {
 Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
                   std::optional<std::array<double, 3>> origin, const py::dict& attributes, const py::dict& reductions,
                   std::uint32_t epsg, const std::string& crs_wkt) {
-  const auto xyz = rows_of_three<double>(points, "points");
-  const auto n = static_cast<std::size_t>(xyz.shape(0));
-  vola::PointCloud cloud;
-  cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
-  for (const auto& [key, value] : attributes) {
-    vola::PointAttribute a;
-    a.name = py::cast<std::string>(key);
-    const py::array raw = py::array::ensure(value);
-    if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
-    a.type = value_type_of(raw.dtype());
-    const auto column = CArray<double>::ensure(raw);
-    if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
-      throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
-                                  "), got shape " + std::string(py::str(raw.attr("shape"))));
-    a.values.assign(column.data(), column.data() + n);
-    a.reduction = vola::Reduction::mean;
-    if (reductions.contains(key)) {
-      const auto name = py::cast<std::string>(reductions[key]);
-      const auto r = vola::parse_reduction(name);
-      if (!r) throw vola::InvalidArgument("attribute '" + a.name + "': reduction '" + name + "' is not one of last mean max min majority");
-      a.reduction = *r;
-    }
-    cloud.attributes.push_back(std::move(a));
+  vola::PointCloud cloud = point_cloud_of(points, attributes);
+  for (vola::PointAttribute& a : cloud.attributes) {
+    if (!reductions.contains(a.name)) continue;
+    const auto name = py::cast<std::string>(reductions[py::str(a.name)]);
+    const auto r = vola::parse_reduction(name);
+    if (!r) throw vola::InvalidArgument("attribute '" + a.name + "': reduction '" + name + "' is not one of last mean max min majority");
+    a.reduction = *r;
   }
   for (const auto& [key, value] : reductions)
     if (!attributes.contains(key)) throw vola::InvalidArgument("reductions names '" + py::cast<std::string>(key) + "', which is not an attribute");

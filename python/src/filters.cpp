@@ -14,23 +14,7 @@ namespace {
 
 py::dict filter_points(const py::handle& points, const py::dict& attributes, const std::vector<std::string>& filters,
                        const std::string& crs) {
-  const auto xyz = rows_of_three<double>(points, "points");
-  const auto n = static_cast<std::size_t>(xyz.shape(0));
-  vola::PointCloud cloud;
-  cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
-  for (const auto& [key, value] : attributes) {
-    vola::PointAttribute a;
-    a.name = py::cast<std::string>(key);
-    const py::array raw = py::array::ensure(value);
-    if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
-    a.type = value_type_of(raw.dtype());
-    const auto column = CArray<double>::ensure(raw);
-    if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
-      throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
-                                  "), got shape " + std::string(py::str(raw.attr("shape"))));
-    a.values.assign(column.data(), column.data() + n);
-    cloud.attributes.push_back(std::move(a));
-  }
+  vola::PointCloud cloud = point_cloud_of(points, attributes);
   const std::optional<std::uint32_t> epsg = crs.empty() ? std::nullopt : vola::epsg_code_of(crs);
   const std::string wkt = epsg ? std::string() : crs;
   vola::filters::FilterResult result;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "vola/attributes.hpp"
+#include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/frame.hpp"
 #include "vola/tree.hpp"
@@ -69,6 +70,29 @@ inline vola::ValueType value_type_of(const py::dtype& dtype) {
   if (kind == 'b') return vola::ValueType::u8;
   if (kind == 'f') return size <= 4 ? vola::ValueType::f32 : vola::ValueType::f64;
   throw py::type_error("attribute dtype " + py::cast<std::string>(dtype.attr("name")) + " is not a number type");
+}
+
+// An (N, 3) array of points and {name: (N,) array} as a point cloud: each column typed by
+// its dtype (reduction mean; callers set others), one value per point or an error.
+inline vola::PointCloud point_cloud_of(const py::handle& points, const py::dict& attributes) {
+  const auto xyz = rows_of_three<double>(points, "points");
+  const auto n = static_cast<std::size_t>(xyz.shape(0));
+  vola::PointCloud cloud;
+  cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
+  for (const auto& [key, value] : attributes) {
+    vola::PointAttribute a;
+    a.name = py::cast<std::string>(key);
+    const py::array raw = py::array::ensure(value);
+    if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
+    a.type = value_type_of(raw.dtype());
+    const auto column = CArray<double>::ensure(raw);
+    if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
+      throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
+                                  "), got shape " + std::string(py::str(raw.attr("shape"))));
+    a.values.assign(column.data(), column.data() + n);
+    cloud.attributes.push_back(std::move(a));
+  }
+  return cloud;
 }
 
 inline py::dtype dtype_of(vola::ValueType type) {
