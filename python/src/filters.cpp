@@ -7,10 +7,16 @@
 
 #include "vola/crs_rules.hpp"
 #include "vola/filters/stages.hpp"
+#include "vola/pipeline.hpp"
 
 namespace vola::python {
 
 namespace {
+
+py::dict stage_dict(const vola::filters::StageReport& s) {
+  return py::dict(py::arg("spec") = s.spec, py::arg("points_in") = s.points_in, py::arg("points_out") = s.points_out,
+                  py::arg("ground") = s.ground);
+}
 
 py::dict filter_points(const py::handle& points, const py::dict& attributes, const std::vector<std::string>& filters,
                        const std::string& crs) {
@@ -32,9 +38,7 @@ py::dict filter_points(const py::handle& points, const py::dict& attributes, con
     columns[py::str(a.name)] = values.attr("astype")(dtype_of(a.type));
   }
   py::list stages;
-  for (const auto& s : result.stages)
-    stages.append(py::dict(py::arg("spec") = s.spec, py::arg("points_in") = s.points_in, py::arg("points_out") = s.points_out,
-                           py::arg("ground") = s.ground));
+  for (const auto& s : result.stages) stages.append(stage_dict(s));
   py::dict out;
   out["points"] = owning_array(std::move(cloud.xyz), {k, py::ssize_t{3}});
   out["attributes"] = columns;
@@ -43,9 +47,30 @@ py::dict filter_points(const py::handle& points, const py::dict& attributes, con
   return out;
 }
 
+// vola::run_pipeline's reports as one dict per writer (vola.pipeline in __init__.py reads
+// the pipeline from a file, a JSON string or Python lists and dicts).
+py::list run_pipeline(const std::string& json, const std::string& name) {
+  std::vector<vola::PipelineOutputReport> reports;
+  {
+    py::gil_scoped_release release;
+    reports = with_python_names([&] { return vola::run_pipeline(json, name); });
+  }
+  py::list out;
+  for (const auto& r : reports) {
+    py::list stages;
+    for (const auto& s : r.stages) stages.append(stage_dict(s));
+    out.append(py::dict(py::arg("input") = r.input, py::arg("output") = r.output, py::arg("voxels") = r.voxels,
+                        py::arg("voxel_count") = r.voxel_count, py::arg("filters") = r.filter_lines,
+                        py::arg("stages") = stages));
+  }
+  return out;
+}
+
 }  // namespace
 
 void bind_filters(py::module_& m) {
+  m.def("_run_pipeline", &run_pipeline, py::arg("json"), py::arg("name"),
+        "vola::run_pipeline on the pipeline's JSON text; `name` names it in errors. Use vola.pipeline.");
   m.def("filter_points", &filter_points, py::arg("points"), py::arg("attributes") = py::dict(),
         py::arg("filters") = std::vector<std::string>{}, py::arg("crs") = "",
         "Runs point filters in order on (N, 3) points and their columns, as `vola translate --filter/--where/--crop`\n"

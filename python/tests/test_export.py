@@ -123,3 +123,51 @@ def test_geotiff_matches_the_cli_and_the_raster(autzen, vola_cli, tmp_path):
         assert data.GetGeoTransform() == pytest.approx(gt)
         assert data.GetRasterBand(1).GetNoDataValue() == vola.RASTER_NODATA
     assert gdal.Open(str(tmp_path / "py.tif")).GetProjection() == gdal.Open(str(tmp_path / "cli.tif")).GetProjection() != ""
+
+
+def test_export_by_extension_writes_what_the_cli_writes(autzen, vola_cli, tmp_path):
+    # vola.export(tree, path, **flags) is `vola export IN path --flags`: the format from the
+    # extension, the CLI's flags as keywords.
+    runs = (
+        ("a.ply", ["--ascii"], {"ascii": True}),
+        ("b.xyz", [], {}),
+        ("c.laz", [], {}),
+        ("d.npy", ["--depth", "4"], {"depth": 4}),
+        ("e.png", ["--map", "--bits", "8"], {"map": True, "bits": 8}),
+        ("f.png", ["--occupancy-above", "20"], {"occupancy_above": 20}),
+        ("g.tif", ["--raster", "dtm", "--resolution", "6"], {"raster": "dtm", "resolution": 6.0}),
+        ("h.bt", [], {}),
+    )
+    (tmp_path / "cli").mkdir()
+    (tmp_path / "py").mkdir()
+    for name, arguments, keywords in runs:
+        cli_export(vola_cli, autzen, tmp_path, tmp_path / "cli" / name, *arguments)
+        vola.export(autzen, tmp_path / "py" / name, **keywords)
+        if name.endswith(".tif"):  # GDAL stamps nothing variable, but compare what matters
+            gdal = pytest.importorskip("osgeo.gdal")
+            ours, theirs = (gdal.Open(str(tmp_path / d / name)) for d in ("py", "cli"))
+            np.testing.assert_array_equal(ours.ReadAsArray(), theirs.ReadAsArray())
+            assert ours.GetGeoTransform() == theirs.GetGeoTransform()
+            assert ours.GetProjection() == theirs.GetProjection()
+        else:
+            assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    assert vola.export(autzen, tmp_path / "x.PLY") == {"vertices": len(autzen), "faces": 0}
+    assert vola.export(autzen, tmp_path / "slices", slices=True, depth=3) > 0
+
+
+def test_export_refuses_what_the_cli_refuses(autzen, tmp_path):
+    refusals = (
+        ("a.foo", {}, r"cannot tell the format from the extension '\.foo'"),
+        ("a.tif", {}, r"GeoTIFF needs raster='dsm'"),
+        ("a.tif", {"map": True}, r"name it \.png; for a GeoTIFF of elevations use raster='dsm'"),
+        ("a.png", {}, "PNG export needs slices=True"),
+        ("a.ply", {"raster": "dsm"}, r"raster writes a GeoTIFF: name .*a\.ply \.tif"),
+        ("a.xyz", {"ascii": True}, "ascii and cubes apply to PLY export"),
+        ("a.las", {"free": autzen}, r"free applies to \.bt, \.ot and \.vdb maps"),
+        ("a.png", {"map": True, "occupancy_above": 3}, "different images: give one"),
+        ("a.png", {"bits": 8, "occupancy_above": 3}, "bits applies to map"),
+    )
+    for name, keywords, message in refusals:
+        with pytest.raises(vola.InvalidArgument, match=message):
+            vola.export(autzen, tmp_path / name, **keywords)
+        assert not (tmp_path / name).exists()

@@ -33,3 +33,34 @@ def test_bad_stages_raise(shared_data, tmp_path):
         vola.convert(autzen, voxel_size=3.0, filters=["ground"])
     with pytest.raises(vola.InvalidArgument, match="no dimension 'Clasification'"):
         vola.translate(autzen, tmp_path / "x.las", filters=["where:Clasification == 2"])
+
+
+def test_pipeline_from_a_file_text_or_lists_writes_what_the_cli_writes(shared_data, vola_cli, tmp_path):
+    import json
+    autzen = shared_data / "las" / "pdal_autzen_trim.las"
+
+    def spec(prefix):
+        return [str(autzen), {"type": "filters.smrf"},
+                {"type": "filters.range", "limits": "Classification[2:2]"},
+                str(tmp_path / f"{prefix}ground.laz"),
+                {"type": "writers.vola", "filename": str(tmp_path / f"{prefix}ground.vol"), "voxel_size": 3}]
+
+    (tmp_path / "cli.json").write_text(json.dumps(spec("cli_")))
+    subprocess.run([vola_cli, "pipeline", str(tmp_path / "cli.json"), "-q"], check=True)
+    (tmp_path / "file.json").write_text(json.dumps(spec("file_")))
+    runs = {"list_": vola.pipeline(spec("list_")), "text_": vola.pipeline(json.dumps(spec("text_"))),
+            "file_": vola.pipeline(tmp_path / "file.json")}
+    for prefix, reports in runs.items():
+        for ext in ("laz", "vol"):
+            assert (tmp_path / f"{prefix}ground.{ext}").read_bytes() == (tmp_path / f"cli_ground.{ext}").read_bytes()
+        points, voxels = reports
+        assert not points["voxels"] and voxels["voxels"]
+        assert [s["spec"].split(":")[0] for s in points["stages"]] == ["smrf", "where"]
+        smrf, where = points["stages"]
+        assert smrf["points_in"] == smrf["points_out"] == 110000 and 0 < smrf["ground"] < 110000
+        assert where["points_out"] == smrf["ground"]
+        assert voxels["voxel_count"] == len(vola.read(tmp_path / f"{prefix}ground.vol"))
+    with pytest.raises(vola.InvalidArgument, match="pipeline stage 1"):
+        vola.pipeline([str(autzen), {"type": "filters.nothing"}, str(tmp_path / "x.las")])
+    with pytest.raises(vola.IoError, match="no_such.json: cannot open"):
+        vola.pipeline(tmp_path / "no_such.json")

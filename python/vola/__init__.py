@@ -43,6 +43,8 @@ function and with the same errors:
     >>> vola.export_raster(tree, "dsm.tif", "dsm"); vola.export_ply(tree, "v.ply", depth=6)
     >>> vola.tile(["a.las", "b.las"], "tiles", tile_size=512, depth=6)
     >>> kept = vola.filter_points(xyz, {"classification": c}, ["smrf", "hag"], crs="EPSG:32610")
+    >>> vola.export(tree, "dsm.tif", raster="dsm"); vola.export(tree, "map.bt")  # by extension
+    >>> vola.pipeline(["autzen.laz", {"type": "filters.smrf"}, "ground.laz"])    # vola pipeline
 
 The export_* functions take the CLI's `vola export --depth K` as depth=K (the grid of the
 tree's first K levels); a format that refuses a deep tree says so naming `depth`.
@@ -50,8 +52,10 @@ tree's first K levels); a format that refuses a deep tree says so naming `depth`
 
 from __future__ import annotations
 
+import builtins
+import json
 import os
-from typing import Union
+from typing import Any, Optional, Union
 
 from ._vola import (
     FREE,
@@ -98,6 +102,7 @@ from ._vola import (
     tile,
     translate,
     union,
+    _run_pipeline,
 )
 
 __all__ = [
@@ -120,6 +125,7 @@ __all__ = [
     "convert",
     "describe_crs",
     "difference",
+    "export",
     "export_binvox",
     "export_height_map",
     "export_las",
@@ -140,6 +146,7 @@ __all__ = [
     "open_mapped",
     "open_tiles",
     "parse",
+    "pipeline",
     "probability",
     "read",
     "state",
@@ -153,3 +160,89 @@ def open(path: Union[str, os.PathLike], mapped: bool = True) -> Tree:  # noqa: A
     """Opens a .vol file: memory-mapped by default (the level words stay in the page
     cache and numpy views of them read the mapping), or read into memory."""
     return open_mapped(path) if mapped else read(path)
+
+
+PathLike = Union[str, os.PathLike]
+
+
+def pipeline(spec: Union[PathLike, list, dict]) -> list:
+    """Runs a PDAL-style pipeline as `vola pipeline FILE.json` does (docs/FILTERS.md): a
+    reader, point filters, writers. spec: the JSON file's path, the JSON text, or the same
+    as Python lists and dicts, e.g. ["autzen.laz", {"type": "filters.smrf"},
+    {"type": "filters.range", "limits": "Classification[2:2]"}, "ground.laz"]. Returns one
+    dict per writer: input, output, voxels (a .vol written), voxel_count, filters (the
+    conversion's filter lines), stages (per stage: spec, points_in, points_out, ground)."""
+    if isinstance(spec, (list, dict)):
+        return _run_pipeline(json.dumps(spec), "<pipeline>")
+    text = os.fspath(spec)
+    if text.lstrip().startswith(("[", "{")):
+        return _run_pipeline(text, "<pipeline>")
+    try:
+        with builtins.open(text, encoding="utf-8") as f:
+            return _run_pipeline(f.read(), text)
+    except OSError as e:
+        raise IoError(f"{text}: cannot open ({e.strerror})") from None
+
+
+_FORMAT_OF_EXTENSION = {
+    ".ply": "ply", ".xyz": "xyz", ".txt": "xyz", ".las": "las", ".laz": "las", ".binvox": "binvox",
+    ".npy": "npy", ".png": "png", ".tif": "tif", ".tiff": "tif", ".bt": "octomap", ".ot": "octomap",
+    ".vdb": "vdb",
+}
+
+
+def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resolution: float = 0.0,
+           map: bool = False, bits: int = 16, occupancy_above: Optional[int] = None,  # noqa: A002 (--map)
+           slices: bool = False, ascii: bool = False, cubes: bool = False,  # noqa: A002 (--ascii)
+           free: Optional[Tree] = None, depth: int = 0) -> Any:
+    """`vola export TREE OUT` in one call: the format from path's extension (.ply, .xyz, .las,
+    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb), options as the CLI's flags:
+    raster='dsm'|'dtm'|'intensity'|'density'|'count' (+ resolution) for a GeoTIFF; map=True
+    (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
+    for PLY; free= for maps. Options that do not apply to the format are refused, as the CLI
+    refuses them. Returns what the export_* function for the format returns."""
+    images = int(slices) + int(map) + int(occupancy_above is not None)
+    if images > 1:
+        raise InvalidArgument("slices, map and occupancy_above are different images: give one")
+    if images and raster is not None:
+        raise InvalidArgument("raster writes a GeoTIFF, slices, map and occupancy_above PNG images: give one")
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if slices:
+        fmt = "slices"
+    elif images:
+        if ext != ".png":
+            raise InvalidArgument(f"{os.fspath(path)}: map and occupancy_above write PNG images (voxel units, with "
+                                  "a .pgw world file): name it .png" +
+                                  ("; for a GeoTIFF of elevations use raster='dsm'" if ext in (".tif", ".tiff") else ""))
+        fmt = "png"
+    elif ext not in _FORMAT_OF_EXTENSION:
+        raise InvalidArgument(f"{os.fspath(path)}: cannot tell the format from the extension '{ext}' "
+                              f"({', '.join(sorted(_FORMAT_OF_EXTENSION))})")
+    else:
+        fmt = _FORMAT_OF_EXTENSION[ext]
+    if fmt == "png" and not images:
+        raise InvalidArgument("PNG export needs slices=True (path is a directory), map=True or occupancy_above=Z")
+    if (raster is not None) != (fmt == "tif"):
+        raise InvalidArgument("a GeoTIFF needs raster='dsm' (or dtm, intensity, density, count)" if fmt == "tif"
+                              else f"raster writes a GeoTIFF: name {os.fspath(path)} .tif")
+    if resolution and raster is None:
+        raise InvalidArgument("resolution applies to raster")
+    if (ascii or cubes) and fmt != "ply":
+        raise InvalidArgument("ascii and cubes apply to PLY export")
+    if bits != 16 and not map:
+        raise InvalidArgument("bits applies to map")
+    if free is not None and fmt not in ("octomap", "vdb"):
+        raise InvalidArgument("free applies to .bt, .ot and .vdb maps")
+    if fmt == "tif":
+        return export_raster(tree, path, raster, resolution, depth)
+    if fmt == "slices":
+        return export_slices(tree, path, True, depth)
+    if fmt == "png":
+        if map:
+            return export_height_map(tree, path, bits, depth)
+        return export_occupancy_above(tree, path, occupancy_above, depth)
+    if fmt == "ply":
+        return export_ply(tree, path, ascii, cubes, depth)
+    if fmt in ("octomap", "vdb"):
+        return export_map(tree, path, free, depth)
+    return {"xyz": export_xyz, "las": export_las, "binvox": export_binvox, "npy": export_npy}[fmt](tree, path, depth)

@@ -1,5 +1,5 @@
 import os
-from typing import Union
+from typing import Any, Dict, List, Optional, Union
 
 from ._vola import (
     FREE as FREE,
@@ -49,3 +49,19 @@ from ._vola import (
 )
 
 def open(path: Union[str, os.PathLike], mapped: bool = True) -> Tree: ...
+def pipeline(spec: Union[str, os.PathLike, list, dict]) -> List[Dict[str, Any]]: ...
+def export(
+    tree: Tree,
+    path: Union[str, os.PathLike],
+    *,
+    raster: Optional[str] = None,
+    resolution: float = 0.0,
+    map: bool = False,
+    bits: int = 16,
+    occupancy_above: Optional[int] = None,
+    slices: bool = False,
+    ascii: bool = False,
+    cubes: bool = False,
+    free: Optional[Tree] = None,
+    depth: int = 0,
+) -> Any: ...

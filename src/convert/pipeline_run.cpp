@@ -1,0 +1,64 @@
+#include <nlohmann/json.hpp>
+
+#include "vola/convert.hpp"
+#include "vola/error.hpp"
+#include "vola/filters/pipeline.hpp"
+#include "vola/io/translate.hpp"
+#include "vola/pipeline.hpp"
+
+namespace vola {
+
+namespace {
+
+// A writers.vola stage's options (JSON text by name) as the conversion's options.
+ConvertOptions convert_options(const filters::PipelineWriter& writer, const std::vector<std::string>& stages) {
+  ConvertOptions options;
+  options.filters = stages;
+  for (const auto& [key, text] : writer.options) {
+    const auto value = nlohmann::json::parse(text);
+    const auto wrong = [&](const char* kind) {
+      return InvalidArgument("pipeline writer " + writer.filename + ": \"" + key + "\" must be " + kind + ", not " + text);
+    };
+    if (key == "voxel_size") {
+      if (!value.is_number()) throw wrong("a number");
+      options.voxel_size = value.get<double>();
+    } else if (key == "depth") {
+      if (!value.is_number_integer()) throw wrong("an integer");
+      options.depth = value.get<int>();
+    } else {
+      if (!value.is_boolean()) throw wrong("true or false");
+      (key == "compress" ? options.compress : key == "dense" ? options.dense : options.attributes) = value.get<bool>();
+    }
+  }
+  return options;
+}
+
+}  // namespace
+
+std::vector<PipelineOutputReport> run_pipeline(const std::string& json, const std::string& name) {
+  const filters::Pipeline pipeline = filters::parse_pipeline(json, name);
+  const std::vector<filters::Stage> stages = filters::parse_stages(pipeline.stages);
+  std::vector<PipelineOutputReport> reports;
+  for (const auto& writer : pipeline.writers) {
+    PipelineOutputReport out;
+    out.input = pipeline.input;
+    out.output = writer.filename;
+    out.voxels = writer.voxels();
+    if (out.voxels) {
+      ConvertReport report;
+      convert_file(pipeline.input, writer.filename, convert_options(writer, pipeline.stages), {}, &report);
+      out.voxel_count = report.build.voxels;
+      out.filter_lines = std::move(report.filters);
+    } else {
+      io::translate_points(pipeline.input, writer.filename, {}, [&](io::PointTable& table) {
+        filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
+        out.stages = std::move(result.stages);
+        return std::move(result.kept);
+      });
+    }
+    reports.push_back(std::move(out));
+  }
+  return reports;
+}
+
+}  // namespace vola
