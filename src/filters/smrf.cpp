@@ -6,6 +6,7 @@
 #include "elevation_grid.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
+#include "vola/parallel.hpp"
 
 namespace vola::filters {
 
@@ -13,7 +14,8 @@ using detail::ElevationGrid;
 
 void SmrfOptions::check() const {
   const auto positive = [](const char* name, double v) {
-    if (!(v > 0.0) || !std::isfinite(v)) throw OptionError(name, "must be a positive number (metres), not " + std::to_string(v));
+    if (!(v > 0.0) || !std::isfinite(v))
+      throw OptionError(name, "must be a positive number (metres), not " + std::to_string(v));
   };
   positive("cell", cell);
   positive("window", window);
@@ -43,6 +45,43 @@ std::vector<bool> progressive_objects(const ElevationGrid& surface, int max_radi
     std::swap(previous, opened);
   }
   return object;
+}
+
+// Cells whose minimum no other cell nearby continues (fewer than kMinSupport cells
+// within `radius` cells lie within kPitDepth + kPitSlope x distance of it in height)
+// while some cell nearby lies that far above it: low outliers that come in scattered
+// clusters at random depths (multipath echoes under glass and water), which the
+// opening below tolerates once they span a few cells. Ground continues ground, even in
+// a forest where only some cells see it; a cell with no filled cell nearby (a thinned
+// survey) is not judged.
+std::vector<bool> unsupported_lows(const ElevationGrid& g, int radius) {
+  constexpr int kMinSupport = 2;
+  const auto r = static_cast<std::ptrdiff_t>(radius);
+  const auto cols = static_cast<std::ptrdiff_t>(g.cols), rows = static_cast<std::ptrdiff_t>(g.rows);
+  // Rows in parallel: each writes only its own cells (a vector<char>, not vector<bool>,
+  // whose bits share words).
+  std::vector<char> low_rows(g.cells(), 0);
+  parallel_for(g.rows, [&](std::size_t first, std::size_t last) {
+    for (auto j = static_cast<std::ptrdiff_t>(first); j < static_cast<std::ptrdiff_t>(last); ++j)
+      for (std::ptrdiff_t i = 0; i < cols; ++i) {
+        const float z = g.z[static_cast<std::size_t>(j * cols + i)];
+        if (std::isnan(z)) continue;
+        int support = 0;
+        bool below_some = false;
+        for (std::ptrdiff_t jj = std::max<std::ptrdiff_t>(0, j - r); jj <= std::min(rows - 1, j + r); ++jj)
+          for (std::ptrdiff_t ii = std::max<std::ptrdiff_t>(0, i - r); ii <= std::min(cols - 1, i + r); ++ii) {
+            const float w = g.z[static_cast<std::size_t>(jj * cols + ii)];
+            if ((ii == i && jj == j) || std::isnan(w)) continue;
+            const double reach =
+                kPitDepth + kPitSlope * std::hypot(static_cast<double>(ii - i), static_cast<double>(jj - j)) * g.cell;
+            if (std::abs(w - z) <= reach) ++support;
+            if (w - z > reach) below_some = true;
+          }
+        low_rows[static_cast<std::size_t>(j * cols + i)] = below_some && support < kMinSupport;
+      }
+  });
+  std::vector<bool> low(low_rows.begin(), low_rows.end());
+  return low;
 }
 
 // Gradient magnitude (rise over run) of a filled grid, central differences inside.
@@ -81,8 +120,8 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   const double c = options.cell;
   const double cols_d = std::floor((maxx - minx) / c) + 1, rows_d = std::floor((maxy - miny) / c) + 1;
   if (cols_d * rows_d > kMaxCells)
-    throw InvalidArgument("smrf: a grid of " + std::to_string(cols_d) + " x " + std::to_string(rows_d) +
-                          " cells of " + std::to_string(c) + " m is too large; give a larger cell or crop first");
+    throw InvalidArgument("smrf: a grid of " + std::to_string(cols_d) + " x " + std::to_string(rows_d) + " cells of " +
+                          std::to_string(c) + " m is too large; give a larger cell or crop first");
   ElevationGrid zmin(static_cast<std::size_t>(cols_d), static_cast<std::size_t>(rows_d), minx, miny, c);
   const auto cell_of = [&](std::size_t i) {
     const auto col = std::min(zmin.cols - 1, static_cast<std::size_t>((xyz[3 * i] * h - minx) / c));
@@ -97,7 +136,16 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
     if (std::isnan(cell) || z < cell) cell = z;
   }
 
-  // Low outliers: pits of the minimum surface, found as peaks of its negation.
+  // Low outliers: cells below their neighbours that no neighbour continues (repeated, as
+  // removing one can leave another without support), then pits of the minimum surface
+  // found as peaks of its negation.
+  const int support_radius = std::max(1, static_cast<int>(std::lround(kSupportRadius / c)));
+  for (int pass = 0; pass < kSupportPasses; ++pass) {
+    const std::vector<bool> low = unsupported_lows(zmin, support_radius);
+    if (std::find(low.begin(), low.end(), true) == low.end()) break;
+    for (std::size_t k = 0; k < zmin.cells(); ++k)
+      if (low[k]) zmin.z[k] = NAN;
+  }
   ElevationGrid negated = zmin;
   for (float& z : negated.z) z = -z;
   detail::inpaint(negated);

@@ -3,10 +3,11 @@
 // airborne LIDAR data", ISPRS J. Photogramm. 77, 2013), written from the paper:
 //
 //  1. the minimum surface: the lowest candidate point of each cell (cell size `cell`);
-//  2. low outliers: cells whose minimum is a pit far below its neighbours (the same
-//     progressive opening run on the negated surface, window kLowOutlierWindow, slope
-//     kLowOutlierSlope) are emptied, so that a stray point below the ground cannot drag
-//     the surface down;
+//  2. low outliers: cells below their neighbours that no neighbour continues in height
+//     (unsupported: scattered echoes at random depths), then cells whose minimum is a
+//     pit far below its neighbours (the same progressive opening run on the negated
+//     surface, window kLowOutlierWindow, slope kLowOutlierSlope), are emptied, so that
+//     a stray point below the ground cannot drag the surface down;
 //  3. empty cells filled (inpainting: a push-pull pyramid, then Laplace smoothing);
 //  4. progressive morphological opening with a disk of radius 1, 2, ... up to
 //     window / cell cells: a cell is an object when one opening lowers it by more than
@@ -44,6 +45,13 @@ struct SmrfOptions {
 // radius within 5 m are not terrain (real ditches and banks are far gentler).
 inline constexpr double kLowOutlierWindow = 5.0;
 inline constexpr double kLowOutlierSlope = 5.0;
+// Before it, a cell is an unsupported low when some filled cell within kSupportRadius
+// metres lies more than kPitDepth + kPitSlope x distance above it and fewer than two lie
+// within that height of it; repeated up to kSupportPasses times.
+inline constexpr double kSupportRadius = 3.0;
+inline constexpr double kPitDepth = 1.0;
+inline constexpr double kPitSlope = 1.0;
+inline constexpr int kSupportPasses = 4;
 
 // Ground flags for points xyz (x y z triples); candidate[i] false leaves point i out of
 // the surface and not ground. Throws InvalidArgument when the grid would pass 2^28 cells
