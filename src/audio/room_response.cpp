@@ -1,0 +1,88 @@
+#include "vola/audio/room_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "vola/error.hpp"
+#include "vola/raycast/world.hpp"
+
+namespace vola::audio {
+
+void RoomOptions::check() const {
+  auto fail = [](const std::string& what, double v) {
+    std::ostringstream s;
+    s << what << " (got " << v << ")";
+    throw InvalidArgument(s.str());
+  };
+  if (!(sample_rate >= 1000.0 && sample_rate <= 768000.0)) fail("the sample rate must be in [1000, 768000] Hz", sample_rate);
+  if (!(speed_of_sound > 0.0 && std::isfinite(speed_of_sound))) fail("the speed of sound must be > 0", speed_of_sound);
+  if (!(order >= 0 && order <= 64)) fail("the image-source order must be in [0, 64]", order);
+  if (!(scattering >= 0.0 && scattering <= 1.0)) fail("the scattering coefficient must be in [0, 1]", scattering);
+  if (!(rays <= (std::uint64_t{1} << 32))) fail("the ray count must be at most 2^32", static_cast<double>(rays));
+  if (!(max_length > 0.0 && max_length <= 60.0)) fail("the response length must be in (0, 60] s", max_length);
+  if (!(decay_floor_db < 0.0 && decay_floor_db >= -200.0)) fail("the decay floor must be in [-200, 0) dB", decay_floor_db);
+  if (!(receiver_radius > 0.0 && std::isfinite(receiver_radius))) fail("the receiver radius must be > 0", receiver_radius);
+}
+
+Room::Room(const AcousticScene& scene)
+    : scene_(&scene), patches_(scene.tree(), scene.materials(), scene.blocks()) {
+  const auto& slots = scene.materials().slots();
+  for (const SurfacePatch& p : patches_.patches()) {
+    const Material& m = slots[p.slot];
+    double energy = 0.0;
+    for (const double r : m.bands) energy += r * r;
+    reflection_.push_back(std::sqrt(energy / static_cast<double>(m.bands.size())));
+  }
+}
+
+RoomResponse room_response(const Room& room, const Point& source, const Point& listener, const RoomOptions& o) {
+  o.check();
+  const AcousticScene& scene = room.scene();
+  scene.check_point(source, "the source");
+  scene.check_point(listener, "the listener");
+  RoomResponse r;
+  const double dx = source[0] - listener[0], dy = source[1] - listener[1], dz = source[2] - listener[2];
+  r.direct_distance = std::sqrt(dx * dx + dy * dy + dz * dz);
+  if (!(r.direct_distance > 0.0)) throw InvalidArgument("the source and the listener are at the same point");
+  const double last = std::ceil(o.max_length * o.sample_rate);
+  if (!(last < static_cast<double>(1u << 28))) throw InvalidArgument("the response would exceed 2^28 samples: shorten it");
+  const double direct_sample = std::nearbyint(r.direct_distance / o.speed_of_sound * o.sample_rate);
+  if (!(direct_sample < last))
+    throw InvalidArgument("the source is further from the listener than sound travels in the response's length");
+  r.direct_sample = static_cast<std::uint32_t>(direct_sample);
+  if (o.occlusion) {
+    const Point s = raycast::world_to_grid(scene.frame(), source), l = raycast::world_to_grid(scene.frame(), listener);
+    r.direct_blocked = scene.caster().cast(raycast::Ray{s, {l[0] - s[0], l[1] - s[1], l[2] - s[2]}, 1.0}).has_value();
+  }
+  r.direct_amplitude = r.direct_blocked ? 0.0 : 1.0 / r.direct_distance;
+
+  r.early = image_sources(room, source, listener, o);
+  r.late = late_energy(room, source, listener, r.early.order, o);
+
+  std::size_t length = std::size_t{r.direct_sample} + 1;
+  for (const ImageSource& is : r.early.images)
+    length = std::max(length, static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate)) + 1);
+  length = std::max(length, r.late.energy.size() * r.late.bin_samples);
+  length = std::min(length, static_cast<std::size_t>(last));
+  r.ir.assign(length, 0.0);
+  r.ir[r.direct_sample] += r.direct_amplitude;
+  for (const ImageSource& is : r.early.images) {
+    const auto n = static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate));
+    if (n < length) r.ir[n] += is.amplitude;
+  }
+  // Each bin's energy as white noise of random signs: sum of squares = the bin's energy.
+  // Not before the earliest deposit: the first bin may start before any sound arrives.
+  std::mt19937_64 rng(o.seed ^ 0x5DEECE66Dull);
+  for (std::size_t b = 0; b < r.late.energy.size(); ++b) {
+    const std::size_t begin = std::max(b * r.late.bin_samples, r.late.first_sample);
+    const std::size_t end = std::min(length, (b + 1) * r.late.bin_samples);
+    if (begin >= end || r.late.energy[b] == 0.0) continue;
+    const double a = std::sqrt(r.late.energy[b] / static_cast<double>(end - begin));
+    for (std::size_t i = begin; i < end; ++i) r.ir[i] += (rng() & 1) ? a : -a;
+  }
+  return r;
+}
+
+}  // namespace vola::audio
