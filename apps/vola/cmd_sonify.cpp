@@ -1,10 +1,12 @@
-// vola sonify: hear a scene. Sources and a listener inside a .vol scene; every surface
-// voxel reflects; the impulse response (direct sound + binned early reflections) filters
-// the dry recording (the paper's SonifEye, section IV).
+// vola sonify: hear a scene. Sources and a listener inside a .vol scene; the impulse
+// response filters the dry recording. Two models: the physical one (room_response.hpp:
+// image sources over planar patches, occlusion, a ray-traced tail) by default, and the
+// paper's SonifEye (section IV: every surface voxel reflects, binned) with --model paper.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/materials.hpp"
 #include "vola/audio/response.hpp"
+#include "vola/audio/room_response.hpp"
 #include "vola/audio/wav.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -23,14 +26,66 @@ namespace vola::cli {
 namespace {
 
 struct SonifyArgs {
-  std::string scene, materials, output, ir, plot, channels = "mix", format = "pcm16";
+  std::string scene, materials, output, ir, plot, channels = "mix", format = "pcm16", model = "physical";
   std::vector<std::vector<double>> sources;
   std::vector<double> listener;
   std::vector<std::string> inputs;
   double reflection = 0.5;
-  bool payload_coefficients = false, no_normalize = false, quiet = false;
-  audio::ResponseOptions response;
+  std::optional<double> absorption;
+  bool payload_coefficients = false, no_normalize = false, quiet = false, no_occlusion = false;
+  audio::ResponseOptions response;  // --model paper
+  audio::RoomOptions room;          // --model physical
 };
+
+// The table of reflection coefficients the flags ask for. --absorption A is the pressure
+// reflection coefficient sqrt(1 - A) for every surface a material table does not list.
+audio::MaterialTable material_table(const SonifyArgs& a) {
+  if (a.absorption && !(*a.absorption >= 0.0 && *a.absorption <= 1.0))
+    throw InvalidArgument("--absorption must be in [0, 1] (got " + std::to_string(*a.absorption) + ")");
+  audio::MaterialTable table = audio::scene_material(a.absorption ? std::sqrt(1.0 - *a.absorption) : a.reflection);
+  if (!a.materials.empty()) {
+    const audio::Material fallback = table.fallback;
+    table = audio::read_material_table(a.materials);
+    if (a.absorption) table.fallback = fallback;
+  }
+  if (a.payload_coefficients) table.source = audio::MaterialSource::payload_value;
+  return table;
+}
+
+// One source's response by the chosen model, and its line of report.
+struct SourceResponse {
+  std::vector<double> ir;
+  std::int64_t direct_sample = -1;  // -1 when blocked
+  std::string report;
+};
+
+SourceResponse physical_response(const audio::Room& room, const Point& source, const Point& listener, const SonifyArgs& a) {
+  const audio::RoomResponse r = audio::room_response(room, source, listener, a.room);
+  const double fs = a.room.sample_rate;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "direct %.3f m, %.2f ms (sample %u)%s; %zu image sources up to order %d of %zu patches; "
+                "tail from %llu rays (receiver radius %.2f m); response %.2f ms",
+                r.direct_distance, r.direct_sample / fs * 1000.0, r.direct_sample,
+                r.direct_blocked ? ", blocked by the scene" : "", r.early.images.size(), r.early.order,
+                room.patches().patches().size(), static_cast<unsigned long long>(a.room.rays), r.late.receiver_radius,
+                static_cast<double>(r.ir.size()) / fs * 1000.0);
+  return {r.ir, r.direct_blocked ? -1 : static_cast<std::int64_t>(r.direct_sample), line};
+}
+
+SourceResponse paper_response(const audio::AcousticScene& scene, const Point& source, const Point& listener, const SonifyArgs& a) {
+  const audio::Thresholded binned = audio::threshold(scene, source, listener, a.response);
+  std::vector<double> ir = audio::make_filter(scene, binned, a.response);
+  const double fs = a.response.sample_rate;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "direct %.3f scene units, %.2f ms (sample %u)%s; %llu reflecting voxels in %zu bins; response %.2f ms",
+                binned.direct_distance, binned.direct_sample / fs * 1000.0, binned.direct_sample,
+                binned.direct_blocked ? ", blocked by the scene" : "", static_cast<unsigned long long>(binned.reflectors),
+                binned.bins.size(), static_cast<double>(ir.size()) / fs * 1000.0);
+  const std::int64_t direct = binned.direct_blocked ? -1 : static_cast<std::int64_t>(binned.direct_sample);
+  return {std::move(ir), direct, line};
+}
 
 audio::SampleFormat sample_format(const std::string& name) {
   if (name == "pcm16") return audio::SampleFormat::pcm16;
@@ -101,40 +156,40 @@ void write_responses(const std::string& path, const std::vector<std::vector<doub
 void run_sonify(SonifyArgs& a) {
   if (a.payload_coefficients && !a.materials.empty())
     throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
+  const bool physical = a.model == "physical";
+  const audio::MaterialTable table = material_table(a);
   const std::vector<audio::Sound> dry = read_dry(a);
   a.response.sample_rate = dry[0].sample_rate;
   a.response.check();
+  a.room.sample_rate = dry[0].sample_rate;
+  a.room.speed_of_sound = a.response.speed_of_sound;
+  a.room.threads = a.response.threads;
+  a.room.occlusion = !a.no_occlusion;
+  a.room.check();
 
-  audio::MaterialTable table = audio::scene_material(a.reflection);
-  if (!a.materials.empty()) table = audio::read_material_table(a.materials);
-  if (a.payload_coefficients) table.source = audio::MaterialSource::payload_value;
   const Tree tree = open_voxels(a.scene);
   const audio::AcousticScene scene(tree, table);
   const Point listener{a.listener[0], a.listener[1], a.listener[2]};
+  // Patches depend on the scene only: found once for every source.
+  std::optional<audio::Room> room;
+  if (physical) room.emplace(scene);
 
   std::vector<std::vector<double>> responses, wet;
   std::vector<PlotPanel> panels;
   for (std::size_t s = 0; s < a.sources.size(); ++s) {
     const Point source{a.sources[s][0], a.sources[s][1], a.sources[s][2]};
     const auto t0 = std::chrono::steady_clock::now();
-    const audio::Thresholded binned = audio::threshold(scene, source, listener, a.response);
-    std::vector<double> ir = audio::make_filter(scene, binned, a.response);
+    SourceResponse r = physical ? physical_response(*room, source, listener, a) : paper_response(scene, source, listener, a);
     const auto t1 = std::chrono::steady_clock::now();
     const std::vector<double> signal = dry[dry.size() == 1 ? 0 : s].mono();
-    wet.push_back(audio::Convolver(ir).apply(signal, a.response.threads));
+    wet.push_back(audio::Convolver(r.ir).apply(signal, a.response.threads));
     const auto t2 = std::chrono::steady_clock::now();
-    if (!a.quiet) {
-      const double fs = a.response.sample_rate;
-      std::printf("source %zu: direct %.3f scene units, %.2f ms (sample %u)%s; %llu reflecting voxels in %zu bins; "
-                  "response %.2f ms; %.1f ms to build, %.1f ms to filter\n",
-                  s + 1, binned.direct_distance, binned.direct_sample / fs * 1000.0, binned.direct_sample,
-                  binned.direct_blocked ? ", blocked by the scene" : "",
-                  static_cast<unsigned long long>(binned.reflectors), binned.bins.size(), static_cast<double>(ir.size()) / fs * 1000.0,
+    if (!a.quiet)
+      std::printf("source %zu: %s; %.1f ms to build, %.1f ms to filter\n", s + 1, r.report.c_str(),
                   std::chrono::duration<double, std::milli>(t1 - t0).count(),
                   std::chrono::duration<double, std::milli>(t2 - t1).count());
-    }
-    panels.push_back(PlotPanel{ir, binned.direct_blocked ? -1 : static_cast<std::int64_t>(binned.direct_sample)});
-    responses.push_back(std::move(ir));
+    panels.push_back(PlotPanel{r.ir, r.direct_sample});
+    responses.push_back(std::move(r.ir));
   }
 
   const audio::Sound out = output_sound(a, wet, dry[0].sample_rate);
@@ -153,22 +208,35 @@ void add_sonify(CLI::App& app) {
   auto args = std::make_shared<SonifyArgs>();
   auto* cmd = app.add_subcommand("sonify", kSonifySummary);
   cmd->footer(
-      "How it works (the VOLA paper's SonifEye): every occupied voxel with an empty 6-neighbour is a\n"
-      "reflector. It reflects through each exposed face that both source and listener are in front of,\n"
-      "at that face's centre, as a patch of one voxel face: amplitude R * sqrt(A/pi) / (r1 * r2), delay\n"
-      "(r1 + r2) / c. The direct sound has amplitude 1/d (1 at 1 m) and is silent when the straight line\n"
-      "crosses an occupied voxel. Paths with the same delay sample and the same attenuation bin\n"
-      "(--bin-width dB) are counted together, and the bins make an FIR filter (the impulse response,\n"
-      "--ir) through which the recording passes by FFT. Only early reflections are modelled: paths\n"
-      "arriving more than --window seconds after the straight-line time are left out.\n"
+      "How it works (--model physical, the default): the scene's surface is split into planar patches\n"
+      "(exposed voxel faces joined by a normal fitted to their neighbourhood). The impulse response is\n"
+      "  direct:  amplitude 1/d (1 at 1 m) after d/c, silent when the line crosses an occupied voxel;\n"
+      "  early:   image sources over the patches up to --order reflections, each kept only when its path\n"
+      "           meets every patch it mirrors in and (unless --no-occlusion) every leg is free of voxels\n"
+      "           (exact voxel ray casts); amplitude prod(R * sqrt(1 - s)) / path length, R the pressure\n"
+      "           reflection coefficient, s = --scattering; a patch smaller than the 1 kHz Fresnel zone\n"
+      "           reflects that fraction of it;\n"
+      "  late:    --rays energy rays traced over the voxels, losing R^2 at each hit and going on\n"
+      "           specularly or (probability s) diffusely; each hit sends its diffuse part straight to\n"
+      "           the listener if it sees it, specular paths are heard by a sphere around the listener,\n"
+      "           and the paths the image sources hold are left out. The energy per millisecond becomes\n"
+      "           noise, so the decay follows the room (T30 within 10% of Eyring's formula in closed\n"
+      "           rooms, tested). --rays 0: no tail.\n"
+      "--model paper: the VOLA paper's SonifEye: every surface voxel reflects through each exposed face that\n"
+      "both ends are in front of, amplitude R * sqrt(A/pi) / (r1 * r2); paths binned by delay sample and\n"
+      "attenuation (--bin-width), kept up to --window s after the direct time, --floor, --visibility.\n"
+      "Its levels grow as the voxel size shrinks: it is the paper's timing reference, not physics.\n"
       "World units are metres; the sample rate is the recording's.\n\n"
-      "Reflection coefficients R (pressure, 0..1): --reflection for the whole scene, or --materials m.json:\n"
+      "Reflection coefficients R (pressure, 0..1): --reflection R or --absorption A (R = sqrt(1 - A)) for the\n"
+      "whole scene, or --materials m.json (--absorption then sets the classes the table does not list):\n"
       "  {\"attribute\": \"classification\", \"default\": 0.3,\n"
       "   \"materials\": {\"2\": 0.2, \"6\": [0.98, 0.97, 0.96, 0.95, 0.93, 0.90]}}\n"
       "mapping the value of a per-voxel attribute (or \"payload\": the payload's low byte) to one\n"
-      "coefficient or six (octave bands 125..4000 Hz), or --payload-coefficients: payload byte / 255.\n\n"
+      "coefficient or six (octave bands 125..4000 Hz; the physical model uses their mean energy), or\n"
+      "--payload-coefficients: payload byte / 255.\n\n"
       "Examples:\n"
       "  vola sonify room.vol --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out wet.wav --ir ir.wav --plot ir.png\n"
+      "  vola sonify room.vol --absorption 0.2 --order 4 --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out wet.wav\n"
       "  vola sonify scan.vol --materials m.json --source 1 2 1 --source 5 2 1 --listener 3 3 1 \\\n"
       "      --in violin.wav --in cello.wav --out duo.wav --channels per-source");
   cmd->add_option("scene", args->scene, "The scene (.vol)")->required()->check(CLI::ExistingFile);
@@ -184,19 +252,39 @@ void add_sonify(CLI::App& app) {
   cmd->add_option("--ir", args->ir, "Also write the impulse responses (32-bit float WAV, one channel per source)");
   cmd->add_option("--plot", args->plot, "Also draw the impulse responses (PNG, dB against ms, direct sound in red)");
   cmd->add_option("--materials", args->materials, "Material table (JSON, see below)")->check(CLI::ExistingFile);
-  cmd->add_option("--reflection", args->reflection, "Scene-wide reflection coefficient (without --materials)")
+  cmd->add_option("--model", args->model, "physical: image sources, occlusion and a ray-traced tail; paper: SonifEye")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"physical", "paper"}));
+  cmd->add_option("--reflection", args->reflection, "Scene-wide pressure reflection coefficient (without --materials)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--absorption", args->absorption,
+                  "Scene-wide energy absorption coefficient in [0, 1], instead of --reflection (R = sqrt(1 - A))")
+      ->excludes("--reflection");
+  cmd->add_option("--order", args->room.order, "Image-source reflections at most (physical)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  cmd->add_flag("--no-occlusion", args->no_occlusion,
+                "Physical: no ray casts (walls do not hide paths, the direct sound included); faster");
+  cmd->add_option("--scattering", args->room.scattering, "Physical: energy fraction reflected diffusely, 0..1")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--rays", args->room.rays, "Physical: rays traced for the late tail (0 = no tail)")->capture_default_str();
+  cmd->add_option("--length", args->room.max_length, "Physical: the response's longest length (s)")->capture_default_str();
+  cmd->add_option("--receiver-radius", args->room.receiver_radius,
+                  "Physical: the tail's receiver sphere (m), shrunk to clear the scene")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->room.seed, "Physical: the tail's random numbers")->capture_default_str();
   cmd->add_flag("--payload-coefficients", args->payload_coefficients, "Reflection coefficient = payload byte / 255");
   cmd->add_option("--speed-of-sound", args->response.speed_of_sound, "Speed of sound (m/s)")->capture_default_str();
   cmd->add_option("--window", args->response.reflection_window,
-                  "Reflections arriving up to this many seconds after the straight-line time")
+                  "Paper: reflections arriving up to this many seconds after the straight-line time")
       ->capture_default_str();
-  cmd->add_option("--bin-width", args->response.bin_width_db, "Attenuation bin width (dB)")->capture_default_str();
-  cmd->add_option("--floor", args->response.floor_db, "Drop reflections weaker than this (dB re 1 at 1 m)")
+  cmd->add_option("--bin-width", args->response.bin_width_db, "Paper: attenuation bin width (dB)")->capture_default_str();
+  cmd->add_option("--floor", args->response.floor_db, "Paper: drop reflections weaker than this (dB re 1 at 1 m)")
       ->capture_default_str();
   cmd->add_flag("--visibility", args->response.visibility,
-                "Keep only reflectors seen from both source and listener (two rays per voxel)");
+                "Paper: keep only reflectors seen from both source and listener (two rays per voxel)");
   cmd->add_option("--channels", args->channels, "mix: one channel, all sources summed; per-source: a channel each")
       ->capture_default_str()
       ->check(CLI::IsMember({"mix", "per-source"}));

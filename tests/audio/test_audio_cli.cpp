@@ -109,6 +109,47 @@ TEST_F(SonifyCli, BadInputsFailWithOneClearLine) {
   r = run(base + " --source 2 1.5 1.25 --source 3 2 2 --in " + dry + " --in " + dry + " --in " + dry, dir_);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("one per --source"), std::string::npos) << r.output;
+  // Recordings at 48 and 16 kHz.
+  r = run(base + " --source 2 1.5 1.25 --source 3 2 2 --in " + dry + " --in " + (audio / "codec2_speech_orig_16k.wav").string(),
+          dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("resample them to one rate"), std::string::npos) << r.output;
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --absorption 1.5", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--absorption must be in [0, 1]"), std::string::npos) << r.output;
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --absorption -0.1", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--absorption must be in [0, 1]"), std::string::npos) << r.output;
+  // The room's grid is 256 voxels of 1/32 m: 8 m.
+  r = run(path("room.vol") + " --listener 9 3 2 --out " + path("o.wav") + " --source 2 1.5 1.25 --in " + dry, dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("the listener (9, 3, 2) is outside the scene's grid"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.wav")));
+}
+
+// The physical model's flags: a wall between source and listener silences the direct sound
+// unless --no-occlusion; --model paper keeps the paper's voxel-by-voxel model.
+TEST_F(SonifyCli, OcclusionAndModels) {
+  VOLA_REQUIRE_AUDIO(audio);
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  // Listener outside the closed room (x = 7 m, beyond the wall at voxel 200 = 6.25 m).
+  const std::string base = path("room.vol") + " --source 2 1.5 1.25 --listener 7 1.5 1.25 --in " + dry +
+                           " --absorption 0.2 --rays 2000 --out " + path("w.wav") + " --ir " + path("ir.wav");
+  const double d = 5.0;
+  const auto direct = static_cast<std::size_t>(std::lround(d / 343.0 * 48000.0));
+  CliRun r = run(base, dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("blocked by the scene"), std::string::npos) << r.output;
+  EXPECT_EQ(vola::audio::read_sound(path("ir.wav")).channels[0][direct], 0.0);
+  r = run(base + " --no-occlusion", dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("blocked"), std::string::npos) << r.output;
+  EXPECT_NEAR(vola::audio::read_sound(path("ir.wav")).channels[0][direct], 1.0 / d, 1e-6);
+  r = run(base + " --model paper --window 0.02", dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("reflecting voxels in"), std::string::npos) << r.output;
+  r = run(base + " --reflection 0.5", dir_);
+  EXPECT_NE(r.status, 0) << "--reflection and --absorption both given";
 }
 
 }  // namespace

@@ -18,11 +18,14 @@
 //   late:    stochastic energy ray tracing (Vorlaender's method) over the voxels: `rays`
 //            rays leave the source uniformly, lose R^2 of their energy at each hit, go
 //            on specularly (probability 1 - s) or Lambert-diffusely (s) from the patch's
-//            normal, and deposit energy * chord / volume when they cross a receiver sphere
-//            around the listener (its radius shrunk to clear every occupied voxel). Paths
-//            the image sources already hold (purely specular, at most `order` reflections,
-//            and the direct path) deposit nothing, so no energy is counted twice. The
-//            energy per millisecond becomes noise of that energy (random signs).
+//            normal. At each hit the diffuse part goes straight to the listener when it
+//            sees it ("diffuse rain": energy s cos(theta) / (pi D^2)); a ray whose last
+//            reflection was specular deposits energy * chord / volume when it crosses a
+//            receiver sphere around the listener (its radius shrunk to clear every
+//            occupied voxel). Paths the image sources already hold (purely specular, at
+//            most the order searched, and the direct path) deposit nothing, so no energy
+//            is counted twice. The energy per millisecond becomes noise of that energy
+//            (random signs), from the earliest deposit on.
 // Normalisation: the source's power is that of the direct sound's 1 / d, so the tail's
 // energy is on the same scale as the image sources' squared amplitudes.
 #pragma once
