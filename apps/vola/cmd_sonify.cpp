@@ -62,14 +62,16 @@ struct SourceResponse {
 SourceResponse physical_response(const audio::Room& room, const Point& source, const Point& listener, const SonifyArgs& a) {
   const audio::RoomResponse r = audio::room_response(room, source, listener, a.room);
   const double fs = a.room.sample_rate;
+  char tail[128] = "no tail";
+  if (a.room.rays > 0)
+    std::snprintf(tail, sizeof tail, "tail from %llu rays (receiver radius %.2f m)",
+                  static_cast<unsigned long long>(a.room.rays), r.late.receiver_radius);
   char line[512];
   std::snprintf(line, sizeof line,
-                "direct %.3f m, %.2f ms (sample %u)%s; %zu image sources up to order %d of %zu patches; "
-                "tail from %llu rays (receiver radius %.2f m); response %.2f ms",
+                "direct %.3f m, %.2f ms (sample %u)%s; %zu image sources up to order %d of %zu patches; %s; response %.2f ms",
                 r.direct_distance, r.direct_sample / fs * 1000.0, r.direct_sample,
                 r.direct_blocked ? ", blocked by the scene" : "", r.early.images.size(), r.early.order,
-                room.patches().patches().size(), static_cast<unsigned long long>(a.room.rays), r.late.receiver_radius,
-                static_cast<double>(r.ir.size()) / fs * 1000.0);
+                room.patches().patches().size(), tail, static_cast<double>(r.ir.size()) / fs * 1000.0);
   return {r.ir, r.direct_blocked ? -1 : static_cast<std::int64_t>(r.direct_sample), line};
 }
 

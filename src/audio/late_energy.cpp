@@ -88,7 +88,7 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   const double radius = std::min(wanted, clearance(scene.tree(), l, wanted));
   late.receiver_radius = radius * voxel;
   late.energy.assign(bins, 0.0);
-  if (!(radius > 0.0)) return late;
+  // A listener on a voxel's face has no room for a sphere: it hears the diffuse rain only.
   const double r2 = radius * radius;
   const double volume = 4.0 / 3.0 * std::numbers::pi * late.receiver_radius * late.receiver_radius * late.receiver_radius;
   // Each ray carries 4 pi / N (m^2): a free field then gives energy 1 / d^2 at d, the
@@ -124,7 +124,7 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         // The chord of the receiver sphere on [0, segment]: for paths whose last reflection was
         // specular (diffuse ones reached the listener as rain, below), unless the image sources
         // hold the path.
-        if (last_specular && !(specular && reflections <= order)) {
+        if (r2 > 0.0 && last_specular && !(specular && reflections <= order)) {
           const Point w{l[0] - origin[0], l[1] - origin[1], l[2] - origin[2]};
           const double along = dot(w, d);
           const double h2 = dot(w, w) - along * along;
