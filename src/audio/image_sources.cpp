@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "vola/audio/room_response.hpp"
+#include "vola/parallel.hpp"
 #include "vola/raycast/world.hpp"
 
 namespace vola::audio {
@@ -71,23 +72,81 @@ bool wholly_behind(const SurfacePatch& patch, const SurfacePatch& of) {
   return true;
 }
 
-}  // namespace
+// One image's reflections, last first: the patches and the images after each.
+struct Trace {
+  std::vector<std::uint32_t> sequence;
+  std::vector<Point> images;
+  std::vector<Point> points;  // where each reflects, last first
+};
 
-ImageSearch image_sources(const Room& room, const Point& source, const Point& listener, const RoomOptions& o) {
-  o.check();
+// Is q within `margin` voxels of the patch's box of face centres? Cheaper than on_patch,
+// and most candidate images of a cluttered scene fail it.
+bool near_box(const SurfacePatch& patch, const Point& q, double margin) {
+  for (int a = 0; a < 3; ++a)
+    if (q[a] < patch.lo[a] - margin || q[a] > patch.hi[a] + margin) return false;
+  return true;
+}
+
+// The path an image stands for, traced back from the listener l to the source s (grid
+// coordinates), or false when it does not exist (room_response.hpp).
+bool path_of(const Room& room, const Point& s, const Point& l, const RoomOptions& o, Trace& t, ImageSource& out) {
   const AcousticScene& scene = room.scene();
   const Frame& frame = scene.frame();
   const double voxel = frame.voxel_size;
   const std::uint32_t side = scene.tree().side();
   const auto& patches = room.patches().patches();
-  const Point s = raycast::world_to_grid(frame, source), l = raycast::world_to_grid(frame, listener);
+  t.points.clear();
+  Point target = l;
+  for (std::size_t k = 0; k < t.sequence.size(); ++k) {
+    const SurfacePatch& patch = patches[t.sequence[k]];
+    const double dt = plane_distance(patch, target), di = plane_distance(patch, t.images[k]);
+    if (!(dt > 0.0 && di < 0.0)) return false;
+    const double u = dt / (dt - di);
+    const Point q{target[0] + u * (t.images[k][0] - target[0]), target[1] + u * (t.images[k][1] - target[1]),
+                  target[2] + u * (t.images[k][2] - target[2])};
+    if (!near_box(patch, q, 1.5) || !on_patch(room.patches(), t.sequence[k], q, side)) return false;
+    if (o.occlusion && !clear(scene.caster(), q, true, target, k > 0)) return false;
+    t.points.push_back(q);
+    target = q;
+  }
+  if (o.occlusion && !clear(scene.caster(), s, false, target, true)) return false;
+  const double path = length(t.images[0], l) * voxel;
+  out.path = path;
+  out.delay = path / o.speed_of_sound;
+  out.image = raycast::grid_to_world(frame, t.images[0]);
+  out.patches.clear();
+  out.points.clear();
   const double wavelength = o.speed_of_sound / 1000.0;  // m, at 1 kHz (Fresnel zone)
   const double scatter = std::sqrt(1.0 - o.scattering);
+  double gain = 1.0;
+  // Source side first: r_in runs from the source to the reflection point along the path.
+  double r_in = 0.0;
+  Point previous = s;
+  for (std::size_t k = t.sequence.size(); k-- > 0;) {
+    const std::uint32_t p = t.sequence[k];
+    r_in += length(previous, t.points[k]) * voxel;
+    previous = t.points[k];
+    const double r_out = path - r_in;
+    const double fresnel = std::numbers::pi * wavelength * r_in * r_out / path;
+    const double area = patches[p].area * voxel * voxel;
+    gain *= room.reflection()[p] * scatter * std::sqrt(std::min(1.0, area / fresnel));
+    out.patches.push_back(p);
+    out.points.push_back(raycast::grid_to_world(frame, t.points[k]));
+  }
+  out.amplitude = gain / path;
+  return out.amplitude > 0.0;
+}
+
+}  // namespace
+
+ImageSearch image_sources(const Room& room, const Point& source, const Point& listener, const RoomOptions& o) {
+  o.check();
+  const Frame& frame = room.scene().frame();
+  const auto& patches = room.patches().patches();
+  const Point s = raycast::world_to_grid(frame, source), l = raycast::world_to_grid(frame, listener);
 
   ImageSearch search;
   std::vector<std::vector<Node>> levels;  // levels[k - 1]: the images of order k
-  std::vector<std::uint32_t> sequence;
-  std::vector<Point> points;
   for (int order = 1; order <= o.order; ++order) {
     std::vector<Node> next;
     bool over_budget = false;
@@ -110,59 +169,32 @@ ImageSearch image_sources(const Room& room, const Point& source, const Point& li
     levels.push_back(std::move(next));
     search.order = order;
 
-    // Each image of this order: its path traced back from the listener.
-    for (const Node& node : levels.back()) {
-      sequence.clear();
-      std::vector<Point> images;  // the node's images, last reflection first
-      for (const Node* n = &node; ; ) {
-        sequence.push_back(n->patch);
-        images.push_back(n->image);
-        const int k = static_cast<int>(sequence.size());
-        if (n->parent == UINT32_MAX) break;
-        n = &levels[static_cast<std::size_t>(order - k - 1)][n->parent];
-      }
-      points.clear();
-      Point target = l;
-      bool valid = true;
-      for (std::size_t k = 0; k < sequence.size() && valid; ++k) {
-        const SurfacePatch& patch = patches[sequence[k]];
-        const double dt = plane_distance(patch, target), di = plane_distance(patch, images[k]);
-        if (!(dt > 0.0 && di < 0.0)) {
-          valid = false;
-          break;
+    // Each image of this order: its path traced back from the listener, in chunks on the
+    // threads; the chunks' results are joined in order, so the thread count changes nothing.
+    const std::vector<Node>& nodes = levels.back();
+    const std::size_t chunks = std::min<std::size_t>(nodes.size() / 256 + 1, 64);
+    std::vector<std::vector<ImageSource>> found(chunks);
+    ParallelOptions parallel;
+    parallel.threads = o.threads;
+    parallel.chunks = chunks;
+    parallel.name = "audio.image_sources";
+    parallel_for(nodes.size(), [&](const Chunk& chunk) {
+      Trace trace;
+      for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+        trace.sequence.clear();
+        trace.images.clear();
+        for (const Node* n = &nodes[i];;) {
+          trace.sequence.push_back(n->patch);
+          trace.images.push_back(n->image);
+          if (n->parent == UINT32_MAX) break;
+          n = &levels[static_cast<std::size_t>(order) - trace.sequence.size() - 1][n->parent];
         }
-        const double u = dt / (dt - di);
-        const Point q{target[0] + u * (images[k][0] - target[0]), target[1] + u * (images[k][1] - target[1]),
-                      target[2] + u * (images[k][2] - target[2])};
-        valid = on_patch(room.patches(), sequence[k], q, side) &&
-                (!o.occlusion || clear(scene.caster(), q, true, target, k > 0));
-        points.push_back(q);
-        target = q;
+        ImageSource is;
+        if (path_of(room, s, l, o, trace, is)) found[chunk.index].push_back(std::move(is));
       }
-      if (!valid || (o.occlusion && !clear(scene.caster(), s, false, target, true))) continue;
-      ImageSource is;
-      const double path = length(images[0], l) * voxel;
-      is.path = path;
-      is.delay = path / o.speed_of_sound;
-      is.image = raycast::grid_to_world(frame, images[0]);
-      double gain = 1.0;
-      // Source side first: r_in runs from the source to the reflection point along the path.
-      double r_in = 0.0;
-      Point previous = s;
-      for (std::size_t k = sequence.size(); k-- > 0;) {
-        const std::uint32_t p = sequence[k];
-        r_in += length(previous, points[k]) * voxel;
-        previous = points[k];
-        const double r_out = path - r_in;
-        const double fresnel = std::numbers::pi * wavelength * r_in * r_out / path;
-        const double area = patches[p].area * voxel * voxel;
-        gain *= room.reflection()[p] * scatter * std::sqrt(std::min(1.0, area / fresnel));
-        is.patches.push_back(p);
-        is.points.push_back(raycast::grid_to_world(frame, points[k]));
-      }
-      is.amplitude = gain / path;
-      if (is.amplitude > 0.0) search.images.push_back(std::move(is));
-    }
+    }, parallel);
+    for (auto& f : found)
+      for (auto& is : f) search.images.push_back(std::move(is));
   }
   std::stable_sort(search.images.begin(), search.images.end(),
                    [](const ImageSource& a, const ImageSource& b) { return a.delay < b.delay; });
