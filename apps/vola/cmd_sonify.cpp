@@ -224,6 +224,9 @@ void add_sonify(CLI::App& app) {
       "           and the paths the image sources hold are left out. The energy per millisecond becomes\n"
       "           noise, so the decay follows the room (T30 within 10% of Eyring's formula in closed\n"
       "           rooms, tested). --rays 0: no tail.\n"
+      "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
+      "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
+      "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
       "--model paper: the VOLA paper's SonifEye: every surface voxel reflects through each exposed face that\n"
       "both ends are in front of, amplitude R * sqrt(A/pi) / (r1 * r2); paths binned by delay sample and\n"
       "attenuation (--bin-width), kept up to --window s after the direct time, --floor, --visibility.\n"
@@ -234,7 +237,7 @@ void add_sonify(CLI::App& app) {
       "  {\"attribute\": \"classification\", \"default\": 0.3,\n"
       "   \"materials\": {\"2\": 0.2, \"6\": [0.98, 0.97, 0.96, 0.95, 0.93, 0.90]}}\n"
       "mapping the value of a per-voxel attribute (or \"payload\": the payload's low byte) to one\n"
-      "coefficient or six (octave bands 125..4000 Hz; the physical model uses their mean energy), or\n"
+      "coefficient or six (octave bands 125..4000 Hz), or\n"
       "--payload-coefficients: payload byte / 255.\n\n"
       "Examples:\n"
       "  vola sonify room.vol --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out wet.wav --ir ir.wav --plot ir.png\n"
@@ -277,6 +280,11 @@ void add_sonify(CLI::App& app) {
                   "Physical: the tail's receiver sphere (m), shrunk to clear the scene")
       ->capture_default_str();
   cmd->add_option("--seed", args->room.seed, "Physical: the tail's random numbers")->capture_default_str();
+  cmd->add_flag("--air", args->room.air, "Physical: air absorption (ISO 9613-1) on every path, per octave band");
+  cmd->add_option("--temperature", args->room.celsius, "Physical, with --air: the air's temperature (degrees C)")
+      ->capture_default_str();
+  cmd->add_option("--humidity", args->room.humidity, "Physical, with --air: relative humidity (percent)")
+      ->capture_default_str();
   cmd->add_flag("--payload-coefficients", args->payload_coefficients, "Reflection coefficient = payload byte / 255");
   cmd->add_option("--speed-of-sound", args->response.speed_of_sound, "Speed of sound (m/s)")->capture_default_str();
   cmd->add_option("--window", args->response.reflection_window,

@@ -119,6 +119,8 @@ bool path_of(const Room& room, const Point& s, const Point& l, const RoomOptions
   const double wavelength = o.speed_of_sound / 1000.0;  // m, at 1 kHz (Fresnel zone)
   const double scatter = std::sqrt(1.0 - o.scattering);
   double gain = 1.0;
+  Bands band_gain;
+  band_gain.fill(1.0);
   // Source side first: r_in runs from the source to the reflection point along the path.
   double r_in = 0.0;
   Point previous = s;
@@ -129,11 +131,20 @@ bool path_of(const Room& room, const Point& s, const Point& l, const RoomOptions
     const double r_out = path - r_in;
     const double fresnel = std::numbers::pi * wavelength * r_in * r_out / path;
     const double area = patches[p].area * voxel * voxel;
-    gain *= room.reflection()[p] * scatter * std::sqrt(std::min(1.0, area / fresnel));
+    const double geometric = scatter * std::sqrt(std::min(1.0, area / fresnel));
+    gain *= room.reflection()[p] * geometric;
+    for (std::size_t b = 0; b < band_gain.size(); ++b) band_gain[b] *= room.band_reflection()[p][b] * geometric;
     out.patches.push_back(p);
     out.points.push_back(raycast::grid_to_world(frame, t.points[k]));
   }
-  out.amplitude = gain / path;
+  const Bands air = air_attenuation(o);
+  double mean_square = 0.0;
+  for (std::size_t b = 0; b < band_gain.size(); ++b) {
+    out.bands[b] = band_gain[b] * std::pow(10.0, -air[b] * path / 20.0) / path;
+    mean_square += out.bands[b] * out.bands[b];
+  }
+  // Broadband materials without air: the bands are equal, and the amplitude is exactly theirs.
+  out.amplitude = room.per_band() || o.air ? std::sqrt(mean_square / static_cast<double>(band_gain.size())) : gain / path;
   return out.amplitude > 0.0;
 }
 

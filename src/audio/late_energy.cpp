@@ -100,21 +100,32 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   const auto& patches = room.patches().patches();
 
   const std::uint64_t chunks = (o.rays + kRaysPerChunk - 1) / kRaysPerChunk;
-  std::vector<std::vector<double>> partial(chunks);
+  std::vector<std::vector<Bands>> partial(chunks);
+  const Bands air = air_attenuation(o);
+  // The energy left after `metres` of air, per band.
+  auto air_loss = [&](double metres, Bands& e) {
+    if (!o.air) return;
+    for (std::size_t b = 0; b < e.size(); ++b) e[b] *= std::pow(10.0, -air[b] * metres / 10.0);
+  };
+  auto add = [](Bands& to, const Bands& e, double scale) {
+    for (std::size_t b = 0; b < e.size(); ++b) to[b] += e[b] * scale;
+  };
   std::vector<double> earliest(chunks, max_distance);  // per chunk, grid units of path
   ParallelOptions parallel;
   parallel.threads = o.threads;
   parallel.chunks = static_cast<std::size_t>(chunks);
   parallel.name = "audio.late_energy";
   parallel_for(static_cast<std::size_t>(chunks), [&](const Chunk& chunk) {
-    std::vector<double>& histogram = partial[chunk.index];
-    histogram.assign(bins, 0.0);
+    std::vector<Bands>& histogram = partial[chunk.index];
+    histogram.assign(bins, Bands{});
     std::mt19937_64 rng(o.seed * 0x9E3779B97F4A7C15ull + chunk.index);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     const std::uint64_t first = chunk.index * kRaysPerChunk, last = std::min(o.rays, first + kRaysPerChunk);
     for (std::uint64_t ray = first; ray < last; ++ray) {
       Point origin = s, d = uniform_direction(rng);
-      double energy = ray_energy, travelled = 0.0;
+      Bands energy;
+      energy.fill(ray_energy);
+      double travelled = 0.0;
       int reflections = 0;
       bool specular = true, last_specular = true;
       while (travelled < max_distance) {
@@ -133,7 +144,11 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
             const double t0 = std::max(0.0, along - half), t1 = std::min(segment, along + half);
             if (t1 > t0) {
               const auto bin = static_cast<std::size_t>((travelled + 0.5 * (t0 + t1)) * bins_per_voxel);
-              if (bin < bins) histogram[bin] += energy * (t1 - t0) * voxel / volume;
+              if (bin < bins) {
+                Bands e = energy;
+                air_loss(0.5 * (t0 + t1) * voxel, e);
+                add(histogram[bin], e, (t1 - t0) * voxel / volume);
+              }
               earliest[chunk.index] = std::min(earliest[chunk.index], travelled + t0);
             }
           }
@@ -149,9 +164,14 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         const std::int64_t p = room.patches().patch_of(hit->voxel, face);
         if (p < 0) break;
         const Point normal = patches[static_cast<std::size_t>(p)].normal;
-        const double r = room.reflection()[static_cast<std::size_t>(p)];
-        energy *= r * r;
-        if (energy < min_energy) break;
+        const Bands& r = room.band_reflection()[static_cast<std::size_t>(p)];
+        air_loss(segment * voxel, energy);
+        double strongest = 0.0;
+        for (std::size_t b = 0; b < energy.size(); ++b) {
+          energy[b] *= r[b] * r[b];
+          strongest = std::max(strongest, energy[b]);
+        }
+        if (strongest < min_energy) break;
         travelled += segment;
         for (int a = 0; a < 3; ++a) origin[a] += segment * d[a];
         ++reflections;
@@ -169,7 +189,11 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
             if (!scene.caster().cast(raycast::Ray{from, to, 1.0})) {
               const auto bin = static_cast<std::size_t>((travelled + distance) * bins_per_voxel);
               const double metres = distance * voxel;
-              if (bin < bins) histogram[bin] += energy * o.scattering * cosine / (std::numbers::pi * metres * metres);
+              if (bin < bins) {
+                Bands e = energy;
+                air_loss(metres, e);
+                add(histogram[bin], e, o.scattering * cosine / (std::numbers::pi * metres * metres));
+              }
               earliest[chunk.index] = std::min(earliest[chunk.index], travelled + distance);
             }
           }
@@ -189,12 +213,21 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
       }
     }
   }, parallel);
+  late.bands.assign(bins, Bands{});
   for (const auto& h : partial)
-    for (std::size_t i = 0; i < bins; ++i) late.energy[i] += h[i];
+    for (std::size_t i = 0; i < bins; ++i) add(late.bands[i], h[i], 1.0);
+  for (std::size_t i = 0; i < bins; ++i) {
+    double sum = 0.0;
+    for (const double e : late.bands[i]) sum += e;
+    late.energy[i] = sum / static_cast<double>(late.bands[i].size());
+  }
   late.first_sample = static_cast<std::size_t>(std::ceil(*std::min_element(earliest.begin(), earliest.end()) * voxel /
                                                           o.speed_of_sound * o.sample_rate));
   // Trailing empty bins carry nothing.
-  while (!late.energy.empty() && late.energy.back() == 0.0) late.energy.pop_back();
+  while (!late.energy.empty() && late.energy.back() == 0.0) {
+    late.energy.pop_back();
+    late.bands.pop_back();
+  }
   return late;
 }
 

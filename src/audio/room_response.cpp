@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
 #include <sstream>
 
+#include "vola/audio/air.hpp"
+#include "vola/audio/band_filters.hpp"
+#include "vola/audio/convolve.hpp"
 #include "vola/error.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -24,6 +28,15 @@ void RoomOptions::check() const {
   if (!(max_length > 0.0 && max_length <= 60.0)) fail("the response length must be in (0, 60] s", max_length);
   if (!(decay_floor_db < 0.0 && decay_floor_db >= -200.0)) fail("the decay floor must be in [-200, 0) dB", decay_floor_db);
   if (!(receiver_radius > 0.0 && std::isfinite(receiver_radius))) fail("the receiver radius must be > 0", receiver_radius);
+  if (!(celsius >= -20.0 && celsius <= 50.0)) fail("the air temperature must be in [-20, 50] degrees C", celsius);
+  if (!(humidity >= 10.0 && humidity <= 100.0)) fail("the relative humidity must be in [10, 100] percent", humidity);
+}
+
+Bands air_attenuation(const RoomOptions& o) {
+  Bands a{};
+  if (o.air)
+    for (std::size_t b = 0; b < a.size(); ++b) a[b] = air_attenuation_db_per_m(kOctaveBands[b], o.celsius, o.humidity);
+  return a;
 }
 
 Room::Room(const AcousticScene& scene)
@@ -34,6 +47,10 @@ Room::Room(const AcousticScene& scene)
     double energy = 0.0;
     for (const double r : m.bands) energy += r * r;
     reflection_.push_back(std::sqrt(energy / static_cast<double>(m.bands.size())));
+    Bands bands;
+    for (std::size_t b = 0; b < bands.size(); ++b) bands[b] = m.per_band() ? m.bands[b] : m.bands[0];
+    band_reflection_.push_back(bands);
+    per_band_ = per_band_ || m.per_band();
   }
 }
 
@@ -57,6 +74,9 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
     r.direct_blocked = scene.caster().cast(raycast::Ray{s, {l[0] - s[0], l[1] - s[1], l[2] - s[2]}, 1.0}).has_value();
   }
   r.direct_amplitude = r.direct_blocked ? 0.0 : 1.0 / r.direct_distance;
+  const Bands air = air_attenuation(o);
+  for (std::size_t b = 0; b < air.size(); ++b)
+    r.direct_bands[b] = r.direct_amplitude * std::pow(10.0, -air[b] * r.direct_distance / 20.0);
 
   r.early = image_sources(room, source, listener, o);
   r.late = late_energy(room, source, listener, r.early.order, o);
@@ -66,21 +86,49 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
     length = std::max(length, static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate)) + 1);
   length = std::max(length, r.late.energy.size() * r.late.bin_samples);
   length = std::min(length, static_cast<std::size_t>(last));
-  r.ir.assign(length, 0.0);
-  r.ir[r.direct_sample] += r.direct_amplitude;
-  for (const ImageSource& is : r.early.images) {
-    const auto n = static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate));
-    if (n < length) r.ir[n] += is.amplitude;
-  }
-  // Each bin's energy as white noise of random signs: sum of squares = the bin's energy.
-  // Not before the earliest deposit: the first bin may start before any sound arrives.
+  // One sign per sample for the tail, the same in every band: equal bands then add up to
+  // the broadband noise exactly.
+  std::vector<double> sign(length);
   std::mt19937_64 rng(o.seed ^ 0x5DEECE66Dull);
-  for (std::size_t b = 0; b < r.late.energy.size(); ++b) {
-    const std::size_t begin = std::max(b * r.late.bin_samples, r.late.first_sample);
-    const std::size_t end = std::min(length, (b + 1) * r.late.bin_samples);
-    if (begin >= end || r.late.energy[b] == 0.0) continue;
-    const double a = std::sqrt(r.late.energy[b] / static_cast<double>(end - begin));
-    for (std::size_t i = begin; i < end; ++i) r.ir[i] += (rng() & 1) ? a : -a;
+  for (double& v : sign) v = (rng() & 1) ? 1.0 : -1.0;
+  // The response of one band (or broadband: band < 0): arrivals as impulses, each bin's
+  // energy as the signs scaled to it (sum of squares = the bin's energy), not before the
+  // earliest deposit (the first bin may start before any sound arrives).
+  auto render = [&](int band) {
+    std::vector<double> h(length, 0.0);
+    const auto k = static_cast<std::size_t>(std::max(band, 0));
+    h[r.direct_sample] += band < 0 ? r.direct_amplitude : r.direct_bands[k];
+    for (const ImageSource& is : r.early.images) {
+      const auto n = static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate));
+      if (n < length) h[n] += band < 0 ? is.amplitude : is.bands[k];
+    }
+    for (std::size_t b = 0; b < r.late.energy.size(); ++b) {
+      const std::size_t begin = std::max(b * r.late.bin_samples, r.late.first_sample);
+      const std::size_t end = std::min(length, (b + 1) * r.late.bin_samples);
+      const double energy = band < 0 ? r.late.energy[b] : r.late.bands[b][k];
+      if (begin >= end || energy == 0.0) continue;
+      const double a = std::sqrt(energy / static_cast<double>(end - begin));
+      for (std::size_t i = begin; i < end; ++i) h[i] += a * sign[i];
+    }
+    return h;
+  };
+  if (!room.per_band() && !o.air) {
+    r.ir = render(-1);
+    return r;
+  }
+  // Bands that differ: each through its filter of the bank, added, from the first arrival
+  // on (the filters are causal: FFT rounding then cannot put sound before it).
+  std::size_t first = r.direct_blocked ? length : r.direct_sample;
+  for (const ImageSource& is : r.early.images)
+    first = std::min(first, static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate)));
+  if (!r.late.energy.empty()) first = std::min(first, r.late.first_sample);
+  const auto bank = octave_filters(o.sample_rate);
+  r.ir.assign(length + bank[0].size() - 1, 0.0);
+  if (first >= length) return r;
+  for (std::size_t b = 0; b < bank.size(); ++b) {
+    const std::vector<double> band = render(static_cast<int>(b));
+    const std::vector<double> filtered = convolve(std::span<const double>(band).subspan(first), bank[b]);
+    for (std::size_t i = 0; i < filtered.size() && first + i < r.ir.size(); ++i) r.ir[first + i] += filtered[i];
   }
   return r;
 }

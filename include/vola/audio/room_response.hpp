@@ -28,8 +28,14 @@
 //            (random signs), from the earliest deposit on.
 // Normalisation: the source's power is that of the direct sound's 1 / d, so the tail's
 // energy is on the same scale as the image sources' squared amplitudes.
+// Frequency: every amplitude and energy is kept per octave band (per-band materials, air
+// absorption with `air`). When the bands differ, each band's response (its arrivals as
+// impulses, its tail as the one noise sequence under the band's envelope) passes through
+// its filter of an octave bank that sums to an impulse (band_filters.hpp), and the six
+// are added; otherwise the response is the one broadband sequence.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -38,6 +44,9 @@
 #include "vola/audio/response.hpp"
 
 namespace vola::audio {
+
+// One value per octave band of kOctaveBands (125 Hz .. 4 kHz).
+using Bands = std::array<double, kOctaveBands.size()>;
 
 struct RoomOptions {
   double sample_rate = 48000.0;    // Hz
@@ -51,10 +60,16 @@ struct RoomOptions {
   double receiver_radius = 0.5;    // m, shrunk to the listener's clearance
   std::uint64_t max_image_nodes = std::uint64_t{1} << 21;  // search budget (see image_sources)
   std::uint64_t seed = 1;          // the tail's random numbers: the same seed, the same response
+  bool air = false;                // air absorption (ISO 9613-1, air.hpp) on every path
+  double celsius = 20.0;           // the air's temperature
+  double humidity = 50.0;          // its relative humidity, percent
   unsigned threads = 0;            // 0 = vola::thread_count()
   // Throws InvalidArgument naming the bad value.
   void check() const;
 };
+
+// Per band: the air's attenuation in dB per metre at the band's centre (0 without `air`).
+Bands air_attenuation(const RoomOptions& options);
 
 // A scene with its patches and their reflection coefficients. The scene must outlive it.
 class Room {
@@ -65,11 +80,17 @@ class Room {
   // Per patch: the pressure reflection coefficient, broadband (a per-band material gives
   // the root of its bands' mean energy reflection).
   const std::vector<double>& reflection() const noexcept { return reflection_; }
+  // Per patch and octave band (kOctaveBands): the band's coefficient.
+  const std::vector<Bands>& band_reflection() const noexcept { return band_reflection_; }
+  // Whether some material has coefficients that differ between bands.
+  bool per_band() const noexcept { return per_band_; }
 
  private:
   const AcousticScene* scene_;
   SurfacePatches patches_;
   std::vector<double> reflection_;
+  std::vector<Bands> band_reflection_;
+  bool per_band_ = false;
 };
 
 struct ImageSource {
@@ -77,7 +98,8 @@ struct ImageSource {
   std::vector<Point> points;           // where (world), source side first
   Point image{};                       // world
   double path = 0.0;                   // m: |image - listener|
-  double amplitude = 0.0;
+  double amplitude = 0.0;              // broadband: the root of the bands' mean square
+  Bands bands{};                       // per octave band (reflections and air)
   double delay = 0.0;                  // s
 };
 
@@ -95,6 +117,8 @@ ImageSearch image_sources(const Room& room, const Point& source, const Point& li
 
 struct LateEnergy {
   std::vector<double> energy;      // per bin: the sum of squared response samples it holds
+                                   // (the bands' mean)
+  std::vector<Bands> bands;        // per bin and band: the energy if every band were this one
   std::size_t bin_samples = 1;     // samples per bin (1 ms)
   std::size_t first_sample = 0;    // the earliest deposit: the tail's noise starts there
   double receiver_radius = 0.0;    // m, as used
@@ -105,7 +129,8 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
 
 struct RoomResponse {
   double direct_distance = 0.0;    // m
-  double direct_amplitude = 0.0;   // 0 when occluded
+  double direct_amplitude = 0.0;   // 0 when occluded; without air absorption
+  Bands direct_bands{};            // per band, with air absorption
   bool direct_blocked = false;
   std::uint32_t direct_sample = 0;
   ImageSearch early;
