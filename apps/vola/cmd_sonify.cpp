@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "open_voxels.hpp"
 #include "ir_plot.hpp"
+#include "vola/audio/binaural.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/materials.hpp"
 #include "vola/audio/response.hpp"
@@ -30,8 +31,10 @@ struct SonifyArgs {
   std::vector<std::vector<double>> sources;
   std::vector<double> listener;
   std::vector<std::string> inputs;
-  double reflection = 0.5;
+  double reflection = 0.5, facing = 0.0;
   std::optional<double> absorption;
+  bool binaural = false;
+  std::string hrtf = "/usr/share/libmysofa/MIT_KEMAR_normal_pinna.sofa";
   bool payload_coefficients = false, no_normalize = false, quiet = false, no_occlusion = false;
   audio::ResponseOptions response;  // --model paper
   audio::RoomOptions room;          // --model physical
@@ -54,12 +57,14 @@ audio::MaterialTable material_table(const SonifyArgs& a) {
 
 // One source's response by the chosen model, and its line of report.
 struct SourceResponse {
-  std::vector<double> ir;
+  std::vector<double> ir;           // the left ear with --binaural
+  std::vector<double> right;        // the right ear with --binaural, else empty
   std::int64_t direct_sample = -1;  // -1 when blocked
   std::string report;
 };
 
-SourceResponse physical_response(const audio::Room& room, const Point& source, const Point& listener, const SonifyArgs& a) {
+SourceResponse physical_response(const audio::Room& room, const Point& source, const Point& listener, const SonifyArgs& a,
+                                 const audio::Hrtf* hrtf) {
   const audio::RoomResponse r = audio::room_response(room, source, listener, a.room);
   const double fs = a.room.sample_rate;
   char tail[128] = "no tail";
@@ -72,7 +77,10 @@ SourceResponse physical_response(const audio::Room& room, const Point& source, c
                 r.direct_distance, r.direct_sample / fs * 1000.0, r.direct_sample,
                 r.direct_blocked ? ", blocked by the scene" : "", r.early.images.size(), r.early.order,
                 room.patches().patches().size(), tail, static_cast<double>(r.ir.size()) / fs * 1000.0);
-  return {r.ir, r.direct_blocked ? -1 : static_cast<std::int64_t>(r.direct_sample), line};
+  const std::int64_t direct = r.direct_blocked ? -1 : static_cast<std::int64_t>(r.direct_sample);
+  if (!hrtf) return {r.ir, {}, direct, line};
+  auto ears = audio::binaural_response(r, *hrtf, source, listener, a.facing, a.room);
+  return {std::move(ears[0]), std::move(ears[1]), direct, line};
 }
 
 SourceResponse paper_response(const audio::AcousticScene& scene, const Point& source, const Point& listener, const SonifyArgs& a) {
@@ -86,7 +94,7 @@ SourceResponse paper_response(const audio::AcousticScene& scene, const Point& so
                 binned.direct_blocked ? ", blocked by the scene" : "", static_cast<unsigned long long>(binned.reflectors),
                 binned.bins.size(), static_cast<double>(ir.size()) / fs * 1000.0);
   const std::int64_t direct = binned.direct_blocked ? -1 : static_cast<std::int64_t>(binned.direct_sample);
-  return {std::move(ir), direct, line};
+  return {std::move(ir), {}, direct, line};
 }
 
 audio::SampleFormat sample_format(const std::string& name) {
@@ -114,12 +122,19 @@ std::vector<audio::Sound> read_dry(const SonifyArgs& a) {
 
 // The sources' wet signals into one sound: mixed to one channel or one channel each,
 // normalised to -1 dBFS unless asked not to.
-audio::Sound output_sound(const SonifyArgs& a, std::vector<std::vector<double>>& wet, int sample_rate) {
+audio::Sound output_sound(const SonifyArgs& a, std::vector<std::vector<double>>& wet, std::vector<std::vector<double>>& wet_right,
+                          int sample_rate) {
   audio::Sound out;
   out.sample_rate = sample_rate;
   std::size_t frames = 0;
   for (const auto& w : wet) frames = std::max(frames, w.size());
-  if (a.channels == "mix") {
+  for (const auto& w : wet_right) frames = std::max(frames, w.size());
+  if (a.binaural) {  // left and right, every source mixed into each
+    out.channels.assign(2, std::vector<double>(frames, 0.0));
+    for (int ear = 0; ear < 2; ++ear)
+      for (const auto& w : ear == 0 ? wet : wet_right)
+        for (std::size_t i = 0; i < w.size(); ++i) out.channels[static_cast<std::size_t>(ear)][i] += w[i];
+  } else if (a.channels == "mix") {
     out.channels.assign(1, std::vector<double>(frames, 0.0));
     for (const auto& w : wet)
       for (std::size_t i = 0; i < w.size(); ++i) out.channels[0][i] += w[i];
@@ -159,6 +174,9 @@ void run_sonify(SonifyArgs& a) {
   if (a.payload_coefficients && !a.materials.empty())
     throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
   const bool physical = a.model == "physical";
+  if (a.binaural && !physical) throw InvalidArgument("--binaural renders the physical model: drop --model paper");
+  if (a.binaural && a.channels != "mix")
+    throw InvalidArgument("--binaural writes two channels (left, right) with every source mixed: drop --channels per-source");
   const audio::MaterialTable table = material_table(a);
   const std::vector<audio::Sound> dry = read_dry(a);
   a.response.sample_rate = dry[0].sample_rate;
@@ -175,16 +193,20 @@ void run_sonify(SonifyArgs& a) {
   // Patches depend on the scene only: found once for every source.
   std::optional<audio::Room> room;
   if (physical) room.emplace(scene);
+  std::optional<audio::Hrtf> hrtf;
+  if (a.binaural) hrtf.emplace(a.hrtf, a.room.sample_rate);
 
-  std::vector<std::vector<double>> responses, wet;
+  std::vector<std::vector<double>> responses, wet, wet_right;
   std::vector<PlotPanel> panels;
   for (std::size_t s = 0; s < a.sources.size(); ++s) {
     const Point source{a.sources[s][0], a.sources[s][1], a.sources[s][2]};
     const auto t0 = std::chrono::steady_clock::now();
-    SourceResponse r = physical ? physical_response(*room, source, listener, a) : paper_response(scene, source, listener, a);
+    SourceResponse r = physical ? physical_response(*room, source, listener, a, hrtf ? &*hrtf : nullptr)
+                                : paper_response(scene, source, listener, a);
     const auto t1 = std::chrono::steady_clock::now();
     const std::vector<double> signal = dry[dry.size() == 1 ? 0 : s].mono();
     wet.push_back(audio::Convolver(r.ir).apply(signal, a.response.threads));
+    if (!r.right.empty()) wet_right.push_back(audio::Convolver(r.right).apply(signal, a.response.threads));
     const auto t2 = std::chrono::steady_clock::now();
     if (!a.quiet)
       std::printf("source %zu: %s; %.1f ms to build, %.1f ms to filter\n", s + 1, r.report.c_str(),
@@ -192,9 +214,13 @@ void run_sonify(SonifyArgs& a) {
                   std::chrono::duration<double, std::milli>(t2 - t1).count());
     panels.push_back(PlotPanel{r.ir, r.direct_sample});
     responses.push_back(std::move(r.ir));
+    if (!r.right.empty()) {  // the right ear next to the left, in the plot and the IR file
+      panels.push_back(PlotPanel{r.right, r.direct_sample});
+      responses.push_back(std::move(r.right));
+    }
   }
 
-  const audio::Sound out = output_sound(a, wet, dry[0].sample_rate);
+  const audio::Sound out = output_sound(a, wet, wet_right, dry[0].sample_rate);
   audio::write_wav(a.output, out, sample_format(a.format));
   if (!a.ir.empty()) write_responses(a.ir, responses, out.sample_rate);
   if (!a.plot.empty()) write_response_plot(a.plot, panels, a.response.sample_rate);
@@ -227,6 +253,9 @@ void add_sonify(CLI::App& app) {
       "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
       "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
       "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
+      "  --binaural: the direct sound and each image source through the HRTF pair (SOFA file, --hrtf) of\n"
+      "           the direction it arrives from at a listener facing --facing degrees; the tail as a\n"
+      "           diffuse field (its energy as an uncorrelated noise at each ear).\n"
       "--model paper: the VOLA paper's SonifEye: every surface voxel reflects through each exposed face that\n"
       "both ends are in front of, amplitude R * sqrt(A/pi) / (r1 * r2); paths binned by delay sample and\n"
       "attenuation (--bin-width), kept up to --window s after the direct time, --floor, --visibility.\n"
@@ -280,6 +309,13 @@ void add_sonify(CLI::App& app) {
                   "Physical: the tail's receiver sphere (m), shrunk to clear the scene")
       ->capture_default_str();
   cmd->add_option("--seed", args->room.seed, "Physical: the tail's random numbers")->capture_default_str();
+  cmd->add_flag("--binaural", args->binaural,
+                "Physical: two channels, the listener's ears, through the HRTF of --hrtf (the IR file and plot "
+                "get left and right per source)");
+  cmd->add_option("--hrtf", args->hrtf, "With --binaural: the HRTF (SOFA file)")->capture_default_str();
+  cmd->add_option("--facing", args->facing,
+                  "With --binaural: the listener faces this azimuth (degrees counterclockwise from +x)")
+      ->capture_default_str();
   cmd->add_flag("--air", args->room.air, "Physical: air absorption (ISO 9613-1) on every path, per octave band");
   cmd->add_option("--temperature", args->room.celsius, "Physical, with --air: the air's temperature (degrees C)")
       ->capture_default_str();

@@ -152,4 +152,37 @@ TEST_F(SonifyCli, OcclusionAndModels) {
   EXPECT_NE(r.status, 0) << "--reflection and --absorption both given";
 }
 
+TEST_F(SonifyCli, BinauralWritesTheTwoEars) {
+  VOLA_REQUIRE_AUDIO(audio);
+  if (!fs::exists("/usr/share/libmysofa/MIT_KEMAR_normal_pinna.sofa")) GTEST_SKIP() << "no MIT KEMAR SOFA file";
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  // The source 1.5 m to the left of a listener facing +x.
+  const std::string base = path("room.vol") + " --source 3 4 1.5 --listener 3 2.5 1.5 --in " + dry +
+                           " --absorption 0.3 --rays 2000 --binaural --out " + path("b.wav") + " --ir " + path("bir.wav");
+  CliRun r = run(base, dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const vola::audio::Sound ir = vola::audio::read_sound(path("bir.wav"));
+  ASSERT_EQ(ir.channels.size(), 2u);
+  EXPECT_EQ(vola::audio::read_sound(path("b.wav")).channels.size(), 2u);
+  // The left ear hears the direct sound first and louder.
+  const auto direct = static_cast<std::size_t>(std::lround(1.5 / 343.0 * 48000.0));
+  double left = 0.0, right = 0.0;
+  std::size_t first_left = 0, first_right = 0;
+  for (std::size_t i = direct; i < direct + 96; ++i) {
+    left += ir.channels[0][i] * ir.channels[0][i];
+    right += ir.channels[1][i] * ir.channels[1][i];
+  }
+  while (std::abs(ir.channels[0][first_left]) < 1e-3) ++first_left;
+  while (std::abs(ir.channels[1][first_right]) < 1e-3) ++first_right;
+  EXPECT_GT(left, 2.0 * right);
+  EXPECT_LT(first_left, first_right);
+  std::ofstream(path("bad.sofa")) << "not a SOFA file";
+  r = run(base + " --hrtf " + path("bad.sofa"), dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("bad.sofa: cannot load the HRTF"), std::string::npos) << r.output;
+  r = run(base + " --model paper", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--binaural renders the physical model"), std::string::npos) << r.output;
+}
+
 }  // namespace
