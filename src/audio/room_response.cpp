@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <span>
 #include <sstream>
@@ -13,6 +14,11 @@
 #include "vola/raycast/world.hpp"
 
 namespace vola::audio {
+
+namespace {
+// Half the length of a fractional-delay arrival (samples).
+constexpr int kFractionalTaps = 16;
+}  // namespace
 
 void RoomOptions::check() const {
   auto fail = [](const std::string& what, double v) {
@@ -85,6 +91,7 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
   for (const ImageSource& is : r.early.images)
     length = std::max(length, static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate)) + 1);
   length = std::max(length, r.late.energy.size() * r.late.bin_samples);
+  if (o.fractional_delay) length += kFractionalTaps;  // the last arrival's band-limited tail
   length = std::min(length, static_cast<std::size_t>(last));
   // One sign per sample for the tail, the same in every band: equal bands then add up to
   // the broadband noise exactly.
@@ -94,14 +101,34 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
   // The response of one band (or broadband: band < 0): arrivals as impulses, each bin's
   // energy as the signs scaled to it (sum of squares = the bin's energy), not before the
   // earliest deposit (the first bin may start before any sound arrives).
+  // An arrival at `time` (samples): at the nearest sample, or (fractional_delay) as a
+  // band-limited impulse at the exact time, a windowed sinc over kFractionalTaps samples
+  // either side (Blackman window, its sum 1 so the level below a few kHz is the arrival's).
+  auto place = [&](std::vector<double>& h, double time, double amplitude) {
+    if (!o.fractional_delay) {
+      const auto n = static_cast<std::size_t>(std::nearbyint(time));
+      if (n < h.size()) h[n] += amplitude;
+      return;
+    }
+    const double base = std::floor(time), fraction = time - base;
+    double taps[2 * kFractionalTaps], sum = 0.0;
+    for (int k = -kFractionalTaps + 1; k <= kFractionalTaps; ++k) {
+      const double x = k - fraction, pix = std::numbers::pi * x;
+      const double window = 0.42 + 0.5 * std::cos(pix / kFractionalTaps) + 0.08 * std::cos(2.0 * pix / kFractionalTaps);
+      taps[k + kFractionalTaps - 1] = (x == 0.0 ? 1.0 : std::sin(pix) / pix) * window;
+      sum += taps[k + kFractionalTaps - 1];
+    }
+    for (int k = -kFractionalTaps + 1; k <= kFractionalTaps; ++k) {
+      const double i = base + k;
+      if (i >= 0.0 && i < static_cast<double>(h.size())) h[static_cast<std::size_t>(i)] += amplitude * taps[k + kFractionalTaps - 1] / sum;
+    }
+  };
+  const double exact_direct = r.direct_distance / o.speed_of_sound * o.sample_rate;
   auto render = [&](int band) {
     std::vector<double> h(length, 0.0);
     const auto k = static_cast<std::size_t>(std::max(band, 0));
-    h[r.direct_sample] += band < 0 ? r.direct_amplitude : r.direct_bands[k];
-    for (const ImageSource& is : r.early.images) {
-      const auto n = static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate));
-      if (n < length) h[n] += band < 0 ? is.amplitude : is.bands[k];
-    }
+    place(h, exact_direct, band < 0 ? r.direct_amplitude : r.direct_bands[k]);
+    for (const ImageSource& is : r.early.images) place(h, is.delay * o.sample_rate, band < 0 ? is.amplitude : is.bands[k]);
     for (std::size_t b = 0; b < r.late.energy.size(); ++b) {
       const std::size_t begin = std::max(b * r.late.bin_samples, r.late.first_sample);
       const std::size_t end = std::min(length, (b + 1) * r.late.bin_samples);
@@ -122,6 +149,7 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
   for (const ImageSource& is : r.early.images)
     first = std::min(first, static_cast<std::size_t>(std::nearbyint(is.delay * o.sample_rate)));
   if (!r.late.energy.empty()) first = std::min(first, r.late.first_sample);
+  if (o.fractional_delay) first = first > kFractionalTaps ? first - kFractionalTaps : 0;
   const auto bank = octave_filters(o.sample_rate);
   r.ir.assign(length + bank[0].size() - 1, 0.0);
   if (first >= length) return r;
