@@ -189,7 +189,7 @@ ImageSearch image_sources(const Room& room, const Point& source, const Point& li
     parallel.threads = o.threads;
     parallel.chunks = chunks;
     parallel.name = "audio.image_sources";
-    parallel_for(nodes.size(), [&](const Chunk& chunk) {
+    const auto trace_chunk = [&](const Chunk& chunk) {
       Trace trace;
       for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
         trace.sequence.clear();
@@ -203,7 +203,10 @@ ImageSearch image_sources(const Room& room, const Point& source, const Point& li
         ImageSource is;
         if (path_of(room, s, l, o, trace, is)) found[chunk.index].push_back(std::move(is));
       }
-    }, parallel);
+    };
+    // A few hundred images are traced on the calling thread: no threads to start.
+    if (chunks == 1) trace_chunk(Chunk{0, 0, nodes.size(), 0});
+    else parallel_for(nodes.size(), trace_chunk, parallel);
     for (auto& f : found)
       for (auto& is : f) search.images.push_back(std::move(is));
   }
