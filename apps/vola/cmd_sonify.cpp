@@ -252,7 +252,8 @@ void add_sonify(CLI::App& app) {
       "           meets every patch it mirrors in and (unless --no-occlusion) every leg is free of voxels\n"
       "           (exact voxel ray casts); amplitude prod(R * sqrt(1 - s)) / path length, R the pressure\n"
       "           reflection coefficient, s = --scattering; a patch smaller than the 1 kHz Fresnel zone\n"
-      "           reflects that fraction of it;\n"
+      "           reflects that fraction of it. A scene of very many patches (a survey) stops the search\n"
+      "           at the order whose candidates would pass 2 million; the report says the order used;\n"
       "  late:    --rays energy rays traced over the voxels, losing R^2 at each hit and going on\n"
       "           specularly or (probability s) diffusely; each hit sends its diffuse part straight to\n"
       "           the listener if it sees it, specular paths are heard by a sphere around the listener,\n"
@@ -262,8 +263,8 @@ void add_sonify(CLI::App& app) {
       "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
       "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
       "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
-      "  arrivals fall on the nearest sample, or with --fractional-delay at their exact time as windowed\n"
-      "           sincs (flat to 0.1 dB and of the exact phase up to 0.3 of the sample rate, tested).\n"
+      "  timing:  arrivals fall on the nearest sample, or with --fractional-delay at their exact time as\n"
+      "           windowed sincs (flat to 0.1 dB, the exact phase, up to 0.3 of the sample rate; tested).\n"
       "  --binaural: the direct sound and each image source through the HRTF pair (SOFA file, --hrtf) of\n"
       "           the direction it arrives from at a listener facing --facing degrees; the tail as a\n"
       "           diffuse field (its energy as an uncorrelated noise at each ear).\n"
@@ -282,6 +283,7 @@ void add_sonify(CLI::App& app) {
       "Examples:\n"
       "  vola sonify room.vol --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out wet.wav --ir ir.wav --plot ir.png\n"
       "  vola sonify room.vol --absorption 0.2 --order 4 --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out wet.wav\n"
+      "  vola sonify room.vol --binaural --facing 90 --air --source 1 2 1.5 --listener 4 3 1.6 --in speech.wav --out ears.wav\n"
       "  vola sonify scan.vol --materials m.json --source 1 2 1 --source 5 2 1 --listener 3 3 1 \\\n"
       "      --in violin.wav --in cello.wav --out duo.wav --channels per-source");
   cmd->add_option("scene", args->scene, "The scene (.vol)")->required()->check(CLI::ExistingFile);
@@ -294,7 +296,7 @@ void add_sonify(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->output, "Wet result (WAV)")->required();
-  cmd->add_option("--ir", args->ir, "Also write the impulse responses (32-bit float WAV, one channel per source)");
+  cmd->add_option("--ir", args->ir, "Also write the impulse responses (32-bit float WAV, one channel per source; left and right with --binaural)");
   cmd->add_option("--plot", args->plot, "Also draw the impulse responses (PNG, dB against ms, direct sound in red)");
   cmd->add_option("--materials", args->materials, "Material table (JSON, see below)")->check(CLI::ExistingFile);
   cmd->add_option("--model", args->model, "physical: image sources, occlusion and a ray-traced tail; paper: SonifEye")
