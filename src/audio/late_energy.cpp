@@ -12,9 +12,12 @@ namespace vola::audio {
 
 namespace {
 
-// Rays per chunk: each chunk has its own random numbers and histogram, summed in chunk
-// order, so the result does not depend on the thread count.
-constexpr std::uint64_t kRaysPerChunk = 512;
+// The rays are split into a fixed number of chunks (at least 512 rays each, at most 64
+// chunks, so the histograms kept until the sum stay bounded whatever the ray count): each
+// chunk has its own random numbers and histogram, summed in chunk order, so the result
+// does not depend on the thread count.
+constexpr std::uint64_t kMinRaysPerChunk = 512;
+constexpr std::uint64_t kMaxChunks = 64;
 
 // The distance (grid units) from p to the nearest occupied voxel, searched up to `limit`.
 double clearance(const Tree& tree, const Point& p, double limit) {
@@ -99,7 +102,7 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   const double bins_per_voxel = voxel / o.speed_of_sound / bin_seconds;
   const auto& patches = room.patches().patches();
 
-  const std::uint64_t chunks = (o.rays + kRaysPerChunk - 1) / kRaysPerChunk;
+  const std::uint64_t chunks = std::min(kMaxChunks, (o.rays + kMinRaysPerChunk - 1) / kMinRaysPerChunk);
   std::vector<std::vector<Bands>> partial(chunks);
   const Bands air = air_attenuation(o);
   // The energy left after `metres` of air, per band.
@@ -115,12 +118,12 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   parallel.threads = o.threads;
   parallel.chunks = static_cast<std::size_t>(chunks);
   parallel.name = "audio.late_energy";
-  parallel_for(static_cast<std::size_t>(chunks), [&](const Chunk& chunk) {
+  parallel_for(static_cast<std::size_t>(o.rays), [&](const Chunk& chunk) {
     std::vector<Bands>& histogram = partial[chunk.index];
     histogram.assign(bins, Bands{});
     std::mt19937_64 rng(o.seed * 0x9E3779B97F4A7C15ull + chunk.index);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    const std::uint64_t first = chunk.index * kRaysPerChunk, last = std::min(o.rays, first + kRaysPerChunk);
+    const std::uint64_t first = chunk.begin, last = chunk.end;
     for (std::uint64_t ray = first; ray < last; ++ray) {
       Point origin = s, d = uniform_direction(rng);
       Bands energy;

@@ -74,7 +74,7 @@ TEST(AudioRoomTail, ClosedShoeboxT30FollowsEyring) {
     RoomOptions o;
     o.sample_rate = kRate;
     o.speed_of_sound = kC;
-    o.rays = 8000;
+    o.rays = 16000;
     o.threads = 2;
     const double expected = eyring(c.size[0], c.size[1], c.size[2], c.absorption);
     o.max_length = 1.5 * expected;
