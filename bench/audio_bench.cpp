@@ -4,6 +4,9 @@
 // thread and on every core, against naive versions in the same run: thresholding that
 // visits every cell of the dense 256^3 grid, and time-domain convolution. The naive
 // thresholding must give the same bins (checked), so the comparison is like for like.
+// Then the physical model (room_response.hpp) on the same room: image sources (order 3,
+// with and without occlusion), the ray-traced tail (20,000 rays), the whole response and
+// its convolution with the source.
 //
 //   vola_audio_bench [--runs N]     (medians of N runs, default 7)
 #include <algorithm>
@@ -21,6 +24,7 @@
 
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/response.hpp"
+#include "vola/audio/room_response.hpp"
 #include "vola/builder.hpp"
 
 namespace {
@@ -184,5 +188,64 @@ int main(int argc, char** argv) {
   std::printf("once, not in the steps: scene preparation (surface faces) %.1f ms, first create filter (with the level table) "
               "%.3f ms, FFTW_MEASURE planning of size %zu %.1f ms\n",
               prepare, first_filter, Convolver(ir).fft_size(), planning);
+
+  // The physical model (room_response.hpp) on the same room and positions: the equivalent
+  // of "threshold environment" is the image-source search plus the traced tail, of "create
+  // filter" the response's assembly, of "apply filter" the convolution with the whole
+  // (long) response.
+  const auto patches_start = std::chrono::steady_clock::now();
+  const Room physical(scene);
+  const double patches_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - patches_start).count();
+  RoomOptions room_one;
+  room_one.threads = 1;
+  RoomOptions room_all = room_one;
+  room_all.threads = cores;
+  RoomOptions no_occlusion = room_one;
+  no_occlusion.occlusion = false;
+  ImageSearch early;
+  const double images1 = median_ms(runs, [&] { early = image_sources(physical, source, listener, room_one); });
+  const double imagesn = median_ms(runs, [&] { early = image_sources(physical, source, listener, room_all); });
+  const double images_open = median_ms(runs, [&] { early = image_sources(physical, source, listener, no_occlusion); });
+  LateEnergy late;
+  const double tail1 = median_ms(runs, [&] { late = late_energy(physical, source, listener, early.order, room_one); });
+  const double tailn = median_ms(runs, [&] { late = late_energy(physical, source, listener, early.order, room_all); });
+  RoomOptions few_one = room_one, few_all = room_all;
+  few_one.rays = few_all.rays = 2000;
+  const double few1 = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, few_one); });
+  const double fewn = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, few_all); });
+  RoomResponse response;
+  const double whole1 = median_ms(runs, [&] { response = room_response(physical, source, listener, room_one); });
+  const double wholen = median_ms(runs, [&] { response = room_response(physical, source, listener, room_all); });
+  const double long_planning = median_ms(1, [&] { Convolver(response.ir, FftPlanning::measure); });
+  const double long1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, 1); });
+  const double longn = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, cores); });
+  // The same response in partitions of 8192 samples (what vola sonify uses past 32,768 taps).
+  const double part1 = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, 1); });
+  const double partn = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, cores); });
+  // A 10 s response (a large hall's tail): one transform of 2^21 points against partitions.
+  std::vector<double> hall(480000);
+  for (std::size_t i = 0; i < hall.size(); ++i) hall[i] = noise(rng) * std::exp(-6.9 * static_cast<double>(i) / 48000.0 / 2.0);
+  const double hall_one = median_ms(std::min(runs, 3), [&] { wet = Convolver(hall).apply(dry, 1); });
+  const double hall_part = median_ms(std::min(runs, 3), [&] { wet = PartitionedConvolver(hall, 8192).apply(dry, 1); });
+  std::printf("\nphysical model: %zu patches (found once: %.1f ms); order %d searched, %llu images tried, %zu valid; "
+              "tail %llu rays, scattering %.2f, receiver %.2f m; response %zu samples (%.1f ms); FFT size %zu (planning %.0f ms)\n\n",
+              physical.patches().patches().size(), patches_ms, early.order,
+              static_cast<unsigned long long>(early.candidates), early.images.size(),
+              static_cast<unsigned long long>(room_one.rays), room_one.scattering, late.receiver_radius, response.ir.size(),
+              static_cast<double>(response.ir.size()) / 48.0, Convolver(response.ir).fft_size(), long_planning);
+  std::printf("%-34s %12s %12s %12s %12s\n", "physical step", "paper (ms)", "1 thread", "threads", "vs paper");
+  auto physical_row = [&](const char* name, double paper, double a, double b) {
+    std::printf("%-34s %12.3f %12.3f %9.3f (%u) %11.1fx\n", name, paper, a, b, cores, paper / std::min(a, b));
+  };
+  physical_row("image sources, order 3", 820.0, images1, imagesn);
+  physical_row("  the same, --no-occlusion", 820.0, images_open, images_open);
+  physical_row("late tail, 20000 rays (default)", 820.0, tail1, tailn);
+  physical_row("late tail, 2000 rays", 820.0, few1, fewn);
+  // The whole response: both searches and the assembly (threshold and create filter).
+  physical_row("whole response", 820.0 + 0.3, whole1, wholen);
+  physical_row("apply whole response", 4.05, long1, longn);
+  physical_row("  the same, partitioned (8192)", 4.05, part1, partn);
+  std::printf("\na 10 s response (480,000 taps) on a 1 s source, FFTW_ESTIMATE plans as in vola sonify, 1 thread: one "
+              "transform %.1f ms, partitioned (8192) %.1f ms\n", hall_one, hall_part);
   return 0;
 }

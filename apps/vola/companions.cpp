@@ -1,7 +1,7 @@
 // Subcommands whose libraries are heavy to load live in companion executables beside
 // vola: vola-learn (dataset, train, classify, evaluate: libtorch, ~0.5 s to load),
 // vola-view (view: cpp-httplib with OpenSSL and Brotli) and vola-sonify (sonify:
-// libsndfile with its codecs, FFTW). Linked into vola, every other command would pay
+// libsndfile with its codecs, FFTW, libmysofa). Linked into vola, every other command would pay
 // their start-up. `vola train ...` replaces itself with `vola-learn train ...` from the
 // same folder, so the commands, their options and their --help are exactly the
 // companion's.

@@ -136,6 +136,92 @@ std::vector<double> Convolver::apply(std::span<const double> signal, unsigned th
   return out;
 }
 
+struct PartitionedConvolver::State {
+  std::size_t filter_size = 0, block = 0, fft = 0;
+  SizePlans plans;
+  std::vector<ComplexBuffer> partitions;  // spectra of the filter's partitions
+};
+
+PartitionedConvolver::PartitionedConvolver(std::span<const double> filter, std::size_t partition, FftPlanning planning)
+    : state_(std::make_unique<State>()) {
+  if (filter.empty()) throw InvalidArgument("convolution: the filter is empty");
+  if (partition < 64 || (partition & (partition - 1)) != 0 || partition > (std::size_t{1} << 24))
+    throw InvalidArgument("convolution: the partition must be a power of two from 64 to 2^24");
+  State& st = *state_;
+  st.filter_size = filter.size();
+  st.block = partition;
+  st.fft = 2 * partition;
+  st.plans = plans_for(st.fft, planning);
+  RealBuffer time = real_buffer(st.fft);
+  for (std::size_t begin = 0; begin < filter.size(); begin += st.block) {
+    const std::size_t n = std::min(st.block, filter.size() - begin);
+    std::fill(time.get(), time.get() + st.fft, 0.0);
+    std::copy_n(filter.data() + begin, n, time.get());
+    st.partitions.push_back(complex_buffer(st.fft / 2 + 1));
+    fftw_execute_dft_r2c(st.plans.forward, time.get(), st.partitions.back().get());
+  }
+}
+
+PartitionedConvolver::~PartitionedConvolver() = default;
+
+std::size_t PartitionedConvolver::partitions() const noexcept { return state_->partitions.size(); }
+
+std::vector<double> PartitionedConvolver::apply(std::span<const double> signal, unsigned threads) const {
+  if (signal.empty()) return {};
+  const State& st = *state_;
+  const std::size_t B = st.block, bins = st.fft / 2 + 1;
+  std::vector<double> out(signal.size() + st.filter_size - 1, 0.0);
+  // Windows holding signal samples: block i's window starts at (i - 1) B, so the last
+  // partial block is also in the first half of one more window.
+  const std::size_t inputs = (signal.size() + B - 1) / B + 1;
+  const std::size_t outputs = (out.size() + B - 1) / B;     // output blocks
+  const double scale = 1.0 / static_cast<double>(st.fft);
+  // X_i: the spectrum of the signal's samples [(i - 1) B, (i + 1) B) (zero outside it).
+  std::vector<ComplexBuffer> input(inputs);
+  ParallelOptions parallel;
+  parallel.threads = resolve_thread_count(threads);
+  parallel.name = "audio.convolve_partitioned";
+  std::vector<RealBuffer> times;
+  std::vector<ComplexBuffer> sums;
+  for (unsigned t = 0; t < parallel.threads; ++t) {
+    times.push_back(real_buffer(st.fft));
+    sums.push_back(complex_buffer(bins));
+  }
+  parallel_for(inputs, [&](const Chunk& chunk) {
+    double* time = times[chunk.worker].get();
+    for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+      for (std::size_t k = 0; k < st.fft; ++k) {
+        const std::size_t at = i * B + k;  // sample at - B of the signal
+        time[k] = at >= B && at - B < signal.size() ? signal[at - B] : 0.0;
+      }
+      input[i] = complex_buffer(bins);
+      fftw_execute_dft_r2c(st.plans.forward, time, input[i].get());
+    }
+  }, parallel);
+  // Output block j: the last B samples of IFFT(sum over p of X_(j - p) H_p), overlap-save.
+  // Each block is one thread's, its sum in the order of p: the same on any thread count.
+  parallel_for(outputs, [&](const Chunk& chunk) {
+    double* time = times[chunk.worker].get();
+    fftw_complex* sum = sums[chunk.worker].get();
+    for (std::size_t j = chunk.begin; j < chunk.end; ++j) {
+      std::fill(&sum[0][0], &sum[0][0] + 2 * bins, 0.0);
+      const std::size_t first = j >= inputs ? j - inputs + 1 : 0;  // partitions whose input block exists
+      for (std::size_t p = first; p <= j && p < st.partitions.size(); ++p) {
+        const fftw_complex* x = input[j - p].get();
+        const fftw_complex* h = st.partitions[p].get();
+        for (std::size_t k = 0; k < bins; ++k) {
+          sum[k][0] += x[k][0] * h[k][0] - x[k][1] * h[k][1];
+          sum[k][1] += x[k][0] * h[k][1] + x[k][1] * h[k][0];
+        }
+      }
+      fftw_execute_dft_c2r(st.plans.inverse, sum, time);
+      const std::size_t begin = j * B, n = std::min(B, out.size() - begin);
+      for (std::size_t k = 0; k < n; ++k) out[begin + k] = time[B + k] * scale;
+    }
+  }, parallel);
+  return out;
+}
+
 std::vector<double> minimum_phase_fir(std::span<const double> magnitude, std::size_t taps) {
   const std::size_t n = 2 * (magnitude.size() >= 1 ? magnitude.size() - 1 : 0);
   if (n < 4 || (n & (n - 1)) != 0 || n > (std::size_t{1} << 24))

@@ -346,7 +346,15 @@ void AcousticScene::check_point(const Point& p, const std::string& what) const {
     if (!std::isfinite(c)) throw InvalidArgument(what + " has a coordinate that is not a finite number");
   const Point g = raycast::world_to_grid(frame_, p);
   const double side = static_cast<double>(tree_->side());
-  if (g[0] >= 0 && g[1] >= 0 && g[2] >= 0 && g[0] < side && g[1] < side && g[2] < side) {
+  if (!(g[0] >= 0 && g[1] >= 0 && g[2] >= 0 && g[0] < side && g[1] < side && g[2] < side)) {
+    // Outside the grid nothing is known: no wall, no floor; the scene cannot say what is heard.
+    std::ostringstream s;
+    const Point hi = raycast::grid_to_world(frame_, {side, side, side});
+    s << what << " (" << p[0] << ", " << p[1] << ", " << p[2] << ") is outside the scene's grid, from (" << frame_.origin[0]
+      << ", " << frame_.origin[1] << ", " << frame_.origin[2] << ") to (" << hi[0] << ", " << hi[1] << ", " << hi[2] << ")";
+    throw InvalidArgument(s.str());
+  }
+  {
     const Voxel v{static_cast<std::uint32_t>(g[0]), static_cast<std::uint32_t>(g[1]), static_cast<std::uint32_t>(g[2])};
     if (tree_->contains(v)) {
       std::ostringstream s;

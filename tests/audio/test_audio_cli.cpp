@@ -109,6 +109,80 @@ TEST_F(SonifyCli, BadInputsFailWithOneClearLine) {
   r = run(base + " --source 2 1.5 1.25 --source 3 2 2 --in " + dry + " --in " + dry + " --in " + dry, dir_);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("one per --source"), std::string::npos) << r.output;
+  // Recordings at 48 and 16 kHz.
+  r = run(base + " --source 2 1.5 1.25 --source 3 2 2 --in " + dry + " --in " + (audio / "codec2_speech_orig_16k.wav").string(),
+          dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("resample them to one rate"), std::string::npos) << r.output;
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --absorption 1.5", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--absorption must be in [0, 1]"), std::string::npos) << r.output;
+  r = run(base + " --source 2 1.5 1.25 --in " + dry + " --absorption -0.1", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--absorption must be in [0, 1]"), std::string::npos) << r.output;
+  // The room's grid is 256 voxels of 1/32 m: 8 m.
+  r = run(path("room.vol") + " --listener 9 3 2 --out " + path("o.wav") + " --source 2 1.5 1.25 --in " + dry, dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("the listener (9, 3, 2) is outside the scene's grid"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.wav")));
+}
+
+// The physical model's flags: a wall between source and listener silences the direct sound
+// unless --no-occlusion; --model paper keeps the paper's voxel-by-voxel model.
+TEST_F(SonifyCli, OcclusionAndModels) {
+  VOLA_REQUIRE_AUDIO(audio);
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  // Listener outside the closed room (x = 7 m, beyond the wall at voxel 200 = 6.25 m).
+  const std::string base = path("room.vol") + " --source 2 1.5 1.25 --listener 7 1.5 1.25 --in " + dry +
+                           " --absorption 0.2 --rays 2000 --out " + path("w.wav") + " --ir " + path("ir.wav");
+  const double d = 5.0;
+  const auto direct = static_cast<std::size_t>(std::lround(d / 343.0 * 48000.0));
+  CliRun r = run(base, dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("blocked by the scene"), std::string::npos) << r.output;
+  EXPECT_EQ(vola::audio::read_sound(path("ir.wav")).channels[0][direct], 0.0);
+  r = run(base + " --no-occlusion", dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("blocked"), std::string::npos) << r.output;
+  EXPECT_NEAR(vola::audio::read_sound(path("ir.wav")).channels[0][direct], 1.0 / d, 1e-6);
+  r = run(base + " --model paper --window 0.02", dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("reflecting voxels in"), std::string::npos) << r.output;
+  r = run(base + " --reflection 0.5", dir_);
+  EXPECT_NE(r.status, 0) << "--reflection and --absorption both given";
+}
+
+TEST_F(SonifyCli, BinauralWritesTheTwoEars) {
+  VOLA_REQUIRE_AUDIO(audio);
+  if (!fs::exists("/usr/share/libmysofa/MIT_KEMAR_normal_pinna.sofa")) GTEST_SKIP() << "no MIT KEMAR SOFA file";
+  const std::string dry = (audio / "alsa_Front_Center.wav").string();
+  // The source 1.5 m to the left of a listener facing +x.
+  const std::string base = path("room.vol") + " --source 3 4 1.5 --listener 3 2.5 1.5 --in " + dry +
+                           " --absorption 0.3 --rays 2000 --binaural --out " + path("b.wav") + " --ir " + path("bir.wav");
+  CliRun r = run(base, dir_);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const vola::audio::Sound ir = vola::audio::read_sound(path("bir.wav"));
+  ASSERT_EQ(ir.channels.size(), 2u);
+  EXPECT_EQ(vola::audio::read_sound(path("b.wav")).channels.size(), 2u);
+  // The left ear hears the direct sound first and louder.
+  const auto direct = static_cast<std::size_t>(std::lround(1.5 / 343.0 * 48000.0));
+  double left = 0.0, right = 0.0;
+  std::size_t first_left = 0, first_right = 0;
+  for (std::size_t i = direct; i < direct + 96; ++i) {
+    left += ir.channels[0][i] * ir.channels[0][i];
+    right += ir.channels[1][i] * ir.channels[1][i];
+  }
+  while (std::abs(ir.channels[0][first_left]) < 1e-3) ++first_left;
+  while (std::abs(ir.channels[1][first_right]) < 1e-3) ++first_right;
+  EXPECT_GT(left, 2.0 * right);
+  EXPECT_LT(first_left, first_right);
+  std::ofstream(path("bad.sofa")) << "not a SOFA file";
+  r = run(base + " --hrtf " + path("bad.sofa"), dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("bad.sofa: cannot load the HRTF"), std::string::npos) << r.output;
+  r = run(base + " --model paper", dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--binaural renders the physical model"), std::string::npos) << r.output;
 }
 
 }  // namespace

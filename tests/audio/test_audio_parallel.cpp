@@ -10,6 +10,7 @@
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/materials.hpp"
 #include "vola/audio/response.hpp"
+#include "vola/audio/room_response.hpp"
 
 namespace {
 
@@ -36,6 +37,42 @@ TEST(AudioParallel, AWorkerErrorInEveryStageReachesTheCaller) {
   const std::vector<double> one = convolver.apply(signal, 1);
   EXPECT_EQ(convolver.apply(signal, 2), one);
   EXPECT_EQ(convolver.apply(signal, 5), one);
+}
+
+// The physical response's stages (image-source tracing, the traced tail, the partitioned
+// convolution): a worker's error reaches the caller, and without one the response is the
+// same on any number of threads (chunks are fixed and joined in order; each has its own
+// random numbers).
+TEST(AudioParallel, ThePhysicalResponseIsTheSameOnAnyThreadCount) {
+  const Tree tree = vola_audio_test::shoebox_tree({{3, 3, 3}, {44, 36, 28}}, 0.1);
+  const AcousticScene scene(tree, scene_material(std::sqrt(0.7)));
+  const Room room(scene);
+  RoomOptions o;
+  o.rays = 3000;
+  o.max_length = 0.4;
+  o.threads = 2;
+  const Point s{1.3, 1.4, 1.1}, l{3.1, 2.2, 1.7};
+  // Order 5: thousands of images, so the tracing has chunks for a worker (256 a chunk).
+  RoomOptions deep = o;
+  deep.order = 5;
+  vola_test::expect_worker_error_reaches_caller("audio.image_sources", [&] { image_sources(room, s, l, deep); });
+  vola_test::expect_worker_error_reaches_caller("audio.late_energy", [&] { late_energy(room, s, l, 3, o); });
+  std::vector<double> filter(40000), signal(20000);
+  for (std::size_t i = 0; i < filter.size(); ++i) filter[i] = std::exp(-0.0001 * static_cast<double>(i));
+  for (std::size_t i = 0; i < signal.size(); ++i) signal[i] = std::sin(0.001 * static_cast<double>(i * i));
+  const PartitionedConvolver partitioned(filter, 4096);
+  vola_test::expect_worker_error_reaches_caller("audio.convolve_partitioned", [&] { partitioned.apply(signal, 2); });
+
+  o.threads = 1;
+  const RoomResponse one = room_response(room, s, l, o);
+  ASSERT_GT(one.early.images.size(), 10u);
+  ASSERT_FALSE(one.late.energy.empty());
+  for (const unsigned threads : {2u, 3u, 8u}) {
+    o.threads = threads;
+    const RoomResponse many = room_response(room, s, l, o);
+    EXPECT_EQ(many.ir, one.ir) << threads << " threads";
+    EXPECT_EQ(many.early.images.size(), one.early.images.size());
+  }
 }
 
 }  // namespace

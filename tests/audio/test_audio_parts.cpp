@@ -3,6 +3,8 @@
 // recordings of $VOLA_SHARED/data/audio.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <cmath>
 #include <complex>
 #include <fstream>
@@ -172,6 +174,30 @@ TEST(AudioConvolve, MatchesTheDirectSumForManyLengths) {
   }
   EXPECT_TRUE(Convolver(std::vector<double>{1.0}).apply(std::vector<double>{}, 1).empty());
   EXPECT_THROW(Convolver(std::vector<double>{}), InvalidArgument);
+}
+
+// Partitioned overlap-save against the direct sum: filters shorter and longer than the
+// signal, one partition or many, a partial last partition.
+TEST(AudioConvolve, PartitionedMatchesTheDirectSum) {
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> noise;
+  for (const auto& [n, m, b] : {std::tuple{1, 1, 64}, {100, 37, 64}, {37, 1000, 64}, {5000, 20000, 1024}, {20000, 3000, 256},
+                                 {9000, 9000, 8192}, {300, 70000, 4096}}) {
+    std::vector<double> x(static_cast<std::size_t>(n)), h(static_cast<std::size_t>(m));
+    for (double& v : x) v = noise(rng);
+    for (double& v : h) v = noise(rng);
+    const PartitionedConvolver c(h, static_cast<std::size_t>(b));
+    EXPECT_EQ(c.partitions(), static_cast<std::size_t>((m + b - 1) / b));
+    const std::vector<double> fast = c.apply(x, 1);
+    const std::vector<double> slow = slow_convolution(x, h);
+    ASSERT_EQ(fast.size(), slow.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < fast.size(); ++i) worst = std::max(worst, std::abs(fast[i] - slow[i]));
+    EXPECT_LT(worst, 1e-9 * std::sqrt(static_cast<double>(m))) << n << " x " << m << " in " << b;
+    EXPECT_EQ(c.apply(x, 3), fast) << "threads changed the result, " << n << " x " << m;
+  }
+  EXPECT_THROW(PartitionedConvolver(std::vector<double>{1.0}, 100), InvalidArgument);
+  EXPECT_THROW(PartitionedConvolver(std::vector<double>{}), InvalidArgument);
 }
 
 TEST(AudioConvolve, BandKernelFollowsTheBandCoefficientsAndStartsAtOnce) {

@@ -318,6 +318,16 @@ TEST(AudioResponse, BadInputsGiveClearErrors) {
   EXPECT_THROW(threshold(scene, world(60, 60, 60), inside_wall, options()), InvalidArgument);
   EXPECT_THROW(threshold(scene, world(60, 60, 60), world(60, 60, 60), options()), InvalidArgument);
   EXPECT_THROW(threshold(scene, {NAN, 1, 1}, world(60, 60, 60), options()), InvalidArgument);
+  // Outside the grid (256 voxels of 1/32 m: 8 m) nothing is known about the surroundings.
+  try {
+    threshold(scene, world(60, 60, 60), {8.5, 1, 1}, options());
+    FAIL() << "a listener outside the grid was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("the listener (8.5, 1, 1) is outside the scene's grid, from (0, 0, 0) to (8, 8, 8)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(threshold(scene, {-0.01, 1, 1}, world(60, 60, 60), options()), InvalidArgument);
   ResponseOptions bad = options();
   bad.bin_width_db = 0;
   EXPECT_THROW(threshold(scene, world(50, 50, 50), world(60, 60, 60), bad), InvalidArgument);

@@ -70,7 +70,7 @@ class AcousticScene {
   // The blocks holding surface voxels, with their exposed faces (found once, here).
   const std::vector<SurfaceBlock>& surface() const noexcept { return surface_; }
   const raycast::RayCaster& caster() const noexcept { return caster_; }
-  // Throws InvalidArgument when `p` is not finite or lies inside an occupied voxel;
+  // Throws InvalidArgument when `p` is not finite, lies outside the grid or inside an occupied voxel;
   // `what` names the point ("source 1", "listener").
   void check_point(const Point& p, const std::string& what) const;
   // Every level a response with these options can have (one pow each), made on first use
