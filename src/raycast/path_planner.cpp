@@ -246,24 +246,34 @@ std::optional<std::vector<Cell>> coarse_route(ClearanceField& field, const Cell&
     Cell cell;
     bool operator>(const Open& o) const { return f > o.f || (f == o.f && g < o.g); }
   };
+  // One entry per coarse cell looked at: whether it is passable (decided once), and for
+  // those reached, g, the parent and whether it is closed.
+  struct Node {
+    double g = std::numeric_limits<double>::infinity();
+    std::uint64_t parent = 0;
+    bool passable = false, closed = false;
+  };
   const auto key = [](const Cell& c) { return brick_key(c[0], c[1], c[2]); };
   std::priority_queue<Open, std::vector<Open>, std::greater<>> open;
-  std::unordered_map<std::uint64_t, std::pair<double, std::uint64_t>> best;  // g, parent key
-  std::unordered_set<std::uint64_t> closed;
-  best[key(start)] = {0.0, key(start)};
-  open.push({octile(start, goal), 0.0, start});
-  const auto passable = [&](const Cell& c) {
-    return c == start || c == goal || coarse_free(field, c, needed);
+  std::unordered_map<std::uint64_t, Node> nodes;
+  const auto node = [&](const Cell& c) -> Node& {
+    auto [it, added] = nodes.try_emplace(key(c));
+    if (added) it->second.passable = c == start || c == goal || coarse_free(field, c, needed);
+    return it->second;
   };
+  node(start).g = 0.0;
+  open.push({octile(start, goal), 0.0, start});
+  std::array<Node*, 27> around{};
   while (!open.empty()) {
     const Open top = open.top();
     open.pop();
-    const std::uint64_t k = key(top.cell);
-    if (!closed.insert(k).second) continue;
+    Node& here = node(top.cell);
+    if (here.closed) continue;
+    here.closed = true;
     if (++expanded > max_expansions) return std::nullopt;
     if (top.cell == goal) {
       std::vector<Cell> path;
-      for (std::uint64_t at = k;; at = best[at].second) {
+      for (std::uint64_t at = key(goal);; at = nodes[at].parent) {
         path.push_back({static_cast<std::int64_t>(at & 0x1fffff), static_cast<std::int64_t>((at >> 21) & 0x1fffff),
                         static_cast<std::int64_t>(at >> 42)});
         if (at == key(start)) break;
@@ -275,17 +285,24 @@ std::optional<std::vector<Cell>> coarse_route(ClearanceField& field, const Cell&
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
+          const int bit = (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1);
+          around[static_cast<std::size_t>(bit)] = nullptr;
           const Cell n{top.cell[0] + dx, top.cell[1] + dy, top.cell[2] + dz};
           if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= side || n[1] >= side || n[2] >= side) continue;
-          if (passable(n)) free |= std::uint32_t{1} << ((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1));
+          Node& other = node(n);  // references into an unordered_map survive its rehashing
+          around[static_cast<std::size_t>(bit)] = &other;
+          if (other.passable) free |= std::uint32_t{1} << bit;
         }
+    const std::uint64_t k = key(top.cell);
     for (int m = 0; m < 26; ++m) {
       if ((free & kMoves.needs[m]) != kMoves.needs[m]) continue;
       const Cell n{top.cell[0] + kMoves.step[m][0], top.cell[1] + kMoves.step[m][1], top.cell[2] + kMoves.step[m][2]};
+      Node& next = *around[static_cast<std::size_t>((kMoves.step[m][0] + 1) + 3 * (kMoves.step[m][1] + 1) +
+                                                    9 * (kMoves.step[m][2] + 1))];
       const double g = top.g + kMoves.cost[m];
-      const auto found = best.find(key(n));
-      if (found != best.end() && found->second.first <= g) continue;
-      best[key(n)] = {g, k};
+      if (next.closed || next.g <= g) continue;
+      next.g = g;
+      next.parent = k;
       open.push({g + octile(n, goal), g, n});
     }
   }
