@@ -1,6 +1,9 @@
 #include "vola/raycast/clearance_field.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "vola/error.hpp"
@@ -21,7 +24,7 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b :
 
 }  // namespace
 
-ClearanceField::ClearanceField(const Tree& obstacles, double radius, const Tree* known)
+ClearanceField::ClearanceField(const Tree& obstacles, double radius, const Tree* known, bool solid_ground)
     : side_(obstacles.side()), known_mode_(known != nullptr) {
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("plan: the radius must be >= 0");
   const double r2 = radius * radius;
@@ -55,13 +58,76 @@ ClearanceField::ClearanceField(const Tree& obstacles, double radius, const Tree*
   };
   store(obstacles, false);
   if (known) store(*known, true);
+  if (solid_ground && !obstacles.empty()) find_ground(obstacles);
   rows_.emplace_back();
   rows_.back().fill(0xFFFF);
   slot_all_free_.push_back(1);
 }
 
+void ClearanceField::find_ground(const Tree& obstacles) {
+  constexpr std::int64_t kWindow = 2;  // columns on each side
+  std::int64_t lo[2] = {side_, side_}, hi[2] = {0, 0};
+  obstacles.for_each_block(obstacles.depth() - 1, [&](std::size_t, std::uint64_t, std::uint32_t ox, std::uint32_t oy,
+                                                      std::uint32_t) {
+    lo[0] = std::min<std::int64_t>(lo[0], ox), lo[1] = std::min<std::int64_t>(lo[1], oy);
+    hi[0] = std::max<std::int64_t>(hi[0], ox + 4), hi[1] = std::max<std::int64_t>(hi[1], oy + 4);
+  });
+  ground_x0_ = std::max<std::int64_t>(0, lo[0] - kWindow);
+  ground_y0_ = std::max<std::int64_t>(0, lo[1] - kWindow);
+  ground_nx_ = std::min<std::int64_t>(side_, hi[0] + kWindow) - ground_x0_;
+  ground_ny_ = std::min<std::int64_t>(side_, hi[1] + kWindow) - ground_y0_;
+  constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
+  std::vector<std::int32_t> lowest(static_cast<std::size_t>(ground_nx_ * ground_ny_), kNone);
+  obstacles.for_each_block(obstacles.depth() - 1, [&](std::size_t, std::uint64_t word, std::uint32_t ox,
+                                                      std::uint32_t oy, std::uint32_t oz) {
+    while (word) {
+      const unsigned b = static_cast<unsigned>(std::countr_zero(word));
+      word &= word - 1;
+      const auto i = static_cast<std::size_t>((oy + ((b >> 2) & 3u) - ground_y0_) * ground_nx_ + (ox + (b & 3u) - ground_x0_));
+      lowest[i] = std::min(lowest[i], static_cast<std::int32_t>(oz + (b >> 4)));
+    }
+  });
+  // The smallest within the window: along x, then along y.
+  std::vector<std::int32_t> along_x(lowest.size(), kNone);
+  for (std::int64_t y = 0; y < ground_ny_; ++y)
+    for (std::int64_t x = 0; x < ground_nx_; ++x)
+      for (std::int64_t d = std::max<std::int64_t>(0, x - kWindow); d <= std::min(ground_nx_ - 1, x + kWindow); ++d)
+        along_x[static_cast<std::size_t>(y * ground_nx_ + x)] =
+            std::min(along_x[static_cast<std::size_t>(y * ground_nx_ + x)], lowest[static_cast<std::size_t>(y * ground_nx_ + d)]);
+  ground_.assign(lowest.size(), kNone);
+  for (std::int64_t y = 0; y < ground_ny_; ++y)
+    for (std::int64_t d = std::max<std::int64_t>(0, y - kWindow); d <= std::min(ground_ny_ - 1, y + kWindow); ++d)
+      for (std::int64_t x = 0; x < ground_nx_; ++x)
+        ground_[static_cast<std::size_t>(y * ground_nx_ + x)] =
+            std::min(ground_[static_cast<std::size_t>(y * ground_nx_ + x)], along_x[static_cast<std::size_t>(d * ground_nx_ + x)]);
+  // Per brick column, the highest ground of the columns within reach (-1: none): a brick
+  // whose cells all lie above it plus the reach needs no ground bits.
+  const std::int64_t bricks = bricks_per_side();
+  ground_by_brick_.assign(static_cast<std::size_t>(bricks * bricks), -1);
+  for (std::int64_t y = 0; y < ground_ny_; ++y)
+    for (std::int64_t x = 0; x < ground_nx_; ++x) {
+      const std::int32_t g = ground_[static_cast<std::size_t>(y * ground_nx_ + x)];
+      if (g == kNone) continue;
+      const std::int64_t gx = x + ground_x0_, gy = y + ground_y0_;
+      for (std::int64_t by = std::max<std::int64_t>(0, (gy - reach_) / kBrick); by <= std::min(bricks - 1, (gy + reach_) / kBrick); ++by)
+        for (std::int64_t bx = std::max<std::int64_t>(0, (gx - reach_) / kBrick); bx <= std::min(bricks - 1, (gx + reach_) / kBrick); ++bx) {
+          auto& top = ground_by_brick_[static_cast<std::size_t>(by * bricks + bx)];
+          top = std::max(top, g);
+        }
+    }
+}
+
+std::int32_t ClearanceField::ground_at(std::int64_t x, std::int64_t y) const noexcept {
+  x -= ground_x0_;
+  y -= ground_y0_;
+  if (x < 0 || y < 0 || x >= ground_nx_ || y >= ground_ny_) return std::numeric_limits<std::int32_t>::max();
+  return ground_[static_cast<std::size_t>(y * ground_nx_ + x)];
+}
+
 bool ClearanceField::near_obstacle(std::int64_t bx, std::int64_t by, std::int64_t bz) const noexcept {
   if (known_mode_ || side_ < kBrick) return true;  // unknown space (or cells off the grid) is everywhere else
+  if (!ground_by_brick_.empty() && bz * kBrick - reach_ < ground_by_brick_[static_cast<std::size_t>(by * bricks_per_side() + bx)])
+    return true;  // under the ground, or within reach of it
   const std::int64_t lo[3] = {bx * kBrick - reach_, by * kBrick - reach_, bz * kBrick - reach_};
   for (std::int64_t z = floor_div(lo[2], kBrick); z <= floor_div(lo[2] + kBrick + 2 * reach_ - 1, kBrick); ++z)
     for (std::int64_t y = floor_div(lo[1], kBrick); y <= floor_div(lo[1] + kBrick + 2 * reach_ - 1, kBrick); ++y)
@@ -110,6 +176,16 @@ bool ClearanceField::compute(std::int64_t bx, std::int64_t by, std::int64_t bz, 
               gathered_[static_cast<std::size_t>(z * W + y)] |= x0 >= 0 ? nibble << x0 : nibble >> -x0;
             }
           }
+        }
+      }
+  // Under the ground: the cells of each row below its columns' ground.
+  if (!ground_by_brick_.empty() && bz * kBrick - R < ground_by_brick_[static_cast<std::size_t>(by * bricks_per_side() + bx)])
+    for (int z = 0; z < W; ++z)
+      for (int y = 0; y < W; ++y) {
+        std::uint64_t& row = gathered_[static_cast<std::size_t>(z * W + y)];
+        for (int x = 0; x < W; ++x) {
+          const std::int32_t ground = ground_at(lo[0] + x, lo[1] + y);
+          if (ground != std::numeric_limits<std::int32_t>::max() && lo[2] + z < ground) row |= std::uint64_t{1} << x;
         }
       }
   // Dilate each row along x by 0..R cells, then OR the rows S names for each brick row.

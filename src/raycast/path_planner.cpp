@@ -377,7 +377,8 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
   std::optional<Tree> known_planning;
   if (options.known) known_planning = level == tree.depth() - 1 ? *options.known : options.known->level_of_detail(level + 1);
   const double cell_size = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
-  ClearanceField field(planning, options.radius / cell_size, known_planning ? &*known_planning : nullptr);
+  ClearanceField field(planning, options.radius / cell_size, known_planning ? &*known_planning : nullptr,
+                       options.solid_ground);
   const Cell from = cell_of(start, cell_size), to = cell_of(goal, cell_size);
   const auto side = static_cast<double>(tree.side());
   for (const auto& [name, p, c] : {std::tuple{"start", start, from}, std::tuple{"goal", goal, to}}) {
@@ -386,7 +387,7 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
                             std::to_string(static_cast<long long>(side)) + ")^3 (grid coordinates)");
     if (!field.free(c[0], c[1], c[2]))
       throw InvalidArgument(std::string("plan: the ") + name + " " + show(p) + " is inside an obstacle" +
-                            (options.known ? " or unknown space" : "") +
+                            (options.known ? " or unknown space" : "") + (options.solid_ground ? " or the ground" : "") +
                             (options.radius > 0 ? " or closer than the radius to one" : ""));
   }
 

@@ -90,6 +90,54 @@ TEST(ClearanceField, UnknownSpaceAndTheGridEdgeAreObstaclesWithKnown) {
   }
 }
 
+// A sloping sampled ground (a sheet with empty columns) under a few boxes: with
+// solid_ground the cells below the ground are blocked too. The brute force: a column's
+// ground is the lowest voxel of the columns within 2 on each axis.
+TEST(ClearanceField, SolidGroundBlocksTheSpaceUnderASampledSheet) {
+  std::mt19937_64 rng(5);
+  std::vector<vola::Voxel> voxels;
+  for (std::uint32_t y = 0; y < 50; ++y)
+    for (std::uint32_t x = 0; x < 60; ++x)
+      if (rng() % 3 != 0) voxels.push_back({x, y, 8 + x / 10 + static_cast<std::uint32_t>(rng() % 2)});
+  for (std::uint32_t z = 20; z < 26; ++z)  // a roof-like slab over columns that keep their ground
+    for (std::uint32_t x = 30; x < 40; ++x) voxels.push_back({x, 20, z});
+  const vola::Tree tree = vola::build_from_voxels(voxels, 3);
+  std::vector<std::int64_t> lowest(64 * 64, 1 << 30), ground(64 * 64, 1 << 30);
+  for (const auto& v : voxels) lowest[v.y * 64 + v.x] = std::min<std::int64_t>(lowest[v.y * 64 + v.x], v.z);
+  for (std::int64_t y = 0; y < 64; ++y)
+    for (std::int64_t x = 0; x < 64; ++x)
+      for (std::int64_t dy = -2; dy <= 2; ++dy)
+        for (std::int64_t dx = -2; dx <= 2; ++dx)
+          if (x + dx >= 0 && y + dy >= 0 && x + dx < 64 && y + dy < 64)
+            ground[y * 64 + x] = std::min(ground[y * 64 + x], lowest[(y + dy) * 64 + x + dx]);
+  const auto obstacle = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    const bool column = x >= 0 && y >= 0 && x < 64 && y < 64;
+    if (column && ground[y * 64 + x] < (1 << 30) && z < ground[y * 64 + x]) return true;  // under the ground
+    if (!column || z < 0 || z >= 64) return false;
+    return tree.contains(vola::Voxel{static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)});
+  };
+  for (const double radius : {0.0, 1.5, 3.0}) {
+    ClearanceField field(tree, radius, nullptr, true);
+    ClearanceField open_below(tree, radius);
+    std::uint64_t differ = 0;
+    const int reach = static_cast<int>(radius + 0.5);
+    for (std::int64_t z = 0; z < 40; ++z)
+      for (std::int64_t y = 0; y < 64; ++y)
+        for (std::int64_t x = 0; x < 64; ++x) {
+          bool free = true;
+          for (int dz = -reach; dz <= reach && free; ++dz)
+            for (int dy = -reach; dy <= reach && free; ++dy)
+              for (int dx = -reach; dx <= reach && free; ++dx) {
+                const auto g = [](int d) { return d ? (std::abs(d) - 0.5) * (std::abs(d) - 0.5) : 0.0; };
+                if (g(dx) + g(dy) + g(dz) <= radius * radius && obstacle(x + dx, y + dy, z + dz)) free = false;
+              }
+          ASSERT_EQ(field.free(x, y, z), free) << x << " " << y << " " << z << " radius " << radius;
+          differ += free != open_below.free(x, y, z);
+        }
+    EXPECT_GT(differ, 10000u);  // the space under the sheet was free without it
+  }
+}
+
 TEST(ClearanceField, WholeBricksAndLimits) {
   const vola::Voxel one[] = {{20, 20, 20}};
   const vola::Tree tree = vola::build_from_voxels(one, 3);

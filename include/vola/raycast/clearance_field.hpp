@@ -18,6 +18,14 @@
 // With `known` (a state map's known voxels on the same grid) unknown space is an obstacle
 // too, and so is everything off the grid. Cells off the grid are never free.
 //
+// With `solid_ground`, the space under the ground is an obstacle too. A map made from
+// points has a sampled ground: a sheet with nothing below it, which a planner can pass
+// under wherever the sheet ends (a generated city's edge). The ground of column (x, y) is
+// taken as its lowest voxel, the smallest within 2 columns on each axis (a sampled ground
+// leaves single columns empty; a column under a roof or a crown with no ground point of
+// its own gets its neighbours' ground); every cell below it is an obstacle. Columns with
+// no voxel within 2 columns have no ground.
+//
 // Not thread-safe: a query may fill the cache.
 #pragma once
 
@@ -38,7 +46,7 @@ class ClearanceField {
 
   // `radius` in cells (>= 0, finite); the trees must outlive the field. Throws
   // InvalidArgument when the radius reaches more than kMaxReach cells.
-  ClearanceField(const Tree& obstacles, double radius, const Tree* known = nullptr);
+  ClearanceField(const Tree& obstacles, double radius, const Tree* known = nullptr, bool solid_ground = false);
 
   std::int64_t side() const noexcept { return side_; }
   bool inside(std::int64_t x, std::int64_t y, std::int64_t z) const noexcept {
@@ -60,6 +68,7 @@ class ClearanceField {
   }
   // The obstacle word of 4x4x4 block (X, Y, Z) (block coordinates), bit x + 4y + 16z.
   std::uint64_t obstacle_word(std::int64_t X, std::int64_t Y, std::int64_t Z) const noexcept;
+  void find_ground(const Tree& obstacles);
   // Could any obstacle be within reach of the brick?
   bool near_obstacle(std::int64_t bx, std::int64_t by, std::int64_t bz) const noexcept;
   // The brick's rows into `out` (256 entries); returns whether every cell is free.
@@ -69,6 +78,11 @@ class ClearanceField {
   int reach_;                        // the largest offset in S along one axis
   std::vector<int> reach_x_;         // per (dy, dz) in [-reach, reach]^2: the largest dx in S, -1: none
   bool known_mode_;
+  // solid_ground: the ground's height per column over the columns of the voxels' box
+  // (grown by 2), INT32_MAX: none; and per brick column, the highest ground within reach.
+  std::int64_t ground_x0_ = 0, ground_y0_ = 0, ground_nx_ = 0, ground_ny_ = 0;
+  std::vector<std::int32_t> ground_, ground_by_brick_;
+  std::int32_t ground_at(std::int64_t x, std::int64_t y) const noexcept;
   // The trees' leaf words by brick: 64 words per brick (block x + 4y + 16z in the brick).
   std::unordered_map<std::uint64_t, std::uint32_t> stored_;
   std::vector<std::uint64_t> occupied_words_, known_words_;

@@ -24,6 +24,9 @@
 // space an obstacle as well: a cell is free only when, besides, every voxel within
 // `radius` of its centre (its own voxel at radius 0) is known; cells off the grid are
 // unknown. At a coarser level a cell is known when any voxel in it is.
+// `solid_ground` makes the space under the ground an obstacle (ClearanceField explains how
+// the ground is found): on a map made from points the sampled ground is a sheet, and the
+// shortest path between two points on it may pass under it where it ends.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +43,7 @@ struct PlanOptions {
   bool hierarchical = false;
   std::uint64_t max_expansions = 20'000'000;  // then the goal counts as unreachable
   const Tree* known = nullptr;   // not owned; null: space outside the tree's voxels is free
+  bool solid_ground = false;     // the space under each column's ground is an obstacle (ClearanceField)
 };
 
 struct PlannedPath {
