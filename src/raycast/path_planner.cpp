@@ -417,6 +417,10 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
     Search search(field, nullptr);
     cells = search.run(from, to, options.max_expansions, out.cost, out.expanded);
   }
+  if (!cells && out.expanded > options.max_expansions)
+    throw InvalidArgument("plan: no path from " + show(start) + " to " + show(goal) + " found within the limit of " +
+                          std::to_string(options.max_expansions) + " expanded cells (a larger limit, or a hierarchical "
+                          "search, may find one)");
   if (!cells)
     throw InvalidArgument("plan: the goal " + show(goal) + " cannot be reached from " + show(start) + " (" +
                           std::to_string(out.expanded) + " cells searched)");

@@ -307,6 +307,13 @@ TEST(PathPlanner, ClearErrors) {
       },
       vola::InvalidArgument);
   EXPECT_THROW(plan_path(tree, {1, 1, 1}, {2, 2, 2}, PlanOptions{.level = 2}), vola::InvalidArgument);
+  // The search's limit is not unreachability: the message says which it was.
+  try {
+    plan_path(tree, {0.5, 0.5, 0.5}, {15.5, 15.5, 15.5}, PlanOptions{.max_expansions = 5});
+    ADD_FAILURE() << "a search past its limit returned";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("within the limit of 5 expanded cells"), std::string::npos) << e.what();
+  }
   // A radius the clearance field cannot reach in one word: refused, naming the way out.
   EXPECT_NE(message({1, 1, 1}, {2, 2, 2}, 30).find("coarser level"), std::string::npos);
 }
