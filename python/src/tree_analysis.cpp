@@ -203,7 +203,9 @@ void bind_tree_analysis(py::class_<Tree>& tree) {
       .def("plan", &plan, py::arg("start"), py::arg("goal"), py::arg("radius") = 0.0, py::arg("world") = false,
            py::arg("smooth") = true, py::arg("level") = -1, py::arg("hierarchical") = false,
            py::arg("max_expansions") = std::uint64_t{20'000'000},
-           "A* path over free voxels for a robot of `radius`. Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
+           "A* path over free voxels for a robot of `radius` (no corner cutting: every leg keeps the sphere clear).\n"
+           "hierarchical=True: a coarse route first, then the voxels near it (scales; cost not guaranteed optimal).\n"
+           "Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
            "Grid coordinates unless world=True. Raises InvalidArgument when start/goal are blocked or unreachable.");
 }
 
