@@ -42,18 +42,23 @@ ClearanceField::ClearanceField(const Tree& obstacles, double radius, const Tree*
       for (int dx = 0; dx <= reach_; ++dx)
         if (gap2(dx) + gap2(dy) + gap2(dz) <= r2) reach_x_[static_cast<std::size_t>((dz + reach_) * n + dy + reach_)] = dx;
 
-  // The leaf words by brick, one pass over each tree's leaf blocks in storage order.
+  // The leaf words by brick, one pass over each tree's leaf blocks in storage order: the
+  // blocks of a brick (a level depth-3 cell) are consecutive there, in the order of their
+  // index in the brick, so each brick's words are appended as one run.
   const auto store = [&](const Tree& tree, bool is_known) {
+    std::uint64_t current = ~std::uint64_t{0};
     tree.for_each_block(tree.depth() - 1, [&](std::size_t, std::uint64_t word, std::uint32_t ox, std::uint32_t oy,
                                              std::uint32_t oz) {
       const std::uint64_t key = brick_key(ox / kBrick, oy / kBrick, oz / kBrick);
-      auto [it, added] = stored_.try_emplace(key, static_cast<std::uint32_t>(stored_.size()));
-      if (added) {
-        occupied_words_.resize(occupied_words_.size() + 64, 0);
-        if (known_mode_) known_words_.resize(known_words_.size() + 64, 0);
+      StoredWords& run = is_known ? stored_[key].known : stored_[key].occupied;
+      const unsigned block = (ox / 4 % 4) + 4 * (oy / 4 % 4) + 16 * (oz / 4 % 4);
+      if (key != current) {
+        if (run.present) throw Error("clearance field: a brick's leaf blocks are not consecutive");
+        run.first = words_.size();
+        current = key;
       }
-      const unsigned sub = (ox / 4 % 4) + 4 * (oy / 4 % 4) + 16 * (oz / 4 % 4);
-      (is_known ? known_words_ : occupied_words_)[std::size_t{it->second} * 64 + sub] = word;
+      run.present |= std::uint64_t{1} << block;
+      words_.push_back(word);
     });
   };
   store(obstacles, false);
@@ -146,16 +151,12 @@ bool ClearanceField::compute(std::int64_t bx, std::int64_t by, std::int64_t bz, 
   for (std::int64_t cz = floor_div(lo[2], kBrick); cz <= floor_div(lo[2] + W - 1, kBrick); ++cz)
     for (std::int64_t cy = floor_div(lo[1], kBrick); cy <= floor_div(lo[1] + W - 1, kBrick); ++cy)
       for (std::int64_t cx = floor_div(lo[0], kBrick); cx <= floor_div(lo[0] + W - 1, kBrick); ++cx) {
-        const std::uint64_t* occupied = nullptr;
-        const std::uint64_t* known = nullptr;
+        const StoredBrick* stored = nullptr;
         if (cx >= 0 && cy >= 0 && cz >= 0) {
           const auto found = stored_.find(brick_key(cx, cy, cz));
-          if (found != stored_.end()) {
-            occupied = &occupied_words_[std::size_t{found->second} * 64];
-            if (known_mode_) known = &known_words_[std::size_t{found->second} * 64];
-          }
+          if (found != stored_.end()) stored = &found->second;
         }
-        if (!occupied && !known_mode_) continue;
+        if (!stored && !known_mode_) continue;
         for (int sub = 0; sub < 64; ++sub) {
           const std::int64_t X = cx * 4 + (sub & 3), Y = cy * 4 + ((sub >> 2) & 3), Z = cz * 4 + (sub >> 4);
           const std::int64_t x0 = X * 4 - lo[0], y0 = Y * 4 - lo[1], z0 = Z * 4 - lo[2];
@@ -163,7 +164,8 @@ bool ClearanceField::compute(std::int64_t bx, std::int64_t by, std::int64_t bz, 
           std::uint64_t word = 0;
           const bool on_grid = X >= 0 && Y >= 0 && Z >= 0 && X < blocks && Y < blocks && Z < blocks;
           if (!on_grid) word = known_mode_ ? ~std::uint64_t{0} : 0;
-          else word = (occupied ? occupied[sub] : 0) | (known_mode_ ? ~(known ? known[sub] : 0) : 0);
+          else if (stored) word = word_of(stored->occupied, sub) | (known_mode_ ? ~word_of(stored->known, sub) : 0);
+          else word = ~std::uint64_t{0};  // known mode, a brick with no known voxel
           if (!word) continue;
           for (int sz = 0; sz < 4; ++sz) {
             const std::int64_t z = z0 + sz;

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <deque>
 #include <unordered_map>
@@ -83,9 +84,22 @@ class ClearanceField {
   std::int64_t ground_x0_ = 0, ground_y0_ = 0, ground_nx_ = 0, ground_ny_ = 0;
   std::vector<std::int32_t> ground_, ground_by_brick_;
   std::int32_t ground_at(std::int64_t x, std::int64_t y) const noexcept;
-  // The trees' leaf words by brick: 64 words per brick (block x + 4y + 16z in the brick).
-  std::unordered_map<std::uint64_t, std::uint32_t> stored_;
-  std::vector<std::uint64_t> occupied_words_, known_words_;
+  // The trees' leaf words by brick, popcount-indexed as VOLA stores a block's children:
+  // bit b of `present` says whether the brick's 4x4x4 block b (x + 4y + 16z) has a word,
+  // its words in that order from `first`. 8 bytes per leaf word, 40 per brick.
+  struct StoredWords {
+    std::uint64_t present = 0;
+    std::uint64_t first = 0;
+  };
+  struct StoredBrick {
+    StoredWords occupied, known;
+  };
+  std::uint64_t word_of(const StoredWords& w, int block) const noexcept {
+    if (!((w.present >> block) & 1u)) return 0;
+    return words_[w.first + static_cast<std::uint64_t>(std::popcount(w.present & ((std::uint64_t{1} << block) - 1)))];
+  }
+  std::unordered_map<std::uint64_t, StoredBrick> stored_;
+  std::vector<std::uint64_t> words_;
   // Computed bricks: slot 0 is the all-free brick, shared. A deque, so that rows handed
   // out stay where they are while later bricks are added.
   std::unordered_map<std::uint64_t, std::uint32_t> rows_of_;
