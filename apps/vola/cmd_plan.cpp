@@ -179,7 +179,7 @@ void add_plan(CLI::App& app) {
       "at least half free first, then the exact search only within one coarse cell of that route\n"
       "(wider, then along wholly free cells, if that holds no path). Its cost is not guaranteed\n"
       "optimal: within 1% of it on the generated cities (docs/BENCHMARKS.md, Planning); a 200 m\n"
-      "city at 0.1 m plans in about 2 s.\n"
+      "city at 0.1 m plans in 1-2 s.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
       "On a state map (vola map) unknown space is an obstacle too (--unknown occupied, the default\n"
       "there): a voxel is free only when it is known free and no unknown voxel is within the radius;\n"
