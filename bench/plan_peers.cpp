@@ -16,16 +16,18 @@
 // The planners, each run --reps times in a forked child (time, and the child's peak RSS
 // growth from a fresh VmHWM), interleaved run by run:
 //   vola A*         plan_path with the radius, finest level, smoothing off: the A* alone
-//                   (hash maps of visited cells, a sphere query per new cell);
+//                   (its state per brick of 16^3 cells reached, the clearance field
+//                   computed a brick at a time);
 //   vola plan       plan_path with `vola plan`'s defaults (smoothing on): what the CLI does
 //                   after opening the file;
 //   vola hier.      plan_path with hierarchical = true (`vola plan --hierarchical`):
-//                   coarse plan first, cost not guaranteed optimal;
+//                   a route over free bricks first, cost not guaranteed optimal;
 //   dense A*        std::vector<uint8_t> occupancy of the box filled from the tree's voxels,
 //                   inflated by the same sphere rule (a cell is blocked when a voxel's
 //                   closed cube lies within the radius of the cell's centre, as
-//                   Collider::sphere decides), then A* with 26 neighbours, Euclidean costs
-//                   and heuristic, g in a std::vector<double>, the parent as a direction
+//                   Collider::sphere decides), then A* with 26 neighbours (a diagonal
+//                   move only when every cell of the box it spans is free, as vola's),
+//                   Euclidean costs and heuristic, g in a std::vector<double>, the parent as a direction
 //                   byte, a binary heap as the open list. Its time includes filling and
 //                   inflating the grid; the search alone is shown too.
 // Checks before any figure is printed: the dense inflation agrees with Collider::sphere on
@@ -203,6 +205,7 @@ class DenseGrid {
     int ddx[26], ddy[26], ddz[26];
     std::int64_t dindex[26];
     double step[26];
+    std::vector<std::int64_t> spanned[26];  // the other cells of the box a move spans: free too (no corner cutting)
     int k = 0;
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
@@ -211,6 +214,11 @@ class DenseGrid {
           ddx[k] = dx, ddy[k] = dy, ddz[k] = dz;
           dindex[k] = dx + nx() * (dy + ny() * dz);
           step[k] = std::sqrt(static_cast<double>(dx * dx + dy * dy + dz * dz));
+          for (int bz = std::min(0, dz); bz <= std::max(0, dz); ++bz)
+            for (int by = std::min(0, dy); by <= std::max(0, dy); ++by)
+              for (int bx = std::min(0, dx); bx <= std::max(0, dx); ++bx)
+                if ((bx || by || bz) && !(bx == dx && by == dy && bz == dz))
+                  spanned[k].push_back(bx + nx() * (by + ny() * bz));
           ++k;
         }
     const double gx = static_cast<double>(goal[0]) + 0.5, gy = static_cast<double>(goal[1]) + 0.5,
@@ -258,6 +266,9 @@ class DenseGrid {
         const std::int64_t n = top.at + dindex[d];
         const auto un = static_cast<std::size_t>(n);
         if (blocked_[un]) continue;
+        bool cut = false;
+        for (const std::int64_t o : spanned[d]) cut = cut || blocked_[static_cast<std::size_t>(top.at + o)];
+        if (cut) continue;
         const double ng = top.g + step[d];
         if (ng >= g[un]) continue;
         g[un] = ng;

@@ -35,10 +35,11 @@ struct PlanArgs {
   double radius = 0.0;
   double margin = 0.0;  // tile sets: around the from-to box; 0 = one tile
   int level = -1;
-  bool hierarchical = false, no_smooth = false, grid = false, quiet = false;
+  bool hierarchical = false, no_smooth = false, grid = false, quiet = false, solid_ground = false;
   bool avoid = false;
   double speed = 0.0, look_ahead = 0.0;  // 0: one voxel, 24 voxels
   std::size_t max_steps = 100000;
+  std::uint64_t max_expansions = raycast::PlanOptions{}.max_expansions;
   std::string unknown;  // "occupied" or "free"; empty: occupied for a state map
 };
 
@@ -103,6 +104,8 @@ Scene load_scene(const PlanArgs& a) {
 }
 
 void run_plan(const PlanArgs& a) {
+  if (a.avoid && a.solid_ground)
+    throw InvalidArgument("--solid-ground: --avoid sees the voxels only, not the ground below them");
   const Scene scene = load_scene(a);
   const Tree& tree = scene.obstacles;
   const Frame frame = tree.frame();
@@ -111,6 +114,8 @@ void run_plan(const PlanArgs& a) {
   options.radius = a.grid ? a.radius : a.radius / frame.voxel_size;
   options.level = a.level;
   options.hierarchical = a.hierarchical;
+  options.solid_ground = a.solid_ground;
+  options.max_expansions = a.max_expansions;
   options.smooth = !a.no_smooth;
   if (scene.known) options.known = &*scene.known;
   if (!a.grid) {
@@ -165,13 +170,26 @@ void add_plan(CLI::App& app) {
   auto* cmd = app.add_subcommand("plan", "Plan a collision-free path between two points (A* over free voxels)");
   cmd->footer(
       "The robot is a sphere of --radius: a voxel is free when no occupied voxel is within the radius\n"
-      "of its centre. A* moves to the 26 neighbours at Euclidean cost, so the cost is optimal on the\n"
-      "planning grid; smoothing then replaces runs by straight segments the sphere can sweep clear.\n"
+      "of its centre (decided for bricks of 16^3 voxels at once, from the obstacles dilated by the\n"
+      "sphere). A* moves to the 26 neighbours at Euclidean cost, a diagonal move only when every\n"
+      "voxel of the box it spans is free (no corner cutting), so the sphere stays clear along every\n"
+      "leg, not only at the voxels; the cost is optimal on the planning grid. Smoothing then\n"
+      "replaces runs by straight segments the sphere can sweep clear (checked exactly).\n"
+      "--hierarchical is the search that scales to a city: a route over coarse cells of 4^3 voxels\n"
+      "at least half free first, then the exact search only within one coarse cell of that route\n"
+      "(wider, then along wholly free cells, if that holds no path). Its cost is not guaranteed\n"
+      "optimal: within 1% of it on the generated cities (docs/BENCHMARKS.md, Planning); a 200 m\n"
+      "city at 0.1 m plans in 1-2 s.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
       "On a state map (vola map) unknown space is an obstacle too (--unknown occupied, the default\n"
       "there): a voxel is free only when it is known free and no unknown voxel is within the radius;\n"
       "--unknown free plans optimistically through unknown space. A .vol made from points has no\n"
       "unknown space: what is not a voxel is free.\n"
+      "--solid-ground: the ground of a map made from points is a sampled sheet with free space under\n"
+      "it, which the shortest path may use where the sheet ends. With it, every voxel below the\n"
+      "ground is an obstacle: a column's ground is its lowest voxel, the lowest within 2 columns.\n"
+      "The radius may reach at most 24 cells of the planning level: for a larger robot plan on a\n"
+      "coarser --level.\n"
       "Coordinates are world coordinates (the file's frame) unless --grid is given.\n"
       "INPUT may be a tile index (index.geojson from vola tile): the search then runs over the tiles\n"
       "that meet the box around --from and --to grown by --margin, and opens no others.\n"
@@ -182,7 +200,8 @@ void add_plan(CLI::App& app) {
       "sees occupied voxels only: on a state map it needs --unknown free.\n"
       "Examples:\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 -o path.csv --ply path.ply\n"
-      "  vola plan site.vol --grid --from 0.5 0.5 0.5 --to 900 900 30 --hierarchical\n"
+      "  vola plan city.vol --from 500001 5000001 100.7 --to 500199 5000199 106.8 --radius 0.3 --hierarchical \\\n"
+      "    --solid-ground\n"
       "  vola plan site.vol --from 10 20 5 --to 300 410 8 --radius 0.5 --avoid --speed 0.25\n"
       "  vola plan map.vol --from 0 0 1 --to 20 5 1 --radius 0.3 --unknown free\n"
       "  vola plan tiles/index.geojson --from 500100 5000100 105 --to 501900 5001200 110 --radius 1");
@@ -191,8 +210,13 @@ void add_plan(CLI::App& app) {
   cmd->add_option("--to", args->to, "Goal X Y Z")->required()->expected(3);
   cmd->add_option("--radius", args->radius, "Robot radius (obstacle inflation)")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--level", args->level, "Plan on this level (0 = coarsest; default: the voxels)");
-  cmd->add_flag("--hierarchical", args->hierarchical, "Plan two levels coarser first, then search near that path");
+  cmd->add_flag("--hierarchical", args->hierarchical,
+                "A coarse route over 4^3-voxel cells first, then the voxels near it (scales; cost within ~1%)");
   cmd->add_flag("--no-smooth", args->no_smooth, "Keep every cell of the A* path");
+  cmd->add_option("--max-expansions", args->max_expansions, "Give up after expanding this many cells")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--solid-ground", args->solid_ground, "The space under the ground is an obstacle (maps made from points)");
   cmd->add_option("-o,--output", args->output, "CSV of waypoints (x,y,z)")->capture_default_str();
   cmd->add_option("--ply", args->ply, "Also write the path as a PLY polyline");
   cmd->add_flag("--avoid", args->avoid, "Fly a reactive obstacle-avoiding agent instead of A*");

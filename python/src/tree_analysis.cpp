@@ -152,7 +152,7 @@ py::dict raycast(const Tree& tree, const py::handle& origins_in, const py::handl
 }
 
 py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 3> goal, double radius, bool world, bool smooth,
-              int level, bool hierarchical, std::uint64_t max_expansions) {
+              int level, bool hierarchical, std::uint64_t max_expansions, bool solid_ground) {
   const vola::Frame frame = tree.frame();
   vola::Point a = to_point(start), b = to_point(goal);
   if (world) {
@@ -166,6 +166,7 @@ py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 
   options.level = level;
   options.hierarchical = hierarchical;
   options.max_expansions = max_expansions;
+  options.solid_ground = solid_ground;
   vola::raycast::PlannedPath path;
   {
     py::gil_scoped_release release;
@@ -202,8 +203,11 @@ void bind_tree_analysis(py::class_<Tree>& tree) {
            "Grid coordinates (voxel (i,j,k) = [i,i+1]^3) unless world=True. Returns {'hit', 'voxel', 't', 'normal', 'point'}.")
       .def("plan", &plan, py::arg("start"), py::arg("goal"), py::arg("radius") = 0.0, py::arg("world") = false,
            py::arg("smooth") = true, py::arg("level") = -1, py::arg("hierarchical") = false,
-           py::arg("max_expansions") = std::uint64_t{20'000'000},
-           "A* path over free voxels for a robot of `radius`. Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
+           py::arg("max_expansions") = std::uint64_t{20'000'000}, py::arg("solid_ground") = false,
+           "A* path over free voxels for a robot of `radius` (no corner cutting: every leg keeps the sphere clear).\n"
+           "hierarchical=True: a coarse route first, then the voxels near it (scales; cost not guaranteed optimal).\n"
+           "solid_ground=True: the space under each column's lowest voxel is an obstacle (`vola plan --solid-ground`).\n"
+           "Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
            "Grid coordinates unless world=True. Raises InvalidArgument when start/goal are blocked or unreachable.");
 }
 

@@ -93,3 +93,21 @@ def test_plan_goes_around_a_wall():
     assert path["length"] == pytest.approx(steps) and path["cost"] >= 11.0
     with pytest.raises(vola.InvalidArgument):
         tree.plan((8.5, 2.5, 8.5), (13.5, 2.5, 8.5))
+
+
+def test_plan_solid_ground_keeps_the_path_out_from_under_a_sheet():
+    # A ground sheet at z = 4 over y < 12 and a wall across the grid from z = 4 to 13: the
+    # short way past the wall is below z = 4, reached past the sheet's edge. With
+    # solid_ground the wall's base and the sheet are ground, everything under them solid,
+    # and the path goes over the wall instead.
+    sheet = [(x, y, 4) for x in range(16) for y in range(12)]
+    wall = [(8, y, z) for y in range(16) for z in range(4, 14)]
+    tree = vola.build_from_voxels(np.array(sheet + wall), depth=2)
+    def under(points):
+        return np.sum((points[:, 2] < 4.0) & (points[:, 1] < 14.0))
+    free = tree.plan((2.5, 8.5, 5.5), (13.5, 8.5, 5.5), smooth=False)
+    solid = tree.plan((2.5, 8.5, 5.5), (13.5, 8.5, 5.5), smooth=False, solid_ground=True)
+    assert under(free["points"]) > 0 and under(solid["points"]) == 0
+    assert solid["cost"] > free["cost"]
+    with pytest.raises(vola.InvalidArgument, match="or the ground"):
+        tree.plan((2.5, 8.5, 1.5), (13.5, 8.5, 5.5), solid_ground=True)

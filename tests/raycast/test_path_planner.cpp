@@ -1,5 +1,6 @@
 // A* against a brute-force Dijkstra over a dense array of small grids (with obstacles and
-// inflation), smoothed paths that stay clear, coarse and hierarchical plans, and errors.
+// inflation, no corner cutting), paths whose every leg keeps the sphere clear (checked
+// voxel by voxel along the leg), coarse and hierarchical plans, and errors.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/raycast/path_planner.hpp"
+#include "plan_checks.hpp"
 
 namespace {
 
@@ -60,7 +62,8 @@ std::vector<char> brute_free(const vola::Tree& tree, double radius) {
   return free;
 }
 
-// Dijkstra over the dense array; +inf when unreachable.
+// Dijkstra over the dense array; +inf when unreachable. A diagonal move needs every cell
+// of the box it spans free.
 double dijkstra(const std::vector<char>& free, std::int64_t side, std::array<std::int64_t, 3> s,
                 std::array<std::int64_t, 3> g) {
   auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return static_cast<std::size_t>((z * side + y) * side + x); };
@@ -82,7 +85,12 @@ double dijkstra(const std::vector<char>& free, std::int64_t side, std::array<std
           if ((!dx && !dy && !dz) || nx < 0 || ny < 0 || nz < 0 || nx >= side || ny >= side || nz >= side) continue;
           const std::size_t n = index(nx, ny, nz);
           const double nd = d + std::sqrt(double(dx * dx + dy * dy + dz * dz));
-          if (free[n] && nd < dist[n]) {
+          bool spanned_free = true;
+          for (std::int64_t bz = std::min(z, nz); bz <= std::max(z, nz); ++bz)
+            for (std::int64_t by = std::min(y, ny); by <= std::max(y, ny); ++by)
+              for (std::int64_t bx = std::min(x, nx); bx <= std::max(x, nx); ++bx)
+                spanned_free = spanned_free && free[index(bx, by, bz)];
+          if (spanned_free && nd < dist[n]) {
             dist[n] = nd;
             q.push({nd, n});
           }
@@ -97,7 +105,7 @@ TEST(PathPlanner, CostEqualsDijkstraOnSmallGrids) {
     const int depth = seed % 2 ? 2 : 3;
     const vola::Tree tree = maze(seed, depth);
     const std::int64_t side = tree.side();
-    for (const double radius : {0.0, 0.9}) {
+    for (const double radius : {0.0, 0.9, 1.5}) {
       const auto free = brute_free(tree, radius);
       std::mt19937_64 rng(seed * 31);
       for (int trial = 0; trial < 6; ++trial) {
@@ -124,26 +132,13 @@ TEST(PathPlanner, CostEqualsDijkstraOnSmallGrids) {
         EXPECT_LE(path.length, path.cost + 1e-9);  // smoothing only shortens
         EXPECT_EQ(path.points.front(), from);
         EXPECT_EQ(path.points.back(), to);
-        // Every smoothed segment keeps the robot clear (sampled finely, brute force).
-        for (std::size_t i = 1; i < path.points.size(); ++i)
-          for (int k = 0; k <= 200; ++k) {
-            const double f = k / 200.0;
-            const auto& a = path.points[i - 1];
-            const auto& b = path.points[i];
-            // Points on a voxel face only touch it (diagonal moves pass edges and corners).
-            bool on_face = false;
-            std::array<std::int64_t, 3> c{};
-            for (int a3 = 0; a3 < 3; ++a3) {
-              const double x = a[a3] + f * (b[a3] - a[a3]);
-              c[a3] = static_cast<std::int64_t>(std::floor(x));
-              on_face = on_face || std::floor(x - 1e-9) != std::floor(x + 1e-9);
-            }
-            if (on_face) continue;
-            const auto v = vola::Voxel{static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
-                                       static_cast<std::uint32_t>(c[2])};
-            ASSERT_FALSE(tree.contains(v)) << "segment " << i << " passes through an occupied voxel, radius "
-                                           << radius << ", f " << f;
-          }
+        // Every leg keeps the robot clear, smoothed or not.
+        EXPECT_EQ(vola::test::legs_clear(tree, nullptr, path.points, radius), "") << "seed " << seed;
+        options.smooth = false;
+        const auto raw = plan_path(tree, from, to, options);
+        EXPECT_NEAR(raw.cost, expected, 1e-9);
+        EXPECT_NEAR(raw.length, raw.cost, 1e-9);  // the cells' steps, one by one
+        EXPECT_EQ(vola::test::legs_clear(tree, nullptr, raw.points, radius), "") << "seed " << seed;
         ++compared;
       }
     }
@@ -230,6 +225,7 @@ TEST(PathPlanner, UnknownSpaceIsAnObstacleWithKnown) {
         }
         const auto path = plan_path(tree, from, to, options);
         EXPECT_NEAR(path.cost, expected, 1e-9) << "seed " << seed << " radius " << radius;
+        EXPECT_EQ(vola::test::legs_clear(tree, &known, path.points, radius), "") << "seed " << seed;
         longer += expected > dijkstra(free, side, s, g) + 1e-9;
         ++compared;
       }
@@ -263,9 +259,7 @@ TEST(PathPlanner, CoarseAndHierarchicalPlans) {
   hierarchical.hierarchical = true;
   const auto h = plan_path(tree, from, to, hierarchical);
   EXPECT_GE(h.cost, optimal.cost - 1e-9);
-  for (const Point& p : h.points)
-    EXPECT_FALSE(tree.contains(vola::Voxel{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
-                                           static_cast<std::uint32_t>(p[2])}));
+  EXPECT_EQ(vola::test::legs_clear(tree, nullptr, h.points, 0.0), "");
   // Level 1 of a depth-3 tree: cells of 4 voxels, centres at 2, 6, ...
   PlanOptions coarse = fine;
   coarse.level = 1;
@@ -313,6 +307,27 @@ TEST(PathPlanner, ClearErrors) {
       },
       vola::InvalidArgument);
   EXPECT_THROW(plan_path(tree, {1, 1, 1}, {2, 2, 2}, PlanOptions{.level = 2}), vola::InvalidArgument);
+  // The search's limit is not unreachability: the message says which it was.
+  try {
+    plan_path(tree, {0.5, 0.5, 0.5}, {15.5, 15.5, 15.5}, PlanOptions{.max_expansions = 5});
+    ADD_FAILURE() << "a search past its limit returned";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("within the limit of 5 expanded cells"), std::string::npos) << e.what();
+  }
+  // A radius the clearance field cannot reach in one word: refused, naming the way out.
+  EXPECT_NE(message({1, 1, 1}, {2, 2, 2}, 30).find("coarser level"), std::string::npos);
+}
+
+// A diagonal move may not cut the corner between two obstacles: at radius 0 the two
+// voxels (1,0,0) and (0,1,0) close the diagonal from (0,0,0) to (1,1,0).
+TEST(PathPlanner, NoCornerCutting) {
+  const vola::Voxel corner[] = {{1, 0, 0}, {0, 1, 0}};
+  const vola::Tree tree = vola::build_from_voxels(corner, 2);
+  PlanOptions o;
+  o.smooth = false;
+  const auto path = plan_path(tree, {0.5, 0.5, 0.5}, {1.5, 1.5, 0.5}, o);
+  EXPECT_GT(path.cost, std::sqrt(2.0) + 1e-9);  // not the one diagonal step
+  EXPECT_EQ(vola::test::legs_clear(tree, nullptr, path.points, 0.0), "");
 }
 
 }  // namespace
