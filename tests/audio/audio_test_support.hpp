@@ -25,6 +25,11 @@ vola::Tree shoebox_tree(const Shoebox& box, double voxel_size);
 // $VOLA_SHARED/data/audio.
 vola_test::fs::path audio_dir();
 
+// T30 of a response sampled at `rate`: the Schroeder curve (energy still to come, in dB
+// of the total) and a least-squares line through its points between -5 and -35 dB,
+// extrapolated to -60 dB.
+double t30(const std::vector<double>& ir, double rate);
+
 }  // namespace vola_audio_test
 
 // Skips the test when the recordings are missing, fails it when CI is set.

@@ -22,6 +22,7 @@ using namespace vola;
 using namespace vola::audio;
 using vola_audio_test::Shoebox;
 using vola_audio_test::shoebox_tree;
+using vola_audio_test::t30;
 
 TEST(AudioAir, AttenuationMatchesTheIsoTable) {
   // ISO 9613-1:1993 table 1, 20 degrees C, 50% relative humidity, 101.325 kPa (dB/km).
@@ -46,19 +47,6 @@ std::vector<double> octave_band_pass(double fc, double rate, std::size_t taps) {
     h[i] = (2.0 * f2 * sinc(2.0 * f2 * n) - 2.0 * f1 * sinc(2.0 * f1 * n)) * w;
   }
   return h;
-}
-
-double t30(const std::vector<double>& ir, double rate) {
-  std::vector<double> edc(ir.size() + 1, 0.0);
-  for (std::size_t i = ir.size(); i-- > 0;) edc[i] = edc[i + 1] + ir[i] * ir[i];
-  double n = 0, st = 0, sl = 0, stt = 0, stl = 0;
-  for (std::size_t i = 0; i < ir.size(); ++i) {
-    const double level = 10.0 * std::log10(edc[i] / edc[0]);
-    if (level > -5.0 || level < -35.0) continue;
-    const double t = static_cast<double>(i) / rate;
-    n += 1, st += t, sl += level, stt += t * t, stl += t * level;
-  }
-  return -60.0 / ((n * stl - st * sl) / (n * stt - st * st));
 }
 
 TEST(AudioRoomBands, PerBandT30FollowsEyringWithTheBandsAbsorptionAndTheAir) {

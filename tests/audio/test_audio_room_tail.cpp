@@ -21,6 +21,7 @@ using namespace vola;
 using namespace vola::audio;
 using vola_audio_test::Shoebox;
 using vola_audio_test::shoebox_tree;
+using vola_audio_test::t30;
 
 constexpr double kC = 343.0;
 constexpr double kRate = 16000.0;  // the decay's shape, not its bandwidth, is under test
@@ -28,26 +29,6 @@ constexpr double kRate = 16000.0;  // the decay's shape, not its bandwidth, is u
 double eyring(double lx, double ly, double lz, double absorption) {
   const double volume = lx * ly * lz, surface = 2.0 * (lx * ly + ly * lz + lz * lx);
   return 24.0 * std::log(10.0) * volume / (kC * surface * -std::log(1.0 - absorption));
-}
-
-// T30 of a response: the Schroeder curve (energy still to come, in dB of the total) and a
-// least-squares line through its points between -5 and -35 dB, extrapolated to -60 dB.
-double t30(const std::vector<double>& ir) {
-  std::vector<double> edc(ir.size() + 1, 0.0);
-  for (std::size_t i = ir.size(); i-- > 0;) edc[i] = edc[i + 1] + ir[i] * ir[i];
-  double n = 0, st = 0, sl = 0, stt = 0, stl = 0;
-  for (std::size_t i = 0; i < ir.size(); ++i) {
-    const double level = 10.0 * std::log10(edc[i] / edc[0]);
-    if (level > -5.0 || level < -35.0) continue;
-    const double t = static_cast<double>(i) / kRate;
-    n += 1;
-    st += t;
-    sl += level;
-    stt += t * t;
-    stl += t * level;
-  }
-  const double slope = (n * stl - st * sl) / (n * stt - st * st);  // dB per second
-  return -60.0 / slope;
 }
 
 struct Case {
@@ -81,7 +62,7 @@ TEST(AudioRoomTail, ClosedShoeboxT30FollowsEyring) {
     const Point s{0.4 + 0.31 * c.size[0], 0.4 + 0.37 * c.size[1], 0.4 + 0.45 * c.size[2]};
     const Point l{0.4 + 0.72 * c.size[0], 0.4 + 0.61 * c.size[1], 0.4 + 0.52 * c.size[2]};
     const RoomResponse r = room_response(room, s, l, o);
-    const double measured = t30(r.ir);
+    const double measured = t30(r.ir, kRate);
     std::printf("%s: T30 %.3f s, Eyring %.3f s (%+.1f%%), %zu images of order <= %d, receiver %.2f m\n", name.c_str(),
                 measured, expected, 100.0 * (measured / expected - 1.0), r.early.images.size(), r.early.order,
                 r.late.receiver_radius);
