@@ -7,8 +7,9 @@
 # write to a regular file fails with EFBIG, over an existing output holding "old": the
 # command must exit 1 with a message (not a signal), the output must still say "old",
 # and no .part file may be left. Then `vola generate` of a large scene is killed with
-# SIGTERM and SIGINT while its temporary is being written: it must die of that signal
-# with the old output intact and no temporary left. Finally a cut WAV is refused.
+# SIGTERM, SIGINT and SIGKILL while its temporary is being written: it must die of that
+# signal with the old output intact and no temporary left (the temporary is an unnamed
+# O_TMPFILE file, found through /proc/PID/fd). Finally a cut WAV is refused.
 # Exit status: 0 all good, 1 failures, 77 shared folder missing (outside CI).
 set -uo pipefail
 
@@ -73,21 +74,35 @@ fails_keeping "plan csv" p.csv "$vola" plan room.vol --from 1 1 1 --to 5 3 2 -o 
 fails_keeping "sonify wav" s.wav "$vola" sonify room.vol --source 2 1.5 1.25 --listener 4 3 2 --in "$dry" \
   --out out/s.wav -q
 
+# temporary_with_bytes PID DIR: true once PID has a file open in DIR, unnamed or named
+# .part, that holds bytes.
+temporary_with_bytes() {
+  local fd target
+  for fd in /proc/"$1"/fd/*; do
+    target=$(readlink "$fd" 2> /dev/null) || continue
+    [[ $target == "$2"/* && ( $target == *"(deleted)" || $target == *.part ) ]] || continue
+    [[ $(stat -L -c %s "$fd" 2> /dev/null || echo 0) -gt 0 ]] && return 0
+  done
+  return 1
+}
+
 # killed_while_writing SIGNAL: generate a scene large enough to take seconds to write,
 # kill it once its temporary holds bytes.
 killed_while_writing() {
   local signal=$1
   mkdir -p big && rm -f big/*
   echo old > big/city.xyz
-  # A background job of a script starts with SIGINT ignored: give it the default back.
-  env --default-signal="$signal" "$vola" generate city big/city.xyz --points 50000000 > /dev/null 2>&1 &
-  local pid=$! part="" i
+  # A background job of a script starts with SIGINT ignored: give it the default back
+  # (SIGKILL's cannot be changed).
+  local defaults=(env --default-signal="$signal")
+  [[ $signal == KILL ]] && defaults=()
+  "${defaults[@]}" "$vola" generate city big/city.xyz --points 50000000 > /dev/null 2>&1 &
+  local pid=$! writing="" i
   for ((i = 0; i < 500; i++)); do
-    part=$(find big -name 'city.xyz.*.part' -size +0 | head -n 1)
-    [[ -n $part ]] && break
+    temporary_with_bytes "$pid" "$PWD/big" && writing=yes && break
     sleep 0.02
   done
-  [[ -n $part ]] || fail "SIG$signal: no temporary appeared"
+  [[ -n $writing ]] || fail "SIG$signal: no temporary appeared"
   kill -s "$signal" "$pid"
   wait "$pid"
   local status=$?
@@ -100,6 +115,7 @@ killed_while_writing() {
 }
 killed_while_writing TERM
 killed_while_writing INT
+killed_while_writing KILL
 
 # A WAV cut in its data chunk: libsndfile would read the shorter sound without a word.
 size=$(stat -c %s "$dry")

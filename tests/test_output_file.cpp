@@ -78,7 +78,10 @@ TEST(OutputFile, AnUncommittedFileLeavesNothing) {
   {
     vola::OutputFile out(path.string());
     out.write("half of it");
-    EXPECT_EQ(names_in(dir.path()).size(), 2u);  // the temporary, beside the old file
+    std::fflush(out.stream());
+    // The temporary exists, unnamed, with the bytes so far.
+    EXPECT_EQ(text_of(out.temporary()), "half of it");
+    EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
   }
   EXPECT_EQ(text_of(path), "old");
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
@@ -142,7 +145,7 @@ TEST(OutputFile, SigtermRemovesTheTemporaryAndEndsByTheSignal) {
   }
   char got = 0;
   ASSERT_EQ(::read(ready[0], &got, 1), 1);
-  EXPECT_EQ(names_in(dir.path()).size(), 2u);  // the temporary is there
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});  // the temporary has no name
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -151,6 +154,54 @@ TEST(OutputFile, SigtermRemovesTheTemporaryAndEndsByTheSignal) {
   ASSERT_TRUE(WIFSIGNALED(status));
   EXPECT_EQ(WTERMSIG(status), SIGTERM);
   EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
+}
+
+// SIGKILL runs no handler: only a temporary without a name can leave nothing behind.
+TEST(OutputFile, SigkillWhileWritingLeavesOnlyTheOldFile) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    vola::OutputFile out(path.string());
+    const std::string block(1 << 20, 'x');
+    for (int i = 0; i < 4; ++i) out.write(block);
+    std::fflush(out.stream());
+    const char one = '1';
+    if (::write(ready[1], &one, 1) != 1) ::_exit(5);
+    for (;;) ::pause();
+  }
+  char got = 0;
+  ASSERT_EQ(::read(ready[0], &got, 1), 1);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ::close(ready[0]);
+  ::close(ready[1]);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+  EXPECT_EQ(text_of(path), "old");
+  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
+}
+
+// Libraries that open files by name (OctoMap's writers) write through temporary().
+TEST(OutputFile, TheTemporaryCanBeWrittenByName) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  {
+    vola::OutputFile out(path.string());
+    std::FILE* by_name = std::fopen(out.temporary().c_str(), "wb");
+    ASSERT_NE(by_name, nullptr) << out.temporary();
+    std::fputs("written by name", by_name);
+    ASSERT_EQ(std::fclose(by_name), 0);
+    EXPECT_EQ(text_of(path), "old");
+    out.commit();
+  }
+  EXPECT_EQ(text_of(path), "written by name");
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
 }
 

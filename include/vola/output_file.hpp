@@ -1,19 +1,22 @@
 // An output file that appears whole or not at all. Every writer of vola (the .vol
 // writer, exports, images, sounds, CSV, tile sets) goes through it:
 //
-//   - the bytes go to a temporary file in the same directory as the final name
+//   - the bytes go to an unnamed file in the same directory as the final name (Linux's
+//     O_TMPFILE), or, on a filesystem without those, to a named temporary
 //     (`<path>.<pid>.<n>.part`, created exclusively, so no stranger's file is reused);
-//   - commit() flushes, fsyncs, closes and renames it onto the final name, then fsyncs
-//     the directory: the old file stays in place, untouched, until the new one is
-//     complete on disk, and is then replaced in one step;
+//   - commit() flushes and fsyncs it, links the unnamed file as `<path>.<pid>.<n>.part`,
+//     closes it and renames it onto the final name, then fsyncs the directory: the old
+//     file stays in place, untouched, until the new one is complete on disk, and is then
+//     replaced in one step;
 //   - on any error, and when the object is destroyed uncommitted (an exception
 //     unwinding), the temporary is closed and removed: no partial file is left;
 //   - while it exists, the temporary's name sits in a fixed, lock-free table, so that a
 //     process killed by SIGINT, SIGTERM or SIGHUP removes it too once
 //     remove_temporaries_on_signal() has installed the handlers (the CLI does at start).
 //
-// What it cannot cover: SIGKILL and power loss leave a `.part` file beside the old,
-// intact file; more than 64 files written at once are not all in the table.
+// What it cannot cover: SIGKILL or power loss in the instant between the link and the
+// rename (or at any time on a filesystem without O_TMPFILE) leaves a `.part` file beside
+// the old, intact file; more than 64 files written at once are not all in the table.
 #pragma once
 
 #include <cstddef>
@@ -47,14 +50,18 @@ class OutputFile {
   // after removing the temporary. Call once.
   void commit();
   const std::string& path() const noexcept { return path_; }
+  // A name the temporary can be written through, for libraries that open files by name
+  // (`/proc/self/fd/N` while it is unnamed).
   const std::string& temporary() const noexcept { return temporary_; }
 
  private:
   void discard() noexcept;
+  int give_a_name() noexcept;  // 0, or the errno
   std::string path_;
   std::string temporary_;
   std::FILE* file_ = nullptr;
-  int slot_ = -1;  // in the table of live temporaries, or -1
+  int slot_ = -1;        // in the table of live temporaries, or -1
+  bool unnamed_ = false;  // an O_TMPFILE file with no name yet
 };
 
 // Installs handlers for SIGINT, SIGTERM and SIGHUP that remove every live temporary

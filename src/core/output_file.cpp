@@ -62,6 +62,10 @@ void sync_directory(const std::string& path) noexcept {
   ::close(fd);
 }
 
+std::string next_temporary_name(const std::string& path) {
+  return path + "." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1)) + ".part";
+}
+
 void on_signal(int signal) {
   detail::remove_live_temporaries();
   struct sigaction action {};
@@ -93,15 +97,23 @@ void remove_temporaries_on_signal() noexcept {
 }
 
 OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
-  temporary_ = path_ + "." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1)) + ".part";
-  // Registered before it exists: a signal between open() and the table would leave it.
-  slot_ = claim_slot(temporary_);
-  const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) {
-    const int e = errno;
-    release_slot(slot_);
-    slot_ = -1;
-    VOLA_THROW(IoError(path_ + ": cannot create " + temporary_ + ": " + std::strerror(e)));
+  // An unnamed file first (Linux's O_TMPFILE): until commit() it has no name, so not even
+  // SIGKILL or a power cut can leave it behind. Filesystems without it get a named one.
+  int fd = ::open(directory_of(path_).c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  if (fd >= 0) {
+    unnamed_ = true;
+    temporary_ = "/proc/self/fd/" + std::to_string(fd);
+  } else {
+    temporary_ = next_temporary_name(path_);
+    // Registered before it exists: a signal between open() and the table would leave it.
+    slot_ = claim_slot(temporary_);
+    fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) {
+      const int e = errno;
+      release_slot(slot_);
+      slot_ = -1;
+      VOLA_THROW(IoError(path_ + ": cannot create " + temporary_ + ": " + std::strerror(e)));
+    }
   }
   // A replaced file keeps its permissions (the temporary has the umask's).
   struct stat old {};
@@ -122,10 +134,29 @@ OutputFile::~OutputFile() { discard(); }
 void OutputFile::discard() noexcept {
   if (file_) std::fclose(file_);
   file_ = nullptr;
-  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+  if (!temporary_.empty() && !unnamed_) ::unlink(temporary_.c_str());
+  unnamed_ = false;
   release_slot(slot_);
   slot_ = -1;
   temporary_.clear();
+}
+
+// The unnamed file, whole and synced, gets a name of its own beside the final one (rename()
+// then replaces that atomically; linkat() cannot replace). The name lives for the instant
+// between the two calls, and is in the table for the signal handlers meanwhile.
+int OutputFile::give_a_name() noexcept {
+  const std::string name = next_temporary_name(path_);
+  slot_ = claim_slot(name);
+  if (::linkat(AT_FDCWD, temporary_.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) != 0 &&
+      ::linkat(::fileno(file_), "", AT_FDCWD, name.c_str(), AT_EMPTY_PATH) != 0) {
+    const int e = errno;
+    release_slot(slot_);
+    slot_ = -1;
+    return e;
+  }
+  unnamed_ = false;
+  temporary_ = name;
+  return 0;
 }
 
 int OutputFile::descriptor() const noexcept { return file_ ? ::fileno(file_) : -1; }
@@ -144,6 +175,7 @@ void OutputFile::commit() {
   if (!file_) e = EBADF;
   else if (std::fflush(file_) != 0 || std::ferror(file_)) e = errno ? errno : EIO;
   else if (::fsync(::fileno(file_)) != 0) e = errno;
+  else if (unnamed_) e = give_a_name();
   if (file_ && std::fclose(file_) != 0 && e == 0) e = errno;
   file_ = nullptr;
   if (e != 0) {
