@@ -89,7 +89,7 @@ ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, const std::string& gi
 bool is_geographic_crs(const std::string& definition) {
   try {
     // The horizontal unit catches a compound CRS on a geographic one (EPSG:4326+5703).
-    const geo::CrsDescription d = geo::describe_crs(definition);
+    const geo::CrsDescription d = geo::describe_crs(definition, geo::EpsgLookup::own_id_only);
     return d.kind.rfind("geographic", 0) == 0 || d.horizontal_unit.find("degree") != std::string::npos;
   } catch (const Error&) {
     return false;

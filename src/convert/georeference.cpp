@@ -17,7 +17,7 @@ bool voxelises_points(const io::Input& input) { return !input.grid && !input.is_
 
 std::string geographic_name(const std::string& definition) {
   try {
-    return geo::describe_crs(definition).name;
+    return geo::describe_crs(definition, geo::EpsgLookup::own_id_only).name;
   } catch (const Error&) {
     return definition.substr(0, 60);
   }

@@ -24,11 +24,11 @@ Units units_of_crs(const std::optional<std::uint32_t>& epsg, const std::string& 
   if (wkt.empty() && !epsg) return {};
   geo::CrsDescription crs;
   try {
-    crs = geo::describe_crs(wkt.empty() ? "EPSG:" + std::to_string(*epsg) : wkt);
+    crs = geo::describe_crs(wkt.empty() ? "EPSG:" + std::to_string(*epsg) : wkt, geo::EpsgLookup::own_id_only);
   } catch (const Error&) {
     // A WKT record PROJ cannot read (pdal_warsaw_small.las holds "''") states no CRS.
     if (!epsg || wkt.empty()) return {};
-    crs = geo::describe_crs("EPSG:" + std::to_string(*epsg));
+    crs = geo::describe_crs("EPSG:" + std::to_string(*epsg), geo::EpsgLookup::own_id_only);
   }
   const auto horizontal = metres_per_unit(crs.horizontal_unit);
   if (!horizontal)

@@ -71,9 +71,10 @@ bool same_crs(const std::string& a, const std::string& b) {
   return same;
 }
 
-CrsDescription describe_crs(const std::string& definition) {
+CrsDescription describe_crs(const std::string& definition, EpsgLookup lookup) {
   CrsDescription out;
-  run("a description of a CRS", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.describe_crs(definition, out, f); });
+  run("a description of a CRS",
+      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.describe_crs(definition, lookup, out, f); });
   return out;
 }
 

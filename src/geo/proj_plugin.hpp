@@ -28,7 +28,8 @@ struct ProjEntries {
   void (*to_wgs84_transform)(const void* state, const Point& in, Point& out, PluginFailure& failure);
   void (*to_wgs84_close)(void* state);
   void (*same_crs)(const std::string& a, const std::string& b, bool& out, PluginFailure& failure);
-  void (*describe_crs)(const std::string& definition, CrsDescription& out, PluginFailure& failure);
+  void (*describe_crs)(const std::string& definition, EpsgLookup lookup, CrsDescription& out,
+                       PluginFailure& failure);
   // A transformation between two CRSs (x = easting/longitude in and out), for one thread
   // at a time: opened, used for many batches of x y z triples in place, closed.
   void (*reprojection_open)(const std::string& from, const std::string& to, void*& state, PluginFailure& failure);

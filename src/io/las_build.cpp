@@ -525,19 +525,26 @@ class RankWalk {
   struct alignas(16) Entry {
     std::uint64_t word, before;
   };
-  // Entries on 2 MiB-aligned memory advised as huge pages (Linux).
+  // Entries of a large tree on 2 MiB-aligned memory advised as huge pages (Linux); a
+  // small tree's on the heap (a huge page would make a small file's conversion 2 MiB
+  // larger than its table).
   class Entries {
    public:
     Entries() = default;
-    explicit Entries(std::size_t n) : bytes_((n * sizeof(Entry) + kHuge - 1) / kHuge * kHuge) {
+    explicit Entries(std::size_t n) : bytes_(n * sizeof(Entry)) {
       if (n == 0) return;
+      if (bytes_ < 2 * kHuge) {
+        data_ = static_cast<Entry*>(::operator new(bytes_, std::align_val_t{alignof(Entry)}));
+        return;
+      }
+      bytes_ = (bytes_ + kHuge - 1) / kHuge * kHuge;
       data_ = static_cast<Entry*>(::operator new(bytes_, std::align_val_t{kHuge}));
 #ifdef MADV_HUGEPAGE
       ::madvise(data_, bytes_, MADV_HUGEPAGE);
 #endif
     }
     ~Entries() {
-      if (data_) ::operator delete(data_, std::align_val_t{kHuge});
+      if (data_) ::operator delete(data_, std::align_val_t{bytes_ < 2 * kHuge ? alignof(Entry) : kHuge});
     }
     Entries(const Entries&) = delete;
     Entries& operator=(Entries&& o) noexcept {

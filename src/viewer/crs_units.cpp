@@ -12,7 +12,7 @@ nlohmann::json crs_units(const Georef& georef) {
   const auto definition = geo::crs_definition(georef);
   if (!definition) return unknown;
   try {
-    const geo::CrsDescription d = geo::describe_crs(*definition);
+    const geo::CrsDescription d = geo::describe_crs(*definition, geo::EpsgLookup::own_id_only);
     if (d.horizontal_unit.empty()) return unknown;
     return {{"crs", d.name}, {"unit", d.horizontal_unit}, {"north", true}};
   } catch (const Error&) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -178,6 +179,28 @@ TEST(DescribeCrs, NamesWhatProjFindsAndInventsNoCode) {
   EXPECT_TRUE(vola::geo::same_crs("EPSG:4326", "EPSG:4326"));
   EXPECT_FALSE(vola::geo::same_crs("EPSG:32610", "EPSG:32611"));
   EXPECT_THROW(vola::geo::describe_crs("not a crs"), vola::Error);
+}
+
+// Without the database search, a description keeps the name, kind and units, and only the
+// CRS's own EPSG id: a WKT stripped of its ids is identified by the search alone.
+TEST(DescribeCrs, OwnIdOnlySkipsTheSearchAndKeepsKindAndUnits) {
+  VOLA_REQUIRE_DATA(data);
+  const auto own = vola::geo::EpsgLookup::own_id_only;
+  for (const std::string definition :
+       {stated_crs_of(data / "las" / "pdal_autzen_trim.las").wkt, stated_crs_of(data / "las" / "pdal_autzen-bmx-2010.las").wkt,
+        std::string("EPSG:32610"), std::string("EPSG:4326")}) {
+    const auto searched = vola::geo::describe_crs(definition), quick = vola::geo::describe_crs(definition, own);
+    EXPECT_EQ(quick.name, searched.name);
+    EXPECT_EQ(quick.kind, searched.kind);
+    EXPECT_EQ(quick.horizontal_unit, searched.horizontal_unit);
+    EXPECT_EQ(quick.vertical_unit, searched.vertical_unit);
+  }
+  EXPECT_EQ(vola::geo::describe_crs("EPSG:32610", own).epsg, 32610u);
+  const std::string without_ids =
+      std::regex_replace(vola::geo::crs_wkt1("EPSG:32610"), std::regex(R"(,AUTHORITY\["EPSG","[0-9]+"\])"), "");
+  ASSERT_EQ(without_ids.find("AUTHORITY"), std::string::npos) << without_ids;
+  EXPECT_EQ(vola::geo::describe_crs(without_ids).epsg, 32610u);
+  EXPECT_FALSE(vola::geo::describe_crs(without_ids, own).epsg.has_value());
 }
 
 // A CRS read from a file (a LAS WKT record, a tile index) may not make PROJ read other

@@ -44,8 +44,12 @@ struct CrsDescription {
   std::string vertical_name;          // the vertical CRS of a compound one (else empty)
   std::string vertical_unit;
 };
+// How describe_crs finds `epsg`: `search` asks PROJ to identify the CRS in its database
+// when it carries no EPSG id of its own; `own_id_only` skips that search (it loads a few
+// MiB of PROJ's database), for callers that want only the kind and units.
+enum class EpsgLookup { search, own_id_only };
 // Throws vola::Error when PROJ cannot read the definition.
-CrsDescription describe_crs(const std::string& definition);
+CrsDescription describe_crs(const std::string& definition, EpsgLookup lookup = EpsgLookup::search);
 // One line: "NAD83(HARN) / Oregon GIC Lambert (ft) (EPSG:2994), projected, foot" or, with
 // no code, "... (no EPSG code), ..."; a compound CRS adds "; vertical NAME (UNIT)".
 std::string crs_summary(const CrsDescription& crs);

@@ -235,7 +235,7 @@ std::string axis_unit(PJ_CONTEXT* ctx, const PJ* crs) {
   return unit ? unit : "";
 }
 
-CrsDescription describe_crs(const std::string& definition) {
+CrsDescription describe_with_proj(const std::string& definition, EpsgLookup lookup) {
   Context ctx = make_context();
   const Pj crs = unbound(ctx.get(), create_crs(ctx.get(), definition));
   CrsDescription out;
@@ -244,7 +244,9 @@ CrsDescription describe_crs(const std::string& definition) {
   out.kind = kind_of(proj_get_type(crs.get()));
   const Pj horizontal = horizontal_part(ctx.get(), Pj(proj_clone(ctx.get(), crs.get())));
   if (horizontal) {
-    out.epsg = identify_epsg(ctx.get(), horizontal.get());
+    out.epsg = lookup == EpsgLookup::search
+                   ? identify_epsg(ctx.get(), horizontal.get())
+                   : epsg_code(proj_get_id_auth_name(horizontal.get(), 0), proj_get_id_code(horizontal.get(), 0));
     out.horizontal_unit = axis_unit(ctx.get(), horizontal.get());
   }
   if (proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
@@ -359,8 +361,8 @@ const plugin::ProjEntries kEntries{
     [](const std::string& a, const std::string& b, bool& out, PluginFailure& failure) {
       capture_failure(failure, [&] { out = same_crs(a, b); });
     },
-    [](const std::string& definition, CrsDescription& out, PluginFailure& failure) {
-      capture_failure(failure, [&] { out = describe_crs(definition); });
+    [](const std::string& definition, EpsgLookup lookup, CrsDescription& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = describe_with_proj(definition, lookup); });
     },
     [](const std::string& from, const std::string& to, void*& state, PluginFailure& failure) {
       capture_failure(failure, [&] { state = new Reprojection(from, to); });
