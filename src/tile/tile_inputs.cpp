@@ -47,6 +47,11 @@ void resolve_tile_crs(const std::string& assign, bool allow_geographic,
     throw OptionError("target_crs", "the inputs are in a geographic CRS: tiles and voxels would be degrees of "
                                     "longitude and latitude by units of height, not cubes; give `target_crs` (a "
                                     "projected CRS such as UTM), or `allow_geographic` to tile in degrees anyway");
+  // The index's footprints go through GDAL, whose PROJ contexts would open the file.
+  if (const std::string named = geo::crs_file_reference(crs.wkt); !named.empty())
+    throw InvalidArgument("the inputs' CRS embeds a PROJ string that names a file ('" + named.substr(0, 80) +
+                          "'); GDAL would open it to place the tile footprints, so this CRS is refused (name the "
+                          "CRS with `assign_crs`, or reproject with `target_crs`)");
   options.epsg = crs.epsg;
   options.crs_wkt = crs.wkt;
 }

@@ -203,6 +203,23 @@ TEST(DescribeCrs, OwnIdOnlySkipsTheSearchAndKeepsKindAndUnits) {
   EXPECT_FALSE(vola::geo::describe_crs(without_ids, own).epsg.has_value());
 }
 
+// What GDAL's PROJ contexts would open: +init files and grids other than @null, in a PROJ
+// string or embedded in a WKT.
+TEST(CrsFileReference, FindsInitFilesAndGridsButNotTheNullGrid) {
+  using vola::geo::crs_file_reference;
+  EXPECT_EQ(crs_file_reference("+init=/etc/x:site +type=crs"), "+init=/etc/x:site");
+  EXPECT_EQ(crs_file_reference(R"(PROJCS["x",EXTENSION["PROJ4","+proj=utm +INIT = epsg:32633"]])"), "+INIT = epsg:32633");
+  EXPECT_EQ(crs_file_reference(R"(REMARK["PROJ CRS string: +proj=longlat +nadgrids=@null,./a.gsb"])"),
+            "+nadgrids=@null,./a.gsb");
+  EXPECT_EQ(crs_file_reference("+proj=vgridshift +grids=egm96_15.gtx"), "+grids=egm96_15.gtx");
+  EXPECT_EQ(crs_file_reference("+proj=tinshift +file=/tmp/t.json"), "+file=/tmp/t.json");
+  EXPECT_EQ(crs_file_reference("+proj=merc +a=6378137 +b=6378137 +nadgrids=@null +wktext"), "");
+  EXPECT_EQ(crs_file_reference("+proj=utm +zone=33 +datum=WGS84 +units=m +no_defs"), "");
+  EXPECT_EQ(crs_file_reference(vola::geo::crs_wkt(32633)), "");
+  EXPECT_EQ(crs_file_reference("+init"), "");
+  EXPECT_EQ(crs_file_reference("+" + std::string(100000, 'a')), "");
+}
+
 // A CRS read from a file (a LAS WKT record, a tile index) may not make PROJ read other
 // local files: "+init=FILE:id" is refused, not read. (Grid files named by path, as in
 // "+nadgrids=FILE", are not opened either; PROJ treats a grid it cannot open as absent.)

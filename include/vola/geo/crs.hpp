@@ -33,6 +33,15 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt);
 // Throws vola::Error when PROJ cannot read either.
 bool same_crs(const std::string& a, const std::string& b);
 
+// A CRS's WKT may carry a PROJ string (WKT1's EXTENSION["PROJ4", ...], WKT2's
+// REMARK["PROJ CRS string: ..."]), which PROJ follows when a transformation is built with
+// the CRS. vola's own PROJ contexts open files only inside PROJ's data folders, but
+// GDAL's (the DEM reader, GeoTIFF export, tile footprints) open whatever file such a
+// string names ("+init=/any/file:id", grids by name or path). The first such reference
+// in `crs_text` ("+init=...", "+nadgrids=...": any grid but PROJ's built-in @null), or
+// empty when there is none. Pure text: PROJ is not asked.
+std::string crs_file_reference(const std::string& crs_text);
+
 // What PROJ says a CRS is, for people.
 struct CrsDescription {
   std::string name;                   // the CRS's own name

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 #include "../reader_plugin.hpp"
 #include "gdal_confined.hpp"
 #include "readers.hpp"
@@ -18,12 +19,16 @@ namespace vola::io {
 
 namespace {
 
-void crs_of(const GDALDataset& dataset, DemRaster& dem) {
+void crs_of(const GDALDataset& dataset, const std::string& path, DemRaster& dem) {
   const OGRSpatialReference* srs = dataset.GetSpatialRef();
   if (!srs) return;
   char* wkt = nullptr;
   if (srs->exportToWkt(&wkt) == OGRERR_NONE && wkt) dem.wkt = wkt;
   CPLFree(wkt);
+  if (const std::string named = geo::crs_file_reference(dem.wkt); !named.empty())
+    throw FormatError(path, std::nullopt,
+                      "its CRS embeds a PROJ string that names a file ('" + named.substr(0, 80) +
+                          "'); GDAL would open it, so this CRS is refused");
   OGRSpatialReference identified(*srs);
   identified.AutoIdentifyEPSG();
   const char* authority = identified.GetAuthorityName(nullptr);
@@ -53,7 +58,7 @@ DemRaster read_dem_with_gdal(const std::string& path,
   if (dem.width * dem.height > kMaxDemCells)
     throw InvalidArgument(path + ": " + std::to_string(dem.width) + " x " + std::to_string(dem.height) +
                           " cells is more than " + std::to_string(kMaxDemCells) + "; crop or resample it first");
-  crs_of(*dataset, dem);
+  crs_of(*dataset, path, dem);
   double gt[6];
   // Without a geotransform GDAL fills the identity: cell (i, j) is at (i, j).
   (void)dataset->GetGeoTransform(gt);

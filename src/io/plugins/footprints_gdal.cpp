@@ -19,6 +19,7 @@
 #include "gdal_memory.hpp"
 #include "readers.hpp"
 #include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 
 namespace vola::io {
 
@@ -49,6 +50,9 @@ class ScopedConfig {
 // are then written as in no CRS: nowhere true to place them).
 std::unique_ptr<OGRSpatialReference> spatial_reference(const std::string& wkt) {
   if (wkt.empty()) return nullptr;
+  if (const std::string named = geo::crs_file_reference(wkt); !named.empty())
+    throw InvalidArgument("footprints: the CRS embeds a PROJ string that names a file ('" + named.substr(0, 80) +
+                          "'); GDAL would open it to place the footprints, so this CRS is refused");
   auto srs = std::make_unique<OGRSpatialReference>();
   srs->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   // importFromWkt only: SetFromUserInput would also open files and URLs.

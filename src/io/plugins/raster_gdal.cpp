@@ -15,6 +15,7 @@
 #include "gdal_memory.hpp"
 #include "readers.hpp"
 #include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 
 namespace vola::io {
 
@@ -44,6 +45,9 @@ std::vector<std::uint8_t> geotiff_with_gdal(const Raster& raster, const std::str
   double gt[6];
   for (int i = 0; i < 6; ++i) gt[i] = raster.geotransform[static_cast<std::size_t>(i)];
   source->SetGeoTransform(gt);
+  if (const std::string named = geo::crs_file_reference(wkt); !named.empty())
+    throw InvalidArgument("GeoTIFF: the CRS embeds a PROJ string that names a file ('" + named.substr(0, 80) +
+                          "'); GDAL could open it, so this CRS is refused");
   if (!wkt.empty() || epsg != 0) {
     OGRSpatialReference srs;
     srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
