@@ -14,6 +14,7 @@
 #include "vola/geo/crs.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/export_format.hpp"
 #include "vola/io/occupancy_maps.hpp"
 
 namespace vola::cli {
@@ -39,52 +40,22 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-std::string format_from_extension(const std::string& path) {
-  const std::string ext = lower_extension(path);
-  if (ext == ".ply") return "ply";
-  if (ext == ".xyz" || ext == ".txt") return "xyz";
-  if (ext == ".las" || ext == ".laz") return "las";
-  if (ext == ".binvox") return "binvox";
-  if (ext == ".npy") return "npy";
-  if (ext == ".png") return "png";
-  if (ext == ".tif" || ext == ".tiff") return "tif";
-  if (ext == ".bt" || ext == ".ot") return "octomap";
-  if (ext == ".vdb") return "vdb";
-  throw InvalidArgument(path + ": cannot tell the format from the extension '" + ext +
-                        "'; say --format (ply, xyz, las, binvox, npy, png, tif, octomap, vdb)");
-}
-
-// The format, after checking that the options given apply to it.
+// The format, after checking that the options given apply to it (the rule Python's
+// vola.export shares).
 std::string resolve_format(const ExportArgs& a) {
-  const int images = int{a.slices} + int{a.map} + int{a.above_given};
-  const bool raster = !a.raster.empty();
-  if (images > 1) throw InvalidArgument("--slices, --map and --occupancy-above are different images: give one");
-  if (images && raster)
-    throw InvalidArgument("--raster writes a GeoTIFF, --slices, --map and --occupancy-above PNG images: give one");
-  std::string format = a.format;
-  if (format == "auto") format = images ? "png" : raster ? "tif" : format_from_extension(a.output);
-  if (images && format != "png") throw InvalidArgument("--slices, --map and --occupancy-above write PNG, not " + format);
-  if (raster && format != "tif") throw InvalidArgument("--raster writes a GeoTIFF, not " + format);
-  // A map is a PNG of voxel units: under another name (a.tif) it would pass for what it
-  // is not.
-  if ((a.map || a.above_given) && a.format == "auto" && lower_extension(a.output) != ".png")
-    throw InvalidArgument(a.output + ": --map and --occupancy-above write PNG images (voxel units, with a .pgw world "
-                          "file): name OUT .png" +
-                          std::string(lower_extension(a.output) == ".tif" || lower_extension(a.output) == ".tiff"
-                                          ? "; for a GeoTIFF of elevations use --raster dsm (or dtm, intensity, "
-                                            "density, count)"
-                                          : ""));
-  if (raster && a.format == "auto" && lower_extension(a.output) != ".tif" && lower_extension(a.output) != ".tiff")
-    throw InvalidArgument(a.output + ": --raster writes a GeoTIFF: name OUT .tif");
-  if (format == "png" && !images)
-    throw InvalidArgument("PNG export needs --slices (OUT is a directory), --map or --occupancy-above Z");
-  if (format == "tif" && !raster)
-    throw InvalidArgument("GeoTIFF export needs --raster dsm, dtm, intensity, density or count");
-  if (a.resolution_given && !raster) throw InvalidArgument("--resolution applies to --raster");
-  if ((a.ascii || a.cubes) && format != "ply") throw InvalidArgument("--ascii and --cubes apply to PLY export");
-  if (a.bits != 16 && !a.map) throw InvalidArgument("--bits applies to --map");
-  if (!a.free.empty() && format != "octomap" && format != "vdb") throw InvalidArgument("--free applies to .bt, .ot and .vdb maps");
-  return format;
+  io::ExportRequest request;
+  request.output = a.output;
+  request.format = a.format;
+  request.slices = a.slices;
+  request.map = a.map;
+  request.occupancy_above = a.above_given;
+  request.raster = !a.raster.empty();
+  request.resolution = a.resolution_given;
+  request.ascii = a.ascii;
+  request.cubes = a.cubes;
+  request.bits = a.bits != 16;
+  request.free = !a.free.empty();
+  return io::resolve_export_format(request);
 }
 
 // The free voxels: a state map's own (vola map), else --free's plain tree, else none.

@@ -12,6 +12,7 @@
 
 #include "vola/io/binvox.hpp"
 #include "vola/io/export.hpp"
+#include "vola/io/export_format.hpp"
 #include "vola/io/occupancy_maps.hpp"
 
 namespace vola::python {
@@ -110,6 +111,28 @@ py::dict export_map(const Tree& tree, const std::filesystem::path& path, const T
 
 void bind_export(py::module_& m, py::class_<Tree>& tree) {
   m.attr("RASTER_NODATA") = vola::io::kRasterNodata;
+  m.def(
+      "_export_format",
+      [](const std::filesystem::path& path, bool slices, bool map, bool occupancy_above, bool raster, bool resolution,
+         bool ascii, bool cubes, bool bits, bool free) {
+        vola::io::ExportRequest request;
+        request.output = path.string();
+        request.slices = slices;
+        request.map = map;
+        request.occupancy_above = occupancy_above;
+        request.raster = raster;
+        request.resolution = resolution;
+        request.ascii = ascii;
+        request.cubes = cubes;
+        request.bits = bits;
+        request.free = free;
+        return with_python_names([&] { return vola::io::resolve_export_format(request); });
+      },
+      py::arg("path"), py::arg("slices"), py::arg("map"), py::arg("occupancy_above"), py::arg("raster"),
+      py::arg("resolution"), py::arg("ascii"), py::arg("cubes"), py::arg("bits"), py::arg("free"),
+      "vola.export's format ('ply', 'xyz', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb') from the\n"
+      "path's extension and which options were given (True: given), by the rule `vola export` uses;\n"
+      "InvalidArgument when an option does not apply to the format.");
   tree.def("raster", &raster, py::arg("product") = "dsm", py::arg("resolution") = 0.0, py::arg("depth") = 0,
            "The grid `vola export --raster PRODUCT` writes, in memory: (values (H, W) float32, row 0 the\n"
            "northernmost, vola.RASTER_NODATA where a cell has no voxel; geotransform: GDAL's six numbers, cell\n"

@@ -158,9 +158,9 @@ def test_export_by_extension_writes_what_the_cli_writes(autzen, vola_cli, tmp_pa
 def test_export_refuses_what_the_cli_refuses(autzen, tmp_path):
     refusals = (
         ("a.foo", {}, r"cannot tell the format from the extension '\.foo'"),
-        ("a.tif", {}, r"GeoTIFF needs raster='dsm'"),
-        ("a.tif", {"map": True}, r"name it \.png; for a GeoTIFF of elevations use raster='dsm'"),
-        ("a.png", {}, "PNG export needs slices=True"),
+        ("a.tif", {}, r"GeoTIFF export needs raster dsm"),
+        ("a.tif", {"map": True}, r"name it \.png; for a GeoTIFF of elevations use raster dsm"),
+        ("a.png", {}, "PNG export needs slices"),
         ("a.ply", {"raster": "dsm"}, r"raster writes a GeoTIFF: name .*a\.ply \.tif"),
         ("a.xyz", {"ascii": True}, "ascii and cubes apply to PLY export"),
         ("a.las", {"free": autzen}, r"free applies to \.bt, \.ot and \.vdb maps"),

@@ -102,6 +102,7 @@ from ._vola import (
     tile,
     translate,
     union,
+    _export_format,
     _run_pipeline,
 )
 
@@ -184,13 +185,6 @@ def pipeline(spec: Union[PathLike, list, dict]) -> list:
         raise IoError(f"{text}: cannot open ({e.strerror})") from None
 
 
-_FORMAT_OF_EXTENSION = {
-    ".ply": "ply", ".xyz": "xyz", ".txt": "xyz", ".las": "las", ".laz": "las", ".binvox": "binvox",
-    ".npy": "npy", ".png": "png", ".tif": "tif", ".tiff": "tif", ".bt": "octomap", ".ot": "octomap",
-    ".vdb": "vdb",
-}
-
-
 def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resolution: float = 0.0,
            map: bool = False, bits: int = 16, occupancy_above: Optional[int] = None,  # noqa: A002 (--map)
            slices: bool = False, ascii: bool = False, cubes: bool = False,  # noqa: A002 (--ascii)
@@ -201,43 +195,14 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
     (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
     for PLY; free= for maps. Options that do not apply to the format are refused, as the CLI
     refuses them. Returns what the export_* function for the format returns."""
-    images = int(slices) + int(map) + int(occupancy_above is not None)
-    if images > 1:
-        raise InvalidArgument("slices, map and occupancy_above are different images: give one")
-    if images and raster is not None:
-        raise InvalidArgument("raster writes a GeoTIFF, slices, map and occupancy_above PNG images: give one")
-    ext = os.path.splitext(os.fspath(path))[1].lower()
-    if slices:
-        fmt = "slices"
-    elif images:
-        if ext != ".png":
-            raise InvalidArgument(f"{os.fspath(path)}: map and occupancy_above write PNG images (voxel units, with "
-                                  "a .pgw world file): name it .png" +
-                                  ("; for a GeoTIFF of elevations use raster='dsm'" if ext in (".tif", ".tiff") else ""))
-        fmt = "png"
-    elif ext not in _FORMAT_OF_EXTENSION:
-        raise InvalidArgument(f"{os.fspath(path)}: cannot tell the format from the extension '{ext}' "
-                              f"({', '.join(sorted(_FORMAT_OF_EXTENSION))})")
-    else:
-        fmt = _FORMAT_OF_EXTENSION[ext]
-    if fmt == "png" and not images:
-        raise InvalidArgument("PNG export needs slices=True (path is a directory), map=True or occupancy_above=Z")
-    if (raster is not None) != (fmt == "tif"):
-        raise InvalidArgument("a GeoTIFF needs raster='dsm' (or dtm, intensity, density, count)" if fmt == "tif"
-                              else f"raster writes a GeoTIFF: name {os.fspath(path)} .tif")
-    if resolution and raster is None:
-        raise InvalidArgument("resolution applies to raster")
-    if (ascii or cubes) and fmt != "ply":
-        raise InvalidArgument("ascii and cubes apply to PLY export")
-    if bits != 16 and not map:
-        raise InvalidArgument("bits applies to map")
-    if free is not None and fmt not in ("octomap", "vdb"):
-        raise InvalidArgument("free applies to .bt, .ot and .vdb maps")
+    fmt = _export_format(os.fspath(path), slices=slices, map=map, occupancy_above=occupancy_above is not None,
+                         raster=raster is not None, resolution=bool(resolution), ascii=ascii, cubes=cubes,
+                         bits=bits != 16, free=free is not None)
     if fmt == "tif":
         return export_raster(tree, path, raster, resolution, depth)
-    if fmt == "slices":
-        return export_slices(tree, path, True, depth)
     if fmt == "png":
+        if slices:
+            return export_slices(tree, path, True, depth)
         if map:
             return export_height_map(tree, path, bits, depth)
         return export_occupancy_above(tree, path, occupancy_above, depth)
