@@ -10,6 +10,7 @@
 #include "open_voxels.hpp"
 #include "vola/map/state_map.hpp"
 #include "vola/error.hpp"
+#include "vola/io/input.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/binvox.hpp"
@@ -33,12 +34,6 @@ struct ExportArgs {
   bool resolution_given = false;
   std::string free;  // maps: a .vol of the free voxels (`vola map --free`)
 };
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 // The format, after checking that the options given apply to it (the rule Python's
 // vola.export shares).
@@ -85,7 +80,7 @@ void export_map(const ExportArgs& a, const Tree& tree, const std::string& format
     what = "OpenVDB grids";
     for (const auto& name : r.grids) what += " " + name;
   } else {
-    const bool binary = lower_extension(a.output) == ".bt";
+    const bool binary = io::lower_extension(a.output) == ".bt";
     what = std::string("OctoMap OcTree ") + (binary ? "(.bt, maximum likelihood)" : "(.ot, " + probabilities + ")") +
            " of " + std::to_string(r.nodes) + " nodes";
   }
@@ -119,9 +114,7 @@ void run_export(const ExportArgs& a) {
     say("XYZ: " + std::to_string(voxels) + " voxel centres");
   } else if (format == "las") {
     const io::LasReport r = io::write_las(tree, a.output);
-    std::string ext = std::filesystem::path(a.output).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    std::string what = std::string(ext == ".laz" ? "LAZ" : "LAS") + " 1.4 point format " +
+    std::string what = std::string(io::lower_extension(a.output) == ".laz" ? "LAZ" : "LAS") + " 1.4 point format " +
                        std::to_string(r.point_format) + ": " + std::to_string(voxels) +
                        " points, CRS ";
     if (r.has_crs) what += "as WKT";

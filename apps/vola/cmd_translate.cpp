@@ -11,6 +11,7 @@
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/stages.hpp"
+#include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/translate.hpp"
 
@@ -24,11 +25,6 @@ struct TranslateArgs {
   bool quiet = false;
 };
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 void run_translate(const TranslateArgs& a) {
   const auto start = std::chrono::steady_clock::now();
@@ -58,7 +54,7 @@ void run_translate(const TranslateArgs& a) {
     std::printf("\n");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (lower_extension(a.output) == ".las" || lower_extension(a.output) == ".laz") {
+  if (io::lower_extension(a.output) == ".las" || io::lower_extension(a.output) == ".laz") {
     const io::LasReader written(a.output);
     std::printf("points:  %llu, point format %u, %u bytes a record\n",
                 static_cast<unsigned long long>(written.header().point_count), written.header().point_format,

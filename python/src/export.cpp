@@ -13,6 +13,7 @@
 #include "vola/io/binvox.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/export_format.hpp"
+#include "vola/io/input.hpp"
 #include "vola/io/occupancy_maps.hpp"
 
 namespace vola::python {
@@ -92,9 +93,7 @@ py::dict export_map(const Tree& tree, const std::filesystem::path& path, const T
     const vola::io::MapVoxels voxels = at_depth(tree, depth, [&](const Tree& t) {
       return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free);
     });
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
+    return vola::io::lower_extension(path.string()) == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
   });
   py::dict report;
   report["occupied"] = r.occupied;

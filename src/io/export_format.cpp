@@ -5,16 +5,11 @@
 #include <filesystem>
 
 #include "vola/error.hpp"
+#include "vola/io/input.hpp"
 
 namespace vola::io {
 
 namespace {
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 std::string format_from_extension(const std::string& path) {
   const std::string ext = lower_extension(path);

@@ -130,6 +130,12 @@ const std::vector<InputFormat>& input_formats() {
   return formats;
 }
 
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
 const InputFormat& find_input_format(const std::string& path, const std::string& name) {
   const auto& formats = input_formats();
   std::string known;
@@ -139,8 +145,7 @@ const InputFormat& find_input_format(const std::string& path, const std::string&
       if (f.name == name) return f;
     throw OptionError("format", "'" + name + "' is not known (" + known + ")");
   }
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower_extension(path);
   for (const auto& f : formats)
     if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) return f;
   throw OptionError("format", path + ": cannot tell the format from the extension '" + ext + "'; say which (" + known + ")");

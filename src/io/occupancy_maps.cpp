@@ -10,17 +10,12 @@
 #include "export_columns.hpp"
 #include "reader_plugin.hpp"
 #include "vola/error.hpp"
+#include "vola/io/input.hpp"
 #include "vola/output_file.hpp"
 
 namespace vola::io {
 
 namespace {
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 std::string number_text(double value) {
   std::string text;

@@ -139,13 +139,6 @@ void write_xyz_points(const PointCloud& cloud, const std::string& path, int coor
   out.commit();
 }
 
-std::string extension_of(const std::string& path) {
-  const auto dot = path.rfind('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 }  // namespace
 
 PointTable read_point_table(const std::string& input, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
@@ -167,7 +160,7 @@ PointTable read_point_table(const std::string& input, const std::function<void(s
 
 void translate_points(const std::string& input, const std::string& output,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress, const PointEdit& edit) {
-  const std::string out_ext = extension_of(output);
+  const std::string out_ext = lower_extension(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";
   if (!las_out && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")

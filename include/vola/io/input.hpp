@@ -74,6 +74,9 @@ struct InputFormat {
 
 // Every format this build reads.
 const std::vector<InputFormat>& input_formats();
+// The file name's extension, lower case, with its dot (".laz"; "" when it has none): what
+// readers and writers choose a format by.
+std::string lower_extension(const std::string& path);
 // The format for `path` ("auto" looks at the extension); throws InvalidArgument
 // listing what is known otherwise.
 const InputFormat& find_input_format(const std::string& path, const std::string& name = "auto");
