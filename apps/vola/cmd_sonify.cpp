@@ -263,8 +263,9 @@ void add_sonify(CLI::App& app) {
       "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
       "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
       "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
-      "  timing:  arrivals fall on the nearest sample, or with --fractional-delay at their exact time as\n"
-      "           windowed sincs (flat to 0.1 dB, the exact phase, up to 0.3 of the sample rate; tested).\n"
+      "  timing:  arrivals at their exact time as windowed sincs, 16 samples either side (flat to 0.1 dB,\n"
+      "           the exact phase, up to 0.3 of the sample rate; tested); --nearest-sample puts each on\n"
+      "           the nearest sample instead (no sound before the direct sound's sample).\n"
       "  --binaural: the direct sound and each image source through the HRTF pair (SOFA file, --hrtf) of\n"
       "           the direction it arrives from at a listener facing --facing degrees; the tail as a\n"
       "           diffuse field (its energy as an uncorrelated noise at each ear).\n"
@@ -322,9 +323,9 @@ void add_sonify(CLI::App& app) {
                   "Physical: the tail's receiver sphere (m), shrunk to clear the scene")
       ->capture_default_str();
   cmd->add_option("--seed", args->room.seed, "Physical: the tail's random numbers")->capture_default_str();
-  cmd->add_flag("--fractional-delay", args->room.fractional_delay,
-                "Physical: each arrival at its exact time as a band-limited impulse (16 samples either side), "
-                "not at the nearest sample");
+  cmd->add_flag("--fractional-delay,!--nearest-sample", args->room.fractional_delay,
+                "Physical: each arrival at its exact time as a band-limited impulse, 16 samples either side (the "
+                "default); --nearest-sample: at the nearest sample");
   cmd->add_flag("--binaural", args->binaural,
                 "Physical: two channels, the listener's ears, through the HRTF of --hrtf (the IR file and plot "
                 "get left and right per source)");

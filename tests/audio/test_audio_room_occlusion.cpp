@@ -23,6 +23,7 @@ RoomOptions options(bool occlusion) {
   o.max_length = 0.1;
   o.occlusion = occlusion;
   o.threads = 1;
+  o.fractional_delay = false;  // each arrival on one sample: amplitudes read exactly
   return o;
 }
 

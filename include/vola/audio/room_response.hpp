@@ -60,8 +60,8 @@ struct RoomOptions {
   double receiver_radius = 0.5;    // m, shrunk to the listener's clearance
   std::uint64_t max_image_nodes = std::uint64_t{1} << 21;  // search budget (see image_sources)
   std::uint64_t seed = 1;          // the tail's random numbers: the same seed, the same response
-  bool fractional_delay = false;   // arrivals at their exact time as band-limited impulses
-                                   // (16 samples either side), not at the nearest sample
+  bool fractional_delay = true;    // arrivals at their exact time as band-limited impulses
+                                   // (16 samples either side); false: at the nearest sample
   bool air = false;                // air absorption (ISO 9613-1, air.hpp) on every path
   double celsius = 20.0;           // the air's temperature
   double humidity = 50.0;          // its relative humidity, percent
