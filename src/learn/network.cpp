@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "vola/output_file.hpp"
 #include "vola/learn/occupancy.hpp"
 
 #ifndef VOLA_LEARN_SOURCE_MODELS
@@ -198,12 +199,13 @@ void read_weights(torch::serialize::InputArchive& archive, Network& network, con
   }
 }
 
-void replace_file(const std::string& path, const std::function<void(const std::string&)>& write) {
-  const std::string temporary = path + ".tmp";
-  write(temporary);
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw IoError("cannot write " + path + ": " + error.message());
+void save_archive(torch::serialize::OutputArchive& archive, const std::string& path) {
+  OutputFile out(path);
+  archive.save_to([&](const void* data, std::size_t size) {
+    out.write(data, size);
+    return size;
+  });
+  out.commit();
 }
 
 void save_model(const Network& network, Architecture architecture, const std::string& path) {
@@ -211,7 +213,7 @@ void save_model(const Network& network, Architecture architecture, const std::st
   write_architecture(archive, architecture);
   network.save(weights);
   archive.write("model", weights);
-  replace_file(path, [&](const std::string& to) { archive.save_to(to); });
+  save_archive(archive, path);
 }
 
 torch::Tensor input_tensor(Batch& batch, int side) {

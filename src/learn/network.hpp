@@ -32,8 +32,8 @@ void read_weights(torch::serialize::InputArchive& archive, Network& network, con
 // The batch as an (N, 1, S, S, S) tensor viewing batch.inputs (no copy).
 torch::Tensor input_tensor(Batch& batch, int side);
 
-// Writes `write` to path + ".tmp" then renames it over `path`: a reader (or a killed
-// run) never sees half a file.
-void replace_file(const std::string& path, const std::function<void(const std::string&)>& write);
+// Writes the archive to `path` through vola::OutputFile: a reader (or a killed run) never
+// sees half a file, and a failed write leaves the old one.
+void save_archive(torch::serialize::OutputArchive& archive, const std::string& path);
 
 }  // namespace vola::learn

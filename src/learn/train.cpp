@@ -52,7 +52,7 @@ void save_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectu
   optimizer.save(optimizer_state);
   archive.write("optimizer", optimizer_state);
   archive.write("epochs_done", torch::tensor(static_cast<std::int64_t>(epochs_done)));
-  replace_file(path, [&](const std::string& to) { archive.save_to(to); });
+  save_archive(archive, path);
 }
 
 // Loads a checkpoint into network and optimizer; returns the epochs it had done.
