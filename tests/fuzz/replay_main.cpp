@@ -3,9 +3,11 @@
 // bytes, header field changes, word overwrites). Used by ctest under the normal
 // compiler; a crash or an abort (broken invariant) fails the test.
 //
-//   fuzz_replay [--mutations N] [--seed S] [--golden DIR] [--regressions DIR] [FILE...]
+//   fuzz_replay [--mutations N | --seconds S] [--seed S] [--golden DIR] [--regressions DIR] [FILE...]
 //   fuzz_replay --write-corpus DIR [--golden DIR] [--regressions DIR]   (for scripts/fuzz)
 //
+// --seconds: mutate for that long instead of N times (a sanitizer run of a target libFuzzer
+// cannot build, docs/SECURITY.md).
 // --regressions: a folder of inputs that once failed (tests/fuzz/regressions), replayed
 // and mutated like the other seeds.
 //
@@ -144,6 +146,7 @@ bool write_file(const fs::path& path, const Bytes& bytes) {
 
 int main(int argc, char** argv) {
   long mutations = 20000;
+  double budget_seconds = 0.0;  // > 0: mutate until then, whatever `mutations` says
   std::uint64_t seed = 1;
   fs::path golden = default_golden();
   fs::path corpus;
@@ -159,6 +162,7 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (arg == "--mutations") mutations = std::stol(value());
+    else if (arg == "--seconds") budget_seconds = std::stod(value());
     else if (arg == "--seed") seed = std::stoull(value());
     else if (arg == "--golden") golden = value();
     else if (arg == "--write-corpus") corpus = value();
@@ -238,7 +242,11 @@ int main(int argc, char** argv) {
       run(b);
     }
   }
-  for (; done < mutations; ++done) {
+  auto more = [&] {
+    if (budget_seconds <= 0.0) return done < mutations;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < budget_seconds;
+  };
+  for (; more(); ++done) {
     Bytes b = seeds[small[rng() % small.size()]].bytes;
     for (int k = 0, n = 1 + static_cast<int>(rng() % 3); k < n; ++k) mutate_once(b, rng);
     run(b);
@@ -246,7 +254,7 @@ int main(int argc, char** argv) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto& stats = vola_fuzz::stats();
   std::cout << "replayed " << seeds.size() << " seeds and " << done << " mutations (seed " << seed << ") in "
-            << seconds << " s: " << stats.parsed << " parsed, " << stats.refused << " refused\n";
+            << seconds << " s: " << stats.parsed << " parsed, " << stats.refused << " refused" << std::endl;  // before LSan at exit
   // Both outcomes must occur, or the mutations are not reaching the reader.
   if (stats.parsed == 0 || stats.refused == 0) {
     std::cerr << "the replay did not exercise both accepted and refused inputs\n";
