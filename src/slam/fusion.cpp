@@ -31,8 +31,7 @@ void FusionParams::check() const {
   if (!(motion_prior >= 0.0 && motion_prior < 1.0)) throw InvalidArgument("motion prior must be in [0, 1)");
   if (!(photometric_weight >= 0.0) || !std::isfinite(photometric_weight) || !positive(photometric_huber))
     throw InvalidArgument("photometric weight must be non-negative and its Huber threshold positive");
-  if (!positive(wide_baseline_translation) || !positive(wide_baseline_rotation_degrees) ||
-      !positive(keyframe_translation) || !positive(keyframe_rotation_degrees) || !positive(feature_icp_translation) ||
+  if (!positive(keyframe_translation) || !positive(keyframe_rotation_degrees) || !positive(feature_icp_translation) ||
       !positive(feature_icp_rotation_degrees))
     throw InvalidArgument("feature tracking thresholds must be positive");
   if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) throw InvalidArgument("minimum overlap must be in [0, 1]");
@@ -743,13 +742,16 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
         }
       if (best) result.feature_inliers = best->inliers;
     }
-    std::optional<Pose> tracked;
-    const bool wide = feature_pose && !within(pose_, *feature_pose, params_.wide_baseline_translation,
-                                               params_.wide_baseline_rotation_degrees);
-    if (!wide) {
-      const std::optional<Pose> prediction = motion_ ? std::optional<Pose>(pose_ * *motion_) : std::nullopt;
-      tracked = track(maps, pose_, model_, pose_, prediction, &correspondences, intensity ? &*intensity : nullptr);
-    }
+    // ICP from the previous pose first (cheap, and the most precise for small motions);
+    // its answer is vetoed when a well-supported feature pose disagrees with it (a jump it
+    // could not follow, converged to a wrong place), and ICP then starts from the
+    // feature pose instead.
+    const std::optional<Pose> prediction = motion_ ? std::optional<Pose>(pose_ * *motion_) : std::nullopt;
+    std::optional<Pose> tracked =
+        track(maps, pose_, model_, pose_, prediction, &correspondences, intensity ? &*intensity : nullptr);
+    if (tracked && feature_pose && result.feature_inliers >= 2 * params_.feature.min_inliers &&
+        !within(*tracked, *feature_pose, params_.feature_icp_translation, params_.feature_icp_rotation_degrees))
+      tracked.reset();
     if (!tracked && feature_pose) {
       tracked = refine_feature_pose(maps, *feature_pose, result.feature_inliers, &correspondences);
       result.wide_baseline = tracked.has_value();

@@ -47,15 +47,17 @@ struct FusionParams {
   // its pose stays the previous one and it is not integrated.
   double max_step_translation = 0.2, max_step_rotation_degrees = 20;
   // Colour features (features.hpp; needs colour frames and a build with OpenCV). Each
-  // frame's ORB features are registered against the last tracked frame's; when that
-  // motion exceeds wide_baseline_translation / _rotation_degrees (beyond where
-  // frame-to-model ICP from the previous pose converges), ICP starts from it instead,
+  // frame's ORB features are registered against the last tracked frame's (and, when few
+  // agree, the nearest keyframes'). ICP from the previous pose runs first; when a feature
+  // pose with at least 2 x feature.min_inliers inliers lies further than
+  // feature_icp_translation / _rotation_degrees from ICP's answer, that answer is
+  // refused (a jump ICP could not follow) and ICP starts from the feature pose instead,
   // against the model raycast from there. A frame that still fails is relocalised
-  // against the keyframes (a tracked frame becomes one when it is keyframe_translation
-  // or keyframe_rotation_degrees from the last), then refined by ICP. ICP's answer is
-  // kept when it stays within feature_icp_translation / _rotation_degrees of the
-  // feature pose; otherwise (or when ICP fails) the feature pose is kept if at least
-  // 2 x feature.min_inliers agreed, and the frame is lost if not.
+  // against all keyframes (a tracked frame becomes one when it is keyframe_translation
+  // or keyframe_rotation_degrees from the last), then refined by ICP. ICP's answer from
+  // a feature pose is kept when it stays within feature_icp_translation /
+  // _rotation_degrees of it; otherwise (or when ICP fails) the feature pose is kept if
+  // at least 2 x feature.min_inliers agreed, and the frame is lost if not.
   bool features = true;
   FeatureParams feature;
   // Photometric term (with colour frames): next to point-to-plane ICP, each model pixel
@@ -67,7 +69,6 @@ struct FusionParams {
   // Coarse to fine on the same pyramid as ICP. 0 disables it.
   double photometric_weight = 0.01;
   double photometric_huber = 0.1;
-  double wide_baseline_translation = 0.02, wide_baseline_rotation_degrees = 1.0;
   double keyframe_translation = 0.1, keyframe_rotation_degrees = 8.0;
   double feature_icp_translation = 0.1, feature_icp_rotation_degrees = 6.0;
   // ICP's answer is refused when fewer than this fraction of the frame's valid pixels
