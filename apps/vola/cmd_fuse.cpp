@@ -91,9 +91,11 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   }
   if (a.quiet) return;
   const auto frames = result.trajectory.size();
-  std::printf("%zu frames (%zu lost, %zu wide-baseline, %zu relocalised) in %.2f s: %.2f frames/s, %u x %u\n", frames,
-              result.lost, result.wide_baseline, result.relocalised, result.seconds,
+  std::printf("%zu frames (%zu lost) in %.2f s: %.2f frames/s, %u x %u\n", frames, result.lost, result.seconds,
               static_cast<double>(frames) / result.seconds, result.width, result.height);
+  if (result.wide_baseline || result.relocalised)
+    std::printf("colour features: %zu frames tracked from a feature pose (large motion), %zu relocalised after a loss\n",
+                result.wide_baseline, result.relocalised);
   print_memory(store, options.params.voxel_size);
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),
               a.mesh.empty() ? "" : (", " + std::to_string(triangles) + " triangles in the mesh").c_str());
@@ -160,9 +162,13 @@ void add_fuse(CLI::App& app) {
       "Each frame is bilateral-filtered, tracked by point-to-plane ICP on a 3-level pyramid against the\n"
       "model raycast from the map, and integrated into 8^3-voxel TSDF bricks allocated only near the\n"
       "observed surfaces and indexed by VOLA occupancy words. With colour frames, ORB features (OpenCV)\n"
-      "registered by RANSAC against the last frame start ICP where the camera moved too far for it, and\n"
-      "a frame ICP cannot track is relocalised against keyframes (then refined by ICP). A frame that\n"
+      "registered by RANSAC against the last frame restart ICP where the camera moved too far for it, and\n"
+      "a frame ICP cannot track is relocalised against keyframes (then refined by ICP); a lost frame is\n"
+      "placed later if a following frame registers with it. A photometric term (the previous frame's\n"
+      "intensities) joins ICP, so texture holds motions that flat geometry leaves free. A frame that\n"
       "still fails keeps the previous pose and is not integrated. With ground truth, ATE and RPE are printed.\n"
+      "The first frame's median depth is checked: a warning names the file when it is implausible\n"
+      "(a wrong --depth-factor) or when most of it lies outside --min-depth..--max-depth.\n"
       "Outputs: the trajectory \"timestamp tx ty tz qx qy qz qw\" (camera to world; the first frame at the\n"
       "origin unless --start-at-groundtruth), the surface voxels as .vol (red/green/blue columns when colour\n"
       "frames exist), a marching-cubes mesh (PLY) and a rendered view (PNG).\n"
