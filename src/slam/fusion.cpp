@@ -35,6 +35,7 @@ void FusionParams::check() const {
       !positive(feature_icp_rotation_degrees))
     throw InvalidArgument("feature tracking thresholds must be positive");
   if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) throw InvalidArgument("minimum overlap must be in [0, 1]");
+  if (relocalisation_min_inliers < 3) throw InvalidArgument("relocalisation needs at least 3 feature inliers");
   if (feature.max_features < 10 || feature.min_inliers < 3 || feature.ransac_iterations < 1 ||
       !(feature.ratio > 0.0 && feature.ratio <= 1.0) || feature.max_hamming < 0 || feature.max_hamming > 256)
     throw InvalidArgument("feature parameters out of range");
@@ -558,16 +559,32 @@ std::optional<Pose> Fusion<Store>::refine_feature_pose(const std::array<VertexMa
   const ModelView model = model_at(guess);
   // The feature pose is an independent measurement: it is the prior's prediction here.
   const auto icp = track(frame, guess, model, guess, guess, correspondences);
-  if (icp && within(guess, *icp, params_.feature_icp_translation, params_.feature_icp_rotation_degrees)) return icp;
+  const bool agrees = icp && within(guess, *icp, params_.feature_icp_translation, params_.feature_icp_rotation_degrees);
+  if (inliers < params_.feature.min_inliers) {
+    // A weak registration (relocalisation only) stands only when the geometry confirms
+    // it: ICP converges near it with min_overlap of the frame associated.
+    std::size_t valid = 0;
+    for (std::size_t i = 0; i < frame[0].vertices.size(); ++i) valid += frame[0].valid(i) ? 1 : 0;
+    if (agrees && static_cast<double>(*correspondences) >= params_.min_overlap * static_cast<double>(valid)) return icp;
+    return std::nullopt;
+  }
+  if (agrees) return icp;
   if (inliers >= 2 * params_.feature.min_inliers) return guess;
   return std::nullopt;
+}
+
+template <class Store>
+FeatureParams Fusion<Store>::weak_feature_params() const {
+  FeatureParams weak = params_.feature;
+  weak.min_inliers = std::min(weak.min_inliers, params_.relocalisation_min_inliers);
+  return weak;
 }
 
 template <class Store>
 void Fusion<Store>::retry_pending() {
   bool placed = false;
   for (auto it = pending_.begin(); it != pending_.end();) {
-    const auto r = register_features(last_features_, it->features, params_.feature);
+    const auto r = register_features(last_features_, it->features, weak_feature_params());
     std::optional<Pose> pose;
     int correspondences = 0;
     if (r) pose = refine_feature_pose(it->maps, pose_ * r->transform, r->inliers, &correspondences);
@@ -761,7 +778,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
       std::optional<FeatureRegistration> best;
       std::size_t best_at = 0;
       for (const std::size_t i : nearest_keyframes(keyframes_.size())) {
-        const auto r = register_features(keyframes_[i].features, features, params_.feature);
+        const auto r = register_features(keyframes_[i].features, features, weak_feature_params());
         if (r && (!best || r->inliers > best->inliers)) {
           best = r;
           best_at = i;

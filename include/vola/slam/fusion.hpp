@@ -77,6 +77,11 @@ struct FusionParams {
   // again against each later tracked frame; when that succeeds it is placed and fused.
   double min_overlap = 0.25;
   std::size_t max_pending = 4;
+  // Relocalisation (a lost frame against keyframes, or later against a tracked frame)
+  // also accepts registrations with this many inliers (fewer than feature.min_inliers)
+  // when ICP from there converges within feature_icp_* of it with min_overlap of the
+  // frame associated: the geometry confirms what the few features say.
+  int relocalisation_min_inliers = 6;
   unsigned threads = 0;  // 0 = vola::thread_count() (the hardware's count unless set)
   // Throws InvalidArgument for values that make no sense.
   void check() const;
@@ -143,6 +148,7 @@ class Fusion {
   // Indices of up to `count` keyframes, nearest to pose_ first.
   std::vector<std::size_t> nearest_keyframes(std::size_t count) const;
   static constexpr std::size_t kNearbyKeyframes = 4;
+  FeatureParams weak_feature_params() const;
   DepthImage clipped(const DepthImage& raw, const RgbImage* rgb) const;
   DepthImage filtered(const DepthImage& depth) const;
   void integrate_and_predict(const DepthImage& depth, const RgbImage* rgb);
