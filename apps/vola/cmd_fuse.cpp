@@ -72,6 +72,9 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
       });
   progress.finish();
   for (const auto& warning : result.warnings) std::fprintf(stderr, "vola fuse: warning: %s\n", warning.c_str());
+  if (!a.quiet)
+    for (const std::size_t frame : result.recovered)
+      std::fprintf(stderr, "frame %zu: placed after all, against a later frame (no longer lost)\n", frame);
   if (result.trajectory.empty()) throw InvalidArgument(a.sequence + ": no frame has a ground-truth pose");
   if (!a.trajectory.empty()) slam::write_trajectory(a.trajectory, result.trajectory);
   const auto surface = slam::surface_voxels(store);

@@ -108,6 +108,7 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
         result.trajectory.at(recovered.frame).pose = recovered.pose;
         --result.lost;
         ++result.relocalised;
+        result.recovered.push_back(recovered.frame + 1);
       }
     if (progress) progress(i + 1, total, r);
   }

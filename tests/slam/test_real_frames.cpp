@@ -78,6 +78,7 @@ TEST(SlamRealFrames, KinectTracksEveryFrameAcrossWideBaselines) {
   const FuseResult r = track_real(s, {518.0, 519.0, 325.5, 253.5}, 1000.0, 7.0);
   ASSERT_EQ(r.trajectory.size(), 5u);
   EXPECT_EQ(r.lost, 0u);  // frame 2 is lost at first, then placed against frame 3
+  EXPECT_EQ(r.recovered, std::vector<std::size_t>{2});
   const AbsoluteError ate = absolute_trajectory_error(s.groundtruth, r.trajectory);
   EXPECT_EQ(ate.pairs, 5u);
   // The target is 3 cm; measured 6.31 cm (the feature poses alone: 6.49 cm).

@@ -26,7 +26,8 @@ struct FuseResult {
   std::vector<StampedPose> trajectory;  // one pose per processed frame
   std::size_t lost = 0;                 // frames whose tracking failed (kept the previous pose)
   std::size_t wide_baseline = 0;        // frames tracked by ICP from a colour-feature pose (large motion)
-  std::size_t relocalised = 0;          // frames tracked only after registering against a keyframe
+  std::size_t relocalised = 0;          // frames placed after a loss (the next frame, or the lost one later)
+  std::vector<std::size_t> recovered;   // 1-based numbers of lost frames placed later (no longer lost)
   double seconds = 0.0;                 // wall time of reading + fusion
   bool coloured = false;                // colour frames were integrated
   std::uint32_t width = 0, height = 0;
