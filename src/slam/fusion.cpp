@@ -767,8 +767,22 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
     std::optional<Pose> tracked =
         track(maps, pose_, model_, pose_, prediction, &correspondences, intensity ? &*intensity : nullptr);
     if (tracked && feature_pose && result.feature_inliers >= 2 * params_.feature.min_inliers &&
-        !within(*tracked, *feature_pose, params_.feature_icp_translation, params_.feature_icp_rotation_degrees))
-      tracked.reset();
+        !within(*tracked, *feature_pose, params_.feature_icp_translation, params_.feature_icp_rotation_degrees)) {
+      // The two disagree: ICP from the feature pose too, and the answer that more of the
+      // frame associates with wins. (Taking the feature pose whenever they disagreed put
+      // one frame of the generated room 12 cm off, its repeating floor tiles matched one
+      // tile over, and the room's ATE went from 0.40 to 1.84 cm.)
+      int count = 0;
+      const ModelView model = model_at(*feature_pose);
+      const auto from_features = track(maps, *feature_pose, model, *feature_pose, *feature_pose, &count);
+      if (from_features &&
+          within(*feature_pose, *from_features, params_.feature_icp_translation, params_.feature_icp_rotation_degrees) &&
+          count > correspondences) {
+        tracked = from_features;
+        correspondences = count;
+        result.wide_baseline = true;
+      }
+    }
     if (!tracked && feature_pose) {
       tracked = refine_feature_pose(maps, *feature_pose, result.feature_inliers, &correspondences);
       result.wide_baseline = tracked.has_value();

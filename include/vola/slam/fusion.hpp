@@ -50,14 +50,15 @@ struct FusionParams {
   // frame's ORB features are registered against the last tracked frame's (and, when few
   // agree, the nearest keyframes'). ICP from the previous pose runs first; when a feature
   // pose with at least 2 x feature.min_inliers inliers lies further than
-  // feature_icp_translation / _rotation_degrees from ICP's answer, that answer is
-  // refused (a jump ICP could not follow) and ICP starts from the feature pose instead,
-  // against the model raycast from there. A frame that still fails is relocalised
-  // against all keyframes (a tracked frame becomes one when it is keyframe_translation
-  // or keyframe_rotation_degrees from the last), then refined by ICP. ICP's answer from
-  // a feature pose is kept when it stays within feature_icp_translation /
-  // _rotation_degrees of it; otherwise (or when ICP fails) the feature pose is kept if
-  // at least 2 x feature.min_inliers agreed, and the frame is lost if not.
+  // feature_icp_translation / _rotation_degrees from ICP's answer, ICP also runs from the
+  // feature pose (against the model raycast there) and the answer with more associated
+  // pixels is kept. When ICP from the previous pose fails, it starts from the feature
+  // pose. A frame that still fails is relocalised against all keyframes (a tracked frame
+  // becomes one when it is keyframe_translation or keyframe_rotation_degrees from the
+  // last), then refined by ICP. ICP's answer from a feature pose is kept when it stays
+  // within feature_icp_translation / _rotation_degrees of it; otherwise (or when ICP
+  // fails) the feature pose is kept if at least 2 x feature.min_inliers agreed, and the
+  // frame is lost if not.
   bool features = true;
   FeatureParams feature;
   // Photometric term (with colour frames): next to point-to-plane ICP, each model pixel
