@@ -25,10 +25,12 @@ struct FuseArgs {
   float max_weight = 64.0f;
   std::vector<int> icp_iterations{10, 5, 4};
   double motion_prior = slam::FusionParams{}.motion_prior;
+  double photometric_weight = slam::FusionParams{}.photometric_weight;
   std::size_t frames = 0, render_frame = 1;
   std::uint32_t bricks = 4096;
   unsigned threads = 0;
-  bool groundtruth_poses = false, start_at_groundtruth = false, no_colour = false, quiet = false, dense = false;
+  bool groundtruth_poses = false, start_at_groundtruth = false, no_colour = false, quiet = false, dense = false,
+       no_features = false;
 };
 
 slam::Pose pose_from(const std::vector<double>& v) {
@@ -61,10 +63,18 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   const slam::FuseResult result =
       slam::fuse_sequence(sequence, options, store, [&](std::size_t done, std::size_t total, const slam::FrameResult& r) {
         if (!r.tracked && !a.quiet)
-          std::fprintf(stderr, "frame %zu: tracking lost (%d associations), pose kept\n", done, r.correspondences);
+          std::fprintf(stderr, "frame %zu: tracking lost (%d associations, %d feature inliers), pose kept\n", done,
+                       r.correspondences, r.feature_inliers);
+        if (r.relocalised && !a.quiet)
+          std::fprintf(stderr, "frame %zu: relocalised against a keyframe (%d feature inliers)\n", done,
+                       r.feature_inliers);
         progress.update(done, total);
       });
   progress.finish();
+  for (const auto& warning : result.warnings) std::fprintf(stderr, "vola fuse: warning: %s\n", warning.c_str());
+  if (!a.quiet)
+    for (const std::size_t frame : result.recovered)
+      std::fprintf(stderr, "frame %zu: placed after all, against a later frame (no longer lost)\n", frame);
   if (result.trajectory.empty()) throw InvalidArgument(a.sequence + ": no frame has a ground-truth pose");
   if (!a.trajectory.empty()) slam::write_trajectory(a.trajectory, result.trajectory);
   const auto surface = slam::surface_voxels(store);
@@ -86,6 +96,9 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   const auto frames = result.trajectory.size();
   std::printf("%zu frames (%zu lost) in %.2f s: %.2f frames/s, %u x %u\n", frames, result.lost, result.seconds,
               static_cast<double>(frames) / result.seconds, result.width, result.height);
+  if (result.wide_baseline || result.relocalised)
+    std::printf("colour features: %zu frames tracked from a feature pose (large motion), %zu relocalised after a loss\n",
+                result.wide_baseline, result.relocalised);
   print_memory(store, options.params.voxel_size);
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),
               a.mesh.empty() ? "" : (", " + std::to_string(triangles) + " triangles in the mesh").c_str());
@@ -120,6 +133,8 @@ void run_fuse(const FuseArgs& a) {
   for (int l = 0; l < slam::kPyramidLevels; ++l) p.icp_iterations[l] = a.icp_iterations[l];
   p.motion_prior = a.motion_prior;
   p.threads = a.threads;
+  p.features = !a.no_features;
+  p.photometric_weight = a.photometric_weight;
   p.check();
   if ((a.groundtruth_poses || a.start_at_groundtruth) && sequence.groundtruth.empty())
     throw InvalidArgument(a.sequence + ": no ground truth (groundtruth.txt or pose.txt) for --groundtruth-poses / --start-at-groundtruth");
@@ -149,8 +164,14 @@ void add_fuse(CLI::App& app) {
       "ICL-NUIM and Kinect frames) works too. Depth in metres = stored value / --depth-factor.\n"
       "Each frame is bilateral-filtered, tracked by point-to-plane ICP on a 3-level pyramid against the\n"
       "model raycast from the map, and integrated into 8^3-voxel TSDF bricks allocated only near the\n"
-      "observed surfaces and indexed by VOLA occupancy words. A frame that fails to track keeps the\n"
-      "previous pose and is not integrated. With ground truth, ATE and RPE are printed.\n"
+      "observed surfaces and indexed by VOLA occupancy words. With colour frames, ORB features (OpenCV)\n"
+      "registered by RANSAC against the last frame restart ICP where the camera moved too far for it, and\n"
+      "a frame ICP cannot track is relocalised against keyframes (then refined by ICP); a lost frame is\n"
+      "placed later if a following frame registers with it. A photometric term (the previous frame's\n"
+      "intensities) joins ICP, so texture holds motions that flat geometry leaves free. A frame that\n"
+      "still fails keeps the previous pose and is not integrated. With ground truth, ATE and RPE are printed.\n"
+      "The first frame's median depth is checked: a warning names the file when it is implausible\n"
+      "(a wrong --depth-factor) or when most of it lies outside --min-depth..--max-depth.\n"
       "Outputs: the trajectory \"timestamp tx ty tz qx qy qz qw\" (camera to world; the first frame at the\n"
       "origin unless --start-at-groundtruth), the surface voxels as .vol (red/green/blue columns when colour\n"
       "frames exist), a marching-cubes mesh (PLY) and a rendered view (PNG).\n"
@@ -176,11 +197,18 @@ void add_fuse(CLI::App& app) {
                   "Constant-velocity prior in directions the depth barely constrains (ICP eigenvalues below this "
                   "fraction of the largest; 0 = none, as KinectFusion)")
       ->capture_default_str();
+  cmd->add_option("--photometric-weight", a->photometric_weight,
+                  "Weight of the colour (intensity) residuals next to ICP's, in metres per intensity unit "
+                  "squared (0 = geometry only)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--frames", a->frames, "Process only the first N frames (0 = all)");
   cmd->add_option("--bricks", a->bricks, "Volume extent in bricks per side, centred on the first camera")->check(CLI::Range(1u, 1u << 17));
   cmd->add_flag("--groundtruth-poses", a->groundtruth_poses, "Map only: integrate every frame at its ground-truth pose");
   cmd->add_flag("--start-at-groundtruth", a->start_at_groundtruth, "Place the first frame at its ground-truth pose");
-  cmd->add_flag("--no-colour", a->no_colour, "Ignore colour frames");
+  cmd->add_flag("--no-colour", a->no_colour, "Ignore colour frames (no integration of colour, no features)");
+  cmd->add_flag("--no-features", a->no_features,
+                "Track by ICP only: no colour features for large motion or relocalisation");
   cmd->add_flag("--dense", a->dense, "Keep the TSDF in a dense grid of --bricks^3 bricks instead (the same pipeline, for comparison)");
   cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)");
   cmd->add_flag("-q,--quiet", a->quiet, "No summary");

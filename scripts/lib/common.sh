@@ -33,6 +33,9 @@ VOLA_BUILD_PACKAGES+=(liboctomap-dev libopenvdb-dev libboost-iostreams-dev)
 # opens the tile index with ogrinfo, as a GIS user would.
 VOLA_BUILD_PACKAGES+=(python3-gdal gdal-bin)
 
+# vola fuse: ORB features (OpenCV) for wide-baseline tracking and relocalisation.
+VOLA_BUILD_PACKAGES+=(libopencv-dev)
+
 # vola tile under mpirun: Open MPI (the tests run 3 ranks on one machine).
 VOLA_BUILD_PACKAGES+=(libopenmpi-dev openmpi-bin)
 

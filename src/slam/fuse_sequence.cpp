@@ -1,6 +1,8 @@
 #include "vola/slam/fuse_sequence.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 
 #include "vola/error.hpp"
@@ -32,6 +34,36 @@ VolumeGeometry centred_geometry(const Eigen::Vector3d& centre, double voxel_size
   return g;
 }
 
+std::optional<std::string> depth_unit_warning(const DepthImage& depth, const std::string& path, double depth_factor,
+                                              const FusionParams& params) {
+  std::vector<float> measured;
+  std::size_t outside = 0;
+  for (const float d : depth.metres)
+    if (d > 0.0f) {
+      measured.push_back(d);
+      if (d < params.min_depth || d > params.max_depth) ++outside;
+    }
+  if (measured.empty()) return path + ": no depth measured in the first frame";
+  auto middle = measured.begin() + static_cast<std::ptrdiff_t>(measured.size() / 2);
+  std::nth_element(measured.begin(), middle, measured.end());
+  const double median = *middle;
+  char text[400];
+  if (median < 0.1 || median > 12.0) {
+    std::snprintf(text, sizeof text,
+                  ": median depth %.3g m at depth factor %g is implausible for an RGB-D camera; is the depth factor "
+                  "right (TUM PNG 5000, millimetres 1000)?",
+                  median, depth_factor);
+    return path + text;
+  }
+  if (outside * 2 > measured.size()) {
+    std::snprintf(text, sizeof text, ": %.0f%% of the measured depth lies outside %g..%g m (median %.3g m)",
+                  100.0 * static_cast<double>(outside) / static_cast<double>(measured.size()), params.min_depth,
+                  params.max_depth, median);
+    return path + text;
+  }
+  return std::nullopt;
+}
+
 template <class Store>
 FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, Store& store,
                          const std::function<void(std::size_t, std::size_t, const FrameResult&)>& progress) {
@@ -58,6 +90,8 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
       result.coloured = true;
     }
     if (!fusion) {
+      if (auto warning = depth_unit_warning(depth, frame.depth_path, options.depth_factor, options.params))
+        result.warnings.push_back(std::move(*warning));
       fusion = std::make_unique<Fusion<Store>>(store, options.intrinsics, depth.width, depth.height, options.params);
       result.width = depth.width;
       result.height = depth.height;
@@ -65,7 +99,17 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     const FrameResult r = options.groundtruth_poses ? fusion->process_at_pose(depth, rgb ? &*rgb : nullptr, *truth[i])
                                                     : fusion->process(depth, rgb ? &*rgb : nullptr, initial);
     if (!r.tracked) ++result.lost;
+    if (r.wide_baseline) ++result.wide_baseline;
+    if (r.relocalised) ++result.relocalised;
     result.trajectory.push_back({frame.timestamp, r.pose});
+    // Lost frames placed later, against a frame tracked after them.
+    if (!options.groundtruth_poses)
+      for (const auto& recovered : fusion->take_recovered()) {
+        result.trajectory.at(recovered.frame).pose = recovered.pose;
+        --result.lost;
+        ++result.relocalised;
+        result.recovered.push_back(recovered.frame + 1);
+      }
     if (progress) progress(i + 1, total, r);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -29,6 +29,16 @@ void FusionParams::check() const {
       !positive(max_step_rotation_degrees))
     throw InvalidArgument("ICP thresholds must be positive");
   if (!(motion_prior >= 0.0 && motion_prior < 1.0)) throw InvalidArgument("motion prior must be in [0, 1)");
+  if (!(photometric_weight >= 0.0) || !std::isfinite(photometric_weight) || !positive(photometric_huber))
+    throw InvalidArgument("photometric weight must be non-negative and its Huber threshold positive");
+  if (!positive(keyframe_translation) || !positive(keyframe_rotation_degrees) || !positive(feature_icp_translation) ||
+      !positive(feature_icp_rotation_degrees))
+    throw InvalidArgument("feature tracking thresholds must be positive");
+  if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) throw InvalidArgument("minimum overlap must be in [0, 1]");
+  if (relocalisation_min_inliers < 3) throw InvalidArgument("relocalisation needs at least 3 feature inliers");
+  if (feature.max_features < 10 || feature.min_inliers < 3 || feature.ransac_iterations < 1 ||
+      !(feature.ratio > 0.0 && feature.ratio <= 1.0) || feature.max_hamming < 0 || feature.max_hamming > 256)
+    throw InvalidArgument("feature parameters out of range");
 }
 
 namespace {
@@ -326,6 +336,106 @@ IcpSums icp_sums(const IcpFrame& f, const Pose& estimate, const ParallelOptions&
   return total;
 }
 
+}  // namespace
+
+IntensityPyramid intensity_pyramid(const RgbImage& rgb) {
+  IntensityPyramid out;
+  IntensityImage& base = out[0];
+  base.width = rgb.width;
+  base.height = rgb.height;
+  base.values.resize(std::size_t{rgb.width} * rgb.height);
+  for (std::size_t i = 0; i < base.values.size(); ++i) {
+    const std::uint8_t* c = &rgb.rgb[i * 3];
+    base.values[i] = (0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2]) / 255.0f;
+  }
+  for (int l = 1; l < kPyramidLevels; ++l) {
+    const IntensityImage& from = out[l - 1];
+    IntensityImage& to = out[l];
+    to.width = from.width / 2;
+    to.height = from.height / 2;
+    to.values.resize(std::size_t{to.width} * to.height);
+    for (std::uint32_t y = 0; y < to.height; ++y)
+      for (std::uint32_t x = 0; x < to.width; ++x) {
+        const std::size_t a = std::size_t{2 * y} * from.width + 2 * x;
+        to.values[std::size_t{y} * to.width + x] =
+            0.25f * (from.values[a] + from.values[a + 1] + from.values[a + from.width] + from.values[a + from.width + 1]);
+      }
+  }
+  return out;
+}
+
+namespace {
+
+// Bilinear intensity at (u, v); false outside [0, width - 1) x [0, height - 1).
+bool bilinear(const IntensityImage& image, double u, double v, double& value) {
+  if (!(u >= 0.0 && v >= 0.0 && u < image.width - 1.0 && v < image.height - 1.0)) return false;
+  const auto x = static_cast<std::size_t>(u), y = static_cast<std::size_t>(v);
+  const double fx = u - static_cast<double>(x), fy = v - static_cast<double>(y);
+  const float* row = image.values.data() + y * image.width + x;
+  value = (1 - fy) * ((1 - fx) * row[0] + fx * row[1]) + fy * ((1 - fx) * row[image.width] + fx * row[image.width + 1]);
+  return true;
+}
+
+struct PhotometricFrame {
+  const VertexMap& reference;           // the previous frame's view: world vertices per pixel
+  const IntensityImage& reference_intensity;
+  const IntensityImage& current;        // this frame's intensity
+  Intrinsics k;
+  double weight, huber;
+};
+
+// The photometric residuals' normal equations (same parameters as icp_sums): the
+// reference pixel's vertex v projected into the current camera at `estimate`, residual
+// I_current(projection) - I_reference(pixel), its derivative through the image gradient
+// and the projection. Flat reference pixels (no gradient) carry nothing and are skipped.
+IcpSums photometric_sums(const PhotometricFrame& f, const Pose& estimate, const ParallelOptions& bands) {
+  std::vector<IcpSums> sums(bands.chunks);
+  const Pose world_to_camera = estimate.inverse();
+  const Eigen::Matrix3d rotation = estimate.linear();
+  const Eigen::Vector3d centre = estimate.translation();
+  const IntensityImage& ref = f.reference_intensity;
+  const auto sum_rows = [&](const Chunk& chunk) {
+    IcpSums& s = sums[chunk.index];
+    for (std::size_t y = std::max<std::size_t>(chunk.begin, 1); y < chunk.end && y + 1 < ref.height; ++y)
+      for (std::uint32_t x = 1; x + 1 < ref.width; ++x) {
+        const std::size_t i = y * ref.width + x;
+        const Eigen::Vector3f& vf = f.reference.vertices[i];
+        if (!(vf.x() == vf.x())) continue;
+        const float gx_ref = ref.values[i + 1] - ref.values[i - 1], gy_ref = ref.values[i + ref.width] - ref.values[i - ref.width];
+        if (gx_ref * gx_ref + gy_ref * gy_ref < 4e-4f) continue;  // under 0.01 per pixel
+        const Eigen::Vector3d v = vf.template cast<double>();
+        const Eigen::Vector3d q = world_to_camera * v;
+        if (q.z() <= 0.0) continue;
+        const double u = f.k.fx * q.x() / q.z() + f.k.cx, w = f.k.fy * q.y() / q.z() + f.k.cy;
+        double i0 = 0.0, il = 0.0, ir = 0.0, iu = 0.0, id = 0.0;
+        if (!bilinear(f.current, u, w, i0) || !bilinear(f.current, u - 1, w, il) || !bilinear(f.current, u + 1, w, ir) ||
+            !bilinear(f.current, u, w - 1, iu) || !bilinear(f.current, u, w + 1, id))
+          continue;
+        const double gx = 0.5 * (ir - il), gy = 0.5 * (id - iu);
+        const double iz = 1.0 / q.z();
+        const Eigen::Vector3d g(gx * f.k.fx * iz, gy * f.k.fy * iz,
+                                -(gx * f.k.fx * q.x() + gy * f.k.fy * q.y()) * iz * iz);
+        const Eigen::Vector3d gw = rotation * g;
+        Vec6 jac;
+        jac << gw.cross(v - centre), -gw;
+        const double r = i0 - ref.values[i];
+        const double robust = std::abs(r) <= f.huber ? 1.0 : f.huber / std::abs(r);
+        const double weight = f.weight * robust;
+        s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac, weight);
+        s.b -= weight * jac * r;
+        ++s.count;
+      }
+  };
+  parallel_for(ref.height, sum_rows, bands);
+  IcpSums total;
+  for (const auto& s : sums) {
+    total.a += s.a;
+    total.b += s.b;
+    total.count += s.count;
+  }
+  return total;
+}
+
 // The increment that solves the normal equations, applied to `estimate`; nothing when the
 // geometry is degenerate. The motion prior: directions observed less than
 // motion_prior * the best one are raised to that floor, pulling towards `prediction`
@@ -367,14 +477,17 @@ std::optional<IcpStep> icp_step(const IcpSums& total, const Pose& estimate, cons
 }  // namespace
 
 template <class Store>
-std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLevels>& frame, int* correspondences) const {
-  // ICP starts at the previous pose, as KinectFusion's does; the constant-velocity
-  // prediction only enters through the prior in the weakly observed directions, and
-  // only once a motion has been tracked (not on the second frame, not after a loss).
+std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLevels>& frame, const Pose& start,
+                                         const ModelView& model, const Pose& model_pose,
+                                         const std::optional<Pose>& prediction, int* correspondences,
+                                         const IntensityPyramid* intensity) const {
+  // ICP starts at `start` (the previous pose, as KinectFusion's does, unless features
+  // say the camera moved further); the constant-velocity prediction only enters through
+  // the prior in the weakly observed directions, and only once a motion has been
+  // tracked (not on the second frame, not after a loss).
   // (Starting at the prediction instead was unstable on room300: from frame 31 the
   // error grew 2.3 times per frame until tracking was lost at frame 39.)
-  const std::optional<Pose> prediction = motion_ ? std::optional<Pose>(pose_ * *motion_) : std::nullopt;
-  Pose estimate = pose_;
+  Pose estimate = start;
   ParallelOptions bands;
   bands.threads = resolve_thread_count(params_.threads);
   bands.chunks = bands.threads;
@@ -382,15 +495,24 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
   int last_count = 0;
   for (int level = kPyramidLevels - 1; level >= 0; --level) {
     const IcpFrame icp{frame[level],
-                       model_.levels[level],
+                       model.levels[level],
                        level_intrinsics(intrinsics_, level),
-                       pose_.inverse(),
+                       model_pose.inverse(),
                        params_.icp_max_distance,
                        std::cos(params_.icp_max_angle_degrees * M_PI / 180.0)};
+    const bool photometric = intensity && reference_intensity_ && params_.photometric_weight > 0.0;
     for (int iteration = 0; iteration < params_.icp_iterations[level]; ++iteration) {
-      const IcpSums total = icp_sums(icp, estimate, bands);
+      IcpSums total = icp_sums(icp, estimate, bands);
       last_count = total.count;
       if (total.count < 6) return std::nullopt;
+      if (photometric) {
+        const PhotometricFrame pf{model_.levels[level], (*reference_intensity_)[level], (*intensity)[level],
+                                  level_intrinsics(intrinsics_, level), params_.photometric_weight,
+                                  params_.photometric_huber};
+        const IcpSums p = photometric_sums(pf, estimate, bands);
+        total.a += p.a;
+        total.b += p.b;
+      }
       const std::optional<IcpStep> step = icp_step(total, estimate, prediction, params_.motion_prior);
       if (!step) return std::nullopt;
       estimate = step->pose;
@@ -398,13 +520,106 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
     }
   }
   *correspondences = last_count;
-  const Pose step = pose_.inverse() * estimate;
+  const Pose step = start.inverse() * estimate;
   const double rotation_degrees = Eigen::AngleAxisd(step.linear()).angle() * 180.0 / M_PI;
   if (step.translation().norm() > params_.max_step_translation || rotation_degrees > params_.max_step_rotation_degrees)
     return std::nullopt;
   const std::size_t pixels = std::size_t{width_} * height_;
   if (static_cast<std::size_t>(last_count) * 100 < pixels) return std::nullopt;  // under 1% associated
+  std::size_t valid = 0;
+  for (std::size_t i = 0; i < frame[0].vertices.size(); ++i) valid += frame[0].valid(i) ? 1 : 0;
+  // (Only from the previous pose: from a feature pose, the frame may see much that the
+  // map has not, and the feature pose bounds where ICP may go.)
+  if (&model == &model_ && static_cast<double>(last_count) < params_.min_overlap * static_cast<double>(valid))
+    return std::nullopt;
   return estimate;
+}
+
+namespace {
+
+bool within(const Pose& a, const Pose& b, double translation, double rotation_degrees) {
+  const Pose d = a.inverse() * b;
+  return d.translation().norm() <= translation &&
+         Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI <= rotation_degrees;
+}
+
+}  // namespace
+
+template <class Store>
+ModelView Fusion<Store>::model_at(const Pose& pose) const {
+  ModelView view;
+  view.levels[0] = raycast(store_, intrinsics_, width_, height_, pose, params_);
+  for (int l = 1; l < kPyramidLevels; ++l) view.levels[l] = halve_vertex_map(view.levels[l - 1]);
+  return view;
+}
+
+template <class Store>
+std::optional<Pose> Fusion<Store>::refine_feature_pose(const std::array<VertexMap, kPyramidLevels>& frame,
+                                                       const Pose& guess, int inliers, int* correspondences) const {
+  const ModelView model = model_at(guess);
+  // The feature pose is an independent measurement: it is the prior's prediction here.
+  const auto icp = track(frame, guess, model, guess, guess, correspondences);
+  const bool agrees = icp && within(guess, *icp, params_.feature_icp_translation, params_.feature_icp_rotation_degrees);
+  if (inliers < params_.feature.min_inliers) {
+    // A weak registration (relocalisation only) stands only when the geometry confirms
+    // it: ICP converges near it with min_overlap of the frame associated.
+    std::size_t valid = 0;
+    for (std::size_t i = 0; i < frame[0].vertices.size(); ++i) valid += frame[0].valid(i) ? 1 : 0;
+    if (agrees && static_cast<double>(*correspondences) >= params_.min_overlap * static_cast<double>(valid)) return icp;
+    return std::nullopt;
+  }
+  if (agrees) return icp;
+  if (inliers >= 2 * params_.feature.min_inliers) return guess;
+  return std::nullopt;
+}
+
+template <class Store>
+FeatureParams Fusion<Store>::weak_feature_params() const {
+  FeatureParams weak = params_.feature;
+  weak.min_inliers = std::min(weak.min_inliers, params_.relocalisation_min_inliers);
+  return weak;
+}
+
+template <class Store>
+void Fusion<Store>::retry_pending() {
+  bool placed = false;
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    const auto r = register_features(last_features_, it->features, weak_feature_params());
+    std::optional<Pose> pose;
+    int correspondences = 0;
+    if (r) pose = refine_feature_pose(it->maps, pose_ * r->transform, r->inliers, &correspondences);
+    if (!pose) {
+      ++it;
+      continue;
+    }
+    integrate(it->depth, it->rgb ? &*it->rgb : nullptr, *pose);
+    keyframes_.push_back({std::move(it->features), *pose});
+    recovered_.push_back({it->frame, *pose, r->inliers});
+    placed = true;
+    it = pending_.erase(it);
+  }
+  if (placed) model_ = model_at(pose_);
+}
+
+template <class Store>
+std::vector<std::size_t> Fusion<Store>::nearest_keyframes(std::size_t count) const {
+  std::vector<std::size_t> order(keyframes_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return (keyframes_[a].pose.translation() - pose_.translation()).norm() <
+           (keyframes_[b].pose.translation() - pose_.translation()).norm();
+  });
+  if (order.size() > count) order.resize(count);
+  return order;
+}
+
+template <class Store>
+void Fusion<Store>::remember_features(FeatureFrame&& features) {
+  if (features.size() == 0) return;
+  if (keyframes_.empty() || !within(keyframes_.back().pose, pose_, params_.keyframe_translation,
+                                    params_.keyframe_rotation_degrees))
+    keyframes_.push_back({features, pose_});
+  last_features_ = std::move(features);
 }
 
 template <class Store>
@@ -504,7 +719,20 @@ void Fusion<Store>::integrate_and_predict(const DepthImage& depth, const RgbImag
 
 template <class Store>
 FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, const Pose& initial_pose) {
-  const DepthImage depth = filtered(clipped(raw, rgb));
+  const DepthImage clipped_depth = clipped(raw, rgb);
+  const DepthImage depth = filtered(clipped_depth);
+  FeatureFrame features;
+  if (params_.features && rgb && features_available()) {
+    // Features keep the far measurements that fusion drops (beyond max_depth): matched
+    // by reprojection, their depth noise matters little, and a view of a far wall may
+    // have little else.
+    DepthImage near_clipped = raw;
+    for (float& d : near_clipped.metres)
+      if (!(d >= params_.min_depth)) d = 0.0f;
+    features = extract_features(*rgb, near_clipped, intrinsics_, params_.feature);
+  }
+  std::optional<IntensityPyramid> intensity;
+  if (rgb && params_.photometric_weight > 0.0) intensity = intensity_pyramid(*rgb);
   FrameResult result;
   if (frames_ == 0) {
     pose_ = initial_pose;
@@ -515,9 +743,71 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
     std::array<VertexMap, kPyramidLevels> maps;
     for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
     int correspondences = 0;
-    const auto tracked = track(maps, &correspondences);
+    // The motion since the last tracked frame from colour features, when they agree;
+    // when few agree, the nearest keyframes may share more of the view.
+    std::optional<Pose> feature_pose;
+    if (features.size() && last_features_.size()) {
+      std::optional<FeatureRegistration> best = register_features(last_features_, features, params_.feature);
+      if (best) feature_pose = pose_ * best->transform;
+      if (!best || best->inliers < 4 * params_.feature.min_inliers)
+        for (const std::size_t i : nearest_keyframes(kNearbyKeyframes)) {
+          const auto r = register_features(keyframes_[i].features, features, params_.feature);
+          if (r && (!best || r->inliers > best->inliers)) {
+            best = r;
+            feature_pose = keyframes_[i].pose * r->transform;
+          }
+        }
+      if (best) result.feature_inliers = best->inliers;
+    }
+    // ICP from the previous pose first (cheap, and the most precise for small motions);
+    // its answer is vetoed when a well-supported feature pose disagrees with it (a jump it
+    // could not follow, converged to a wrong place), and ICP then starts from the
+    // feature pose instead.
+    const std::optional<Pose> prediction = motion_ ? std::optional<Pose>(pose_ * *motion_) : std::nullopt;
+    std::optional<Pose> tracked =
+        track(maps, pose_, model_, pose_, prediction, &correspondences, intensity ? &*intensity : nullptr);
+    if (tracked && feature_pose && result.feature_inliers >= 2 * params_.feature.min_inliers &&
+        !within(*tracked, *feature_pose, params_.feature_icp_translation, params_.feature_icp_rotation_degrees)) {
+      // The two disagree: ICP from the feature pose too, and the answer that more of the
+      // frame associates with wins. (Taking the feature pose whenever they disagreed put
+      // one frame of the generated room 12 cm off, its repeating floor tiles matched one
+      // tile over, and the room's ATE went from 0.40 to 1.84 cm.)
+      int count = 0;
+      const ModelView model = model_at(*feature_pose);
+      const auto from_features = track(maps, *feature_pose, model, *feature_pose, *feature_pose, &count);
+      if (from_features &&
+          within(*feature_pose, *from_features, params_.feature_icp_translation, params_.feature_icp_rotation_degrees) &&
+          count > correspondences) {
+        tracked = from_features;
+        correspondences = count;
+        result.wide_baseline = true;
+      }
+    }
+    if (!tracked && feature_pose) {
+      tracked = refine_feature_pose(maps, *feature_pose, result.feature_inliers, &correspondences);
+      result.wide_baseline = tracked.has_value();
+    }
+    if (!tracked && features.size()) {
+      // Relocalisation: the keyframe with the most feature inliers, nearest first on ties.
+      std::optional<FeatureRegistration> best;
+      std::size_t best_at = 0;
+      for (const std::size_t i : nearest_keyframes(keyframes_.size())) {
+        const auto r = register_features(keyframes_[i].features, features, weak_feature_params());
+        if (r && (!best || r->inliers > best->inliers)) {
+          best = r;
+          best_at = i;
+        }
+      }
+      if (best) {
+        result.feature_inliers = best->inliers;
+        tracked = refine_feature_pose(maps, keyframes_[best_at].pose * best->transform, best->inliers, &correspondences);
+        result.relocalised = tracked.has_value();
+      }
+    }
     result.correspondences = correspondences;
     result.tracked = tracked.has_value();
+    if (tracked && previous_lost_) result.relocalised = true;
+    previous_lost_ = !tracked;
     // The constant-velocity model: the last motion, forgotten when a frame is lost.
     motion_.reset();
     if (tracked) motion_ = Pose(pose_.inverse() * *tracked);
@@ -525,7 +815,21 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
   }
   result.pose = pose_;
   ++frames_;
-  if (result.tracked) integrate_and_predict(depth, rgb);
+  if (result.tracked) {
+    integrate_and_predict(depth, rgb);
+    remember_features(std::move(features));
+    reference_intensity_ = std::move(intensity);
+    retry_pending();
+  } else if (frames_ > 1 && features.size() && params_.max_pending > 0) {
+    if (pending_.size() >= params_.max_pending) pending_.erase(pending_.begin());
+    std::array<VertexMap, kPyramidLevels> maps;
+    std::array<DepthImage, kPyramidLevels> pyramid;
+    pyramid[0] = depth;
+    for (int l = 1; l < kPyramidLevels; ++l) pyramid[l] = halve_depth(pyramid[l - 1], params_.bilateral_sigma_depth);
+    for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
+    pending_.push_back({frames_ - 1, std::move(features), std::move(maps), depth,
+                        rgb ? std::optional<RgbImage>(*rgb) : std::nullopt});
+  }
   return result;
 }
 
@@ -537,6 +841,8 @@ FrameResult Fusion<Store>::process_at_pose(const DepthImage& raw, const RgbImage
   pose_ = pose;
   ++frames_;
   integrate_and_predict(depth, rgb);
+  reference_intensity_.reset();
+  if (rgb && params_.photometric_weight > 0.0) reference_intensity_ = intensity_pyramid(*rgb);
   FrameResult result;
   result.pose = pose_;
   return result;

@@ -141,7 +141,7 @@ std::vector<TimedPath> read_timed_list(const std::string& file) {
   for_each_data_line(file, [&](std::size_t number, const std::string& line) {
     const auto fields = fields_of(line);
     if (fields.size() != 2) line_error(file, number, "expected 'timestamp path', found " + std::to_string(fields.size()) + " fields");
-    list.push_back({parse_number(fields[0], file, number, "the timestamp"), fields[1]});
+    list.push_back({parse_number(fields[0], file, number, "the timestamp"), fields[1], number});
   });
   return list;
 }
@@ -225,10 +225,18 @@ Sequence read_sequence(const std::string& directory, double max_difference) {
     if (!(depth[i].timestamp > depth[i - 1].timestamp))
       throw FormatError((dir / "depth.txt").string(), std::nullopt,
                         "timestamps must increase: frame " + std::to_string(i + 1) + " is not after frame " + std::to_string(i));
+  // A listed frame that is missing fails here, naming the list's line, not minutes later.
+  const auto require_files = [](const fs::path& list_file, const fs::path& base, const std::vector<TimedPath>& list) {
+    for (const auto& entry : list)
+      if (!fs::is_regular_file(resolve(base, entry.path)))
+        line_error(list_file.string(), entry.line, "frame file '" + resolve(base, entry.path) + "' does not exist");
+  };
+  require_files(dir / "depth.txt", dir, depth);
   Sequence sequence;
   for (const auto& d : depth) sequence.frames.push_back({d.timestamp, resolve(dir, d.path), {}});
   if (fs::exists(dir / "rgb.txt")) {
     const auto rgb = read_timed_list((dir / "rgb.txt").string());
+    require_files(dir / "rgb.txt", dir, rgb);
     std::vector<double> td, tr;
     for (const auto& d : depth) td.push_back(d.timestamp);
     for (const auto& r : rgb) tr.push_back(r.timestamp);

@@ -7,6 +7,7 @@
 
 #include "slam_test_support.hpp"
 #include "vola/error.hpp"
+#include "vola/slam/fuse_sequence.hpp"
 #include "vola/slam/image.hpp"
 #include "vola/slam/sequence.hpp"
 
@@ -120,6 +121,15 @@ TEST(SlamSequence, TumLayoutAssociatesColourByNearestTimestamp) {
   write_text(dir.path() / "rgb.txt", "1.005 rgb/1.png\n1.19 rgb/3.png\n1.50 rgb/9.png\n");
   write_text(dir.path() / "groundtruth.txt", "1.0 1 2 3 0 0 0 1\n");
   write_text(dir.path() / "intrinsics.txt", "500 -480 320 240\n");
+  // A listed frame that does not exist is named with its list's line.
+  const std::string missing = format_error([&] { read_sequence(dir.path().string()); });
+  EXPECT_NE(missing.find("depth.txt: line 1: frame file"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("does not exist"), std::string::npos) << missing;
+  fs::create_directories(dir.path() / "rgb");
+  for (const char* f : {"depth/1.png", "depth/2.png", "depth/3.png", "rgb/1.png", "rgb/3.png"}) write_text(dir.path() / f, "");
+  const std::string missing_rgb = format_error([&] { read_sequence(dir.path().string()); });
+  EXPECT_NE(missing_rgb.find("rgb.txt: line 3: frame file"), std::string::npos) << missing_rgb;
+  write_text(dir.path() / "rgb/9.png", "");
   const Sequence s = read_sequence(dir.path().string());
   ASSERT_EQ(s.frames.size(), 3u);
   EXPECT_EQ(s.frames[0].rgb_path, (dir.path() / "rgb/1.png").string());
@@ -166,6 +176,44 @@ TEST(SlamSequence, SharedIclNuimAndKinectFrames) {
   const DepthImage k = read_depth(kinect.frames[0].depth_path, 1000.0);
   EXPECT_EQ(k.width, 640u);
   EXPECT_GT(std::count(k.metres.begin(), k.metres.end(), 0.0f), 1000);  // Kinect holes
+}
+
+}  // namespace
+
+namespace {
+
+TEST(SlamSequence, ImplausibleDepthUnitIsWarnedAbout) {
+  FusionParams p;
+  DepthImage depth{32, 24, std::vector<float>(32 * 24, 2.5f)};
+  EXPECT_FALSE(depth_unit_warning(depth, "d.png", 5000.0, p));
+  // Millimetres read as TUM's fifths of a millimetre: a room 5 times too deep.
+  for (float& d : depth.metres) d *= 5.0f;
+  const auto too_far = depth_unit_warning(depth, "d.png", 1000.0, p);
+  ASSERT_TRUE(too_far);
+  EXPECT_NE(too_far->find("d.png: median depth 12.5 m"), std::string::npos) << *too_far;
+  EXPECT_NE(too_far->find("depth factor"), std::string::npos) << *too_far;
+  for (float& d : depth.metres) d = 0.02f;
+  EXPECT_TRUE(depth_unit_warning(depth, "d.png", 5000.0, p));
+  for (float& d : depth.metres) d = 7.0f;  // plausible, but beyond --max-depth 5
+  const auto outside = depth_unit_warning(depth, "d.png", 5000.0, p);
+  ASSERT_TRUE(outside);
+  EXPECT_NE(outside->find("100% of the measured depth lies outside"), std::string::npos) << *outside;
+}
+
+TEST(SlamSequence, ColourOfAnotherSizeThanDepthIsAnErrorNamingTheFile) {
+  ScratchDir dir("sizes");
+  fs::create_directories(dir.path() / "depth");
+  fs::create_directories(dir.path() / "color");
+  write_depth_png((dir.path() / "depth/1.png").string(), DepthImage{16, 12, std::vector<float>(16 * 12, 1.0f)}, 5000.0);
+  write_rgb_png((dir.path() / "color/1.png").string(), RgbImage{8, 6, std::vector<std::uint8_t>(8 * 6 * 3, 100)});
+  const Sequence s = read_sequence(dir.path().string());
+  FuseOptions o;
+  o.params.voxel_size = 0.05;
+  o.params.truncation = 0.2;
+  SparseTsdfStore store(centred_geometry(Eigen::Vector3d::Zero(), o.params.voxel_size, 64));
+  const std::string message = format_error([&] { fuse_sequence(s, o, store); });
+  EXPECT_NE(message.find("color/1.png"), std::string::npos) << message;
+  EXPECT_NE(message.find("colour frame is 8 x 6, its depth frame 16 x 12"), std::string::npos) << message;
 }
 
 }  // namespace

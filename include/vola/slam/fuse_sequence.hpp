@@ -3,6 +3,8 @@
 #pragma once
 
 #include <functional>
+#include <optional>
+#include <string>
 
 #include "vola/slam/fusion.hpp"
 #include "vola/slam/sequence.hpp"
@@ -23,10 +25,22 @@ struct FuseOptions {
 struct FuseResult {
   std::vector<StampedPose> trajectory;  // one pose per processed frame
   std::size_t lost = 0;                 // frames whose tracking failed (kept the previous pose)
+  std::size_t wide_baseline = 0;        // frames tracked by ICP from a colour-feature pose (large motion)
+  std::size_t relocalised = 0;          // frames placed after a loss (the next frame, or the lost one later)
+  std::vector<std::size_t> recovered;   // 1-based numbers of lost frames placed later (no longer lost)
   double seconds = 0.0;                 // wall time of reading + fusion
   bool coloured = false;                // colour frames were integrated
   std::uint32_t width = 0, height = 0;
+  // Implausible input that did not stop the run (depth in the wrong unit, most of the
+  // depth outside the depth range), each naming the file.
+  std::vector<std::string> warnings;
 };
+
+// A warning when the frame's median measured depth is implausible for an RGB-D camera
+// (under 0.1 m or over 12 m: the depth factor is likely wrong), or when most of its
+// measurements lie outside [min_depth, max_depth]; nothing otherwise.
+std::optional<std::string> depth_unit_warning(const DepthImage& depth, const std::string& path, double depth_factor,
+                                              const FusionParams& params);
 
 // The ground-truth pose associated with each frame (nullopt where none is within
 // max_difference).

@@ -9,8 +9,10 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
+#include "vola/slam/features.hpp"
 #include "vola/slam/image.hpp"
 #include "vola/slam/preprocess.hpp"
 #include "vola/slam/sequence.hpp"
@@ -44,10 +46,56 @@ struct FusionParams {
   // A frame whose ICP update exceeds these (or has too few associations) is "lost":
   // its pose stays the previous one and it is not integrated.
   double max_step_translation = 0.2, max_step_rotation_degrees = 20;
+  // Colour features (features.hpp; needs colour frames and a build with OpenCV). Each
+  // frame's ORB features are registered against the last tracked frame's (and, when few
+  // agree, the nearest keyframes'). ICP from the previous pose runs first; when a feature
+  // pose with at least 2 x feature.min_inliers inliers lies further than
+  // feature_icp_translation / _rotation_degrees from ICP's answer, ICP also runs from the
+  // feature pose (against the model raycast there) and the answer with more associated
+  // pixels is kept. When ICP from the previous pose fails, it starts from the feature
+  // pose. A frame that still fails is relocalised against all keyframes (a tracked frame
+  // becomes one when it is keyframe_translation or keyframe_rotation_degrees from the
+  // last), then refined by ICP. ICP's answer from a feature pose is kept when it stays
+  // within feature_icp_translation / _rotation_degrees of it; otherwise (or when ICP
+  // fails) the feature pose is kept if at least 2 x feature.min_inliers agreed, and the
+  // frame is lost if not.
+  bool features = true;
+  FeatureParams feature;
+  // Photometric term (with colour frames): next to point-to-plane ICP, each model pixel
+  // of the previous frame's view (its raycast vertex, its intensity in [0, 1] in the
+  // previous colour frame) is projected into the current frame, and the intensity
+  // difference there (Huber-weighted beyond photometric_huber) joins the same normal
+  // equations, weighted by photometric_weight against the geometric residuals in metres:
+  // texture holds the motions that planar geometry leaves free (sliding along a wall).
+  // Coarse to fine on the same pyramid as ICP. 0 disables it.
+  double photometric_weight = 0.01;
+  double photometric_huber = 0.1;
+  double keyframe_translation = 0.1, keyframe_rotation_degrees = 8.0;
+  double feature_icp_translation = 0.1, feature_icp_rotation_degrees = 6.0;
+  // ICP's answer is refused when fewer than this fraction of the frame's valid pixels
+  // found a model point (a jump ICP cannot follow converges to a wrong place with a
+  // small overlap). A lost frame is kept (up to max_pending of them) and registered
+  // again against each later tracked frame; when that succeeds it is placed and fused.
+  double min_overlap = 0.25;
+  std::size_t max_pending = 4;
+  // Relocalisation (a lost frame against keyframes, or later against a tracked frame)
+  // also accepts registrations with this many inliers (fewer than feature.min_inliers)
+  // when ICP from there converges within feature_icp_* of it with min_overlap of the
+  // frame associated: the geometry confirms what the few features say.
+  int relocalisation_min_inliers = 6;
   unsigned threads = 0;  // 0 = vola::thread_count() (the hardware's count unless set)
   // Throws InvalidArgument for values that make no sense.
   void check() const;
 };
+
+// Intensity in [0, 1] per pixel, row-major (the photometric term's images).
+struct IntensityImage {
+  std::uint32_t width = 0, height = 0;
+  std::vector<float> values;
+};
+using IntensityPyramid = std::array<IntensityImage, kPyramidLevels>;
+// Grey levels of an RGB image (Rec. 601 weights) and its 2x2-averaged halvings.
+IntensityPyramid intensity_pyramid(const RgbImage& rgb);
 
 // The model surface seen from a pose: world-coordinate vertices and normals per pixel.
 struct ModelView {
@@ -56,8 +104,11 @@ struct ModelView {
 
 struct FrameResult {
   Pose pose = Pose::Identity();
-  bool tracked = true;     // false: ICP failed, the previous pose was kept
+  bool tracked = true;     // false: tracking and relocalisation failed, the previous pose was kept
+  bool relocalised = false;  // the previous frame was lost; this one was placed by registering against keyframes
+  bool wide_baseline = false;  // ICP started from the feature pose (large motion)
   int correspondences = 0;  // at level 0 in the last iteration
+  int feature_inliers = 0;  // of the feature registration used (0: none)
 };
 
 template <class Store>
@@ -66,6 +117,14 @@ class Fusion {
   // The volume's geometry comes with the store; its voxel size must match params'.
   Fusion(Store& store, const Intrinsics& intrinsics, std::uint32_t width, std::uint32_t height,
          const FusionParams& params);
+  // A lost frame placed later (see min_overlap): its index among the processed frames
+  // (0 = the first) and pose. take_recovered() hands them over once.
+  struct Recovered {
+    std::size_t frame = 0;
+    Pose pose;
+    int feature_inliers = 0;
+  };
+  std::vector<Recovered> take_recovered() { return std::exchange(recovered_, {}); }
   // Tracks (from the second frame on) and integrates one frame. `rgb` may be null or
   // must have the depth's size. The first frame is placed at `initial_pose`.
   FrameResult process(const DepthImage& depth, const RgbImage* rgb, const Pose& initial_pose = Pose::Identity());
@@ -76,7 +135,21 @@ class Fusion {
   Store& store() noexcept { return store_; }
 
  private:
-  std::optional<Pose> track(const std::array<VertexMap, kPyramidLevels>& frame, int* correspondences) const;
+  // ICP from `start` against `model` (raycast from model_pose).
+  // With `intensity` (the current frame's), the photometric term against the previous
+  // frame's view (model_ and reference_intensity_) joins the geometric one.
+  std::optional<Pose> track(const std::array<VertexMap, kPyramidLevels>& frame, const Pose& start,
+                            const ModelView& model, const Pose& model_pose, const std::optional<Pose>& prediction,
+                            int* correspondences, const IntensityPyramid* intensity = nullptr) const;
+  // ICP from a feature pose against the model raycast from it, checked against it.
+  std::optional<Pose> refine_feature_pose(const std::array<VertexMap, kPyramidLevels>& frame, const Pose& guess,
+                                          int inliers, int* correspondences) const;
+  ModelView model_at(const Pose& pose) const;
+  void remember_features(FeatureFrame&& features);
+  // Indices of up to `count` keyframes, nearest to pose_ first.
+  std::vector<std::size_t> nearest_keyframes(std::size_t count) const;
+  static constexpr std::size_t kNearbyKeyframes = 4;
+  FeatureParams weak_feature_params() const;
   DepthImage clipped(const DepthImage& raw, const RgbImage* rgb) const;
   DepthImage filtered(const DepthImage& depth) const;
   void integrate_and_predict(const DepthImage& depth, const RgbImage* rgb);
@@ -90,6 +163,24 @@ class Fusion {
   std::optional<Pose> motion_;  // the last tracked frame-to-frame motion, previous^-1 * current
   std::size_t frames_ = 0;
   ModelView model_;
+  struct Keyframe {
+    FeatureFrame features;
+    Pose pose;
+  };
+  FeatureFrame last_features_;  // of the last tracked frame, at pose_
+  std::optional<IntensityPyramid> reference_intensity_;  // the last tracked frame's, seen as model_
+  struct Pending {
+    std::size_t frame = 0;
+    FeatureFrame features;
+    std::array<VertexMap, kPyramidLevels> maps;
+    DepthImage depth;
+    std::optional<RgbImage> rgb;
+  };
+  std::vector<Pending> pending_;  // lost frames, oldest first
+  std::vector<Recovered> recovered_;
+  bool previous_lost_ = false;
+  void retry_pending();
+  std::vector<Keyframe> keyframes_;
 };
 
 // Raycasts the TSDF from `pose` through the pinhole camera: world vertices and normals

@@ -49,6 +49,7 @@ void write_intrinsics(const std::string& file, const Intrinsics& intrinsics);
 struct TimedPath {
   double timestamp = 0.0;
   std::string path;
+  std::size_t line = 0;  // in the list file (1-based)
 };
 
 // One "timestamp path" list. Throws FormatError "<file>: line N: ..." for a line that is
@@ -63,7 +64,8 @@ std::vector<StampedPose> read_numbered_poses(const std::string& file);
 // Writes the TUM format with full double precision; throws IoError.
 void write_trajectory(const std::string& file, const std::vector<StampedPose>& poses);
 
-// Reads either layout (see above); throws FormatError/IoError naming what is missing.
+// Reads either layout (see above); throws FormatError/IoError naming what is missing
+// (a frame file that a list names but that does not exist: the list's file and line).
 Sequence read_sequence(const std::string& directory, double max_difference = 0.02);
 
 // Pairs a[i] with the b of nearest timestamp within max_difference, each b used at
