@@ -94,6 +94,9 @@ void run_train(TrainArgs& a) {
                       {"weight_decay", options.weight_decay},
                       {"seed", options.seed},
                       {"max_rotation_degrees", options.max_rotation_degrees},
+                      {"max_scale", options.max_scale},
+                      {"max_shift", options.max_shift},
+                      {"balanced", options.balanced},
                       {"threads", options.threads}};
     run["model"] = options.model_path;
     run["checkpoint"] = options.checkpoint_path;
@@ -146,6 +149,16 @@ void add_train(CLI::App& app) {
   cmd->add_option("--max-rotation", args->options.max_rotation_degrees, "Augmentation: largest turn about z, degrees")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));
+  cmd->add_option("--max-scale", args->options.max_scale,
+                  "Augmentation: scale uniform in [1 - S, 1 + S] about the grid's centre (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--max-shift", args->options.max_shift,
+                  "Augmentation: shift uniform in [-V, V] voxels of the 64^3 tree along each axis (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 16.0));
+  cmd->add_flag("--balanced", args->options.balanced,
+                "Weigh the loss by 1/sqrt(class share) so rare classes count more");
   cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
   cmd->add_option("--json", args->json, "Run record (default OUTPUT.json)");

@@ -10,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/learn/classifier.hpp"
 #include "vola/learn/npz.hpp"
+#include "vola/learn/occupancy.hpp"
 
 namespace {
 
@@ -121,6 +122,62 @@ TEST(Classifier, RefusesFilesThatAreNotModels) {
   } catch (const vola::FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("junk.pt"), std::string::npos) << e.what();
   }
+}
+
+
+// Voting over 12 orientations 30 degrees apart: an input turned by a quarter turn (a
+// multiple of 30 degrees that a voxel grid can be turned by exactly) sees the same 12
+// inputs in another order, so the averaged probabilities agree. One vote does not.
+TEST(Classifier, TwelveVotesAreInvariantToQuarterTurns) {
+  const Classifier classifier(vola_learn_test::committed_model_path());
+  double single_vote_change = 0;
+  for (int shape = 0; shape < 4; ++shape) {
+    const vola::Tree tree = clean_scene(shape_grid(shape, 40 + std::uint64_t(shape)), 32);
+    const vola::Tree* original[] = {&tree};
+    const auto votes = classifier.classify(original, 12).front();
+    const auto single = classifier.classify(original, 1).front();
+    EXPECT_NEAR(std::accumulate(votes.begin(), votes.end(), 0.0), 1.0, 1e-5);
+    for (int quarters = 1; quarters < 4; ++quarters) {
+      const vola::Tree turned = turn_quarters(tree, quarters);
+      const vola::Tree* input[] = {&turned};
+      const auto turned_votes = classifier.classify(input, 12).front();
+      const auto turned_single = classifier.classify(input, 1).front();
+      for (int k = 0; k < kClassCount; ++k) {
+        EXPECT_NEAR(turned_votes[std::size_t(k)], votes[std::size_t(k)], 1e-5)
+            << "shape " << shape << ", " << quarters << " quarter turns, class " << kClassNames[std::size_t(k)];
+        single_vote_change = std::max(single_vote_change, double(std::abs(turned_single[std::size_t(k)] - single[std::size_t(k)])));
+      }
+    }
+  }
+  // The check can fail: without voting, turning the input moves the probabilities.
+  EXPECT_GT(single_vote_change, 1e-3);
+  const vola::Tree tree = clean_scene(shape_grid(0, 1), 32);
+  const vola::Tree* input[] = {&tree};
+  EXPECT_THROW(classifier.classify(input, 0), vola::InvalidArgument);
+}
+
+// A model file damaged in storage (truncated, or one byte changed inside a record) is
+// refused with a FormatError that names it, before libtorch reads it.
+TEST(Classifier, RefusesDamagedModelFiles) {
+  vola_test::TempDir dir;
+  const std::vector<std::uint8_t> good = vola_test::read_bytes(vola_learn_test::committed_model_path());
+  ASSERT_GT(good.size(), 100000u);
+  const auto refused = [&](const std::vector<std::uint8_t>& bytes, const std::string& name) {
+    vola_test::write_bytes(dir / name, bytes);
+    try {
+      Classifier classifier((dir / name).string());
+      return std::string("accepted");
+    } catch (const vola::FormatError& e) {
+      return std::string(e.what()).find(name) != std::string::npos ? std::string() : std::string("unnamed: ") + e.what();
+    }
+  };
+  EXPECT_EQ(refused(std::vector<std::uint8_t>(good.begin(), good.begin() + long(good.size() / 2)), "half.pt"), "");
+  std::vector<std::uint8_t> flipped = good;
+  flipped[good.size() / 2] ^= 0x40;  // inside the weights' record: its CRC no longer matches
+  EXPECT_EQ(refused(flipped, "flipped.pt"), "");
+  // The intact copy loads (the damage, not the copying, is what is refused).
+  vola_test::write_bytes(dir / "intact.pt", good);
+  EXPECT_NO_THROW(Classifier((dir / "intact.pt").string()));
 }
 
 }  // namespace
