@@ -3,6 +3,9 @@
 // are refused.
 #include <gtest/gtest.h>
 
+#include <zip.h>
+
+#include <filesystem>
 #include <numeric>
 
 #include "learn_test_data.hpp"
@@ -53,6 +56,10 @@ TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
   options.epochs = 3;
   options.batch_size = 5;
   options.threads = 1;  // one thread: bit-for-bit repeatable sums
+  options.max_rotation_degrees = 180;  // every augmentation draws from the seeded generator
+  options.max_scale = 0.1;
+  options.max_shift = 2;
+  options.balanced = true;
   options.model_path = (dir / "whole.pt").string();
   options.checkpoint_path = (dir / "whole.ckpt").string();
   const auto whole = train(samples, samples, options);
@@ -178,6 +185,59 @@ TEST(Classifier, RefusesDamagedModelFiles) {
   // The intact copy loads (the damage, not the copying, is what is refused).
   vola_test::write_bytes(dir / "intact.pt", good);
   EXPECT_NO_THROW(Classifier((dir / "intact.pt").string()));
+}
+
+
+// A copy of `model` with the 8-byte record `<root>/data/<index>` (an int64 tensor)
+// replaced by `value`; libzip writes fresh CRCs, so only the content is wrong.
+void rewrite_int64_record(const std::filesystem::path& model, int index, std::int64_t value) {
+  int code = 0;
+  zip_t* archive = zip_open(model.c_str(), 0, &code);
+  ASSERT_NE(archive, nullptr) << code;
+  const std::string suffix = "/data/" + std::to_string(index);
+  zip_int64_t found = -1;
+  for (zip_int64_t i = 0; i < zip_get_num_entries(archive, 0); ++i) {
+    const std::string name = zip_get_name(archive, zip_uint64_t(i), 0);
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        name.find('/') == name.size() - suffix.size())
+      found = i;
+  }
+  ASSERT_GE(found, 0) << "no record " << suffix;
+  static std::int64_t buffer;  // libzip reads it at zip_close
+  buffer = value;
+  zip_source_t* source = zip_source_buffer(archive, &buffer, sizeof buffer, 0);
+  ASSERT_EQ(zip_file_replace(archive, zip_uint64_t(found), source, 0), 0) << zip_strerror(archive);
+  ASSERT_EQ(zip_close(archive), 0);
+}
+
+// A well-formed archive whose records say something this build cannot use: another model
+// version, or an architecture whose network the weights do not fit.
+TEST(Classifier, RefusesMismatchedModelFiles) {
+  vola_test::TempDir dir;
+  const auto good = vola_test::read_bytes(vola_learn_test::committed_model_path());
+  const auto message = [&](const std::string& name) {
+    try {
+      Classifier classifier((dir / name).string());
+      return std::string("accepted");
+    } catch (const vola::FormatError& e) {
+      return std::string(e.what());
+    }
+  };
+  // Records 0 and 1 are the version and the architecture (write_architecture's order).
+  vola_test::write_bytes(dir / "version.pt", good);
+  rewrite_int64_record(dir / "version.pt", 0, 2);
+  EXPECT_NE(message("version.pt").find("vola model version 2"), std::string::npos) << message("version.pt");
+  vola_test::write_bytes(dir / "arch.pt", good);
+  rewrite_int64_record(dir / "arch.pt", 1, 0);  // says paper, holds the small network's weights
+  EXPECT_NE(message("arch.pt").find("weights do not fit"), std::string::npos) << message("arch.pt");
+  EXPECT_NE(message("arch.pt").find("arch.pt"), std::string::npos);
+  vola_test::write_bytes(dir / "unknown.pt", good);
+  rewrite_int64_record(dir / "unknown.pt", 1, 9);
+  EXPECT_NE(message("unknown.pt").find("unknown network architecture 9"), std::string::npos) << message("unknown.pt");
+  // The unchanged record rewritten the same way still loads: the rewriting is sound.
+  vola_test::write_bytes(dir / "same.pt", good);
+  rewrite_int64_record(dir / "same.pt", 1, 1);
+  EXPECT_EQ(message("same.pt"), "accepted");
 }
 
 }  // namespace
