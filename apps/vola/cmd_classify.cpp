@@ -1,8 +1,11 @@
 // vola classify / vola evaluate: a trained 3D CNN (the committed small model unless
 // --model) on one .vol file or on a labelled dataset folder.
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +14,7 @@
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/output_stream.hpp"
 #include "vola/learn/classifier.hpp"
 
 namespace vola::cli {
@@ -22,7 +26,7 @@ using learn::kClassNames;
 
 struct ClassifyArgs {
   std::vector<std::string> inputs;
-  std::string model, png = "confusion.png";
+  std::string model, png = "confusion.png", json;
   int threads = 0, batch = 32, votes = 1;
 };
 
@@ -127,6 +131,31 @@ void run_evaluate(const ClassifyArgs& a) {
     write_confusion_png(a.png, confusion);
     std::printf("confusion matrix image: %s\n", a.png.c_str());
   }
+  if (!a.json.empty()) {
+    // Merged into the file (a model's run record, say) under "evaluation_votes_<N>".
+    nlohmann::json record = nlohmann::json::object();
+    if (std::ifstream previous(a.json); previous) {
+      record = nlohmann::json::parse(previous, nullptr, false);
+      if (record.is_discarded() || !record.is_object()) throw FormatError(a.json, std::nullopt, "not a JSON object");
+    }
+    nlohmann::json per_class = nlohmann::json::object();
+    for (int k = 0; k < kClassCount; ++k) {
+      std::size_t total = 0;
+      for (std::size_t c : confusion[std::size_t(k)]) total += c;
+      if (total) per_class[std::string(kClassNames[std::size_t(k)])] = double(confusion[std::size_t(k)][std::size_t(k)]) / double(total);
+    }
+    record["evaluation_votes_" + std::to_string(a.votes)] = {
+        {"dir", a.inputs.front()},
+        {"samples", samples.size()},
+        {"votes", a.votes},
+        {"accuracy", double(correct) / double(samples.size())},
+        {"mean_per_class_accuracy", class_accuracy_sum / classes_seen},
+        {"per_class_accuracy", per_class},
+        {"confusion_rows_true_columns_predicted", confusion}};
+    OutputStream out(a.json);
+    out << record.dump(2) << '\n';
+    out.commit();
+  }
   std::printf("mean per-class accuracy: %.4f (%d classes)\n", class_accuracy_sum / classes_seen, classes_seen);
   std::printf("accuracy: %.4f\n", double(correct) / double(samples.size()));
 }
@@ -168,6 +197,9 @@ void add_classify(CLI::App& app) {
                    "Example:\n  vola evaluate data/clean/val --votes 12 --png val_confusion.png");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();
+  evaluate->add_option("--json", eargs->json,
+                       "Also write the figures and confusion matrix into this JSON file (e.g. the model's run record), "
+                       "under \"evaluation_votes_<N>\"; other keys are kept");
   evaluate->add_option("--batch", eargs->batch, "Samples per batch")->capture_default_str()->check(CLI::Range(1, 4096));
   add_model_options(evaluate, *eargs);
   evaluate->callback([eargs] { run_evaluate(*eargs); });
