@@ -165,7 +165,7 @@ void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
   cmd->add_option("--threads", args.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--votes", args.votes,
                   "Test-time voting: see each object turned about z by 360*k/N degrees (k = 0..N-1) and "
-                  "average the N softmax outputs")
+                  "average the N softmax outputs (for models trained with --max-rotation 180)")
       ->capture_default_str()
       ->check(CLI::Range(1, 360));
 }
