@@ -94,9 +94,9 @@ TEST(Classifier, CommittedModelKnowsTrainingSamples) {
   const Classifier classifier(vola_learn_test::committed_model_path());
   EXPECT_EQ(classifier.architecture(), Architecture::small);
   const auto grids = read_labelled_grids((data / "modelnet" / "modelnet10_32_train.npz").string());
-  // Five samples of each class from the training part of the default split (vola dataset's
-  // --validation-fraction 0.1 --seed 1): the model was trained on exactly these.
-  const Split split = stratified_split(grids.labels, 0.1, 1);
+  // Five samples of each class from the training part of the balanced split (vola dataset's
+  // --validation-per-class 100 --seed 1): the model was trained on exactly these.
+  const Split split = balanced_split(grids.labels, 100, 1);
   std::vector<vola::Tree> trees;
   std::vector<int> labels;
   std::vector<int> taken(kClassCount, 0);
