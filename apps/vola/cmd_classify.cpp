@@ -1,8 +1,11 @@
 // vola classify / vola evaluate: a trained 3D CNN (the committed small model unless
 // --model) on one .vol file or on a labelled dataset folder.
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +14,7 @@
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/output_stream.hpp"
 #include "vola/learn/classifier.hpp"
 
 namespace vola::cli {
@@ -22,8 +26,8 @@ using learn::kClassNames;
 
 struct ClassifyArgs {
   std::vector<std::string> inputs;
-  std::string model, png = "confusion.png";
-  int threads = 0, batch = 32;
+  std::string model, png = "confusion.png", json;
+  int threads = 0, batch = 32, votes = 1;
 };
 
 learn::Classifier load_classifier(const ClassifyArgs& a) {
@@ -44,7 +48,7 @@ void run_classify(const ClassifyArgs& a) {
       throw InvalidArgument(input + ": a " + std::to_string(tree.side()) + "^3 grid; the model reads " +
                             std::to_string(side) + "^3 or finer");
     const Tree* trees[] = {&tree};
-    const auto p = classifier.classify(trees).front();
+    const auto p = classifier.classify(trees, a.votes).front();
     const std::size_t best = best_class(p);
     if (a.inputs.size() > 1) std::printf("%s: ", input.c_str());
     std::printf("%s %.4f\n", std::string(kClassNames[best]).c_str(), p[best]);
@@ -90,7 +94,7 @@ void run_evaluate(const ClassifyArgs& a) {
     const std::size_t count = std::min(std::size_t(a.batch), samples.size() - first);
     std::vector<const Tree*> trees;
     for (std::size_t i = 0; i < count; ++i) trees.push_back(&samples[first + i].tree);
-    const auto probabilities = classifier.classify(trees);
+    const auto probabilities = classifier.classify(trees, a.votes);
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t truth = std::size_t(samples[first + i].label), predicted = best_class(probabilities[i]);
       ++confusion[truth][predicted];
@@ -100,14 +104,18 @@ void run_evaluate(const ClassifyArgs& a) {
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, fill + network)\n\n", samples.size(),
+  std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, %d vote%s, fill + network)\n\n", samples.size(),
               std::string(learn::architecture_name(classifier.architecture())).c_str(),
-              1000 * seconds / double(samples.size()), a.batch);
+              1000 * seconds / double(samples.size()), a.batch, a.votes, a.votes == 1 ? "" : "s");
   std::printf("per-class accuracy:\n");
+  double class_accuracy_sum = 0;
+  int classes_seen = 0;
   for (int k = 0; k < kClassCount; ++k) {
     std::size_t total = 0;
     for (std::size_t c : confusion[std::size_t(k)]) total += c;
     if (total == 0) continue;
+    class_accuracy_sum += double(confusion[std::size_t(k)][std::size_t(k)]) / double(total);
+    ++classes_seen;
     std::printf("  %-12s %.4f  (%zu of %zu)\n", std::string(kClassNames[std::size_t(k)]).c_str(),
                 double(confusion[std::size_t(k)][std::size_t(k)]) / double(total), confusion[std::size_t(k)][std::size_t(k)], total);
   }
@@ -123,12 +131,43 @@ void run_evaluate(const ClassifyArgs& a) {
     write_confusion_png(a.png, confusion);
     std::printf("confusion matrix image: %s\n", a.png.c_str());
   }
+  if (!a.json.empty()) {
+    // Merged into the file (a model's run record, say) under "evaluation_votes_<N>".
+    nlohmann::json record = nlohmann::json::object();
+    if (std::ifstream previous(a.json); previous) {
+      record = nlohmann::json::parse(previous, nullptr, false);
+      if (record.is_discarded() || !record.is_object()) throw FormatError(a.json, std::nullopt, "not a JSON object");
+    }
+    nlohmann::json per_class = nlohmann::json::object();
+    for (int k = 0; k < kClassCount; ++k) {
+      std::size_t total = 0;
+      for (std::size_t c : confusion[std::size_t(k)]) total += c;
+      if (total) per_class[std::string(kClassNames[std::size_t(k)])] = double(confusion[std::size_t(k)][std::size_t(k)]) / double(total);
+    }
+    record["evaluation_votes_" + std::to_string(a.votes)] = {
+        {"dir", a.inputs.front()},
+        {"samples", samples.size()},
+        {"votes", a.votes},
+        {"accuracy", double(correct) / double(samples.size())},
+        {"mean_per_class_accuracy", class_accuracy_sum / classes_seen},
+        {"per_class_accuracy", per_class},
+        {"confusion_rows_true_columns_predicted", confusion}};
+    OutputStream out(a.json);
+    out << record.dump(2) << '\n';
+    out.commit();
+  }
+  std::printf("mean per-class accuracy: %.4f (%d classes)\n", class_accuracy_sum / classes_seen, classes_seen);
   std::printf("accuracy: %.4f\n", double(correct) / double(samples.size()));
 }
 
 void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
   cmd->add_option("--model", args.model, "Model file written by `vola train` (default: the committed small model)");
   cmd->add_option("--threads", args.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--votes", args.votes,
+                  "Test-time voting: see each object turned about z by 360*k/N degrees (k = 0..N-1) and "
+                  "average the N softmax outputs (for models trained with --max-rotation 180)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 360));
 }
 
 constexpr const char* kModelFooter =
@@ -144,7 +183,7 @@ void add_classify(CLI::App& app) {
   classify->footer(std::string(kModelFooter) +
                    "Prints the most likely class and its probability, then all ten probabilities.\n"
                    "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
-                   "Example:\n  vola classify data/clean/val/chair/chair_01234.vol");
+                   "Example:\n  vola classify data/clean/val/chair/chair_01234.vol --votes 12");
   classify->add_option("file", args->inputs, ".vol files")->required()->check(CLI::ExistingFile);
   add_model_options(classify, *args);
   classify->callback([args] { run_classify(*args); });
@@ -154,10 +193,13 @@ void add_classify(CLI::App& app) {
   evaluate->footer(std::string(kModelFooter) +
                    "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
                    "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
-                   "with the line `accuracy: 0.xxxx`.\n"
-                   "Example:\n  vola evaluate data/clean/val --png val_confusion.png");
+                   "with the lines `mean per-class accuracy: 0.xxxx` and `accuracy: 0.xxxx`.\n"
+                   "Example:\n  vola evaluate data/clean/val --votes 12 --png val_confusion.png");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();
+  evaluate->add_option("--json", eargs->json,
+                       "Also write the figures and confusion matrix into this JSON file (e.g. the model's run record), "
+                       "under \"evaluation_votes_<N>\"; other keys are kept");
   evaluate->add_option("--batch", eargs->batch, "Samples per batch")->capture_default_str()->check(CLI::Range(1, 4096));
   add_model_options(evaluate, *eargs);
   evaluate->callback([eargs] { run_evaluate(*eargs); });

@@ -23,6 +23,7 @@ struct DatasetArgs {
   std::string input, output, split, class_name;
   bool background = false;
   double validation_fraction = 0.1;
+  std::size_t validation_per_class = 0;  // > 0: a class-balanced split instead of the fraction
   std::uint64_t seed = 1;
 };
 
@@ -52,10 +53,14 @@ void run_npz(const DatasetArgs& a) {
   if (learn::kSceneSide % grids.side != 0)
     throw FormatError(a.input, std::nullopt, "grids of side " + std::to_string(grids.side) + ": expected a divisor of 64 (32, 16, ...)");
   // The training split gives up a stratified validation split; any other is written whole.
-  const bool carve = grids.split == "train" && a.validation_fraction > 0;
+  const bool carve = grids.split == "train" && (a.validation_fraction > 0 || a.validation_per_class > 0);
   std::vector<char> held_out(grids.size(), 0);
-  if (carve)
-    for (std::size_t i : learn::stratified_split(grids.labels, a.validation_fraction, a.seed).validation) held_out[i] = 1;
+  if (carve) {
+    const learn::Split split = a.validation_per_class > 0
+                                   ? learn::balanced_split(grids.labels, a.validation_per_class, a.seed)
+                                   : learn::stratified_split(grids.labels, a.validation_fraction, a.seed);
+    for (std::size_t i : split.validation) held_out[i] = 1;
+  }
   const fs::path root(a.output);
   std::vector<std::size_t> per_split[2];
   Progress progress("dataset");
@@ -68,7 +73,10 @@ void run_npz(const DatasetArgs& a) {
   }
   progress.finish();
   std::printf("%zu %s samples -> %s\n", per_split[0].size(), grids.split.c_str(), (root / grids.split).string().c_str());
-  if (carve)
+  if (carve && a.validation_per_class > 0)
+    std::printf("%zu validation samples (%zu of each class, at most half of it, seed %llu) -> %s\n", per_split[1].size(),
+                a.validation_per_class, static_cast<unsigned long long>(a.seed), (root / "val").string().c_str());
+  else if (carve)
     std::printf("%zu validation samples (%.0f%% of each class, seed %llu) -> %s\n", per_split[1].size(),
                 a.validation_fraction * 100, static_cast<unsigned long long>(a.seed), (root / "val").string().c_str());
   std::printf("%s, 64^3 at depth 3\n", a.background ? "objects in generated rooms" : "clean objects");
@@ -121,7 +129,8 @@ void add_dataset(CLI::App& app) {
       "at 5/4 size, turned by a random angle about z and put on the floor of a room with two walls\n"
       "and random boxes of clutter (the paper's objects with background).\n"
       "Layout: OUTDIR/<split>/<class>/<class>_<row>.vol for an npz; the train split gives up a\n"
-      "stratified, seeded validation split in OUTDIR/val/. Meshes: OUTDIR/<class>/<file name>.vol, the\n"
+      "stratified, seeded validation split in OUTDIR/val/ (10% of each class, or N of each with\n"
+      "--validation-per-class N). Meshes: OUTDIR/<class>/<file name>.vol, the\n"
       "class from --class or from a class name in the file name.\n"
       "Examples:\n"
       "  vola dataset modelnet10_32_train.npz data/clean                  # data/clean/train, data/clean/val\n"
@@ -136,6 +145,10 @@ void add_dataset(CLI::App& app) {
                   "npz train split: the part of each class held out in val/")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--validation-per-class", args->validation_per_class,
+                  "npz train split: hold out N of each class instead (at most half of a class; 0: use the fraction)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", args->seed, "Seed of the validation split and the rooms")->capture_default_str();
   cmd->add_option("--class", args->class_name, "Meshes: the class of every file");
   cmd->callback([args] { run_dataset(*args); });

@@ -94,6 +94,9 @@ void run_train(TrainArgs& a) {
                       {"weight_decay", options.weight_decay},
                       {"seed", options.seed},
                       {"max_rotation_degrees", options.max_rotation_degrees},
+                      {"max_scale", options.max_scale},
+                      {"max_shift", options.max_shift},
+                      {"balanced", options.balanced},
                       {"threads", options.threads}};
     run["model"] = options.model_path;
     run["checkpoint"] = options.checkpoint_path;
@@ -124,13 +127,15 @@ void add_train(CLI::App& app) {
       "64^3 trees, ~0.9 M weights) and paper (the VOLA paper's 64^3 network: three 8^3 convolutions to\n"
       "8, 16, 16 channels, dropout 0.5, one fully connected layer, softmax; ~13 M weights, slow on a CPU).\n"
       "Inputs are filled straight from the VOLA bits by a producer thread while the network trains;\n"
-      "each training sample is turned by a random angle in [-max, max] about the vertical axis.\n"
+      "each training sample is turned by a random angle in [-max, max] about the vertical axis, and\n"
+      "with --max-scale / --max-shift scaled and moved at random. The validation accuracy printed per\n"
+      "epoch is of one orientation; `vola evaluate --votes 12` gives the voted figure.\n"
       "After every epoch the model (OUTPUT), a checkpoint (OUTPUT.ckpt: weights, optimizer, epoch) and\n"
       "a JSON record of the run (OUTPUT.json) are written. With --resume a run continues from the\n"
       "checkpoint and repeats exactly what an uninterrupted run would have done (same seed per epoch);\n"
       "--epochs-this-run N trains at most N epochs, for long runs done in pieces.\n"
       "Examples:\n"
-      "  vola train data/clean -o small.pt --epochs 30\n"
+      "  vola train data/clean -o small.pt --epochs 30 --max-rotation 180 --max-shift 2 --max-scale 0.1 --balanced\n"
       "  vola train data/clean -o paper.pt --arch paper --epochs 20 --epochs-this-run 1 --resume");
   cmd->add_option("train", args->train_dir, "Training folder (or a folder with train/ and val/)")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("--validation", args->validation_dir, "Validation folder")->check(CLI::ExistingDirectory);
@@ -146,6 +151,16 @@ void add_train(CLI::App& app) {
   cmd->add_option("--max-rotation", args->options.max_rotation_degrees, "Augmentation: largest turn about z, degrees")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));
+  cmd->add_option("--max-scale", args->options.max_scale,
+                  "Augmentation: scale uniform in [1 - S, 1 + S] about the grid's centre (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--max-shift", args->options.max_shift,
+                  "Augmentation: shift uniform in [-V, V] voxels of the 64^3 tree along each axis (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 16.0));
+  cmd->add_flag("--balanced", args->options.balanced,
+                "Weigh the loss by 1/sqrt(class share) so rare classes count more");
   cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
   cmd->add_option("--json", args->json, "Run record (default OUTPUT.json)");

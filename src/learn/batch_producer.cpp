@@ -10,12 +10,17 @@ namespace vola::learn {
 BatchProducer::BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order,
                              std::size_t batch_size, int side, std::uint64_t seed, double max_rotation,
                              std::size_t ahead)
+    : BatchProducer(samples, std::move(order), batch_size, side, seed, Augmentation{max_rotation, 0, 0}, ahead) {}
+
+BatchProducer::BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order,
+                             std::size_t batch_size, int side, std::uint64_t seed, const Augmentation& augmentation,
+                             std::size_t ahead)
     : samples_(samples),
       order_(std::move(order)),
       batch_size_(std::max<std::size_t>(1, batch_size)),
       side_(side),
       seed_(seed),
-      max_rotation_(max_rotation),
+      augmentation_(augmentation),
       ahead_(std::max<std::size_t>(1, ahead)) {
   thread_ = std::thread([this] { run(); });
 }
@@ -32,7 +37,10 @@ BatchProducer::~BatchProducer() {
 void BatchProducer::run() {
   try {
     std::mt19937_64 random(seed_);
-    std::uniform_real_distribution<double> angle(-max_rotation_, max_rotation_);
+    const Augmentation& a = augmentation_;
+    std::uniform_real_distribution<double> angle(-a.max_rotation, a.max_rotation);
+    std::uniform_real_distribution<double> scale(1 - a.max_scale, 1 + a.max_scale);
+    std::uniform_real_distribution<double> shift(-a.max_shift, a.max_shift);
     const std::size_t cells = std::size_t(side_) * side_ * side_;
     for (std::size_t first = 0; first < order_.size(); first += batch_size_) {
       const std::size_t count = std::min(batch_size_, order_.size() - first);
@@ -41,8 +49,12 @@ void BatchProducer::run() {
       for (std::size_t k = 0; k < count; ++k) {
         const std::size_t index = order_[first + k];
         const Sample& sample = samples_[index];
-        const double turn = max_rotation_ > 0 ? angle(random) : 0.0;
-        fill_occupancy(sample.tree, side_, turn, std::span<float>(batch.inputs.data() + k * cells, cells));
+        Placement placement;
+        placement.angle_radians = a.max_rotation > 0 ? angle(random) : 0.0;
+        if (a.max_scale > 0) placement.scale = scale(random);
+        if (a.max_shift > 0)
+          for (double& d : placement.shift) d = shift(random);
+        fill_occupancy(sample.tree, side_, placement, std::span<float>(batch.inputs.data() + k * cells, cells));
         batch.labels.push_back(sample.label);
         batch.indices.push_back(index);
       }

@@ -17,6 +17,13 @@
 
 namespace vola::learn {
 
+// Random placement of training samples (radians, fraction of size, tree voxels).
+struct Augmentation {
+  double max_rotation = 0;
+  double max_scale = 0;
+  double max_shift = 0;
+};
+
 struct Batch {
   std::vector<float> inputs;          // count * side^3
   std::vector<std::int64_t> labels;   // count
@@ -28,10 +35,14 @@ class BatchProducer {
  public:
   // Batches of `batch_size` (the last may be smaller) over samples[order[...]] at input
   // grid `side`. Angles are uniform in [-max_rotation, max_rotation] radians, drawn in
-  // order from a generator seeded with `seed` (0 radians when max_rotation is 0). At
-  // most `ahead` batches wait in the queue.
+  // order from a generator seeded with `seed` (0 radians when max_rotation is 0); then,
+  // when augmentation asks for them, a scale uniform in [1 - max_scale, 1 + max_scale]
+  // and a shift uniform in [-max_shift, max_shift] tree voxels along each axis. At most
+  // `ahead` batches wait in the queue.
   BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order, std::size_t batch_size, int side,
                 std::uint64_t seed, double max_rotation, std::size_t ahead = 2);
+  BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order, std::size_t batch_size, int side,
+                std::uint64_t seed, const Augmentation& augmentation, std::size_t ahead = 2);
   ~BatchProducer();
   BatchProducer(const BatchProducer&) = delete;
   BatchProducer& operator=(const BatchProducer&) = delete;
@@ -47,7 +58,7 @@ class BatchProducer {
   std::size_t batch_size_;
   int side_;
   std::uint64_t seed_;
-  double max_rotation_;
+  Augmentation augmentation_;
   std::size_t ahead_;
 
   std::mutex mutex_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <cctype>
 #include <numbers>
 #include <tuple>
@@ -144,9 +145,10 @@ Tree room_scene(std::span<const std::uint8_t> grid, int side, std::mt19937_64& r
   return build_from_voxels(voxels, kSceneDepth);
 }
 
-Split stratified_split(std::span<const int> labels, double validation_fraction, std::uint64_t seed) {
-  if (!(validation_fraction >= 0 && validation_fraction < 1))
-    throw InvalidArgument("validation fraction must be in [0, 1), got " + std::to_string(validation_fraction));
+namespace {
+
+// Holds out count_of(class size) shuffled members of each class.
+Split split_by_class(std::span<const int> labels, std::uint64_t seed, const std::function<std::size_t(std::size_t)>& count_of) {
   std::vector<std::vector<std::size_t>> by_class(kClassCount);
   for (std::size_t i = 0; i < labels.size(); ++i) {
     if (labels[i] < 0 || labels[i] >= kClassCount) throw InvalidArgument("label " + std::to_string(labels[i]) + " out of 0..9");
@@ -155,15 +157,29 @@ Split stratified_split(std::span<const int> labels, double validation_fraction, 
   std::mt19937_64 random(seed);
   std::vector<bool> held_out(labels.size(), false);
   for (auto& members : by_class) {
-    std::size_t count = static_cast<std::size_t>(std::llround(double(members.size()) * validation_fraction));
-    if (validation_fraction > 0 && members.size() >= 2) count = std::max<std::size_t>(count, 1);
-    count = std::min(count, members.size());
+    const std::size_t count = std::min(count_of(members.size()), members.size());
     std::shuffle(members.begin(), members.end(), random);
     for (std::size_t k = 0; k < count; ++k) held_out[members[k]] = true;
   }
   Split split;
   for (std::size_t i = 0; i < labels.size(); ++i) (held_out[i] ? split.validation : split.train).push_back(i);
   return split;
+}
+
+}  // namespace
+
+Split stratified_split(std::span<const int> labels, double validation_fraction, std::uint64_t seed) {
+  if (!(validation_fraction >= 0 && validation_fraction < 1))
+    throw InvalidArgument("validation fraction must be in [0, 1), got " + std::to_string(validation_fraction));
+  return split_by_class(labels, seed, [&](std::size_t size) {
+    std::size_t count = static_cast<std::size_t>(std::llround(double(size) * validation_fraction));
+    if (validation_fraction > 0 && size >= 2) count = std::max<std::size_t>(count, 1);
+    return count;
+  });
+}
+
+Split balanced_split(std::span<const int> labels, std::size_t per_class, std::uint64_t seed) {
+  return split_by_class(labels, seed, [&](std::size_t size) { return std::min(per_class, size / 2); });
 }
 
 std::optional<int> class_from_file_name(std::string_view file_name) noexcept {

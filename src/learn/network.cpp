@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <new>
+#include <numbers>
 #include <vector>
 
 #include "vola/error.hpp"
@@ -241,22 +242,34 @@ Classifier& Classifier::operator=(Classifier&&) noexcept = default;
 
 Architecture Classifier::architecture() const noexcept { return impl_->architecture; }
 
-std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const Tree* const> trees) const {
+std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const Tree* const> trees, int votes) const {
+  if (votes < 1) throw InvalidArgument("votes must be at least 1, got " + std::to_string(votes));
   std::vector<std::array<float, kClassCount>> result;
   if (trees.empty()) return result;
   const int side = input_side(impl_->architecture);
   const std::size_t cells = std::size_t(side) * side * side;
+  const std::size_t n = trees.size() * std::size_t(votes);
   Batch batch;
-  batch.inputs.resize(trees.size() * cells);
-  batch.labels.assign(trees.size(), 0);
+  batch.inputs.resize(n * cells);
+  batch.labels.assign(n, 0);
   for (std::size_t i = 0; i < trees.size(); ++i)
-    fill_occupancy(*trees[i], side, 0.0, std::span<float>(batch.inputs.data() + i * cells, cells));
+    for (int k = 0; k < votes; ++k) {
+      const double angle = 2 * std::numbers::pi * k / votes;
+      fill_occupancy(*trees[i], side, angle,
+                     std::span<float>(batch.inputs.data() + (i * std::size_t(votes) + std::size_t(k)) * cells, cells));
+    }
   torch::NoGradGuard no_grad;
   const torch::Tensor probabilities = torch::softmax(impl_->network->forward(input_tensor(batch, side)), 1).contiguous();
   const float* p = probabilities.data_ptr<float>();
   result.resize(trees.size());
   for (std::size_t i = 0; i < trees.size(); ++i)
-    for (int k = 0; k < kClassCount; ++k) result[i][std::size_t(k)] = p[i * kClassCount + std::size_t(k)];
+    for (int c = 0; c < kClassCount; ++c) {
+      // Summed in double over the votes in order: a permutation of the votes changes the
+      // result only by float rounding of each vote (well below 1e-6).
+      double sum = 0;
+      for (int k = 0; k < votes; ++k) sum += p[(i * std::size_t(votes) + std::size_t(k)) * kClassCount + std::size_t(c)];
+      result[i][std::size_t(c)] = static_cast<float>(sum / votes);
+    }
   return result;
 }
 

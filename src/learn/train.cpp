@@ -104,7 +104,28 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
   }
 
   std::vector<EpochReport> reports;
-  const double max_rotation = options.max_rotation_degrees * std::numbers::pi / 180;
+  Augmentation augmentation;
+  augmentation.max_rotation = options.max_rotation_degrees * std::numbers::pi / 180;
+  augmentation.max_scale = options.max_scale;
+  augmentation.max_shift = options.max_shift;
+  // Class weights of the loss: 1 / sqrt(share of the class), normalised to a mean of 1
+  // over the classes present, so rare classes (bathtub) count more without dominating.
+  torch::Tensor class_weights;
+  if (options.balanced) {
+    std::vector<double> counts(kClassCount, 0);
+    for (const auto& sample : train_set) ++counts[std::size_t(sample.label)];
+    std::vector<float> weights(kClassCount, 0.0f);
+    double total = 0;
+    int present = 0;
+    for (int k = 0; k < kClassCount; ++k)
+      if (counts[std::size_t(k)] > 0) {
+        weights[std::size_t(k)] = float(1 / std::sqrt(counts[std::size_t(k)] / double(train_set.size())));
+        total += weights[std::size_t(k)];
+        ++present;
+      }
+    for (float& w : weights) w = float(w * present / total);
+    class_weights = torch::tensor(weights);
+  }
   for (int epoch = first_epoch; epoch < options.epochs; ++epoch) {
     if (options.max_epochs_this_run > 0 && epoch - first_epoch >= options.max_epochs_this_run) break;
     const auto start = std::chrono::steady_clock::now();
@@ -122,7 +143,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
 
     network->train();
     BatchProducer producer(train_set, std::move(order), std::size_t(options.batch_size), side,
-                           epoch_seed(options.seed, epoch, 2), max_rotation);
+                           epoch_seed(options.seed, epoch, 2), augmentation);
     double loss_sum = 0;
     std::size_t seen = 0, correct = 0, step = 0;
     while (auto batch = producer.next()) {
@@ -130,7 +151,8 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
                                                     torch::kInt64);
       optimizer.zero_grad();
       const torch::Tensor logits = network->forward(input_tensor(*batch, side));
-      const torch::Tensor loss = torch::nn::functional::cross_entropy(logits, labels);
+      const torch::Tensor loss = torch::nn::functional::cross_entropy(
+          logits, labels, torch::nn::functional::CrossEntropyFuncOptions().weight(class_weights));
       loss.backward();
       optimizer.step();
       const double value = loss.item<double>();

@@ -3,6 +3,9 @@
 // are refused.
 #include <gtest/gtest.h>
 
+#include <zip.h>
+
+#include <filesystem>
 #include <numeric>
 
 #include "learn_test_data.hpp"
@@ -10,6 +13,7 @@
 #include "vola/error.hpp"
 #include "vola/learn/classifier.hpp"
 #include "vola/learn/npz.hpp"
+#include "vola/learn/occupancy.hpp"
 
 namespace {
 
@@ -52,6 +56,10 @@ TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
   options.epochs = 3;
   options.batch_size = 5;
   options.threads = 1;  // one thread: bit-for-bit repeatable sums
+  options.max_rotation_degrees = 180;  // every augmentation draws from the seeded generator
+  options.max_scale = 0.1;
+  options.max_shift = 2;
+  options.balanced = true;
   options.model_path = (dir / "whole.pt").string();
   options.checkpoint_path = (dir / "whole.ckpt").string();
   const auto whole = train(samples, samples, options);
@@ -86,9 +94,9 @@ TEST(Classifier, CommittedModelKnowsTrainingSamples) {
   const Classifier classifier(vola_learn_test::committed_model_path());
   EXPECT_EQ(classifier.architecture(), Architecture::small);
   const auto grids = read_labelled_grids((data / "modelnet" / "modelnet10_32_train.npz").string());
-  // Five samples of each class from the training part of the default split (vola dataset's
-  // --validation-fraction 0.1 --seed 1): the model was trained on exactly these.
-  const Split split = stratified_split(grids.labels, 0.1, 1);
+  // Five samples of each class from the training part of the balanced split (vola dataset's
+  // --validation-per-class 100 --seed 1): the model was trained on exactly these.
+  const Split split = balanced_split(grids.labels, 100, 1);
   std::vector<vola::Tree> trees;
   std::vector<int> labels;
   std::vector<int> taken(kClassCount, 0);
@@ -121,6 +129,115 @@ TEST(Classifier, RefusesFilesThatAreNotModels) {
   } catch (const vola::FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("junk.pt"), std::string::npos) << e.what();
   }
+}
+
+
+// Voting over 12 orientations 30 degrees apart: an input turned by a quarter turn (a
+// multiple of 30 degrees that a voxel grid can be turned by exactly) sees the same 12
+// inputs in another order, so the averaged probabilities agree. One vote does not.
+TEST(Classifier, TwelveVotesAreInvariantToQuarterTurns) {
+  const Classifier classifier(vola_learn_test::committed_model_path());
+  double single_vote_change = 0;
+  for (int shape = 0; shape < 4; ++shape) {
+    const vola::Tree tree = clean_scene(shape_grid(shape, 40 + std::uint64_t(shape)), 32);
+    const vola::Tree* original[] = {&tree};
+    const auto votes = classifier.classify(original, 12).front();
+    const auto single = classifier.classify(original, 1).front();
+    EXPECT_NEAR(std::accumulate(votes.begin(), votes.end(), 0.0), 1.0, 1e-5);
+    for (int quarters = 1; quarters < 4; ++quarters) {
+      const vola::Tree turned = turn_quarters(tree, quarters);
+      const vola::Tree* input[] = {&turned};
+      const auto turned_votes = classifier.classify(input, 12).front();
+      const auto turned_single = classifier.classify(input, 1).front();
+      for (int k = 0; k < kClassCount; ++k) {
+        EXPECT_NEAR(turned_votes[std::size_t(k)], votes[std::size_t(k)], 1e-5)
+            << "shape " << shape << ", " << quarters << " quarter turns, class " << kClassNames[std::size_t(k)];
+        single_vote_change = std::max(single_vote_change, double(std::abs(turned_single[std::size_t(k)] - single[std::size_t(k)])));
+      }
+    }
+  }
+  // The check can fail: without voting, turning the input moves the probabilities.
+  EXPECT_GT(single_vote_change, 1e-3);
+  const vola::Tree tree = clean_scene(shape_grid(0, 1), 32);
+  const vola::Tree* input[] = {&tree};
+  EXPECT_THROW(classifier.classify(input, 0), vola::InvalidArgument);
+}
+
+// A model file damaged in storage (truncated, or one byte changed inside a record) is
+// refused with a FormatError that names it, before libtorch reads it.
+TEST(Classifier, RefusesDamagedModelFiles) {
+  vola_test::TempDir dir;
+  const std::vector<std::uint8_t> good = vola_test::read_bytes(vola_learn_test::committed_model_path());
+  ASSERT_GT(good.size(), 100000u);
+  const auto refused = [&](const std::vector<std::uint8_t>& bytes, const std::string& name) {
+    vola_test::write_bytes(dir / name, bytes);
+    try {
+      Classifier classifier((dir / name).string());
+      return std::string("accepted");
+    } catch (const vola::FormatError& e) {
+      return std::string(e.what()).find(name) != std::string::npos ? std::string() : std::string("unnamed: ") + e.what();
+    }
+  };
+  EXPECT_EQ(refused(std::vector<std::uint8_t>(good.begin(), good.begin() + long(good.size() / 2)), "half.pt"), "");
+  std::vector<std::uint8_t> flipped = good;
+  flipped[good.size() / 2] ^= 0x40;  // inside the weights' record: its CRC no longer matches
+  EXPECT_EQ(refused(flipped, "flipped.pt"), "");
+  // The intact copy loads (the damage, not the copying, is what is refused).
+  vola_test::write_bytes(dir / "intact.pt", good);
+  EXPECT_NO_THROW(Classifier((dir / "intact.pt").string()));
+}
+
+
+// A copy of `model` with the 8-byte record `<root>/data/<index>` (an int64 tensor)
+// replaced by `value`; libzip writes fresh CRCs, so only the content is wrong.
+void rewrite_int64_record(const std::filesystem::path& model, int index, std::int64_t value) {
+  int code = 0;
+  zip_t* archive = zip_open(model.c_str(), 0, &code);
+  ASSERT_NE(archive, nullptr) << code;
+  const std::string suffix = "/data/" + std::to_string(index);
+  zip_int64_t found = -1;
+  for (zip_int64_t i = 0; i < zip_get_num_entries(archive, 0); ++i) {
+    const std::string name = zip_get_name(archive, zip_uint64_t(i), 0);
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        name.find('/') == name.size() - suffix.size())
+      found = i;
+  }
+  ASSERT_GE(found, 0) << "no record " << suffix;
+  static std::int64_t buffer;  // libzip reads it at zip_close
+  buffer = value;
+  zip_source_t* source = zip_source_buffer(archive, &buffer, sizeof buffer, 0);
+  ASSERT_EQ(zip_file_replace(archive, zip_uint64_t(found), source, 0), 0) << zip_strerror(archive);
+  ASSERT_EQ(zip_close(archive), 0);
+}
+
+// A well-formed archive whose records say something this build cannot use: another model
+// version, or an architecture whose network the weights do not fit.
+TEST(Classifier, RefusesMismatchedModelFiles) {
+  vola_test::TempDir dir;
+  const auto good = vola_test::read_bytes(vola_learn_test::committed_model_path());
+  const auto message = [&](const std::string& name) {
+    try {
+      Classifier classifier((dir / name).string());
+      return std::string("accepted");
+    } catch (const vola::FormatError& e) {
+      return std::string(e.what());
+    }
+  };
+  // Records 0 and 1 are the version and the architecture (write_architecture's order).
+  vola_test::write_bytes(dir / "version.pt", good);
+  rewrite_int64_record(dir / "version.pt", 0, 2);
+  EXPECT_NE(message("version.pt").find("vola model version 2"), std::string::npos) << message("version.pt");
+  vola_test::write_bytes(dir / "arch.pt", good);
+  rewrite_int64_record(dir / "arch.pt", 1, 0);  // says paper, holds the small network's weights
+  EXPECT_NE(message("arch.pt").find("weights do not fit"), std::string::npos) << message("arch.pt");
+  EXPECT_NE(message("arch.pt").find("arch.pt"), std::string::npos);
+  vola_test::write_bytes(dir / "unknown.pt", good);
+  rewrite_int64_record(dir / "unknown.pt", 1, 9);
+  EXPECT_NE(message("unknown.pt").find("unknown network architecture 9"), std::string::npos) << message("unknown.pt");
+  // The unchanged record rewritten the same way still loads: the rewriting is sound.
+  vola_test::write_bytes(dir / "same.pt", good);
+  rewrite_int64_record(dir / "same.pt", 1, 1);
+  EXPECT_EQ(message("same.pt"), "accepted");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <set>
 
 #include "learn_test_data.hpp"
@@ -176,6 +177,44 @@ TEST(Occupancy, FillFromBitsEqualsBruteForceDenseFill) {
   EXPECT_THROW(fill_occupancy(tree, 32, 0, wrong), vola::InvalidArgument);
   std::vector<float> big(std::size_t(128) * 128 * 128);
   EXPECT_THROW(fill_occupancy(tree, 128, 0, big), vola::InvalidArgument);
+}
+
+
+// The ground the voting's invariance stands on: a grid turned exactly by a quarter turn
+// (turn_quarters), then filled at a vote's angle, is the same input as the original
+// filled at the angle a quarter turn further, for every multiple of 30 degrees.
+TEST(Occupancy, QuarterTurnThenVoteAngleEqualsTheLaterVoteAngle) {
+  const vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
+  const std::size_t cells = std::size_t(32) * 32 * 32;
+  for (int quarters = 1; quarters < 4; ++quarters) {
+    const vola::Tree turned = turn_quarters(tree, quarters);
+    EXPECT_EQ(turned.voxel_count(), tree.voxel_count());
+    for (int k = 0; k < 12; ++k) {
+      std::vector<float> a(cells), b(cells);
+      fill_occupancy(turned, 32, 2 * std::numbers::pi * k / 12, a);
+      fill_occupancy(tree, 32, 2 * std::numbers::pi * (k + 3 * quarters) / 12, b);
+      EXPECT_EQ(a, b) << quarters << " quarter turns, vote " << k;
+    }
+  }
+  // Not a tautology: the turned grid differs from the original.
+  std::vector<float> a(cells), b(cells);
+  fill_occupancy(turn_quarters(tree, 1), 32, 0.0, a);
+  fill_occupancy(tree, 32, 0.0, b);
+  EXPECT_NE(a, b);
+}
+
+TEST(Dataset, BalancedSplitHoldsOutAFixedCountPerClass) {
+  std::vector<int> labels;
+  const int sizes[kClassCount] = {106, 515, 889, 200, 200, 465, 200, 680, 392, 344};  // ModelNet10's train split
+  for (int k = 0; k < kClassCount; ++k) labels.insert(labels.end(), std::size_t(sizes[k]), k);
+  const Split split = balanced_split(labels, 100, 1);
+  std::vector<int> held(kClassCount, 0);
+  for (std::size_t i : split.validation) ++held[std::size_t(labels[i])];
+  EXPECT_EQ(held[0], 53);  // half of 106: bathtub keeps 53 to train on
+  for (int k = 1; k < kClassCount; ++k) EXPECT_EQ(held[std::size_t(k)], 100) << kClassNames[std::size_t(k)];
+  EXPECT_EQ(split.train.size() + split.validation.size(), labels.size());
+  EXPECT_EQ(balanced_split(labels, 100, 1).validation, split.validation);
+  EXPECT_NE(balanced_split(labels, 100, 2).validation, split.validation);
 }
 
 }  // namespace

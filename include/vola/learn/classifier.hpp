@@ -49,6 +49,9 @@ struct TrainOptions {
   double weight_decay = 1e-4;
   std::uint64_t seed = 1;        // weights, shuffling, augmentation, dropout
   double max_rotation_degrees = 15;  // augmentation: uniform angle in [-max, max] about z
+  double max_scale = 0;              // augmentation: scale uniform in [1 - max, 1 + max] (0: none)
+  double max_shift = 0;              // augmentation: shift uniform in [-max, max] tree voxels per axis
+  bool balanced = false;             // loss weights 1/sqrt(class share), normalised to mean 1
   int threads = 0;                  // torch intra-op threads; 0: all cores
   std::string model_path;           // the trained weights, written after every epoch
   std::string checkpoint_path;      // weights + optimizer + epoch, after every epoch
@@ -88,8 +91,11 @@ class Classifier {
   Classifier& operator=(Classifier&&) noexcept;
 
   Architecture architecture() const noexcept;
-  // Class probabilities (softmax) of each tree, in one batch.
-  std::vector<std::array<float, kClassCount>> classify(std::span<const Tree* const> trees) const;
+  // Class probabilities (softmax) of each tree, in one batch. With votes > 1, each tree
+  // is seen turned about z by 360 * k / votes degrees (k = 0..votes-1) and the votes'
+  // probabilities are averaged: turning the input by a multiple of 360 / votes degrees
+  // only permutes the votes (exactly so for quarter turns, see fill_occupancy).
+  std::vector<std::array<float, kClassCount>> classify(std::span<const Tree* const> trees, int votes = 1) const;
 
  private:
   struct Impl;

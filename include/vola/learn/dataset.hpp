@@ -47,6 +47,10 @@ struct Split {
   std::vector<std::size_t> train, validation;
 };
 Split stratified_split(std::span<const int> labels, double validation_fraction, std::uint64_t seed);
+// A class-balanced split: per class min(per_class, half the class) samples go to
+// `validation` (the half keeps a small class trainable), chosen as stratified_split
+// chooses them (same generator use, so the same seed shuffles alike).
+Split balanced_split(std::span<const int> labels, std::size_t per_class, std::uint64_t seed);
 
 // A mesh file (OFF, OBJ, STL, anything vola's mesh reader reads) as a solid side^3 grid
 // in the npz's convention: z up, the longest extent spanning the grid, centred.
