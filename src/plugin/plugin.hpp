@@ -2,8 +2,9 @@
 // libraries they link cost every program start-up time (mapping and relocating them)
 // although few runs need them: libvola_gdal.so (elevation rasters), libvola_assimp.so
 // (meshes), libvola_proj.so (coordinate reference systems), libvola_mpi.so (vola tile
-// under mpirun), libvola_octomap.so (OctoMap .bt/.ot maps), libvola_openvdb.so (OpenVDB
-// .vdb maps, with TBB, Blosc and Boost behind it). Internal: a plugin is built
+// under mpirun), libvola_octomap.so (OctoMap .bt/.ot maps), libvola_opencv.so (ORB
+// features for vola fuse), libvola_openvdb.so (OpenVDB .vdb maps, with TBB, Blosc and
+// Boost behind it). Internal: a plugin is built
 // with the same compiler and library as its loader, so C++ types cross the boundary;
 // errors cross as a PluginFailure, not as exceptions.
 #pragma once

@@ -7,10 +7,7 @@
 #include <cstring>
 #include <random>
 
-#if VOLA_SLAM_WITH_OPENCV
-#include <opencv2/core.hpp>
-#include <opencv2/features2d.hpp>
-#endif
+#include "orb_plugin.hpp"
 
 namespace vola::slam {
 
@@ -19,21 +16,23 @@ bool features_available() noexcept { return VOLA_SLAM_WITH_OPENCV != 0; }
 FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
                               const FeatureParams& params) {
   FeatureFrame out;
-#if VOLA_SLAM_WITH_OPENCV
+  if (!features_available()) return out;
   if (rgb.width != depth.width || rgb.height != depth.height || rgb.width < 16 || rgb.height < 16) return out;
-  cv::Mat grey(static_cast<int>(rgb.height), static_cast<int>(rgb.width), CV_8UC1);
-  for (std::size_t i = 0, n = std::size_t{rgb.width} * rgb.height; i < n; ++i) {
+  std::vector<std::uint8_t> grey(std::size_t{rgb.width} * rgb.height);
+  for (std::size_t i = 0; i < grey.size(); ++i) {
     const std::uint8_t* c = &rgb.rgb[i * 3];
-    grey.data[i] = static_cast<std::uint8_t>((299 * c[0] + 587 * c[1] + 114 * c[2] + 500) / 1000);
+    grey[i] = static_cast<std::uint8_t>((299 * c[0] + 587 * c[1] + 114 * c[2] + 500) / 1000);
   }
+  // OpenCV is loaded on the first colour frame (libvola_opencv.so), not at every start.
+  static const auto detect = reinterpret_cast<plugin::DetectOrbEntry>(
+      vola::plugin::plugin_symbol("opencv", plugin::kDetectOrbSymbol, "ORB features of a colour frame"));
+  std::vector<plugin::OrbKeypoint> keypoints;
+  vola::plugin::PluginFailure failure;
+  detect(grey.data(), rgb.width, rgb.height, params.max_features, params.fast_threshold, keypoints, failure);
+  vola::plugin::throw_failure(failure);
   out.intrinsics = k;
-  cv::Ptr<cv::ORB> orb = cv::ORB::create(params.max_features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
-                                         params.fast_threshold);
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-  orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
-  for (std::size_t i = 0; i < keypoints.size(); ++i) {
-    const int u = static_cast<int>(std::lround(keypoints[i].pt.x)), v = static_cast<int>(std::lround(keypoints[i].pt.y));
+  for (const plugin::OrbKeypoint& kp : keypoints) {
+    const int u = static_cast<int>(std::lround(kp.x)), v = static_cast<int>(std::lround(kp.y));
     if (u < 1 || v < 1 || u + 1 >= static_cast<int>(depth.width) || v + 1 >= static_cast<int>(depth.height)) continue;
     const float z = depth.at(static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(v));
     if (!(z > 0.0f)) continue;
@@ -47,18 +46,12 @@ FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, cons
         }
       }
     if (edge) continue;
-    out.points.emplace_back((keypoints[i].pt.x - k.cx) / k.fx * z, (keypoints[i].pt.y - k.cy) / k.fy * z, z);
-    out.pixels.emplace_back(keypoints[i].pt.x, keypoints[i].pt.y);
+    out.points.emplace_back((kp.x - k.cx) / k.fx * z, (kp.y - k.cy) / k.fy * z, z);
+    out.pixels.emplace_back(kp.x, kp.y);
     Descriptor d;
-    std::memcpy(d.data(), descriptors.ptr<std::uint8_t>(static_cast<int>(i)), 32);
+    std::memcpy(d.data(), kp.descriptor.data(), 32);
     out.descriptors.push_back(d);
   }
-#else
-  (void)rgb;
-  (void)depth;
-  (void)k;
-  (void)params;
-#endif
   return out;
 }
 
