@@ -127,32 +127,44 @@ TEST(OutputFile, AFailedVolWriteKeepsTheOldFile) {
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"big.vol"});
 }
 
-TEST(OutputFile, SigtermRemovesTheTemporaryAndEndsByTheSignal) {
-  TempDir dir;
-  const fs::path path = dir / "out.txt";
-  put_text(path, "old");
+// A child writes `bytes` bytes to `path` (over "old") and waits; once they are written,
+// it gets `signal`. Returns the names in the folder while it waited and the child's
+// wait status; with `handlers` it installs remove_temporaries_on_signal() first.
+struct KilledWriter {
+  std::vector<std::string> names_while_writing;
+  int status = 0;
+};
+KilledWriter kill_while_writing(const fs::path& path, std::size_t bytes, int signal, bool handlers) {
+  KilledWriter result;
   int ready[2];
-  ASSERT_EQ(::pipe(ready), 0);
+  if (::pipe(ready) != 0) return result;
   const pid_t pid = ::fork();
   if (pid == 0) {
-    vola::remove_temporaries_on_signal();
+    if (handlers) vola::remove_temporaries_on_signal();
     vola::OutputFile out(path.string());
-    out.write("half of it");
+    out.write(std::string(bytes, 'x'));
     std::fflush(out.stream());
     const char one = '1';
     if (::write(ready[1], &one, 1) != 1) ::_exit(5);
     for (;;) ::pause();
   }
   char got = 0;
-  ASSERT_EQ(::read(ready[0], &got, 1), 1);
-  EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});  // the temporary has no name
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  if (::read(ready[0], &got, 1) == 1) result.names_while_writing = names_in(path.parent_path());
+  ::kill(pid, signal);
+  ::waitpid(pid, &result.status, 0);
   ::close(ready[0]);
   ::close(ready[1]);
-  ASSERT_TRUE(WIFSIGNALED(status));
-  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  return result;
+}
+
+TEST(OutputFile, SigtermRemovesTheTemporaryAndEndsByTheSignal) {
+  TempDir dir;
+  const fs::path path = dir / "out.txt";
+  put_text(path, "old");
+  const KilledWriter k = kill_while_writing(path, 10, SIGTERM, true);
+  EXPECT_EQ(k.names_while_writing, std::vector<std::string>{"out.txt"});  // the temporary has no name
+  ASSERT_TRUE(WIFSIGNALED(k.status));
+  EXPECT_EQ(WTERMSIG(k.status), SIGTERM);
   EXPECT_EQ(text_of(path), "old");
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
 }
@@ -162,27 +174,9 @@ TEST(OutputFile, SigkillWhileWritingLeavesOnlyTheOldFile) {
   TempDir dir;
   const fs::path path = dir / "out.txt";
   put_text(path, "old");
-  int ready[2];
-  ASSERT_EQ(::pipe(ready), 0);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    vola::OutputFile out(path.string());
-    const std::string block(1 << 20, 'x');
-    for (int i = 0; i < 4; ++i) out.write(block);
-    std::fflush(out.stream());
-    const char one = '1';
-    if (::write(ready[1], &one, 1) != 1) ::_exit(5);
-    for (;;) ::pause();
-  }
-  char got = 0;
-  ASSERT_EQ(::read(ready[0], &got, 1), 1);
-  ::kill(pid, SIGKILL);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  ::close(ready[0]);
-  ::close(ready[1]);
-  ASSERT_TRUE(WIFSIGNALED(status));
-  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+  const KilledWriter k = kill_while_writing(path, std::size_t{4} << 20, SIGKILL, false);
+  ASSERT_TRUE(WIFSIGNALED(k.status));
+  EXPECT_EQ(WTERMSIG(k.status), SIGKILL);
   EXPECT_EQ(text_of(path), "old");
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
 }
