@@ -96,6 +96,7 @@ void run_train(TrainArgs& a) {
                       {"max_rotation_degrees", options.max_rotation_degrees},
                       {"max_scale", options.max_scale},
                       {"max_shift", options.max_shift},
+                      {"hollow", options.hollow},
                       {"balanced", options.balanced},
                       {"threads", options.threads}};
     run["model"] = options.model_path;
@@ -159,6 +160,11 @@ void add_train(CLI::App& app) {
                   "Augmentation: shift uniform in [-V, V] voxels of the 64^3 tree along each axis (0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 16.0));
+  cmd->add_option("--hollow", args->options.hollow,
+                  "Augmentation: probability P that a training object is given as its surface shell only, as "
+                  "a scan or a surface-voxelised mesh gives it (0: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--balanced", args->options.balanced,
                 "Weigh the loss by 1/sqrt(class share) so rare classes count more");
   cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);

@@ -41,6 +41,7 @@ void BatchProducer::run() {
     std::uniform_real_distribution<double> angle(-a.max_rotation, a.max_rotation);
     std::uniform_real_distribution<double> scale(1 - a.max_scale, 1 + a.max_scale);
     std::uniform_real_distribution<double> shift(-a.max_shift, a.max_shift);
+    std::bernoulli_distribution hollow(a.hollow);
     const std::size_t cells = std::size_t(side_) * side_ * side_;
     for (std::size_t first = 0; first < order_.size(); first += batch_size_) {
       const std::size_t count = std::min(batch_size_, order_.size() - first);
@@ -54,7 +55,10 @@ void BatchProducer::run() {
         if (a.max_scale > 0) placement.scale = scale(random);
         if (a.max_shift > 0)
           for (double& d : placement.shift) d = shift(random);
-        fill_occupancy(sample.tree, side_, placement, std::span<float>(batch.inputs.data() + k * cells, cells));
+        const std::span<float> input(batch.inputs.data() + k * cells, cells);
+        fill_occupancy(sample.tree, side_, placement, input);
+        // Drawn only when asked for, so that runs without it keep their random sequence.
+        if (a.hollow > 0 && hollow(random)) keep_surface(input, side_);
         batch.labels.push_back(sample.label);
         batch.indices.push_back(index);
       }

@@ -22,6 +22,7 @@ struct Augmentation {
   double max_rotation = 0;
   double max_scale = 0;
   double max_shift = 0;
+  double hollow = 0;  // probability of a sample's input being its surface shell (keep_surface)
 };
 
 struct Batch {
@@ -37,7 +38,8 @@ class BatchProducer {
   // grid `side`. Angles are uniform in [-max_rotation, max_rotation] radians, drawn in
   // order from a generator seeded with `seed` (0 radians when max_rotation is 0); then,
   // when augmentation asks for them, a scale uniform in [1 - max_scale, 1 + max_scale]
-  // and a shift uniform in [-max_shift, max_shift] tree voxels along each axis. At most
+  // and a shift uniform in [-max_shift, max_shift] tree voxels along each axis; then, with
+  // probability `hollow`, only the input's surface shell (keep_surface). At most
   // `ahead` batches wait in the queue.
   BatchProducer(const std::vector<Sample>& samples, std::vector<std::size_t> order, std::size_t batch_size, int side,
                 std::uint64_t seed, double max_rotation, std::size_t ahead = 2);

@@ -85,6 +85,21 @@ void fill_occupancy(const Tree& tree, int out_side, const Placement& placement, 
   });
 }
 
+void keep_surface(std::span<float> cells, int side) {
+  const std::size_t n = static_cast<std::size_t>(side);
+  if (cells.size() != n * n * n)
+    throw InvalidArgument("keep_surface: " + std::to_string(cells.size()) + " cells are not a grid of side " +
+                          std::to_string(side));
+  const std::vector<float> solid(cells.begin(), cells.end());
+  auto filled = [&](std::size_t x, std::size_t y, std::size_t z) { return solid[(z * n + y) * n + x] > 0.0f; };
+  for (std::size_t z = 1; z + 1 < n; ++z)
+    for (std::size_t y = 1; y + 1 < n; ++y)
+      for (std::size_t x = 1; x + 1 < n; ++x)
+        if (filled(x, y, z) && filled(x - 1, y, z) && filled(x + 1, y, z) && filled(x, y - 1, z) &&
+            filled(x, y + 1, z) && filled(x, y, z - 1) && filled(x, y, z + 1))
+          cells[(z * n + y) * n + x] = 0.0f;
+}
+
 Tree turn_quarters(const Tree& tree, int quarter_turns) {
   const int quarters = ((quarter_turns % 4) + 4) % 4;
   std::vector<Voxel> voxels;

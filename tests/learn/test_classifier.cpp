@@ -5,6 +5,7 @@
 
 #include <zip.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <numeric>
 
@@ -59,6 +60,7 @@ TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
   options.max_rotation_degrees = 180;  // every augmentation draws from the seeded generator
   options.max_scale = 0.1;
   options.max_shift = 2;
+  options.hollow = 0.5;
   options.balanced = true;
   options.model_path = (dir / "whole.pt").string();
   options.checkpoint_path = (dir / "whole.ckpt").string();
@@ -135,6 +137,25 @@ TEST(Classifier, RefusesFilesThatAreNotModels) {
 // Voting over 12 orientations 30 degrees apart: an input turned by a quarter turn (a
 // multiple of 30 degrees that a voxel grid can be turned by exactly) sees the same 12
 // inputs in another order, so the averaged probabilities agree. One vote does not.
+// The surface shell of a solid: a cube of 8 in a grid of 16 keeps 8^3 - 6^3 cells, every one
+// with an empty face neighbour; a grid full to its border keeps its outer layer.
+TEST(Occupancy, KeepSurfaceLeavesTheShell) {
+  const int side = 16;
+  std::vector<float> cells(std::size_t(side) * side * side, 0.0f);
+  auto at = [&](int x, int y, int z) -> float& { return cells[(std::size_t(z) * side + std::size_t(y)) * side + std::size_t(x)]; };
+  for (int z = 4; z < 12; ++z)
+    for (int y = 4; y < 12; ++y)
+      for (int x = 4; x < 12; ++x) at(x, y, z) = 1.0f;
+  vola::learn::keep_surface(cells, side);
+  EXPECT_EQ(std::count(cells.begin(), cells.end(), 1.0f), 8 * 8 * 8 - 6 * 6 * 6);
+  EXPECT_EQ(at(4, 7, 7), 1.0f);
+  EXPECT_EQ(at(5, 7, 7), 0.0f);
+  std::vector<float> full(64, 1.0f);
+  vola::learn::keep_surface(full, 4);
+  EXPECT_EQ(std::count(full.begin(), full.end(), 1.0f), 64 - 8);
+  EXPECT_THROW(vola::learn::keep_surface(full, 5), vola::InvalidArgument);
+}
+
 TEST(Classifier, TwelveVotesAreInvariantToQuarterTurns) {
   const Classifier classifier(vola_learn_test::committed_model_path());
   double single_vote_change = 0;

@@ -51,6 +51,8 @@ struct TrainOptions {
   double max_rotation_degrees = 15;  // augmentation: uniform angle in [-max, max] about z
   double max_scale = 0;              // augmentation: scale uniform in [1 - max, 1 + max] (0: none)
   double max_shift = 0;              // augmentation: shift uniform in [-max, max] tree voxels per axis
+  double hollow = 0;                 // augmentation: probability of giving a sample as its surface
+                                     // shell only (what a scan or a surface-voxelised mesh gives)
   bool balanced = false;             // loss weights 1/sqrt(class share), normalised to mean 1
   int threads = 0;                  // torch intra-op threads; 0: all cores
   std::string model_path;           // the trained weights, written after every epoch

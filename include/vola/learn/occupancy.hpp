@@ -33,6 +33,11 @@ void fill_occupancy(const Tree& tree, int out_side, double angle_radians, std::s
 // are dropped.
 void fill_occupancy(const Tree& tree, int out_side, const Placement& placement, std::span<float> out);
 
+// Keeps only the surface of an occupancy grid (side^3 cells, x fastest): a filled cell
+// stays when one of its six face neighbours is empty or outside the grid. A solid object
+// becomes the one-cell shell a scan or a surface-voxelised mesh gives.
+void keep_surface(std::span<float> cells, int side);
+
 // The tree turned by quarter_turns * 90 degrees about z (through the grid's centre):
 // voxel (x, y, z) goes to (N-1-y, x, z) for one turn. Exact; for tests and tools.
 Tree turn_quarters(const Tree& tree, int quarter_turns);
