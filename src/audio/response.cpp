@@ -14,6 +14,7 @@
 #include "vola/audio/convolve.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
+#include "option_checks.hpp"
 #include "vola/parallel.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -296,13 +297,8 @@ void sort_keys(std::vector<Key>& keys, int key_bits) {
 }  // namespace
 
 void ResponseOptions::check() const {
-  auto fail = [](const std::string& what, double v) {
-    std::ostringstream s;
-    s << what << " (got " << v << ")";
-    throw InvalidArgument(s.str());
-  };
-  if (!(sample_rate >= 1000.0 && sample_rate <= 768000.0)) fail("the sample rate must be in [1000, 768000] Hz", sample_rate);
-  if (!(speed_of_sound > 0.0 && std::isfinite(speed_of_sound))) fail("the speed of sound must be > 0", speed_of_sound);
+  const auto fail = &detail::refuse_option;
+  detail::check_sound_options(sample_rate, speed_of_sound);
   if (!(reflection_window >= 0.0 && reflection_window <= 10.0)) fail("the reflection window must be in [0, 10] s", reflection_window);
   if (!(bin_width_db > 0.0 && bin_width_db <= 6.0)) fail("the bin width must be in (0, 6] dB", bin_width_db);
   if (!(floor_db >= -300.0 && floor_db < 0.0)) fail("the floor must be in [-300, 0) dB", floor_db);

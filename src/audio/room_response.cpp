@@ -5,12 +5,12 @@
 #include <numbers>
 #include <random>
 #include <span>
-#include <sstream>
 
 #include "vola/audio/air.hpp"
 #include "vola/audio/band_filters.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/error.hpp"
+#include "option_checks.hpp"
 #include "vola/raycast/world.hpp"
 
 namespace vola::audio {
@@ -21,13 +21,8 @@ constexpr int kFractionalTaps = 16;
 }  // namespace
 
 void RoomOptions::check() const {
-  auto fail = [](const std::string& what, double v) {
-    std::ostringstream s;
-    s << what << " (got " << v << ")";
-    throw InvalidArgument(s.str());
-  };
-  if (!(sample_rate >= 1000.0 && sample_rate <= 768000.0)) fail("the sample rate must be in [1000, 768000] Hz", sample_rate);
-  if (!(speed_of_sound > 0.0 && std::isfinite(speed_of_sound))) fail("the speed of sound must be > 0", speed_of_sound);
+  const auto fail = &detail::refuse_option;
+  detail::check_sound_options(sample_rate, speed_of_sound);
   if (!(order >= 0 && order <= 64)) fail("the image-source order must be in [0, 64]", order);
   if (!(scattering >= 0.0 && scattering <= 1.0)) fail("the scattering coefficient must be in [0, 1]", scattering);
   if (!(rays <= (std::uint64_t{1} << 32))) fail("the ray count must be at most 2^32", static_cast<double>(rays));

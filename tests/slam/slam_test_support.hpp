@@ -6,6 +6,7 @@
 #include <string>
 
 #include "test_support.hpp"
+#include "vola/slam/fusion.hpp"
 #include "vola/slam/sequence.hpp"
 
 namespace vola_slam_test {
@@ -32,6 +33,15 @@ void write_text(const fs::path& path, const std::string& text);
 // the Kinect noise model, written into `directory` (the generator's output).
 void make_room_sequence(const fs::path& directory, std::size_t frames, std::uint32_t width, std::uint32_t height,
                         double degrees_per_frame, bool noise);
+
+// Fusion at 2 cm voxels, 8 cm truncation, two threads: the small scenes of the unit tests.
+inline vola::slam::FusionParams small_scene_params() {
+  vola::slam::FusionParams p;
+  p.voxel_size = 0.02;
+  p.truncation = 0.08;
+  p.threads = 2;
+  return p;
+}
 
 }  // namespace vola_slam_test
 

@@ -47,14 +47,6 @@ const Rendered& rendered() {
   return r;
 }
 
-FusionParams params() {
-  FusionParams p;
-  p.voxel_size = 0.02;
-  p.truncation = 0.08;
-  p.threads = 2;
-  return p;
-}
-
 TEST(SlamRelocalisation, FeaturesRegisterAWideBaselinePair) {
   if (!features_available()) {
     if (std::getenv("CI")) FAIL() << "vola was built without OpenCV (libopencv-dev): no colour features";
@@ -108,7 +100,7 @@ TEST(SlamRelocalisation, ALostFrameIsFollowedByRelocalisationAgainstKeyframes) {
     GTEST_SKIP() << "built without OpenCV";
   }
   const Rendered& r = rendered();
-  const std::vector<FrameResult> results = run_with_loss(params());
+  const std::vector<FrameResult> results = run_with_loss(vola_slam_test::small_scene_params());
   ASSERT_EQ(results.size(), r.poses.size() + 3);
   for (std::size_t i = 0; i < r.poses.size(); ++i) {
     EXPECT_TRUE(results[i].tracked) << "frame " << i;
@@ -123,7 +115,7 @@ TEST(SlamRelocalisation, ALostFrameIsFollowedByRelocalisationAgainstKeyframes) {
   }
   EXPECT_TRUE(results[r.poses.size() + 1].relocalised);
   // ICP alone cannot make the jump back.
-  FusionParams icp_only = params();
+  FusionParams icp_only = vola_slam_test::small_scene_params();
   icp_only.features = false;
   const std::vector<FrameResult> without = run_with_loss(icp_only);
   const FrameResult& jump = without[r.poses.size() + 1];

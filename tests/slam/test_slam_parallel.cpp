@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "slam_test_support.hpp"
 #include "parallel_fault.hpp"
 #include "vola/slam/fuse_sequence.hpp"
 #include "vola/slam/fusion.hpp"
@@ -27,19 +28,11 @@ DepthImage wall() {
   return d;
 }
 
-FusionParams params() {
-  FusionParams p;
-  p.voxel_size = 0.02;
-  p.truncation = 0.08;
-  p.threads = 2;
-  return p;
-}
-
 // Two frames through a fresh map: the first integrates (filter, integration, raycast),
 // the second also tracks.
 void fuse_two_frames() {
   SparseTsdfStore store(centred_geometry(Eigen::Vector3d(0, 0, 1.5), 0.02, 256));
-  Fusion<SparseTsdfStore> fusion(store, kIntrinsics, kWidth, kHeight, params());
+  Fusion<SparseTsdfStore> fusion(store, kIntrinsics, kWidth, kHeight, vola_slam_test::small_scene_params());
   const DepthImage depth = wall();
   fusion.process(depth, nullptr);
   fusion.process(depth, nullptr);
@@ -57,9 +50,9 @@ TEST(SlamParallel, PerPixelStagesDoNotDependOnTheThreadCount) {
   for (const unsigned threads : {2u, 3u, 8u}) EXPECT_EQ(bilateral_filter(depth, 3, 4.5, 0.03, threads).metres, one.metres);
 
   SparseTsdfStore store(centred_geometry(Eigen::Vector3d(0, 0, 1.5), 0.02, 256));
-  Fusion<SparseTsdfStore> fusion(store, kIntrinsics, kWidth, kHeight, params());
+  Fusion<SparseTsdfStore> fusion(store, kIntrinsics, kWidth, kHeight, vola_slam_test::small_scene_params());
   fusion.process(depth, nullptr);
-  FusionParams p = params();
+  FusionParams p = vola_slam_test::small_scene_params();
   p.threads = 1;
   const VertexMap a = raycast(store, kIntrinsics, kWidth, kHeight, Pose::Identity(), p);
   std::size_t valid = 0;
