@@ -41,11 +41,14 @@ class ItemCursor {
   const Item* take(std::uint16_t type, std::uint16_t size, bool layered) {
     if (at_ == info_.items.size() || info_.items[at_].type != type) return nullptr;
     const Item& item = info_.items[at_];
-    if (item.type == kWavePacket13 || item.type == kWavePacket14)
-      fail("wave packets (" + describe_item(item) + ") are not supported");
     if (size ? item.size != size : item.size == 0) fail(describe_item(item) + " has the wrong size");
-    const bool supported = layered ? (item.version == 3 || item.version == 4) : item.version == 2;
-    if (!supported) fail(describe_item(item) + " is not supported (point-wise items need version 2, layered 3 or 4)");
+    // LASzip defines WAVEPACKET13 in version 1 only, beside version 2 of the other items.
+    const bool supported = layered                    ? (item.version == 3 || item.version == 4)
+                           : item.type == kWavePacket13 ? item.version == 1
+                                                        : item.version == 2;
+    if (!supported)
+      fail(describe_item(item) +
+           " is not supported (point-wise items need version 2, wave packets 1; layered items 3 or 4)");
     ++at_;
     return &item;
   }
@@ -92,7 +95,7 @@ RecordLayout record_layout(const LaszipInfo& info, const std::string& source, st
     layout.length = 20;
     if (cursor.take(kGpsTime11, 8, false)) layout.gps_at = std::exchange(layout.length, layout.length + 8);
     if (cursor.take(kRgb12, 6, false)) layout.rgb_at = std::exchange(layout.length, layout.length + 6);
-    cursor.take(kWavePacket13, 29, false);  // refuses
+    if (cursor.take(kWavePacket13, 29, false)) layout.wave_at = std::exchange(layout.length, layout.length + 29);
     if (const Item* bytes = cursor.take(kByte, 0, false)) {
       layout.bytes_at = layout.length;
       layout.bytes = bytes->size;
@@ -111,7 +114,10 @@ RecordLayout record_layout(const LaszipInfo& info, const std::string& source, st
       layout.rgb_v4 = rgb->version == 4;
       layout.length += rgb->size;
     }
-    cursor.take(kWavePacket14, 29, true);  // refuses
+    if (const Item* wave = cursor.take(kWavePacket14, 29, true)) {
+      layout.wave_at = std::exchange(layout.length, layout.length + 29);
+      layout.wave_v4 = wave->version == 4;
+    }
     if (const Item* bytes = cursor.take(kByte14, 0, true)) {
       layout.bytes_at = layout.length;
       layout.bytes = bytes->size;
@@ -175,27 +181,28 @@ std::vector<std::uint8_t> laszip_vlr_payload(const LaszipInfo& info) {
 }
 
 LaszipInfo laszip_info_for(std::uint8_t point_format, std::uint16_t record_length) {
-  static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 0, 0, 30, 36, 38};
-  if (point_format > 8 || kBase[point_format] == 0)
-    VOLA_THROW(InvalidArgument("LAZ: point format " + std::to_string(point_format) +
-                               " is not supported (wave packets, or unknown)"));
+  static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  if (point_format > 10)
+    VOLA_THROW(InvalidArgument("LAZ: point format " + std::to_string(point_format) + " is unknown (0-10)"));
   const std::uint16_t base = kBase[point_format];
   if (record_length < base)
     VOLA_THROW(InvalidArgument("LAZ: record length " + std::to_string(record_length) + " is below format " +
                                std::to_string(point_format) + "'s " + std::to_string(base)));
   LaszipInfo info;
   const std::uint16_t extra = record_length - base;
-  if (point_format <= 3) {
+  if (point_format <= 5) {
     info.compressor = 2;
     info.items.push_back({kPoint10, 20, 2});
-    if (point_format == 1 || point_format == 3) info.items.push_back({kGpsTime11, 8, 2});
-    if (point_format >= 2) info.items.push_back({kRgb12, 6, 2});
+    if (point_format != 0 && point_format != 2) info.items.push_back({kGpsTime11, 8, 2});
+    if (point_format == 2 || point_format == 3 || point_format == 5) info.items.push_back({kRgb12, 6, 2});
+    if (point_format >= 4) info.items.push_back({kWavePacket13, 29, 1});
     if (extra) info.items.push_back({kByte, extra, 2});
   } else {
     info.compressor = 3;
     info.items.push_back({kPoint14, 30, 3});
     if (point_format == 7) info.items.push_back({kRgb14, 6, 3});
-    if (point_format == 8) info.items.push_back({kRgbNir14, 8, 3});
+    if (point_format == 8 || point_format == 10) info.items.push_back({kRgbNir14, 8, 3});
+    if (point_format >= 9) info.items.push_back({kWavePacket14, 29, 3});
     if (extra) info.items.push_back({kByte14, extra, 3});
   }
   return info;

@@ -1,8 +1,8 @@
 // Compressor 3 chunks:
 //   the first record, raw
 //   uint32  number of points in the chunk (the first included)
-//   uint32  byte size of each layer: POINT14's 9, then RGB (1) or RGBNIR (2), then one
-//           per extra byte
+//   uint32  byte size of each layer: POINT14's 9, then RGB (1) or RGBNIR (2), then the
+//           wave packets (1), then one per extra byte
 //   the layers' bytes in the same order
 #include <memory>
 #include <optional>
@@ -17,21 +17,24 @@ namespace vola::io::laz {
 namespace {
 
 std::size_t layer_count(const RecordLayout& layout) {
-  return kLayers14 + (layout.rgb_at ? (layout.nir ? 2 : 1) : 0) + layout.bytes;
+  return kLayers14 + (layout.rgb_at ? (layout.nir ? 2 : 1) : 0) + (layout.wave_at ? 1 : 0) + layout.bytes;
 }
 
 struct LayeredCoders {
   LayeredCoders(const RecordLayout& record, bool decoding) : point(decoding, record.point_v4), layout(record) {
     if (layout.rgb_at) rgb.emplace(decoding, layout.nir, layout.rgb_v4);
+    if (layout.wave_at) wave.emplace(decoding, layout.wave_v4);
     if (layout.bytes) bytes.emplace(layout.bytes, decoding, layout.bytes_v4);
   }
   void start(const std::uint8_t* first) {
     const std::uint32_t context = point.start(first);
     if (rgb) rgb->start(first + layout.rgb_at, context);
+    if (wave) wave->start(first + layout.wave_at, context);
     if (bytes) bytes->start(first + layout.bytes_at, context);
   }
   Point14Coder point;
   std::optional<Rgb14Coder> rgb;
+  std::optional<WavePacket14Coder> wave;
   std::optional<Byte14Coder> bytes;
   RecordLayout layout;
 };
@@ -94,16 +97,20 @@ std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const s
     coders->rgb->set_layers(spans[next], layout.nir ? spans[next + 1] : std::span<const std::uint8_t>{});
     next += layout.nir ? 2 : 1;
   }
+  if (coders->wave) coders->wave->set_layer(spans[next++]);
   if (coders->bytes) coders->bytes->set_layers(std::span(spans).subspan(next));
   Rgb14Coder* rgb = coders->rgb ? &*coders->rgb : nullptr;
+  WavePacket14Coder* wave = coders->wave ? &*coders->wave : nullptr;
   Byte14Coder* bytes = coders->bytes ? &*coders->bytes : nullptr;
   std::uint8_t* out = records + n;
   for (std::uint64_t i = 1; i < count; ++i, out += n) {
     const std::uint32_t context = coders->point.decode(out);
     if (rgb) rgb->decode(context, out + layout.rgb_at);
+    if (wave) wave->decode(context, out + layout.wave_at);
     if (bytes) bytes->decode(context, out + layout.bytes_at);
   }
-  return coders->point.overrun() + (rgb ? rgb->overrun() : 0) + (bytes ? bytes->overrun() : 0);
+  return coders->point.overrun() + (rgb ? rgb->overrun() : 0) + (wave ? wave->overrun() : 0) +
+         (bytes ? bytes->overrun() : 0);
 }
 
 void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8_t> records,
@@ -117,6 +124,7 @@ void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8
     const std::uint8_t* in = records.data() + i * n;
     const std::uint32_t context = coders->point.encode(in);
     if (coders->rgb) coders->rgb->encode(context, in + layout.rgb_at);
+    if (coders->wave) coders->wave->encode(context, in + layout.wave_at);
     if (coders->bytes) coders->bytes->encode(context, in + layout.bytes_at);
   }
   std::vector<std::vector<std::uint8_t>> layers;
@@ -126,6 +134,7 @@ void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8
     layers.push_back(std::move(rgb[0]));
     if (layout.nir) layers.push_back(std::move(rgb[1]));
   }
+  if (coders->wave) layers.push_back(coders->wave->finish());
   if (coders->bytes)
     for (auto& layer : coders->bytes->finish()) layers.push_back(std::move(layer));
   out.insert(out.end(), records.begin(), records.begin() + static_cast<std::ptrdiff_t>(n));

@@ -1,8 +1,10 @@
-// RGB14, RGBNIR14 and BYTE14 (versions 3 and 4): colour, near infrared and extra bytes
-// of LAS 1.4 records, each in its own layer(s), with models per scanner channel.
+// RGB14, RGBNIR14, WAVEPACKET14 and BYTE14 (versions 3 and 4): colour, near infrared,
+// wave packets and extra bytes of LAS 1.4 records, each in its own layer(s), with models
+// per scanner channel.
 #include <cstring>
 
 #include "layered_items.hpp"
+#include "wave_packet_coder.hpp"
 
 namespace vola::io::laz {
 
@@ -113,6 +115,74 @@ std::array<std::vector<std::uint8_t>, 2> Rgb14Coder::finish() {
     layers[i] = std::move(encoders_[i].bytes());
   }
   return layers;
+}
+
+struct WavePacket14Coder::Context {
+  explicit Context(bool decoding) : coder(decoding) {}
+  void start(const std::uint8_t* seed) {
+    coder.reset();
+    std::memcpy(last, seed, sizeof last);
+    used = true;
+  }
+  bool used = false;
+  std::uint8_t last[kWavePacketBytes] = {};
+  WavePacketCoder coder;
+};
+
+WavePacket14Coder::WavePacket14Coder(bool decoding, bool version4) : decoding_(decoding), version4_(version4) {}
+WavePacket14Coder::~WavePacket14Coder() = default;
+
+void WavePacket14Coder::start(const std::uint8_t* first, std::uint32_t context) {
+  for (auto& c : contexts_)
+    if (c) c->used = false;
+  current_ = context;
+  if (!contexts_[current_]) contexts_[current_] = std::make_unique<Context>(decoding_);
+  contexts_[current_]->start(first);
+  std::memcpy(previous_, first, sizeof previous_);
+  encoder_.clear();
+  changed_ = false;
+}
+
+WavePacket14Coder::Context& WavePacket14Coder::follow(std::uint32_t context) {  // as Rgb14Coder::follow
+  Context* owner = contexts_[current_].get();
+  if (context == current_) return *owner;
+  current_ = context;
+  auto& next = contexts_[current_];
+  if (!next) next = std::make_unique<Context>(decoding_);
+  if (!next->used) {
+    next->start(owner->last);
+    return *next;
+  }
+  return version4_ ? *next : *owner;
+}
+
+void WavePacket14Coder::set_layer(std::span<const std::uint8_t> layer) {
+  present_ = !layer.empty();
+  if (present_) decoder_.start(layer);
+}
+
+std::uint64_t WavePacket14Coder::overrun() const { return present_ ? decoder_.overrun() : 0; }
+
+void WavePacket14Coder::decode(std::uint32_t context, std::uint8_t* out) {
+  Context& owner = follow(context);
+  if (present_) {
+    contexts_[current_]->coder.decode(decoder_, owner.last, owner.last);
+    std::memcpy(previous_, owner.last, sizeof previous_);
+  }
+  std::memcpy(out, previous_, sizeof previous_);
+}
+
+void WavePacket14Coder::encode(std::uint32_t context, const std::uint8_t* in) {
+  Context& owner = follow(context);
+  changed_ |= std::memcmp(in, owner.last, sizeof owner.last) != 0;
+  contexts_[current_]->coder.encode(encoder_, owner.last, in);
+  std::memcpy(owner.last, in, sizeof owner.last);
+}
+
+std::vector<std::uint8_t> WavePacket14Coder::finish() {
+  if (!changed_) return {};
+  encoder_.finish();
+  return std::move(encoder_.bytes());
 }
 
 struct Byte14Coder::Context {

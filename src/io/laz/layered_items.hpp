@@ -1,5 +1,5 @@
-// The layered item coders (compressor 3, LAS 1.4 formats 6-8): POINT14, RGB14,
-// RGBNIR14 and BYTE14, versions 3 and 4. Each field group is coded into its own stream
+// The layered item coders (compressor 3, LAS 1.4 formats 6-10): POINT14, RGB14,
+// RGBNIR14, WAVEPACKET14 and BYTE14, versions 3 and 4. Each field group is coded into its own stream
 // (a "layer"), so a reader may skip layers and a layer whose values never change in a
 // chunk is left out (size 0: every point keeps the chunk's first value).
 //
@@ -100,6 +100,34 @@ class Rgb14Coder {
   bool present_[2] = {};
   ArithmeticEncoder encoders_[2];
   bool changed_[2] = {};
+};
+
+// WAVEPACKET14: one layer. Where it is absent, every point repeats the packet of the
+// point before it (as LASzip leaves its record buffer untouched).
+class WavePacket14Coder {
+ public:
+  WavePacket14Coder(bool decoding, bool version4);
+  ~WavePacket14Coder();
+  void start(const std::uint8_t* first, std::uint32_t context);
+  void set_layer(std::span<const std::uint8_t> layer);
+  void decode(std::uint32_t context, std::uint8_t* out);
+  void encode(std::uint32_t context, const std::uint8_t* in);
+  std::uint64_t overrun() const;
+  std::vector<std::uint8_t> finish();
+
+  struct Context;
+
+ private:
+  Context& follow(std::uint32_t context);
+
+  bool decoding_, version4_;
+  std::array<std::unique_ptr<Context>, 4> contexts_;
+  std::uint32_t current_ = 0;
+  std::uint8_t previous_[29] = {};  // the last point's packet
+  ArithmeticDecoder decoder_;
+  bool present_ = false;
+  ArithmeticEncoder encoder_;
+  bool changed_ = false;
 };
 
 // BYTE14: one layer per extra byte.

@@ -16,18 +16,21 @@ struct PointwiseCoders {
   PointwiseCoders(const RecordLayout& record, bool decoding) : point(decoding), layout(record) {
     if (layout.gps_at) gps.emplace(decoding);
     if (layout.rgb_at) rgb.emplace(decoding);
+    if (layout.wave_at) wave.emplace(decoding);
     if (layout.bytes) bytes.emplace(layout.bytes, decoding);
   }
   void start(const std::uint8_t* first) {
     point.start(first);
     if (gps) gps->start(first + layout.gps_at);
     if (rgb) rgb->start(first + layout.rgb_at);
+    if (wave) wave->start(first + layout.wave_at);
     if (bytes) bytes->start(first + layout.bytes_at);
   }
 
   Point10Coder point;
   std::optional<GpsTime11Coder> gps;
   std::optional<Rgb12Coder> rgb;
+  std::optional<WavePacket13Coder> wave;
   std::optional<ByteCoder> bytes;
   RecordLayout layout;
 };
@@ -57,12 +60,14 @@ std::uint64_t decode_pointwise_chunk(const RecordLayout& layout, std::span<const
   Point10Coder& point = coders.point;
   GpsTime11Coder* gps = coders.gps ? &*coders.gps : nullptr;
   Rgb12Coder* rgb = coders.rgb ? &*coders.rgb : nullptr;
+  WavePacket13Coder* wave = coders.wave ? &*coders.wave : nullptr;
   ByteCoder* bytes = coders.bytes ? &*coders.bytes : nullptr;
   std::uint8_t* out = records + n;
   for (std::uint64_t i = 1; i < count; ++i, out += n) {
     point.decode(d, out);
     if (gps) gps->decode(d, out + layout.gps_at);
     if (rgb) rgb->decode(d, out + layout.rgb_at);
+    if (wave) wave->decode(d, out + layout.wave_at);
     if (bytes) bytes->decode(d, out + layout.bytes_at);
     // A stream that ran dry stays dry: stop early rather than decode zeros.
     if (d.overrun() > 4) return d.overrun();
@@ -84,6 +89,7 @@ void encode_pointwise_chunk(const RecordLayout& layout, std::span<const std::uin
     coders.point.encode(e, in);
     if (coders.gps) coders.gps->encode(e, in + layout.gps_at);
     if (coders.rgb) coders.rgb->encode(e, in + layout.rgb_at);
+    if (coders.wave) coders.wave->encode(e, in + layout.wave_at);
     if (coders.bytes) coders.bytes->encode(e, in + layout.bytes_at);
   }
   e.finish();

@@ -1,6 +1,6 @@
 // The point-wise item coders (compressors 1 and 2): every part of a record is coded
 // into one arithmetic stream, point after point. POINT10 v2 (the 20 bytes common to LAS
-// formats 0-5), GPSTIME11 v2, RGB12 v2 and BYTE v2 (extra bytes). Each coder keeps the
+// formats 0-5), GPSTIME11 v2, RGB12 v2, WAVEPACKET13 v1 and BYTE v2 (extra bytes). Each coder keeps the
 // last record's values and its models; start() resets both from a chunk's first record
 // (which the chunk stores raw). Internal to the LAZ codec (src/io/laz).
 #pragma once
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "item_common.hpp"
+#include "wave_packet_coder.hpp"
 #include "vola/little_endian.hpp"
 
 namespace vola::io::laz {
@@ -175,6 +176,28 @@ class Rgb12Coder {
  private:
   RgbModels models_;
   std::uint16_t last_[3] = {};
+};
+
+// WAVEPACKET13 (version 1, the only one LASzip defines).
+class WavePacket13Coder {
+ public:
+  explicit WavePacket13Coder(bool decoding) : coder_(decoding) {}
+  void start(const std::uint8_t* first) {
+    coder_.reset();
+    std::memcpy(last_, first, kWavePacketBytes);
+  }
+  [[gnu::always_inline]] void decode(ArithmeticDecoder& d, std::uint8_t* out) {
+    coder_.decode(d, last_, last_);
+    std::memcpy(out, last_, kWavePacketBytes);
+  }
+  void encode(ArithmeticEncoder& e, const std::uint8_t* in) {
+    coder_.encode(e, last_, in);
+    std::memcpy(last_, in, kWavePacketBytes);
+  }
+
+ private:
+  WavePacketCoder coder_;
+  std::uint8_t last_[kWavePacketBytes] = {};
 };
 
 // Extra bytes: each byte as its difference to the same byte of the last record, one

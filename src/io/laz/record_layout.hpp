@@ -1,8 +1,9 @@
 // Internal to the LAZ codec: where each item sits in a point record, checked once per
 // call so that the per-point loops only test flags. A record is one of the sequences
-//   POINT10 [GPSTIME11] [RGB12] [BYTE]                  (compressors 1, 2; version 2)
-//   POINT14 [RGB14 | RGBNIR14] [BYTE14]                 (compressor 3; version 3 or 4)
-// which are the layouts of LAS point formats 0-3 and 6-8 with extra bytes.
+//   POINT10 [GPSTIME11] [RGB12] [WAVEPACKET13] [BYTE]    (compressors 1, 2; version 2,
+//                                                         wave packets version 1)
+//   POINT14 [RGB14 | RGBNIR14] [WAVEPACKET14] [BYTE14]   (compressor 3; version 3 or 4)
+// which are the layouts of LAS point formats 0-10 with extra bytes.
 #pragma once
 
 #include <cstddef>
@@ -19,11 +20,12 @@ struct RecordLayout {
   bool layered = false;
   // Version 4 of the layered items fixes how they follow the scanner channel (see
   // layered_chunk.cpp); each item has its own version.
-  bool point_v4 = false, rgb_v4 = false, bytes_v4 = false;
+  bool point_v4 = false, rgb_v4 = false, wave_v4 = false, bytes_v4 = false;
   std::size_t length = 0;
   std::size_t gps_at = 0;    // 0 = none (point-wise only; layered records always have it)
   std::size_t rgb_at = 0;    // 0 = none
   bool nir = false;          // RGBNIR14: NIR after RGB
+  std::size_t wave_at = 0;   // 0 = none: the wave packet (29 bytes)
   std::size_t bytes_at = 0;  // extra bytes
   std::size_t bytes = 0;
   bool operator==(const RecordLayout&) const = default;
