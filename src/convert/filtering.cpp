@@ -13,7 +13,11 @@ namespace {
 
 // LAS record fields vola convert does not keep per voxel (io::las_attributes).
 bool dropped_las_field(const std::string& name) {
-  return name == "return_number" || name == "user_data" || name == "point_source_id" || name == "gps_time";
+  static const char* const kDropped[] = {"return_number", "user_data", "point_source_id", "gps_time", "scan_angle_rank",
+                                         "classification_flags", "scan_direction_flag", "edge_of_flight_line",
+                                         "scanner_channel", "nir", "wave_packet_index", "wave_offset",
+                                         "wave_packet_size", "wave_return_point", "wave_dx", "wave_dy", "wave_dz"};
+  return std::any_of(std::begin(kDropped), std::end(kDropped), [&](const char* dropped) { return name == dropped; });
 }
 
 // The table of every LAS field (Reduction::last) as the columns io::las_attributes

@@ -11,8 +11,20 @@ std::string dimension_key(const std::string& name) {
   return key;
 }
 
+namespace {
+
+// PDAL's names for LAS fields that vola's columns spell otherwise (after dimension_key).
+std::string vola_spelling(const std::string& key) {
+  if (key == "scanchannel") return "scannerchannel";
+  if (key == "infrared") return "nir";
+  if (key == "classflags") return "classificationflags";
+  return key;
+}
+
+}  // namespace
+
 std::optional<Dimension> find_dimension(const PointCloud& cloud, const std::string& name) {
-  const std::string key = dimension_key(name);
+  const std::string key = vola_spelling(dimension_key(name));
   for (std::size_t c = 0; c < cloud.attributes.size(); ++c)
     if (dimension_key(cloud.attributes[c].name) == key) return Dimension{-1, c};
   if (key == "x") return Dimension{0, 0};

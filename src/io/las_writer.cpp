@@ -94,6 +94,11 @@ struct LasColumns {
   const AttributeColumn* user_data = nullptr;
   const AttributeColumn* point_source_id = nullptr;
   const AttributeColumn* gps_time = nullptr;
+  const AttributeColumn* scan_angle = nullptr;            // degrees
+  const AttributeColumn* classification_flags = nullptr;  // 4 bits
+  const AttributeColumn* scanner_channel = nullptr;       // 2 bits
+  const AttributeColumn* scan_direction = nullptr;        // 1 bit
+  const AttributeColumn* edge = nullptr;                  // 1 bit
   std::vector<const AttributeColumn*> extra;
   std::vector<std::string> extra_names;  // at most 32 bytes, unique
   bool rgb() const noexcept { return red && green && blue; }
@@ -116,11 +121,18 @@ LasColumns sort_columns(const Attributes& a) {
   c.user_data = a.find("user_data");
   c.point_source_id = a.find("point_source_id");
   c.gps_time = a.find("gps_time");
+  c.scan_angle = a.find("scan_angle_rank");
+  c.classification_flags = a.find("classification_flags");
+  c.scanner_channel = a.find("scanner_channel");
+  c.scan_direction = a.find("scan_direction_flag");
+  c.edge = a.find("edge_of_flight_line");
   for (const auto& column : a.columns()) {
     const std::string& name = column.name();
     const bool standard = name == "intensity" || name == "classification" || name == "number_of_returns" ||
                           name == "return_number" || name == "user_data" || name == "point_source_id" ||
-                          name == "gps_time" || (c.rgb() && (name == "red" || name == "green" || name == "blue"));
+                          name == "gps_time" || name == "scan_angle_rank" || name == "classification_flags" ||
+                          name == "scanner_channel" || name == "scan_direction_flag" || name == "edge_of_flight_line" ||
+                          (c.rgb() && (name == "red" || name == "green" || name == "blue"));
     if (standard) continue;
     std::string short_name = name.substr(0, 32);
     for (int n = 2; std::find(c.extra_names.begin(), c.extra_names.end(), short_name) != c.extra_names.end(); ++n) {
@@ -288,8 +300,17 @@ std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasC
     if (columns.intensity && columns.intensity->get(rank) > 65535.0) ++clamped_intensities;
     const auto [number, count] = returns_of(columns, rank);
     record[14] = static_cast<std::uint8_t>(number | count << 4);
+    record[15] = static_cast<std::uint8_t>(field_value(columns.classification_flags, rank, 15.0, 0) |
+                                           field_value(columns.scanner_channel, rank, 3.0, 0) << 4 |
+                                           field_value(columns.scan_direction, rank, 1.0, 0) << 6 |
+                                           field_value(columns.edge, rank, 1.0, 0) << 7);
     record[16] = static_cast<std::uint8_t>(field_value(columns.classification, rank, 255.0, 0));
     record[17] = static_cast<std::uint8_t>(field_value(columns.user_data, rank, 255.0, 0));
+    if (columns.scan_angle) {  // units of 0.006 degrees, within the field's +-180 degrees
+      const double angle = columns.scan_angle->get(rank);
+      const double units = std::isnan(angle) ? 0.0 : std::clamp(std::nearbyint(angle / 0.006), -30000.0, 30000.0);
+      put<std::int16_t>(record, 18, static_cast<std::int16_t>(units));
+    }
     put<std::uint16_t>(record, 20, static_cast<std::uint16_t>(field_value(columns.point_source_id, rank, 65535.0, 0)));
     if (columns.gps_time) put<double>(record, 22, columns.gps_time->get(rank));
     if (columns.rgb()) {

@@ -1,7 +1,8 @@
 // vola translate beyond LAS <-> LAZ: any point file vola reads, as points with named
 // columns (a PointCloud), written as PLY or XYZ text, point by point in input order. A
 // LAS/LAZ/COPC input gives every field of its records: intensity, return number and
-// count, classification, user data, point source id, GPS time, colour, extra bytes.
+// count, classification, user data, point source id, GPS time, colour, scan angle, the
+// flags, scanner channel, NIR, wave packets, extra bytes.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -19,6 +20,73 @@
 namespace vola::io {
 
 namespace {
+
+// The record fields that LasChunk leaves out (vola convert keeps none of them per
+// voxel), as columns after the colour: their names, types and decoding.
+class RecordFieldColumns {
+ public:
+  explicit RecordFieldColumns(const LasHeader& hd) : hd_(hd) {
+    const std::uint8_t f = hd.point_format;
+    names_ = {"scan_angle_rank", "classification_flags", "scan_direction_flag", "edge_of_flight_line"};
+    types_ = {ValueType::f32, ValueType::u8, ValueType::u8, ValueType::u8};
+    if (hd.extended_format()) add("scanner_channel", ValueType::u8);
+    if (f == 8 || f == 10) add("nir", ValueType::u16);
+    // The wave packet: LAS formats 4, 5, 9 and 10 end with it (before any extra bytes).
+    if (f == 4 || f == 5 || f >= 9) {
+      wave_at_ = f == 4 ? 28 : f == 5 ? 34 : f == 9 ? 30 : 38;
+      add("wave_packet_index", ValueType::u8);
+      add("wave_offset", ValueType::u64);
+      add("wave_packet_size", ValueType::u32);
+      add("wave_return_point", ValueType::f32);
+      add("wave_dx", ValueType::f32);
+      add("wave_dy", ValueType::f32);
+      add("wave_dz", ValueType::f32);
+    }
+  }
+  const std::vector<const char*>& names() const { return names_; }
+  const std::vector<ValueType>& types() const { return types_; }
+
+  // Appends one value per record to each of `columns` (in names() order).
+  void append(std::span<const std::uint8_t> records, std::span<PointAttribute> columns) const {
+    const std::size_t length = hd_.record_length;
+    const bool extended = hd_.extended_format();
+    for (std::size_t at = 0; at + length <= records.size(); at += length) {
+      const std::uint8_t* r = records.data() + at;
+      std::size_t c = 0;
+      const auto put = [&](double v) { columns[c++].values.push_back(v); };
+      if (extended) {
+        put(load_le<std::int16_t>(r + 18) * 0.006);  // units of 0.006 degrees
+        put(r[15] & 15u);                            // synthetic, key-point, withheld, overlap
+        put((r[15] >> 6) & 1u);
+        put(r[15] >> 7);
+        put((r[15] >> 4) & 3u);
+      } else {
+        put(static_cast<std::int8_t>(r[16]));  // whole degrees
+        put(r[15] >> 5);                       // synthetic, key-point, withheld
+        put((r[14] >> 6) & 1u);
+        put(r[14] >> 7);
+      }
+      if (hd_.point_format == 8 || hd_.point_format == 10) put(load_le<std::uint16_t>(r + 36));
+      if (wave_at_) {
+        const std::uint8_t* w = r + wave_at_;
+        put(w[0]);
+        put(static_cast<double>(load_le<std::uint64_t>(w + 1)));
+        put(load_le<std::uint32_t>(w + 9));
+        for (int k = 0; k < 4; ++k) put(load_le<float>(w + 13 + 4 * k));
+      }
+    }
+  }
+
+ private:
+  void add(const char* name, ValueType type) {
+    names_.push_back(name);
+    types_.push_back(type);
+  }
+  const LasHeader& hd_;
+  std::vector<const char*> names_;
+  std::vector<ValueType> types_;
+  std::size_t wave_at_ = 0;
+};
 
 // The columns of a LAS file's records, in record order.
 PointTable las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
@@ -45,9 +113,16 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
     add("green", ValueType::u16);
     add("blue", ValueType::u16);
   }
+  const RecordFieldColumns fields(hd);
+  const std::size_t fields_at = cloud.attributes.size();
+  for (std::size_t k = 0; k < fields.names().size(); ++k) add(fields.names()[k], fields.types()[k]);
   for (const auto& f : hd.extra_fields) cloud.attributes.push_back({f.name, ValueType::f64, Reduction::last, {}});
   LasChunk chunk;
-  while (reader.read(chunk, std::size_t{1} << 20) > 0) {
+  for (;;) {
+    const std::span<const std::uint8_t> records = reader.read_records(std::size_t{1} << 16);
+    if (records.empty()) break;
+    chunk.clear();
+    decode_las_records(hd, records, chunk);
     cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
     std::size_t c = 0;
     const auto append = [&](const auto& values) {
@@ -66,6 +141,8 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
       append(chunk.green);
       append(chunk.blue);
     }
+    fields.append(records, std::span(cloud.attributes).subspan(fields_at, fields.names().size()));
+    c += fields.names().size();
     for (const auto& e : chunk.extra) append(e);
     if (progress) progress(reader.points_read(), reader.points_total());
   }

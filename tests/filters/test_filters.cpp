@@ -39,6 +39,24 @@ double distance2(const std::vector<double>& xyz, std::size_t i, const double* q,
   return d2;
 }
 
+// Dimension names as users type them: vola's columns, PDAL's spellings, any case.
+TEST(Dimensions, PdalNamesFindVolaColumns) {
+  vola::PointCloud cloud;
+  cloud.xyz = {1, 2, 3};
+  for (const char* name : {"scanner_channel", "nir", "classification_flags", "scan_angle_rank", "return_number"})
+    cloud.attributes.push_back({name, vola::ValueType::u8, vola::Reduction::last, {0}});
+  const std::pair<const char*, std::size_t> cases[] = {{"ScanChannel", 0},   {"scanner_channel", 0}, {"Infrared", 1},
+                                                       {"NIR", 1},           {"ClassFlags", 2},      {"ScanAngleRank", 3},
+                                                       {"ReturnNumber", 4}};
+  for (const auto& [name, column] : cases) {
+    const auto d = find_dimension(cloud, name);
+    ASSERT_TRUE(d && d->axis < 0) << name;
+    EXPECT_EQ(d->column, column) << name;
+  }
+  EXPECT_FALSE(find_dimension(cloud, "ScanAngle"));
+  EXPECT_EQ(find_dimension(cloud, "Z")->axis, 2);
+}
+
 TEST(KdTree, NearestEqualsBruteForceIn2dAnd3d) {
   const auto xyz = random_points(2000, 1);
   const KdTree<3> tree3(xyz, 3);

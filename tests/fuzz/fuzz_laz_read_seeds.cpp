@@ -1,6 +1,6 @@
 // Seeds for fuzz_laz_read: the small LAZ files of the shared data folder (beside
 // golden/) and LAZ files written here with the codec's encoder (point formats 0-3 and
-// 6-8, extra bytes, several chunks, variable chunks, compressor 1, item version 4).
+// 6-8, the wave-packet formats 4, 5, 9 and 10, extra bytes, several chunks, variable chunks, compressor 1, item version 4).
 // Linked into fuzz_laz_replay in place of fuzz_seeds.cpp.
 #include <algorithm>
 #include <cstring>
@@ -74,8 +74,8 @@ Bytes records(std::uint16_t length, std::size_t count, std::uint64_t seed) {
 
 std::vector<Seed> synthetic_seeds() {
   std::vector<Seed> seeds;
-  static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 0, 0, 30, 36, 38};
-  for (const int format : {0, 1, 2, 3, 6, 7, 8}) {
+  static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  for (const int format : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}) {
     const auto length = static_cast<std::uint16_t>(kBase[format] + 3);
     const std::string name = "laz_format" + std::to_string(format);
     laz::LaszipInfo info = laz::laszip_info_for(static_cast<std::uint8_t>(format), length);

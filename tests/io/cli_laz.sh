@@ -118,7 +118,8 @@ PY
 done
 
 # vola translate to PLY and XYZ keeps every field of every record, in order (laspy_simple.laz:
-# point format 3), checked against the records of its decoded LAS.
+# point format 3), checked against the records of its decoded LAS (the scan angle and the
+# flags too).
 "$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.las" -q
 "$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.ply" -q
 "$vola" translate "$data/laz/laspy_simple.laz" "$tmp/simple.xyz" -q
@@ -135,7 +136,7 @@ las = np.frombuffer(d, offset=offset, count=count, dtype=np.dtype([("xyz", "<i4"
 ply = open(sys.argv[2], "rb").read()
 body = ply.index(b"end_header\n") + len(b"end_header\n")
 names = [l.split()[-1].decode() for l in ply[:body].split(b"\n") if l.startswith(b"property")]
-types = {b"double": "<f8", b"ushort": "<u2", b"uchar": "u1"}
+types = {b"double": "<f8", b"float": "<f4", b"ushort": "<u2", b"uchar": "u1"}
 dtype = np.dtype([(l.split()[-1].decode(), types[l.split()[1]]) for l in ply[:body].split(b"\n") if l.startswith(b"property")])
 p = np.frombuffer(ply, offset=body, count=count, dtype=dtype)
 xyz = las["xyz"] * scale + origin
@@ -143,10 +144,42 @@ assert np.array_equal(np.stack([p["x"], p["y"], p["z"]], 1), xyz), "coordinates"
 for f in ("intensity", "classification", "user_data", "point_source_id", "gps_time", "red", "green", "blue"):
     assert np.array_equal(p[f], las[f]), f
 assert np.array_equal(p["return_number"], las["returns"] & 7) and np.array_equal(p["number_of_returns"], (las["returns"] >> 3) & 7)
+assert np.array_equal(p["scan_angle_rank"], las["angle"]), "scan angle"
+assert np.array_equal(p["scan_direction_flag"], (las["returns"] >> 6) & 1) and np.array_equal(p["edge_of_flight_line"], las["returns"] >> 7)
+assert np.array_equal(p["classification_flags"], las["classification"] >> 5), "classification flags"
 text = np.loadtxt(sys.argv[3], comments="#")
 assert text.shape[0] == count and np.allclose(text[:, :3], xyz, atol=0.5 * scale.max(), rtol=0), "xyz text"
 assert np.array_equal(text[:, 9], las["gps_time"]), "gps_time text"
 PY
+# The fields LAS 1.4 records and wave packets add: laspy_simple1_4.las (format 7) and
+# laspy_simple1_3.las (format 4, wave packets), each through LAZ first, against its records.
+for las in "$data/las/laspy_simple1_4.las" "$data/las/laspy_simple1_3.las"; do
+  "$vola" translate "$las" "$tmp/fields.laz" -q
+  "$vola" translate "$tmp/fields.laz" "$tmp/fields.xyz" -q
+  "${VOLA_PYTHON:-/usr/bin/python3}" - "$las" "$tmp/fields.xyz" <<'PY' || fail "$(basename "$las"): XYZ lost LAS 1.4 or wave-packet fields"
+import struct, sys
+import numpy as np
+d = open(sys.argv[1], "rb").read()
+offset, length, count = struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<H", d, 105)[0], struct.unpack_from("<I", d, 107)[0]
+records = np.frombuffer(d, offset=offset, count=count * length, dtype="u1").reshape(count, length)
+names = open(sys.argv[2]).readline().split()[1:]
+text = np.loadtxt(sys.argv[2], comments="#", ndmin=2)
+column = lambda name: text[:, names.index(name)]
+if d[104] & 63 == 7:
+    angle = records[:, 18:20].copy().view("<i2")[:, 0] * 0.006
+    assert np.allclose(column("scan_angle_rank"), angle, atol=1e-6), "scan angle"
+    assert np.array_equal(column("classification_flags"), records[:, 15] & 15), "flags"
+    assert np.array_equal(column("scanner_channel"), (records[:, 15] >> 4) & 3), "channel"
+    assert np.array_equal(column("edge_of_flight_line"), records[:, 15] >> 7), "edge"
+else:
+    wave = records[:, 28:57]
+    assert np.array_equal(column("wave_packet_index"), wave[:, 0]), "descriptor index"
+    assert np.array_equal(column("wave_offset"), wave[:, 1:9].copy().view("<u8")[:, 0]), "offset"
+    assert np.array_equal(column("wave_packet_size"), wave[:, 9:13].copy().view("<u4")[:, 0]), "size"
+    assert np.array_equal(column("wave_return_point").astype("<f4"), wave[:, 13:17].copy().view("<f4")[:, 0]), "return point"
+    assert np.array_equal(column("wave_dz").astype("<f4"), wave[:, 25:29].copy().view("<f4")[:, 0]), "dz"
+PY
+done
 # Other point files to LAS and LAZ: the same points and columns come back (PDAL's PLY,
 # PCL's coloured PCD), at the written scale; meshes are refused.
 for cloud in "$data/ply/pdal_simple_binary.ply" "$data/pcd/pcl_milk_color.pcd"; do
