@@ -19,24 +19,12 @@ if [[ $# -ne 2 ]]; then
 fi
 vola=$(realpath "$1")
 shared=$(realpath "${VOLA_SHARED:-$2}")
+keep_going=1
+source "$(dirname "$0")/lib/cli_test.sh"
 dry=$shared/data/audio/codec2_speech_orig_16k.wav
-if [[ ! -f $dry ]]; then
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: $dry is missing (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: $dry is missing" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+[[ -f $dry ]] || skip "$dry is missing"
+work=$tmp
 cd "$work" || exit 1
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
 
 # A 6 x 4 x 3 m room of 25 cm voxels (for sonify and plan) and a generated city.
 awk 'BEGIN { for (i = 0; i <= 24; i++) for (j = 0; j <= 16; j++) for (k = 0; k <= 12; k++)

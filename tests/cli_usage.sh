@@ -4,9 +4,7 @@
 # Usage: cli_usage.sh VOLA
 set -euo pipefail
 vola=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/lib/cli_test.sh"
 
 expect_suggestion() {  # WORD SUGGESTION
   if "$vola" "$1" a b 2> "$tmp/err.txt"; then fail "'$1' ran"; fi

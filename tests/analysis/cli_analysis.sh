@@ -4,10 +4,7 @@
 # Usage: cli_analysis.sh VOLA SCIPY_DUMP SHARED_DATA_DIR
 set -euo pipefail
 vola=$1 dump=$2 data=$3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 # Debian's interpreter, where python3-scipy installs (a python3 earlier on PATH may lack it).
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

@@ -6,14 +6,9 @@
 # Usage: cli_sonify_open_scene.sh VOLA SHARED_DIR
 set -euo pipefail
 vola=$1 shared=${VOLA_SHARED:-$2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 las=$shared/data/las/pdal_autzen_trim.las wav=$shared/data/audio/alsa_Front_Center.wav
-if [ ! -f "$las" ] || [ ! -f "$wav" ]; then
-  [ -n "${CI:-}" ] && fail "shared data missing at $shared (CI is set)"
-  echo "skipped: no shared data at $shared"; exit 77
-fi
+[ -f "$las" ] && [ -f "$wav" ] || skip "no shared data at $shared"
 
 "$vola" convert "$las" "$tmp/autzen.vol" --voxel-size 3 -q
 # Feet: the speed of sound in ft/s. Source 45 ft from the listener, 6 ft above the ground.

@@ -4,12 +4,9 @@
 set -euo pipefail
 test_capi=$1 vola=$2 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$3}  # VOLA_SHARED wins over the configured default
-scratch=$(mktemp -d)
-trap 'rm -rf "$scratch"' EXIT
+source "$(dirname "$0")/../lib/cli_test.sh"
+scratch=$tmp
 las=$data/las/pdal_1.2-with-color.las
-if [ ! -f "$las" ]; then
-  if [ -n "${CI:-}" ]; then echo "missing $las (CI is set)" >&2; exit 1; fi
-  echo "skipped: $las missing (set VOLA_SHARED)"; exit 77
-fi
+[ -f "$las" ] || skip "$las missing (set VOLA_SHARED)"
 "$vola" convert "$las" "$scratch/survey.vol" --voxel-size 5 --quiet
 "$test_capi" "$scratch" "$scratch/survey.vol"

@@ -12,10 +12,7 @@
 set -euo pipefail
 vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 laz=$data/laz/pdal_autzen_trim.laz
 [ -f "$laz" ] || skip "no $laz (set VOLA_SHARED)"
 laz_bytes=$(stat -c %s "$laz")

@@ -19,22 +19,9 @@ vola=$1
 shared=${VOLA_SHARED:-$2}
 las=$shared/data/las/pdal_autzen-utm.las
 golden=$shared/golden
-if [[ ! -f $las || ! -d $golden ]]; then
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: $las or $golden is missing (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: $las or $golden is missing" >&2
-  exit 77
-fi
-
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
+[[ -f $las && -d $golden ]] || skip "$las or $golden is missing"
 # expect_error MESSAGE_PART COMMAND...: the command fails and says MESSAGE_PART.
 expect_error() {
   local part=$1

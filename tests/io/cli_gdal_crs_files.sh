@@ -18,14 +18,9 @@ if [[ $# -ne 2 ]]; then
 fi
 vola=$(realpath "$1")
 python=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
 cd "$tmp" || exit 1
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
 
 mkfifo trap.init
 wkt='PROJCS["x",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",0],PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],PARAMETER["false_northing",0],UNIT["metre",1],EXTENSION["PROJ4","+init='"$tmp"'/trap.init:site +wktext"]]'

@@ -16,22 +16,9 @@ fi
 vola=$1
 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$2}
-if [[ ! -d $data/binvox || ! -d $data/ply ]]; then
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: data folder $data is missing (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: data folder $data is missing" >&2
-  exit 77
-fi
-
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
+[[ -d $data/binvox && -d $data/ply ]] || skip "data folder $data is missing"
 
 # voxels FILE.vol: the occupied count `vola info --json` reports.
 voxels() {

@@ -8,10 +8,7 @@
 set -euo pipefail
 vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 [ -d "$data/laz" ] || skip "no $data/laz (set VOLA_SHARED)"
 
 # SHA-256 of a LAS file's point records (count x record length bytes after the offset).

@@ -18,22 +18,9 @@ fi
 vola=$1
 shared=${VOLA_SHARED:-$2}
 las=$shared/data/las/pdal_autzen-utm.las
-if [[ ! -f $las ]]; then
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: $las is missing (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: $las is missing" >&2
-  exit 77
-fi
-
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
+[[ -f $las ]] || skip "$las is missing"
 # expect_error MESSAGE_PART COMMAND...: the command fails and says MESSAGE_PART.
 expect_error() {
   local part=$1

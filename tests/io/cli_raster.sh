@@ -25,24 +25,10 @@ shared=${VOLA_SHARED:-$2}
 python=${3:-/usr/bin/python3}
 las=$shared/data/las/pdal_autzen_trim.las
 golden=$shared/golden/crs29902_sparse/crs29902_sparse.vol  # a reference file: EPSG code only
-missing() {
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: $1 (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: $1" >&2
-  exit 77
-}
-[[ -f $las && -f $golden ]] || missing "$las or $golden is missing"
-"$python" -c 'import numpy; from osgeo import gdal, osr' 2>/dev/null || missing "$python has no numpy or osgeo.gdal"
-
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
+[[ -f $las && -f $golden ]] || skip "$las or $golden is missing"
+"$python" -c 'import numpy; from osgeo import gdal, osr' 2>/dev/null || skip "$python has no numpy or osgeo.gdal"
 expect_error() {
   local part=$1
   shift

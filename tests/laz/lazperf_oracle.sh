@@ -9,10 +9,7 @@ set -euo pipefail
 vola=$1 node=$2 lazperf=$3 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$4}
 here=$(cd "$(dirname "$0")" && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 [ -d "$data/laz" ] || skip "no $data/laz (set VOLA_SHARED)"
 [ -f "$lazperf/package.json" ] || fail "laz-perf is not installed at $lazperf (the build runs npm ci for it)"
 

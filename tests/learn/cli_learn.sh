@@ -4,16 +4,12 @@
 set -euo pipefail
 vola=$1
 data=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/../lib/cli_test.sh"
+work=$tmp
 
 # 20 samples: two per class, cut from the real training split (rows 0, 120, ... spread over classes).
 npz=$data/modelnet/modelnet10_32_train.npz
-if [[ ! -f $npz ]]; then
-  [[ -n ${CI:-} ]] && fail "missing $npz (CI is set)"
-  echo "skip: no $npz"; exit 77
-fi
+[[ -f $npz ]] || skip "no $npz"
 /usr/bin/python3 - "$npz" "$work/small.npz" <<'PY'
 import sys, numpy as np
 d = np.load(sys.argv[1]); X, y = d["X_train"], d["y_train"]

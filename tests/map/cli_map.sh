@@ -7,9 +7,7 @@
 # Usage: cli_map.sh VOLA
 set -euo pipefail
 vola=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 
 mkdir "$tmp/scans"
 printf '1.0 0 0\n' > "$tmp/scans/ahead.xyz"

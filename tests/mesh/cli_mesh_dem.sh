@@ -15,22 +15,9 @@ if [[ $# -ne 2 ]]; then
 fi
 vola=$1
 data=$2
-if [[ ! -d $data/mesh || ! -d $data/dem ]]; then
-  if [[ -n ${CI:-} ]]; then
-    echo "FAIL: data folder $data is missing (CI is set)" >&2
-    exit 1
-  fi
-  echo "SKIP: data folder $data is missing" >&2
-  exit 77
-fi
-
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+keep_going=1
+source "$(dirname "$0")/../lib/cli_test.sh"
+[[ -d $data/mesh && -d $data/dem ]] || skip "data folder $data is missing"
 
 # info_field FILE KEY: one field of `vola info --json`.
 info_field() {

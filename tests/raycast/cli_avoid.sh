@@ -5,9 +5,7 @@
 # Usage: cli_avoid.sh VOLA
 set -euo pipefail
 vola=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 
 # A 64^3 grid: a 9x9 pillar (x, y in [28, 37), every z) and the far corner voxel.
 /usr/bin/env python3 - "$tmp/pillar.xyz" <<'PY'

@@ -6,10 +6,7 @@
 set -euo pipefail
 vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$2}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-skip() { if [ -n "${CI:-}" ]; then fail "$*"; fi; echo "SKIP: $*"; exit 77; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 
 # expect STATUS OUTPUT_PATTERN ARGS...: runs vola collide, checks the exit status and output
 # (STATUS "usage": any status CLI11 gives a usage error, i.e. not 0, 1 or 3).

@@ -7,9 +7,7 @@
 # Usage: cli_plan_search.sh VOLA
 set -euo pipefail
 vola=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "$0")/../lib/cli_test.sh"
 
 # A 1.5 m-voxel wall across a 2048-voxel-long box (grid of depth 6: 4096 voxels a side),
 # with a gap near one end, and the far corner so the grid spans the run.

@@ -6,10 +6,9 @@
 # Usage: cli_tile_killed.sh VOLA
 set -euo pipefail
 vola=$1
-tmp=$(mktemp -d)
+source "$(dirname "$0")/../lib/cli_test.sh"
 pid=
 trap '[ -n "$pid" ] && kill -9 "$pid" 2> /dev/null; rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
 out=$tmp/tiles
 common=(--tile-size 200 --depth 5 -o "$out" --threads 1 -q)
 
