@@ -242,7 +242,7 @@ Classifier& Classifier::operator=(Classifier&&) noexcept = default;
 
 Architecture Classifier::architecture() const noexcept { return impl_->architecture; }
 
-std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const Tree* const> trees, int votes) const {
+std::vector<std::array<float, kClassCount>> Classifier::classify_votes(std::span<const Tree* const> trees, int votes) const {
   if (votes < 1) throw InvalidArgument("votes must be at least 1, got " + std::to_string(votes));
   std::vector<std::array<float, kClassCount>> result;
   if (trees.empty()) return result;
@@ -261,13 +261,21 @@ std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const
   torch::NoGradGuard no_grad;
   const torch::Tensor probabilities = torch::softmax(impl_->network->forward(input_tensor(batch, side)), 1).contiguous();
   const float* p = probabilities.data_ptr<float>();
-  result.resize(trees.size());
+  result.resize(n);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t c = 0; c < std::size_t(kClassCount); ++c) result[j][c] = p[j * kClassCount + c];
+  return result;
+}
+
+std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const Tree* const> trees, int votes) const {
+  const auto each = classify_votes(trees, votes);
+  std::vector<std::array<float, kClassCount>> result(trees.size());
   for (std::size_t i = 0; i < trees.size(); ++i)
     for (int c = 0; c < kClassCount; ++c) {
       // Summed in double over the votes in order: a permutation of the votes changes the
       // result only by float rounding of each vote (well below 1e-6).
       double sum = 0;
-      for (int k = 0; k < votes; ++k) sum += p[(i * std::size_t(votes) + std::size_t(k)) * kClassCount + std::size_t(c)];
+      for (int k = 0; k < votes; ++k) sum += each[i * std::size_t(votes) + std::size_t(k)][std::size_t(c)];
       result[i][std::size_t(c)] = static_cast<float>(sum / votes);
     }
   return result;

@@ -98,6 +98,9 @@ class Classifier {
   // probabilities are averaged: turning the input by a multiple of 360 / votes degrees
   // only permutes the votes (exactly so for quarter turns, see fill_occupancy).
   std::vector<std::array<float, kClassCount>> classify(std::span<const Tree* const> trees, int votes = 1) const;
+  // Every vote's probabilities, tree after tree: element i * votes + k is tree i turned
+  // by 360 * k / votes degrees. classify() is their mean per tree.
+  std::vector<std::array<float, kClassCount>> classify_votes(std::span<const Tree* const> trees, int votes) const;
 
  private:
   struct Impl;
