@@ -107,6 +107,13 @@ class Classifier {
   std::unique_ptr<Impl> impl_;
 };
 
+namespace detail {
+// Test hook: when true, classify() runs the network's training-time forward pass (torch's
+// own layer choices) instead of the inference pass, which computes the same function up
+// to float rounding in oneDNN. Not thread-safe; for tests and benchmarks only.
+extern bool reference_inference;
+}  // namespace detail
+
 // Torch's intra-op thread count (0: leave torch's default of all cores).
 void set_threads(int threads);
 
