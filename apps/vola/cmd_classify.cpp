@@ -55,7 +55,7 @@ void print_segmentation(const learn::Segmentation& s, double vote_degrees) {
   for (const auto& p : s.removal.planes)
     std::printf(" %s %s (%s = %u, %d layer%s, %llu voxels);", axis_name(p.axis), p.at_max ? "max" : "min", axis_name(p.axis),
                 p.first, p.layers, p.layers == 1 ? "" : "s", static_cast<unsigned long long>(p.voxels));
-  std::printf("\ncomponents left: %zu\n", s.components);
+  std::printf("\npieces left: %zu\n", s.components);
   if (s.found())
     std::printf("object: %llu voxels, box (%u %u %u)-(%u %u %u), footprint turned %.0f degrees, classified "
                 "turned %.0f more\n",
@@ -90,7 +90,7 @@ void run_classify(const ClassifyArgs& a) {
       found = learn::classify_segmented(classifier, trees, options, a.segment_votes()).front();
       if (!found.segmentation.found())
         throw InvalidArgument(input + ": no object left once the bounding planes were removed (" +
-                              std::to_string(found.segmentation.removal.planes.size()) + " planes, no component of " +
+                              std::to_string(found.segmentation.removal.planes.size()) + " planes, no piece of " +
                               std::to_string(options.min_voxels) + " voxels or more)");
       p = found.probabilities;
     } else {
@@ -251,12 +251,12 @@ void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
       ->capture_default_str()
       ->check(CLI::Range(1, 360));
   cmd->add_flag("--segment", args.segment,
-                "Find the object first: remove the floor, walls and ceiling (layers at the scene's bounds that are at "
-                "least --plane-fill full), take connected components (26-connected, at least 16 voxels), keep the one "
-                "with the largest bounding box and the components standing in its footprint, turn it to its "
-                "footprint's axes, scale its longest extent to 64 voxels, centre it, and classify that with a model of "
-                "clean objects (the default model), turned by the --votes (4: the quarter turns); --orientations "
-                "says how the votes are combined");
+                "Find the object first: remove the floor, walls and ceiling (layers at the scene's bounds that fill at "
+                "least --plane-fill of its cross-section, up to 4 deep), group the 26-connected components whose boxes "
+                "touch into pieces (16 voxels or more), keep the piece with the largest bounding box and the pieces "
+                "standing in its footprint, turn it to the axes of its horizontal layers, scale its longest extent to "
+                "64 voxels, centre it, and classify that with a model of clean objects (the default model), turned by "
+                "the --votes (4: the quarter turns); --orientations says how the votes are combined");
   cmd->add_option("--plane-fill", args.segment_options.plane_fill,
                   "With --segment: the share of the scene's cross-section a bounding layer must fill to be a plane")
       ->capture_default_str()
@@ -264,7 +264,8 @@ void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
   cmd->add_option("--orientations", args.orientations,
                   "With --segment: 'best' keeps the most confident vote (models trained on aligned objects, as the "
                   "default), 'mean' averages them (models trained with --max-rotation 180)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"best", "mean"}));
 }
 
 constexpr const char* kModelFooter =
@@ -280,7 +281,15 @@ void add_classify(CLI::App& app) {
   classify->footer(std::string(kModelFooter) +
                    "Prints the most likely class and its probability, then all ten probabilities.\n"
                    "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
-                   "Example:\n  vola classify data/clean/val/chair/chair_01234.vol --votes 12");
+                   "With --segment the object is first found in a scene (a room with floor, walls, clutter: `vola\n"
+                   "dataset --background`, or a voxelised scan): the class lines come first, then the planes removed,\n"
+                   "the pieces left and the object kept (voxels, box, the turn of its footprint, the vote kept).\n"
+                   "A scene with no object left once its planes are removed is an error.\n"
+                   "Examples:\n  vola classify data/clean/val/chair/chair_01234.vol\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --model models/modelnet10-small-room.pt --votes 12\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --segment\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --segment --model models/modelnet10-small-full-circle.pt \\\n"
+                   "    --votes 12 --orientations mean");
   classify->add_option("file", args->inputs, ".vol files")->required()->check(CLI::ExistingFile);
   add_model_options(classify, *args);
   classify->callback([args] { run_classify(*args); });
@@ -291,7 +300,11 @@ void add_classify(CLI::App& app) {
                    "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
                    "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
                    "with the lines `mean per-class accuracy: 0.xxxx` and `accuracy: 0.xxxx`.\n"
-                   "Example:\n  vola evaluate data/clean/val --votes 12 --png val_confusion.png");
+                   "With --segment each scene's object is found first (see `vola classify --help`); scenes where none\n"
+                   "is found count as wrong and are said.\n"
+                   "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"
+                   "  vola evaluate data/room/val --model models/modelnet10-small-room.pt --votes 12\n"
+                   "  vola evaluate data/room/val --segment --model models/modelnet10-small-full-circle.pt --votes 12 --orientations mean");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();
   evaluate->add_option("--json", eargs->json,
