@@ -16,6 +16,7 @@
 #include "vola/file.hpp"
 #include "vola/output_stream.hpp"
 #include "vola/learn/classifier.hpp"
+#include "vola/learn/segment.hpp"
 
 namespace vola::cli {
 
@@ -28,7 +29,39 @@ struct ClassifyArgs {
   std::vector<std::string> inputs;
   std::string model, png = "confusion.png", json;
   int threads = 0, batch = 32, votes = 1;
+  bool segment = false;
+  std::string orientations = "best";
+  learn::SegmentOptions segment_options;
+  CLI::Option* votes_option = nullptr;
+  // With --segment: the votes given, or the four quarter turns of the object's footprint.
+  int segment_votes() const { return votes_option && votes_option->count() ? votes : 4; }
+  std::string vote_key() const {
+    return std::string(segment ? "evaluation_segment_votes_" : "evaluation_votes_") +
+           std::to_string(segment ? segment_votes() : votes);
+  }
 };
+
+void check_segment_args(const ClassifyArgs& a) {
+  if (!a.segment) return;
+  if (a.orientations != "best" && a.orientations != "mean")
+    throw InvalidArgument("--orientations must be best or mean, got '" + a.orientations + "'");
+}
+
+const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+
+void print_segmentation(const learn::Segmentation& s, double vote_degrees) {
+  std::printf("removed planes:");
+  if (s.removal.planes.empty()) std::printf(" none");
+  for (const auto& p : s.removal.planes)
+    std::printf(" %s %s (%s = %u, %d layer%s, %llu voxels);", axis_name(p.axis), p.at_max ? "max" : "min", axis_name(p.axis),
+                p.first, p.layers, p.layers == 1 ? "" : "s", static_cast<unsigned long long>(p.voxels));
+  std::printf("\npieces left: %zu\n", s.components);
+  if (s.found())
+    std::printf("object: %llu voxels, box (%u %u %u)-(%u %u %u), footprint turned %.0f degrees, classified "
+                "turned %.0f more\n",
+                static_cast<unsigned long long>(s.object.voxel_count()), s.min.x, s.min.y, s.min.z, s.max.x, s.max.y, s.max.z,
+                s.footprint_angle * 180 / 3.14159265358979323846, vote_degrees);
+}
 
 learn::Classifier load_classifier(const ClassifyArgs& a) {
   learn::set_threads(a.threads);
@@ -40,6 +73,7 @@ std::size_t best_class(const std::array<float, kClassCount>& p) {
 }
 
 void run_classify(const ClassifyArgs& a) {
+  check_segment_args(a);
   const learn::Classifier classifier = load_classifier(a);
   const int side = learn::input_side(classifier.architecture());
   for (const auto& input : a.inputs) {
@@ -48,12 +82,26 @@ void run_classify(const ClassifyArgs& a) {
       throw InvalidArgument(input + ": a " + std::to_string(tree.side()) + "^3 grid; the model reads " +
                             std::to_string(side) + "^3 or finer");
     const Tree* trees[] = {&tree};
-    const auto p = classifier.classify(trees, a.votes).front();
+    std::array<float, kClassCount> p;
+    learn::SegmentedClassification found;
+    if (a.segment) {
+      learn::SegmentOptions options = a.segment_options;
+      options.average_orientations = a.orientations == "mean";
+      found = learn::classify_segmented(classifier, trees, options, a.segment_votes()).front();
+      if (!found.segmentation.found())
+        throw InvalidArgument(input + ": no object left once the bounding planes were removed (" +
+                              std::to_string(found.segmentation.removal.planes.size()) + " planes, no piece of " +
+                              std::to_string(options.min_voxels) + " voxels or more)");
+      p = found.probabilities;
+    } else {
+      p = classifier.classify(trees, a.votes).front();
+    }
     const std::size_t best = best_class(p);
     if (a.inputs.size() > 1) std::printf("%s: ", input.c_str());
     std::printf("%s %.4f\n", std::string(kClassNames[best]).c_str(), p[best]);
     for (int k = 0; k < kClassCount; ++k)
       std::printf("  %-12s %.4f\n", std::string(kClassNames[std::size_t(k)]).c_str(), p[std::size_t(k)]);
+    if (a.segment) print_segmentation(found.segmentation, 360.0 * found.vote / a.segment_votes());
   }
 }
 
@@ -83,7 +131,12 @@ void write_confusion_png(const std::string& path, const std::vector<std::vector<
 }
 
 void run_evaluate(const ClassifyArgs& a) {
+  check_segment_args(a);
   const learn::Classifier classifier = load_classifier(a);
+  learn::SegmentOptions segment_options = a.segment_options;
+  segment_options.average_orientations = a.orientations == "mean";
+  std::size_t not_found = 0;
+  std::vector<std::size_t> missed(kClassCount, 0);  // per true class: scenes where no object was found
   const auto entries = learn::list_dataset(a.inputs.front());
   const auto samples = learn::load_samples(entries, learn::input_side(classifier.architecture()));
   std::vector<std::vector<std::size_t>> confusion(kClassCount, std::vector<std::size_t>(kClassCount, 0));
@@ -94,9 +147,25 @@ void run_evaluate(const ClassifyArgs& a) {
     const std::size_t count = std::min(std::size_t(a.batch), samples.size() - first);
     std::vector<const Tree*> trees;
     for (std::size_t i = 0; i < count; ++i) trees.push_back(&samples[first + i].tree);
-    const auto probabilities = classifier.classify(trees, a.votes);
+    std::vector<std::array<float, kClassCount>> probabilities;
+    std::vector<bool> found(count, true);
+    if (a.segment) {
+      const auto segmented = learn::classify_segmented(classifier, trees, segment_options, a.segment_votes());
+      for (std::size_t i = 0; i < count; ++i) {
+        probabilities.push_back(segmented[i].probabilities);
+        found[i] = segmented[i].segmentation.found();
+      }
+    } else {
+      probabilities = classifier.classify(trees, a.votes);
+    }
     for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t truth = std::size_t(samples[first + i].label), predicted = best_class(probabilities[i]);
+      const std::size_t truth = std::size_t(samples[first + i].label);
+      if (!found[i]) {  // no object: wrong, and outside the confusion matrix
+        ++not_found;
+        ++missed[truth];
+        continue;
+      }
+      const std::size_t predicted = best_class(probabilities[i]);
       ++confusion[truth][predicted];
       correct += truth == predicted;
     }
@@ -104,15 +173,23 @@ void run_evaluate(const ClassifyArgs& a) {
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, %d vote%s, fill + network)\n\n", samples.size(),
-              std::string(learn::architecture_name(classifier.architecture())).c_str(),
-              1000 * seconds / double(samples.size()), a.batch, a.votes, a.votes == 1 ? "" : "s");
+  if (a.segment)
+    std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, segmented, %d votes, %s, "
+                "segmentation + fill + network)\nno object found in %zu (counted as wrong, not in the matrix)\n\n",
+                samples.size(), std::string(learn::architecture_name(classifier.architecture())).c_str(),
+                1000 * seconds / double(samples.size()), a.batch, a.segment_votes(),
+                a.orientations == "mean" ? "their mean" : "the most confident kept", not_found);
+  else
+    std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, %d vote%s, fill + network)\n\n", samples.size(),
+                std::string(learn::architecture_name(classifier.architecture())).c_str(),
+                1000 * seconds / double(samples.size()), a.batch, a.votes, a.votes == 1 ? "" : "s");
   std::printf("per-class accuracy:\n");
   double class_accuracy_sum = 0;
   int classes_seen = 0;
   for (int k = 0; k < kClassCount; ++k) {
     std::size_t total = 0;
     for (std::size_t c : confusion[std::size_t(k)]) total += c;
+    total += missed[std::size_t(k)];
     if (total == 0) continue;
     class_accuracy_sum += double(confusion[std::size_t(k)][std::size_t(k)]) / double(total);
     ++classes_seen;
@@ -132,7 +209,8 @@ void run_evaluate(const ClassifyArgs& a) {
     std::printf("confusion matrix image: %s\n", a.png.c_str());
   }
   if (!a.json.empty()) {
-    // Merged into the file (a model's run record, say) under "evaluation_votes_<N>".
+    // Merged into the file (a model's run record, say) under "evaluation_votes_<N>"
+    // ("evaluation_segment_votes_<N>" with --segment).
     nlohmann::json record = nlohmann::json::object();
     if (std::ifstream previous(a.json); previous) {
       record = nlohmann::json::parse(previous, nullptr, false);
@@ -142,12 +220,15 @@ void run_evaluate(const ClassifyArgs& a) {
     for (int k = 0; k < kClassCount; ++k) {
       std::size_t total = 0;
       for (std::size_t c : confusion[std::size_t(k)]) total += c;
+      total += missed[std::size_t(k)];
       if (total) per_class[std::string(kClassNames[std::size_t(k)])] = double(confusion[std::size_t(k)][std::size_t(k)]) / double(total);
     }
-    record["evaluation_votes_" + std::to_string(a.votes)] = {
+    record[a.vote_key()] = {
         {"dir", a.inputs.front()},
         {"samples", samples.size()},
-        {"votes", a.votes},
+        {"votes", a.segment ? a.segment_votes() : a.votes},
+        {"segment", a.segment},
+        {"not_found", not_found},
         {"accuracy", double(correct) / double(samples.size())},
         {"mean_per_class_accuracy", class_accuracy_sum / classes_seen},
         {"per_class_accuracy", per_class},
@@ -163,11 +244,28 @@ void run_evaluate(const ClassifyArgs& a) {
 void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
   cmd->add_option("--model", args.model, "Model file written by `vola train` (default: the committed small model)");
   cmd->add_option("--threads", args.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--votes", args.votes,
+  args.votes_option = cmd->add_option("--votes", args.votes,
                   "Test-time voting: see each object turned about z by 360*k/N degrees (k = 0..N-1) and "
-                  "average the N softmax outputs (for models trained with --max-rotation 180)")
+                  "average the N softmax outputs (for models trained with --max-rotation 180); with --segment: the "
+                  "turns of the found object, 4 by default")
       ->capture_default_str()
       ->check(CLI::Range(1, 360));
+  cmd->add_flag("--segment", args.segment,
+                "Find the object first: remove the floor, walls and ceiling (layers at the scene's bounds that fill at "
+                "least --plane-fill of its cross-section, up to 4 deep), group the 26-connected components whose boxes "
+                "touch into pieces (16 voxels or more), keep the piece with the largest bounding box and the pieces "
+                "standing in its footprint, turn it to the axes of its horizontal layers, scale its longest extent to "
+                "64 voxels, centre it, and classify that with a model of clean objects (the default model), turned by "
+                "the --votes (4: the quarter turns); --orientations says how the votes are combined");
+  cmd->add_option("--plane-fill", args.segment_options.plane_fill,
+                  "With --segment: the share of the scene's cross-section a bounding layer must fill to be a plane")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 1.0));
+  cmd->add_option("--orientations", args.orientations,
+                  "With --segment: 'best' keeps the most confident vote (models trained on aligned objects, as the "
+                  "default), 'mean' averages them (models trained with --max-rotation 180)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"best", "mean"}));
 }
 
 constexpr const char* kModelFooter =
@@ -183,7 +281,15 @@ void add_classify(CLI::App& app) {
   classify->footer(std::string(kModelFooter) +
                    "Prints the most likely class and its probability, then all ten probabilities.\n"
                    "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
-                   "Example:\n  vola classify data/clean/val/chair/chair_01234.vol --votes 12");
+                   "With --segment the object is first found in a scene (a room with floor, walls, clutter: `vola\n"
+                   "dataset --background`, or a voxelised scan): the class lines come first, then the planes removed,\n"
+                   "the pieces left and the object kept (voxels, box, the turn of its footprint, the vote kept).\n"
+                   "A scene with no object left once its planes are removed is an error.\n"
+                   "Examples:\n  vola classify data/clean/val/chair/chair_01234.vol\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --model models/modelnet10-small-room.pt --votes 12\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --segment\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --segment --model models/modelnet10-small-full-circle.pt \\\n"
+                   "    --votes 12 --orientations mean");
   classify->add_option("file", args->inputs, ".vol files")->required()->check(CLI::ExistingFile);
   add_model_options(classify, *args);
   classify->callback([args] { run_classify(*args); });
@@ -194,12 +300,16 @@ void add_classify(CLI::App& app) {
                    "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
                    "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
                    "with the lines `mean per-class accuracy: 0.xxxx` and `accuracy: 0.xxxx`.\n"
-                   "Example:\n  vola evaluate data/clean/val --votes 12 --png val_confusion.png");
+                   "With --segment each scene's object is found first (see `vola classify --help`); scenes where none\n"
+                   "is found count as wrong and are said.\n"
+                   "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"
+                   "  vola evaluate data/room/val --model models/modelnet10-small-room.pt --votes 12\n"
+                   "  vola evaluate data/room/val --segment --model models/modelnet10-small-full-circle.pt --votes 12 --orientations mean");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();
   evaluate->add_option("--json", eargs->json,
                        "Also write the figures and confusion matrix into this JSON file (e.g. the model's run record), "
-                       "under \"evaluation_votes_<N>\"; other keys are kept");
+                       "under \"evaluation_votes_<N>\" (\"evaluation_segment_votes_<N>\" with --segment); other keys are kept");
   evaluate->add_option("--batch", eargs->batch, "Samples per batch")->capture_default_str()->check(CLI::Range(1, 4096));
   add_model_options(evaluate, *eargs);
   evaluate->callback([eargs] { run_evaluate(*eargs); });

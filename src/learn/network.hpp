@@ -15,6 +15,10 @@ namespace vola::learn {
 // A classification network: (N, 1, S, S, S) occupancy -> (N, 10) logits.
 struct Network : torch::nn::Module {
   virtual torch::Tensor forward(torch::Tensor input) = 0;
+  // For a network that will only infer (eval mode, weights fixed from here on): computes
+  // what infer() needs. infer() is forward() up to float rounding, for InferenceMode.
+  virtual void prepare_inference() {}
+  virtual torch::Tensor infer(torch::Tensor input) { return forward(input); }
 };
 
 std::shared_ptr<Network> make_network(Architecture architecture);

@@ -56,6 +56,21 @@ grep -q "4 votes" "$work/eval4.txt" || fail "votes not stated: $(head -n 1 "$wor
 [[ $(head -n 1 "$work/one12.txt" | cut -d' ' -f1) == monitor ]] || fail "classify --votes 12: $(cat "$work/one12.txt")"
 if "$vola" classify --votes 0 "$work/clean/test/monitor/monitor_00010.vol" 2> /dev/null; then fail "--votes 0 accepted"; fi
 
+# --segment: the object found in a room (floor and walls removed, components), classified
+# with the clean model; the first line still names the class, the last says what was found.
+"$vola" classify --segment "$work/room/test/sofa/sofa_00014.vol" > "$work/seg.txt"
+[[ $(wc -l < "$work/seg.txt") == 14 ]] || fail "classify --segment: $(cat "$work/seg.txt")"
+grep -Eq "^[a-z_]+ [01]\.[0-9]{4}$" <<< "$(head -n 1 "$work/seg.txt")" || fail "classify --segment first line"
+grep -q "^removed planes: x min (x = 0, 1 layer" "$work/seg.txt" || fail "no wall removed: $(cat "$work/seg.txt")"
+grep -q "^object: " "$work/seg.txt" || fail "no object line"
+"$vola" evaluate "$work/room/test" --segment --png '' --threads 2 > "$work/segeval.txt"
+grep -q "segmented, 4 votes" "$work/segeval.txt" || fail "segment evaluate: $(head -n 2 "$work/segeval.txt")"
+[[ $(tail -n 1 "$work/segeval.txt") =~ ^accuracy:\ (0\.[0-9]{4}|1\.0000)$ ]] || fail "segment evaluate: last line"
+# A room with nothing in it but its floor: refused, saying why.
+"$vola" crop "$work/room/test/sofa/sofa_00014.vol" "$work/floor.vol" --min 0 0 0 --max 63 63 0 > /dev/null
+if "$vola" classify --segment "$work/floor.vol" 2> "$work/err.txt"; then fail "empty room classified"; fi
+grep -q "no object left" "$work/err.txt" || fail "empty room message: $(cat "$work/err.txt")"
+
 # Errors: exit 1 and a message naming the file.
 if "$vola" dataset "$work/small.npz.bad.npz" "$work/bad" 2> "$work/err.txt"; then fail "bad npz accepted"; fi
 grep -q "X_test" "$work/err.txt" || fail "bad npz message: $(cat "$work/err.txt")"

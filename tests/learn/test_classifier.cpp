@@ -184,6 +184,37 @@ TEST(Classifier, TwelveVotesAreInvariantToQuarterTurns) {
   EXPECT_THROW(classifier.classify(input, 0), vola::InvalidArgument);
 }
 
+// The inference pass (oneDNN for every layer with weights, batch norm folded, fc1 as a
+// convolution) computes the training-time forward pass's function: the probabilities of
+// both committed models agree within float rounding, for one object and for a batch with
+// votes, and the argmax is the same.
+TEST(Classifier, InferencePassEqualsTheForwardPass) {
+  for (const char* file : {"modelnet10-small.pt", "modelnet10-small-room.pt"}) {
+    const std::filesystem::path model = std::filesystem::path(vola_learn_test::committed_model_path()).parent_path() / file;
+    const Classifier classifier(model.string());
+    std::vector<vola::Tree> trees;
+    for (int shape = 0; shape < kClassCount; ++shape) trees.push_back(clean_scene(shape_grid(shape, 70 + std::uint64_t(shape)), 32));
+    std::vector<const vola::Tree*> all;
+    for (const auto& t : trees) all.push_back(&t);
+    for (const int votes : {1, 12})
+      for (const std::size_t batch : {std::size_t(1), all.size()}) {
+        const std::span<const vola::Tree* const> input(all.data(), batch);
+        const auto fast = classifier.classify_votes(input, votes);
+        detail::reference_inference = true;
+        const auto reference = classifier.classify_votes(input, votes);
+        detail::reference_inference = false;
+        ASSERT_EQ(fast.size(), reference.size());
+        for (std::size_t i = 0; i < fast.size(); ++i) {
+          for (int k = 0; k < kClassCount; ++k)
+            EXPECT_NEAR(fast[i][std::size_t(k)], reference[i][std::size_t(k)], 2e-5)
+                << file << ", " << votes << " votes, batch " << batch << ", input " << i << ", class " << k;
+          EXPECT_EQ(std::max_element(fast[i].begin(), fast[i].end()) - fast[i].begin(),
+                    std::max_element(reference[i].begin(), reference[i].end()) - reference[i].begin());
+        }
+      }
+  }
+}
+
 // A model file damaged in storage (truncated, or one byte changed inside a record) is
 // refused with a FormatError that names it, before libtorch reads it.
 TEST(Classifier, RefusesDamagedModelFiles) {

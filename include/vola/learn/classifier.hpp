@@ -98,11 +98,21 @@ class Classifier {
   // probabilities are averaged: turning the input by a multiple of 360 / votes degrees
   // only permutes the votes (exactly so for quarter turns, see fill_occupancy).
   std::vector<std::array<float, kClassCount>> classify(std::span<const Tree* const> trees, int votes = 1) const;
+  // Every vote's probabilities, tree after tree: element i * votes + k is tree i turned
+  // by 360 * k / votes degrees. classify() is their mean per tree.
+  std::vector<std::array<float, kClassCount>> classify_votes(std::span<const Tree* const> trees, int votes) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+namespace detail {
+// Test hook: when true, classify() runs the network's training-time forward pass (torch's
+// own layer choices) instead of the inference pass, which computes the same function up
+// to float rounding in oneDNN. Not thread-safe; for tests and benchmarks only.
+extern bool reference_inference;
+}  // namespace detail
 
 // Torch's intra-op thread count (0: leave torch's default of all cores).
 void set_threads(int threads);
