@@ -124,7 +124,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
         total += weights[std::size_t(k)];
         ++present;
       }
-    for (float& w : weights) w = float(w * present / total);
+    for (float& w : weights) w = float(w * static_cast<float>(present) / total);
     class_weights = torch::tensor(weights);
   }
   for (int epoch = first_epoch; epoch < options.epochs; ++epoch) {
