@@ -12,7 +12,7 @@
 // `--only vola|octomap` inserts with one peer alone and prints the process's peak memory
 // (getrusage), for whole-process memory figures (bench/map_peers.sh runs both).
 //
-//   vola_map_peers SCANLIST --voxel-size R [--max-range M] [--reps 3] [--only vola|octomap] [--out DIR]
+//   vola_map_peers SCANLIST --voxel-size R [--max-range M] [--reps 3] [--only vola|octomap [--threads N]] [--out DIR]
 #include <octomap/OcTree.h>
 #include <sys/resource.h>
 
@@ -45,6 +45,7 @@ struct Args {
   std::string list, only, out = ".";
   double voxel = 0.1, max_range = 0.0;
   int reps = 3;
+  unsigned threads = 0;  // vola's threads with --only (0: all)
 };
 
 Args parse(int argc, char** argv) {
@@ -59,6 +60,7 @@ Args parse(int argc, char** argv) {
     else if (arg == "--max-range") a.max_range = std::stod(value());
     else if (arg == "--reps") a.reps = std::stoi(value());
     else if (arg == "--only") a.only = value();
+    else if (arg == "--threads") a.threads = static_cast<unsigned>(std::stoul(value()));
     else if (arg == "--out") a.out = value();
     else a.list = arg;
   }
@@ -193,7 +195,7 @@ int main(int argc, char** argv) try {
     const long before = peak_rss_mib();
     double seconds = 0;
     std::size_t bytes = 0;
-    if (a.only == "vola") bytes = vola_insert(scans, a, 0, seconds).memory_bytes();
+    if (a.only == "vola") bytes = vola_insert(scans, a, a.threads, seconds).memory_bytes();
     else if (a.only == "octomap") bytes = octomap_insert(scans, a, seconds)->memoryUsage();
     else throw std::runtime_error("--only vola or octomap");
     std::printf("%s alone: %.3f s, map %.1f MiB, process peak %ld MiB (%ld MiB before inserting)\n", a.only.c_str(),
