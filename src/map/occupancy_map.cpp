@@ -47,19 +47,19 @@ struct Masks {
 // One worker's masks of blocks the map does not have yet.
 class FreshBlocks {
  public:
-  void add(std::uint64_t key, const Masks& bits) {
+  // The position of `key`'s masks, added empty when new.
+  std::uint32_t find_or_add(std::uint64_t key) {
     bool added = false;
     const std::uint32_t at = index_.find_or_add(key, added);
     if (added) {
       keys_.push_back(key);
       masks_.emplace_back();
     }
-    masks_[at].passed |= bits.passed;
-    masks_[at].hit |= bits.hit;
+    return at;
   }
   std::size_t size() const noexcept { return keys_.size(); }
   std::uint64_t key(std::size_t b) const noexcept { return keys_[b]; }
-  const Masks& masks(std::size_t b) const noexcept { return masks_[b]; }
+  Masks& masks(std::size_t b) noexcept { return masks_[b]; }
 
  private:
   detail::BlockIndex index_;
@@ -80,11 +80,19 @@ class ScanWorker {
   void hit(const detail::Cell& c) { at(block_key(c)).hit |= bit_of(c); }
   void flush() {
     if (key_ == detail::BlockIndex::kEmpty) return;
-    const std::int64_t b = map_->size() == 0 ? -1 : map_->find(key_);
-    if (b < 0) {
-      fresh.add(key_, bits_);
+    // Neighbouring rays enter the same blocks: a small direct-mapped cache of where each
+    // block's masks are saves most probes of the two hashes.
+    Recent& r = recent_[(key_ * 0x9e3779b97f4a7c15ull) >> (64 - kRecentBits)];
+    if (r.key != key_) {
+      const std::int64_t b = map_->size() == 0 ? -1 : map_->find(key_);
+      r = b < 0 ? Recent{key_, fresh.find_or_add(key_), true} : Recent{key_, static_cast<std::uint32_t>(b), false};
+    }
+    if (r.fresh) {
+      Masks& m = fresh.masks(r.at);
+      m.passed |= bits_.passed;
+      m.hit |= bits_.hit;
     } else {
-      Masks& m = (*pending_)[static_cast<std::size_t>(b)];
+      Masks& m = (*pending_)[r.at];
       or_into(m.passed, bits_.passed);
       or_into(m.hit, bits_.hit);
     }
@@ -109,8 +117,16 @@ class ScanWorker {
     return bits_;
   }
 
+  struct Recent {
+    std::uint64_t key = detail::BlockIndex::kEmpty;
+    std::uint32_t at = 0;  // in the scan's masks of the map's blocks, or in `fresh`
+    bool fresh = false;
+  };
+  static constexpr int kRecentBits = 12;
+
   const detail::BlockIndex* map_;
   std::vector<Masks>* pending_;
+  std::vector<Recent> recent_ = std::vector<Recent>(std::size_t{1} << kRecentBits);
   std::uint64_t key_ = detail::BlockIndex::kEmpty;
   Masks bits_;
 };
