@@ -68,42 +68,60 @@ class FreshBlocks {
 };
 
 // What one worker's rays of a scan pass and hit. Consecutive voxels of a ray mostly share
-// a block (and consecutive rays start in the origin's), so the bits of the current block
-// gather in two words and leave when a ray enters another block: into the scan's masks of
-// a block the map has (an atomic OR, skipped when the bits are there already), or into
-// the worker's fresh blocks.
+// a block, so the bits of the current block gather in two words; when the ray enters
+// another block they go into a small direct-mapped cache of recent blocks (neighbouring
+// rays enter the same blocks), which writes a block's bits back when another block takes
+// its slot, and at the end: into the scan's masks of a block the map has (an atomic OR,
+// skipped when the bits are there already), or into the worker's fresh blocks.
 class ScanWorker {
  public:
   ScanWorker(const detail::BlockIndex& map, std::vector<Masks>& pending) : map_(&map), pending_(&pending) {}
 
   void pass(const detail::Cell& c) { at(block_key(c)).passed |= bit_of(c); }
   void hit(const detail::Cell& c) { at(block_key(c)).hit |= bit_of(c); }
+  // The current block's bits into the cache.
   void flush() {
     if (key_ == detail::BlockIndex::kEmpty) return;
-    // Neighbouring rays enter the same blocks: a small direct-mapped cache of where each
-    // block's masks are saves most probes of the two hashes.
     Recent& r = recent_[(key_ * 0x9e3779b97f4a7c15ull) >> (64 - kRecentBits)];
     if (r.key != key_) {
-      const std::int64_t b = map_->size() == 0 ? -1 : map_->find(key_);
-      r = b < 0 ? Recent{key_, fresh.find_or_add(key_), true} : Recent{key_, static_cast<std::uint32_t>(b), false};
+      write_back(r);
+      r.key = key_;
     }
-    if (r.fresh) {
-      Masks& m = fresh.masks(r.at);
-      m.passed |= bits_.passed;
-      m.hit |= bits_.hit;
-    } else {
-      Masks& m = (*pending_)[r.at];
-      or_into(m.passed, bits_.passed);
-      or_into(m.hit, bits_.hit);
-    }
+    r.bits.passed |= bits_.passed;
+    r.bits.hit |= bits_.hit;
     bits_ = {};
     key_ = detail::BlockIndex::kEmpty;
+  }
+  // Everything into the scan's and the fresh masks.
+  void drain() {
+    flush();
+    for (Recent& r : recent_) write_back(r);
   }
 
   FreshBlocks fresh;
   ScanReport report;
 
  private:
+  struct Recent {
+    std::uint64_t key = detail::BlockIndex::kEmpty;
+    Masks bits;
+  };
+  static constexpr int kRecentBits = 11;
+
+  void write_back(Recent& r) {
+    if (r.key == detail::BlockIndex::kEmpty) return;
+    const std::int64_t b = map_->size() == 0 ? -1 : map_->find(r.key);
+    if (b < 0) {
+      Masks& m = fresh.masks(fresh.find_or_add(r.key));
+      m.passed |= r.bits.passed;
+      m.hit |= r.bits.hit;
+    } else {
+      Masks& m = (*pending_)[static_cast<std::size_t>(b)];
+      or_into(m.passed, r.bits.passed);
+      or_into(m.hit, r.bits.hit);
+    }
+    r = {};
+  }
   static void or_into(std::uint64_t& word, std::uint64_t bits) {
     if (!bits) return;
     std::atomic_ref<std::uint64_t> shared(word);
@@ -116,13 +134,6 @@ class ScanWorker {
     }
     return bits_;
   }
-
-  struct Recent {
-    std::uint64_t key = detail::BlockIndex::kEmpty;
-    std::uint32_t at = 0;  // in the scan's masks of the map's blocks, or in `fresh`
-    bool fresh = false;
-  };
-  static constexpr int kRecentBits = 12;
 
   const detail::BlockIndex* map_;
   std::vector<Masks>* pending_;
@@ -283,6 +294,11 @@ ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& o
         mine.flush();
       },
       ParallelOptions{.threads = workers, .grain = 2048, .name = "map.insert_scan"});
+  // The workers' cached bits, drained in parallel (one worker each; the scan's masks take
+  // atomic ORs).
+  parallel_for(
+      scans.size(), [&](const Chunk& chunk) { scans[chunk.index].drain(); },
+      ParallelOptions{.threads = workers, .grain = 1, .name = "map.insert_scan"});
   ScanReport report;
   report.points = count;
   // New blocks join the map in worker order (block numbers do not reach the map's

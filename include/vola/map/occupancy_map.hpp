@@ -27,10 +27,11 @@
 // Storage, as VOLA's own: 4x4x4 blocks, each its key, a 64-bit word of known voxels (bit
 // x + 4y + 16z) and 64 levels (144 bytes), in fixed pages (growing never copies the map),
 // found through one open-addressing hash of block keys. A scan's rays mark the voxels they
-// pass and hit as bits, gathered per block while a ray stays in it; when the ray leaves,
-// the bits go with one atomic OR into the scan's masks of a block the map has, or into the
-// worker's own masks of blocks new to the map (the only part merged serially). Every
-// block's masks are then applied in parallel: a scan touches only the blocks it changes,
+// pass and hit as bits, gathered per block while a ray stays in it and then in a small
+// cache of each worker's recent blocks (neighbouring rays enter the same blocks); a block
+// leaving the cache takes one probe and one atomic OR into the scan's masks of a block the
+// map has, or goes into the worker's own masks of blocks new to the map (the only part
+// merged serially). Every block's masks are then applied in parallel: a scan touches only the blocks it changes,
 // and memory follows the map (its blocks, plus 16 bytes per block during a scan), never the
 // scans already inserted.
 //
