@@ -21,8 +21,9 @@
 //  - an update adds the hit or miss log-odds and clamps to [clamp_min, clamp_max].
 // Log-odds are held as 16-bit levels between the clamps (detail/log_odds_levels.hpp):
 // updates are exact integer steps there, and a value differs from OctoMap's float sum by
-// under 1e-7 per update it has had (OctoMap's defaults); what the map reports and saves is
-// the level's float, which restore() maps back to the same level.
+// at most 3e-6 + 5e-7 per update it has had (OctoMap's defaults; a step is 8.7e-5); what
+// the map reports and saves is the level's float, which restore() maps back to the same
+// level.
 //
 // Storage, as VOLA's own: 4x4x4 blocks, each its key, a 64-bit word of known voxels (bit
 // x + 4y + 16z) and 64 levels (144 bytes), in fixed pages (growing never copies the map),
@@ -31,12 +32,13 @@
 // cache of each worker's recent blocks (neighbouring rays enter the same blocks); a block
 // leaving the cache takes one probe and one atomic OR into the scan's masks of a block the
 // map has, or goes into the worker's own masks of blocks new to the map (the only part
-// merged serially). Every block's masks are then applied in parallel: a scan touches only the blocks it changes,
-// and memory follows the map (its blocks, plus 16 bytes per block during a scan), never the
-// scans already inserted.
+// merged serially). Every block's masks are then applied in parallel: a scan touches only
+// the blocks it changes, and memory follows the map (its blocks, plus 16 bytes per block
+// during a scan), never the scans already inserted.
 //
-// Costs: a scan of n rays of m voxels each is O(n m) bit operations plus one probe per
-// block a ray enters, run in parallel with vola::parallel_for.
+// Costs: a scan of n rays of m voxels each is O(n m) bit operations plus at most one probe
+// per block a ray enters (fewer where the cache holds it), run in parallel with
+// vola::parallel_for.
 #pragma once
 
 #include <array>
