@@ -77,8 +77,8 @@ class ScanWorker {
  public:
   ScanWorker(const detail::BlockIndex& map, std::vector<Masks>& pending) : map_(&map), pending_(&pending) {}
 
-  void pass(const detail::Cell& c) { at(block_key(c)).passed |= bit_of(c); }
-  void hit(const detail::Cell& c) { at(block_key(c)).hit |= bit_of(c); }
+  void pass(const detail::Cell& c) { at(c).passed |= bit_of(c); }
+  void hit(const detail::Cell& c) { at(c).hit |= bit_of(c); }
   // The current block's bits into the cache.
   void flush() {
     if (key_ == detail::BlockIndex::kEmpty) return;
@@ -91,6 +91,7 @@ class ScanWorker {
     r.bits.hit |= bits_.hit;
     bits_ = {};
     key_ = detail::BlockIndex::kEmpty;
+    base_ = kNoCell;
   }
   // Everything into the scan's and the fresh masks.
   void drain() {
@@ -127,10 +128,12 @@ class ScanWorker {
     std::atomic_ref<std::uint64_t> shared(word);
     if ((shared.load(std::memory_order_relaxed) & bits) != bits) shared.fetch_or(bits, std::memory_order_relaxed);
   }
-  Masks& at(std::uint64_t key) {
-    if (key != key_) {
+  // Cells of one block differ only in their two low bits: the test is three XORs.
+  Masks& at(const detail::Cell& c) {
+    if (((c[0] ^ base_[0]) | (c[1] ^ base_[1]) | (c[2] ^ base_[2])) & ~std::int64_t{3}) {
       flush();
-      key_ = key;
+      base_ = c;
+      key_ = block_key(c);
     }
     return bits_;
   }
@@ -139,6 +142,9 @@ class ScanWorker {
   std::vector<Masks>* pending_;
   std::vector<Recent> recent_ = std::vector<Recent>(std::size_t{1} << kRecentBits);
   std::uint64_t key_ = detail::BlockIndex::kEmpty;
+  // A cell of the current block, or one beyond the index range (no cell's block) when none.
+  static constexpr detail::Cell kNoCell{std::int64_t{1} << 40, 0, 0};
+  detail::Cell base_ = kNoCell;
   Masks bits_;
 };
 
