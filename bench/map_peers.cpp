@@ -2,7 +2,9 @@
 // the same scans in one process: vola::map::OccupancyMap::insert_scan (1 and 2 threads)
 // and octomap::OcTree::insertPointCloud (OctoMap's defaults: hit 0.7, miss 0.4, clamping
 // 0.1192/0.971; discretize off, lazy evaluation off), fresh maps each repetition, the
-// median of --reps. Then, from the last repetition's maps:
+// median of --reps. Each scan is read just before it is inserted and freed after, as a
+// robot gets them, so memory holds one scan at a time; the clock runs only around the
+// insertion (for OctoMap, after the conversion to its float point cloud). Then, from the last repetition's maps:
 //   - files: OctoMap .ot (probabilities) and .bt (max likelihood, pruned) against vola's
 //     state map with log-odds and without (the two bits per voxel), compressed;
 //   - decisions: occupied / free / unknown at voxel centres, over every voxel either map
@@ -10,7 +12,7 @@
 // `--only vola|octomap` inserts with one peer alone and prints the process's peak memory
 // (getrusage), for whole-process memory figures (bench/map_peers.sh runs both).
 //
-//   vola_map_peers SCANLIST --voxel-size R [--max-range M] [--reps 3] [--only vola|octomap] [--out DIR]
+//   vola_map_peers SCANLIST --voxel-size R [--max-range M] [--reps 3] [--only vola|octomap [--threads N]] [--out DIR]
 #include <octomap/OcTree.h>
 #include <sys/resource.h>
 
@@ -43,6 +45,7 @@ struct Args {
   std::string list, only, out = ".";
   double voxel = 0.1, max_range = 0.0;
   int reps = 3;
+  unsigned threads = 0;  // vola's threads with --only (0: all)
 };
 
 Args parse(int argc, char** argv) {
@@ -57,6 +60,7 @@ Args parse(int argc, char** argv) {
     else if (arg == "--max-range") a.max_range = std::stod(value());
     else if (arg == "--reps") a.reps = std::stoi(value());
     else if (arg == "--only") a.only = value();
+    else if (arg == "--threads") a.threads = static_cast<unsigned>(std::stoul(value()));
     else if (arg == "--out") a.out = value();
     else a.list = arg;
   }
@@ -64,16 +68,14 @@ Args parse(int argc, char** argv) {
   return a;
 }
 
-std::vector<Scan> read_scans(const std::string& list) {
-  std::vector<Scan> scans;
-  for (const vola::map::ScanEntry& e : vola::map::read_scan_list(list)) {
-    vola::io::InputOptions options;
-    options.attributes = false;
-    vola::io::Input in = vola::io::read_input(e.file, "auto", options);
-    e.pose.apply(in.cloud.xyz);
-    scans.push_back({std::move(in.cloud.xyz), e.pose.translation});
-  }
-  return scans;
+// One scan in the world frame, read when it is about to be inserted: a robot gets its
+// scans one at a time, so neither peer holds more than the scan it is inserting.
+Scan read_scan(const vola::map::ScanEntry& e) {
+  vola::io::InputOptions options;
+  options.attributes = false;
+  vola::io::Input in = vola::io::read_input(e.file, "auto", options);
+  e.pose.apply(in.cloud.xyz);
+  return {std::move(in.cloud.xyz), e.pose.translation};
 }
 
 double median(std::vector<double> v) {
@@ -83,32 +85,51 @@ double median(std::vector<double> v) {
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-vola::map::OccupancyMap vola_insert(const std::vector<Scan>& scans, const Args& a, unsigned threads, double& seconds) {
+// Insertion time only: each scan is read (and, for OctoMap, converted to its float point
+// cloud) outside the clock and freed after it is inserted.
+vola::map::OccupancyMap vola_insert(const std::vector<vola::map::ScanEntry>& scans, const Args& a, unsigned threads,
+                                    double& seconds) {
   vola::map::OccupancyMap map(a.voxel);
-  const auto start = Clock::now();
-  for (const Scan& s : scans) map.insert_scan(s.world, s.origin, a.max_range, threads);
-  seconds = seconds_since(start);
+  seconds = 0;
+  for (const vola::map::ScanEntry& e : scans) {
+    const Scan s = read_scan(e);
+    const auto start = Clock::now();
+    map.insert_scan(s.world, s.origin, a.max_range, threads);
+    seconds += seconds_since(start);
+  }
   return map;
 }
 
-std::unique_ptr<octomap::OcTree> octomap_insert(const std::vector<Scan>& scans, const Args& a, double& seconds) {
+std::unique_ptr<octomap::OcTree> octomap_insert(const std::vector<vola::map::ScanEntry>& scans, const Args& a,
+                                                double& seconds) {
   auto tree = std::make_unique<octomap::OcTree>(a.voxel);
-  std::vector<octomap::Pointcloud> clouds(scans.size());
-  for (std::size_t i = 0; i < scans.size(); ++i) {
-    clouds[i].reserve(scans[i].world.size() / 3);
-    for (std::size_t p = 0; p + 2 < scans[i].world.size(); p += 3)
-      clouds[i].push_back(static_cast<float>(scans[i].world[p]), static_cast<float>(scans[i].world[p + 1]),
-                          static_cast<float>(scans[i].world[p + 2]));
-  }
-  const auto start = Clock::now();
-  for (std::size_t i = 0; i < scans.size(); ++i) {
-    const vola::Point& o = scans[i].origin;
-    tree->insertPointCloud(clouds[i], octomap::point3d(static_cast<float>(o[0]), static_cast<float>(o[1]),
-                                                       static_cast<float>(o[2])),
+  seconds = 0;
+  for (const vola::map::ScanEntry& e : scans) {
+    octomap::Pointcloud cloud;
+    vola::Point o{};
+    {
+      const Scan s = read_scan(e);
+      cloud.reserve(s.world.size() / 3);
+      for (std::size_t p = 0; p + 2 < s.world.size(); p += 3)
+        cloud.push_back(static_cast<float>(s.world[p]), static_cast<float>(s.world[p + 1]),
+                        static_cast<float>(s.world[p + 2]));
+      o = s.origin;
+    }
+    const auto start = Clock::now();
+    tree->insertPointCloud(cloud, octomap::point3d(static_cast<float>(o[0]), static_cast<float>(o[1]),
+                                                   static_cast<float>(o[2])),
                            a.max_range > 0 ? a.max_range : -1.0, false, false);
+    seconds += seconds_since(start);
   }
-  seconds = seconds_since(start);
   return tree;
+}
+
+// The process's CPU time (all threads, user and system), robust to a shared machine.
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto s = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return s(usage.ru_utime) + s(usage.ru_stime);
 }
 
 long peak_rss_mib() {
@@ -173,20 +194,23 @@ void compare_decisions(const vola::map::OccupancyMap& map, const octomap::OcTree
 
 int main(int argc, char** argv) try {
   const Args a = parse(argc, argv);
-  const std::vector<Scan> scans = read_scans(a.list);
+  const std::vector<vola::map::ScanEntry> scans = vola::map::read_scan_list(a.list);
   std::size_t points = 0;
-  for (const Scan& s : scans) points += s.world.size() / 3;
+  for (const vola::map::ScanEntry& e : scans) points += read_scan(e).world.size() / 3;
   std::printf("scans: %zu, %zu points, voxel %g, max range %g, OctoMap %s\n", scans.size(), points, a.voxel, a.max_range,
               VOLA_OCTOMAP_VERSION);
   if (!a.only.empty()) {
     const long before = peak_rss_mib();
+    const double cpu_before = cpu_seconds();
     double seconds = 0;
     std::size_t bytes = 0;
-    if (a.only == "vola") bytes = vola_insert(scans, a, 0, seconds).memory_bytes();
+    if (a.only == "vola") bytes = vola_insert(scans, a, a.threads, seconds).memory_bytes();
     else if (a.only == "octomap") bytes = octomap_insert(scans, a, seconds)->memoryUsage();
     else throw std::runtime_error("--only vola or octomap");
-    std::printf("%s alone: %.3f s, map %.1f MiB, process peak %ld MiB (%ld MiB before inserting)\n", a.only.c_str(),
-                seconds, static_cast<double>(bytes) / (1 << 20), peak_rss_mib(), before);
+    std::printf("%s alone: %.3f s (process CPU %.3f s, reading included), map %.1f MiB, process peak %ld MiB (%ld MiB "
+                "before inserting)\n",
+                a.only.c_str(), seconds, cpu_seconds() - cpu_before, static_cast<double>(bytes) / (1 << 20),
+                peak_rss_mib(), before);
     return 0;
   }
   std::vector<double> one, two, octo;

@@ -1,6 +1,7 @@
 #include "vola/map/occupancy_map.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 #include "ray_voxels.hpp"
@@ -39,56 +40,119 @@ std::uint64_t bit_of(const detail::Cell& c) noexcept {
   return std::uint64_t{1} << ((c[0] & 3) | (c[1] & 3) << 2 | (c[2] & 3) << 4);
 }
 
-// What one worker's rays of a scan pass and hit, as bits in block masks. Consecutive
-// voxels of a ray mostly share a block, so the last block is remembered.
-class ScanBlocks {
- public:
-  struct Masks {
-    std::uint64_t passed = 0, hit = 0;
-  };
+struct Masks {
+  std::uint64_t passed = 0, hit = 0;
+};
 
-  void pass(const detail::Cell& c) { masks_of(block_key(c)).passed |= bit_of(c); }
-  void hit(const detail::Cell& c) { masks_of(block_key(c)).hit |= bit_of(c); }
-  // Adds another worker's bits.
-  void add(const ScanBlocks& other) {
-    for (std::size_t b = 0; b < other.keys_.size(); ++b) {
-      Masks& m = masks_of(other.keys_[b]);
-      m.passed |= other.masks_[b].passed;
-      m.hit |= other.masks_[b].hit;
+// One worker's masks of blocks the map does not have yet.
+class FreshBlocks {
+ public:
+  // The position of `key`'s masks, added empty when new.
+  std::uint32_t find_or_add(std::uint64_t key) {
+    bool added = false;
+    const std::uint32_t at = index_.find_or_add(key, added);
+    if (added) {
+      keys_.push_back(key);
+      masks_.emplace_back();
     }
+    return at;
   }
   std::size_t size() const noexcept { return keys_.size(); }
   std::uint64_t key(std::size_t b) const noexcept { return keys_[b]; }
-  const Masks& masks(std::size_t b) const noexcept { return masks_[b]; }
-
-  ScanReport report;
+  Masks& masks(std::size_t b) noexcept { return masks_[b]; }
 
  private:
-  Masks& masks_of(std::uint64_t key) {
-    if (key != last_key_) {
-      bool added = false;
-      last_ = index_.find_or_add(key, added);
-      if (added) {
-        keys_.push_back(key);
-        masks_.emplace_back();
-      }
-      last_key_ = key;
-    }
-    return masks_[last_];
-  }
-
   detail::BlockIndex index_;
   std::vector<std::uint64_t> keys_;
   std::vector<Masks> masks_;
-  std::uint64_t last_key_ = detail::BlockIndex::kEmpty;
-  std::uint32_t last_ = 0;
+};
+
+// What one worker's rays of a scan pass and hit. Consecutive voxels of a ray mostly share
+// a block, so the bits of the current block gather in two words; when the ray enters
+// another block they go into a small direct-mapped cache of recent blocks (neighbouring
+// rays enter the same blocks), which writes a block's bits back when another block takes
+// its slot, and at the end: into the scan's masks of a block the map has (an atomic OR,
+// skipped when the bits are there already), or into the worker's fresh blocks.
+class ScanWorker {
+ public:
+  ScanWorker(const detail::BlockIndex& map, std::vector<Masks>& pending) : map_(&map), pending_(&pending) {}
+
+  void pass(const detail::Cell& c) { at(c).passed |= bit_of(c); }
+  void hit(const detail::Cell& c) { at(c).hit |= bit_of(c); }
+  // The current block's bits into the cache.
+  void flush() {
+    if (key_ == detail::BlockIndex::kEmpty) return;
+    Recent& r = recent_[(key_ * 0x9e3779b97f4a7c15ull) >> (64 - kRecentBits)];
+    if (r.key != key_) {
+      write_back(r);
+      r.key = key_;
+    }
+    r.bits.passed |= bits_.passed;
+    r.bits.hit |= bits_.hit;
+    bits_ = {};
+    key_ = detail::BlockIndex::kEmpty;
+    base_ = kNoCell;
+  }
+  // Everything into the scan's and the fresh masks.
+  void drain() {
+    flush();
+    for (Recent& r : recent_) write_back(r);
+  }
+
+  FreshBlocks fresh;
+  ScanReport report;
+
+ private:
+  struct Recent {
+    std::uint64_t key = detail::BlockIndex::kEmpty;
+    Masks bits;
+  };
+  static constexpr int kRecentBits = 11;
+
+  void write_back(Recent& r) {
+    if (r.key == detail::BlockIndex::kEmpty) return;
+    const std::int64_t b = map_->size() == 0 ? -1 : map_->find(r.key);
+    if (b < 0) {
+      Masks& m = fresh.masks(fresh.find_or_add(r.key));
+      m.passed |= r.bits.passed;
+      m.hit |= r.bits.hit;
+    } else {
+      Masks& m = (*pending_)[static_cast<std::size_t>(b)];
+      or_into(m.passed, r.bits.passed);
+      or_into(m.hit, r.bits.hit);
+    }
+    r = {};
+  }
+  static void or_into(std::uint64_t& word, std::uint64_t bits) {
+    if (!bits) return;
+    std::atomic_ref<std::uint64_t> shared(word);
+    if ((shared.load(std::memory_order_relaxed) & bits) != bits) shared.fetch_or(bits, std::memory_order_relaxed);
+  }
+  // Cells of one block differ only in their two low bits: the test is three XORs.
+  Masks& at(const detail::Cell& c) {
+    if (((c[0] ^ base_[0]) | (c[1] ^ base_[1]) | (c[2] ^ base_[2])) & ~std::int64_t{3}) {
+      flush();
+      base_ = c;
+      key_ = block_key(c);
+    }
+    return bits_;
+  }
+
+  const detail::BlockIndex* map_;
+  std::vector<Masks>* pending_;
+  std::vector<Recent> recent_ = std::vector<Recent>(std::size_t{1} << kRecentBits);
+  std::uint64_t key_ = detail::BlockIndex::kEmpty;
+  // A cell of the current block, or one beyond the index range (no cell's block) when none.
+  static constexpr detail::Cell kNoCell{std::int64_t{1} << 40, 0, 0};
+  detail::Cell base_ = kNoCell;
+  Masks bits_;
 };
 
 // One ray into a worker's masks. Cells are in range: both ends are, and the walk stays
 // inside their box.
 // Grid units by division, as voxel_of: floor(x * (1 / R)) would differ from floor(x / R)
 // where x / R rounds across an integer.
-void cast(const Point& origin, const Point& point, double size, double max_range, ScanBlocks& out) {
+void cast(const Point& origin, const Point& point, double size, double max_range, ScanWorker& out) {
   const detail::GridPoint o{origin[0] / size, origin[1] / size, origin[2] / size};
   Point end = point;
   bool hit = true;
@@ -122,6 +186,18 @@ OccupancyMap::OccupancyMap(double voxel_size, SensorModel model) : voxel_size_(v
   if (!std::isfinite(voxel_size) || !(voxel_size > 0.0))
     throw OptionError("voxel_size", "must be finite and > 0, got " + std::to_string(voxel_size));
   model_.check();
+  levels_ = detail::LogOddsLevels(model_.hit, model_.miss, model_.clamp_min, model_.clamp_max);
+}
+
+std::size_t OccupancyMap::block_of(std::uint64_t key) {
+  bool added = false;
+  const std::uint32_t at = index_.find_or_add(key, added);
+  if (added) {
+    if ((block_count_ >> kPageBits) == pages_.size()) pages_.emplace_back(std::size_t{1} << kPageBits);
+    block_at(block_count_).key = key;
+    ++block_count_;
+  }
+  return at;
 }
 
 std::uint64_t OccupancyMap::pack(const VoxelIndex& v) noexcept {
@@ -150,8 +226,7 @@ std::optional<VoxelIndex> OccupancyMap::voxel_of(const Point& p) const noexcept 
   return index_of(c);
 }
 
-VoxelIndex OccupancyMap::voxel_at(std::size_t block, int bit) const noexcept {
-  const std::uint64_t key = block_keys_[block];
+VoxelIndex OccupancyMap::voxel_at(std::uint64_t key, int bit) noexcept {
   const auto axis = [&](int field, int low) {
     const std::int64_t b = static_cast<std::int64_t>((key >> (field * kBlockBits)) & kBlockMask) - kBlockOffset;
     return static_cast<std::int32_t>(b * 4 + low);
@@ -163,10 +238,10 @@ std::optional<float> OccupancyMap::log_odds(const VoxelIndex& v) const {
   const detail::Cell c{v.i, v.j, v.k};
   const std::int64_t block = index_.find(block_key(c));
   if (block < 0) return std::nullopt;
-  const Block& b = blocks_[static_cast<std::size_t>(block)];
+  const Block& b = block_at(static_cast<std::size_t>(block));
   const std::uint64_t bit = bit_of(c);
   if (!(b.known & bit)) return std::nullopt;
-  return b.log_odds[static_cast<std::size_t>(__builtin_ctzll(bit))];
+  return levels_.value(b.level[static_cast<std::size_t>(__builtin_ctzll(bit))]);
 }
 
 std::vector<std::pair<VoxelIndex, float>> OccupancyMap::voxels() const {
@@ -182,21 +257,16 @@ void OccupancyMap::restore(const VoxelIndex& v, float log_odds) {
     throw InvalidArgument("log-odds " + std::to_string(log_odds) + " is outside the map's clamping range");
   const detail::Cell c{v.i, v.j, v.k};
   if (!in_range(c)) throw InvalidArgument("voxel outside the map's index range");
-  bool added = false;
-  const std::uint32_t at = index_.find_or_add(block_key(c), added);
-  if (added) {
-    block_keys_.push_back(block_key(c));
-    blocks_.emplace_back();
-  }
-  Block& block = blocks_[at];
+  Block& block = block_at(block_of(block_key(c)));
   const std::uint64_t bit = bit_of(c);
   if (!(block.known & bit)) ++known_;
   block.known |= bit;
-  block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bit))] = log_odds;
+  block.level[static_cast<std::size_t>(__builtin_ctzll(bit))] = levels_.level_of(log_odds);
 }
 
 std::size_t OccupancyMap::memory_bytes() const noexcept {
-  return index_.memory_bytes() + block_keys_.capacity() * sizeof(std::uint64_t) + blocks_.capacity() * sizeof(Block);
+  return index_.memory_bytes() + pages_.capacity() * sizeof(std::vector<Block>) +
+         pages_.size() * (sizeof(Block) << kPageBits);
 }
 
 ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& origin, double max_range,
@@ -208,11 +278,13 @@ ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& o
   if (xyz.size() % 3 != 0) throw InvalidArgument("xyz must hold 3 coordinates per point");
   const std::size_t count = xyz.size() / 3;
   const unsigned workers = resolve_thread_count(threads);
-  std::vector<ScanBlocks> scans(workers);
+  // The scan's masks of the map's blocks; blocks new to the map go to the workers first.
+  std::vector<Masks> pending(block_count_);
+  std::vector<ScanWorker> scans(workers, ScanWorker(index_, pending));
   parallel_for(
       count,
       [&](const Chunk& chunk) {
-        ScanBlocks& mine = scans[chunk.worker];
+        ScanWorker& mine = scans[chunk.worker];
         for (std::size_t n = chunk.begin; n < chunk.end; ++n) {
           const Point p{xyz[3 * n], xyz[3 * n + 1], xyz[3 * n + 2]};
           if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
@@ -225,45 +297,70 @@ ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& o
           }
           cast(origin, p, voxel_size_, max_range, mine);
         }
+        mine.flush();
       },
       ParallelOptions{.threads = workers, .grain = 2048, .name = "map.insert_scan"});
-  ScanBlocks& scan = scans[0];
-  for (std::size_t w = 1; w < scans.size(); ++w) {
-    scan.add(scans[w]);
-    scan.report.not_finite += scans[w].report.not_finite;
-    scan.report.outside += scans[w].report.outside;
-    scan.report.cut += scans[w].report.cut;
+  // The workers' cached bits, drained in parallel (one worker each; the scan's masks take
+  // atomic ORs).
+  parallel_for(
+      scans.size(), [&](const Chunk& chunk) { scans[chunk.index].drain(); },
+      ParallelOptions{.threads = workers, .grain = 1, .name = "map.insert_scan"});
+  ScanReport report;
+  report.points = count;
+  // New blocks join the map in worker order (block numbers do not reach the map's
+  // voxels or files); each worker's masks are freed once merged.
+  for (ScanWorker& w : scans) {
+    report.not_finite += w.report.not_finite;
+    report.outside += w.report.outside;
+    report.cut += w.report.cut;
+    for (std::size_t b = 0; b < w.fresh.size(); ++b) {
+      const std::size_t at = block_of(w.fresh.key(b));
+      if (at == pending.size()) pending.emplace_back();
+      pending[at].passed |= w.fresh.masks(b).passed;
+      pending[at].hit |= w.fresh.masks(b).hit;
+    }
+    w.fresh = {};
   }
   // One update per voxel, as OctoMap's updateNode: add, then clamp (a voxel already at
   // the bound stays there, which is what OctoMap's early abort amounts to). A voxel both
-  // hit and passed counts as hit (OctoMap's computeUpdate).
-  const auto update = [&](Block& block, std::uint64_t bits, float change) {
-    for (; bits; bits &= bits - 1) {
-      float& value = block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bits))];
-      value = std::clamp(value + change, model_.clamp_min, model_.clamp_max);
-    }
+  // hit and passed counts as hit (OctoMap's computeUpdate). Blocks are independent.
+  struct Counts {
+    std::uint64_t hit = 0, free = 0, fresh = 0;
   };
-  for (std::size_t b = 0; b < scan.size(); ++b) {
-    const ScanBlocks::Masks& m = scan.masks(b);
-    const std::uint64_t free = m.passed & ~m.hit;
-    bool added = false;
-    const std::uint32_t at = index_.find_or_add(scan.key(b), added);
-    if (added) {
-      block_keys_.push_back(scan.key(b));
-      blocks_.emplace_back();
-    }
-    Block& block = blocks_[at];
-    const std::uint64_t fresh = (free | m.hit) & ~block.known;
-    for (std::uint64_t bits = fresh; bits; bits &= bits - 1) block.log_odds[static_cast<std::size_t>(__builtin_ctzll(bits))] = 0.0f;
-    block.known |= fresh;
-    known_ += static_cast<std::size_t>(__builtin_popcountll(fresh));
-    update(block, free, model_.miss);
-    update(block, m.hit, model_.hit);
-    scan.report.hit_voxels += static_cast<std::uint64_t>(__builtin_popcountll(m.hit));
-    scan.report.free_voxels += static_cast<std::uint64_t>(__builtin_popcountll(free));
+  std::vector<Counts> counts(workers);
+  parallel_for(
+      pending.size(),
+      [&](const Chunk& chunk) {
+        Counts& c = counts[chunk.worker];
+        for (std::size_t b = chunk.begin; b < chunk.end; ++b) {
+          const Masks& m = pending[b];
+          if (!(m.passed | m.hit)) continue;
+          Block& block = block_at(b);
+          const std::uint64_t free = m.passed & ~m.hit;
+          const std::uint64_t fresh = (free | m.hit) & ~block.known;
+          for (std::uint64_t bits = fresh; bits; bits &= bits - 1)
+            block.level[static_cast<std::size_t>(__builtin_ctzll(bits))] = levels_.zero();
+          block.known |= fresh;
+          for (std::uint64_t bits = free; bits; bits &= bits - 1) {
+            auto& q = block.level[static_cast<std::size_t>(__builtin_ctzll(bits))];
+            q = levels_.miss(q);
+          }
+          for (std::uint64_t bits = m.hit; bits; bits &= bits - 1) {
+            auto& q = block.level[static_cast<std::size_t>(__builtin_ctzll(bits))];
+            q = levels_.hit(q);
+          }
+          c.fresh += static_cast<std::uint64_t>(__builtin_popcountll(fresh));
+          c.hit += static_cast<std::uint64_t>(__builtin_popcountll(m.hit));
+          c.free += static_cast<std::uint64_t>(__builtin_popcountll(free));
+        }
+      },
+      ParallelOptions{.threads = workers, .grain = 4096, .name = "map.apply_scan"});
+  for (const Counts& c : counts) {
+    known_ += c.fresh;
+    report.hit_voxels += c.hit;
+    report.free_voxels += c.free;
   }
-  scan.report.points = count;
-  return scan.report;
+  return report;
 }
 
 }  // namespace vola::map

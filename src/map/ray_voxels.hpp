@@ -52,8 +52,9 @@ void walk_ray(const GridPoint& origin, const GridPoint& end, Visit&& visit) {
   // rounding (a guard, never reached by a correct walk).
   std::int64_t budget = 4;
   for (int a = 0; a < 3; ++a) budget += std::abs(last[a] - cell[a]) + 1;
-  while (cell != last && budget-- > 0) {
-    if (cell != first) visit(cell);
+  if (cell == last || budget-- <= 0) return;
+  if (cell != first) visit(cell);
+  for (;;) {
     const double t = std::min(next[0], std::min(next[1], next[2]));
     // The segment ends (t = 1 is the end point) before it leaves this cell.
     if (!(t < 1.0)) return;
@@ -66,6 +67,10 @@ void walk_ray(const GridPoint& origin, const GridPoint& end, Visit&& visit) {
       next[a] = after[a];
       after[a] = crossing(a, 2);
     }
+    // A step moves some axis away from `first` for good, so only the cell before the
+    // first step can be `first` again.
+    if (cell == last || budget-- <= 0) return;
+    visit(cell);
   }
 }
 

@@ -6,7 +6,7 @@
 // (OctoMap computes floor(x * (1/R)), which differs from floor(x / R) only where x / R
 // rounds across an integer).
 //
-// A voxel holds a float log-odds, 0 before its first update. One scan is one batch, as in
+// A voxel holds a log-odds, 0 before its first update. One scan is one batch, as in
 // OctoMap's insertPointCloud (computeUpdate, then updateNode):
 //  - every point is a ray from the sensor origin; the voxels it passes get a miss and its
 //    end voxel (the one holding the point) a hit;
@@ -18,17 +18,27 @@
 //    update per scan, so the result does not depend on point order or thread count;
 //  - a point farther than max_range (when > 0) is cut at max_range: the segment up to the
 //    cut point passes voxels as above (the cut point's voxel excluded) and nothing is hit;
-//  - an update adds the hit or miss log-odds (float) and clamps to [clamp_min, clamp_max].
+//  - an update adds the hit or miss log-odds and clamps to [clamp_min, clamp_max].
+// Log-odds are held as 16-bit levels between the clamps (detail/log_odds_levels.hpp):
+// updates are exact integer steps there, and a value differs from OctoMap's float sum by
+// at most 3e-6 + 5e-7 per update it has had (OctoMap's defaults; a step is 8.7e-5); what
+// the map reports and saves is the level's float, which restore() maps back to the same
+// level.
 //
-// Storage, as VOLA's own: 4x4x4 blocks, each a 64-bit word of known voxels (bit
-// x + 4y + 16z) and 64 floats, found through one hash of block keys. A scan marks the
-// voxels its rays pass and hit as bits in per-worker block masks (a hash probe only when
-// a ray enters another block, not per voxel), merged, then applied block by block: a scan
-// touches only the blocks it changes, and memory follows the map (its blocks), never the
-// scans already inserted.
+// Storage, as VOLA's own: 4x4x4 blocks, each its key, a 64-bit word of known voxels (bit
+// x + 4y + 16z) and 64 levels (144 bytes), in fixed pages (growing never copies the map),
+// found through one open-addressing hash of block keys. A scan's rays mark the voxels they
+// pass and hit as bits, gathered per block while a ray stays in it and then in a small
+// cache of each worker's recent blocks (neighbouring rays enter the same blocks); a block
+// leaving the cache takes one probe and one atomic OR into the scan's masks of a block the
+// map has, or goes into the worker's own masks of blocks new to the map (the only part
+// merged serially). Every block's masks are then applied in parallel: a scan touches only
+// the blocks it changes, and memory follows the map (its blocks, plus 16 bytes per block
+// during a scan), never the scans already inserted.
 //
-// Costs: a scan of n rays of m voxels each is O(n m) bit operations plus one probe per
-// block a ray enters, run in parallel with vola::parallel_for.
+// Costs: a scan of n rays of m voxels each is O(n m) bit operations plus at most one probe
+// per block a ray enters (fewer where the cache holds it), run in parallel with
+// vola::parallel_for.
 #pragma once
 
 #include <array>
@@ -40,6 +50,7 @@
 
 #include "vola/frame.hpp"
 #include "vola/map/detail/block_index.hpp"
+#include "vola/map/detail/log_odds_levels.hpp"
 #include "vola/tree.hpp"
 
 namespace vola::map {
@@ -93,7 +104,8 @@ class OccupancyMap {
                          unsigned threads = 0);
 
   // Sets a voxel's log-odds as a saved map had it (thaw, state_map.hpp): the voxel becomes
-  // known. Throws InvalidArgument for a value outside [clamp_min, clamp_max] or NaN.
+  // known, at the level nearest the value (the same level for a value this map reported).
+  // Throws InvalidArgument for a value outside [clamp_min, clamp_max] or NaN.
   void restore(const VoxelIndex& v, float log_odds);
 
   double voxel_size() const noexcept { return voxel_size_; }
@@ -110,11 +122,13 @@ class OccupancyMap {
   // Visits every known voxel, in no particular order: f(const VoxelIndex&, float log_odds).
   template <class F>
   void for_each(F&& f) const {
-    for (std::size_t b = 0; b < blocks_.size(); ++b)
-      for (std::uint64_t bits = blocks_[b].known; bits; bits &= bits - 1) {
+    for (std::size_t b = 0; b < block_count_; ++b) {
+      const Block& block = block_at(b);
+      for (std::uint64_t bits = block.known; bits; bits &= bits - 1) {
         const int bit = __builtin_ctzll(bits);
-        f(voxel_at(b, bit), blocks_[b].log_odds[static_cast<std::size_t>(bit)]);
+        f(voxel_at(block.key, bit), levels_.value(block.level[static_cast<std::size_t>(bit)]));
       }
+    }
   }
 
   // Packing of indices into one 63-bit key (exposed for the tests).
@@ -123,22 +137,33 @@ class OccupancyMap {
 
   // Bytes the map holds (blocks and their index), for memory reports.
   std::size_t memory_bytes() const noexcept;
-  std::size_t block_count() const noexcept { return blocks_.size(); }
+  std::size_t block_count() const noexcept { return block_count_; }
+  // The levels log-odds are held in (the step a value is rounded to).
+  const detail::LogOddsLevels& levels() const noexcept { return levels_; }
 
  private:
   struct Block {
-    std::uint64_t known = 0;            // bit x + 4y + 16z: the voxel was updated
-    std::array<float, 64> log_odds{};   // meaningful where known
+    std::uint64_t key = 0;
+    std::uint64_t known = 0;                            // bit x + 4y + 16z: the voxel was updated
+    std::array<detail::LogOddsLevels::Level, 64> level{};  // meaningful where known
   };
+  // Pages of 512 blocks (72 KiB): at most one page is partly empty.
+  static constexpr std::size_t kPageBits = 9;
+  static constexpr std::size_t kPageMask = (std::size_t{1} << kPageBits) - 1;
 
   double voxel_size_;
   SensorModel model_;
-  detail::BlockIndex index_;             // block key -> position in blocks_
-  std::vector<std::uint64_t> block_keys_;
-  std::vector<Block> blocks_;
+  detail::LogOddsLevels levels_;
+  detail::BlockIndex index_;             // block key -> block number
+  std::vector<std::vector<Block>> pages_;
+  std::size_t block_count_ = 0;
   std::size_t known_ = 0;
 
-  VoxelIndex voxel_at(std::size_t block, int bit) const noexcept;
+  Block& block_at(std::size_t b) noexcept { return pages_[b >> kPageBits][b & kPageMask]; }
+  const Block& block_at(std::size_t b) const noexcept { return pages_[b >> kPageBits][b & kPageMask]; }
+  // The block of `key`, added (empty) when the map has none.
+  std::size_t block_of(std::uint64_t key);
+  static VoxelIndex voxel_at(std::uint64_t block_key, int bit) noexcept;
 };
 
 // freeze(map) (state_map.hpp) stores the map as one VOLA tree of its known voxels with
