@@ -7,6 +7,28 @@
 #include "wave_packet_coder.hpp"
 
 namespace vola::io::laz {
+namespace {
+
+// The context whose last values predict this point, for the items that follow
+// POINT14's scanner channel. Switching to a new context seeds it from the current one;
+// switching back to a known one keeps predicting from the current one's values in
+// version 3 (as LASzip 3.x writes), from its own in version 4. `make` creates a context.
+template <class Context, class Make>
+Context& follow_channel(std::array<std::unique_ptr<Context>, 4>& contexts, std::uint32_t& current,
+                        std::uint32_t context, bool version4, const Make& make) {
+  Context* owner = contexts[current].get();
+  if (context == current) return *owner;
+  current = context;
+  auto& next = contexts[current];
+  if (!next) next = make();
+  if (!next->used) {
+    next->start_from(*owner);
+    return *next;
+  }
+  return version4 ? *next : *owner;
+}
+
+}  // namespace
 
 struct Rgb14Coder::Context {
   explicit Context(bool decoding) {
@@ -21,6 +43,7 @@ struct Rgb14Coder::Context {
     std::memcpy(last, seed, sizeof last);
     used = true;
   }
+  void start_from(const Context& other) { start(other.last); }
   bool used = false;
   std::uint16_t last[4] = {};
   RgbModels rgb;
@@ -42,20 +65,8 @@ void Rgb14Coder::start(const std::uint8_t* first, std::uint32_t context) {
   changed_[0] = changed_[1] = false;
 }
 
-// The context whose last values predict this point. Switching to a new context seeds
-// it from the current one; switching back to a known one keeps predicting from the
-// current one's values in version 3 (as LASzip 3.x writes), from its own in version 4.
 Rgb14Coder::Context& Rgb14Coder::follow(std::uint32_t context) {
-  Context* owner = contexts_[current_].get();
-  if (context == current_) return *owner;
-  current_ = context;
-  auto& next = contexts_[current_];
-  if (!next) next = std::make_unique<Context>(decoding_);
-  if (!next->used) {
-    next->start(owner->last);
-    return *next;
-  }
-  return version4_ ? *next : *owner;
+  return follow_channel(contexts_, current_, context, version4_, [&] { return std::make_unique<Context>(decoding_); });
 }
 
 void Rgb14Coder::set_layers(std::span<const std::uint8_t> rgb, std::span<const std::uint8_t> nir) {
@@ -124,6 +135,7 @@ struct WavePacket14Coder::Context {
     std::memcpy(last, seed, sizeof last);
     used = true;
   }
+  void start_from(const Context& other) { start(other.last); }
   bool used = false;
   std::uint8_t last[kWavePacketBytes] = {};
   WavePacketCoder coder;
@@ -143,17 +155,8 @@ void WavePacket14Coder::start(const std::uint8_t* first, std::uint32_t context) 
   changed_ = false;
 }
 
-WavePacket14Coder::Context& WavePacket14Coder::follow(std::uint32_t context) {  // as Rgb14Coder::follow
-  Context* owner = contexts_[current_].get();
-  if (context == current_) return *owner;
-  current_ = context;
-  auto& next = contexts_[current_];
-  if (!next) next = std::make_unique<Context>(decoding_);
-  if (!next->used) {
-    next->start(owner->last);
-    return *next;
-  }
-  return version4_ ? *next : *owner;
+WavePacket14Coder::Context& WavePacket14Coder::follow(std::uint32_t context) {
+  return follow_channel(contexts_, current_, context, version4_, [&] { return std::make_unique<Context>(decoding_); });
 }
 
 void WavePacket14Coder::set_layer(std::span<const std::uint8_t> layer) {
@@ -194,6 +197,7 @@ struct Byte14Coder::Context {
     std::memcpy(last.data(), seed, last.size());
     used = true;
   }
+  void start_from(const Context& other) { start(other.last.data()); }
   bool used = false;
   std::vector<std::uint8_t> last;
   std::vector<SymbolModel> models;
@@ -214,17 +218,9 @@ void Byte14Coder::start(const std::uint8_t* first, std::uint32_t context) {
   std::fill(changed_.begin(), changed_.end(), 0);
 }
 
-Byte14Coder::Context& Byte14Coder::follow(std::uint32_t context) {  // as Rgb14Coder::follow
-  Context* owner = contexts_[current_].get();
-  if (context == current_) return *owner;
-  current_ = context;
-  auto& next = contexts_[current_];
-  if (!next) next = std::make_unique<Context>(count_, decoding_);
-  if (!next->used) {
-    next->start(owner->last.data());
-    return *next;
-  }
-  return version4_ ? *next : *owner;
+Byte14Coder::Context& Byte14Coder::follow(std::uint32_t context) {
+  return follow_channel(contexts_, current_, context, version4_,
+                        [&] { return std::make_unique<Context>(count_, decoding_); });
 }
 
 void Byte14Coder::set_layers(std::span<const std::span<const std::uint8_t>> layers) {
