@@ -12,6 +12,7 @@
 #include "vola/file.hpp"
 #include "vola/learn/dataset.hpp"
 #include "vola/learn/npz.hpp"
+#include "vola/learn/segment.hpp"
 
 namespace vola::cli {
 
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 struct DatasetArgs {
   std::string input, output, split, class_name;
   bool background = false;
+  bool segment = false;  // write the object `vola classify --segment` finds in each scene
   double validation_fraction = 0.1;
   std::size_t validation_per_class = 0;  // > 0: a class-balanced split instead of the fraction
   std::uint64_t seed = 1;
@@ -34,12 +36,19 @@ std::mt19937_64 sample_random(std::uint64_t seed, std::size_t index) {
   return std::mt19937_64(sequence);
 }
 
-void write_sample(std::span<const std::uint8_t> grid, int side, const DatasetArgs& a, std::size_t index,
+// Writes the sample; false (nothing written) when --segment finds no object in it.
+bool write_sample(std::span<const std::uint8_t> grid, int side, const DatasetArgs& a, std::size_t index,
                   const fs::path& path) {
-  fs::create_directories(path.parent_path());
   std::mt19937_64 random = sample_random(a.seed, index);
-  const Tree tree = a.background ? learn::room_scene(grid, side, random) : learn::clean_scene(grid, side);
+  Tree tree = a.background ? learn::room_scene(grid, side, random) : learn::clean_scene(grid, side);
+  if (a.segment) {
+    const learn::Segmentation found = learn::segment_object(tree);
+    if (!found.found()) return false;
+    tree = learn::normalise_object(found.object, found.footprint_angle);
+  }
+  fs::create_directories(path.parent_path());
   write(tree, path.string());
+  return true;
 }
 
 std::string sample_name(int label, std::size_t index) {
@@ -63,15 +72,20 @@ void run_npz(const DatasetArgs& a) {
   }
   const fs::path root(a.output);
   std::vector<std::size_t> per_split[2];
+  std::size_t not_found = 0;
   Progress progress("dataset");
   for (std::size_t i = 0; i < grids.size(); ++i) {
     const std::string split = held_out[i] ? "val" : grids.split;
-    write_sample(grids.grid(i), grids.side, a, i,
-                 root / split / std::string(learn::kClassNames[std::size_t(grids.labels[i])]) / sample_name(grids.labels[i], i));
-    per_split[held_out[i] ? 1 : 0].push_back(i);
+    if (write_sample(grids.grid(i), grids.side, a, i,
+                     root / split / std::string(learn::kClassNames[std::size_t(grids.labels[i])]) /
+                         sample_name(grids.labels[i], i)))
+      per_split[held_out[i] ? 1 : 0].push_back(i);
+    else
+      ++not_found;
     progress.update(i + 1, grids.size());
   }
   progress.finish();
+  if (not_found) std::printf("%zu scenes without an object to segment were left out\n", not_found);
   std::printf("%zu %s samples -> %s\n", per_split[0].size(), grids.split.c_str(), (root / grids.split).string().c_str());
   if (carve && a.validation_per_class > 0)
     std::printf("%zu validation samples (%zu of each class, at most half of it, seed %llu) -> %s\n", per_split[1].size(),
@@ -79,7 +93,8 @@ void run_npz(const DatasetArgs& a) {
   else if (carve)
     std::printf("%zu validation samples (%.0f%% of each class, seed %llu) -> %s\n", per_split[1].size(),
                 a.validation_fraction * 100, static_cast<unsigned long long>(a.seed), (root / "val").string().c_str());
-  std::printf("%s, 64^3 at depth 3\n", a.background ? "objects in generated rooms" : "clean objects");
+  std::printf("%s%s, 64^3 at depth 3\n", a.background ? "objects in generated rooms" : "clean objects",
+              a.segment ? ", segmented and normalised as vola classify --segment does" : "");
 }
 
 void run_meshes(const DatasetArgs& a) {
@@ -104,8 +119,10 @@ void run_meshes(const DatasetArgs& a) {
     const std::vector<std::uint8_t> grid = learn::mesh_object_grid(files[i].string(), learn::kObjectSide);
     const fs::path out = fs::path(a.output) / std::string(learn::kClassNames[std::size_t(*label)]) /
                          (files[i].stem().string() + ".vol");
-    write_sample(grid, learn::kObjectSide, a, i, out);
-    std::printf("%s -> %s\n", files[i].string().c_str(), out.string().c_str());
+    if (write_sample(grid, learn::kObjectSide, a, i, out))
+      std::printf("%s -> %s\n", files[i].string().c_str(), out.string().c_str());
+    else
+      std::printf("%s: no object found to segment, left out\n", files[i].string().c_str());
   }
 }
 
@@ -127,7 +144,9 @@ void add_dataset(CLI::App& app) {
       "STL, ...) or a folder of them, voxelized solid at 32^3 like the npz grids (z up, centred).\n"
       "Each object becomes a 64^3 tree of depth 3: clean (each cell a 2x2x2 block), or with --background\n"
       "at 5/4 size, turned by a random angle about z and put on the floor of a room with two walls\n"
-      "and random boxes of clutter (the paper's objects with background).\n"
+      "and random boxes of clutter (the paper's objects with background). With --segment, each scene\n"
+      "gives the object vola classify --segment finds in it, normalised as that option classifies it\n"
+      "(data to train a model for --segment on; scenes where nothing is found are left out).\n"
       "Layout: OUTDIR/<split>/<class>/<class>_<row>.vol for an npz; the train split gives up a\n"
       "stratified, seeded validation split in OUTDIR/val/ (10% of each class, or N of each with\n"
       "--validation-per-class N). Meshes: OUTDIR/<class>/<file name>.vol, the\n"
@@ -135,11 +154,15 @@ void add_dataset(CLI::App& app) {
       "Examples:\n"
       "  vola dataset modelnet10_32_train.npz data/clean                  # data/clean/train, data/clean/val\n"
       "  vola dataset modelnet10_32_train.npz data/room --background\n"
+      "  vola dataset modelnet10_32_train.npz data/room-seg --background --segment   # for --segment models\n"
       "  vola dataset modelnet10_32_test.npz data/clean                   # data/clean/test\n"
       "  vola dataset meshes/ data/meshes                                 # bathtub_0001.off -> data/meshes/bathtub/");
   cmd->add_option("input", args->input, ".npz, mesh file or folder of mesh files")->required()->check(CLI::ExistingPath);
   cmd->add_option("outdir", args->output, "Output folder")->required();
   cmd->add_flag("--background", args->background, "Place each object in a generated room");
+  cmd->add_flag("--segment", args->segment,
+                "Write the object found in each scene (floor and walls removed), normalised as "
+                "vola classify --segment gives it to the model");
   cmd->add_option("--split", args->split, "npz: which X_<split>/y_<split> (default: the only one)");
   cmd->add_option("--validation-fraction", args->validation_fraction,
                   "npz train split: the part of each class held out in val/")

@@ -97,6 +97,7 @@ void run_train(TrainArgs& a) {
                       {"max_scale", options.max_scale},
                       {"max_shift", options.max_shift},
                       {"hollow", options.hollow},
+                      {"quarter_turns", options.quarter_turns},
                       {"balanced", options.balanced},
                       {"threads", options.threads}};
     run["model"] = options.model_path;
@@ -165,6 +166,9 @@ void add_train(CLI::App& app) {
                   "a scan or a surface-voxelised mesh gives it (0: never)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--quarter-turns", args->options.quarter_turns,
+                "Augmentation: turn each object by a random multiple of 90 degrees as well (for data from "
+                "vola dataset --segment, aligned to the object's footprint up to a quarter turn)");
   cmd->add_flag("--balanced", args->options.balanced,
                 "Weigh the loss by 1/sqrt(class share) so rare classes count more");
   cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);

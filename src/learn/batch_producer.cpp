@@ -1,6 +1,7 @@
 #include "batch_producer.hpp"
 
 #include <algorithm>
+#include <numbers>
 #include <random>
 
 #include "vola/learn/occupancy.hpp"
@@ -42,6 +43,7 @@ void BatchProducer::run() {
     std::uniform_real_distribution<double> scale(1 - a.max_scale, 1 + a.max_scale);
     std::uniform_real_distribution<double> shift(-a.max_shift, a.max_shift);
     std::bernoulli_distribution hollow(a.hollow);
+    std::uniform_int_distribution<int> quarter(0, 3);
     const std::size_t cells = std::size_t(side_) * side_ * side_;
     for (std::size_t first = 0; first < order_.size(); first += batch_size_) {
       const std::size_t count = std::min(batch_size_, order_.size() - first);
@@ -52,6 +54,8 @@ void BatchProducer::run() {
         const Sample& sample = samples_[index];
         Placement placement;
         placement.angle_radians = a.max_rotation > 0 ? angle(random) : 0.0;
+        // Drawn only when asked for, as hollow below.
+        if (a.quarter_turns) placement.angle_radians += quarter(random) * std::numbers::pi / 2;
         if (a.max_scale > 0) placement.scale = scale(random);
         if (a.max_shift > 0)
           for (double& d : placement.shift) d = shift(random);

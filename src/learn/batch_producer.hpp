@@ -23,6 +23,7 @@ struct Augmentation {
   double max_scale = 0;
   double max_shift = 0;
   double hollow = 0;  // probability of a sample's input being its surface shell (keep_surface)
+  bool quarter_turns = false;  // a random multiple of 90 degrees added to the angle
 };
 
 struct Batch {
@@ -36,7 +37,8 @@ class BatchProducer {
  public:
   // Batches of `batch_size` (the last may be smaller) over samples[order[...]] at input
   // grid `side`. Angles are uniform in [-max_rotation, max_rotation] radians, drawn in
-  // order from a generator seeded with `seed` (0 radians when max_rotation is 0); then,
+  // order from a generator seeded with `seed` (0 radians when max_rotation is 0), plus
+  // a random quarter turn with `quarter_turns`; then,
   // when augmentation asks for them, a scale uniform in [1 - max_scale, 1 + max_scale]
   // and a shift uniform in [-max_shift, max_shift] tree voxels along each axis; then, with
   // probability `hollow`, only the input's surface shell (keep_surface). At most

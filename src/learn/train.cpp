@@ -109,6 +109,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
   augmentation.max_scale = options.max_scale;
   augmentation.max_shift = options.max_shift;
   augmentation.hollow = options.hollow;
+  augmentation.quarter_turns = options.quarter_turns;
   // Class weights of the loss: 1 / sqrt(share of the class), normalised to a mean of 1
   // over the classes present, so rare classes (bathtub) count more without dominating.
   torch::Tensor class_weights;

@@ -66,6 +66,15 @@ grep -q "^object: " "$work/seg.txt" || fail "no object line"
 "$vola" evaluate "$work/room/test" --segment --png '' --threads 2 > "$work/segeval.txt"
 grep -q "segmented, 4 votes" "$work/segeval.txt" || fail "segment evaluate: $(head -n 2 "$work/segeval.txt")"
 [[ $(tail -n 1 "$work/segeval.txt") =~ ^accuracy:\ (0\.[0-9]{4}|1\.0000)$ ]] || fail "segment evaluate: last line"
+# dataset --segment writes what --segment gives the model: classifying the written object
+# (one vote) says what classifying the room with --segment --votes 1 says.
+"$vola" dataset "$work/small.npz" "$work/seg" --background --segment > "$work/segdata.txt"
+[[ $(find "$work/seg/test" -name '*.vol' | wc -l) == 20 ]] || fail "dataset --segment: $(cat "$work/segdata.txt")"
+grep -q "segmented and normalised" "$work/segdata.txt" || fail "dataset --segment summary: $(cat "$work/segdata.txt")"
+"$vola" classify "$work/seg/test/sofa/sofa_00014.vol" | head -n 1 > "$work/seg_written.txt"
+"$vola" classify --segment --votes 1 "$work/room/test/sofa/sofa_00014.vol" | head -n 1 > "$work/seg_found.txt"
+cmp -s "$work/seg_written.txt" "$work/seg_found.txt" ||
+  fail "dataset --segment differs from classify --segment: $(cat "$work/seg_written.txt") / $(cat "$work/seg_found.txt")"
 # A room with nothing in it but its floor: refused, saying why.
 "$vola" crop "$work/room/test/sofa/sofa_00014.vol" "$work/floor.vol" --min 0 0 0 --max 63 63 0 > /dev/null
 if "$vola" classify --segment "$work/floor.vol" 2> "$work/err.txt"; then fail "empty room classified"; fi

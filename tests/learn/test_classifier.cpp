@@ -61,6 +61,7 @@ TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
   options.max_scale = 0.1;
   options.max_shift = 2;
   options.hollow = 0.5;
+  options.quarter_turns = true;
   options.balanced = true;
   options.model_path = (dir / "whole.pt").string();
   options.checkpoint_path = (dir / "whole.ckpt").string();

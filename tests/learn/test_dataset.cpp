@@ -2,10 +2,14 @@
 // filled from the VOLA bits against a brute-force dense fill.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
+#include <optional>
 #include <set>
 
+#include "batch_producer.hpp"
 #include "learn_test_data.hpp"
 #include "test_support.hpp"
 #include "vola/builder.hpp"
@@ -201,6 +205,33 @@ TEST(Occupancy, QuarterTurnThenVoteAngleEqualsTheLaterVoteAngle) {
   fill_occupancy(turn_quarters(tree, 1), 32, 0.0, a);
   fill_occupancy(tree, 32, 0.0, b);
   EXPECT_NE(a, b);
+}
+
+// --quarter-turns alone: every training input is the sample turned by a whole number of
+// quarter turns (the exact turn_quarters grid), and all four turns occur.
+TEST(Augmentation, QuarterTurnsTurnTheSampleByWholeQuarters) {
+  const vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
+  const std::size_t cells = std::size_t(64) * 64 * 64;
+  std::vector<std::vector<float>> turned(4, std::vector<float>(cells));
+  for (int q = 0; q < 4; ++q) fill_occupancy(turn_quarters(tree, q), 64, 0.0, turned[std::size_t(q)]);
+  const std::vector<Sample> samples(40, Sample{tree, 0});
+  std::vector<std::size_t> order(samples.size());
+  std::iota(order.begin(), order.end(), 0);
+  Augmentation augmentation;
+  augmentation.quarter_turns = true;
+  BatchProducer producer(samples, order, samples.size(), 64, 5, augmentation);
+  const std::optional<Batch> batch = producer.next();
+  ASSERT_TRUE(batch && batch->count() == samples.size());
+  std::set<int> seen;
+  for (std::size_t k = 0; k < batch->count(); ++k) {
+    const std::vector<float> input(batch->inputs.begin() + std::ptrdiff_t(k * cells),
+                                   batch->inputs.begin() + std::ptrdiff_t((k + 1) * cells));
+    const auto match = std::find(turned.begin(), turned.end(), input);
+    ASSERT_NE(match, turned.end()) << "input " << k << " is not a quarter turn of the sample";
+    seen.insert(int(match - turned.begin()));
+  }
+  EXPECT_EQ(seen.size(), 4u);
+  EXPECT_NE(turned[0], turned[1]);  // the shape is not symmetric under a quarter turn
 }
 
 TEST(Dataset, BalancedSplitHoldsOutAFixedCountPerClass) {

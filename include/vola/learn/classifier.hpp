@@ -53,6 +53,9 @@ struct TrainOptions {
   double max_shift = 0;              // augmentation: shift uniform in [-max, max] tree voxels per axis
   double hollow = 0;                 // augmentation: probability of giving a sample as its surface
                                      // shell only (what a scan or a surface-voxelised mesh gives)
+  bool quarter_turns = false;        // augmentation: a random multiple of 90 degrees about z on
+                                     // top of the angle (for objects aligned to their footprint's
+                                     // axes up to a quarter turn, as --segment gives them)
   bool balanced = false;             // loss weights 1/sqrt(class share), normalised to mean 1
   int threads = 0;                  // torch intra-op threads; 0: all cores
   std::string model_path;           // the trained weights, written after every epoch
