@@ -65,7 +65,9 @@ void print_segmentation(const learn::Segmentation& s, double vote_degrees) {
 
 learn::Classifier load_classifier(const ClassifyArgs& a) {
   learn::set_threads(a.threads);
-  return learn::Classifier(a.model.empty() ? learn::default_model_path() : a.model);
+  if (!a.model.empty()) return learn::Classifier(a.model);
+  return learn::Classifier(learn::default_model_path(a.segment ? learn::kSegmentedRoomModelFile
+                                                                : learn::kDefaultModelFile));
 }
 
 std::size_t best_class(const std::array<float, kClassCount>& p) {
@@ -269,7 +271,8 @@ void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
 }
 
 constexpr const char* kModelFooter =
-    "Without --model the committed small model models/modelnet10-small.pt is used, looked for in\n"
+    "Without --model the committed small model models/modelnet10-small.pt is used (with --segment\n"
+    "models/modelnet10-small-room-segmented.pt, trained on the objects --segment finds in rooms), looked for in\n"
     "$VOLA_MODEL, <vola's folder>/../share/vola/models/ (installed), <vola's folder>/../models/ and\n"
     "../../models/ (a build folder in the source tree), then the source tree vola was built from.\n";
 
@@ -287,7 +290,7 @@ void add_classify(CLI::App& app) {
                    "A scene with no object left once its planes are removed is an error.\n"
                    "Examples:\n  vola classify data/clean/val/chair/chair_01234.vol\n"
                    "  vola classify data/room/val/chair/chair_01234.vol --model models/modelnet10-small-room.pt --votes 12\n"
-                   "  vola classify data/room/val/chair/chair_01234.vol --segment\n"
+                   "  vola classify data/room/val/chair/chair_01234.vol --segment        # the room-segmented model\n"
                    "  vola classify data/room/val/chair/chair_01234.vol --segment --model models/modelnet10-small-full-circle.pt \\\n"
                    "    --votes 12 --orientations mean");
   classify->add_option("file", args->inputs, ".vol files")->required()->check(CLI::ExistingFile);
@@ -304,6 +307,7 @@ void add_classify(CLI::App& app) {
                    "is found count as wrong and are said.\n"
                    "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"
                    "  vola evaluate data/room/val --model models/modelnet10-small-room.pt --votes 12\n"
+                   "  vola evaluate data/room/val --segment                 # the room-segmented model, 4 votes\n"
                    "  vola evaluate data/room/val --segment --model models/modelnet10-small-full-circle.pt --votes 12 --orientations mean");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();

@@ -343,7 +343,7 @@ std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const
   return result;
 }
 
-std::string default_model_path() {
+std::string default_model_path(std::string_view file) {
   namespace fs = std::filesystem;
   std::vector<fs::path> candidates;
   if (const char* env = std::getenv("VOLA_MODEL"); env && *env) candidates.emplace_back(env);
@@ -351,17 +351,17 @@ std::string default_model_path() {
   const fs::path exe = fs::read_symlink("/proc/self/exe", error);
   if (!error) {
     const fs::path dir = exe.parent_path();
-    candidates.push_back(dir / ".." / "share" / "vola" / "models" / kDefaultModelFile);
-    candidates.push_back(dir / ".." / "models" / kDefaultModelFile);
-    candidates.push_back(dir / ".." / ".." / "models" / kDefaultModelFile);
+    candidates.push_back(dir / ".." / "share" / "vola" / "models" / file);
+    candidates.push_back(dir / ".." / "models" / file);
+    candidates.push_back(dir / ".." / ".." / "models" / file);
   }
-  if (*VOLA_LEARN_SOURCE_MODELS) candidates.push_back(fs::path(VOLA_LEARN_SOURCE_MODELS) / kDefaultModelFile);
+  if (*VOLA_LEARN_SOURCE_MODELS) candidates.push_back(fs::path(VOLA_LEARN_SOURCE_MODELS) / file);
   std::string looked;
   for (const auto& candidate : candidates) {
     if (fs::is_regular_file(candidate, error)) return candidate.lexically_normal().string();
     looked += "\n  " + candidate.lexically_normal().string();
   }
-  throw IoError("no model given and the default " + std::string(kDefaultModelFile) +
+  throw IoError("no model given and the default " + std::string(file) +
                 " is in none of:" + looked);
 }
 

@@ -187,10 +187,10 @@ TEST(Classifier, TwelveVotesAreInvariantToQuarterTurns) {
 
 // The inference pass (oneDNN for every layer with weights, batch norm folded, fc1 as a
 // convolution) computes the training-time forward pass's function: the probabilities of
-// both committed models agree within float rounding, for one object and for a batch with
+// the committed models agree within float rounding, for one object and for a batch with
 // votes, and the argmax is the same.
 TEST(Classifier, InferencePassEqualsTheForwardPass) {
-  for (const char* file : {"modelnet10-small.pt", "modelnet10-small-room.pt"}) {
+  for (const char* file : {"modelnet10-small.pt", "modelnet10-small-room.pt", "modelnet10-small-room-segmented.pt"}) {
     const std::filesystem::path model = std::filesystem::path(vola_learn_test::committed_model_path()).parent_path() / file;
     const Classifier classifier(model.string());
     std::vector<vola::Tree> trees;

@@ -120,12 +120,15 @@ extern bool reference_inference;
 // Torch's intra-op thread count (0: leave torch's default of all cores).
 void set_threads(int threads);
 
-// Where the committed small model is looked for, in order: $VOLA_MODEL; next to the
-// executable's prefix, <exe dir>/../share/vola/models/ (install) and <exe dir>/../models/
-// and <exe dir>/../../models/ (a build folder inside the source tree); the source tree
-// the library was built from. Returns the first that exists, or throws IoError listing
-// where it looked.
-std::string default_model_path();
+// Where a committed model (by default the small clean one) is looked for, in order:
+// $VOLA_MODEL; next to the executable's prefix, <exe dir>/../share/vola/models/ (install)
+// and <exe dir>/../models/ and <exe dir>/../../models/ (a build folder inside the source
+// tree); the source tree the library was built from. Returns the first that exists, or
+// throws IoError listing where it looked.
 inline constexpr std::string_view kDefaultModelFile = "modelnet10-small.pt";
+// The model for objects found in rooms (`classify --segment`): trained on what
+// segment_object and normalise_object give.
+inline constexpr std::string_view kSegmentedRoomModelFile = "modelnet10-small-room-segmented.pt";
+std::string default_model_path(std::string_view file = kDefaultModelFile);
 
 }  // namespace vola::learn
