@@ -9,6 +9,27 @@ namespace vola::slam {
 
 namespace {
 constexpr std::size_t kRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
+
+// exp(-x) for x >= 0, linear between 4096 samples over [0, 32] (absolute error under
+// 8e-6) and 0 beyond (e^-32 is 1e-14): the bilateral filter's depth weights, which took
+// half of the filter's time in libm's exp.
+class NegativeExpTable {
+ public:
+  static constexpr double kEnd = 32.0;
+  static constexpr int kSteps = 4096;
+  NegativeExpTable() {
+    for (int i = 0; i <= kSteps + 1; ++i) values_[i] = std::exp(-i * (kEnd / kSteps));
+  }
+  double operator()(double x) const {
+    if (!(x < kEnd)) return 0.0;
+    const double at = x * (kSteps / kEnd);
+    const int i = static_cast<int>(at);
+    return values_[i] + (at - i) * (values_[i + 1] - values_[i]);
+  }
+
+ private:
+  double values_[kSteps + 2];
+};
 }  // namespace
 
 DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_space, double sigma_depth,
@@ -19,6 +40,7 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
   for (int dy = -radius; dy <= radius; ++dy)
     for (int dx = -radius; dx <= radius; ++dx)
       spatial[(dy + radius) * (2 * radius + 1) + dx + radius] = std::exp(-(dx * dx + dy * dy) * space);
+  static const NegativeExpTable negative_exp;
   const int w = static_cast<int>(depth.width), h = static_cast<int>(depth.height);
   ParallelOptions parallel;
   parallel.threads = threads;
@@ -35,7 +57,8 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
             const float d = depth.metres[std::size_t(y + dy) * w + x + dx];
             if (d <= 0.0f) continue;
             const double diff = d - centre;
-            const double weight = spatial[(dy + radius) * (2 * radius + 1) + dx + radius] * std::exp(-diff * diff * range);
+            const double weight =
+                spatial[(dy + radius) * (2 * radius + 1) + dx + radius] * negative_exp(diff * diff * range);
             sum += weight * d;
             weights += weight;
           }

@@ -46,6 +46,23 @@ class TsdfReader {
     const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
     const double ax = s.x() - fx, ay = s.y() - fy, az = s.z() - fz;
     double sum = 0.0;
+    if ((x & 7) != 7 && (y & 7) != 7 && (z & 7) != 7) {
+      // All eight in one brick (7 cells in 8 per axis): one brick lookup, not eight.
+      const TsdfVoxel* b = brick_at(x >> 3, y >> 3, z >> 3);
+      if (!b) return false;
+      const TsdfVoxel* base = b + local_index(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                              static_cast<std::uint32_t>(z));
+      constexpr int kOffsets[8] = {0, 1, kBrickSide, kBrickSide + 1, kBrickSide * kBrickSide,
+                                   kBrickSide * kBrickSide + 1, kBrickSide * kBrickSide + kBrickSide,
+                                   kBrickSide * kBrickSide + kBrickSide + 1};
+      for (int c = 0; c < 8; ++c) {
+        const TsdfVoxel& v = base[kOffsets[c]];
+        if (!(v.weight > 0.0f)) return false;
+        sum += ((c & 1) ? ax : 1 - ax) * ((c & 2) ? ay : 1 - ay) * ((c & 4) ? az : 1 - az) * v.tsdf;
+      }
+      f = sum;
+      return true;
+    }
     for (int c = 0; c < 8; ++c) {
       const TsdfVoxel* v = voxel(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
       if (!v) return false;
