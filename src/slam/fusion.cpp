@@ -105,7 +105,8 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
     const Eigen::Vector3d g = grid_at(t);
     const double fx = std::floor(g.x()), fy = std::floor(g.y()), fz = std::floor(g.z());
     const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
-    if (!reader.brick_at(x >> 3, y >> 3, z >> 3)) {
+    const TsdfVoxel* brick = reader.brick_at(x >> 3, y >> 3, z >> 3);
+    if (!brick) {
       // Leave the brick: the nearest exit plane over the three axes.
       double exit = std::numeric_limits<double>::infinity();
       const std::int64_t cell[3] = {x >> 3, y >> 3, z >> 3};
@@ -118,8 +119,9 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
       prev_valid = false;
       continue;
     }
-    const TsdfVoxel* v = reader.voxel(x, y, z);
-    if (!v) {
+    const TsdfVoxel* v = brick + local_index(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                             static_cast<std::uint32_t>(z));
+    if (!(v->weight > 0.0f)) {
       prev_valid = false;
       t += vs;
       continue;
@@ -292,31 +294,48 @@ RgbImage render_view(const Store& store, const Intrinsics& k, std::uint32_t widt
 }
 
 std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics& k, const Pose& pose,
-                                       const VolumeGeometry& geometry, double truncation) {
+                                       const VolumeGeometry& geometry, double truncation, unsigned threads) {
   const double brick_metres = kBrickSide * geometry.voxel_size;
   const double side = geometry.bricks_per_side;
+  // Each band of rows collects its keys sorted and unique (neighbouring pixels share
+  // most bricks, so the bands' lists are short), then the lists are merged: a set, the
+  // same whatever the bands.
+  ParallelOptions bands;
+  bands.threads = threads;
+  bands.chunks = std::max<std::size_t>(1, std::min<std::size_t>(depth.height, 16));
+  bands.name = "slam.bricks_in_band";
+  std::vector<std::vector<std::uint64_t>> band_keys(bands.chunks);
+  parallel_for(
+      depth.height,
+      [&](const Chunk& chunk) {
+        std::vector<std::uint64_t>& keys = band_keys[chunk.index];
+        std::uint64_t last = ~std::uint64_t{0};
+        for (auto y = static_cast<std::uint32_t>(chunk.begin); y < chunk.end; ++y)
+          for (std::uint32_t x = 0; x < depth.width; ++x) {
+            const double d = depth.at(x, y);
+            if (!(d > 0.0)) continue;
+            const Eigen::Vector3d dir = pixel_direction(k, x, y);
+            // Depth steps short enough that consecutive samples are at most half a brick apart.
+            const double step = brick_metres / (2 * dir.norm());
+            const int samples = static_cast<int>(std::ceil(2 * truncation / step));
+            for (int s = 0; s <= samples; ++s) {
+              const double z = d - truncation + 2 * truncation * s / samples;
+              if (z <= 0.0) continue;
+              const Eigen::Vector3d g = (pose * (dir * z) - geometry.origin) / brick_metres;
+              const double bx = std::floor(g.x()), by = std::floor(g.y()), bz = std::floor(g.z());
+              if (!(bx >= 0 && by >= 0 && bz >= 0 && bx < side && by < side && bz < side)) continue;
+              const std::uint64_t key = static_cast<std::uint64_t>(bz) << 42 | static_cast<std::uint64_t>(by) << 21 |
+                                        static_cast<std::uint64_t>(bx);
+              if (key != last) keys.push_back(key);
+              last = key;
+            }
+          }
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+      },
+      bands);
   std::vector<std::uint64_t> keys;
-  std::uint64_t last = ~std::uint64_t{0};
-  for (std::uint32_t y = 0; y < depth.height; ++y)
-    for (std::uint32_t x = 0; x < depth.width; ++x) {
-      const double d = depth.at(x, y);
-      if (!(d > 0.0)) continue;
-      const Eigen::Vector3d dir = pixel_direction(k, x, y);
-      // Depth steps short enough that consecutive samples are at most half a brick apart.
-      const double step = brick_metres / (2 * dir.norm());
-      const int samples = static_cast<int>(std::ceil(2 * truncation / step));
-      for (int s = 0; s <= samples; ++s) {
-        const double z = d - truncation + 2 * truncation * s / samples;
-        if (z <= 0.0) continue;
-        const Eigen::Vector3d g = (pose * (dir * z) - geometry.origin) / brick_metres;
-        const double bx = std::floor(g.x()), by = std::floor(g.y()), bz = std::floor(g.z());
-        if (!(bx >= 0 && by >= 0 && bz >= 0 && bx < side && by < side && bz < side)) continue;
-        const std::uint64_t key = static_cast<std::uint64_t>(bz) << 42 | static_cast<std::uint64_t>(by) << 21 |
-                                  static_cast<std::uint64_t>(bx);
-        if (key != last) keys.push_back(key);
-        last = key;
-      }
-    }
+  for (const auto& band : band_keys) keys.insert(keys.end(), band.begin(), band.end());
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   std::vector<BrickCoord> bricks;
@@ -700,7 +719,8 @@ void Fusion<Store>::remember_features(FeatureFrame&& features) {
 template <class Store>
 void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, const Pose& pose) {
   const VolumeGeometry& geometry = store_.geometry();
-  const std::vector<BrickCoord> bricks = bricks_in_band(depth, intrinsics_, pose, geometry, params_.truncation);
+  const std::vector<BrickCoord> bricks =
+      bricks_in_band(depth, intrinsics_, pose, geometry, params_.truncation, params_.threads);
   // Bricks not yet in the store are integrated into scratch space first and only stored
   // when at least one voxel was observed: the band test is per pixel ray, so a brick it
   // names can still have every voxel behind the surface or projecting outside the

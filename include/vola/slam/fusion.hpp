@@ -196,8 +196,9 @@ RgbImage render_view(const Store& store, const Intrinsics& k, std::uint32_t widt
                      const Pose& pose, const FusionParams& params, bool use_colour);
 
 // The bricks whose voxels lie within `truncation` of a measured depth along its pixel
-// ray, in the order both stores allocate them (sorted).
+// ray, in the order both stores allocate them (sorted); the same list on any number of
+// threads (0: vola::thread_count()).
 std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics& k, const Pose& pose,
-                                       const VolumeGeometry& geometry, double truncation);
+                                       const VolumeGeometry& geometry, double truncation, unsigned threads = 0);
 
 }  // namespace vola::slam
