@@ -610,7 +610,7 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
       const std::optional<IcpStep> step = icp_step(total, estimate, prediction, params_.motion_prior);
       if (!step) return std::nullopt;
       estimate = step->pose;
-      if (step->twist_norm < 1e-7) break;
+      if (step->twist_norm < 1e-5) break;
     }
   }
   *correspondences = last_count;
