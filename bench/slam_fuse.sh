@@ -23,7 +23,7 @@ for i in $(seq 1 "$runs"); do
     --render "$work/room300_view.png" --render-frame 150 > "$work/room300_run$i.txt"
 done
 cat "$work/room300_run1.txt"
-echo "median frames/s: $(for i in $(seq 1 "$runs"); do awk '/frames\/s/ { sub(":", "", $7); print $7 }' "$work/room300_run$i.txt"; done | median)"
+echo "median frames/s: $(for i in $(seq 1 "$runs"); do awk '/ lost\) in / { print $8 }' "$work/room300_run$i.txt"; done | median)"
 "$vola" rgbd-eval "$work/room300/groundtruth.txt" "$work/room300_est.txt"
 
 for seed in ${SLAM_SEEDS-2 3}; do

@@ -96,6 +96,8 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   const auto frames = result.trajectory.size();
   std::printf("%zu frames (%zu lost) in %.2f s: %.2f frames/s, %u x %u\n", frames, result.lost, result.seconds,
               static_cast<double>(frames) / result.seconds, result.width, result.height);
+  std::printf("tracking + fusion: %.2f s, %.2f frames/s (the rest reads the frames)\n", result.fusion_seconds,
+              static_cast<double>(frames) / result.fusion_seconds);
   if (result.wide_baseline || result.relocalised)
     std::printf("colour features: %zu frames tracked from a feature pose (large motion), %zu relocalised after a loss\n",
                 result.wide_baseline, result.relocalised);

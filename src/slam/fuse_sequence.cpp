@@ -96,8 +96,10 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
       result.width = depth.width;
       result.height = depth.height;
     }
+    const auto fusion_start = std::chrono::steady_clock::now();
     const FrameResult r = options.groundtruth_poses ? fusion->process_at_pose(depth, rgb ? &*rgb : nullptr, *truth[i])
                                                     : fusion->process(depth, rgb ? &*rgb : nullptr, initial);
+    result.fusion_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - fusion_start).count();
     if (!r.tracked) ++result.lost;
     if (r.wide_baseline) ++result.wide_baseline;
     if (r.relocalised) ++result.relocalised;

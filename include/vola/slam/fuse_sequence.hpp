@@ -29,6 +29,7 @@ struct FuseResult {
   std::size_t relocalised = 0;          // frames placed after a loss (the next frame, or the lost one later)
   std::vector<std::size_t> recovered;   // 1-based numbers of lost frames placed later (no longer lost)
   double seconds = 0.0;                 // wall time of reading + fusion
+  double fusion_seconds = 0.0;          // of which tracking + fusion (the frames' processing alone)
   bool coloured = false;                // colour frames were integrated
   std::uint32_t width = 0, height = 0;
   // Implausible input that did not stop the run (depth in the wrong unit, most of the
