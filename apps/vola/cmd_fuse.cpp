@@ -30,7 +30,7 @@ struct FuseArgs {
   std::uint32_t bricks = 4096;
   unsigned threads = 0;
   bool groundtruth_poses = false, start_at_groundtruth = false, no_colour = false, quiet = false, dense = false,
-       no_features = false;
+       no_features = false, no_loop_closure = false;
 };
 
 slam::Pose pose_from(const std::vector<double>& v) {
@@ -101,6 +101,16 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   if (result.wide_baseline || result.relocalised)
     std::printf("colour features: %zu frames tracked from a feature pose (large motion), %zu relocalised after a loss\n",
                 result.wide_baseline, result.relocalised);
+  if (result.loop_corrected)
+    std::printf("loop closure: %zu loop edge%s, up to %.3f m / %.2f deg from the tracked trajectory; keyframes moved "
+                "by up to %.3f m, map integrated again in %.2f s\n",
+                result.loop_edges, result.loop_edges == 1 ? "" : "s", result.loop_disagreement.metres,
+                result.loop_disagreement.degrees, result.loop_max_move, result.reintegration_seconds);
+  else if (result.loop_edges)
+    std::printf("loop closure: %zu loop edge%s, all within %.3f m / %.2f deg of the tracked trajectory: nothing to "
+                "correct\n",
+                result.loop_edges, result.loop_edges == 1 ? "" : "s", result.loop_disagreement.metres,
+                result.loop_disagreement.degrees);
   print_memory(store, options.params.voxel_size);
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),
               a.mesh.empty() ? "" : (", " + std::to_string(triangles) + " triangles in the mesh").c_str());
@@ -136,6 +146,7 @@ void run_fuse(const FuseArgs& a) {
   p.motion_prior = a.motion_prior;
   p.threads = a.threads;
   p.features = !a.no_features;
+  p.loop_closure = !a.no_loop_closure;
   p.photometric_weight = a.photometric_weight;
   p.check();
   if ((a.groundtruth_poses || a.start_at_groundtruth) && sequence.groundtruth.empty())
@@ -211,6 +222,9 @@ void add_fuse(CLI::App& app) {
   cmd->add_flag("--no-colour", a->no_colour, "Ignore colour frames (no integration of colour, no features)");
   cmd->add_flag("--no-features", a->no_features,
                 "Track by ICP only: no colour features for large motion or relocalisation");
+  cmd->add_flag("--no-loop-closure", a->no_loop_closure,
+                "No loop closure (by default a keyframe whose colour features register against an older one "
+                "closes a loop: a pose graph corrects the trajectory and the map is integrated again)");
   cmd->add_flag("--dense", a->dense, "Keep the TSDF in a dense grid of --bricks^3 bricks instead (the same pipeline, for comparison)");
   cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)");
   cmd->add_flag("-q,--quiet", a->quiet, "No summary");

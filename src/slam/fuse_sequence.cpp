@@ -75,20 +75,24 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
   if (options.groundtruth_poses) truth = groundtruth_per_frame(sequence, options.max_difference);
   const Pose initial = first_pose(sequence, options);
   FuseResult result;
+  const auto read_colour = [&](const SequenceFrame& frame, const DepthImage& depth) -> std::optional<RgbImage> {
+    if (!options.use_colour || frame.rgb_path.empty()) return std::nullopt;
+    RgbImage rgb = read_rgb_png(frame.rgb_path);
+    if (rgb.width != depth.width || rgb.height != depth.height)
+      throw FormatError(frame.rgb_path, std::nullopt, "colour frame is " + std::to_string(rgb.width) + " x " +
+                                                          std::to_string(rgb.height) + ", its depth frame " +
+                                                          std::to_string(depth.width) + " x " + std::to_string(depth.height));
+    result.coloured = true;
+    return rgb;
+  };
   std::unique_ptr<Fusion<Store>> fusion;
+  std::vector<std::size_t> sequence_index;  // of each processed frame
+  std::vector<bool> integrated;             // per processed frame: in the map (tracked or placed later)
   for (std::size_t i = 0; i < total; ++i) {
     const SequenceFrame& frame = sequence.frames[i];
     if (options.groundtruth_poses && !truth[i]) continue;  // no pose to place it at
     const DepthImage depth = read_depth(frame.depth_path, options.depth_factor);
-    std::optional<RgbImage> rgb;
-    if (options.use_colour && !frame.rgb_path.empty()) {
-      rgb = read_rgb_png(frame.rgb_path);
-      if (rgb->width != depth.width || rgb->height != depth.height)
-        throw FormatError(frame.rgb_path, std::nullopt, "colour frame is " + std::to_string(rgb->width) + " x " +
-                                                            std::to_string(rgb->height) + ", its depth frame " +
-                                                            std::to_string(depth.width) + " x " + std::to_string(depth.height));
-      result.coloured = true;
-    }
+    const std::optional<RgbImage> rgb = read_colour(frame, depth);
     if (!fusion) {
       if (auto warning = depth_unit_warning(depth, frame.depth_path, options.depth_factor, options.params))
         result.warnings.push_back(std::move(*warning));
@@ -100,6 +104,8 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     const FrameResult r = options.groundtruth_poses ? fusion->process_at_pose(depth, rgb ? &*rgb : nullptr, *truth[i])
                                                     : fusion->process(depth, rgb ? &*rgb : nullptr, initial);
     result.fusion_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - fusion_start).count();
+    sequence_index.push_back(i);
+    integrated.push_back(r.tracked);
     if (!r.tracked) ++result.lost;
     if (r.wide_baseline) ++result.wide_baseline;
     if (r.relocalised) ++result.relocalised;
@@ -108,6 +114,7 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     if (!options.groundtruth_poses)
       for (const auto& recovered : fusion->take_recovered()) {
         result.trajectory.at(recovered.frame).pose = recovered.pose;
+        integrated.at(recovered.frame) = true;
         --result.lost;
         ++result.relocalised;
         result.recovered.push_back(recovered.frame + 1);
@@ -115,6 +122,32 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     if (progress) progress(i + 1, total, r);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (fusion && !options.groundtruth_poses && options.params.loop_closure && !fusion->loops().empty()) {
+    result.loop_edges = fusion->loops().size();
+    result.loop_disagreement = loop_disagreement(fusion->keyframe_poses(), fusion->loops());
+    result.loop_corrected = result.loop_disagreement.metres > options.params.loop_min_correction ||
+                            result.loop_disagreement.degrees > options.params.loop_min_correction_degrees;
+  }
+  if (result.loop_corrected) {
+    // The map again, every integrated frame at its corrected pose.
+    const auto again_start = std::chrono::steady_clock::now();
+    std::vector<Pose> poses;
+    for (const auto& p : result.trajectory) poses.push_back(p.pose);
+    const LoopCorrection correction = correct_trajectory(poses, fusion->keyframe_poses(), fusion->loops());
+    result.loop_max_move = correction.max_keyframe_move;
+    for (std::size_t f = 0; f < poses.size(); ++f) result.trajectory[f].pose = correction.poses[f];
+    fusion.reset();
+    store.clear();
+    Fusion<Store> again(store, options.intrinsics, result.width, result.height, options.params);
+    for (std::size_t f = 0; f < poses.size(); ++f) {
+      if (!integrated[f]) continue;
+      const SequenceFrame& frame = sequence.frames[sequence_index[f]];
+      const DepthImage depth = read_depth(frame.depth_path, options.depth_factor);
+      const std::optional<RgbImage> rgb = read_colour(frame, depth);
+      again.integrate_at_pose(depth, rgb ? &*rgb : nullptr, correction.poses[f]);
+    }
+    result.reintegration_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - again_start).count();
+  }
   return result;
 }
 

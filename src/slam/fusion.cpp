@@ -687,7 +687,7 @@ void Fusion<Store>::retry_pending() {
       continue;
     }
     integrate(it->depth, it->rgb ? &*it->rgb : nullptr, *pose);
-    keyframes_.push_back({std::move(it->features), *pose});
+    keyframes_.push_back({std::move(it->features), *pose, it->frame});
     recovered_.push_back({it->frame, *pose, r->inliers});
     placed = true;
     it = pending_.erase(it);
@@ -711,9 +711,56 @@ template <class Store>
 void Fusion<Store>::remember_features(FeatureFrame&& features) {
   if (features.size() == 0) return;
   if (keyframes_.empty() || !within(keyframes_.back().pose, pose_, params_.keyframe_translation,
-                                    params_.keyframe_rotation_degrees))
-    keyframes_.push_back({features, pose_});
+                                    params_.keyframe_rotation_degrees)) {
+    if (params_.loop_closure) detect_loop(features);
+    keyframes_.push_back({features, pose_, frames_ - 1});
+  }
   last_features_ = std::move(features);
+}
+
+// The keyframe about to be added (at pose_) against the older ones within the loop gate
+// (drift is bounded; a place that merely looks alike elsewhere is not a loop), nearest
+// in position and viewing direction first.
+template <class Store>
+void Fusion<Store>::detect_loop(const FeatureFrame& features) {
+  if (keyframes_.size() <= params_.loop_skip_keyframes) return;
+  const std::size_t older = keyframes_.size() - params_.loop_skip_keyframes;
+  const auto apart = [&](std::size_t i) {
+    const Pose d = keyframes_[i].pose.inverse() * pose_;
+    return d.translation().norm() / params_.loop_gate_translation +
+           Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI / params_.loop_gate_rotation_degrees;
+  };
+  std::vector<std::size_t> candidates;
+  for (std::size_t i = 0; i < older; ++i)
+    if (within(keyframes_[i].pose, pose_, params_.loop_gate_translation, params_.loop_gate_rotation_degrees))
+      candidates.push_back(i);
+  std::stable_sort(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) { return apart(a) < apart(b); });
+  candidates.resize(std::min<std::size_t>(candidates.size(), 3));
+  std::optional<LoopEdge> best;
+  for (const std::size_t i : candidates) {
+    const auto r = register_features(keyframes_[i].features, features, params_.feature);
+    if (!r || r->inliers < params_.loop_min_inliers || (best && r->inliers <= best->inliers)) continue;
+    if (!within(keyframes_[i].pose * r->transform, pose_, params_.loop_gate_translation,
+                params_.loop_gate_rotation_degrees))
+      continue;
+    best = LoopEdge{i, keyframes_.size(), r->transform, r->inliers};
+  }
+  if (best) loops_.push_back(*best);
+}
+
+template <class Store>
+std::vector<KeyframePose> Fusion<Store>::keyframe_poses() const {
+  std::vector<KeyframePose> out;
+  out.reserve(keyframes_.size());
+  for (const Keyframe& k : keyframes_) out.push_back({k.frame, k.pose});
+  return out;
+}
+
+template <class Store>
+void Fusion<Store>::integrate_at_pose(const DepthImage& raw, const RgbImage* rgb, const Pose& pose) {
+  integrate(filtered(clipped(raw, rgb)), rgb, pose);
+  pose_ = pose;
+  ++frames_;
 }
 
 template <class Store>

@@ -1,5 +1,6 @@
 #include "vola/slam/tsdf_store.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -45,6 +46,12 @@ TsdfVoxel* SparseTsdfStore::allocate(const BrickCoord& c) {
   return voxels_.back().get();
 }
 
+void SparseTsdfStore::clear() {
+  index_ = BrickIndex(levels_for(geometry_.bricks_per_side));
+  voxels_.clear();
+  coords_.clear();
+}
+
 std::size_t SparseTsdfStore::memory_bytes() const noexcept {
   return voxels_.size() * (kBrickVoxels * sizeof(TsdfVoxel) + sizeof(std::unique_ptr<TsdfVoxel[]>)) +
          coords_.capacity() * sizeof(BrickCoord) + index_.memory_bytes();
@@ -77,6 +84,15 @@ TsdfVoxel* DenseTsdfStore::allocate(const BrickCoord& c) {
     ++touched_count_;
   }
   return voxels_.data() + at * kBrickVoxels;
+}
+
+void DenseTsdfStore::clear() {
+  for (const std::size_t at : touched_order_) {
+    std::fill_n(voxels_.begin() + static_cast<std::ptrdiff_t>(at * kBrickVoxels), kBrickVoxels, TsdfVoxel{});
+    touched_[at] = false;
+  }
+  touched_order_.clear();
+  touched_count_ = 0;
 }
 
 BrickCoord DenseTsdfStore::coord_of(std::size_t at) const noexcept {

@@ -31,6 +31,16 @@ struct FuseResult {
   double seconds = 0.0;                 // wall time of reading + fusion
   double fusion_seconds = 0.0;          // of which tracking + fusion (the frames' processing alone)
   bool coloured = false;                // colour frames were integrated
+  // Loop closure (FusionParams::loop_closure): loop edges found, how far they disagree
+  // with the tracked trajectory, whether it was corrected (the disagreement exceeds
+  // FusionParams::loop_min_correction), the largest keyframe move the pose graph made,
+  // and the time spent integrating the map again at the corrected poses (not part of
+  // `seconds`).
+  std::size_t loop_edges = 0;
+  LoopDisagreement loop_disagreement;
+  bool loop_corrected = false;
+  double loop_max_move = 0.0;
+  double reintegration_seconds = 0.0;
   std::uint32_t width = 0, height = 0;
   // Implausible input that did not stop the run (depth in the wrong unit, most of the
   // depth outside the depth range), each naming the file.

@@ -14,6 +14,7 @@
 
 #include "vola/slam/features.hpp"
 #include "vola/slam/image.hpp"
+#include "vola/slam/loop_closure.hpp"
 #include "vola/slam/preprocess.hpp"
 #include "vola/slam/sequence.hpp"
 #include "vola/slam/tsdf_store.hpp"
@@ -83,6 +84,19 @@ struct FusionParams {
   // when ICP from there converges within feature_icp_* of it with min_overlap of the
   // frame associated: the geometry confirms what the few features say.
   int relocalisation_min_inliers = 6;
+  // Loop closure (loop_closure.hpp): when a tracked frame becomes a keyframe, its features
+  // are registered against the (up to 3) nearest keyframes older than the last
+  // loop_skip_keyframes; a registration with loop_min_inliers inliers whose pose lies
+  // within loop_gate_translation / _rotation_degrees of the tracked one (drift, not a
+  // different place that looks alike) is a loop edge.
+  // The trajectory is corrected (and the map integrated again) only when a loop edge
+  // disagrees with it by more than loop_min_correction metres or _degrees: below that,
+  // frame-to-model tracking has closed the loop already, better than features measure it.
+  bool loop_closure = true;
+  std::size_t loop_skip_keyframes = 5;
+  int loop_min_inliers = 40;
+  double loop_gate_translation = 0.5, loop_gate_rotation_degrees = 30.0;
+  double loop_min_correction = 0.03, loop_min_correction_degrees = 2.0;
   unsigned threads = 0;  // 0 = vola::thread_count() (the hardware's count unless set)
   // Throws InvalidArgument for values that make no sense.
   void check() const;
@@ -130,6 +144,12 @@ class Fusion {
   FrameResult process(const DepthImage& depth, const RgbImage* rgb, const Pose& initial_pose = Pose::Identity());
   // Integrates one frame at a known pose (mapping only, no tracking).
   FrameResult process_at_pose(const DepthImage& depth, const RgbImage* rgb, const Pose& pose);
+  // Integrates one frame at a pose, without tracking or a new model raycast (mapping
+  // again after a loop correction).
+  void integrate_at_pose(const DepthImage& depth, const RgbImage* rgb, const Pose& pose);
+  // The loop edges found so far, and the keyframes they join (poses as tracked).
+  const std::vector<LoopEdge>& loops() const noexcept { return loops_; }
+  std::vector<KeyframePose> keyframe_poses() const;
   const Pose& pose() const noexcept { return pose_; }
   std::size_t frames() const noexcept { return frames_; }
   Store& store() noexcept { return store_; }
@@ -166,6 +186,7 @@ class Fusion {
   struct Keyframe {
     FeatureFrame features;
     Pose pose;
+    std::size_t frame = 0;  // index among the processed frames
   };
   FeatureFrame last_features_;  // of the last tracked frame, at pose_
   std::optional<IntensityPyramid> reference_intensity_;  // the last tracked frame's, seen as model_
@@ -181,6 +202,8 @@ class Fusion {
   bool previous_lost_ = false;
   void retry_pending();
   std::vector<Keyframe> keyframes_;
+  void detect_loop(const FeatureFrame& features);
+  std::vector<LoopEdge> loops_;
 };
 
 // Raycasts the TSDF from `pose` through the pinhole camera: world vertices and normals

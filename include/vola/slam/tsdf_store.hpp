@@ -60,6 +60,8 @@ class SparseTsdfStore {
   const TsdfVoxel* brick(const BrickCoord& c) const noexcept;
   // The brick's voxels, created (all unobserved) when missing. c must be in the extent.
   TsdfVoxel* allocate(const BrickCoord& c);
+  // Every brick removed (the map starts again, same geometry).
+  void clear();
   std::size_t brick_count() const noexcept { return coords_.size(); }
   // f(coord, voxels) for every allocated brick, in allocation order.
   template <class F>
@@ -85,6 +87,8 @@ class DenseTsdfStore {
   TsdfVoxel* brick(const BrickCoord& c) noexcept;
   const TsdfVoxel* brick(const BrickCoord& c) const noexcept;
   TsdfVoxel* allocate(const BrickCoord& c);
+  // Every touched brick back to unobserved and untouched.
+  void clear();
   std::size_t brick_count() const noexcept { return touched_count_; }
   template <class F>
   void for_each_brick(F&& f) const {
