@@ -43,7 +43,7 @@ struct FusionParams {
   // a sofa give no normal along the wall, so sliding along it is free) the prediction
   // decides instead of noise. No prior until a frame-to-frame motion has been tracked
   // (the second frame, the first after a lost one). 0 disables it (KinectFusion's tracker).
-  double motion_prior = 1e-3;
+  double motion_prior = 1e-2;
   // A frame whose ICP update exceeds these (or has too few associations) is "lost":
   // its pose stays the previous one and it is not integrated.
   double max_step_translation = 0.2, max_step_rotation_degrees = 20;
