@@ -28,6 +28,7 @@
 #include "reductions.hpp"
 #include "store_value.hpp"
 #include "vola/error.hpp"
+#include "vola/little_endian.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -469,35 +470,33 @@ inline std::uint64_t field_bits(const RecordField& f, const std::uint8_t* p) noe
   std::uint64_t x;
   switch (f.kind) {
     case Kind::u8: x = p[0]; break;
-    case Kind::u16: x = load<std::uint16_t>(reinterpret_cast<const std::byte*>(p)); break;
-    case Kind::u32: x = load<std::uint32_t>(reinterpret_cast<const std::byte*>(p)); break;
-    default: x = load<std::uint64_t>(reinterpret_cast<const std::byte*>(p)); break;
+    case Kind::u16: x = load_le<std::uint16_t>(p); break;
+    case Kind::u32: x = load_le<std::uint32_t>(p); break;
+    default: x = load_le<std::uint64_t>(p); break;
   }
   return (x >> f.shift) & f.mask;
 }
 
 // A field's value as las::extra_value and the LAS reader decode it: load, x * scale + add.
-inline double field_value(const RecordField& f, const std::uint8_t* record) noexcept {
-  const std::uint8_t* p = record + f.offset;
-  const auto* b = reinterpret_cast<const std::byte*>(p);
+inline double field_value(const RecordField& f, const std::uint8_t* p) noexcept {
   double x;
   switch (f.kind) {
-    case Kind::u8: case Kind::u16: case Kind::u32: x = static_cast<double>(field_bits(f, p)); break;
-    case Kind::u64: x = static_cast<double>(field_bits(f, p)); break;
-    case Kind::i8: x = load<std::int8_t>(b); break;
-    case Kind::i16: x = load<std::int16_t>(b); break;
-    case Kind::i32: x = load<std::int32_t>(b); break;
-    case Kind::i64: x = static_cast<double>(load<std::int64_t>(b)); break;
-    case Kind::f32: x = load<float>(b); break;
-    default: x = load<double>(b); break;
+    case Kind::u8: case Kind::u16: case Kind::u32: case Kind::u64: x = static_cast<double>(field_bits(f, p)); break;
+    case Kind::i8: x = load_le<std::int8_t>(p); break;
+    case Kind::i16: x = load_le<std::int16_t>(p); break;
+    case Kind::i32: x = load_le<std::int32_t>(p); break;
+    case Kind::i64: x = static_cast<double>(load_le<std::int64_t>(p)); break;
+    case Kind::f32: x = load_le<float>(p); break;
+    default: x = load_le<double>(p); break;
   }
-  return x * f.scale + f.add;
+  return f.scaled ? x * f.scale + f.add : x;
 }
 
 // The largest value of a field that is a whole number in a known range (u8 or u16, no
 // scale or offset), or -1.
 double whole_field_max(const RecordField& f) noexcept {
-  if ((f.kind != Kind::u8 && f.kind != Kind::u16) || f.scale != 1.0 || f.add != 0.0 || f.shift >= 16) return -1.0;
+  if ((f.kind != Kind::u8 && f.kind != Kind::u16) || (f.scaled && (f.scale != 1.0 || f.add != 0.0)) || f.shift >= 16)
+    return -1.0;
   const std::uint64_t top = (f.kind == Kind::u8 ? 255u : 65535u) >> f.shift;
   return static_cast<double>(std::min<std::uint64_t>(top, f.mask));
 }
@@ -506,17 +505,31 @@ double whole_field_max(const RecordField& f) noexcept {
 
 void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::uint8_t* records, std::size_t stride,
                                std::span<const std::uint32_t> index, std::span<const RecordField> fields) {
+  std::vector<FieldColumn> columns;
+  for (const RecordField& f : fields) columns.push_back({records, stride, f});
+  add_fields(ranks, index, columns);
+}
+
+void VoxelReducer::add_columns(std::span<const std::uint64_t> ranks, std::span<const FieldColumn> columns) {
+  add_fields(ranks, {}, columns);
+}
+
+void VoxelReducer::add_fields(std::span<const std::uint64_t> ranks, std::span<const std::uint32_t> index,
+                              std::span<const FieldColumn> columns) {
   flush_pending();
   State& s = *state_;
   const std::size_t na = s.specs.size(), n = ranks.size();
-  if (fields.size() != na)
-    VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(fields.size()) + " record fields for " +
+  if (columns.size() != na)
+    VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(columns.size()) + " record fields for " +
                                std::to_string(na) + " attributes"));
   if (!index.empty() && index.size() != n)
     VOLA_THROW(InvalidArgument("voxel reducer: the record index's length differs from the ranks'"));
   if (na == 0 || n == 0) return;
   check_ranks(ranks);
-  const auto record_of = [&](std::size_t i) { return records + (index.empty() ? i : std::size_t{index[i]}) * stride; };
+  const auto at = [&](std::size_t i) { return index.empty() ? i : std::size_t{index[i]}; };
+  const auto record_of = [&](const FieldColumn& c, std::size_t i) { return c.data + at(i) * c.stride; };
+  std::vector<RecordField> fields;
+  for (const FieldColumn& c : columns) fields.push_back(c.field);
   // A narrow slot takes a whole-number field whose range it holds as is; any other field
   // is checked value by value first (and widens the slot as add() would).
   std::vector<double> check;
@@ -526,7 +539,7 @@ void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::
     const double hi = s.slot[a] == Slot::small_u8 ? 255.0 : 65535.0;
     if (top >= 0.0 && top <= hi) continue;
     check.resize(n);
-    for (std::size_t i = 0; i < n; ++i) check[i] = field_value(fields[a], record_of(i));
+    for (std::size_t i = 0; i < n; ++i) check[i] = field_value(fields[a], record_of(columns[a], i) + fields[a].offset);
     if (!fits(s.slot[a], check.data(), n)) s.widen(a);
   }
 
@@ -537,11 +550,17 @@ void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::
     bool whole;
     std::uint32_t row;
     RecordField field;
+    const std::uint8_t* data;  // + the field's offset
+    std::size_t stride;
   };
   std::vector<Column> cols(na);
-  for (std::size_t a = 0; a < na; ++a)
-    cols[a] = {op_of(s.slot[a], s.specs[a].reduction), s.slot[a] != Slot::f64 && whole_field_max(fields[a]) >= 0.0,
-               static_cast<std::uint32_t>(s.offset[a]), fields[a]};
+  for (std::size_t a = 0; a < na; ++a) {
+    RecordField f = fields[a];
+    const std::uint8_t* data = columns[a].data + f.offset;
+    f.offset = 0;
+    cols[a] = {op_of(s.slot[a], s.specs[a].reduction), s.slot[a] != Slot::f64 && whole_field_max(f) >= 0.0,
+               static_cast<std::uint32_t>(s.offset[a]), f, data, columns[a].stride};
+  }
 
   std::byte* const base = s.rows.data();
   const std::size_t row_stride = s.stride;
@@ -557,7 +576,7 @@ void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::
       __builtin_prefetch(ahead + row_stride - 1, 1);
     }
     const std::uint64_t rank = ranks[i];
-    const std::uint8_t* record = record_of(i);
+    const std::size_t point = at(i);
     std::byte* row = base + rank * row_stride;
     const std::uint32_t count = load<std::uint32_t>(row);
     const bool first = count == 0;
@@ -565,7 +584,7 @@ void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::
       const Column& c = cols[a];
       std::byte* p = row + c.row;
       if (c.whole) {
-        const auto x = static_cast<std::uint32_t>(field_bits(c.field, record + c.field.offset));
+        const auto x = static_cast<std::uint32_t>(field_bits(c.field, c.data + point * c.stride));
         switch (c.op) {
           case Op::u32_sum: {
             if (first) {
@@ -589,7 +608,7 @@ void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::
         }
         continue;
       }
-      const double v = field_value(c.field, record);
+      const double v = field_value(c.field, c.data + point * c.stride);
       switch (c.op) {
         case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
         case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
