@@ -3,7 +3,9 @@
 // NaN rules included, however the points are split into calls.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -44,8 +46,53 @@ vola::PointCloud random_cloud(std::uint64_t seed, std::size_t n) {
 
 // The reducer over `cloud` (ranks from a tree built on its coordinates, points split
 // into calls of random sizes up to max_call) against vola::build: the same bytes.
+// How the values reach the reducer: as double arrays (add), packed in records
+// (add_records: each call's values as u8 or u16 fields where they are whole numbers
+// that fit, doubles otherwise, through a shuffled index), or read in place from the
+// cloud's arrays (add_columns).
+enum class Feed { values, records, columns };
+
+void feed_records(vola::VoxelReducer& reducer, const vola::PointCloud& cloud, std::size_t at, std::size_t n,
+                  std::span<const std::uint64_t> ranks, std::mt19937_64& rng) {
+  using Kind = vola::RecordField::Kind;
+  std::vector<vola::RecordField> fields;
+  std::uint32_t stride = 0;
+  for (const auto& a : cloud.attributes) {
+    double hi = 0.0;
+    bool whole = true;
+    for (std::size_t i = at; i < at + n; ++i) {
+      const double v = a.values[i];
+      whole = whole && v >= 0.0 && v <= 65535.0 && v == std::floor(v);
+      hi = std::max(hi, v);
+    }
+    const Kind kind = !whole ? Kind::f64 : hi <= 255.0 && rng() % 2 ? Kind::u8 : Kind::u16;
+    fields.push_back({.kind = kind, .offset = stride, .scaled = false});
+    stride += kind == Kind::f64 ? 8 : kind == Kind::u16 ? 2 : 1;
+  }
+  // Record j holds point order[j]; index[i] = j finds point i again.
+  std::vector<std::uint32_t> order(n), index(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<std::uint8_t> records(n * stride + 1);
+  for (std::size_t j = 0; j < n; ++j) {
+    index[order[j]] = static_cast<std::uint32_t>(j);
+    for (std::size_t a = 0; a < fields.size(); ++a) {
+      const double v = cloud.attributes[a].values[at + order[j]];
+      std::uint8_t* p = records.data() + j * stride + fields[a].offset;
+      if (fields[a].kind == Kind::u8) *p = static_cast<std::uint8_t>(v);
+      else if (fields[a].kind == Kind::u16) {
+        const auto x = static_cast<std::uint16_t>(v);
+        std::memcpy(p, &x, 2);
+      } else {
+        std::memcpy(p, &v, 8);
+      }
+    }
+  }
+  reducer.add_records(ranks, records.data(), stride, index, fields);
+}
+
 void expect_reducer_equals_build(const vola::PointCloud& cloud, const vola::BuildOptions& options, std::uint64_t seed,
-                                 std::size_t max_call = 2000) {
+                                 std::size_t max_call = 2000, Feed feed = Feed::values) {
   const vola::Tree expected = vola::build(cloud, options);
   vola::PointCloud xyz_only;
   xyz_only.xyz = cloud.xyz;
@@ -63,9 +110,19 @@ void expect_reducer_equals_build(const vola::PointCloud& cloud, const vola::Buil
       ASSERT_TRUE(quantizer.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v));
       ranks.push_back(*got.rank(v));
     }
-    std::vector<std::span<const double>> values;
-    for (const auto& a : cloud.attributes) values.emplace_back(a.values.data() + at, n);
-    reducer.add(ranks, values);
+    if (feed == Feed::records) {
+      feed_records(reducer, cloud, at, n, ranks, rng);
+    } else if (feed == Feed::columns) {
+      std::vector<vola::FieldColumn> columns;
+      for (const auto& a : cloud.attributes)
+        columns.push_back({reinterpret_cast<const std::uint8_t*>(a.values.data() + at), sizeof(double),
+                           {.kind = vola::RecordField::Kind::f64, .scaled = false}});
+      reducer.add_columns(ranks, columns);
+    } else {
+      std::vector<std::span<const double>> values;
+      for (const auto& a : cloud.attributes) values.emplace_back(a.values.data() + at, n);
+      reducer.add(ranks, values);
+    }
     at += n;
   }
   reducer.finish_into(got);
@@ -92,6 +149,49 @@ TEST_P(VoxelReducerEqualsBuild, BitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, VoxelReducerEqualsBuild, ::testing::Range(1, 7));
+
+// A record field's decoding: shift and mask of the unsigned kinds, x * scale + add
+// (as a LAS reader decodes), signed and floating kinds; -0 kept when not scaled.
+TEST(VoxelReducer, RecordFieldsDecodeLikeTheValues) {
+  using Kind = vola::RecordField::Kind;
+  const std::vector<vola::AttributeSpec> specs = {{"returns", vola::ValueType::u8, vola::Reduction::max},
+                                                  {"z", vola::ValueType::f64, vola::Reduction::mean},
+                                                  {"s", vola::ValueType::f64, vola::Reduction::last},
+                                                  {"f", vola::ValueType::f32, vola::Reduction::majority}};
+  const std::vector<vola::RecordField> fields = {{.kind = Kind::u8, .offset = 0, .shift = 3, .mask = 7},
+                                                 {.kind = Kind::i32, .offset = 1, .scale = 0.001, .add = 1234.5},
+                                                 {.kind = Kind::i16, .offset = 5},
+                                                 {.kind = Kind::f32, .offset = 7, .scaled = false}};
+  std::mt19937_64 rng(11);
+  const std::size_t n = 5000, stride = 11;
+  std::vector<std::uint8_t> records(n * stride);
+  std::vector<std::uint64_t> ranks(n);
+  std::vector<std::vector<double>> values(4, std::vector<double>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint8_t* r = records.data() + i * stride;
+    r[0] = static_cast<std::uint8_t>(rng());
+    const auto z = static_cast<std::int32_t>(rng());
+    const auto s16 = static_cast<std::int16_t>(rng());
+    const float f = i % 5 == 0 ? -0.0f : static_cast<float>(rng() % 4) * 0.5f;
+    std::memcpy(r + 1, &z, 4);
+    std::memcpy(r + 5, &s16, 2);
+    std::memcpy(r + 7, &f, 4);
+    ranks[i] = rng() % 700;
+    values[0][i] = (r[0] >> 3) & 7;
+    values[1][i] = static_cast<double>(z) * 0.001 + 1234.5;
+    values[2][i] = static_cast<double>(s16) * 1.0 + 0.0;
+    values[3][i] = f;
+  }
+  vola::VoxelReducer by_values(specs, 700), by_records(specs, 700);
+  const std::vector<std::span<const double>> views(values.begin(), values.end());
+  by_values.add(ranks, views);
+  by_records.add_records(ranks, records.data(), stride, {}, fields);
+  const auto expected = by_values.finish(), got = by_records.finish();
+  for (std::size_t a = 0; a < specs.size(); ++a)
+    EXPECT_TRUE(std::equal(got[a].bytes().begin(), got[a].bytes().end(), expected[a].bytes().begin(),
+                           expected[a].bytes().end()))
+        << specs[a].name;
+}
 
 TEST(VoxelReducer, RefusesRanksOutOfRangeAndMismatchedArrays) {
   vola::VoxelReducer reducer({{"m", vola::ValueType::f32, vola::Reduction::mean}}, 3);
@@ -246,5 +346,29 @@ TEST(VoxelReducer, NarrowSlotsEqualBuild) {
   for (const double hi : {3.0, 255.0, 65535.0}) {
     SCOPED_TRACE(hi);
     expect_reducer_equals_build(narrow_cloud(40000, 5, hi), unit_grid(), 5);
+  }
+}
+
+// Values read from packed records or from columns in place give build's bytes too:
+// whole-number fields folded as integers, the others (fractions, negative numbers, NaN,
+// -0) decoded, narrow slots widened when a field's values do not fit them.
+TEST(VoxelReducer, RecordsAndColumnsEqualBuild) {
+  for (const Feed feed : {Feed::records, Feed::columns}) {
+    SCOPED_TRACE(static_cast<int>(feed));
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      vola::BuildOptions options;
+      options.quantization = vola::Quantization::grid;
+      options.voxel_size = 1.0 + static_cast<double>(seed % 3);
+      expect_reducer_equals_build(random_cloud(seed, 20000), options, seed, 2000, feed);
+    }
+    for (const double hi : {3.0, 255.0, 65535.0}) expect_reducer_equals_build(narrow_cloud(30000, 5, hi), unit_grid(), 5, 2000, feed);
+    for (const double odd : {2.5, -3.0, 300.0, 70000.0, kNaN}) {
+      vola::PointCloud cloud = narrow_cloud(20000, 4, 200);
+      for (auto& a : cloud.attributes) {
+        a.values[9000] = odd;
+        a.values[15000] = odd;
+      }
+      expect_reducer_equals_build(cloud, unit_grid(), 4, 3000, feed);
+    }
   }
 }

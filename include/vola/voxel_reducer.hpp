@@ -23,6 +23,30 @@
 namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
+// Where one attribute's value lies in a packed record and how it is decoded: the bytes
+// at `offset` as `kind` (little-endian), for the unsigned kinds then (x >> shift) & mask,
+// then value * scale + add, in doubles (a LAS field: load, then x * scale + offset), or
+// the value as loaded when `scaled` is false (so -0 stays -0). A field of kind u8 or u16
+// with scale 1 and add 0 is a whole number in a known range, which the reducer folds as
+// an integer.
+struct RecordField {
+  enum class Kind : std::uint8_t { u8, i8, u16, i16, u32, i32, u64, i64, f32, f64 };
+  Kind kind = Kind::f64;
+  std::uint32_t offset = 0;
+  std::uint8_t shift = 0;
+  std::uint64_t mask = ~std::uint64_t{0};
+  double scale = 1.0, add = 0.0;
+  bool scaled = true;
+};
+
+// A column of values in memory: value i of the attribute is the field at
+// data + i * stride (+ field.offset).
+struct FieldColumn {
+  const std::uint8_t* data = nullptr;
+  std::size_t stride = 0;
+  RecordField field;
+};
+
 class VoxelReducer {
  public:
   VoxelReducer(std::vector<AttributeSpec> specs, std::uint64_t voxels);
@@ -34,6 +58,14 @@ class VoxelReducer {
   // its value of attribute a. Throws InvalidArgument on a rank out of range or arrays of
   // other lengths.
   void add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values);
+  // n points in input order read straight from packed records: point i is the record at
+  // records + index[i] * stride (i itself when index is empty), attribute a its field
+  // fields[a]. The same partials as add() with the decoded values, without them.
+  void add_records(std::span<const std::uint64_t> ranks, const std::uint8_t* records, std::size_t stride,
+                   std::span<const std::uint32_t> index, std::span<const RecordField> fields);
+  // n points in input order, attribute a's value of point i in columns[a] (say a tree's
+  // attribute columns, reduced into a coarser tree's voxels).
+  void add_columns(std::span<const std::uint64_t> ranks, std::span<const FieldColumn> columns);
   // One point: values[a] for attribute a (buffered, and reduced in batches, in order).
   void add(std::uint64_t rank, std::span<const double> values);
 
@@ -55,6 +87,9 @@ class VoxelReducer {
  private:
   void flush_pending();
   void add_now(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values);
+  void check_ranks(std::span<const std::uint64_t> ranks) const;
+  void add_fields(std::span<const std::uint64_t> ranks, std::span<const std::uint32_t> index,
+                  std::span<const FieldColumn> columns);
   struct State;
   std::unique_ptr<State> state_;
 };

@@ -28,6 +28,7 @@
 #include "reductions.hpp"
 #include "store_value.hpp"
 #include "vola/error.hpp"
+#include "vola/little_endian.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -310,8 +311,8 @@ inline void update_f64(std::byte* p, double v, bool first) noexcept {
   put(p, detail::combine<R>(load<double>(p), v));
 }
 
-template <class T, Reduction R>
-inline void update_small(std::byte* p, double v, bool first) noexcept {
+template <class T, Reduction R, class V>
+inline void update_small(std::byte* p, V v, bool first) noexcept {
   const T x = static_cast<T>(v);
   if (first) return put(p, x);
   const T old = load<T>(p);
@@ -322,11 +323,11 @@ inline void update_small(std::byte* p, double v, bool first) noexcept {
 
 // A narrow majority slot holds the voxel's first value; a point with another value is
 // counted in `others` by (rank, value).
-template <class T, class Others>
-inline void update_majority(std::byte* p, double v, bool first, Others& others, std::uint64_t rank) {
+template <class T, class V, class Others>
+inline void update_majority(std::byte* p, V v, bool first, Others& others, std::uint64_t rank) {
   const T x = static_cast<T>(v);
   if (first) put(p, x);
-  else if (load<T>(p) != x) ++others[PairKey{rank, bits_of(v)}];
+  else if (load<T>(p) != x) ++others[PairKey{rank, bits_of(static_cast<double>(v))}];
 }
 
 // What one attribute does per point, resolved once per call.
@@ -372,12 +373,7 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
     if (v.size() != ranks.size())
       VOLA_THROW(InvalidArgument("voxel reducer: an attribute array's length differs from the ranks'"));
   if (s.specs.empty()) return;
-  if (s.finishing) VOLA_THROW(InvalidArgument("voxel reducer: points added after finish_range()"));
-  std::uint64_t highest = 0;
-  for (const std::uint64_t r : ranks) highest = std::max(highest, r);
-  if (!ranks.empty() && highest >= s.voxels)
-    VOLA_THROW(InvalidArgument("voxel reducer: rank " + std::to_string(highest) + " of " + std::to_string(s.voxels) +
-                               " voxels"));
+  check_ranks(ranks);
   // A value a narrow slot cannot hold widens the attribute first (before any count of
   // this call is taken, so the widened partials are those of the earlier points).
   for (std::size_t a = 0; a < s.specs.size(); ++a)
@@ -420,6 +416,199 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
       const Column& c = cols[a];
       std::byte* p = row + c.offset;
       const double v = c.in[i];
+      switch (c.op) {
+        case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
+        case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
+        case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
+        case Op::f64_last: put(p, v); break;
+        case Op::f64_majority: {
+          if (first) put(p, v);
+          else if (const double f = load<double>(p); !detail::same_value(f, v)) ++s.others[a][PairKey{rank, bits_of(v)}];
+          break;
+        }
+        case Op::u32_sum: {
+          const std::uint32_t x = static_cast<std::uint32_t>(v);
+          if (first) {
+            put(p, x);
+          } else {
+            const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
+            put(p, sum);
+            if (sum < old) ++s.carries[a][rank];
+          }
+          break;
+        }
+        case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
+        case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
+        case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
+        case Op::u8_majority: update_majority<std::uint8_t>(p, v, first, s.others[a], rank); break;
+        case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
+        case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
+        case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
+        case Op::u16_majority: update_majority<std::uint16_t>(p, v, first, s.others[a], rank); break;
+      }
+    }
+    put(row, count + 1);
+  }
+}
+
+void VoxelReducer::check_ranks(std::span<const std::uint64_t> ranks) const {
+  const State& s = *state_;
+  if (s.finishing) VOLA_THROW(InvalidArgument("voxel reducer: points added after finish_range()"));
+  std::uint64_t highest = 0;
+  for (const std::uint64_t r : ranks) highest = std::max(highest, r);
+  if (!ranks.empty() && highest >= s.voxels)
+    VOLA_THROW(InvalidArgument("voxel reducer: rank " + std::to_string(highest) + " of " + std::to_string(s.voxels) +
+                               " voxels"));
+}
+
+namespace {
+
+using Kind = RecordField::Kind;
+
+// The raw bits of an unsigned field, shifted and masked.
+inline std::uint64_t field_bits(const RecordField& f, const std::uint8_t* p) noexcept {
+  std::uint64_t x;
+  switch (f.kind) {
+    case Kind::u8: x = p[0]; break;
+    case Kind::u16: x = load_le<std::uint16_t>(p); break;
+    case Kind::u32: x = load_le<std::uint32_t>(p); break;
+    default: x = load_le<std::uint64_t>(p); break;
+  }
+  return (x >> f.shift) & f.mask;
+}
+
+// A field's value as las::extra_value and the LAS reader decode it: load, x * scale + add.
+inline double field_value(const RecordField& f, const std::uint8_t* p) noexcept {
+  double x;
+  switch (f.kind) {
+    case Kind::u8: case Kind::u16: case Kind::u32: case Kind::u64: x = static_cast<double>(field_bits(f, p)); break;
+    case Kind::i8: x = load_le<std::int8_t>(p); break;
+    case Kind::i16: x = load_le<std::int16_t>(p); break;
+    case Kind::i32: x = load_le<std::int32_t>(p); break;
+    case Kind::i64: x = static_cast<double>(load_le<std::int64_t>(p)); break;
+    case Kind::f32: x = load_le<float>(p); break;
+    default: x = load_le<double>(p); break;
+  }
+  return f.scaled ? x * f.scale + f.add : x;
+}
+
+// The largest value of a field that is a whole number in a known range (u8 or u16, no
+// scale or offset), or -1.
+double whole_field_max(const RecordField& f) noexcept {
+  if ((f.kind != Kind::u8 && f.kind != Kind::u16) || (f.scaled && (f.scale != 1.0 || f.add != 0.0)) || f.shift >= 16)
+    return -1.0;
+  const std::uint64_t top = (f.kind == Kind::u8 ? 255u : 65535u) >> f.shift;
+  return static_cast<double>(std::min<std::uint64_t>(top, f.mask));
+}
+
+}  // namespace
+
+void VoxelReducer::add_records(std::span<const std::uint64_t> ranks, const std::uint8_t* records, std::size_t stride,
+                               std::span<const std::uint32_t> index, std::span<const RecordField> fields) {
+  std::vector<FieldColumn> columns;
+  for (const RecordField& f : fields) columns.push_back({records, stride, f});
+  add_fields(ranks, index, columns);
+}
+
+void VoxelReducer::add_columns(std::span<const std::uint64_t> ranks, std::span<const FieldColumn> columns) {
+  add_fields(ranks, {}, columns);
+}
+
+void VoxelReducer::add_fields(std::span<const std::uint64_t> ranks, std::span<const std::uint32_t> index,
+                              std::span<const FieldColumn> columns) {
+  flush_pending();
+  State& s = *state_;
+  const std::size_t na = s.specs.size(), n = ranks.size();
+  if (columns.size() != na)
+    VOLA_THROW(InvalidArgument("voxel reducer: " + std::to_string(columns.size()) + " record fields for " +
+                               std::to_string(na) + " attributes"));
+  if (!index.empty() && index.size() != n)
+    VOLA_THROW(InvalidArgument("voxel reducer: the record index's length differs from the ranks'"));
+  if (na == 0 || n == 0) return;
+  check_ranks(ranks);
+  const auto at = [&](std::size_t i) { return index.empty() ? i : std::size_t{index[i]}; };
+  const auto record_of = [&](const FieldColumn& c, std::size_t i) { return c.data + at(i) * c.stride; };
+  std::vector<RecordField> fields;
+  for (const FieldColumn& c : columns) fields.push_back(c.field);
+  // A narrow slot takes a whole-number field whose range it holds as is; any other field
+  // is checked value by value first (and widens the slot as add() would).
+  std::vector<double> check;
+  for (std::size_t a = 0; a < na; ++a) {
+    if (s.slot[a] == Slot::f64) continue;
+    const double top = whole_field_max(fields[a]);
+    const double hi = s.slot[a] == Slot::small_u8 ? 255.0 : 65535.0;
+    if (top >= 0.0 && top <= hi) continue;
+    check.resize(n);
+    for (std::size_t i = 0; i < n; ++i) check[i] = field_value(fields[a], record_of(columns[a], i) + fields[a].offset);
+    if (!fits(s.slot[a], check.data(), n)) s.widen(a);
+  }
+
+  // Per attribute, what a point does: whole-number fields into narrow slots fold as
+  // integers; every other field is decoded to a double first.
+  struct Column {
+    Op op;
+    bool whole;
+    std::uint32_t row;
+    RecordField field;
+    const std::uint8_t* data;  // + the field's offset
+    std::size_t stride;
+  };
+  std::vector<Column> cols(na);
+  for (std::size_t a = 0; a < na; ++a) {
+    RecordField f = fields[a];
+    const std::uint8_t* data = columns[a].data + f.offset;
+    f.offset = 0;
+    cols[a] = {op_of(s.slot[a], s.specs[a].reduction), s.slot[a] != Slot::f64 && whole_field_max(f) >= 0.0,
+               static_cast<std::uint32_t>(s.offset[a]), f, data, columns[a].stride};
+  }
+
+  std::byte* const base = s.rows.data();
+  const std::size_t row_stride = s.stride;
+  constexpr std::size_t kAhead = 12;  // rows requested this many points ahead
+  for (std::size_t i = 0; i < std::min(n, kAhead); ++i) {
+    __builtin_prefetch(base + ranks[i] * row_stride, 1);
+    __builtin_prefetch(base + ranks[i] * row_stride + row_stride - 1, 1);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + kAhead < n) {
+      const std::byte* ahead = base + ranks[i + kAhead] * row_stride;
+      __builtin_prefetch(ahead, 1);
+      __builtin_prefetch(ahead + row_stride - 1, 1);
+    }
+    const std::uint64_t rank = ranks[i];
+    const std::size_t point = at(i);
+    std::byte* row = base + rank * row_stride;
+    const std::uint32_t count = load<std::uint32_t>(row);
+    const bool first = count == 0;
+    for (std::size_t a = 0; a < na; ++a) {
+      const Column& c = cols[a];
+      std::byte* p = row + c.row;
+      if (c.whole) {
+        const auto x = static_cast<std::uint32_t>(field_bits(c.field, c.data + point * c.stride));
+        switch (c.op) {
+          case Op::u32_sum: {
+            if (first) {
+              put(p, x);
+            } else {
+              const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
+              put(p, sum);
+              if (sum < old) ++s.carries[a][rank];
+            }
+            break;
+          }
+          case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, x, first); break;
+          case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, x, first); break;
+          case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, x, first); break;
+          case Op::u8_majority: update_majority<std::uint8_t>(p, x, first, s.others[a], rank); break;
+          case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, x, first); break;
+          case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, x, first); break;
+          case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, x, first); break;
+          case Op::u16_majority: update_majority<std::uint16_t>(p, x, first, s.others[a], rank); break;
+          default: break;  // (whole fields go to narrow slots only)
+        }
+        continue;
+      }
+      const double v = field_value(c.field, c.data + point * c.stride);
       switch (c.op) {
         case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
         case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
@@ -498,6 +687,35 @@ void VoxelReducer::finish_range(std::uint64_t first, std::uint64_t last, std::sp
       const std::vector<State::Other>& o = s.sorted_others[a];
       std::size_t k = s.at[a];
       while (k < o.size() && o[k].rank < first) ++k;  // voxels skipped over
+      if (spec.reduction != Reduction::majority) {
+        // The slot's kind and the reduction resolved once for the range, not per voxel.
+        const std::byte* rows = s.rows.data() + s.offset[a];
+        const std::size_t stride = s.stride;
+        const Reduction r = spec.reduction;
+        const auto run = [&](auto partial_of) {
+          for (std::uint64_t v = first; v < last; ++v) {
+            const std::byte* slot = rows + v * stride;
+            const std::uint32_t count = load<std::uint32_t>(slot - s.offset[a]);
+            const double value = count == 0 ? 0.0 : detail::finish(r, partial_of(slot, v), count);
+            detail::store_as<T>(to + (v - first) * sizeof(T), value);
+          }
+        };
+        switch (s.slot[a]) {
+          case Slot::f64: run([](const std::byte* p, std::uint64_t) { return load<double>(p); }); break;
+          case Slot::sum_u32:
+            if (s.carries[a].empty())
+              run([](const std::byte* p, std::uint64_t) { return static_cast<double>(load<std::uint32_t>(p)); });
+            else
+              run([&](const std::byte* p, std::uint64_t v) { return s.slot_value(p - s.offset[a], a, v); });
+            break;
+          case Slot::small_u16:
+            run([](const std::byte* p, std::uint64_t) { return static_cast<double>(load<std::uint16_t>(p)); });
+            break;
+          default: run([](const std::byte* p, std::uint64_t) { return static_cast<double>(load<std::uint8_t>(p)); });
+        }
+        s.at[a] = k;
+        return;
+      }
       for (std::uint64_t v = first; v < last; ++v) {
         const std::byte* row = s.rows.data() + v * s.stride;
         const std::uint32_t count = load<std::uint32_t>(row);

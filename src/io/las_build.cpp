@@ -675,6 +675,8 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
                        const std::function<void(std::uint64_t)>& progress) {
   const LasHeader& hd = reader.header();
   const std::vector<AttributeSpec> specs = las_attributes(hd);
+  std::vector<RecordField> fields;
+  const bool by_fields = las_record_fields(hd, fields);
   const RankParts parts(tree.voxel_count(), thread_count());
   std::vector<VoxelReducer> reducers;
   for (unsigned k = 0; k < parts.parts; ++k) reducers.emplace_back(specs, parts.size[k]);
@@ -776,6 +778,10 @@ void reduce_attributes(LasReader& reader, const Quantizer& quantizer, const std:
           for (const Slice& slice : slices) {
             const std::vector<std::uint32_t>& index = slice.index[k];
             const std::vector<std::uint64_t>& local = slice.ranks[k];
+            if (by_fields) {  // the values straight from the records into the rows
+              reducers[k].add_records(local, records.data(), length, index, fields);
+              continue;
+            }
             for (std::size_t from = 0; from < index.size(); from += batch) {
               const std::size_t n = std::min(batch, index.size() - from);
               las_record_attribute_values(hd, records.data(), std::span(index).subspan(from, n), s.values);

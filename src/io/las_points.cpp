@@ -113,6 +113,42 @@ void las_record_attribute_values(const LasHeader& hd, const std::uint8_t* record
       column([&](const std::uint8_t* r) { return las::extra_value(r + f.offset, f.data_type) * f.scale + f.add; });
 }
 
+bool las_record_fields(const LasHeader& hd, std::vector<RecordField>& fields) {
+  using Kind = RecordField::Kind;
+  const bool extended = hd.extended_format();
+  fields.clear();
+  if (hd.has_rgb()) {
+    const std::uint32_t rgb_at = extended ? 30 : (hd.point_format == 2 ? 20 : 28);
+    for (std::uint32_t k = 0; k < 3; ++k) fields.push_back({.kind = Kind::u16, .offset = rgb_at + 2 * k});
+  }
+  fields.push_back({.kind = Kind::u16, .offset = 12});
+  if (extended) fields.push_back({.kind = Kind::u8, .offset = 16});
+  else fields.push_back({.kind = Kind::u8, .offset = 15, .mask = 31});
+  constexpr Kind kinds[] = {Kind::u8, Kind::i8, Kind::u16, Kind::i16, Kind::u32,
+                            Kind::i32, Kind::u64, Kind::i64, Kind::f32, Kind::f64};
+  const auto extra = [&](const LasExtraField& f) {
+    if (f.data_type < 1 || f.data_type > 10) return false;
+    fields.push_back({.kind = kinds[f.data_type - 1], .offset = f.offset, .scale = f.scale, .add = f.add});
+    return true;
+  };
+  const LasExtraField* height = nullptr;
+  for (const auto& f : hd.extra_fields)
+    if (f.name == "height") {
+      height = &f;
+      break;
+    }
+  if (height) {
+    if (!extra(*height)) return false;
+  } else {
+    fields.push_back({.kind = Kind::i32, .offset = 8, .scale = hd.scale[2], .add = hd.offset[2]});
+  }
+  if (extended) fields.push_back({.kind = Kind::u8, .offset = 14, .shift = 4});
+  else fields.push_back({.kind = Kind::u8, .offset = 14, .shift = 3, .mask = 7});
+  for (const auto& f : hd.extra_fields)
+    if (f.name != "height" && !extra(f)) return false;
+  return fields.size() == las_attributes(hd).size();
+}
+
 void las_payloads(const LasHeader& hd, const LasChunk& chunk, std::vector<std::uint64_t>& payloads) {
   const std::size_t n = chunk.size();
   payloads.resize(n);

@@ -54,6 +54,22 @@ Tree open_child(const Node& child, const OverviewContext& c) {
   return tree;
 }
 
+RecordField::Kind field_kind(ValueType t) {
+  using K = RecordField::Kind;
+  switch (t) {
+    case ValueType::u8: return K::u8;
+    case ValueType::u16: return K::u16;
+    case ValueType::u32: return K::u32;
+    case ValueType::u64: return K::u64;
+    case ValueType::i8: return K::i8;
+    case ValueType::i16: return K::i16;
+    case ValueType::i32: return K::i32;
+    case ValueType::i64: return K::i64;
+    case ValueType::f32: return K::f32;
+    default: return K::f64;
+  }
+}
+
 // The parent's attribute columns: each child voxel's values reduced into the parent
 // voxel that covers it, by the column's own reduction (a mean is the mean of the finer
 // voxels' values, each finer voxel counting once), children in index order and voxels
@@ -65,8 +81,6 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
   std::vector<AttributeSpec> specs;
   std::optional<VoxelReducer> reducer;  // made with the first child's columns
   std::vector<std::uint64_t> ranks;      // a child's voxels' parent voxels
-  std::vector<std::vector<double>> values;
-  std::vector<std::span<const double>> views;
   for (const Node* child : children) {
     const Tree tree_of_child = open_child(*child, c);
     if (!reducer) {
@@ -74,8 +88,6 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
         specs.push_back({column.name(), column.type(), column.reduction()});
       if (specs.empty()) return;
       reducer.emplace(specs, tree.voxel_count());
-      values.resize(specs.size());
-      views.resize(specs.size());
     }
     std::vector<const AttributeColumn*> columns;
     for (const AttributeSpec& spec : specs) {
@@ -95,12 +107,12 @@ void reduce_children(const TileIndex& parent, const std::vector<const Node*>& ch
       while (keys[at] < up) ++at;
       ranks.push_back(at);
     });
-    for (std::size_t a = 0; a < specs.size(); ++a) {
-      values[a].resize(ranks.size());
-      for (std::size_t r = 0; r < ranks.size(); ++r) values[a][r] = columns[a]->get(r);
-      views[a] = values[a];
-    }
-    reducer->add(ranks, views);
+    // The child's columns read in place (little-endian values of their type).
+    std::vector<FieldColumn> in;
+    for (const AttributeColumn* column : columns)
+      in.push_back({reinterpret_cast<const std::uint8_t*>(column->bytes().data()), size_of(column->type()),
+                    {.kind = field_kind(column->type()), .scaled = false}});
+    reducer->add_columns(ranks, in);
   }
   reducer->finish_into(tree);
 }

@@ -499,8 +499,12 @@ void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
   if (const auto it = value_runs.find(t); it != value_runs.end()) {
     const std::size_t words = record_words();
     std::vector<std::uint64_t> ranks;
-    std::vector<std::vector<double>> values(specs.size());
-    std::vector<std::span<const double>> views(specs.size());
+    // The values are the records' words 2.. (doubles), read in place by the reducer.
+    std::vector<RecordField> fields(specs.size());
+    for (std::size_t a = 0; a < specs.size(); ++a)
+      fields[a] = {.kind = RecordField::Kind::f64,
+                   .offset = static_cast<std::uint32_t>((2 + a) * sizeof(std::uint64_t)),
+                   .scaled = false};
     visit_records(it->second, [&](const std::uint64_t* records, std::size_t n) {
       ranks.resize(n);
       for (std::size_t r = 0; r < n; ++r) {
@@ -508,12 +512,8 @@ void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
         if (!rank) throw Error("tile: an attribute record names a voxel the tile does not hold");
         ranks[r] = *rank;
       }
-      for (std::size_t a = 0; a < specs.size(); ++a) {  // the stretch's values, column by column
-        values[a].resize(n);
-        for (std::size_t r = 0; r < n; ++r) values[a][r] = std::bit_cast<double>(records[r * words + 2 + a]);
-        views[a] = values[a];
-      }
-      reducer.add(ranks, views);
+      reducer.add_records(ranks, reinterpret_cast<const std::uint8_t*>(records), words * sizeof(std::uint64_t), {},
+                          fields);
     });
   }
   reducer.finish_into(tree);

@@ -19,6 +19,7 @@
 #include "vola/io/copc.hpp"
 #include "vola/io/laz.hpp"
 #include "vola/stream_builder.hpp"
+#include "vola/voxel_reducer.hpp"
 
 namespace vola::io {
 
@@ -199,6 +200,10 @@ void las_attribute_values(const LasHeader& header, const LasChunk& chunk, std::v
 // of records[index[j] * record_length] into values[a][j] (resized to index.size()).
 void las_record_attribute_values(const LasHeader& header, const std::uint8_t* records,
                                  std::span<const std::uint32_t> index, std::vector<std::vector<double>>& values);
+// Where las_record_attribute_values finds each value in a record, for
+// VoxelReducer::add_records (the same order and decoding). False when a column cannot
+// be described so (an extra field of raw bytes): use the values then.
+bool las_record_fields(const LasHeader& header, std::vector<RecordField>& fields);
 // The reference's payload word per point.
 void las_payloads(const LasHeader& header, const LasChunk& chunk, std::vector<std::uint64_t>& payloads);
 
