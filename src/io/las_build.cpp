@@ -396,6 +396,19 @@ namespace {
 // grid allows), or with attribute columns and payloads reduced per chunk and merged
 // (the path of payloads). `used` gets the grid the keys were made on and stored_lo/hi
 // a range holding every stored integer (the points' own when a pass saw them).
+// While alive, a LAZ reader decodes only the coordinates of layered chunks
+// (LasReader::set_coordinates_only): the passes that need nothing else.
+class CoordinatesOnly {
+ public:
+  CoordinatesOnly(LasReader& reader, bool on) : reader_(reader) { reader_.set_coordinates_only(on); }
+  ~CoordinatesOnly() { reader_.set_coordinates_only(false); }
+  CoordinatesOnly(const CoordinatesOnly&) = delete;
+  CoordinatesOnly& operator=(const CoordinatesOnly&) = delete;
+
+ private:
+  LasReader& reader_;
+};
+
 Tree build_streamed(LasReader& reader, const BuildOptions& requested, bool attributes, bool payload,
                     BuildReport* report, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                     std::size_t chunk_points, std::optional<Quantizer>& used, std::int32_t stored_lo[3],
@@ -405,6 +418,7 @@ Tree build_streamed(LasReader& reader, const BuildOptions& requested, bool attri
   skip_copc_nodes_outside_the_grid(reader, requested);
   LasChunk chunk;
   const bool occupancy_only = !attributes && !payload;
+  const CoordinatesOnly coordinates_only(reader, occupancy_only);
   // Keys are 8 bytes a point; decoded coordinates (the path without key tables) 24.
   const std::size_t decoded_chunk = chunk_points == 0 ? kLasChunkPoints : chunk_points;
   if (chunk_points == 0) chunk_points = occupancy_only ? kLasKeyChunkPoints : kLasChunkPoints;
@@ -431,9 +445,11 @@ Tree build_streamed(LasReader& reader, const BuildOptions& requested, bool attri
   // Pass 1: the points' bounds, as the reference takes them (the header's may be stale).
   if (!options.bbox) {
     reader.rewind();
+    reader.set_coordinates_only(true);
     options.bbox = las_bounds(reader, chunk_points, stored_lo, stored_hi, [&](std::uint64_t done) {
       if (progress) progress(done, passes * reader.points_total());
     });
+    reader.set_coordinates_only(occupancy_only);
   }
   const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
   used = quantizer;

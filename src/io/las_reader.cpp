@@ -157,6 +157,13 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
 
 LasReader::~LasReader() { settle_laz_prefetch(); }
 
+void LasReader::set_coordinates_only(bool on) {
+  if (on == coordinates_only_) return;
+  settle_laz_prefetch();  // a batch decoded ahead was decoded the other way
+  coordinates_only_ = on;
+  rewind();
+}
+
 void LasReader::rewind() {
   next_ = 0;
   settle_laz_prefetch();

@@ -41,7 +41,7 @@ void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& r
   }
   records.resize(static_cast<std::size_t>(c.point_count) * hd.record_length);
   laz::decode_chunk(*hd.laszip, compressed, c.point_count, records.data(), hd.record_length, chunk, c.byte_offset,
-                    path_);
+                    path_, coordinates_only_);
 }
 
 void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optional<int> max_level) {

@@ -498,7 +498,7 @@ void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
   VoxelReducer reducer(specs, tree.voxel_count());
   if (const auto it = value_runs.find(t); it != value_runs.end()) {
     const std::size_t words = record_words();
-    std::vector<std::uint64_t> ranks;
+    std::vector<std::uint64_t> voxel_ranks;
     // The values are the records' words 2.. (doubles), read in place by the reducer.
     std::vector<RecordField> fields(specs.size());
     for (std::size_t a = 0; a < specs.size(); ++a)
@@ -506,13 +506,13 @@ void Tiling::reduce_attributes(const TileIndex& t, Tree& tree) const {
                    .offset = static_cast<std::uint32_t>((2 + a) * sizeof(std::uint64_t)),
                    .scaled = false};
     visit_records(it->second, [&](const std::uint64_t* records, std::size_t n) {
-      ranks.resize(n);
+      voxel_ranks.resize(n);
       for (std::size_t r = 0; r < n; ++r) {
-        const std::optional<std::uint64_t> rank = tree.rank(decode(records[r * words]));
-        if (!rank) throw Error("tile: an attribute record names a voxel the tile does not hold");
-        ranks[r] = *rank;
+        const std::optional<std::uint64_t> voxel = tree.rank(decode(records[r * words]));
+        if (!voxel) throw Error("tile: an attribute record names a voxel the tile does not hold");
+        voxel_ranks[r] = *voxel;
       }
-      reducer.add_records(ranks, reinterpret_cast<const std::uint8_t*>(records), words * sizeof(std::uint64_t), {},
+      reducer.add_records(voxel_ranks, reinterpret_cast<const std::uint8_t*>(records), words * sizeof(std::uint64_t), {},
                           fields);
     });
   }

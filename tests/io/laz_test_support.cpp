@@ -50,7 +50,7 @@ LasFile parse_las_file(Bytes bytes, std::string name) {
   return f;
 }
 
-Bytes decode_all(const LasFile& file) {
+Bytes decode_all(const LasFile& file, bool coordinates_only) {
   namespace laz = vola::io::laz;
   const laz::LaszipInfo info = laz::parse_laszip_vlr(file.laszip, file.name, file.laszip_offset);
   const auto read_at = [&file](std::uint64_t offset, std::uint64_t n, std::uint8_t* out) {
@@ -63,7 +63,8 @@ Bytes decode_all(const LasFile& file) {
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     const laz::ChunkEntry& c = chunks[i];
     laz::decode_chunk(info, std::span(file.bytes).subspan(c.byte_offset, c.byte_size), c.point_count,
-                      records.data() + done * file.record_length, file.record_length, i, c.byte_offset, file.name);
+                      records.data() + done * file.record_length, file.record_length, i, c.byte_offset, file.name,
+                      coordinates_only);
     done += c.point_count;
   }
   return records;

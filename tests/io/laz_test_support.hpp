@@ -29,8 +29,9 @@ struct LasFile {
 LasFile read_las_file(const vola_io_test::fs::path& path);
 LasFile parse_las_file(Bytes bytes, std::string name);
 
-// Every record of a LAZ file, decoded chunk by chunk.
-Bytes decode_all(const LasFile& file);
+// Every record of a LAZ file, decoded chunk by chunk (with coordinates_only, as
+// laz::decode_chunk gives them for coordinates alone).
+Bytes decode_all(const LasFile& file, bool coordinates_only = false);
 // The uncompressed point records of a LAS file.
 Bytes las_records(const LasFile& file);
 

@@ -4,6 +4,7 @@
 // encode -> decode round trip; malformed input must be refused with FormatError.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <sstream>
 
 #include "io_test_data.hpp"
@@ -48,6 +49,34 @@ TEST(LazDecode, EveryFileHashesAsLazPerfDecodedIt) {
     }
     EXPECT_EQ(vola_test::sha256_hex(records), sha);
   }
+}
+
+// Coordinates alone (the occupancy conversion's decode): X, Y and Z exactly as decoded
+// whole (layered chunks skip their other layers); point-wise chunks decode everything.
+TEST(LazDecode, CoordinatesAloneAreTheWholeDecodesCoordinates) {
+  VOLA_REQUIRE_DATA(data);
+  std::size_t layered = 0;
+  for (const fs::path& path : vola_io_test::files_ending(data / "laz", ".laz")) {
+    SCOPED_TRACE(path.filename().string());
+    const LasFile file = vola_laz_test::read_las_file(path);
+    const Bytes whole = vola_laz_test::decode_all(file);
+    const Bytes coordinates = vola_laz_test::decode_all(file, true);
+    ASSERT_EQ(coordinates.size(), whole.size());
+    if (file.point_format < 6) {
+      EXPECT_TRUE(coordinates == whole);
+      continue;
+    }
+    ++layered;
+    const std::size_t n = file.record_length;
+    bool others_differ = false;
+    for (std::uint64_t i = 0; i < file.point_count; ++i) {
+      ASSERT_EQ(std::memcmp(coordinates.data() + i * n, whole.data() + i * n, 12), 0) << "record " << i;
+      others_differ = others_differ || std::memcmp(coordinates.data() + i * n, whole.data() + i * n, n) != 0;
+    }
+    // The layers were skipped (a file whose other fields never change would not show it).
+    if (file.point_count > 100) EXPECT_TRUE(others_differ);
+  }
+  EXPECT_GE(layered, 3u);  // formats 6, 7 and 8 among the shared files
 }
 
 TEST(LazDecode, LasTwinsGiveTheSameRecords) {

@@ -121,6 +121,11 @@ class LasReader {
   std::optional<int> copc_level() const noexcept { return copc_level_; }
   // Back to the first point (for a second pass).
   void rewind();
+  // LAZ: read_records() may give records whose fields other than X, Y and Z are not
+  // decoded (layered chunks, point formats 6-10, then decode only the layers of their
+  // coordinates; the other fields hold values of earlier points), for passes that use
+  // only the coordinates. Off by default; changing it rewinds.
+  void set_coordinates_only(bool on);
 
   // LAZ: chunk `chunk` of header().laz_chunks decoded into `records` (resized to its
   // point count x record_length). Safe to call from many threads at once on a file
@@ -158,6 +163,7 @@ class LasReader {
   std::vector<std::size_t> chunk_order_;      // the chunks read, in file order (all, or the selected COPC nodes)
   std::uint64_t points_total_ = 0;
   std::optional<int> copc_level_;
+  bool coordinates_only_ = false;
   mutable std::atomic<std::uint64_t> bytes_read_{0};
 };
 

@@ -110,9 +110,13 @@ std::vector<std::uint8_t> chunk_table_bytes(const LaszipInfo& info, std::span<co
 // Decodes one chunk (its bytes exactly, as the chunk table gives them) into `count`
 // LAS point records of record_length bytes each (the bytes an uncompressed LAS file
 // would hold). `chunk_index` and `chunk_offset` only name the chunk in errors.
+// With xyz_only, a layered chunk (point formats 6-10) decodes only the layers X, Y and Z
+// need (LASzip's selective decompression): the records' coordinates are exact, their
+// other fields are not (they hold values of earlier points). Point-wise chunks (formats
+// 0-5), whose items share one stream, are always decoded whole.
 void decode_chunk(const LaszipInfo& info, std::span<const std::uint8_t> chunk, std::uint64_t count,
                   std::uint8_t* records, std::size_t record_length, std::uint64_t chunk_index = 0,
-                  std::uint64_t chunk_offset = 0, const std::string& source = {});
+                  std::uint64_t chunk_offset = 0, const std::string& source = {}, bool xyz_only = false);
 
 // Appends the chunk holding `records` (a whole number of record_length records, at
 // least one) to `out`.

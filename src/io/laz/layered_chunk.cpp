@@ -4,6 +4,7 @@
 //   uint32  byte size of each layer: POINT14's 9, then RGB (1) or RGBNIR (2), then the
 //           wave packets (1), then one per extra byte
 //   the layers' bytes in the same order
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -81,7 +82,7 @@ std::vector<std::span<const std::uint8_t>> split_layers(const RecordLayout& layo
 
 std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8_t> chunk,
                                    std::uint64_t count, std::uint8_t* records, const std::string& where,
-                                   std::uint64_t chunk_offset, const std::string& source) {
+                                   std::uint64_t chunk_offset, const std::string& source, bool xyz_only) {
   if (count == 0) return 0;
   const std::size_t n = layout.length;
   const auto spans = split_layers(layout, chunk, count, where, chunk_offset, source);
@@ -91,7 +92,17 @@ std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const s
   coders->start(records);
   std::array<std::span<const std::uint8_t>, kLayers14> point_layers;
   std::copy(spans.begin(), spans.begin() + kLayers14, point_layers.begin());
-  coders->point.set_layers(point_layers);
+  coders->point.set_layers(point_layers, xyz_only);
+  if (xyz_only) {
+    // The items after POINT14 are not decoded: their bytes repeat the first record's.
+    constexpr std::size_t kPoint14Bytes = 30;
+    std::uint8_t* out = records + n;
+    for (std::uint64_t i = 1; i < count; ++i, out += n) {
+      coders->point.decode(out);
+      if (n > kPoint14Bytes) std::memcpy(out + kPoint14Bytes, records + kPoint14Bytes, n - kPoint14Bytes);
+    }
+    return coders->point.overrun();
+  }
   std::size_t next = kLayers14;
   if (coders->rgb) {
     coders->rgb->set_layers(spans[next], layout.nir ? spans[next + 1] : std::span<const std::uint8_t>{});

@@ -50,8 +50,10 @@ class Point14Coder {
   ~Point14Coder();
 
   std::uint32_t start(const std::uint8_t* first);
-  // Decoding: the layers' bytes (empty = absent).
-  void set_layers(const std::array<std::span<const std::uint8_t>, kLayers14>& layers);
+  // Decoding: the layers' bytes (empty = absent). With xyz_only, every layer but XY and
+  // Z is treated as absent (its fields keep the chunk's first values): XY and Z depend on
+  // no other layer, so the coordinates come out the same (LASzip's selective decoding).
+  void set_layers(const std::array<std::span<const std::uint8_t>, kLayers14>& layers, bool xyz_only = false);
   std::uint32_t decode(std::uint8_t* out);
   std::uint64_t overrun() const;
 

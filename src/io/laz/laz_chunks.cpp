@@ -131,7 +131,7 @@ std::vector<std::uint8_t> chunk_table_bytes(const LaszipInfo& info, std::span<co
 
 void decode_chunk(const LaszipInfo& info, std::span<const std::uint8_t> chunk, std::uint64_t count,
                   std::uint8_t* records, std::size_t record_length, std::uint64_t chunk_index,
-                  std::uint64_t chunk_offset, const std::string& source) {
+                  std::uint64_t chunk_offset, const std::string& source, bool xyz_only) {
   const RecordLayout layout = record_layout(info, source, 0);
   const std::string name = "chunk " + std::to_string(chunk_index);
   if (record_length != layout.length)
@@ -140,7 +140,7 @@ void decode_chunk(const LaszipInfo& info, std::span<const std::uint8_t> chunk, s
   if (info.compressor == 2 && info.chunk_size != kVariableChunkSize && count > info.chunk_size)
     fail(source, chunk_offset, name + ": " + std::to_string(count) + " points in chunks of " + std::to_string(info.chunk_size));
   const std::uint64_t overrun =
-      layout.layered ? decode_layered_chunk(layout, chunk, count, records, name, chunk_offset, source)
+      layout.layered ? decode_layered_chunk(layout, chunk, count, records, name, chunk_offset, source, xyz_only)
                      : decode_pointwise_chunk(layout, chunk, count, records);
   if (overrun)
     fail(source, chunk_offset + chunk.size(),

@@ -133,10 +133,10 @@ std::uint32_t Point14Coder::start(const std::uint8_t* first) {
   return current_;
 }
 
-void Point14Coder::set_layers(const std::array<std::span<const std::uint8_t>, kLayers14>& layers) {
+void Point14Coder::set_layers(const std::array<std::span<const std::uint8_t>, kLayers14>& layers, bool xyz_only) {
   for (int i = 0; i < kLayers14; ++i) {
     // XY is decoded even when empty: a chunk of more than one point must have it.
-    present_[i] = i == kXy || !layers[i].empty();
+    present_[i] = i == kXy || (!layers[i].empty() && (!xyz_only || i == kZ));
     if (present_[i]) decoders_[i].start(layers[i]);
   }
 }

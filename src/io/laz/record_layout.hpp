@@ -44,9 +44,10 @@ void encode_pointwise_chunk(const RecordLayout& layout, std::span<const std::uin
 
 // Compressor 3 chunks: the first record raw, the point count, every layer's size, then
 // the layers. Throws FormatError(source, offset, ...) for inconsistent layer sizes.
+// With xyz_only, only the XY and Z layers are decoded (see laz::decode_chunk).
 std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8_t> chunk, std::uint64_t count,
                           std::uint8_t* records, const std::string& where, std::uint64_t chunk_offset,
-                          const std::string& source);
+                          const std::string& source, bool xyz_only = false);
 void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8_t> records,
                           std::vector<std::uint8_t>& out);
 
