@@ -259,10 +259,11 @@ void add_sonify(CLI::App& app) {
       "           the listener if it sees it, specular paths are heard by a sphere around the listener,\n"
       "           and the paths the image sources hold are left out. The energy per millisecond becomes\n"
       "           noise, so the decay follows the room (T30 within 10% of Eyring's formula in closed\n"
-      "           rooms, tested). Rays are traced in rounds of 1024 until the energy of every 10 ms\n"
-      "           window down to 60 dB below the loudest has a relative standard error of at most\n"
-      "           --tail-error (judged from the spread between chunks of 128 rays), or --rays are traced;\n"
-      "           --tail-error 0: all --rays. --rays 0: no tail.\n"
+      "           rooms, tested). Rays are traced in rounds of 1024 (2048 at least) until the relative\n"
+      "           standard error of the energy per 10 ms window, root mean square over the windows down\n"
+      "           to 60 dB below the loudest, is at most --tail-error (0.1: about 0.4 dB; judged from\n"
+      "           the spread between chunks of 128 rays), or --rays are traced; --tail-error 0: all\n"
+      "           --rays. --rays 0: no tail.\n"
       "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
       "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
       "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
@@ -323,8 +324,8 @@ void add_sonify(CLI::App& app) {
   cmd->add_option("--rays", args->room.rays, "Physical: rays traced for the late tail at most (0 = no tail)")
       ->capture_default_str();
   cmd->add_option("--tail-error", args->room.tail_error,
-                  "Physical: stop tracing once every 10 ms window of the tail has this relative standard error "
-                  "(0 = all --rays)")
+                  "Physical: stop tracing once the tail's 10 ms windows have this relative standard error "
+                  "(root mean square; 0 = all --rays)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--length", args->room.max_length, "Physical: the response's longest length (s)")->capture_default_str();

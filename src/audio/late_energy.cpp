@@ -23,27 +23,30 @@ constexpr std::uint64_t kRaysPerChunk = 128;
 constexpr std::uint64_t kChunksPerRound = 8;
 // Rounds before the spread is trusted: 16 chunks.
 constexpr std::uint64_t kMinRounds = 2;
-// The precision is judged on windows of this many bins (ms), down to kErrorRange below
-// the loudest window.
+// The precision is judged on windows of this many bins (ms), down to kErrorRange (60 dB)
+// below the loudest window.
 constexpr std::size_t kErrorWindow = 10;
 constexpr double kErrorRange = 1e-6;
 
-// The relative standard error of the sum of n chunks' energies, per window: sum and
-// squares hold per window the sum of the chunks' energies and of their squares; the
-// largest over the windows within kErrorRange of the loudest.
+// The relative standard error of the sum of n chunks' energies per window (sum and
+// squares hold per window the sum of the chunks' energies and of their squares), root
+// mean square over the windows within kErrorRange of the loudest: the typical error of a
+// window's level (a relative error e is about 4.3 e dB).
 double tail_relative_error(const std::vector<double>& sum, const std::vector<double>& squares, double n) {
   if (n < 2.0) return std::numeric_limits<double>::infinity();
   double loudest = 0.0;
   for (const double e : sum) loudest = std::max(loudest, e);
   if (!(loudest > 0.0)) return std::numeric_limits<double>::infinity();
-  double worst = 0.0;
+  double total = 0.0;
+  std::size_t windows = 0;
   for (std::size_t w = 0; w < sum.size(); ++w) {
     if (!(sum[w] >= kErrorRange * loudest)) continue;
     // The chunks' sample variance times n: the variance of their sum.
     const double variance = std::max(0.0, squares[w] - sum[w] * sum[w] / n) * n / (n - 1.0);
-    worst = std::max(worst, std::sqrt(variance) / sum[w]);
+    total += variance / (sum[w] * sum[w]);
+    ++windows;
   }
-  return worst;
+  return std::sqrt(total / static_cast<double>(windows));
 }
 
 // The random numbers of chunk c: its own generator, seeded by a hash (splitmix64's
@@ -211,9 +214,10 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         Point face_normal{0, 0, 0};
         face_normal[axis] = n[axis];
         // A face a ray enters from an empty cell is exposed, so it is in a patch.
-        const std::int64_t element = surface.element_of(hit->voxel, face);
+        std::uint32_t patch = 0;
+        const std::int64_t element = surface.element_of(hit->voxel, face, patch);
         if (element < 0) break;
-        const auto p = static_cast<std::size_t>(surface.patch_of_element(static_cast<std::size_t>(element)));
+        const auto p = static_cast<std::size_t>(patch);
         const Point normal = patches[p].normal;
         const Bands& r = room.band_reflection()[p];
         air_loss(segment * voxel, energy);

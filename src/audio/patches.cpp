@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "vola/error.hpp"
+
 namespace vola::audio {
 
 namespace {
@@ -77,6 +79,11 @@ struct Raw {
   Point normal{};
 };
 
+// A surface voxel's entry: exposed faces (bits 0-5), its first element (bits 8-39), the
+// patch of that element (bits 40-63, kNoPatch when it does not fit).
+constexpr std::uint64_t kNoPatch = 0xFFFFFF;
+std::uint64_t first_of(std::uint64_t entry) noexcept { return (entry >> 8) & 0xFFFFFFFFull; }
+
 }  // namespace
 
 SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials, const std::vector<LeafBlock>& blocks) {
@@ -114,6 +121,7 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
     surface_voxels += static_cast<std::uint64_t>(std::popcount(b.voxels));
   }
   voxel_faces_.assign(surface_voxels, 0);
+  if (raw.size() >= (std::uint64_t{1} << 32)) throw InvalidArgument("the scene has 2^32 exposed voxel faces or more");
   for (std::size_t i = 0; i < raw.size(); ++i) {
     std::uint64_t& entry = const_cast<std::uint64_t&>(*find(raw[i].voxel.x, raw[i].voxel.y, raw[i].voxel.z));
     if ((entry & 0xFF) == 0) entry = static_cast<std::uint64_t>(i) << 8;
@@ -124,7 +132,7 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
     if (!in_grid(x, y, z, side)) return -1;
     const std::uint64_t* it = find(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y), static_cast<std::uint64_t>(z));
     if (!it || !(*it & (1u << face))) return -1;
-    return static_cast<std::int64_t>((*it >> 8) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
+    return static_cast<std::int64_t>(first_of(*it) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
   };
 
   // Normals: a plane through the same-facing faces around each face.
@@ -210,7 +218,7 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
             if (!in_grid(x, y, z, side)) continue;
             const std::uint64_t* it = find(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y), static_cast<std::uint64_t>(z));
             if (!it) continue;
-            auto j = static_cast<std::uint32_t>(*it >> 8);
+            auto j = static_cast<std::uint32_t>(first_of(*it));
             for (unsigned mask = static_cast<unsigned>(*it & 0xFF); mask; mask &= mask - 1, ++j) {
               if (patch_of_element[j] != kUnset) continue;
               const Raw& o = raw[j];
@@ -235,6 +243,12 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
   }
   elements_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) elements_[i] = Element{patch_of_element[i], raw[i].face};
+  // The first element's patch in the voxel's entry: a wall voxel has one exposed face, so
+  // the tracer finds its patch without a further load.
+  for (std::uint64_t& entry : voxel_faces_) {
+    const std::uint64_t patch = elements_[first_of(entry)].patch;
+    entry |= (patch < kNoPatch ? patch : kNoPatch) << 40;
+  }
 }
 
 const std::uint64_t* SurfacePatches::find(std::uint64_t x, std::uint64_t y, std::uint64_t z) const noexcept {
@@ -265,7 +279,17 @@ SurfacePatches::Block& SurfacePatches::insert(std::uint64_t key) {
 std::int64_t SurfacePatches::element_of(const Voxel& v, int face) const noexcept {
   const std::uint64_t* it = find(v.x, v.y, v.z);
   if (!it || !(*it & (1u << face))) return -1;
-  return static_cast<std::int64_t>((*it >> 8) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
+  return static_cast<std::int64_t>(first_of(*it) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
+}
+
+std::int64_t SurfacePatches::element_of(const Voxel& v, int face, std::uint32_t& patch) const noexcept {
+  const std::uint64_t* it = find(v.x, v.y, v.z);
+  if (!it || !(*it & (1u << face))) return -1;
+  const auto below = static_cast<unsigned>(*it & ((1u << face) - 1));
+  const std::uint64_t e = first_of(*it) + static_cast<std::uint64_t>(std::popcount(below));
+  const std::uint64_t stored = *it >> 40;
+  patch = below == 0 && stored != kNoPatch ? static_cast<std::uint32_t>(stored) : elements_[e].patch;
+  return static_cast<std::int64_t>(e);
 }
 
 std::int64_t SurfacePatches::patch_of(const Voxel& v, int face) const noexcept {
@@ -277,7 +301,7 @@ bool SurfacePatches::voxel_in_patch(const Voxel& v, std::uint32_t p) const noexc
   const std::uint64_t* it = find(v.x, v.y, v.z);
   if (!it) return false;
   const auto n = static_cast<std::uint32_t>(std::popcount(static_cast<unsigned>(*it & 0xFF)));
-  const std::uint64_t first = *it >> 8;
+  const std::uint64_t first = first_of(*it);
   for (std::uint32_t i = 0; i < n; ++i)
     if (elements_[first + i].patch == p) return true;
   return false;

@@ -59,11 +59,12 @@ struct RoomOptions {
   bool occlusion = true;           // ray casts on every leg, the direct path included
   double scattering = 0.3;         // energy fraction reflected diffusely, [0, 1]
   std::uint64_t rays = 20000;      // for the late tail, at most; 0 = no tail
-  double tail_error = 0.1;         // rays are traced in rounds of 1024 until the tail's
-                                   // energy in every 10 ms window (down to 60 dB below the
-                                   // loudest) has a relative standard error at most this
-                                   // (from the spread between chunks of 128 rays, 2048 rays
-                                   // at least); 0 = all `rays`
+  double tail_error = 0.1;         // rays are traced in rounds of 1024 until the relative
+                                   // standard error of the tail's energy per 10 ms window,
+                                   // root mean square over the windows down to 60 dB below
+                                   // the loudest, is at most this (from the spread between
+                                   // chunks of 128 rays; 2048 rays at least); 0 = all `rays`.
+                                   // 0.1 is about 0.4 dB on a window's level
   double max_length = 10.0;        // s: the tail is traced at most this long
   double decay_floor_db = -70.0;   // a ray stops once its energy fell this far
   double receiver_radius = 0.5;    // m, shrunk to the listener's clearance
@@ -134,8 +135,8 @@ struct LateEnergy {
   std::size_t first_sample = 0;    // the earliest deposit: the tail's noise starts there
   double receiver_radius = 0.0;    // m, as used
   std::uint64_t rays = 0;          // rays traced
-  double relative_error = 0.0;     // the largest relative standard error of a 10 ms window's
-                                   // energy, down to 60 dB below the loudest (tail_error)
+  double relative_error = 0.0;     // the 10 ms windows' relative standard error reached
+                                   // (root mean square, as tail_error)
 };
 
 // The ray-traced energy histogram, without the paths the image sources of `order` hold.
