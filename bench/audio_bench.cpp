@@ -5,7 +5,8 @@
 // visits every cell of the dense 256^3 grid, and time-domain convolution. The naive
 // thresholding must give the same bins (checked), so the comparison is like for like.
 // Then the physical model (room_response.hpp) on the same room: image sources (order 3,
-// with and without occlusion), the ray-traced tail (20,000 rays), the whole response and
+// with and without occlusion), the ray-traced tail (the default: rays until the
+// histogram's error bound, and 20,000 and 2,000 rays without it), the whole response and
 // its convolution with the source.
 //
 //   vola_audio_bench [--runs N]     (medians of N runs, default 7)
@@ -206,11 +207,18 @@ int main(int argc, char** argv) {
   const double images1 = median_ms(runs, [&] { early = image_sources(physical, source, listener, room_one); });
   const double imagesn = median_ms(runs, [&] { early = image_sources(physical, source, listener, room_all); });
   const double images_open = median_ms(runs, [&] { early = image_sources(physical, source, listener, no_occlusion); });
+  early = image_sources(physical, source, listener, room_one);  // the default's images, reported below
   LateEnergy late;
   const double tail1 = median_ms(runs, [&] { late = late_energy(physical, source, listener, early.order, room_one); });
   const double tailn = median_ms(runs, [&] { late = late_energy(physical, source, listener, early.order, room_all); });
+  const LateEnergy default_late = late;
   RoomOptions few_one = room_one, few_all = room_all;
   few_one.rays = few_all.rays = 2000;
+  few_one.tail_error = few_all.tail_error = 0.0;
+  RoomOptions fixed_one = room_one, fixed_all = room_all;
+  fixed_one.tail_error = fixed_all.tail_error = 0.0;
+  const double fixed1 = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, fixed_one); });
+  const double fixedn = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, fixed_all); });
   const double few1 = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, few_one); });
   const double fewn = median_ms(runs, [&] { late_energy(physical, source, listener, early.order, few_all); });
   RoomResponse response;
@@ -228,10 +236,10 @@ int main(int argc, char** argv) {
   const double hall_one = median_ms(std::min(runs, 3), [&] { wet = Convolver(hall).apply(dry, 1); });
   const double hall_part = median_ms(std::min(runs, 3), [&] { wet = PartitionedConvolver(hall, 8192).apply(dry, 1); });
   std::printf("\nphysical model: %zu patches (found once: %.1f ms); order %d searched, %llu images tried, %zu valid; "
-              "tail %llu rays, scattering %.2f, receiver %.2f m; response %zu samples (%.1f ms); FFT size %zu (planning %.0f ms)\n\n",
+              "tail %llu rays (relative error %.3f, at most %.2f), scattering %.2f, receiver %.2f m; response %zu samples (%.1f ms); FFT size %zu (planning %.0f ms)\n\n",
               physical.patches().patches().size(), patches_ms, early.order,
               static_cast<unsigned long long>(early.candidates), early.images.size(),
-              static_cast<unsigned long long>(room_one.rays), room_one.scattering, late.receiver_radius, response.ir.size(),
+              static_cast<unsigned long long>(default_late.rays), default_late.relative_error, room_one.tail_error, room_one.scattering, late.receiver_radius, response.ir.size(),
               static_cast<double>(response.ir.size()) / 48.0, Convolver(response.ir).fft_size(), long_planning);
   std::printf("%-34s %12s %12s %12s %12s\n", "physical step", "paper (ms)", "1 thread", "threads", "vs paper");
   auto physical_row = [&](const char* name, double paper, double a, double b) {
@@ -239,8 +247,9 @@ int main(int argc, char** argv) {
   };
   physical_row("image sources, order 3", 820.0, images1, imagesn);
   physical_row("  the same, --no-occlusion", 820.0, images_open, images_open);
-  physical_row("late tail, 20000 rays (default)", 820.0, tail1, tailn);
-  physical_row("late tail, 2000 rays", 820.0, few1, fewn);
+  physical_row("late tail (default: to the error)", 820.0, tail1, tailn);
+  physical_row("late tail, 20000 rays (no bound)", 820.0, fixed1, fixedn);
+  physical_row("late tail, 2000 rays (no bound)", 820.0, few1, fewn);
   // The whole response: both searches and the assembly (threshold and create filter).
   physical_row("whole response", 820.0 + 0.3, whole1, wholen);
   physical_row("apply whole response", 4.05, long1, longn);

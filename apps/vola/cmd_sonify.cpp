@@ -69,8 +69,8 @@ SourceResponse physical_response(const audio::Room& room, const Point& source, c
   const double fs = a.room.sample_rate;
   char tail[128] = "no tail";
   if (a.room.rays > 0)
-    std::snprintf(tail, sizeof tail, "tail from %llu rays (receiver radius %.2f m)",
-                  static_cast<unsigned long long>(a.room.rays), r.late.receiver_radius);
+    std::snprintf(tail, sizeof tail, "tail from %llu rays (relative error %.3f; receiver radius %.2f m)",
+                  static_cast<unsigned long long>(r.late.rays), r.late.relative_error, r.late.receiver_radius);
   char line[512];
   std::snprintf(line, sizeof line,
                 "direct %.3f m, %.2f ms (sample %u)%s; %zu image sources up to order %d of %zu patches; %s; response %.2f ms",
@@ -254,12 +254,16 @@ void add_sonify(CLI::App& app) {
       "           reflection coefficient, s = --scattering; a patch smaller than the 1 kHz Fresnel zone\n"
       "           reflects that fraction of it. A scene of very many patches (a survey) stops the search\n"
       "           at the order whose candidates would pass 2 million; the report says the order used;\n"
-      "  late:    --rays energy rays traced over the voxels, losing R^2 at each hit and going on\n"
+      "  late:    energy rays traced over the voxels, losing R^2 at each hit and going on\n"
       "           specularly or (probability s) diffusely; each hit sends its diffuse part straight to\n"
       "           the listener if it sees it, specular paths are heard by a sphere around the listener,\n"
       "           and the paths the image sources hold are left out. The energy per millisecond becomes\n"
       "           noise, so the decay follows the room (T30 within 10% of Eyring's formula in closed\n"
-      "           rooms, tested). --rays 0: no tail.\n"
+      "           rooms, tested). Rays are traced in rounds of 1024 (2048 at least) until the relative\n"
+      "           standard error of the energy per 10 ms window, root mean square over the windows down\n"
+      "           to 60 dB below the loudest, is at most --tail-error (0.1: about 0.4 dB; judged from\n"
+      "           the spread between chunks of 128 rays), or --rays are traced; --tail-error 0: all\n"
+      "           --rays. --rays 0: no tail.\n"
       "  bands:   amplitudes and energies are kept per octave band (125 Hz .. 4 kHz): per-band materials\n"
       "           and, with --air, air absorption (ISO 9613-1 at --temperature, --humidity). Bands that\n"
       "           differ are rendered each through an octave filter bank that sums to an impulse.\n"
@@ -317,7 +321,13 @@ void add_sonify(CLI::App& app) {
   cmd->add_option("--scattering", args->room.scattering, "Physical: energy fraction reflected diffusely, 0..1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--rays", args->room.rays, "Physical: rays traced for the late tail (0 = no tail)")->capture_default_str();
+  cmd->add_option("--rays", args->room.rays, "Physical: rays traced for the late tail at most (0 = no tail)")
+      ->capture_default_str();
+  cmd->add_option("--tail-error", args->room.tail_error,
+                  "Physical: stop tracing once the tail's 10 ms windows have this relative standard error "
+                  "(root mean square; 0 = all --rays)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--length", args->room.max_length, "Physical: the response's longest length (s)")->capture_default_str();
   cmd->add_option("--receiver-radius", args->room.receiver_radius,
                   "Physical: the tail's receiver sphere (m), shrunk to clear the scene")

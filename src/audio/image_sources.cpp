@@ -2,6 +2,7 @@
 // checked by tracing its path back from the listener (room_response.hpp).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "vola/audio/room_response.hpp"
@@ -29,6 +30,9 @@ struct Node {
 // it must not count its own surface as an obstacle.
 constexpr double kSurfaceSkip = 1.5;
 
+// The fraction of a segment left out at its far end.
+constexpr double kShortOfEnd = 1e-9;
+
 // Is the segment from a to b free of occupied voxels? Ends on a patch skip kSurfaceSkip
 // voxels next to them.
 bool clear(const raycast::RayCaster& caster, const Point& a, bool a_on_surface, const Point& b, bool b_on_surface) {
@@ -37,7 +41,9 @@ bool clear(const raycast::RayCaster& caster, const Point& a, bool a_on_surface, 
   if (len <= skip_a + skip_b) return true;
   const Point u{(b[0] - a[0]) / len, (b[1] - a[1]) / len, (b[2] - a[2]) / len};
   const Point from{a[0] + skip_a * u[0], a[1] + skip_a * u[1], a[2] + skip_a * u[2]};
-  return !caster.cast(raycast::Ray{from, u, len - skip_a - skip_b}).has_value();
+  // Up to just short of b: a listener standing on a face (a table top, the floor) is not
+  // hidden by the voxel it stands on.
+  return !caster.cast(raycast::Ray{from, u, (len - skip_a - skip_b) * (1.0 - kShortOfEnd)}).has_value();
 }
 
 // Does point q of patch p's plane lie on the patch: is the voxel just behind it (or a
@@ -87,6 +93,42 @@ bool near_box(const SurfacePatch& patch, const Point& q, double margin) {
   return true;
 }
 
+// Can a path from image i through (a point of) patch `through` go on to patch `to`: does
+// the beam from i through the box of `through` (grown by kBoxMargin) meet the box of `to`
+// (grown too)? A path's reflection point on a patch is within kBoxMargin of its box
+// (path_of checks near_box), and the next one lies on the ray from i through it, past
+// it: i + t (y - i), t >= 1, y in the box. At a fixed t that is a box too, so per axis
+// the t for which it overlaps `to` is an interval: the beam meets `to` when the intervals
+// and [1, inf) have a point in common. Only a box is tested, so it may say yes for a patch
+// the path cannot reach, never no for one it can.
+constexpr double kBoxMargin = 1.5;
+bool beam_meets(const Point& i, const SurfacePatch& through, const SurfacePatch& to) {
+  double t_lo = 1.0, t_hi = std::numeric_limits<double>::infinity();
+  // c t <= r
+  auto at_most = [&](double c, double r) {
+    if (c > 0.0) t_hi = std::min(t_hi, r / c);
+    else if (c < 0.0) t_lo = std::max(t_lo, r / c);
+    else if (r < 0.0) t_hi = -1.0;
+  };
+  for (int a = 0; a < 3; ++a) {
+    const double lo = through.lo[a] - kBoxMargin - i[a], hi = through.hi[a] + kBoxMargin - i[a];
+    // The beam's lower end at t is i + t lo, at most the far side of `to`; its upper end
+    // i + t hi at least the near side.
+    at_most(lo, to.hi[a] + kBoxMargin - i[a] + 1e-9);
+    at_most(-hi, -(to.lo[a] - kBoxMargin - i[a]) + 1e-9);
+  }
+  return t_lo <= t_hi * (1.0 + 1e-12) + 1e-12;
+}
+
+// Does the line from the listener l to image i cross the patch's plane, in front of it,
+// within kBoxMargin of its box? (The first test of path_of, for the last reflection.)
+bool last_leg_meets(const SurfacePatch& patch, const Point& i, const Point& l) {
+  const double dt = plane_distance(patch, l), di = plane_distance(patch, i);
+  if (!(dt > 0.0 && di < 0.0)) return false;
+  const double u = dt / (dt - di);
+  return near_box(patch, Point{l[0] + u * (i[0] - l[0]), l[1] + u * (i[1] - l[1]), l[2] + u * (i[2] - l[2])}, kBoxMargin);
+}
+
 // The path an image stands for, traced back from the listener l to the source s (grid
 // coordinates), or false when it does not exist (room_response.hpp).
 bool path_of(const Room& room, const Point& s, const Point& l, const RoomOptions& o, Trace& t, ImageSource& out) {
@@ -104,7 +146,7 @@ bool path_of(const Room& room, const Point& s, const Point& l, const RoomOptions
     const double u = dt / (dt - di);
     const Point q{target[0] + u * (t.images[k][0] - target[0]), target[1] + u * (t.images[k][1] - target[1]),
                   target[2] + u * (t.images[k][2] - target[2])};
-    if (!near_box(patch, q, 1.5) || !on_patch(room.patches(), t.sequence[k], q, side)) return false;
+    if (!near_box(patch, q, kBoxMargin) || !on_patch(room.patches(), t.sequence[k], q, side)) return false;
     if (o.occlusion && !clear(scene.caster(), q, true, target, k > 0)) return false;
     t.points.push_back(q);
     target = q;
@@ -166,8 +208,14 @@ ImageSearch image_sources(const Room& room, const Point& source, const Point& li
       const Node* parent = order == 1 ? nullptr : &levels.back()[i];
       const Point from = parent ? parent->image : s;
       for (std::uint32_t p = 0; p < patches.size(); ++p) {
-        if (parent && (p == parent->patch || wholly_behind(patches[p], patches[parent->patch]))) continue;
+        if (parent && (p == parent->patch || !beam_meets(from, patches[parent->patch], patches[p]) ||
+                       wholly_behind(patches[p], patches[parent->patch])))
+          continue;
         if (!(plane_distance(patches[p], from) > 1e-9)) continue;  // behind the mirror: no image
+        // At the last order an image is only traced, not reflected again: one whose last leg
+        // (from the listener) misses its patch is no path (path_of's first test, made here
+        // before the image is kept).
+        if (order == o.order && !last_leg_meets(patches[p], mirror(patches[p], from), l)) continue;
         if (next.size() >= o.max_image_nodes) {
           over_budget = true;
           break;

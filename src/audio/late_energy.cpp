@@ -1,6 +1,8 @@
 // The late tail's energy by stochastic ray tracing over the voxels (room_response.hpp).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -12,12 +14,49 @@ namespace vola::audio {
 
 namespace {
 
-// The rays are split into a fixed number of chunks (at least 512 rays each, at most 64
-// chunks, so the histograms kept until the sum stay bounded whatever the ray count): each
-// chunk has its own random numbers and histogram, summed in chunk order, so the result
-// does not depend on the thread count.
-constexpr std::uint64_t kMinRaysPerChunk = 512;
-constexpr std::uint64_t kMaxChunks = 64;
+// The rays are traced in chunks of kRaysPerChunk, each with its own random numbers (seeded
+// by the chunk's number) and histogram, kChunksPerRound chunks a round; the histograms are
+// summed in chunk order, so the result does not depend on the thread count. After each
+// round the chunks' spread says how precise the sum is, and tracing stops once it is
+// precise enough (RoomOptions::tail_error) or `rays` are traced.
+constexpr std::uint64_t kRaysPerChunk = 128;
+constexpr std::uint64_t kChunksPerRound = 8;
+// Rounds before the spread is trusted: 16 chunks.
+constexpr std::uint64_t kMinRounds = 2;
+// The precision is judged on windows of this many bins (ms), down to kErrorRange (60 dB)
+// below the loudest window.
+constexpr std::size_t kErrorWindow = 10;
+constexpr double kErrorRange = 1e-6;
+
+// The relative standard error of the sum of n chunks' energies per window (sum and
+// squares hold per window the sum of the chunks' energies and of their squares), root
+// mean square over the windows within kErrorRange of the loudest: the typical error of a
+// window's level (a relative error e is about 4.3 e dB).
+double tail_relative_error(const std::vector<double>& sum, const std::vector<double>& squares, double n) {
+  if (n < 2.0) return std::numeric_limits<double>::infinity();
+  double loudest = 0.0;
+  for (const double e : sum) loudest = std::max(loudest, e);
+  if (!(loudest > 0.0)) return std::numeric_limits<double>::infinity();
+  double total = 0.0;
+  std::size_t windows = 0;
+  for (std::size_t w = 0; w < sum.size(); ++w) {
+    if (!(sum[w] >= kErrorRange * loudest)) continue;
+    // The chunks' sample variance times n: the variance of their sum.
+    const double variance = std::max(0.0, squares[w] - sum[w] * sum[w] / n) * n / (n - 1.0);
+    total += variance / (sum[w] * sum[w]);
+    ++windows;
+  }
+  return std::sqrt(total / static_cast<double>(windows));
+}
+
+// The random numbers of chunk c: its own generator, seeded by a hash (splitmix64's
+// finaliser) of the seed and c, so neighbouring chunks' seeds share no bits.
+std::uint64_t chunk_seed(std::uint64_t seed, std::uint64_t c) noexcept {
+  std::uint64_t z = seed * 0x9E3779B97F4A7C15ull + (c + 1) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
 
 // The distance (grid units) from p to the nearest occupied voxel, searched up to `limit`.
 double clearance(const Tree& tree, const Point& p, double limit) {
@@ -90,20 +129,36 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   const double wanted = std::min(o.receiver_radius / voxel, 64.0);
   const double radius = std::min(wanted, clearance(scene.tree(), l, wanted));
   late.receiver_radius = radius * voxel;
-  late.energy.assign(bins, 0.0);
   // A listener on a voxel's face has no room for a sphere: it hears the diffuse rain only.
   const double r2 = radius * radius;
   const double volume = 4.0 / 3.0 * std::numbers::pi * late.receiver_radius * late.receiver_radius * late.receiver_radius;
-  // Each ray carries 4 pi / N (m^2): a free field then gives energy 1 / d^2 at d, the
-  // direct sound's squared amplitude.
-  const double ray_energy = 4.0 * std::numbers::pi / static_cast<double>(o.rays);
-  const double min_energy = ray_energy * std::pow(10.0, o.decay_floor_db / 10.0);
+  // Rays start with energy 1 and the sum is scaled at the end by 4 pi / N (m^2) for the N
+  // rays traced: a free field then gives energy 1 / d^2 at d, the direct sound's squared
+  // amplitude.
+  const double min_energy = std::pow(10.0, o.decay_floor_db / 10.0);
   const double max_distance = o.max_length * o.speed_of_sound / voxel;  // grid units
   const double bins_per_voxel = voxel / o.speed_of_sound / bin_seconds;
-  const auto& patches = room.patches().patches();
+  const SurfacePatches& surface = room.patches();
+  const auto& patches = surface.patches();
 
-  const std::uint64_t chunks = std::min(kMaxChunks, (o.rays + kMinRaysPerChunk - 1) / kMinRaysPerChunk);
-  std::vector<std::vector<Bands>> partial(chunks);
+  // Whether the listener sees an exposed face (from its centre), asked once per face for
+  // the diffuse rain: 0 not asked yet, 1 seen, 2 hidden. A face's answer is the same
+  // whichever thread asks first, so the cache changes no result.
+  std::vector<std::atomic<std::uint8_t>> sees(surface.element_count());
+  for (auto& v : sees) v.store(0, std::memory_order_relaxed);
+  auto listener_sees = [&](std::int64_t element, const Voxel& v, int axis, int sign) {
+    auto& known = sees[static_cast<std::size_t>(element)];
+    const std::uint8_t k = known.load(std::memory_order_relaxed);
+    if (k) return k == 1;
+    Point from{v.x + 0.5, v.y + 0.5, v.z + 0.5};
+    from[axis] += 0.5 * sign + 1e-7 * sign;
+    const Point to{l[0] - from[0], l[1] - from[1], l[2] - from[2]};
+    // The segment stops just short of the listener: one on a face still hears that side.
+    const bool seen = !scene.caster().cast(raycast::Ray{from, to, 1.0 - 1e-9}).has_value();
+    known.store(seen ? 1 : 2, std::memory_order_relaxed);
+    return seen;
+  };
+
   const Bands air = air_attenuation(o);
   // The energy left after `metres` of air, per band.
   auto air_loss = [&](double metres, Bands& e) {
@@ -113,21 +168,16 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
   auto add = [](Bands& to, const Bands& e, double scale) {
     for (std::size_t b = 0; b < e.size(); ++b) to[b] += e[b] * scale;
   };
-  std::vector<double> earliest(chunks, max_distance);  // per chunk, grid units of path
-  ParallelOptions parallel;
-  parallel.threads = o.threads;
-  parallel.chunks = static_cast<std::size_t>(chunks);
-  parallel.name = "audio.late_energy";
-  parallel_for(static_cast<std::size_t>(o.rays), [&](const Chunk& chunk) {
-    std::vector<Bands>& histogram = partial[chunk.index];
-    histogram.assign(bins, Bands{});
-    std::mt19937_64 rng(o.seed * 0x9E3779B97F4A7C15ull + chunk.index);
+  // One chunk's rays into its histogram; returns the earliest deposit (grid units of path).
+  auto trace_chunk = [&](std::uint64_t chunk, std::vector<Bands>& histogram) {
+    double earliest = max_distance;
+    std::mt19937_64 rng(chunk_seed(o.seed, chunk));
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    const std::uint64_t first = chunk.begin, last = chunk.end;
+    const std::uint64_t first = chunk * kRaysPerChunk, last = std::min(o.rays, first + kRaysPerChunk);
     for (std::uint64_t ray = first; ray < last; ++ray) {
       Point origin = s, d = uniform_direction(rng);
       Bands energy;
-      energy.fill(ray_energy);
+      energy.fill(1.0);
       double travelled = 0.0;
       int reflections = 0;
       bool specular = true, last_specular = true;
@@ -152,7 +202,7 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
                 air_loss(0.5 * (t0 + t1) * voxel, e);
                 add(histogram[bin], e, (t1 - t0) * voxel / volume);
               }
-              earliest[chunk.index] = std::min(earliest[chunk.index], travelled + t0);
+              earliest = std::min(earliest, travelled + t0);
             }
           }
         }
@@ -164,10 +214,12 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         Point face_normal{0, 0, 0};
         face_normal[axis] = n[axis];
         // A face a ray enters from an empty cell is exposed, so it is in a patch.
-        const std::int64_t p = room.patches().patch_of(hit->voxel, face);
-        if (p < 0) break;
-        const Point normal = patches[static_cast<std::size_t>(p)].normal;
-        const Bands& r = room.band_reflection()[static_cast<std::size_t>(p)];
+        std::uint32_t patch = 0;
+        const std::int64_t element = surface.element_of(hit->voxel, face, patch);
+        if (element < 0) break;
+        const auto p = static_cast<std::size_t>(patch);
+        const Point normal = patches[p].normal;
+        const Bands& r = room.band_reflection()[p];
         air_loss(segment * voxel, energy);
         double strongest = 0.0;
         for (std::size_t b = 0; b < energy.size(); ++b) {
@@ -180,25 +232,21 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         ++reflections;
         // Diffuse rain: the part s of the energy scattered here (Lambert: cos(theta) / pi per
         // steradian) that reaches the listener straight, energy s cos(theta) / (pi D^2), if it
-        // sees the listener. Every reflection contributes, so the tail is smooth even where
-        // few rays pass the receiver (open scenes).
+        // sees the listener (from the face's centre). Every reflection contributes, so the
+        // tail is smooth even where few rays pass the receiver (open scenes).
         if (o.scattering > 0.0) {
           const Point to{l[0] - origin[0], l[1] - origin[1], l[2] - origin[2]};
           const double distance = std::sqrt(dot(to, to));
           const double cosine = dot(to, normal) / distance;
-          if (cosine > 0.0 && dot(to, face_normal) > 0.0) {
-            Point from = origin;
-            from[axis] = std::round(from[axis]) + 1e-7 * n[axis];
-            if (!scene.caster().cast(raycast::Ray{from, to, 1.0})) {
-              const auto bin = static_cast<std::size_t>((travelled + distance) * bins_per_voxel);
-              const double metres = distance * voxel;
-              if (bin < bins) {
-                Bands e = energy;
-                air_loss(metres, e);
-                add(histogram[bin], e, o.scattering * cosine / (std::numbers::pi * metres * metres));
-              }
-              earliest[chunk.index] = std::min(earliest[chunk.index], travelled + distance);
+          if (cosine > 0.0 && dot(to, face_normal) > 0.0 && listener_sees(element, hit->voxel, axis, n[axis])) {
+            const auto bin = static_cast<std::size_t>((travelled + distance) * bins_per_voxel);
+            const double metres = distance * voxel;
+            if (bin < bins) {
+              Bands e = energy;
+              air_loss(metres, e);
+              add(histogram[bin], e, o.scattering * cosine / (std::numbers::pi * metres * metres));
             }
+            earliest = std::min(earliest, travelled + distance);
           }
         }
         last_specular = !(u(rng) < o.scattering);
@@ -215,17 +263,63 @@ LateEnergy late_energy(const Room& room, const Point& source, const Point& liste
         origin[axis] = std::round(origin[axis]) + 1e-7 * n[axis];
       }
     }
-  }, parallel);
+    return earliest;
+  };
+
+  // Rounds of chunks; per bin the sum of the chunks' energies (the bands' mean) and of their
+  // squares, for the spread.
+  const std::uint64_t chunks = (o.rays + kRaysPerChunk - 1) / kRaysPerChunk;
   late.bands.assign(bins, Bands{});
-  for (const auto& h : partial)
-    for (std::size_t i = 0; i < bins; ++i) add(late.bands[i], h[i], 1.0);
-  for (std::size_t i = 0; i < bins; ++i) {
-    double sum = 0.0;
-    for (const double e : late.bands[i]) sum += e;
-    late.energy[i] = sum / static_cast<double>(late.bands[i].size());
+  const std::size_t windows = (bins + kErrorWindow - 1) / kErrorWindow;
+  std::vector<double> sum(windows, 0.0), squares(windows, 0.0);
+  std::vector<std::vector<Bands>> partial(kChunksPerRound);
+  std::vector<double> earliest(kChunksPerRound);
+  double first_path = max_distance;
+  std::uint64_t traced = 0, rounds = 0;
+  ParallelOptions parallel;
+  parallel.threads = o.threads;
+  parallel.name = "audio.late_energy";
+  while (traced < chunks) {
+    const std::uint64_t count = std::min(kChunksPerRound, chunks - traced);
+    parallel.chunks = static_cast<std::size_t>(count);
+    parallel_for(static_cast<std::size_t>(count), [&](const Chunk& c) {
+      partial[c.index].assign(bins, Bands{});
+      earliest[c.index] = trace_chunk(traced + c.index, partial[c.index]);
+    }, parallel);
+    for (std::uint64_t c = 0; c < count; ++c) {
+      first_path = std::min(first_path, earliest[c]);
+      const std::vector<Bands>& h = partial[c];
+      for (std::size_t w = 0; w < windows; ++w) {
+        double e = 0.0;
+        for (std::size_t i = w * kErrorWindow; i < std::min(bins, (w + 1) * kErrorWindow); ++i)
+          for (std::size_t b = 0; b < h[i].size(); ++b) {
+            late.bands[i][b] += h[i][b];
+            e += h[i][b];
+          }
+        sum[w] += e;
+        squares[w] += e * e;
+      }
+    }
+    traced += count;
+    ++rounds;
+    if (o.tail_error > 0.0 && rounds >= kMinRounds && traced < chunks &&
+        tail_relative_error(sum, squares, static_cast<double>(traced)) <= o.tail_error)
+      break;
   }
-  late.first_sample = static_cast<std::size_t>(std::ceil(*std::min_element(earliest.begin(), earliest.end()) * voxel /
-                                                          o.speed_of_sound * o.sample_rate));
+  const std::uint64_t rays = std::min(o.rays, traced * kRaysPerChunk);
+  late.rays = rays;
+  late.relative_error = tail_relative_error(sum, squares, static_cast<double>(traced));
+  const double ray_energy = 4.0 * std::numbers::pi / static_cast<double>(rays);
+  late.energy.assign(bins, 0.0);
+  for (std::size_t i = 0; i < bins; ++i) {
+    double total = 0.0;
+    for (double& e : late.bands[i]) {
+      e *= ray_energy;
+      total += e;
+    }
+    late.energy[i] = total / static_cast<double>(late.bands[i].size());
+  }
+  late.first_sample = static_cast<std::size_t>(std::ceil(first_path * voxel / o.speed_of_sound * o.sample_rate));
   // Trailing empty bins carry nothing.
   while (!late.energy.empty() && late.energy.back() == 0.0) {
     late.energy.pop_back();

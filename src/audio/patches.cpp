@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "vola/error.hpp"
+
 namespace vola::audio {
 
 namespace {
@@ -77,6 +79,11 @@ struct Raw {
   Point normal{};
 };
 
+// A surface voxel's entry: exposed faces (bits 0-5), its first element (bits 8-39), the
+// patch of that element (bits 40-63, kNoPatch when it does not fit).
+constexpr std::uint64_t kNoPatch = 0xFFFFFF;
+std::uint64_t first_of(std::uint64_t entry) noexcept { return (entry >> 8) & 0xFFFFFFFFull; }
+
 }  // namespace
 
 SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials, const std::vector<LeafBlock>& blocks) {
@@ -92,18 +99,40 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
     const std::uint64_t ka = voxel_key(a.voxel.x, a.voxel.y, a.voxel.z), kb = voxel_key(b.voxel.x, b.voxel.y, b.voxel.z);
     return ka != kb ? ka < kb : a.face < b.face;
   });
-  voxels_.reserve(raw.size());
+  // The surface voxels' blocks, then where each block's voxels start, then the voxels.
+  std::size_t block_count = 0;
+  {
+    std::vector<std::uint64_t> keys;
+    for (const Raw& r : raw) keys.push_back(voxel_key(r.voxel.x >> 2, r.voxel.y >> 2, r.voxel.z >> 2));
+    std::sort(keys.begin(), keys.end());
+    block_count = static_cast<std::size_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
+  }
+  std::size_t capacity = 16;
+  while (capacity < 2 * block_count) capacity *= 2;
+  blocks_.assign(capacity, Block{});
+  slot_mask_ = capacity - 1;
+  slot_shift_ = 64 - std::countr_zero(capacity);
+  auto bit_of = [](const Voxel& v) { return std::uint64_t{1} << ((v.x & 3) + 4 * (v.y & 3) + 16 * (v.z & 3)); };
+  for (const Raw& r : raw) insert(voxel_key(r.voxel.x >> 2, r.voxel.y >> 2, r.voxel.z >> 2)).voxels |= bit_of(r.voxel);
+  std::uint64_t surface_voxels = 0;
+  for (Block& b : blocks_) {
+    if (b.key == kNoKey) continue;
+    b.offset = surface_voxels;
+    surface_voxels += static_cast<std::uint64_t>(std::popcount(b.voxels));
+  }
+  voxel_faces_.assign(surface_voxels, 0);
+  if (raw.size() >= (std::uint64_t{1} << 32)) throw InvalidArgument("the scene has 2^32 exposed voxel faces or more");
   for (std::size_t i = 0; i < raw.size(); ++i) {
-    auto& entry = voxels_[voxel_key(raw[i].voxel.x, raw[i].voxel.y, raw[i].voxel.z)];
-    if (entry.mask == 0) entry.first = static_cast<std::uint32_t>(i);
-    entry.mask = static_cast<std::uint8_t>(entry.mask | (1u << raw[i].face));
+    std::uint64_t& entry = const_cast<std::uint64_t&>(*find(raw[i].voxel.x, raw[i].voxel.y, raw[i].voxel.z));
+    if ((entry & 0xFF) == 0) entry = static_cast<std::uint64_t>(i) << 8;
+    entry |= std::uint64_t{1} << raw[i].face;
   }
   const auto side = static_cast<std::int64_t>(tree.side());
   auto element = [&](std::int64_t x, std::int64_t y, std::int64_t z, int face) -> std::int64_t {
     if (!in_grid(x, y, z, side)) return -1;
-    const auto it = voxels_.find(voxel_key(x, y, z));
-    if (it == voxels_.end() || !(it->second.mask & (1u << face))) return -1;
-    return it->second.first + std::popcount(static_cast<unsigned>(it->second.mask & ((1u << face) - 1)));
+    const std::uint64_t* it = find(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y), static_cast<std::uint64_t>(z));
+    if (!it || !(*it & (1u << face))) return -1;
+    return static_cast<std::int64_t>(first_of(*it) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
   };
 
   // Normals: a plane through the same-facing faces around each face.
@@ -187,10 +216,10 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
           for (int dx = -1; dx <= 1; ++dx) {
             const std::int64_t x = std::int64_t{e.voxel.x} + dx, y = std::int64_t{e.voxel.y} + dy, z = std::int64_t{e.voxel.z} + dz;
             if (!in_grid(x, y, z, side)) continue;
-            const auto it = voxels_.find(voxel_key(x, y, z));
-            if (it == voxels_.end()) continue;
-            std::uint32_t j = it->second.first;
-            for (unsigned mask = it->second.mask; mask; mask &= mask - 1, ++j) {
+            const std::uint64_t* it = find(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y), static_cast<std::uint64_t>(z));
+            if (!it) continue;
+            auto j = static_cast<std::uint32_t>(first_of(*it));
+            for (unsigned mask = static_cast<unsigned>(*it & 0xFF); mask; mask &= mask - 1, ++j) {
               if (patch_of_element[j] != kUnset) continue;
               const Raw& o = raw[j];
               if (o.slot != s.slot) continue;
@@ -214,20 +243,67 @@ SurfacePatches::SurfacePatches(const Tree& tree, const VoxelMaterials& materials
   }
   elements_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) elements_[i] = Element{patch_of_element[i], raw[i].face};
+  // The first element's patch in the voxel's entry: a wall voxel has one exposed face, so
+  // the tracer finds its patch without a further load.
+  for (std::uint64_t& entry : voxel_faces_) {
+    const std::uint64_t patch = elements_[first_of(entry)].patch;
+    entry |= (patch < kNoPatch ? patch : kNoPatch) << 40;
+  }
+}
+
+const std::uint64_t* SurfacePatches::find(std::uint64_t x, std::uint64_t y, std::uint64_t z) const noexcept {
+  if (blocks_.empty()) return nullptr;
+  const std::uint64_t key = voxel_key(static_cast<std::int64_t>(x >> 2), static_cast<std::int64_t>(y >> 2), static_cast<std::int64_t>(z >> 2));
+  const std::uint64_t bit = std::uint64_t{1} << ((x & 3) + 4 * (y & 3) + 16 * (z & 3));
+  for (std::uint64_t i = (key * 0x9E3779B97F4A7C15ull) >> slot_shift_;; i = (i + 1) & slot_mask_) {
+    const Block& b = blocks_[i];
+    if (b.key == key) {
+      if (!(b.voxels & bit)) return nullptr;
+      return &voxel_faces_[b.offset + static_cast<std::uint64_t>(std::popcount(b.voxels & (bit - 1)))];
+    }
+    if (b.key == kNoKey) return nullptr;
+  }
+}
+
+SurfacePatches::Block& SurfacePatches::insert(std::uint64_t key) {
+  for (std::uint64_t i = (key * 0x9E3779B97F4A7C15ull) >> slot_shift_;; i = (i + 1) & slot_mask_) {
+    Block& b = blocks_[i];
+    if (b.key == key) return b;
+    if (b.key == kNoKey) {
+      b.key = key;
+      return b;
+    }
+  }
+}
+
+std::int64_t SurfacePatches::element_of(const Voxel& v, int face) const noexcept {
+  const std::uint64_t* it = find(v.x, v.y, v.z);
+  if (!it || !(*it & (1u << face))) return -1;
+  return static_cast<std::int64_t>(first_of(*it) + std::popcount(static_cast<unsigned>(*it & ((1u << face) - 1))));
+}
+
+std::int64_t SurfacePatches::element_of(const Voxel& v, int face, std::uint32_t& patch) const noexcept {
+  const std::uint64_t* it = find(v.x, v.y, v.z);
+  if (!it || !(*it & (1u << face))) return -1;
+  const auto below = static_cast<unsigned>(*it & ((1u << face) - 1));
+  const std::uint64_t e = first_of(*it) + static_cast<std::uint64_t>(std::popcount(below));
+  const std::uint64_t stored = *it >> 40;
+  patch = below == 0 && stored != kNoPatch ? static_cast<std::uint32_t>(stored) : elements_[e].patch;
+  return static_cast<std::int64_t>(e);
 }
 
 std::int64_t SurfacePatches::patch_of(const Voxel& v, int face) const noexcept {
-  const auto it = voxels_.find(voxel_key(v.x, v.y, v.z));
-  if (it == voxels_.end() || !(it->second.mask & (1u << face))) return -1;
-  return elements_[it->second.first + std::popcount(static_cast<unsigned>(it->second.mask & ((1u << face) - 1)))].patch;
+  const std::int64_t e = element_of(v, face);
+  return e < 0 ? std::int64_t{-1} : std::int64_t{elements_[static_cast<std::size_t>(e)].patch};
 }
 
 bool SurfacePatches::voxel_in_patch(const Voxel& v, std::uint32_t p) const noexcept {
-  const auto it = voxels_.find(voxel_key(v.x, v.y, v.z));
-  if (it == voxels_.end()) return false;
-  const std::uint32_t n = static_cast<std::uint32_t>(std::popcount(static_cast<unsigned>(it->second.mask)));
+  const std::uint64_t* it = find(v.x, v.y, v.z);
+  if (!it) return false;
+  const auto n = static_cast<std::uint32_t>(std::popcount(static_cast<unsigned>(*it & 0xFF)));
+  const std::uint64_t first = first_of(*it);
   for (std::uint32_t i = 0; i < n; ++i)
-    if (elements_[it->second.first + i].patch == p) return true;
+    if (elements_[first + i].patch == p) return true;
   return false;
 }
 

@@ -26,6 +26,7 @@ void RoomOptions::check() const {
   if (!(order >= 0 && order <= 64)) fail("the image-source order must be in [0, 64]", order);
   if (!(scattering >= 0.0 && scattering <= 1.0)) fail("the scattering coefficient must be in [0, 1]", scattering);
   if (!(rays <= (std::uint64_t{1} << 32))) fail("the ray count must be at most 2^32", static_cast<double>(rays));
+  if (!(tail_error >= 0.0 && tail_error < 1.0)) fail("the tail's relative error must be in [0, 1)", tail_error);
   if (!(max_length > 0.0 && max_length <= 60.0)) fail("the response length must be in (0, 60] s", max_length);
   if (!(decay_floor_db < 0.0 && decay_floor_db >= -200.0)) fail("the decay floor must be in [-200, 0) dB", decay_floor_db);
   if (!(receiver_radius > 0.0 && std::isfinite(receiver_radius))) fail("the receiver radius must be > 0", receiver_radius);
@@ -72,7 +73,9 @@ RoomResponse room_response(const Room& room, const Point& source, const Point& l
   r.direct_sample = static_cast<std::uint32_t>(direct_sample);
   if (o.occlusion) {
     const Point s = raycast::world_to_grid(scene.frame(), source), l = raycast::world_to_grid(scene.frame(), listener);
-    r.direct_blocked = scene.caster().cast(raycast::Ray{s, {l[0] - s[0], l[1] - s[1], l[2] - s[2]}, 1.0}).has_value();
+    // Up to just short of the listener: one standing on a face is not hidden by its voxel.
+    r.direct_blocked =
+        scene.caster().cast(raycast::Ray{s, {l[0] - s[0], l[1] - s[1], l[2] - s[2]}, 1.0 - 1e-9}).has_value();
   }
   r.direct_amplitude = r.direct_blocked ? 0.0 : 1.0 / r.direct_distance;
   const Bands air = air_attenuation(o);

@@ -23,7 +23,6 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "vola/audio/materials.hpp"
@@ -56,6 +55,14 @@ class SurfacePatches {
   std::int64_t patch_of(const Voxel& v, int face) const noexcept;
   // Whether any exposed face of v belongs to patch p.
   bool voxel_in_patch(const Voxel& v, std::uint32_t p) const noexcept;
+  // The exposed faces ("elements"), numbered 0 .. element_count() - 1: the index of face
+  // `face` of voxel v, or -1 when that face is not exposed.
+  std::int64_t element_of(const Voxel& v, int face) const noexcept;
+  // The same, and the element's patch into `patch` (when not -1): one lookup.
+  std::int64_t element_of(const Voxel& v, int face, std::uint32_t& patch) const noexcept;
+  std::size_t element_count() const noexcept { return elements_.size(); }
+  // The patch holding element e.
+  std::uint32_t patch_of_element(std::size_t e) const noexcept { return elements_[e].patch; }
 
  private:
   struct Element {
@@ -64,11 +71,25 @@ class SurfacePatches {
   };
   // Per surface voxel (x, y, z packed in 20 bits each) its exposed faces (Face bits) and
   // its first element; a voxel's elements are consecutive, in face order.
-  struct VoxelFaces {
-    std::uint32_t first = 0;
-    std::uint8_t mask = 0;
+  // Per surface voxel its exposed faces (Face bits, low 8 bits) and its first element
+  // (above them); a voxel's elements are consecutive, in face order. Found through its
+  // 4x4x4 block in an open-addressing table (linear probing, a power-of-two size at least
+  // twice the blocks) whose entry has a bit per surface voxel and where the block's voxels
+  // start in voxel_faces_: both small enough to stay in cache, where a lookup per voxel in
+  // a node-based map misses it several times (a lookup per reflection of the traced tail).
+  static constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+  struct Block {
+    std::uint64_t key = kNoKey;
+    std::uint64_t voxels = 0;
+    std::uint64_t offset = 0;
   };
-  std::unordered_map<std::uint64_t, VoxelFaces> voxels_;
+  // The packed faces of surface voxel (x, y, z), or nullptr.
+  const std::uint64_t* find(std::uint64_t x, std::uint64_t y, std::uint64_t z) const noexcept;
+  Block& insert(std::uint64_t key);
+  std::vector<Block> blocks_;
+  std::uint64_t slot_mask_ = 0;
+  int slot_shift_ = 64;
+  std::vector<std::uint64_t> voxel_faces_;
   std::vector<Element> elements_;
   std::vector<SurfacePatch> patches_;
 };

@@ -19,13 +19,17 @@
 //            rays leave the source uniformly, lose R^2 of their energy at each hit, go
 //            on specularly (probability 1 - s) or Lambert-diffusely (s) from the patch's
 //            normal. At each hit the diffuse part goes straight to the listener when it
-//            sees it ("diffuse rain": energy s cos(theta) / (pi D^2)); a ray whose last
+//            sees it ("diffuse rain": energy s cos(theta) / (pi D^2); whether the listener
+//            sees the face hit is cast once per face, from its centre); a ray whose last
 //            reflection was specular deposits energy * chord / volume when it crosses a
 //            receiver sphere around the listener (its radius shrunk to clear every
 //            occupied voxel). Paths the image sources already hold (purely specular, at
 //            most the order searched, and the direct path) deposit nothing, so no energy
 //            is counted twice. The energy per millisecond becomes noise of that energy
-//            (random signs), from the earliest deposit on.
+//            (random signs), from the earliest deposit on. Rays are traced in rounds
+//            until the histogram is precise enough (RoomOptions::tail_error), at most
+//            `rays`. Legs that end at the listener stop just short of it: a listener
+//            standing on a face (a table top) is not hidden by the voxel under it.
 // Normalisation: the source's power is that of the direct sound's 1 / d, so the tail's
 // energy is on the same scale as the image sources' squared amplitudes.
 // Frequency: every amplitude and energy is kept per octave band (per-band materials, air
@@ -54,7 +58,13 @@ struct RoomOptions {
   int order = 3;                   // image-source reflections at most
   bool occlusion = true;           // ray casts on every leg, the direct path included
   double scattering = 0.3;         // energy fraction reflected diffusely, [0, 1]
-  std::uint64_t rays = 20000;      // for the late tail; 0 = no tail
+  std::uint64_t rays = 20000;      // for the late tail, at most; 0 = no tail
+  double tail_error = 0.1;         // rays are traced in rounds of 1024 until the relative
+                                   // standard error of the tail's energy per 10 ms window,
+                                   // root mean square over the windows down to 60 dB below
+                                   // the loudest, is at most this (from the spread between
+                                   // chunks of 128 rays; 2048 rays at least); 0 = all `rays`.
+                                   // 0.1 is about 0.4 dB on a window's level
   double max_length = 10.0;        // s: the tail is traced at most this long
   double decay_floor_db = -70.0;   // a ray stops once its energy fell this far
   double receiver_radius = 0.5;    // m, shrunk to the listener's clearance
@@ -124,6 +134,9 @@ struct LateEnergy {
   std::size_t bin_samples = 1;     // samples per bin (1 ms)
   std::size_t first_sample = 0;    // the earliest deposit: the tail's noise starts there
   double receiver_radius = 0.0;    // m, as used
+  std::uint64_t rays = 0;          // rays traced
+  double relative_error = 0.0;     // the 10 ms windows' relative standard error reached
+                                   // (root mean square, as tail_error)
 };
 
 // The ray-traced energy histogram, without the paths the image sources of `order` hold.
