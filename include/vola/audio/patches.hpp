@@ -61,8 +61,6 @@ class SurfacePatches {
   // The same, and the element's patch into `patch` (when not -1): one lookup.
   std::int64_t element_of(const Voxel& v, int face, std::uint32_t& patch) const noexcept;
   std::size_t element_count() const noexcept { return elements_.size(); }
-  // The patch holding element e.
-  std::uint32_t patch_of_element(std::size_t e) const noexcept { return elements_[e].patch; }
 
  private:
   struct Element {
