@@ -348,6 +348,42 @@ Op op_of(Slot s, Reduction r) noexcept {
   }
 }
 
+// One point's value v folded into its slot p of voxel `rank`'s row; `others` and
+// `carries` are the attribute's majority counts and sum carries.
+template <class Others, class Carries>
+inline void fold(Op op, std::byte* p, double v, bool first, std::uint64_t rank, Others& others, Carries& carries) {
+  switch (op) {
+    case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
+    case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
+    case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
+    case Op::f64_last: put(p, v); break;
+    case Op::f64_majority: {
+      if (first) put(p, v);
+      else if (const double f = load<double>(p); !detail::same_value(f, v)) ++others[PairKey{rank, bits_of(v)}];
+      break;
+    }
+    case Op::u32_sum: {
+      const std::uint32_t x = static_cast<std::uint32_t>(v);
+      if (first) {
+        put(p, x);
+      } else {
+        const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
+        put(p, sum);
+        if (sum < old) ++carries[rank];
+      }
+      break;
+    }
+    case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
+    case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
+    case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
+    case Op::u8_majority: update_majority<std::uint8_t>(p, v, first, others, rank); break;
+    case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
+    case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
+    case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
+    case Op::u16_majority: update_majority<std::uint16_t>(p, v, first, others, rank); break;
+  }
+}
+
 }  // namespace
 
 void VoxelReducer::add(std::span<const std::uint64_t> ranks, std::span<const std::span<const double>> values) {
@@ -415,37 +451,7 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
     for (std::size_t a = 0; a < na; ++a) {
       const Column& c = cols[a];
       std::byte* p = row + c.offset;
-      const double v = c.in[i];
-      switch (c.op) {
-        case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
-        case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
-        case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
-        case Op::f64_last: put(p, v); break;
-        case Op::f64_majority: {
-          if (first) put(p, v);
-          else if (const double f = load<double>(p); !detail::same_value(f, v)) ++s.others[a][PairKey{rank, bits_of(v)}];
-          break;
-        }
-        case Op::u32_sum: {
-          const std::uint32_t x = static_cast<std::uint32_t>(v);
-          if (first) {
-            put(p, x);
-          } else {
-            const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
-            put(p, sum);
-            if (sum < old) ++s.carries[a][rank];
-          }
-          break;
-        }
-        case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
-        case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
-        case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
-        case Op::u8_majority: update_majority<std::uint8_t>(p, v, first, s.others[a], rank); break;
-        case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
-        case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
-        case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
-        case Op::u16_majority: update_majority<std::uint16_t>(p, v, first, s.others[a], rank); break;
-      }
+      fold(c.op, p, c.in[i], first, rank, s.others[a], s.carries[a]);
     }
     put(row, count + 1);
   }
@@ -608,37 +614,7 @@ void VoxelReducer::add_fields(std::span<const std::uint64_t> ranks, std::span<co
         }
         continue;
       }
-      const double v = field_value(c.field, c.data + point * c.stride);
-      switch (c.op) {
-        case Op::f64_mean: update_f64<Reduction::mean>(p, v, first); break;
-        case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
-        case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
-        case Op::f64_last: put(p, v); break;
-        case Op::f64_majority: {
-          if (first) put(p, v);
-          else if (const double f = load<double>(p); !detail::same_value(f, v)) ++s.others[a][PairKey{rank, bits_of(v)}];
-          break;
-        }
-        case Op::u32_sum: {
-          const std::uint32_t x = static_cast<std::uint32_t>(v);
-          if (first) {
-            put(p, x);
-          } else {
-            const std::uint32_t old = load<std::uint32_t>(p), sum = old + x;
-            put(p, sum);
-            if (sum < old) ++s.carries[a][rank];
-          }
-          break;
-        }
-        case Op::u8_max: update_small<std::uint8_t, Reduction::max>(p, v, first); break;
-        case Op::u8_min: update_small<std::uint8_t, Reduction::min>(p, v, first); break;
-        case Op::u8_last: update_small<std::uint8_t, Reduction::last>(p, v, first); break;
-        case Op::u8_majority: update_majority<std::uint8_t>(p, v, first, s.others[a], rank); break;
-        case Op::u16_max: update_small<std::uint16_t, Reduction::max>(p, v, first); break;
-        case Op::u16_min: update_small<std::uint16_t, Reduction::min>(p, v, first); break;
-        case Op::u16_last: update_small<std::uint16_t, Reduction::last>(p, v, first); break;
-        case Op::u16_majority: update_majority<std::uint16_t>(p, v, first, s.others[a], rank); break;
-      }
+      fold(c.op, p, field_value(c.field, c.data + point * c.stride), first, rank, s.others[a], s.carries[a]);
     }
     put(row, count + 1);
   }

@@ -46,6 +46,13 @@ const std::vector<double>* height_field(const LasHeader& hd, const LasChunk& chu
   return nullptr;
 }
 
+// The same field's description, or nullptr.
+const LasExtraField* height_extra_field(const LasHeader& hd) {
+  for (const auto& f : hd.extra_fields)
+    if (f.name == "height") return &f;
+  return nullptr;
+}
+
 }  // namespace
 
 void las_attribute_values(const LasHeader& hd, const LasChunk& chunk, std::vector<std::vector<double>>& values) {
@@ -92,12 +99,7 @@ void las_record_attribute_values(const LasHeader& hd, const std::uint8_t* record
   column([](const std::uint8_t* r) { return static_cast<double>(load_le<std::uint16_t>(r + 12)); });
   if (extended) column([](const std::uint8_t* r) { return static_cast<double>(r[16]); });
   else column([](const std::uint8_t* r) { return static_cast<double>(r[15] & 31u); });
-  const LasExtraField* height = nullptr;
-  for (const auto& f : hd.extra_fields)
-    if (f.name == "height") {
-      height = &f;
-      break;
-    }
+  const LasExtraField* height = height_extra_field(hd);
   if (height) {
     column([&](const std::uint8_t* r) {
       return las::extra_value(r + height->offset, height->data_type) * height->scale + height->add;
@@ -131,12 +133,7 @@ bool las_record_fields(const LasHeader& hd, std::vector<RecordField>& fields) {
     fields.push_back({.kind = kinds[f.data_type - 1], .offset = f.offset, .scale = f.scale, .add = f.add});
     return true;
   };
-  const LasExtraField* height = nullptr;
-  for (const auto& f : hd.extra_fields)
-    if (f.name == "height") {
-      height = &f;
-      break;
-    }
+  const LasExtraField* height = height_extra_field(hd);
   if (height) {
     if (!extra(*height)) return false;
   } else {
