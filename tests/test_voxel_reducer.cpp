@@ -251,7 +251,9 @@ TEST(VoxelReducer, FinishInRangesEqualsFinish) {
     const std::uint64_t last = std::min<std::uint64_t>(tree.voxel_count(), first + rng() % 700);
     for (std::size_t a = 0; a < specs.size(); ++a) to[a] = got[a].data() + first * vola::size_of(specs[a].type);
     ranged.finish_range(first, last, to);
-    if (first > 0) EXPECT_THROW(ranged.finish_range(first - 1, last, to), vola::InvalidArgument);
+    if (first > 0) {
+      EXPECT_THROW(ranged.finish_range(first - 1, last, to), vola::InvalidArgument);
+    }
     first = last;
   }
   EXPECT_THROW(ranged.add(std::span<const std::uint64_t>(ranks.data(), 1),

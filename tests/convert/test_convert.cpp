@@ -186,7 +186,7 @@ TEST(DescribeCrs, NamesWhatProjFindsAndInventsNoCode) {
 TEST(DescribeCrs, OwnIdOnlySkipsTheSearchAndKeepsKindAndUnits) {
   VOLA_REQUIRE_DATA(data);
   const auto own = vola::geo::EpsgLookup::own_id_only;
-  for (const std::string definition :
+  for (const std::string& definition :
        {stated_crs_of(data / "las" / "pdal_autzen_trim.las").wkt, stated_crs_of(data / "las" / "pdal_autzen-bmx-2010.las").wkt,
         std::string("EPSG:32610"), std::string("EPSG:4326")}) {
     const auto searched = vola::geo::describe_crs(definition), quick = vola::geo::describe_crs(definition, own);

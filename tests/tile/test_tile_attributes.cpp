@@ -54,7 +54,7 @@ std::map<std::string, std::vector<std::uint8_t>> tree_bytes(const fs::path& dir)
 
 TEST(TileAttributes, EveryTileEqualsBuildOverItsPointsInFileOrder) {
   VOLA_REQUIRE_DATA(data);
-  for (const fs::path input : {data / "las" / "pdal_autzen_trim.las", data / "laz" / "pdal_autzen_trim.laz",
+  for (const fs::path& input : {data / "las" / "pdal_autzen_trim.las", data / "laz" / "pdal_autzen_trim.laz",
                                data / "las" / "pdal_extrabytes.las"}) {
     SCOPED_TRACE(input.string());
     vola_test::TempDir dir;
