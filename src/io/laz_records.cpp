@@ -28,7 +28,7 @@ void check_chunk_size(const std::string& path, const LasHeader& hd, std::size_t 
 
 }  // namespace
 
-void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records) const {
+void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records, bool coordinates_only) const {
   const LasHeader& hd = header_;
   if (chunk >= hd.laz_chunks.size()) throw InvalidArgument(path_ + ": no LAZ chunk " + std::to_string(chunk));
   check_chunk_size(path_, hd, chunk);
@@ -41,7 +41,7 @@ void LasReader::decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& r
   }
   records.resize(static_cast<std::size_t>(c.point_count) * hd.record_length);
   laz::decode_chunk(*hd.laszip, compressed, c.point_count, records.data(), hd.record_length, chunk, c.byte_offset,
-                    path_, coordinates_only_);
+                    path_, coordinates_only);
 }
 
 void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optional<int> max_level) {
@@ -86,7 +86,9 @@ void LasReader::decode_laz_batch(LazBatch& batch, std::size_t begin) const {
   options.name = "las.decode_laz";
   parallel_for(
       batch.count,
-      [&](const Chunk& chunk) { decode_laz_chunk(chunk_order_[begin + chunk.index], batch.records[chunk.index]); },
+      [&](const Chunk& chunk) {
+        decode_laz_chunk(chunk_order_[begin + chunk.index], batch.records[chunk.index], coordinates_only_);
+      },
       options);
 }
 

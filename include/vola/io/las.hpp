@@ -130,7 +130,8 @@ class LasReader {
   // LAZ: chunk `chunk` of header().laz_chunks decoded into `records` (resized to its
   // point count x record_length). Safe to call from many threads at once on a file
   // opened by path; throws FormatError naming the chunk and its byte offset.
-  void decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records) const;
+  // With coordinates_only, only X, Y and Z are decoded exactly (see set_coordinates_only).
+  void decode_laz_chunk(std::size_t chunk, std::vector<std::uint8_t>& records, bool coordinates_only = false) const;
 
  private:
   std::string path_;
