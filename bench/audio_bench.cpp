@@ -164,9 +164,9 @@ int main(int argc, char** argv) {
   std::vector<double> wet;
   // FFTW plans its transform size once per process (FFTW_MEASURE), outside the timed step;
   // the step is then the filter's spectrum and the overlap-add of the source.
-  const double planning = median_ms(1, [&] { Convolver(ir, FftPlanning::measure); });
-  const double apply1 = median_ms(runs, [&] { wet = Convolver(ir, FftPlanning::measure).apply(dry, 1); });
-  const double applyn = median_ms(runs, [&] { wet = Convolver(ir, FftPlanning::measure).apply(dry, cores); });
+  const double planning = median_ms(1, [&] { Convolver(ir, FftPlanning::measure, dry.size()); });
+  const double apply1 = median_ms(runs, [&] { wet = Convolver(ir, FftPlanning::measure, dry.size()).apply(dry, 1); });
+  const double applyn = median_ms(runs, [&] { wet = Convolver(ir, FftPlanning::measure, dry.size()).apply(dry, cores); });
   std::vector<double> slow;
   const double apply_naive = median_ms(std::min(runs, 3), [&] { slow = naive_convolution(dry, ir); });
   double worst = 0.0;
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
 
   std::printf("%llu reflecting voxels in %zu bins; response %zu samples (%.1f ms); FFT size %zu; max |fft - direct| %.2g\n\n",
               static_cast<unsigned long long>(t.reflectors), t.bins.size(), ir.size(), static_cast<double>(ir.size()) / 48.0,
-              Convolver(ir).fft_size(), worst);
+              Convolver(ir, FftPlanning::estimate, dry.size()).fft_size(), worst);
   std::printf("%-22s %12s %12s %12s %14s %12s %12s\n", "step", "paper (ms)", "1 thread", "threads", "naive (ms)",
               "vs paper", "vs naive");
   auto row = [&](const char* name, double paper, double a, double b, double naive_ms) {
@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
   std::printf("\n(vs naive: the naive single-threaded time over ours on one thread; create filter has no naive variant)\n");
   std::printf("once, not in the steps: scene preparation (surface faces) %.1f ms, first create filter (with the level table) "
               "%.3f ms, FFTW_MEASURE planning of size %zu %.1f ms\n",
-              prepare, first_filter, Convolver(ir).fft_size(), planning);
+              prepare, first_filter, Convolver(ir, FftPlanning::estimate, dry.size()).fft_size(), planning);
 
   // The physical model (room_response.hpp) on the same room and positions: the equivalent
   // of "threshold environment" is the image-source search plus the traced tail, of "create
@@ -224,23 +224,37 @@ int main(int argc, char** argv) {
   RoomResponse response;
   const double whole1 = median_ms(runs, [&] { response = room_response(physical, source, listener, room_one); });
   const double wholen = median_ms(runs, [&] { response = room_response(physical, source, listener, room_all); });
-  const double long_planning = median_ms(1, [&] { Convolver(response.ir, FftPlanning::measure); });
-  const double long1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, 1); });
-  const double longn = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, cores); });
+  // The response's spectrum, at the transform size chosen for the 1 s source, belongs to
+  // making the filter (the paper's "create filter"); applying it is the overlap-add.
+  const double long_planning = median_ms(1, [&] { Convolver(response.ir, FftPlanning::measure, dry.size()); });
+  const double spectrum = median_ms(runs, [&] { Convolver(response.ir, FftPlanning::measure, dry.size()); });
+  const Convolver sized(response.ir, FftPlanning::measure, dry.size());
+  // Into one output buffer reused from call to call, as a program filtering sound after
+  // sound would; the row after it makes a new output vector and the spectrum every time.
+  std::vector<double> reused(dry.size() + response.ir.size() - 1);
+  const double long1 = median_ms(runs, [&] { sized.apply_into(dry, reused, 1); });
+  const double longn = median_ms(runs, [&] { sized.apply_into(dry, reused, cores); });
+  const double both1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure, dry.size()).apply(dry, 1); });
+  const double bothn = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure, dry.size()).apply(dry, cores); });
+  // One transform four times the response (the size for long signals).
+  const double longest1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, 1); });
   // The same response in partitions of 8192 samples (what vola sonify uses past 32,768 taps).
   const double part1 = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, 1); });
   const double partn = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, cores); });
+  double apart = 0.0;
+  for (std::size_t i = 0; i < wet.size(); ++i) apart = std::max(apart, std::abs(wet[i] - reused[i]));
   // A 10 s response (a large hall's tail): one transform of 2^21 points against partitions.
   std::vector<double> hall(480000);
   for (std::size_t i = 0; i < hall.size(); ++i) hall[i] = noise(rng) * std::exp(-6.9 * static_cast<double>(i) / 48000.0 / 2.0);
   const double hall_one = median_ms(std::min(runs, 3), [&] { wet = Convolver(hall).apply(dry, 1); });
   const double hall_part = median_ms(std::min(runs, 3), [&] { wet = PartitionedConvolver(hall, 8192).apply(dry, 1); });
   std::printf("\nphysical model: %zu patches (found once: %.1f ms); order %d searched, %llu images tried, %zu valid; "
-              "tail %llu rays (relative error %.3f, at most %.2f), scattering %.2f, receiver %.2f m; response %zu samples (%.1f ms); FFT size %zu (planning %.0f ms)\n\n",
+              "tail %llu rays (relative error %.3f, at most %.2f), scattering %.2f, receiver %.2f m; response %zu samples (%.1f ms); "
+              "FFT size %zu for the 1 s source (planning %.0f ms); max |one transform - partitioned| %.2g\n\n",
               physical.patches().patches().size(), patches_ms, early.order,
               static_cast<unsigned long long>(early.candidates), early.images.size(),
               static_cast<unsigned long long>(default_late.rays), default_late.relative_error, room_one.tail_error, room_one.scattering, late.receiver_radius, response.ir.size(),
-              static_cast<double>(response.ir.size()) / 48.0, Convolver(response.ir).fft_size(), long_planning);
+              static_cast<double>(response.ir.size()) / 48.0, sized.fft_size(), long_planning, apart);
   std::printf("%-34s %12s %12s %12s %12s\n", "physical step", "paper (ms)", "1 thread", "threads", "vs paper");
   auto physical_row = [&](const char* name, double paper, double a, double b) {
     std::printf("%-34s %12.3f %12.3f %9.3f (%u) %11.1fx\n", name, paper, a, b, cores, paper / std::min(a, b));
@@ -252,7 +266,10 @@ int main(int argc, char** argv) {
   physical_row("late tail, 2000 rays (no bound)", 820.0, few1, fewn);
   // The whole response: both searches and the assembly (threshold and create filter).
   physical_row("whole response", 820.0 + 0.3, whole1, wholen);
-  physical_row("apply whole response", 4.05, long1, longn);
+  physical_row("  its spectrum (for the 1 s source)", 0.3, spectrum, spectrum);
+  physical_row("apply whole response (reused output)", 4.05, long1, longn);
+  physical_row("  the same, new output and spectrum", 4.05, both1, bothn);
+  physical_row("  one transform of 4x the response", 4.05, longest1, longest1);
   physical_row("  the same, partitioned (8192)", 4.05, part1, partn);
   std::printf("\na 10 s response (480,000 taps) on a 1 s source, FFTW_ESTIMATE plans as in vola sonify, 1 thread: one "
               "transform %.1f ms, partitioned (8192) %.1f ms\n", hall_one, hall_part);

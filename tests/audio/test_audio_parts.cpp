@@ -171,9 +171,30 @@ TEST(AudioConvolve, MatchesTheDirectSumForManyLengths) {
     for (std::size_t i = 0; i < fast.size(); ++i) worst = std::max(worst, std::abs(fast[i] - slow[i]));
     EXPECT_LT(worst, 1e-9 * std::sqrt(static_cast<double>(m))) << n << " x " << m;
     EXPECT_EQ(Convolver(h).apply(x, 3), fast) << "threads changed the result, " << n << " x " << m;
+    // Sized for this signal (blocks that may overlap several neighbours), into a buffer.
+    const Convolver sized(h, FftPlanning::estimate, x.size());
+    std::vector<double> into(fast.size(), 7.0);
+    sized.apply_into(x, into, 2);
+    double worst_sized = 0.0;
+    for (std::size_t i = 0; i < into.size(); ++i) worst_sized = std::max(worst_sized, std::abs(into[i] - slow[i]));
+    EXPECT_LT(worst_sized, 1e-9 * std::sqrt(static_cast<double>(m))) << n << " x " << m << ", size " << sized.fft_size();
+    EXPECT_EQ(sized.apply(x, 1), into) << "threads changed the result, " << n << " x " << m;
   }
   EXPECT_TRUE(Convolver(std::vector<double>{1.0}).apply(std::vector<double>{}, 1).empty());
+  std::vector<double> wrong(10);
+  EXPECT_THROW(Convolver(std::vector<double>{1.0, 2.0}).apply_into(std::vector<double>(10, 1.0), wrong), InvalidArgument);
   EXPECT_THROW(Convolver(std::vector<double>{}), InvalidArgument);
+}
+
+// The transform size: four times the filter for long signals; for a known signal the size
+// with the least FFT work (a 1 s, 48 kHz signal through a 0.86 s response: two blocks of
+// 65,536 points, not one of 262,144 that is mostly padding).
+TEST(AudioConvolve, TheTransformFitsTheSignal) {
+  EXPECT_EQ(Convolver::transform_size(41392, 0), std::size_t{262144});
+  EXPECT_EQ(Convolver::transform_size(41392, 48000), std::size_t{65536});
+  EXPECT_EQ(Convolver::transform_size(300, 48000), std::size_t{4096});
+  EXPECT_EQ(Convolver::transform_size(300, 0), std::size_t{4096});
+  EXPECT_EQ(Convolver::transform_size(5000, 1'000'000), std::size_t{32768});
 }
 
 // Partitioned overlap-save against the direct sum: filters shorter and longer than the

@@ -18,8 +18,11 @@ enum class FftPlanning : std::uint8_t { estimate, measure };
 // A filter ready to apply: its spectrum is made once, the FFT plans once per size.
 class Convolver {
  public:
-  // Throws InvalidArgument for an empty filter.
-  explicit Convolver(std::span<const double> filter, FftPlanning planning = FftPlanning::estimate);
+  // The transform size is chosen for signals of about `signal_size` samples (0: long
+  // signals, four times the filter); apply takes a signal of any length. Throws
+  // InvalidArgument for an empty filter.
+  explicit Convolver(std::span<const double> filter, FftPlanning planning = FftPlanning::estimate,
+                     std::size_t signal_size = 0);
   ~Convolver();
   Convolver(const Convolver&) = delete;
   Convolver& operator=(const Convolver&) = delete;
@@ -28,8 +31,15 @@ class Convolver {
   // empty signal) on `threads` threads (0 = vola::thread_count()). The result does not depend on the
   // thread count: blocks are added in a fixed order.
   std::vector<double> apply(std::span<const double> signal, unsigned threads = 1) const;
+  // The same into `out`, which must hold signal.size() + filter size - 1 samples (a
+  // program that filters block after block reuses one buffer). Throws InvalidArgument for
+  // another size.
+  void apply_into(std::span<const double> signal, std::span<double> out, unsigned threads = 1) const;
 
   std::size_t fft_size() const noexcept { return fft_size_; }
+  // The transform size the constructor picks for `taps` taps and signals of about
+  // `signal_size` samples.
+  static std::size_t transform_size(std::size_t taps, std::size_t signal_size);
 
  private:
   struct Plans;
