@@ -157,7 +157,6 @@ void Convolver::apply_into(std::span<const double> signal, std::span<double> out
     throw InvalidArgument("convolution: the output holds " + std::to_string(out.size()) + " samples, not the " +
                           std::to_string(signal.empty() ? 0 : signal.size() + filter_size_ - 1) + " of the result");
   if (signal.empty()) return;
-  std::fill(out.begin(), out.end(), 0.0);
   const std::size_t blocks = (signal.size() + block_ - 1) / block_;
   const std::size_t bins = fft_size_ / 2 + 1;
   ParallelOptions parallel;
@@ -173,6 +172,7 @@ void Convolver::apply_into(std::span<const double> signal, std::span<double> out
     std::vector<BlockScratch>& buffers;
     ~GiveBack() { plans.give_back(buffers); }
   } give_back{*plans_, scratch};
+  std::size_t written = 0;  // out[0, written) holds the blocks added so far
   for (std::size_t first = 0; first < blocks; first += round) {
     const std::size_t count = std::min(round, blocks - first);
     parallel_for(count, [&](const Chunk& chunk) {
@@ -196,10 +196,15 @@ void Convolver::apply_into(std::span<const double> signal, std::span<double> out
     }, parallel);
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t begin = (first + i) * block_;
-      const std::size_t valid = std::min(fft_size_, out.size() - begin);
-      const double* time = scratch[i].time.get();
+      const std::size_t end = begin + std::min(fft_size_, out.size() - begin);
+      const double* time = scratch[i].time.get();  // time[k] adds to out[begin + k]
+      // Blocks tile the output without gaps (a block reaches the next one's start):
+      // added where earlier blocks wrote, copied beyond, so the output is never zeroed.
+      const std::size_t overlap = std::min(end, written) - begin;
       double* o = out.data() + begin;
-      for (std::size_t j = 0; j < valid; ++j) o[j] += time[j];
+      for (std::size_t k = 0; k < overlap; ++k) o[k] += time[k];
+      std::copy(time + overlap, time + (end - begin), o + overlap);
+      written = std::max(written, end);
     }
   }
 }
