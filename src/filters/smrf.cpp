@@ -1,11 +1,14 @@
 #include "vola/filters/smrf.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 
 #include "elevation_grid.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
+#include "vola/filters/kd_tree.hpp"
 #include "vola/parallel.hpp"
 
 namespace vola::filters {
@@ -47,39 +50,99 @@ std::vector<bool> progressive_objects(const ElevationGrid& surface, int max_radi
   return object;
 }
 
-// Cells whose minimum no other cell nearby continues (fewer than kMinSupport cells
-// within `radius` cells lie within kPitDepth + kPitSlope x distance of it in height)
-// while some cell nearby lies that far above it: low outliers that come in scattered
-// clusters at random depths (multipath echoes under glass and water), which the
-// opening below tolerates once they span a few cells. Ground continues ground, even in
-// a forest where only some cells see it; a cell with no filled cell nearby (a thinned
-// survey) is not judged.
-std::vector<bool> unsupported_lows(const ElevationGrid& g, int radius) {
+// Heights of a cell's neighbours and their distances (metres) from it.
+struct Neighbour {
+  double distance;
+  float z;
+};
+
+// A cell at height z is an unsupported low when some neighbour lies more than
+// kPitDepth + kPitSlope x distance above it and fewer than kMinSupport lie within that
+// height of it: nothing continues it, as ground continues ground, even in a forest where
+// only some cells see it.
+bool unsupported(float z, std::span<const Neighbour> near) {
   constexpr int kMinSupport = 2;
-  const auto r = static_cast<std::ptrdiff_t>(radius);
+  int support = 0;
+  bool below_some = false;
+  for (const Neighbour& n : near) {
+    const double reach = kPitDepth + kPitSlope * n.distance;
+    if (std::abs(n.z - z) <= reach) ++support;
+    if (n.z - z > reach) below_some = true;
+  }
+  return below_some && support < kMinSupport;
+}
+
+// The filled cells within `radius` cells of cell (i, j), but itself.
+void neighbours_within(const ElevationGrid& g, std::ptrdiff_t i, std::ptrdiff_t j, std::ptrdiff_t r,
+                       std::vector<Neighbour>& near) {
   const auto cols = static_cast<std::ptrdiff_t>(g.cols), rows = static_cast<std::ptrdiff_t>(g.rows);
-  // Rows in parallel: each writes only its own cells (a vector<char>, not vector<bool>,
-  // whose bits share words).
+  near.clear();
+  for (std::ptrdiff_t jj = std::max<std::ptrdiff_t>(0, j - r); jj <= std::min(rows - 1, j + r); ++jj)
+    for (std::ptrdiff_t ii = std::max<std::ptrdiff_t>(0, i - r); ii <= std::min(cols - 1, i + r); ++ii) {
+      const float w = g.z[static_cast<std::size_t>(jj * cols + ii)];
+      if ((ii == i && jj == j) || std::isnan(w)) continue;
+      near.push_back({std::hypot(static_cast<double>(ii - i), static_cast<double>(jj - j)) * g.cell, w});
+    }
+}
+
+// The filled cells' centres (in cells) and their indices, for nearest-cell queries.
+struct FilledCells {
+  std::vector<double> centres;  // x y pairs
+  std::vector<std::size_t> index;
+  explicit FilledCells(const ElevationGrid& g) {
+    for (std::size_t k = 0; k < g.cells(); ++k)
+      if (!std::isnan(g.z[k])) {
+        centres.push_back(static_cast<double>(k % g.cols));
+        centres.push_back(static_cast<double>(k / g.cols));
+        index.push_back(k);
+      }
+  }
+};
+
+// Cells whose minimum no other cell nearby continues (unsupported(), over the cells
+// within `radius` cells) while some cell nearby lies far above it: low outliers that come
+// in scattered clusters at random depths (multipath echoes under glass and water), which
+// the opening below tolerates once they span a few cells. Where fewer than
+// kSparseNeighbours cells lie within the radius (a thinned survey, the edge of the data,
+// an echo out in a void), the neighbourhood grows to the kSparseNeighbours nearest filled
+// cells, whatever their distance: the reach grows with the distance, so sparse ground is
+// still continued by its neighbours, while an echo tens of metres below the data a few
+// metres away is not.
+std::vector<bool> unsupported_lows(const ElevationGrid& g, int radius) {
+  const auto r = static_cast<std::ptrdiff_t>(radius);
+  const auto cols = static_cast<std::ptrdiff_t>(g.cols);
+  // Rows in parallel: each writes only its own cells (vectors of char, not vector<bool>,
+  // whose bits share words). 2 marks a cell with too few neighbours in the radius.
+  constexpr char kSparse = 2;
   std::vector<char> low_rows(g.cells(), 0);
   parallel_for(g.rows, [&](std::size_t first, std::size_t last) {
+    std::vector<Neighbour> near;
     for (auto j = static_cast<std::ptrdiff_t>(first); j < static_cast<std::ptrdiff_t>(last); ++j)
       for (std::ptrdiff_t i = 0; i < cols; ++i) {
-        const float z = g.z[static_cast<std::size_t>(j * cols + i)];
-        if (std::isnan(z)) continue;
-        int support = 0;
-        bool below_some = false;
-        for (std::ptrdiff_t jj = std::max<std::ptrdiff_t>(0, j - r); jj <= std::min(rows - 1, j + r); ++jj)
-          for (std::ptrdiff_t ii = std::max<std::ptrdiff_t>(0, i - r); ii <= std::min(cols - 1, i + r); ++ii) {
-            const float w = g.z[static_cast<std::size_t>(jj * cols + ii)];
-            if ((ii == i && jj == j) || std::isnan(w)) continue;
-            const double reach =
-                kPitDepth + kPitSlope * std::hypot(static_cast<double>(ii - i), static_cast<double>(jj - j)) * g.cell;
-            if (std::abs(w - z) <= reach) ++support;
-            if (w - z > reach) below_some = true;
-          }
-        low_rows[static_cast<std::size_t>(j * cols + i)] = below_some && support < kMinSupport;
+        const auto k = static_cast<std::size_t>(j * cols + i);
+        if (std::isnan(g.z[k])) continue;
+        neighbours_within(g, i, j, r, near);
+        low_rows[k] = near.size() < kSparseNeighbours ? kSparse : unsupported(g.z[k], near);
       }
   });
+  std::vector<std::size_t> sparse;
+  for (std::size_t k = 0; k < g.cells(); ++k)
+    if (low_rows[k] == kSparse) sparse.push_back(k);
+  if (!sparse.empty()) {
+    const FilledCells filled(g);
+    const KdTree<2> tree(filled.centres, 2);
+    parallel_for(sparse.size(), [&](std::size_t first, std::size_t last) {
+      std::vector<Neighbour> near;
+      for (std::size_t s = first; s < last; ++s) {
+        const std::size_t k = sparse[s];
+        near.clear();
+        const std::array<double, 2> centre{static_cast<double>(k % g.cols), static_cast<double>(k / g.cols)};
+        for (const auto& [d2, id] : tree.nearest(centre, kSparseNeighbours + 1))
+          if (filled.index[id] != k) near.push_back({std::sqrt(d2) * g.cell, g.z[filled.index[id]]});
+        low_rows[k] = unsupported(g.z[k], near);
+      }
+    });
+  }
   std::vector<bool> low(low_rows.begin(), low_rows.end());
   return low;
 }

@@ -277,6 +277,42 @@ TEST(Smrf, ScatteredLowEchoesDoNotTakeTheGroundAroundThem) {
   EXPECT_EQ(wrong, 0u);
 }
 
+// A 40 x 40 m patch of ground at one point per m2 in an otherwise empty 100 x 100 m
+// survey, with single echoes 20 to 60 m below the ground scattered 4 to 12 m beyond its
+// edge, each more than 3 m from any other cell: no cell within 3 m judges them, so they must be
+// judged against their nearest cells, however far. Kept, the surface filled around them
+// sinks at the edge of the patch and the opening reads the ground along it as objects.
+TEST(Smrf, EchoesOutInAnEmptySurveyDoNotTakeTheEdgeOfTheGround) {
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> u(0.0, 40.0), out(4.0, 12.0), depth(20.0, 60.0);
+  std::normal_distribution<double> noise(0.0, 0.03);
+  std::vector<double> xyz;
+  std::vector<bool> is_ground;
+  const auto ground_z = [](double x, double y) { return 80.0 + 0.03 * x + 0.02 * y; };
+  for (int i = 0; i < 1600; ++i) {
+    const double x = u(rng), y = u(rng);
+    xyz.insert(xyz.end(), {x, y, ground_z(x, y) + noise(rng)});
+    is_ground.push_back(true);
+  }
+  for (int i = 0; i < 8; ++i) {  // beyond the east edge, 5 m apart along it
+    const double x = 40.0 + out(rng), y = 2.5 + 5.0 * i;
+    xyz.insert(xyz.end(), {x, y, ground_z(x, y) - depth(rng)});
+    is_ground.push_back(false);
+  }
+  xyz.insert(xyz.end(), {100.0, 100.0, ground_z(100.0, 100.0)});  // the survey's far corner
+  is_ground.push_back(true);
+  const std::vector<bool> all(is_ground.size(), true);
+  const std::vector<bool> ground = smrf_ground(xyz, all, SmrfOptions{}, Units{});
+  std::size_t truth = 0, found = 0, wrong = 0;
+  for (std::size_t i = 0; i < ground.size(); ++i) {
+    truth += is_ground[i];
+    found += is_ground[i] && ground[i];
+    wrong += !is_ground[i] && ground[i];
+  }
+  EXPECT_GE(static_cast<double>(found), 0.995 * static_cast<double>(truth)) << found << " of " << truth;
+  EXPECT_EQ(wrong, 0u);
+}
+
 // The same scene in US survey feet gives the same answer as in metres.
 TEST(Smrf, ParametersAreMetresWhateverTheUnits) {
   std::mt19937_64 rng(9);

@@ -40,11 +40,6 @@ constexpr KnownMiss kKnownMisses[] = {
      "a thinned survey: 6280 points over 5 x 5 km (one per ~4000 m2), so 1 m cells hold isolated points; the "
      "filled surface peaks at each point and hilltop ground reads as objects; the points it calls ground above "
      "the file's ground are mostly class 12 (overlap), measured against ground points ~60 m away"},
-    {"laspy_append-bug.laz", 93.0, 1.5,
-     "a dense drone-like survey (~200 points per m2 in one corner of a 1 km tile) with a layer of echoes tens of "
-     "metres below the ground (its class 65): the scattered ones are removed as unsupported lows (88.2% found "
-     "before), but coherent patches of them where no ground return lies beside them survive, and the opening then "
-     "reads the ground around them as objects; without the class-65 points below 90 m it finds 97.6% (0.9% above)"},
     {"pdal_sample_c.las", 99.0, 90.0,
      "a clip that is 87% one building (class 6, 78 x 70 units; no CRS, so metres): a roof wider than the 18 m "
      "window, with ground on one side only, is not removed by any opening"},

@@ -52,6 +52,9 @@ inline constexpr double kSupportRadius = 3.0;
 inline constexpr double kPitDepth = 1.0;
 inline constexpr double kPitSlope = 1.0;
 inline constexpr int kSupportPasses = 4;
+// Where fewer filled cells than this lie within kSupportRadius, a cell is judged against
+// this many nearest filled cells instead, however far (thinned surveys, data edges).
+inline constexpr std::size_t kSparseNeighbours = 8;
 
 // Ground flags for points xyz (x y z triples); candidate[i] false leaves point i out of
 // the surface and not ground. Throws InvalidArgument when the grid would pass 2^28 cells
