@@ -236,13 +236,29 @@ int main(int argc, char** argv) {
   const double longn = median_ms(runs, [&] { sized.apply_into(dry, reused, cores); });
   const double both1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure, dry.size()).apply(dry, 1); });
   const double bothn = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure, dry.size()).apply(dry, cores); });
+  // Single precision, as vola sonify applies a response (the same transform size).
+  const Convolver single(response.ir, FftPlanning::measure, dry.size(), SamplePrecision::float32);
+  const double single1 = median_ms(runs, [&] { single.apply_into(dry, reused, 1); });
+  const double singlen = median_ms(runs, [&] { single.apply_into(dry, reused, cores); });
+  const double single_both1 = median_ms(runs, [&] {
+    wet = Convolver(response.ir, FftPlanning::measure, dry.size(), SamplePrecision::float32).apply(dry, 1);
+  });
+  double single_apart = 0.0, scale = 0.0;
+  {
+    const std::vector<double> exact = sized.apply(dry, 1), rounded = single.apply(dry, 1);
+    for (std::size_t i = 0; i < exact.size(); ++i) {
+      single_apart = std::max(single_apart, std::abs(exact[i] - rounded[i]));
+      scale = std::max(scale, std::abs(exact[i]));
+    }
+  }
   // One transform four times the response (the size for long signals).
   const double longest1 = median_ms(runs, [&] { wet = Convolver(response.ir, FftPlanning::measure).apply(dry, 1); });
   // The same response in partitions of 8192 samples (what vola sonify uses past 32,768 taps).
   const double part1 = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, 1); });
   const double partn = median_ms(runs, [&] { wet = PartitionedConvolver(response.ir, 8192, FftPlanning::measure).apply(dry, cores); });
   double apart = 0.0;
-  for (std::size_t i = 0; i < wet.size(); ++i) apart = std::max(apart, std::abs(wet[i] - reused[i]));
+  const std::vector<double> one_transform = sized.apply(dry, 1);
+  for (std::size_t i = 0; i < wet.size(); ++i) apart = std::max(apart, std::abs(wet[i] - one_transform[i]));
   // A 10 s response (a large hall's tail): one transform of 2^21 points against partitions.
   std::vector<double> hall(480000);
   for (std::size_t i = 0; i < hall.size(); ++i) hall[i] = noise(rng) * std::exp(-6.9 * static_cast<double>(i) / 48000.0 / 2.0);
@@ -269,8 +285,12 @@ int main(int argc, char** argv) {
   physical_row("  its spectrum (for the 1 s source)", 0.3, spectrum, spectrum);
   physical_row("apply whole response (reused output)", 4.05, long1, longn);
   physical_row("  the same, new output and spectrum", 4.05, both1, bothn);
+  physical_row("  single precision (as vola sonify)", 4.05, single1, singlen);
+  physical_row("  single, new output and spectrum", 4.05, single_both1, single_both1);
   physical_row("  one transform of 4x the response", 4.05, longest1, longest1);
   physical_row("  the same, partitioned (8192)", 4.05, part1, partn);
+  std::printf("\nsingle precision: max |single - double| %.2g, %.2g of the output's peak\n", single_apart,
+              single_apart / scale);
   std::printf("\na 10 s response (480,000 taps) on a 1 s source, FFTW_ESTIMATE plans as in vola sonify, 1 thread: one "
               "transform %.1f ms, partitioned (8192) %.1f ms\n", hall_one, hall_part);
   return 0;

@@ -23,47 +23,90 @@ std::mutex& planner_mutex() {
   return m;
 }
 
+// FFTW's double and single precision interfaces under one name.
+template <typename Real>
+struct Fftw;
+template <>
+struct Fftw<double> {
+  using Complex = fftw_complex;
+  using Plan = fftw_plan;
+  static double* alloc_real(std::size_t n) { return fftw_alloc_real(n); }
+  static Complex* alloc_complex(std::size_t n) { return fftw_alloc_complex(n); }
+  static void free(void* p) { fftw_free(p); }
+  static Plan plan_r2c(int n, double* in, Complex* out, unsigned flags) { return fftw_plan_dft_r2c_1d(n, in, out, flags); }
+  static Plan plan_c2r(int n, Complex* in, double* out, unsigned flags) { return fftw_plan_dft_c2r_1d(n, in, out, flags); }
+  static void r2c(Plan p, double* in, Complex* out) { fftw_execute_dft_r2c(p, in, out); }
+  static void c2r(Plan p, Complex* in, double* out) { fftw_execute_dft_c2r(p, in, out); }
+};
+template <>
+struct Fftw<float> {
+  using Complex = fftwf_complex;
+  using Plan = fftwf_plan;
+  static float* alloc_real(std::size_t n) { return fftwf_alloc_real(n); }
+  static Complex* alloc_complex(std::size_t n) { return fftwf_alloc_complex(n); }
+  static void free(void* p) { fftwf_free(p); }
+  static Plan plan_r2c(int n, float* in, Complex* out, unsigned flags) { return fftwf_plan_dft_r2c_1d(n, in, out, flags); }
+  static Plan plan_c2r(int n, Complex* in, float* out, unsigned flags) { return fftwf_plan_dft_c2r_1d(n, in, out, flags); }
+  static void r2c(Plan p, float* in, Complex* out) { fftwf_execute_dft_r2c(p, in, out); }
+  static void c2r(Plan p, Complex* in, float* out) { fftwf_execute_dft_c2r(p, in, out); }
+};
+
+template <typename Real>
 struct FftwFree {
-  void operator()(void* p) const noexcept { fftw_free(p); }
+  void operator()(void* p) const noexcept { Fftw<Real>::free(p); }
 };
-using RealBuffer = std::unique_ptr<double[], FftwFree>;
-using ComplexBuffer = std::unique_ptr<fftw_complex[], FftwFree>;
+template <typename Real>
+using RealBufferOf = std::unique_ptr<Real[], FftwFree<Real>>;
+template <typename Real>
+using ComplexBufferOf = std::unique_ptr<typename Fftw<Real>::Complex[], FftwFree<Real>>;
 
-RealBuffer real_buffer(std::size_t n) {
-  auto* p = fftw_alloc_real(n);
+template <typename Real>
+RealBufferOf<Real> real_buffer_of(std::size_t n) {
+  auto* p = Fftw<Real>::alloc_real(n);
   if (!p) throw std::bad_alloc();
-  return RealBuffer(p);
+  return RealBufferOf<Real>(p);
 }
-ComplexBuffer complex_buffer(std::size_t n) {
-  auto* p = fftw_alloc_complex(n);
+template <typename Real>
+ComplexBufferOf<Real> complex_buffer_of(std::size_t n) {
+  auto* p = Fftw<Real>::alloc_complex(n);
   if (!p) throw std::bad_alloc();
-  return ComplexBuffer(p);
+  return ComplexBufferOf<Real>(p);
 }
 
-// Plans for one transform size, made once per process and size (under the planner mutex)
-// and kept: planning, above all with FFTW_MEASURE, costs far more than one execution.
-struct SizePlans {
-  fftw_plan forward = nullptr;
-  fftw_plan inverse = nullptr;
+using RealBuffer = RealBufferOf<double>;
+using ComplexBuffer = ComplexBufferOf<double>;
+RealBuffer real_buffer(std::size_t n) { return real_buffer_of<double>(n); }
+ComplexBuffer complex_buffer(std::size_t n) { return complex_buffer_of<double>(n); }
+
+// Plans for one transform size, made once per process, precision and size (under the
+// planner mutex) and kept: planning, above all with FFTW_MEASURE, costs far more than one
+// execution.
+template <typename Real>
+struct SizePlansOf {
+  typename Fftw<Real>::Plan forward = nullptr;
+  typename Fftw<Real>::Plan inverse = nullptr;
 };
+using SizePlans = SizePlansOf<double>;
 
-SizePlans plans_for(std::size_t n, FftPlanning planning) {
-  static std::vector<std::pair<std::pair<std::size_t, FftPlanning>, SizePlans>> cache;
+template <typename Real>
+SizePlansOf<Real> plans_of(std::size_t n, FftPlanning planning) {
+  static std::vector<std::pair<std::pair<std::size_t, FftPlanning>, SizePlansOf<Real>>> cache;
   std::lock_guard lock(planner_mutex());
   for (const auto& [key, plans] : cache)
     if (key == std::pair{n, planning}) return plans;
   // Scratch arrays from fftw_malloc: plans then run on any fftw_malloc'ed arrays (same
   // alignment) through the new-array execute functions.
-  RealBuffer time = real_buffer(n);
-  ComplexBuffer spectrum = complex_buffer(n / 2 + 1);
+  RealBufferOf<Real> time = real_buffer_of<Real>(n);
+  ComplexBufferOf<Real> spectrum = complex_buffer_of<Real>(n / 2 + 1);
   const unsigned flags = planning == FftPlanning::measure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  SizePlans p;
-  p.forward = fftw_plan_dft_r2c_1d(static_cast<int>(n), time.get(), spectrum.get(), flags);
-  p.inverse = fftw_plan_dft_c2r_1d(static_cast<int>(n), spectrum.get(), time.get(), flags);
+  SizePlansOf<Real> p;
+  p.forward = Fftw<Real>::plan_r2c(static_cast<int>(n), time.get(), spectrum.get(), flags);
+  p.inverse = Fftw<Real>::plan_c2r(static_cast<int>(n), spectrum.get(), time.get(), flags);
   if (!p.forward || !p.inverse) throw Error("convolution: FFTW could not plan a transform");
   cache.emplace_back(std::pair{n, planning}, p);
   return p;
 }
+SizePlans plans_for(std::size_t n, FftPlanning planning) { return plans_of<double>(n, planning); }
 
 // The transform size for a filter of `taps` taps and signals of about `signal` samples.
 // For long signals (0), the power of two at least four times the filter: the FFT work per
@@ -89,54 +132,127 @@ std::size_t best_transform_size(std::size_t taps, std::size_t signal) {
   return best;
 }
 
-}  // namespace
-
-// A block's transform buffers. Kept by the Convolver between calls (taken and given back
-// under a lock, so concurrent calls are safe): fresh megabyte buffers would cost their
-// page faults on every call, a quarter of a 65,536-point call's time.
-struct BlockScratch {
-  RealBuffer time;
-  ComplexBuffer spectrum;
+// Convolver's work in one precision: the filter's spectrum and the overlap-add.
+class BlockEngine {
+ public:
+  virtual ~BlockEngine() = default;
+  virtual void apply_into(std::span<const double> signal, std::span<double> out, unsigned threads) = 0;
 };
 
-struct Convolver::Plans {
-  SizePlans size;
-  ComplexBuffer filter_spectrum;
-  std::mutex scratch_mutex;
-  std::vector<BlockScratch> scratch;
+template <typename Real>
+class Engine final : public BlockEngine {
+ public:
+  Engine(std::span<const double> filter, std::size_t n, FftPlanning planning)
+      : n_(n), block_(n - filter.size() + 1), plans_(plans_of<Real>(n, planning)),
+        filter_spectrum_(complex_buffer_of<Real>(n / 2 + 1)) {
+    RealBufferOf<Real> time = real_buffer_of<Real>(n);
+    // The inverse transform's 1 / n is folded into the filter, once.
+    const double scale = 1.0 / static_cast<double>(n);
+    std::fill(time.get(), time.get() + n, Real{0});
+    std::transform(filter.begin(), filter.end(), time.get(), [scale](double v) { return static_cast<Real>(v * scale); });
+    Fftw<Real>::r2c(plans_.forward, time.get(), filter_spectrum_.get());
+  }
 
-  std::vector<BlockScratch> take(std::size_t count, std::size_t n) {
-    std::vector<BlockScratch> taken;
-    {
-      const std::lock_guard lock(scratch_mutex);
-      while (taken.size() < count && !scratch.empty()) {
-        taken.push_back(std::move(scratch.back()));
-        scratch.pop_back();
+  void apply_into(std::span<const double> signal, std::span<double> out, unsigned threads) override {
+    const std::size_t blocks = (signal.size() + block_ - 1) / block_;
+    const std::size_t bins = n_ / 2 + 1;
+    ParallelOptions parallel;
+    parallel.threads = static_cast<unsigned>(std::min<std::size_t>(resolve_thread_count(threads), blocks));
+    parallel.name = "audio.convolve";
+    // Blocks are filtered in rounds of one per thread, each into its own buffer, then added
+    // to the output in block order: every sample gets its contributions in the same order
+    // whatever the thread count, and however far a block's tail reaches.
+    const std::size_t round = parallel.threads;
+    std::vector<Scratch> scratch = take(round);
+    struct GiveBack {
+      Engine& engine;
+      std::vector<Scratch>& buffers;
+      ~GiveBack() { engine.give_back(buffers); }
+    } give_back{*this, scratch};
+    std::size_t written = 0;  // out[0, written) holds the blocks added so far
+    for (std::size_t first = 0; first < blocks; first += round) {
+      const std::size_t count = std::min(round, blocks - first);
+      parallel_for(count, [&](const Chunk& chunk) {
+        for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
+          Real* time = scratch[i].time.get();
+          auto* spectrum = scratch[i].spectrum.get();
+          const std::size_t begin = (first + i) * block_;
+          const std::size_t n = std::min(block_, signal.size() - begin);
+          std::copy_n(signal.data() + begin, n, time);
+          std::fill(time + n, time + n_, Real{0});
+          Fftw<Real>::r2c(plans_.forward, time, spectrum);
+          const auto* h = filter_spectrum_.get();
+          for (std::size_t k = 0; k < bins; ++k) {  // written out: std::complex's * checks for NaN
+            const Real re = spectrum[k][0] * h[k][0] - spectrum[k][1] * h[k][1];
+            const Real im = spectrum[k][0] * h[k][1] + spectrum[k][1] * h[k][0];
+            spectrum[k][0] = re;
+            spectrum[k][1] = im;
+          }
+          Fftw<Real>::c2r(plans_.inverse, spectrum, time);
+        }
+      }, parallel);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t begin = (first + i) * block_;
+        const std::size_t end = begin + std::min(n_, out.size() - begin);
+        const Real* time = scratch[i].time.get();  // time[k] adds to out[begin + k]
+        // Blocks tile the output without gaps (a block reaches the next one's start):
+        // added where earlier blocks wrote, copied beyond, so the output is never zeroed.
+        const std::size_t overlap = std::min(end, written) - begin;
+        double* o = out.data() + begin;
+        for (std::size_t k = 0; k < overlap; ++k) o[k] += time[k];
+        std::copy(time + overlap, time + (end - begin), o + overlap);
+        written = std::max(written, end);
       }
     }
-    while (taken.size() < count) taken.push_back({real_buffer(n), complex_buffer(n / 2 + 1)});
+  }
+
+ private:
+  // A block's transform buffers. Kept between calls (taken and given back under a lock,
+  // so concurrent calls are safe): fresh megabyte buffers would cost their page faults on
+  // every call, a quarter of a 65,536-point call's time.
+  struct Scratch {
+    RealBufferOf<Real> time;
+    ComplexBufferOf<Real> spectrum;
+  };
+  std::vector<Scratch> take(std::size_t count) {
+    std::vector<Scratch> taken;
+    {
+      const std::lock_guard lock(scratch_mutex_);
+      while (taken.size() < count && !scratch_.empty()) {
+        taken.push_back(std::move(scratch_.back()));
+        scratch_.pop_back();
+      }
+    }
+    while (taken.size() < count) taken.push_back({real_buffer_of<Real>(n_), complex_buffer_of<Real>(n_ / 2 + 1)});
     return taken;
   }
-  void give_back(std::vector<BlockScratch>& buffers) {
-    const std::lock_guard lock(scratch_mutex);
-    for (BlockScratch& b : buffers) scratch.push_back(std::move(b));
+  void give_back(std::vector<Scratch>& buffers) {
+    const std::lock_guard lock(scratch_mutex_);
+    for (Scratch& b : buffers) scratch_.push_back(std::move(b));
   }
+
+  std::size_t n_, block_;  // transform size; input samples per block
+  SizePlansOf<Real> plans_;
+  ComplexBufferOf<Real> filter_spectrum_;
+  std::mutex scratch_mutex_;
+  std::vector<Scratch> scratch_;
 };
 
-Convolver::Convolver(std::span<const double> filter, FftPlanning planning, std::size_t signal_size)
+}  // namespace
+
+struct Convolver::Plans {
+  std::unique_ptr<BlockEngine> engine;
+};
+
+Convolver::Convolver(std::span<const double> filter, FftPlanning planning, std::size_t signal_size,
+                     SamplePrecision precision)
     : filter_size_(filter.size()), plans_(std::make_unique<Plans>()) {
   if (filter.empty()) throw InvalidArgument("convolution: the filter is empty");
   fft_size_ = best_transform_size(filter.size(), signal_size);
-  block_ = fft_size_ - filter.size() + 1;
-  const std::size_t bins = fft_size_ / 2 + 1;
-  plans_->size = plans_for(fft_size_, planning);
-  RealBuffer time = real_buffer(fft_size_);
-  plans_->filter_spectrum = complex_buffer(bins);
-  // The inverse transform's 1 / n is folded into the filter, once.
-  const double scale = 1.0 / static_cast<double>(fft_size_);
-  std::fill(time.get(), time.get() + fft_size_, 0.0);
-  std::transform(filter.begin(), filter.end(), time.get(), [scale](double v) { return v * scale; });
-  fftw_execute_dft_r2c(plans_->size.forward, time.get(), plans_->filter_spectrum.get());
+  if (precision == SamplePrecision::float32)
+    plans_->engine = std::make_unique<Engine<float>>(filter, fft_size_, planning);
+  else
+    plans_->engine = std::make_unique<Engine<double>>(filter, fft_size_, planning);
 }
 
 Convolver::~Convolver() = default;
@@ -157,56 +273,7 @@ void Convolver::apply_into(std::span<const double> signal, std::span<double> out
     throw InvalidArgument("convolution: the output holds " + std::to_string(out.size()) + " samples, not the " +
                           std::to_string(signal.empty() ? 0 : signal.size() + filter_size_ - 1) + " of the result");
   if (signal.empty()) return;
-  const std::size_t blocks = (signal.size() + block_ - 1) / block_;
-  const std::size_t bins = fft_size_ / 2 + 1;
-  ParallelOptions parallel;
-  parallel.threads = static_cast<unsigned>(std::min<std::size_t>(resolve_thread_count(threads), blocks));
-  parallel.name = "audio.convolve";
-  // Blocks are filtered in rounds of one per thread, each into its own buffer, then added
-  // to the output in block order: every sample gets its contributions in the same order
-  // whatever the thread count, and however far a block's tail reaches.
-  const std::size_t round = parallel.threads;
-  std::vector<BlockScratch> scratch = plans_->take(round, fft_size_);
-  struct GiveBack {
-    Plans& plans;
-    std::vector<BlockScratch>& buffers;
-    ~GiveBack() { plans.give_back(buffers); }
-  } give_back{*plans_, scratch};
-  std::size_t written = 0;  // out[0, written) holds the blocks added so far
-  for (std::size_t first = 0; first < blocks; first += round) {
-    const std::size_t count = std::min(round, blocks - first);
-    parallel_for(count, [&](const Chunk& chunk) {
-      for (std::size_t i = chunk.begin; i < chunk.end; ++i) {
-        double* time = scratch[i].time.get();
-        fftw_complex* spectrum = scratch[i].spectrum.get();
-        const std::size_t begin = (first + i) * block_;
-        const std::size_t n = std::min(block_, signal.size() - begin);
-        std::copy_n(signal.data() + begin, n, time);
-        std::fill(time + n, time + fft_size_, 0.0);
-        fftw_execute_dft_r2c(plans_->size.forward, time, spectrum);
-        const fftw_complex* h = plans_->filter_spectrum.get();
-        for (std::size_t k = 0; k < bins; ++k) {  // written out: std::complex's * checks for NaN
-          const double re = spectrum[k][0] * h[k][0] - spectrum[k][1] * h[k][1];
-          const double im = spectrum[k][0] * h[k][1] + spectrum[k][1] * h[k][0];
-          spectrum[k][0] = re;
-          spectrum[k][1] = im;
-        }
-        fftw_execute_dft_c2r(plans_->size.inverse, spectrum, time);
-      }
-    }, parallel);
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t begin = (first + i) * block_;
-      const std::size_t end = begin + std::min(fft_size_, out.size() - begin);
-      const double* time = scratch[i].time.get();  // time[k] adds to out[begin + k]
-      // Blocks tile the output without gaps (a block reaches the next one's start):
-      // added where earlier blocks wrote, copied beyond, so the output is never zeroed.
-      const std::size_t overlap = std::min(end, written) - begin;
-      double* o = out.data() + begin;
-      for (std::size_t k = 0; k < overlap; ++k) o[k] += time[k];
-      std::copy(time + overlap, time + (end - begin), o + overlap);
-      written = std::max(written, end);
-    }
-  }
+  plans_->engine->apply_into(signal, out, threads);
 }
 
 struct PartitionedConvolver::State {

@@ -179,6 +179,15 @@ TEST(AudioConvolve, MatchesTheDirectSumForManyLengths) {
     for (std::size_t i = 0; i < into.size(); ++i) worst_sized = std::max(worst_sized, std::abs(into[i] - slow[i]));
     EXPECT_LT(worst_sized, 1e-9 * std::sqrt(static_cast<double>(m))) << n << " x " << m << ", size " << sized.fft_size();
     EXPECT_EQ(sized.apply(x, 1), into) << "threads changed the result, " << n << " x " << m;
+    // Single precision: errors of float rounding, relative to the output's scale (the
+    // inputs are unit normal, so the output's is sqrt(m)).
+    const Convolver single(h, FftPlanning::estimate, x.size(), SamplePrecision::float32);
+    const std::vector<double> rounded = single.apply(x, 1);
+    double worst_single = 0.0;
+    for (std::size_t i = 0; i < rounded.size(); ++i) worst_single = std::max(worst_single, std::abs(rounded[i] - slow[i]));
+    EXPECT_LT(worst_single, 1e-5 * std::sqrt(static_cast<double>(m))) << n << " x " << m << " in single precision";
+    EXPECT_GT(worst_single, 0.0) << "single precision gave double's result";
+    EXPECT_EQ(single.apply(x, 3), rounded) << "threads changed the result, " << n << " x " << m;
   }
   EXPECT_TRUE(Convolver(std::vector<double>{1.0}).apply(std::vector<double>{}, 1).empty());
   std::vector<double> wrong(10);
