@@ -11,7 +11,7 @@
 //   wide:  deeper, on the same 32^3 input: conv 5^3 stride 2 -> 32 (14^3), conv 3^3 -> 64
 //          (12^3), conv 3^3 -> 64 (10^3), max pool 2 (5^3), conv 3^3 padded -> 128 (5^3),
 //          max pool 3 stride 2 (2^3), fully connected -> 256 -> 10, batch norm after every
-//          convolution, dropout; about 0.66 M weights (2.7 MB), 4x small's multiply-adds.
+//          convolution, dropout; about 0.66 M weights (2.6 MB), 4x small's multiply-adds.
 #pragma once
 
 #include <array>
