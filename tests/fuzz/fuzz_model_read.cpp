@@ -23,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const vola::learn::Classifier classifier(path);
     const auto a = classifier.architecture();
-    if (a != vola::learn::Architecture::small && a != vola::learn::Architecture::paper) std::abort();
+    if (a != vola::learn::Architecture::small && a != vola::learn::Architecture::paper && a != vola::learn::Architecture::wide)
+      std::abort();
     ++vola_fuzz::stats().parsed;
   } catch (const vola::Error& e) {
     if (std::getenv("VOLA_FUZZ_VERBOSE")) std::fprintf(stderr, "%s\n", e.what());  // replaying one input
