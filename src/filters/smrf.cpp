@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <span>
 
 #include "elevation_grid.hpp"
@@ -161,6 +162,110 @@ std::vector<float> slope_of(const ElevationGrid& g) {
   return s;
 }
 
+// Ground cells on a raised plateau: patches of the ground surface left after the
+// opening that stand on walls above the ground beside them. The opening removes what its
+// window spans; a roof wider than the window (a warehouse, a survey clipped to one
+// building) survives it as a flat patch. Measured cells (NaN elsewhere) that see each
+// other across at most kLinkRadius of empty cells join one patch when they rise by at
+// most kLinkRise + kLinkSlope x distance, as terrain does; two such cells of different
+// patches form a wall. A patch is raised when:
+//  - it is the upper side of most of its wall pairs with patches of at least
+//    kMinBaseArea that it does not enclose (ground is what roofs stand on; a pit or an
+//    excavation inside the ground, within its bounding box, does not raise the ground);
+//  - its heights span less than its walls rise on average (a roof is flat; a steep
+//    hillside cut into patches by voids spans more than its steps).
+// What it cannot tell from a roof: flat ground on top of a retaining wall or a quay more
+// than kLinkRise + 0.5 m high, with no higher ground beside it (docs/FILTERS.md).
+std::vector<bool> raised_plateaus(const ElevationGrid& g) {
+  const std::size_t cols = g.cols, rows = g.rows, cells = g.cells();
+  const double c = g.cell;
+  const double reach = std::max(kLinkRadius, c);
+  const auto gentle = [&](float a, float b, double distance) {
+    return std::abs(double{a} - double{b}) <= kLinkRise + kLinkSlope * distance;
+  };
+  // Union-find over measured cells.
+  std::vector<std::uint32_t> parent(cells);
+  for (std::size_t k = 0; k < cells; ++k) parent[k] = static_cast<std::uint32_t>(k);
+  const auto root = [&](std::size_t k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  // Pairs of measured cells that see each other across empty cells: from every measured
+  // cell, the first measured cell along each of 8 directions (half of 16, so that each
+  // pair comes once), up to the reach. A void (a building's shadow, a removed object) is
+  // crossed; dense data pairs each cell with its neighbours only.
+  static constexpr int kDirections[8][2] = {{1, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 1}, {-1, 2}, {-1, 1}, {-2, 1}};
+  const auto for_each_pair = [&](auto&& visit) {
+    for (std::size_t row = 0; row < rows; ++row)
+      for (std::size_t col = 0; col < cols; ++col) {
+        const std::size_t a = row * cols + col;
+        if (std::isnan(g.z[a])) continue;
+        for (const auto& [dx, dy] : kDirections) {
+          const double step = c * std::sqrt(double(dx * dx + dy * dy));
+          auto x = static_cast<std::ptrdiff_t>(col), y = static_cast<std::ptrdiff_t>(row);
+          for (double d = step; d <= reach + 1e-9; d += step) {
+            x += dx, y += dy;
+            if (x < 0 || y < 0 || x >= static_cast<std::ptrdiff_t>(cols) || y >= static_cast<std::ptrdiff_t>(rows)) break;
+            const std::size_t b = static_cast<std::size_t>(y) * cols + static_cast<std::size_t>(x);
+            if (std::isnan(g.z[b])) continue;
+            visit(a, b, d);
+            break;
+          }
+        }
+      }
+  };
+  for_each_pair([&](std::size_t a, std::size_t b, double d) {
+    if (gentle(g.z[a], g.z[b], d)) parent[root(a)] = static_cast<std::uint32_t>(root(b));
+  });
+  std::vector<std::uint32_t> area(cells, 0);
+  for (std::size_t k = 0; k < cells; ++k)
+    if (!std::isnan(g.z[k])) ++area[root(k)];
+  const auto min_base = static_cast<std::uint32_t>(std::ceil(kMinBaseArea / (c * c)));
+  // Each patch's bounding box in cells: a patch inside another's box (a pit, a sunken
+  // yard, an excavation) is enclosed by it, and its walls do not raise the one around it.
+  struct CellBox {
+    std::size_t col0 = SIZE_MAX, row0 = SIZE_MAX, col1 = 0, row1 = 0;
+    bool inside(const CellBox& o) const { return col0 >= o.col0 && col1 <= o.col1 && row0 >= o.row0 && row1 <= o.row1; }
+  };
+  std::vector<CellBox> box(cells);
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (std::isnan(g.z[k])) continue;
+    CellBox& b = box[root(k)];
+    const std::size_t col = k % cols, row = k / cols;
+    b.col0 = std::min(b.col0, col), b.col1 = std::max(b.col1, col);
+    b.row0 = std::min(b.row0, row), b.row1 = std::max(b.row1, row);
+  }
+  std::vector<std::uint32_t> upper(cells, 0), lower(cells, 0);  // wall pairs, by patch root
+  std::vector<double> rise(cells, 0.0);                          // summed over the upper pairs
+  for_each_pair([&](std::size_t a, std::size_t b, double) {
+    const std::size_t ra = root(a), rb = root(b);
+    if (ra == rb) return;
+    const bool a_above = g.z[a] > g.z[b];
+    const std::size_t high = a_above ? ra : rb, low = a_above ? rb : ra;
+    if (area[low] >= min_base && !box[low].inside(box[high])) {
+      ++upper[high];
+      rise[high] += std::abs(double{g.z[a]} - double{g.z[b]});
+    }
+    if (area[high] >= min_base) ++lower[low];
+  });
+  // A roof is flat beside its walls: its heights span less than the walls rise. A
+  // hillside cut into patches by voids spans more than its steps.
+  std::vector<float> low_z(cells, INFINITY), high_z(cells, -INFINITY);
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (std::isnan(g.z[k])) continue;
+    const std::size_t r = root(k);
+    low_z[r] = std::min(low_z[r], g.z[k]);
+    high_z[r] = std::max(high_z[r], g.z[k]);
+  }
+  std::vector<bool> raised(cells, false);
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (std::isnan(g.z[k])) continue;
+    const std::size_t r = root(k);
+    raised[k] = upper[r] > lower[r] && double{high_z[r]} - double{low_z[r]} < rise[r] / upper[r];
+  }
+  return raised;
+}
+
 }  // namespace
 
 std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<bool>& candidate,
@@ -225,6 +330,9 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   ElevationGrid surface = zmin;
   for (std::size_t k = 0; k < surface.cells(); ++k)
     if (object[k]) surface.z[k] = NAN;
+  const std::vector<bool> raised = raised_plateaus(surface);
+  for (std::size_t k = 0; k < surface.cells(); ++k)
+    if (raised[k]) surface.z[k] = NAN;
   detail::inpaint(surface);
   const std::vector<float> slope = slope_of(surface);
 

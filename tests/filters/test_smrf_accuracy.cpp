@@ -40,9 +40,6 @@ constexpr KnownMiss kKnownMisses[] = {
      "a thinned survey: 6280 points over 5 x 5 km (one per ~4000 m2), so 1 m cells hold isolated points; the "
      "filled surface peaks at each point and hilltop ground reads as objects; the points it calls ground above "
      "the file's ground are mostly class 12 (overlap), measured against ground points ~60 m away"},
-    {"pdal_sample_c.las", 99.0, 90.0,
-     "a clip that is 87% one building (class 6, 78 x 70 units; no CRS, so metres): a roof wider than the 18 m "
-     "window, with ground on one side only, is not removed by any opening"},
 };
 constexpr std::size_t kMinGround = 500;
 

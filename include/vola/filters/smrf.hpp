@@ -55,6 +55,16 @@ inline constexpr int kSupportPasses = 4;
 // Where fewer filled cells than this lie within kSupportRadius, a cell is judged against
 // this many nearest filled cells instead, however far (thinned surveys, data edges).
 inline constexpr std::size_t kSparseNeighbours = 8;
+// After the opening, patches of the ground surface that stand on walls above the rest
+// are roofs wider than the window: measured cells that see each other across at most
+// kLinkRadius metres (of empty cells) belong to one patch when they rise by at most
+// kLinkRise + kLinkSlope x distance; a flat patch that is the upper side of most of its
+// walls with patches of at least kMinBaseArea square metres (that it does not enclose)
+// is not ground.
+inline constexpr double kLinkRadius = 20.0;
+inline constexpr double kLinkRise = 3.0;
+inline constexpr double kLinkSlope = 0.5;
+inline constexpr double kMinBaseArea = 16.0;
 
 // Ground flags for points xyz (x y z triples); candidate[i] false leaves point i out of
 // the surface and not ground. Throws InvalidArgument when the grid would pass 2^28 cells
