@@ -733,6 +733,23 @@ std::optional<Pose> Fusion<Store>::relocalise_wide(WideFeatures& wide, const std
   return refine_feature_pose(maps, keyframes_[best_at].pose * best->transform, best->inliers, correspondences);
 }
 
+// Keeps the colour and depth frames of the wide_frames_kept newest keyframes holding
+// them; an older keyframe keeps its SIFT features if they were extracted.
+template <class Store>
+void Fusion<Store>::release_old_wide_frames() {
+  std::size_t kept = 0;
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
+    if (!it->wide || it->wide->rgb.rgb.empty()) continue;
+    if (++kept <= params_.wide_frames_kept) continue;
+    if (!it->wide->sift) {
+      it->wide.reset();
+    } else {
+      it->wide->rgb = RgbImage{};
+      it->wide->depth = DepthImage{};
+    }
+  }
+}
+
 template <class Store>
 void Fusion<Store>::remember_features(FeatureFrame&& features, std::optional<WideFeatures>&& wide) {
   if (features.size() == 0) return;
@@ -740,6 +757,7 @@ void Fusion<Store>::remember_features(FeatureFrame&& features, std::optional<Wid
                                     params_.keyframe_rotation_degrees)) {
     if (params_.loop_closure) detect_loop(features);
     keyframes_.push_back({features, pose_, frames_ - 1, std::move(wide)});
+    release_old_wide_frames();
   }
   last_features_ = std::move(features);
 }

@@ -88,8 +88,12 @@ struct FusionParams {
   // registered against those of the wide_keyframes keyframes nearest to the last pose,
   // under the same rules. SIFT is extracted only then (for a keyframe, once: its colour
   // and depth frames are kept for it), so tracking that holds never pays for it.
+  // The frames kept for SIFT cost ~2 MiB a keyframe at 640 x 480, so only the
+  // wide_frames_kept newest keyframes keep theirs (older ones keep their SIFT features
+  // if they were extracted, else none): memory stays bounded on long sequences.
   bool wide_features = true;
   std::size_t wide_keyframes = 4;
+  std::size_t wide_frames_kept = 32;
   // Loop closure (loop_closure.hpp): when a tracked frame becomes a keyframe, its features
   // are registered against the (up to 3) nearest keyframes older than the last
   // loop_skip_keyframes; a registration with loop_min_inliers inliers whose pose lies
@@ -183,6 +187,7 @@ class Fusion {
   std::optional<Pose> relocalise_wide(WideFeatures& wide, const std::array<VertexMap, kPyramidLevels>& maps,
                                       FrameResult& result, int* correspondences);
   void remember_features(FeatureFrame&& features, std::optional<WideFeatures>&& wide);
+  void release_old_wide_frames();
   // Indices of up to `count` keyframes, nearest to pose_ first.
   std::vector<std::size_t> nearest_keyframes(std::size_t count) const;
   static constexpr std::size_t kNearbyKeyframes = 4;
