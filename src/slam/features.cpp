@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "orb_plugin.hpp"
@@ -13,16 +14,45 @@ namespace vola::slam {
 
 bool features_available() noexcept { return VOLA_SLAM_WITH_OPENCV != 0; }
 
-FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
-                              const FeatureParams& params) {
-  FeatureFrame out;
-  if (!features_available()) return out;
-  if (rgb.width != depth.width || rgb.height != depth.height || rgb.width < 16 || rgb.height < 16) return out;
+namespace {
+
+std::vector<std::uint8_t> grey_of(const RgbImage& rgb) {
   std::vector<std::uint8_t> grey(std::size_t{rgb.width} * rgb.height);
   for (std::size_t i = 0; i < grey.size(); ++i) {
     const std::uint8_t* c = &rgb.rgb[i * 3];
     grey[i] = static_cast<std::uint8_t>((299 * c[0] + 587 * c[1] + 114 * c[2] + 500) / 1000);
   }
+  return grey;
+}
+
+bool usable(const RgbImage& rgb, const DepthImage& depth) {
+  return features_available() && rgb.width == depth.width && rgb.height == depth.height && rgb.width >= 16 &&
+         rgb.height >= 16;
+}
+
+// The camera-frame point of a keypoint, when its pixel has a depth and is not at a depth
+// edge (the 3x3 neighbourhood within 5% of the centre).
+std::optional<Eigen::Vector3d> keypoint_point(float x, float y, const DepthImage& depth, const Intrinsics& k) {
+  const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
+  if (u < 1 || v < 1 || u + 1 >= static_cast<int>(depth.width) || v + 1 >= static_cast<int>(depth.height))
+    return std::nullopt;
+  const float z = depth.at(static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(v));
+  if (!(z > 0.0f)) return std::nullopt;
+  for (int dv = -1; dv <= 1; ++dv)
+    for (int du = -1; du <= 1; ++du) {
+      const float n = depth.at(static_cast<std::uint32_t>(u + du), static_cast<std::uint32_t>(v + dv));
+      if (!(n > 0.0f) || std::abs(n - z) > 0.05f * z) return std::nullopt;
+    }
+  return Eigen::Vector3d((x - k.cx) / k.fx * z, (y - k.cy) / k.fy * z, z);
+}
+
+}  // namespace
+
+FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
+                              const FeatureParams& params) {
+  FeatureFrame out;
+  if (!usable(rgb, depth)) return out;
+  const std::vector<std::uint8_t> grey = grey_of(rgb);
   // OpenCV is loaded on the first colour frame (libvola_opencv.so), not at every start.
   static const auto detect = reinterpret_cast<plugin::DetectOrbEntry>(
       vola::plugin::plugin_symbol("opencv", plugin::kDetectOrbSymbol, "ORB features of a colour frame"));
@@ -32,25 +62,36 @@ FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, cons
   vola::plugin::throw_failure(failure);
   out.intrinsics = k;
   for (const plugin::OrbKeypoint& kp : keypoints) {
-    const int u = static_cast<int>(std::lround(kp.x)), v = static_cast<int>(std::lround(kp.y));
-    if (u < 1 || v < 1 || u + 1 >= static_cast<int>(depth.width) || v + 1 >= static_cast<int>(depth.height)) continue;
-    const float z = depth.at(static_cast<std::uint32_t>(u), static_cast<std::uint32_t>(v));
-    if (!(z > 0.0f)) continue;
-    bool edge = false;
-    for (int dv = -1; dv <= 1 && !edge; ++dv)
-      for (int du = -1; du <= 1; ++du) {
-        const float n = depth.at(static_cast<std::uint32_t>(u + du), static_cast<std::uint32_t>(v + dv));
-        if (!(n > 0.0f) || std::abs(n - z) > 0.05f * z) {
-          edge = true;
-          break;
-        }
-      }
-    if (edge) continue;
-    out.points.emplace_back((kp.x - k.cx) / k.fx * z, (kp.y - k.cy) / k.fy * z, z);
+    const auto point = keypoint_point(kp.x, kp.y, depth, k);
+    if (!point) continue;
+    out.points.push_back(*point);
     out.pixels.emplace_back(kp.x, kp.y);
     Descriptor d;
     std::memcpy(d.data(), kp.descriptor.data(), 32);
     out.descriptors.push_back(d);
+  }
+  return out;
+}
+
+FeatureFrame extract_sift_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
+                                   const FeatureParams& params) {
+  FeatureFrame out;
+  if (!usable(rgb, depth)) return out;
+  const std::vector<std::uint8_t> grey = grey_of(rgb);
+  static const auto detect = reinterpret_cast<plugin::DetectSiftEntry>(
+      vola::plugin::plugin_symbol("opencv", plugin::kDetectSiftSymbol, "SIFT features of a colour frame"));
+  std::vector<plugin::SiftKeypoint> keypoints;
+  vola::plugin::PluginFailure failure;
+  detect(grey.data(), rgb.width, rgb.height, params.sift_max_features, params.sift_contrast_threshold, keypoints,
+         failure);
+  vola::plugin::throw_failure(failure);
+  out.intrinsics = k;
+  for (const plugin::SiftKeypoint& kp : keypoints) {
+    const auto point = keypoint_point(kp.x, kp.y, depth, k);
+    if (!point) continue;
+    out.points.push_back(*point);
+    out.pixels.emplace_back(kp.x, kp.y);
+    out.sift_descriptors.push_back(kp.descriptor);
   }
   return out;
 }
@@ -62,9 +103,46 @@ int hamming(const Descriptor& a, const Descriptor& b) noexcept {
          std::popcount(a[3] ^ b[3]);
 }
 
+// For each SIFT descriptor of `from`, the index of its nearest in `to` (Euclidean) when
+// it passes the ratio test (else -1). The squared distances come from one matrix
+// product, |a|^2 + |b|^2 - 2 a.b, which is what makes brute force affordable here.
+std::vector<int> nearest_sift(const FeatureFrame& from, const FeatureFrame& to, const FeatureParams& params) {
+  const auto matrix_of = [](const FeatureFrame& f) {
+    Eigen::MatrixXf m(128, static_cast<Eigen::Index>(f.size()));
+    for (std::size_t i = 0; i < f.size(); ++i)
+      for (std::size_t j = 0; j < 128; ++j) m(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = f.sift_descriptors[i][j];
+    return m;
+  };
+  const Eigen::MatrixXf a = matrix_of(from), b = matrix_of(to);
+  const Eigen::MatrixXf dot = a.transpose() * b;
+  const Eigen::VectorXf b_norms = b.colwise().squaredNorm().transpose();
+  const float ratio2 = static_cast<float>(params.sift_ratio * params.sift_ratio);
+  std::vector<int> out(from.size(), -1);
+  for (Eigen::Index i = 0; i < dot.rows(); ++i) {
+    float best = std::numeric_limits<float>::max(), second = best;
+    int at = -1;
+    for (Eigen::Index j = 0; j < dot.cols(); ++j) {
+      const float d = b_norms[j] - 2.0f * dot(i, j);  // |a_i|^2 left out: the same for every j
+      if (d < best) {
+        second = best;
+        best = d;
+        at = static_cast<int>(j);
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (at < 0 || dot.cols() < 2) continue;
+    const float own = a.col(i).squaredNorm();
+    if (best + own < ratio2 * (second + own)) out[static_cast<std::size_t>(i)] = at;
+  }
+  return out;
+}
+
 // For each descriptor of `from`, the index of its nearest in `to` when it passes the
 // ratio test and the distance limit (else -1).
 std::vector<int> nearest(const FeatureFrame& from, const FeatureFrame& to, const FeatureParams& params) {
+  if (from.sift() != to.sift()) return std::vector<int>(from.size(), -1);
+  if (from.sift()) return nearest_sift(from, to, params);
   std::vector<int> out(from.size(), -1);
   for (std::size_t i = 0; i < from.size(); ++i) {
     int best = 1 << 20, second = 1 << 20, at = -1;

@@ -687,7 +687,7 @@ void Fusion<Store>::retry_pending() {
       continue;
     }
     integrate(it->depth, it->rgb ? &*it->rgb : nullptr, *pose);
-    keyframes_.push_back({std::move(it->features), *pose, it->frame});
+    keyframes_.push_back({std::move(it->features), *pose, it->frame, std::nullopt});
     recovered_.push_back({it->frame, *pose, r->inliers});
     placed = true;
     it = pending_.erase(it);
@@ -708,12 +708,56 @@ std::vector<std::size_t> Fusion<Store>::nearest_keyframes(std::size_t count) con
 }
 
 template <class Store>
-void Fusion<Store>::remember_features(FeatureFrame&& features) {
+const FeatureFrame& Fusion<Store>::sift_of(WideFeatures& wide) const {
+  if (!wide.sift) wide.sift = extract_sift_features(wide.rgb, wide.depth, intrinsics_, params_.feature);
+  return *wide.sift;
+}
+
+template <class Store>
+std::optional<Pose> Fusion<Store>::relocalise_wide(WideFeatures& wide, const std::array<VertexMap, kPyramidLevels>& maps,
+                                                   FrameResult& result, int* correspondences) {
+  const FeatureFrame& current = sift_of(wide);
+  if (current.size() < 3) return std::nullopt;
+  std::optional<FeatureRegistration> best;
+  std::size_t best_at = 0;
+  for (const std::size_t i : nearest_keyframes(params_.wide_keyframes)) {
+    if (!keyframes_[i].wide) continue;
+    const auto r = register_features(sift_of(*keyframes_[i].wide), current, weak_feature_params());
+    if (r && (!best || r->inliers > best->inliers)) {
+      best = r;
+      best_at = i;
+    }
+  }
+  if (!best) return std::nullopt;
+  result.feature_inliers = best->inliers;
+  return refine_feature_pose(maps, keyframes_[best_at].pose * best->transform, best->inliers, correspondences);
+}
+
+// Keeps the colour and depth frames of the wide_frames_kept newest keyframes holding
+// them; an older keyframe keeps its SIFT features if they were extracted.
+template <class Store>
+void Fusion<Store>::release_old_wide_frames() {
+  std::size_t kept = 0;
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
+    if (!it->wide || it->wide->rgb.rgb.empty()) continue;
+    if (++kept <= params_.wide_frames_kept) continue;
+    if (!it->wide->sift) {
+      it->wide.reset();
+    } else {
+      it->wide->rgb = RgbImage{};
+      it->wide->depth = DepthImage{};
+    }
+  }
+}
+
+template <class Store>
+void Fusion<Store>::remember_features(FeatureFrame&& features, std::optional<WideFeatures>&& wide) {
   if (features.size() == 0) return;
   if (keyframes_.empty() || !within(keyframes_.back().pose, pose_, params_.keyframe_translation,
                                     params_.keyframe_rotation_degrees)) {
     if (params_.loop_closure) detect_loop(features);
-    keyframes_.push_back({features, pose_, frames_ - 1});
+    keyframes_.push_back({features, pose_, frames_ - 1, std::move(wide)});
+    release_old_wide_frames();
   }
   last_features_ = std::move(features);
 }
@@ -864,6 +908,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
   const DepthImage clipped_depth = clipped(raw, rgb);
   const DepthImage depth = filtered(clipped_depth);
   FeatureFrame features;
+  std::optional<WideFeatures> wide;
   if (params_.features && rgb && features_available()) {
     // Features keep the far measurements that fusion drops (beyond max_depth): matched
     // by reprojection, their depth noise matters little, and a view of a far wall may
@@ -872,6 +917,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
     for (float& d : near_clipped.metres)
       if (!(d >= params_.min_depth)) d = 0.0f;
     features = extract_features(*rgb, near_clipped, intrinsics_, params_.feature);
+    if (params_.wide_features) wide = WideFeatures{*rgb, std::move(near_clipped), std::nullopt};
   }
   std::optional<IntensityPyramid> intensity;
   if (rgb && params_.photometric_weight > 0.0) intensity = intensity_pyramid(*rgb);
@@ -946,6 +992,10 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
         result.relocalised = tracked.has_value();
       }
     }
+    if (!tracked && wide) {
+      tracked = relocalise_wide(*wide, maps, result, &correspondences);
+      result.relocalised = tracked.has_value();
+    }
     result.correspondences = correspondences;
     result.tracked = tracked.has_value();
     if (tracked && previous_lost_) result.relocalised = true;
@@ -959,7 +1009,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
   ++frames_;
   if (result.tracked) {
     integrate_and_predict(depth, rgb);
-    remember_features(std::move(features));
+    remember_features(std::move(features), std::move(wide));
     reference_intensity_ = std::move(intensity);
     retry_pending();
   } else if (frames_ > 1 && features.size() && params_.max_pending > 0) {

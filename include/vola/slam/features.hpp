@@ -3,7 +3,9 @@
 // and registered by RANSAC over 3-point rigid fits (3D-3D, Umeyama) whose inliers
 // reproject within a few pixels both ways. The tracker (fusion.hpp) uses them where frame-to-model
 // ICP cannot hold: large motion between frames, and relocalising a lost frame against
-// keyframes. Only detection needs OpenCV; a build without it has features_available()
+// keyframes. Where ORB finds too few matches (a view turned far from every other one),
+// SIFT features, slower but matching across wider changes of viewpoint, are registered
+// the same way. Only detection needs OpenCV; a build without it has features_available()
 // false and extracts none.
 #pragma once
 
@@ -18,14 +20,18 @@
 namespace vola::slam {
 
 using Descriptor = std::array<std::uint64_t, 4>;  // 256-bit ORB
+using SiftDescriptor = std::array<std::uint8_t, 128>;
 
-// Keypoints that have a valid depth: camera-frame points (metres) and descriptors.
+// Keypoints that have a valid depth: camera-frame points (metres) and descriptors, ORB
+// (`descriptors`) or SIFT (`sift_descriptors`); only frames of the same kind match.
 struct FeatureFrame {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;  // where each was detected
   std::vector<Descriptor> descriptors;
+  std::vector<SiftDescriptor> sift_descriptors;
   Intrinsics intrinsics;
   std::size_t size() const noexcept { return points.size(); }
+  bool sift() const noexcept { return !sift_descriptors.empty(); }
 };
 
 struct FeatureParams {
@@ -37,6 +43,12 @@ struct FeatureParams {
   int min_inliers = 12;        // a registration with fewer is refused
   double max_reprojection = 4.0;  // pixels, an inlier's error in both images
   std::uint64_t seed = 1;      // RANSAC sampling (deterministic)
+  // SIFT, where ORB fails: at most sift_max_features (the strongest); the contrast
+  // threshold is a quarter of OpenCV's default (0.04), for the same reason as the low
+  // FAST threshold (weakly textured views); Lowe's ratio 0.8 on Euclidean distances.
+  int sift_max_features = 1500;
+  double sift_contrast_threshold = 0.01;
+  double sift_ratio = 0.8;
 };
 
 // True when vola was built with OpenCV (features can be extracted).
@@ -47,6 +59,10 @@ bool features_available() noexcept;
 FeatureFrame extract_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
                               const FeatureParams& params);
 
+// The same with SIFT keypoints (100-300 ms a 640 x 480 frame, ORB's tenfold and more).
+FeatureFrame extract_sift_features(const RgbImage& rgb, const DepthImage& depth, const Intrinsics& k,
+                                   const FeatureParams& params);
+
 struct FeatureRegistration {
   // Maps points of `current` onto `reference`: reference ~ transform * current (so with
   // reference's camera-to-world pose P, the current camera's pose is P * transform).
@@ -55,7 +71,8 @@ struct FeatureRegistration {
   double rms = 0.0;  // pixels over the inliers (reference points in the reference image)
 };
 
-// Matches (each current feature's nearest reference descriptor passing the ratio test,
+// Matches (each current feature's nearest reference descriptor passing the ratio test:
+// Hamming distances for ORB, Euclidean for SIFT;
 // each reference feature used once), samples rigid fits of 3 matches (RANSAC; inliers
 // reproject within max_reprojection pixels into both images), refits on the inliers,
 // then refines the pose by Gauss-Newton on the symmetric reprojection error of the

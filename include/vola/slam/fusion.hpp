@@ -84,6 +84,16 @@ struct FusionParams {
   // when ICP from there converges within feature_icp_* of it with min_overlap of the
   // frame associated: the geometry confirms what the few features say.
   int relocalisation_min_inliers = 6;
+  // When ORB cannot relocalise a frame, SIFT features (feature.sift_*) of it are
+  // registered against those of the wide_keyframes keyframes nearest to the last pose,
+  // under the same rules. SIFT is extracted only then (for a keyframe, once: its colour
+  // and depth frames are kept for it), so tracking that holds never pays for it.
+  // The frames kept for SIFT cost ~2 MiB a keyframe at 640 x 480, so only the
+  // wide_frames_kept newest keyframes keep theirs (older ones keep their SIFT features
+  // if they were extracted, else none): memory stays bounded on long sequences.
+  bool wide_features = true;
+  std::size_t wide_keyframes = 4;
+  std::size_t wide_frames_kept = 32;
   // Loop closure (loop_closure.hpp): when a tracked frame becomes a keyframe, its features
   // are registered against the (up to 3) nearest keyframes older than the last
   // loop_skip_keyframes; a registration with loop_min_inliers inliers whose pose lies
@@ -165,7 +175,19 @@ class Fusion {
   std::optional<Pose> refine_feature_pose(const std::array<VertexMap, kPyramidLevels>& frame, const Pose& guess,
                                           int inliers, int* correspondences) const;
   ModelView model_at(const Pose& pose) const;
-  void remember_features(FeatureFrame&& features);
+  // SIFT features of a frame, extracted on first use from the frames kept for them.
+  struct WideFeatures {
+    RgbImage rgb;
+    DepthImage depth;  // as ORB's (near-clipped only)
+    std::optional<FeatureFrame> sift;
+  };
+  const FeatureFrame& sift_of(WideFeatures& wide) const;
+  // The wide_keyframes nearest keyframes' SIFT features against the frame's: ICP
+  // refines the best registration, as for ORB relocalisation.
+  std::optional<Pose> relocalise_wide(WideFeatures& wide, const std::array<VertexMap, kPyramidLevels>& maps,
+                                      FrameResult& result, int* correspondences);
+  void remember_features(FeatureFrame&& features, std::optional<WideFeatures>&& wide);
+  void release_old_wide_frames();
   // Indices of up to `count` keyframes, nearest to pose_ first.
   std::vector<std::size_t> nearest_keyframes(std::size_t count) const;
   static constexpr std::size_t kNearbyKeyframes = 4;
@@ -187,6 +209,7 @@ class Fusion {
     FeatureFrame features;
     Pose pose;
     std::size_t frame = 0;  // index among the processed frames
+    std::optional<WideFeatures> wide;
   };
   FeatureFrame last_features_;  // of the last tracked frame, at pose_
   std::optional<IntensityPyramid> reference_intensity_;  // the last tracked frame's, seen as model_
