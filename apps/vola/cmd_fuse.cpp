@@ -30,7 +30,7 @@ struct FuseArgs {
   std::uint32_t bricks = 4096;
   unsigned threads = 0;
   bool groundtruth_poses = false, start_at_groundtruth = false, no_colour = false, quiet = false, dense = false,
-       no_features = false, no_loop_closure = false;
+       no_features = false, no_loop_closure = false, no_refine = false;
 };
 
 slam::Pose pose_from(const std::vector<double>& v) {
@@ -111,6 +111,16 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
                 "correct\n",
                 result.loop_edges, result.loop_edges == 1 ? "" : "s", result.loop_disagreement.metres,
                 result.loop_disagreement.degrees);
+  if (result.refined)
+    std::printf("keyframe refinement: %zu keyframe pairs aligned, keyframes moved by up to %.3f m / %.2f deg (%.2f s); "
+                "map integrated again in %.2f s\n",
+                result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
+                result.refinement_seconds, result.reintegration_seconds);
+  else if (result.refinement_pairs)
+    std::printf("keyframe refinement: %zu keyframe pairs aligned, keyframes would move by up to %.3f m / %.2f deg "
+                "(%.2f s): trajectory kept\n",
+                result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
+                result.refinement_seconds);
   print_memory(store, options.params.voxel_size);
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),
               a.mesh.empty() ? "" : (", " + std::to_string(triangles) + " triangles in the mesh").c_str());
@@ -147,6 +157,7 @@ void run_fuse(const FuseArgs& a) {
   p.threads = a.threads;
   p.features = !a.no_features;
   p.loop_closure = !a.no_loop_closure;
+  p.refine_keyframes = !a.no_refine;
   p.photometric_weight = a.photometric_weight;
   p.check();
   if ((a.groundtruth_poses || a.start_at_groundtruth) && sequence.groundtruth.empty())
@@ -225,6 +236,10 @@ void add_fuse(CLI::App& app) {
   cmd->add_flag("--no-loop-closure", a->no_loop_closure,
                 "No loop closure (by default a keyframe whose colour features register against an older one "
                 "closes a loop: a pose graph corrects the trajectory and the map is integrated again)");
+  cmd->add_flag("--no-refine", a->no_refine,
+                "No keyframe refinement (by default, at the end, every keyframe's depth is aligned with its "
+                "overlapping keyframes' at once; when that moves a keyframe by over 2 cm or 1 degree, the "
+                "frames move with their keyframes and the map is integrated again)");
   cmd->add_flag("--dense", a->dense, "Keep the TSDF in a dense grid of --bricks^3 bricks instead (the same pipeline, for comparison)");
   cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)");
   cmd->add_flag("-q,--quiet", a->quiet, "No summary");

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "vola/error.hpp"
+#include "vola/slam/keyframe_refinement.hpp"
 
 namespace vola::slam {
 
@@ -128,14 +129,47 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     result.loop_corrected = result.loop_disagreement.metres > options.params.loop_min_correction ||
                             result.loop_disagreement.degrees > options.params.loop_min_correction_degrees;
   }
+  if (!fusion || options.groundtruth_poses) return result;
+  std::vector<Pose> poses;
+  for (const auto& p : result.trajectory) poses.push_back(p.pose);
+  std::vector<KeyframePose> keyframes = fusion->keyframe_poses();
   if (result.loop_corrected) {
+    const LoopCorrection correction = correct_trajectory(poses, keyframes, fusion->loops());
+    result.loop_max_move = correction.max_keyframe_move;
+    poses = correction.poses;
+    for (KeyframePose& k : keyframes) k.pose = poses[k.frame];
+  }
+  bool refined = false;
+  if (options.params.refine_keyframes && keyframes.size() >= 2) {
+    const auto refine_start = std::chrono::steady_clock::now();
+    std::vector<VertexMap> views;
+    std::vector<Pose> keyframe_poses;
+    for (const KeyframePose& k : keyframes) {
+      const SequenceFrame& frame = sequence.frames[sequence_index.at(k.frame)];
+      views.push_back(keyframe_view(read_depth(frame.depth_path, options.depth_factor), options.intrinsics,
+                                    options.params));
+      keyframe_poses.push_back(k.pose);
+    }
+    KeyframeRefinementParams refine;
+    refine.min_depth = options.params.min_depth;
+    refine.max_depth = options.params.max_depth;
+    refine.threads = options.params.threads;
+    refine.sample_step = std::max(1, refine.sample_step >> options.params.refine_level);
+    const KeyframeRefinementResult refinement = refine_keyframes(
+        views, keyframe_poses, keyframe_view_intrinsics(options.intrinsics, options.params), refine);
+    result.refinement_pairs = refinement.pairs;
+    result.refinement_max_move = refinement.max_move_metres;
+    result.refinement_max_move_degrees = refinement.max_move_degrees;
+    refined = refinement.improved && (refinement.max_move_metres > options.params.refine_min_move ||
+                                      refinement.max_move_degrees > options.params.refine_min_move_degrees);
+    if (refined) poses = move_with_keyframes(poses, keyframes, refinement.poses);
+    result.refined = refined;
+    result.refinement_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count();
+  }
+  if (result.loop_corrected || refined) {
     // The map again, every integrated frame at its corrected pose.
     const auto again_start = std::chrono::steady_clock::now();
-    std::vector<Pose> poses;
-    for (const auto& p : result.trajectory) poses.push_back(p.pose);
-    const LoopCorrection correction = correct_trajectory(poses, fusion->keyframe_poses(), fusion->loops());
-    result.loop_max_move = correction.max_keyframe_move;
-    for (std::size_t f = 0; f < poses.size(); ++f) result.trajectory[f].pose = correction.poses[f];
+    for (std::size_t f = 0; f < poses.size(); ++f) result.trajectory[f].pose = poses[f];
     fusion.reset();
     store.clear();
     Fusion<Store> again(store, options.intrinsics, result.width, result.height, options.params);
@@ -144,7 +178,7 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
       const SequenceFrame& frame = sequence.frames[sequence_index[f]];
       const DepthImage depth = read_depth(frame.depth_path, options.depth_factor);
       const std::optional<RgbImage> rgb = read_colour(frame, depth);
-      again.integrate_at_pose(depth, rgb ? &*rgb : nullptr, correction.poses[f]);
+      again.integrate_at_pose(depth, rgb ? &*rgb : nullptr, poses[f]);
     }
     result.reintegration_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - again_start).count();
   }

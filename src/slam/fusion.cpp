@@ -39,6 +39,10 @@ void FusionParams::check() const {
   if (feature.max_features < 10 || feature.min_inliers < 3 || feature.ransac_iterations < 1 ||
       !(feature.ratio > 0.0 && feature.ratio <= 1.0) || feature.max_hamming < 0 || feature.max_hamming > 256)
     throw InvalidArgument("feature parameters out of range");
+  if (refine_level < 0 || refine_level >= kPyramidLevels)
+    throw InvalidArgument("keyframe refinement level must be 0 .. " + std::to_string(kPyramidLevels - 1));
+  if (!(refine_min_move >= 0.0 && refine_min_move_degrees >= 0.0))
+    throw InvalidArgument("keyframe refinement thresholds must not be negative");
 }
 
 namespace {

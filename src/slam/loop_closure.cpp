@@ -15,6 +15,15 @@ PoseGraphEdge edge(std::size_t from, std::size_t to, const Pose& measured, doubl
   return {from, to, measured, 1.0 / (metres * metres), 1.0 / (radians * radians)};
 }
 
+// The keyframes' indices in frame order (a lost frame placed later becomes a keyframe late).
+std::vector<std::size_t> frame_order(const std::vector<KeyframePose>& keyframes) {
+  std::vector<std::size_t> chain(keyframes.size());
+  for (std::size_t k = 0; k < chain.size(); ++k) chain[k] = k;
+  std::stable_sort(chain.begin(), chain.end(),
+                   [&](std::size_t a, std::size_t b) { return keyframes[a].frame < keyframes[b].frame; });
+  return chain;
+}
+
 }  // namespace
 
 LoopDisagreement loop_disagreement(const std::vector<KeyframePose>& keyframes, const std::vector<LoopEdge>& loops) {
@@ -43,11 +52,7 @@ LoopCorrection correct_trajectory(const std::vector<Pose>& frame_poses, const st
   LoopCorrection out;
   out.poses = frame_poses;
   if (keyframes.size() < 2 || loops.empty()) return out;
-  // The keyframes in frame order (a lost frame placed later becomes a keyframe late).
-  std::vector<std::size_t> chain(keyframes.size());
-  for (std::size_t k = 0; k < chain.size(); ++k) chain[k] = k;
-  std::stable_sort(chain.begin(), chain.end(),
-                   [&](std::size_t a, std::size_t b) { return keyframes[a].frame < keyframes[b].frame; });
+  const std::vector<std::size_t> chain = frame_order(keyframes);
   // Graph node j is chain[j]; the graph holds node 0, the first keyframe, fixed.
   std::vector<Pose> ordered(chain.size());
   std::vector<std::size_t> place(chain.size());
@@ -60,14 +65,34 @@ LoopCorrection correct_trajectory(const std::vector<Pose>& frame_poses, const st
     edges.push_back(edge(j - 1, j, Pose(ordered[j - 1].inverse() * ordered[j]), 0.01, 0.5));
   for (const LoopEdge& loop : loops) edges.push_back(edge(place[loop.older], place[loop.newer], loop.measured, 0.02, 1.0));
   out.graph = optimise_pose_graph(ordered, edges);
+  std::vector<Pose> moved(keyframes.size());
+  for (std::size_t j = 0; j < chain.size(); ++j) {
+    moved[chain[j]] = ordered[j];
+    out.max_keyframe_move =
+        std::max(out.max_keyframe_move, (ordered[j].translation() - keyframes[chain[j]].pose.translation()).norm());
+  }
+  out.poses = move_with_keyframes(frame_poses, keyframes, moved);
+  return out;
+}
+
+std::vector<Pose> move_with_keyframes(const std::vector<Pose>& frame_poses, const std::vector<KeyframePose>& keyframes,
+                                      const std::vector<Pose>& moved) {
+  if (moved.size() != keyframes.size())
+    throw InvalidArgument("moving frames with their keyframes: " + std::to_string(moved.size()) + " poses for " +
+                          std::to_string(keyframes.size()) + " keyframes");
+  for (std::size_t k = 0; k < keyframes.size(); ++k)
+    if (keyframes[k].frame >= frame_poses.size())
+      throw InvalidArgument("moving frames with their keyframes: keyframe " + std::to_string(k) + " names frame " +
+                            std::to_string(keyframes[k].frame) + " of " + std::to_string(frame_poses.size()));
+  if (keyframes.empty()) return frame_poses;
+  const std::vector<std::size_t> chain = frame_order(keyframes);
+  std::vector<Pose> out(frame_poses.size());
   std::size_t anchor = 0;  // position in the chain
   for (std::size_t f = 0; f < frame_poses.size(); ++f) {
     while (anchor + 1 < chain.size() && keyframes[chain[anchor + 1]].frame <= f) ++anchor;
-    out.poses[f] = ordered[anchor] * keyframes[chain[anchor]].pose.inverse() * frame_poses[f];
+    const std::size_t k = chain[anchor];
+    out[f] = moved[k] * keyframes[k].pose.inverse() * frame_poses[f];
   }
-  for (std::size_t j = 0; j < chain.size(); ++j)
-    out.max_keyframe_move =
-        std::max(out.max_keyframe_move, (ordered[j].translation() - keyframes[chain[j]].pose.translation()).norm());
   return out;
 }
 

@@ -40,7 +40,16 @@ struct FuseResult {
   LoopDisagreement loop_disagreement;
   bool loop_corrected = false;
   double loop_max_move = 0.0;
-  double reintegration_seconds = 0.0;
+  // Keyframe refinement (FusionParams::refine_keyframes): keyframe pairs aligned, the
+  // largest move it made (metres, degrees; 0 when it did not improve the alignment) and
+  // whether the trajectory took it (a move above FusionParams::refine_min_move), and the
+  // time it took (not part of `seconds`; integrating the map again is in
+  // reintegration_seconds).
+  std::size_t refinement_pairs = 0;
+  double refinement_max_move = 0.0, refinement_max_move_degrees = 0.0;
+  bool refined = false;
+  double refinement_seconds = 0.0;
+  double reintegration_seconds = 0.0;  // integrating the map again after loop closure or refinement
   std::uint32_t width = 0, height = 0;
   // Implausible input that did not stop the run (depth in the wrong unit, most of the
   // depth outside the depth range), each naming the file.

@@ -42,6 +42,13 @@ LoopDisagreement loop_disagreement(const std::vector<KeyframePose>& keyframes, c
 // (features are less precise than ICP). Frame f moves with the last keyframe at or
 // before it (the first keyframe for frames before it). Throws InvalidArgument for a
 // keyframe or loop naming a frame or keyframe that does not exist.
+// Every frame moved with its keyframe: frame f, tracked after keyframe a (the last one
+// at or before it in frame order; the first keyframe for frames before it), becomes
+// moved[a] * keyframes[a].pose^-1 * frame_poses[f]. Throws InvalidArgument when moved
+// and keyframes differ in number or a keyframe names a frame that does not exist.
+std::vector<Pose> move_with_keyframes(const std::vector<Pose>& frame_poses, const std::vector<KeyframePose>& keyframes,
+                                      const std::vector<Pose>& moved);
+
 LoopCorrection correct_trajectory(const std::vector<Pose>& frame_poses, const std::vector<KeyframePose>& keyframes,
                                   const std::vector<LoopEdge>& loops);
 
