@@ -112,14 +112,14 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
                 result.loop_edges, result.loop_edges == 1 ? "" : "s", result.loop_disagreement.metres,
                 result.loop_disagreement.degrees);
   if (result.refined)
-    std::printf("keyframe refinement: %zu keyframe pairs aligned, keyframes moved by up to %.3f m / %.2f deg (%.2f s); "
-                "map integrated again in %.2f s\n",
-                result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
+    std::printf("keyframe refinement: %zu keyframes, %zu pairs aligned, keyframes moved by up to %.3f m / %.2f deg "
+                "(%.2f s); map integrated again in %.2f s\n",
+                result.keyframes, result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
                 result.refinement_seconds, result.reintegration_seconds);
   else if (result.refinement_pairs)
-    std::printf("keyframe refinement: %zu keyframe pairs aligned, keyframes would move by up to %.3f m / %.2f deg "
-                "(%.2f s): trajectory kept\n",
-                result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
+    std::printf("keyframe refinement: %zu keyframes, %zu pairs aligned, keyframes would move by up to %.3f m / "
+                "%.2f deg (%.2f s): trajectory kept\n",
+                result.keyframes, result.refinement_pairs, result.refinement_max_move, result.refinement_max_move_degrees,
                 result.refinement_seconds);
   print_memory(store, options.params.voxel_size);
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),

@@ -133,6 +133,7 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
   std::vector<Pose> poses;
   for (const auto& p : result.trajectory) poses.push_back(p.pose);
   std::vector<KeyframePose> keyframes = fusion->keyframe_poses();
+  result.keyframes = keyframes.size();
   if (result.loop_corrected) {
     const LoopCorrection correction = correct_trajectory(poses, keyframes, fusion->loops());
     result.loop_max_move = correction.max_keyframe_move;
@@ -140,23 +141,34 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     for (KeyframePose& k : keyframes) k.pose = poses[k.frame];
   }
   bool refined = false;
-  if (options.params.refine_keyframes && keyframes.size() >= 2) {
+  int level = options.params.refine_level;  // the finest whose views fit refine_memory
+  const auto views_fit = [&] {
+    return keyframes.size() * keyframe_view_bytes(result.width, result.height, level) <= options.params.refine_memory;
+  };
+  while (level + 1 < kPyramidLevels && !views_fit()) ++level;
+  const bool refine = options.params.refine_keyframes && keyframes.size() >= 2;
+  if (refine && !views_fit())
+    result.warnings.push_back("keyframe refinement skipped: the views of " + std::to_string(keyframes.size()) +
+                              " keyframes need more than FusionParams::refine_memory (" +
+                              std::to_string(options.params.refine_memory >> 20) + " MiB) even at a quarter size");
+  if (refine && views_fit()) {
     const auto refine_start = std::chrono::steady_clock::now();
+    result.refinement_level = level;
     std::vector<VertexMap> views;
     std::vector<Pose> keyframe_poses;
     for (const KeyframePose& k : keyframes) {
       const SequenceFrame& frame = sequence.frames[sequence_index.at(k.frame)];
       views.push_back(keyframe_view(read_depth(frame.depth_path, options.depth_factor), options.intrinsics,
-                                    options.params));
+                                    options.params, level));
       keyframe_poses.push_back(k.pose);
     }
-    KeyframeRefinementParams refine;
-    refine.min_depth = options.params.min_depth;
-    refine.max_depth = options.params.max_depth;
-    refine.threads = options.params.threads;
-    refine.sample_step = std::max(1, refine.sample_step >> options.params.refine_level);
+    KeyframeRefinementParams settings;
+    settings.min_depth = options.params.min_depth;
+    settings.max_depth = options.params.max_depth;
+    settings.threads = options.params.threads;
+    settings.sample_step = std::max(1, settings.sample_step >> level);  // the same pixels at any level
     const KeyframeRefinementResult refinement = refine_keyframes(
-        views, keyframe_poses, keyframe_view_intrinsics(options.intrinsics, options.params), refine);
+        views, keyframe_poses, keyframe_view_intrinsics(options.intrinsics, level), settings);
     result.refinement_pairs = refinement.pairs;
     result.refinement_max_move = refinement.max_move_metres;
     result.refinement_max_move_degrees = refinement.max_move_degrees;

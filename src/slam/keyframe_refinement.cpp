@@ -258,19 +258,23 @@ void KeyframeRefinementParams::check() const {
     throw InvalidArgument("keyframe refinement: the depth range must be increasing and not negative");
 }
 
-Intrinsics keyframe_view_intrinsics(const Intrinsics& k, const FusionParams& params) {
-  Intrinsics level = k;
-  for (int l = 0; l < params.refine_level; ++l) level = level.halved();
-  return level;
+Intrinsics keyframe_view_intrinsics(const Intrinsics& k, int level) {
+  Intrinsics out = k;
+  for (int l = 0; l < level; ++l) out = out.halved();
+  return out;
 }
 
-VertexMap keyframe_view(DepthImage depth, const Intrinsics& k, const FusionParams& params) {
+std::size_t keyframe_view_bytes(std::uint32_t width, std::uint32_t height, int level) {
+  return std::size_t{width >> level} * (height >> level) * 2 * sizeof(Eigen::Vector3f);
+}
+
+VertexMap keyframe_view(DepthImage depth, const Intrinsics& k, const FusionParams& params, int level) {
   for (float& d : depth.metres)
     if (!(d >= params.min_depth && d <= params.max_depth)) d = 0.0f;
   depth = bilateral_filter(depth, params.bilateral_radius, params.bilateral_sigma_space, params.bilateral_sigma_depth,
                            params.threads);
-  for (int l = 0; l < params.refine_level; ++l) depth = halve_depth(depth, params.bilateral_sigma_depth);
-  return vertex_normal_map(depth, keyframe_view_intrinsics(k, params));
+  for (int l = 0; l < level; ++l) depth = halve_depth(depth, params.bilateral_sigma_depth);
+  return vertex_normal_map(depth, keyframe_view_intrinsics(k, level));
 }
 
 KeyframeRefinementResult refine_keyframes(const std::vector<VertexMap>& views, const std::vector<Pose>& poses,

@@ -7,6 +7,7 @@
 
 #include "slam_test_support.hpp"
 #include "vola/error.hpp"
+#include "vola/slam/fuse_sequence.hpp"
 #include "vola/slam/keyframe_refinement.hpp"
 
 namespace {
@@ -28,9 +29,9 @@ Keyframes room_keyframes(const fs::path& dir) {
   const Sequence s = read_sequence(dir.string());
   Keyframes out;
   const FusionParams params;  // the views vola fuse aligns: half size, bilateral-filtered
-  out.k = keyframe_view_intrinsics(*s.intrinsics, params);
+  out.k = keyframe_view_intrinsics(*s.intrinsics, params.refine_level);
   for (std::size_t f = 0; f < s.frames.size(); f += 4) {
-    out.views.push_back(keyframe_view(read_depth(s.frames[f].depth_path, 5000.0), *s.intrinsics, params));
+    out.views.push_back(keyframe_view(read_depth(s.frames[f].depth_path, 5000.0), *s.intrinsics, params, params.refine_level));
     out.truth.push_back(s.groundtruth.at(f).pose);
   }
   return out;
@@ -110,6 +111,35 @@ TEST(SlamKeyframeRefinement, KeyframesThatSeeNothingInCommonStayWhereTheyAre) {
   EXPECT_EQ(r.pairs, 0u);
   EXPECT_FALSE(r.improved);
   EXPECT_TRUE(r.poses[1].isApprox(poses[1]));
+}
+
+TEST(SlamKeyframeRefinement, ViewsShrinkToTheMemoryBudgetOrTheRefinementIsSkipped) {
+  ScratchDir dir("refine_budget");
+  vola_slam_test::make_room_sequence(dir.path(), 12, 320, 240, 3.0, true);
+  const Sequence s = read_sequence(dir.path().string());
+  FuseOptions o;
+  o.intrinsics = *s.intrinsics;
+  o.params = vola_slam_test::small_scene_params();
+  const auto fuse = [&](std::size_t budget) {
+    o.params.refine_memory = budget;
+    SparseTsdfStore store(centred_geometry(Eigen::Vector3d::Zero(), o.params.voxel_size, 512));
+    return fuse_sequence(s, o, store);
+  };
+  const FuseResult roomy = fuse(std::size_t{512} << 20);
+  EXPECT_EQ(roomy.refinement_level, 1);
+  EXPECT_GT(roomy.refinement_pairs, 0u);
+  EXPECT_TRUE(roomy.warnings.empty());
+  ASSERT_GE(roomy.keyframes, 2u);
+  // Room for the quarter-size views of every keyframe, not the half-size ones.
+  const FuseResult tight = fuse(roomy.keyframes * keyframe_view_bytes(320, 240, 2));
+  EXPECT_EQ(tight.refinement_level, 2);
+  const FuseResult none = fuse(1);
+  EXPECT_EQ(none.refinement_level, -1);
+  EXPECT_EQ(none.refinement_pairs, 0u);
+  ASSERT_EQ(none.warnings.size(), 1u);
+  EXPECT_NE(none.warnings[0].find("keyframe refinement skipped"), std::string::npos);
+  // Only the refinement differs: the tracked trajectory is the same.
+  ASSERT_EQ(none.trajectory.size(), roomy.trajectory.size());
 }
 
 TEST(SlamKeyframeRefinement, BadInputIsRefused) {

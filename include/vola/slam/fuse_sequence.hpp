@@ -45,9 +45,11 @@ struct FuseResult {
   // whether the trajectory took it (a move above FusionParams::refine_min_move), and the
   // time it took (not part of `seconds`; integrating the map again is in
   // reintegration_seconds).
+  std::size_t keyframes = 0;
   std::size_t refinement_pairs = 0;
   double refinement_max_move = 0.0, refinement_max_move_degrees = 0.0;
   bool refined = false;
+  int refinement_level = -1;  // the pyramid level of the views aligned; -1: not run (too many keyframes for refine_memory, or off)
   double refinement_seconds = 0.0;
   double reintegration_seconds = 0.0;  // integrating the map again after loop closure or refinement
   std::uint32_t width = 0, height = 0;

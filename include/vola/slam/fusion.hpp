@@ -116,8 +116,11 @@ struct FusionParams {
   // quarter of the tracking time, for millimetres where tracking already holds (the
   // generated 300-frame room: 0.33 to 0.20 cm, keyframes moved by up to 1 cm / 0.55
   // degrees). Real frames far apart move by centimetres (the Kinect frames: 12 cm).
+  // The views are halved further while all of them together would exceed refine_memory
+  // bytes; when even the smallest level would, the refinement is skipped (and said so).
   bool refine_keyframes = true;
   int refine_level = 1;
+  std::size_t refine_memory = std::size_t{512} << 20;
   double refine_min_move = 0.02, refine_min_move_degrees = 1.0;
   unsigned threads = 0;  // 0 = vola::thread_count() (the hardware's count unless set)
   // Throws InvalidArgument for values that make no sense.

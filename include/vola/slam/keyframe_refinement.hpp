@@ -46,10 +46,11 @@ struct KeyframeRefinementResult {
 
 // A keyframe's depth as the refinement aligns it: clipped to the depth range,
 // bilateral-filtered as tracking does (normals of raw Kinect depth scatter by tens of
-// degrees), halved params.refine_level times, as camera-coordinate vertices and normals.
-VertexMap keyframe_view(DepthImage depth, const Intrinsics& k, const FusionParams& params);
-// The intrinsics of those views.
-Intrinsics keyframe_view_intrinsics(const Intrinsics& k, const FusionParams& params);
+// degrees), halved `level` times, as camera-coordinate vertices and normals.
+VertexMap keyframe_view(DepthImage depth, const Intrinsics& k, const FusionParams& params, int level);
+// The intrinsics of those views, and the bytes one of them holds for a width x height frame.
+Intrinsics keyframe_view_intrinsics(const Intrinsics& k, int level);
+std::size_t keyframe_view_bytes(std::uint32_t width, std::uint32_t height, int level);
 
 // `views` are the keyframes' vertex/normal maps in camera coordinates (keyframe_view),
 // `poses` their camera-to-world poses, `k` the intrinsics of the views.
