@@ -1,6 +1,9 @@
 #include "vola/slam/preprocess.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "vola/parallel.hpp"
@@ -10,60 +13,80 @@ namespace vola::slam {
 namespace {
 constexpr std::size_t kRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
 
-// exp(-x) for x >= 0, linear between 4096 samples over [0, 32] (absolute error under
-// 8e-6) and 0 beyond (e^-32 is 1e-14): the bilateral filter's depth weights, which took
-// half of the filter's time in libm's exp.
-class NegativeExpTable {
- public:
-  static constexpr double kEnd = 32.0;
-  static constexpr int kSteps = 4096;
-  NegativeExpTable() {
-    for (int i = 0; i <= kSteps + 1; ++i) values_[i] = std::exp(-i * (kEnd / kSteps));
-  }
-  double operator()(double x) const {
-    if (!(x < kEnd)) return 0.0;
-    const double at = x * (kSteps / kEnd);
-    const int i = static_cast<int>(at);
-    return values_[i] + (at - i) * (values_[i + 1] - values_[i]);
-  }
-
- private:
-  double values_[kSteps + 2];
-};
+// exp(-x) for 0 <= x (clamped at 80, where it is 2e-35), as 2^-(x log2 e): the integer
+// part goes into the float's exponent bits, the fraction (in (-1, 0]) through a degree-7
+// Taylor polynomial of 2^f (relative error under 2e-6). The depth weights took half of
+// the filter's time in libm's exp, and a lookup table's gathers kept the loop scalar
+// (7.5 ns per tap at 320 x 240). No float comparison either: under the default
+// -ftrapping-math GCC will not turn a float select into vector code, so the clamp
+// compares bit patterns (ordered like the values for non-negative floats).
+inline float negative_exp(float x) {
+  const float clamped =
+      std::bit_cast<float>(std::min(std::bit_cast<std::int32_t>(x), std::bit_cast<std::int32_t>(80.0f)));
+  const float t = -clamped * 1.44269504f;
+  const auto whole = static_cast<std::int32_t>(t);  // toward zero: t - whole is in (-1, 0]
+  const float f = (t - static_cast<float>(whole)) * 0.693147181f;
+  float p = 1.0f / 5040;
+  p = p * f + 1.0f / 720;
+  p = p * f + 1.0f / 120;
+  p = p * f + 1.0f / 24;
+  p = p * f + 1.0f / 6;
+  p = p * f + 0.5f;
+  p = p * f + 1.0f;
+  p = p * f + 1.0f;
+  return p * std::bit_cast<float>((whole + 127) << 23);
+}
 }  // namespace
 
+// Tap by tap over whole rows rather than pixel by pixel: for each of the (2r + 1)^2
+// offsets, one pass along the row accumulates weight x (depth - centre depth) and weight
+// for every pixel, which the compiler vectorises (in floats, the differences keep the
+// sums' rounding far below a micrometre). The image is padded by r with zeros (holes, so
+// weight 0) so that no pass tests the borders.
 DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_space, double sigma_depth,
                             unsigned threads) {
   DepthImage out{depth.width, depth.height, std::vector<float>(depth.metres.size(), 0.0f)};
-  const double space = 1.0 / (2 * sigma_space * sigma_space), range = 1.0 / (2 * sigma_depth * sigma_depth);
-  std::vector<double> spatial((2 * radius + 1) * (2 * radius + 1));
+  const int w = static_cast<int>(depth.width), h = static_cast<int>(depth.height);
+  const int side = 2 * radius + 1;
+  const float range = static_cast<float>(1.0 / (2 * sigma_depth * sigma_depth));
+  std::vector<float> spatial(std::size_t(side) * side);
   for (int dy = -radius; dy <= radius; ++dy)
     for (int dx = -radius; dx <= radius; ++dx)
-      spatial[(dy + radius) * (2 * radius + 1) + dx + radius] = std::exp(-(dx * dx + dy * dy) * space);
-  static const NegativeExpTable negative_exp;
-  const int w = static_cast<int>(depth.width), h = static_cast<int>(depth.height);
+      spatial[std::size_t(dy + radius) * side + dx + radius] =
+          static_cast<float>(std::exp(-(dx * dx + dy * dy) / (2 * sigma_space * sigma_space)));
+  const std::size_t padded_width = std::size_t(w) + 2 * radius;
+  std::vector<float> padded(padded_width * (std::size_t(h) + 2 * radius), 0.0f);
+  for (int y = 0; y < h; ++y)
+    std::copy_n(depth.metres.data() + std::size_t(y) * w, w, padded.data() + (y + radius) * padded_width + radius);
   ParallelOptions parallel;
   parallel.threads = threads;
   parallel.grain = kRowsPerChunk;
   parallel.name = "slam.bilateral_filter";
   const auto filter_rows = [&](std::size_t begin, std::size_t end) {
-    for (int y = static_cast<int>(begin); y < static_cast<int>(end); ++y)
-      for (int x = 0; x < w; ++x) {
-        const float centre = depth.metres[std::size_t(y) * w + x];
-        if (centre <= 0.0f) continue;
-        double sum = 0.0, weights = 0.0;
-        for (int dy = std::max(-radius, -y); dy <= std::min(radius, h - 1 - y); ++dy)
-          for (int dx = std::max(-radius, -x); dx <= std::min(radius, w - 1 - x); ++dx) {
-            const float d = depth.metres[std::size_t(y + dy) * w + x + dx];
-            if (d <= 0.0f) continue;
-            const double diff = d - centre;
-            const double weight =
-                spatial[(dy + radius) * (2 * radius + 1) + dx + radius] * negative_exp(diff * diff * range);
-            sum += weight * d;
-            weights += weight;
+    std::vector<float> sums(w), weights(w);
+    for (int y = static_cast<int>(begin); y < static_cast<int>(end); ++y) {
+      std::fill(sums.begin(), sums.end(), 0.0f);
+      std::fill(weights.begin(), weights.end(), 0.0f);
+      const float* centre = depth.metres.data() + std::size_t(y) * w;
+      for (int dy = 0; dy < side; ++dy)
+        for (int dx = 0; dx < side; ++dx) {
+          const float* row = padded.data() + (y + dy) * padded_width + dx;  // offset (dx - r, dy - r)
+          const std::int32_t s = std::bit_cast<std::int32_t>(spatial[std::size_t(dy) * side + dx]);
+          float* sum = sums.data();
+          float* weight = weights.data();
+          for (int x = 0; x < w; ++x) {
+            const float d = row[x], diff = d - centre[x];
+            // Computed for holes too, then zeroed by masking the spatial weight's bits
+            // (a branch or a float select would keep the loop scalar).
+            const std::int32_t valid = -static_cast<std::int32_t>(std::bit_cast<std::int32_t>(d) > 0);
+            const float wt = std::bit_cast<float>(s & valid) * negative_exp(diff * diff * range);
+            sum[x] += wt * diff;
+            weight[x] += wt;
           }
-        out.metres[std::size_t(y) * w + x] = static_cast<float>(sum / weights);
-      }
+        }
+      float* target = out.metres.data() + std::size_t(y) * w;
+      for (int x = 0; x < w; ++x) target[x] = centre[x] > 0.0f ? centre[x] + sums[x] / weights[x] : 0.0f;
+    }
   };
   parallel_for(depth.height, filter_rows, parallel);
   return out;
