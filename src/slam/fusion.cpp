@@ -51,6 +51,7 @@ namespace {
 // are written per pixel and per brick, so the chunking does not change them.
 constexpr std::size_t kRowsPerChunk = 4;
 constexpr std::size_t kBricksPerChunk = 16;
+constexpr std::size_t kTrackBands = 16;  // partial sums of the ICP and photometric terms
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -104,8 +105,11 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
                                   const Eigen::Vector3d& d, double t_near, double t_far, double truncation,
                                   bool with_normal) {
   const double vs = geometry.voxel_size;
-  const Eigen::Vector3d go = (o - geometry.origin) / vs;
-  auto grid_at = [&](double t) -> Eigen::Vector3d { return go + d * (t / vs); };
+  // Grid coordinates along the ray, and the inverse direction for the brick exits: no
+  // division per step.
+  const Eigen::Vector3d go = (o - geometry.origin) / vs, dg = d / vs;
+  const Eigen::Vector3d inverse_d(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
+  auto grid_at = [&](double t) -> Eigen::Vector3d { return go + dg * t; };
   double t = t_near, t_prev = 0.0, f_prev = 0.0;
   bool prev_valid = false;
   while (t < t_far) {
@@ -120,7 +124,7 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
       for (int a = 0; a < 3; ++a) {
         if (d[a] == 0.0) continue;
         const double plane = static_cast<double>((d[a] > 0 ? cell[a] + 1 : cell[a]) * kBrickSide);
-        exit = std::min(exit, (plane - go[a]) / d[a] * vs);
+        exit = std::min(exit, (plane - go[a]) * inverse_d[a] * vs);
       }
       t = std::max(t + vs * 1e-3, exit + vs * 1e-3);
       prev_valid = false;
@@ -337,6 +341,10 @@ std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics
                                        const VolumeGeometry& geometry, double truncation, unsigned threads) {
   const double brick_metres = kBrickSide * geometry.voxel_size;
   const double side = geometry.bricks_per_side;
+  // Brick coordinates of the camera centre and of the rotation, so that a sample at depth
+  // z along a pixel's ray is camera_in_bricks + (rotation_in_bricks * dir) z.
+  const Eigen::Vector3d camera_in_bricks = (pose.translation() - geometry.origin) / brick_metres;
+  const Eigen::Matrix3d rotation_in_bricks = pose.linear() / brick_metres;
   // Each band of rows collects its keys sorted and unique (neighbouring pixels share
   // most bricks, so the bands' lists are short), then the lists are merged: a set, the
   // same whatever the bands.
@@ -358,10 +366,11 @@ std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics
             // Depth steps short enough that consecutive samples are at most half a brick apart.
             const double step = brick_metres / (2 * dir.norm());
             const int samples = static_cast<int>(std::ceil(2 * truncation / step));
+            const Eigen::Vector3d along = rotation_in_bricks * dir;  // bricks per metre of depth
             for (int s = 0; s <= samples; ++s) {
               const double z = d - truncation + 2 * truncation * s / samples;
               if (z <= 0.0) continue;
-              const Eigen::Vector3d g = (pose * (dir * z) - geometry.origin) / brick_metres;
+              const Eigen::Vector3d g = camera_in_bricks + along * z;
               const double bx = std::floor(g.x()), by = std::floor(g.y()), bz = std::floor(g.z());
               if (!(bx >= 0 && by >= 0 && bz >= 0 && bx < side && by < side && bz < side)) continue;
               const std::uint64_t key = static_cast<std::uint64_t>(bz) << 42 | static_cast<std::uint64_t>(by) << 21 |
@@ -417,8 +426,39 @@ struct IcpFrame {
   double max_distance, cos_max;   // association limits: distance, normal angle
 };
 
-// One partial sum per thread, over equal bands of rows, added in band order: the same
-// sums for the same thread count (not across thread counts: the bands move).
+// Running sums of weight jac jac^T (its upper triangle) and -weight jac r in plain local
+// arrays: summed into the band's IcpSums in the shared vector, every addition was a
+// store the compiler could not keep in registers (it may alias the frame's data), and
+// Eigen's rankUpdate is a call per point that does not inline.
+class NormalEquations {
+ public:
+  void add(const Vec6& jac, double weight, double residual) {
+    int k = 0;
+    for (int col = 0; col < 6; ++col) {
+      const double weighted = weight * jac[col];
+      for (int row = 0; row <= col; ++row) a_[k++] += weighted * jac[row];
+      b_[col] -= weighted * residual;
+    }
+    ++count_;
+  }
+  IcpSums sums() const {
+    IcpSums out;
+    int k = 0;
+    for (int col = 0; col < 6; ++col) {
+      for (int row = 0; row <= col; ++row) out.a(row, col) = a_[k++];
+      out.b[col] = b_[col];
+    }
+    out.count = count_;
+    return out;
+  }
+
+ private:
+  double a_[21] = {}, b_[6] = {};
+  int count_ = 0;
+};
+
+// One partial sum per band of rows, added in band order: the same sums on any number
+// of threads.
 // Updates rotate about the estimate's camera centre, then translate. About the world
 // origin instead, a camera metres away couples every rotation with a large translation:
 // the 6x6 system's conditioning (and the degeneracy test) then depended on where the
@@ -428,37 +468,36 @@ IcpSums icp_sums(const IcpFrame& f, const Pose& estimate, const ParallelOptions&
   std::vector<IcpSums> sums(bands.chunks);
   const Eigen::Matrix3d rotation = estimate.linear();
   const Eigen::Vector3d centre = estimate.translation();
+  const Pose to_previous = f.previous_inverse * estimate;  // this frame's camera to the model's
   const VertexMap& current = f.current;
   const VertexMap& model = f.model;
+  const double fx = f.k.fx, fy = f.k.fy, cx = f.k.cx, cy = f.k.cy;
+  const double max_squared = f.max_distance * f.max_distance, cos_max = f.cos_max;
+  const double model_width = model.width, model_height = model.height;
   const auto sum_rows = [&](const Chunk& chunk) {
-    IcpSums& s = sums[chunk.index];
+    NormalEquations equations;
     for (std::size_t y = chunk.begin; y < chunk.end; ++y)
       for (std::uint32_t x = 0; x < current.width; ++x) {
         const std::size_t i = y * current.width + x;
         if (!current.valid(i)) continue;
-        const Eigen::Vector3d p = estimate * current.vertices[i].template cast<double>();
-        const Eigen::Vector3d n = rotation * current.normals[i].template cast<double>();
-        const Eigen::Vector3d q = f.previous_inverse * p;
+        const Eigen::Vector3d c = current.vertices[i].template cast<double>();
+        const Eigen::Vector3d q = to_previous * c;
         if (q.z() <= 0.0) continue;
-        const double u = std::floor(f.k.fx * q.x() / q.z() + f.k.cx + 0.5),
-                     v = std::floor(f.k.fy * q.y() / q.z() + f.k.cy + 0.5);
-        if (!(u >= 0 && v >= 0 && u < model.width && v < model.height)) continue;
+        const double inverse_z = 1.0 / q.z();
+        const double u = std::floor(fx * q.x() * inverse_z + cx + 0.5), v = std::floor(fy * q.y() * inverse_z + cy + 0.5);
+        if (!(u >= 0 && v >= 0 && u < model_width && v < model_height)) continue;
         const std::size_t j = static_cast<std::size_t>(v) * model.width + static_cast<std::size_t>(u);
         if (!model.valid(j)) continue;
+        const Eigen::Vector3d p = estimate * c;
         const Eigen::Vector3d vm = model.vertices[j].template cast<double>(), nm = model.normals[j].template cast<double>();
         const Eigen::Vector3d diff = p - vm;
-        if (diff.squaredNorm() > f.max_distance * f.max_distance) continue;
-        if (n.dot(nm) < f.cos_max) continue;
+        if (diff.squaredNorm() > max_squared) continue;
+        if ((rotation * current.normals[i].template cast<double>()).dot(nm) < cos_max) continue;
         Vec6 jac;
         jac << (p - centre).cross(nm), nm;
-        const double r = nm.dot(diff);
-        // The upper triangle of jac jac^T, written out: Eigen's rankUpdate is a call
-        // per point that does not inline (a quarter of the ICP time at 640 x 480).
-        for (int col = 0; col < 6; ++col)
-          for (int row = 0; row <= col; ++row) s.a(row, col) += jac[col] * jac[row];
-        s.b -= jac * r;
-        ++s.count;
+        equations.add(jac, 1.0, nm.dot(diff));
       }
+    sums[chunk.index] = equations.sums();
   };
   parallel_for(current.height, sum_rows, bands);
   IcpSums total;
@@ -529,7 +568,7 @@ IcpSums photometric_sums(const PhotometricFrame& f, const Pose& estimate, const 
   const Eigen::Vector3d centre = estimate.translation();
   const IntensityImage& ref = f.reference_intensity;
   const auto sum_rows = [&](const Chunk& chunk) {
-    IcpSums& s = sums[chunk.index];
+    NormalEquations equations;
     for (std::size_t y = std::max<std::size_t>(chunk.begin, 1); y < chunk.end && y + 1 < ref.height; ++y)
       for (std::uint32_t x = 1; x + 1 < ref.width; ++x) {
         const std::size_t i = y * ref.width + x;
@@ -554,11 +593,9 @@ IcpSums photometric_sums(const PhotometricFrame& f, const Pose& estimate, const 
         jac << gw.cross(v - centre), -gw;
         const double r = i0 - ref.values[i];
         const double robust = std::abs(r) <= f.huber ? 1.0 : f.huber / std::abs(r);
-        const double weight = f.weight * robust;
-        s.a.template selfadjointView<Eigen::Upper>().rankUpdate(jac, weight);
-        s.b -= weight * jac * r;
-        ++s.count;
+        equations.add(jac, f.weight * robust, r);
       }
+    sums[chunk.index] = equations.sums();
   };
   parallel_for(ref.height, sum_rows, bands);
   IcpSums total;
@@ -622,9 +659,13 @@ std::optional<Pose> Fusion<Store>::track(const std::array<VertexMap, kPyramidLev
   // (Starting at the prediction instead was unstable on room300: from frame 31 the
   // error grew 2.3 times per frame until tracking was lost at frame 39.)
   Pose estimate = start;
+  // Sixteen bands whatever the thread count: the sums, added in band order, are then
+  // the same on any number of threads, and the threads share the bands dynamically (one
+  // band per thread left a thread idle while the other summed the half of the image
+  // with more valid pixels).
   ParallelOptions bands;
-  bands.threads = resolve_thread_count(params_.threads);
-  bands.chunks = bands.threads;
+  bands.threads = params_.threads;
+  bands.chunks = kTrackBands;
   bands.name = "slam.track";
   int last_count = 0;
   for (int level = kPyramidLevels - 1; level >= 0; --level) {
@@ -874,34 +915,47 @@ void Fusion<Store>::integrate(const DepthImage& depth, const RgbImage* rgb, cons
   parallel.threads = params_.threads;
   parallel.grain = kBricksPerChunk;
   parallel.name = "slam.integrate";
+  // A voxel's camera position is the brick corner's plus whole steps along the three
+  // axes (r's columns times the voxel size), added up rather than a matrix product per
+  // voxel.
+  const Eigen::Vector3d step_x = r.col(0) * vs, step_y = r.col(1) * vs, step_z = r.col(2) * vs;
+  const auto colour_mean = [](std::uint8_t old, std::uint8_t sample, float w) {
+    return static_cast<std::uint8_t>((old * w + sample) / (w + 1.0f) + 0.5f);  // both non-negative: rounds half up
+  };
   const auto integrate_bricks = [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const BrickCoord c = bricks[b];
-      for (int i = 0; i < kBrickVoxels; ++i) {
-        const int lx = i & 7, ly = (i >> 3) & 7, lz = i >> 6;
-        const Eigen::Vector3d world =
-            geometry.origin + vs * Eigen::Vector3d(c.x * 8.0 + lx + 0.5, c.y * 8.0 + ly + 0.5, c.z * 8.0 + lz + 0.5);
-        const Eigen::Vector3d p = r * world + t;
-        if (p.z() <= 0.0) continue;
-        const double u = std::floor(k.fx * p.x() / p.z() + k.cx + 0.5), v = std::floor(k.fy * p.y() / p.z() + k.cy + 0.5);
-        if (!(u >= 0 && v >= 0 && u < depth.width && v < depth.height)) continue;
-        const std::size_t pixel = static_cast<std::size_t>(v) * depth.width + static_cast<std::size_t>(u);
-        const double d = depth.metres[pixel];
-        if (!(d > 0.0)) continue;
-        const double sdf = d - p.z();
-        if (sdf < -truncation) continue;
-        const float f = static_cast<float>(std::min(1.0, sdf / truncation));
-        TsdfVoxel& voxel = data[b][i];
-        const float w = voxel.weight;
-        voxel.tsdf = (voxel.tsdf * w + f) / (w + 1.0f);
-        if (rgb && std::abs(sdf) < truncation * 0.5) {
-          const std::uint8_t* c3 = &rgb->rgb[pixel * 3];
-          voxel.r = static_cast<std::uint8_t>(std::lround((voxel.r * w + c3[0]) / (w + 1.0f)));
-          voxel.g = static_cast<std::uint8_t>(std::lround((voxel.g * w + c3[1]) / (w + 1.0f)));
-          voxel.b = static_cast<std::uint8_t>(std::lround((voxel.b * w + c3[2]) / (w + 1.0f)));
+      const Eigen::Vector3d corner =
+          r * (geometry.origin + vs * Eigen::Vector3d(c.x * 8.0 + 0.5, c.y * 8.0 + 0.5, c.z * 8.0 + 0.5)) + t;
+      TsdfVoxel* brick = data[b];
+      for (int lz = 0; lz < kBrickSide; ++lz)
+        for (int ly = 0; ly < kBrickSide; ++ly) {
+          const Eigen::Vector3d row = corner + step_y * ly + step_z * lz;
+          for (int lx = 0; lx < kBrickSide; ++lx) {
+            const Eigen::Vector3d p = row + step_x * lx;
+            if (p.z() <= 0.0) continue;
+            const double inverse_z = 1.0 / p.z();
+            const double u = std::floor(k.fx * p.x() * inverse_z + k.cx + 0.5),
+                         v = std::floor(k.fy * p.y() * inverse_z + k.cy + 0.5);
+            if (!(u >= 0 && v >= 0 && u < depth.width && v < depth.height)) continue;
+            const std::size_t pixel = static_cast<std::size_t>(v) * depth.width + static_cast<std::size_t>(u);
+            const double d = depth.metres[pixel];
+            if (!(d > 0.0)) continue;
+            const double sdf = d - p.z();
+            if (sdf < -truncation) continue;
+            const float f = static_cast<float>(std::min(1.0, sdf / truncation));
+            TsdfVoxel& voxel = brick[(lz * kBrickSide + ly) * kBrickSide + lx];
+            const float w = voxel.weight;
+            voxel.tsdf = (voxel.tsdf * w + f) / (w + 1.0f);
+            if (rgb && std::abs(sdf) < truncation * 0.5) {
+              const std::uint8_t* c3 = &rgb->rgb[pixel * 3];
+              voxel.r = colour_mean(voxel.r, c3[0], w);
+              voxel.g = colour_mean(voxel.g, c3[1], w);
+              voxel.b = colour_mean(voxel.b, c3[2], w);
+            }
+            voxel.weight = std::min(w + 1.0f, max_weight);
+          }
         }
-        voxel.weight = std::min(w + 1.0f, max_weight);
-      }
     }
   };
   parallel_for(bricks.size(), integrate_bricks, parallel);
