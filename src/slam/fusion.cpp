@@ -112,11 +112,20 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
   auto grid_at = [&](double t) -> Eigen::Vector3d { return go + dg * t; };
   double t = t_near, t_prev = 0.0, f_prev = 0.0;
   bool prev_valid = false;
+  // The brick of the last step, looked up again only when a step leaves it (most steps
+  // stay: a brick is 8 voxels, a step 1 to 3).
+  std::int64_t last_brick[3] = {-1, -1, -1};
+  const TsdfVoxel* brick = nullptr;
   while (t < t_far) {
-    const Eigen::Vector3d g = grid_at(t);
-    const double fx = std::floor(g.x()), fy = std::floor(g.y()), fz = std::floor(g.z());
-    const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
-    const TsdfVoxel* brick = reader.brick_at(x >> 3, y >> 3, z >> 3);
+    const auto x = static_cast<std::int64_t>(std::floor(go.x() + dg.x() * t)),
+               y = static_cast<std::int64_t>(std::floor(go.y() + dg.y() * t)),
+               z = static_cast<std::int64_t>(std::floor(go.z() + dg.z() * t));
+    if ((x >> 3) != last_brick[0] || (y >> 3) != last_brick[1] || (z >> 3) != last_brick[2]) {
+      last_brick[0] = x >> 3;
+      last_brick[1] = y >> 3;
+      last_brick[2] = z >> 3;
+      brick = reader.brick_at(x >> 3, y >> 3, z >> 3);
+    }
     if (!brick) {
       // Leave the brick: the nearest exit plane over the three axes.
       double exit = std::numeric_limits<double>::infinity();
@@ -724,7 +733,7 @@ template <class Store>
 ModelView Fusion<Store>::model_at(const Pose& pose) const {
   ModelView view;
   view.levels[0] = raycast(store_, intrinsics_, width_, height_, pose, params_);
-  for (int l = 1; l < kPyramidLevels; ++l) view.levels[l] = halve_vertex_map(view.levels[l - 1]);
+  for (int l = 1; l < kPyramidLevels; ++l) view.levels[l] = halve_vertex_map(view.levels[l - 1], params_.threads);
   return view;
 }
 
@@ -990,11 +999,23 @@ DepthImage Fusion<Store>::filtered(const DepthImage& depth) const {
                           params_.threads);
 }
 
+// The frame's vertex and normal maps at every pyramid level (depth halved level by level).
+template <class Store>
+std::array<VertexMap, kPyramidLevels> Fusion<Store>::frame_maps(const DepthImage& depth) const {
+  std::array<VertexMap, kPyramidLevels> maps;
+  DepthImage level = depth;
+  for (int l = 0; l < kPyramidLevels; ++l) {
+    if (l > 0) level = halve_depth(level, params_.bilateral_sigma_depth, params_.threads);
+    maps[l] = vertex_normal_map(level, level_intrinsics(intrinsics_, l), params_.threads);
+  }
+  return maps;
+}
+
 template <class Store>
 void Fusion<Store>::integrate_and_predict(const DepthImage& depth, const RgbImage* rgb) {
   integrate(depth, rgb, pose_);
   model_.levels[0] = raycast(store_, intrinsics_, width_, height_, pose_, params_);
-  for (int l = 1; l < kPyramidLevels; ++l) model_.levels[l] = halve_vertex_map(model_.levels[l - 1]);
+  for (int l = 1; l < kPyramidLevels; ++l) model_.levels[l] = halve_vertex_map(model_.levels[l - 1], params_.threads);
 }
 
 template <class Store>
@@ -1019,11 +1040,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
   if (frames_ == 0) {
     pose_ = initial_pose;
   } else {
-    std::array<DepthImage, kPyramidLevels> pyramid;
-    pyramid[0] = depth;
-    for (int l = 1; l < kPyramidLevels; ++l) pyramid[l] = halve_depth(pyramid[l - 1], params_.bilateral_sigma_depth);
-    std::array<VertexMap, kPyramidLevels> maps;
-    for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
+    const std::array<VertexMap, kPyramidLevels> maps = frame_maps(depth);
     int correspondences = 0;
     // The motion since the last tracked frame from colour features, when they agree;
     // when few agree, the nearest keyframes may share more of the view.
@@ -1108,12 +1125,7 @@ FrameResult Fusion<Store>::process(const DepthImage& raw, const RgbImage* rgb, c
     retry_pending();
   } else if (frames_ > 1 && features.size() && params_.max_pending > 0) {
     if (pending_.size() >= params_.max_pending) pending_.erase(pending_.begin());
-    std::array<VertexMap, kPyramidLevels> maps;
-    std::array<DepthImage, kPyramidLevels> pyramid;
-    pyramid[0] = depth;
-    for (int l = 1; l < kPyramidLevels; ++l) pyramid[l] = halve_depth(pyramid[l - 1], params_.bilateral_sigma_depth);
-    for (int l = 0; l < kPyramidLevels; ++l) maps[l] = vertex_normal_map(pyramid[l], level_intrinsics(intrinsics_, l));
-    pending_.push_back({frames_ - 1, std::move(features), std::move(maps), depth,
+    pending_.push_back({frames_ - 1, std::move(features), frame_maps(depth), depth,
                         rgb ? std::optional<RgbImage>(*rgb) : std::nullopt});
   }
   return result;

@@ -273,8 +273,8 @@ VertexMap keyframe_view(DepthImage depth, const Intrinsics& k, const FusionParam
     if (!(d >= params.min_depth && d <= params.max_depth)) d = 0.0f;
   depth = bilateral_filter(depth, params.bilateral_radius, params.bilateral_sigma_space, params.bilateral_sigma_depth,
                            params.threads);
-  for (int l = 0; l < level; ++l) depth = halve_depth(depth, params.bilateral_sigma_depth);
-  return vertex_normal_map(depth, keyframe_view_intrinsics(k, level));
+  for (int l = 0; l < level; ++l) depth = halve_depth(depth, params.bilateral_sigma_depth, params.threads);
+  return vertex_normal_map(depth, keyframe_view_intrinsics(k, level), params.threads);
 }
 
 KeyframeRefinementResult refine_keyframes(const std::vector<VertexMap>& views, const std::vector<Pose>& poses,

@@ -13,6 +13,15 @@ namespace vola::slam {
 namespace {
 constexpr std::size_t kRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
 
+// The parallel loop over rows that every per-pixel step here uses.
+ParallelOptions rows(unsigned threads, const char* name) {
+  ParallelOptions options;
+  options.threads = threads;
+  options.grain = kRowsPerChunk;
+  options.name = name;
+  return options;
+}
+
 // exp(-x) for 0 <= x (clamped at 80, where it is 2e-35), as 2^-(x log2 e): the integer
 // part goes into the float's exponent bits, the fraction (in (-1, 0]) through a degree-7
 // Taylor polynomial of 2^f (relative error under 2e-6). The depth weights took half of
@@ -58,10 +67,6 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
   std::vector<float> padded(padded_width * (std::size_t(h) + 2 * radius), 0.0f);
   for (int y = 0; y < h; ++y)
     std::copy_n(depth.metres.data() + std::size_t(y) * w, w, padded.data() + (y + radius) * padded_width + radius);
-  ParallelOptions parallel;
-  parallel.threads = threads;
-  parallel.grain = kRowsPerChunk;
-  parallel.name = "slam.bilateral_filter";
   const auto filter_rows = [&](std::size_t begin, std::size_t end) {
     std::vector<float> sums(w), weights(w);
     for (int y = static_cast<int>(begin); y < static_cast<int>(end); ++y) {
@@ -88,62 +93,77 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
       for (int x = 0; x < w; ++x) target[x] = centre[x] > 0.0f ? centre[x] + sums[x] / weights[x] : 0.0f;
     }
   };
-  parallel_for(depth.height, filter_rows, parallel);
+  parallel_for(depth.height, filter_rows, rows(threads, "slam.bilateral_filter"));
   return out;
 }
 
-DepthImage halve_depth(const DepthImage& depth, double sigma_depth) {
+DepthImage halve_depth(const DepthImage& depth, double sigma_depth, unsigned threads) {
   DepthImage out{depth.width / 2, depth.height / 2, {}};
   out.metres.assign(std::size_t{out.width} * out.height, 0.0f);
-  for (std::uint32_t y = 0; y < out.height; ++y)
-    for (std::uint32_t x = 0; x < out.width; ++x) {
-      const float first = depth.at(2 * x, 2 * y);
-      if (first <= 0.0f) continue;
-      double sum = 0.0;
-      int n = 0;
-      for (std::uint32_t dy = 0; dy < 2; ++dy)
-        for (std::uint32_t dx = 0; dx < 2; ++dx) {
-          const float d = depth.at(2 * x + dx, 2 * y + dy);
-          if (d > 0.0f && std::abs(d - first) <= 3 * sigma_depth) {
-            sum += d;
-            ++n;
+  parallel_for(
+      out.height,
+      [&](std::size_t begin, std::size_t end) {
+        for (auto y = static_cast<std::uint32_t>(begin); y < end; ++y)
+          for (std::uint32_t x = 0; x < out.width; ++x) {
+            const float first = depth.at(2 * x, 2 * y);
+            if (first <= 0.0f) continue;
+            double sum = 0.0;
+            int n = 0;
+            for (std::uint32_t dy = 0; dy < 2; ++dy)
+              for (std::uint32_t dx = 0; dx < 2; ++dx) {
+                const float d = depth.at(2 * x + dx, 2 * y + dy);
+                if (d > 0.0f && std::abs(d - first) <= 3 * sigma_depth) {
+                  sum += d;
+                  ++n;
+                }
+              }
+            out.metres[std::size_t{y} * out.width + x] = static_cast<float>(sum / n);
           }
-        }
-      out.metres[std::size_t{y} * out.width + x] = static_cast<float>(sum / n);
-    }
+      },
+      rows(threads, "slam.halve_depth"));
   return out;
 }
 
-VertexMap vertex_normal_map(const DepthImage& depth, const Intrinsics& k) {
+VertexMap vertex_normal_map(const DepthImage& depth, const Intrinsics& k, unsigned threads) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::size_t n = depth.metres.size();
   VertexMap map{depth.width, depth.height, std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan)),
                 std::vector<Eigen::Vector3f>(n, Eigen::Vector3f::Constant(nan))};
-  for (std::uint32_t y = 0; y < depth.height; ++y)
-    for (std::uint32_t x = 0; x < depth.width; ++x) {
-      const float d = depth.at(x, y);
-      if (d <= 0.0f) continue;
-      map.vertices[std::size_t{y} * depth.width + x] =
-          Eigen::Vector3f(static_cast<float>((x - k.cx) / k.fx * d), static_cast<float>((y - k.cy) / k.fy * d), d);
-    }
-  for (std::uint32_t y = 0; y + 1 < depth.height; ++y)
-    for (std::uint32_t x = 0; x + 1 < depth.width; ++x) {
-      const std::size_t i = std::size_t{y} * depth.width + x;
-      const Eigen::Vector3f& v = map.vertices[i];
-      const Eigen::Vector3f& right = map.vertices[i + 1];
-      const Eigen::Vector3f& down = map.vertices[i + depth.width];
-      if (!(v.x() == v.x() && right.x() == right.x() && down.x() == down.x())) continue;
-      Eigen::Vector3f normal = (right - v).cross(down - v);
-      const float length = normal.norm();
-      if (!(length > 0.0f)) continue;
-      normal /= length;
-      if (normal.dot(v) > 0.0f) normal = -normal;  // face the camera, whatever the sign of fy
-      map.normals[i] = normal;
-    }
+  parallel_for(
+      depth.height,
+      [&](std::size_t begin, std::size_t end) {
+        for (auto y = static_cast<std::uint32_t>(begin); y < end; ++y)
+          for (std::uint32_t x = 0; x < depth.width; ++x) {
+            const float d = depth.at(x, y);
+            if (d <= 0.0f) continue;
+            map.vertices[std::size_t{y} * depth.width + x] = Eigen::Vector3f(
+                static_cast<float>((x - k.cx) / k.fx * d), static_cast<float>((y - k.cy) / k.fy * d), d);
+          }
+      },
+      rows(threads, "slam.vertex_map"));
+  parallel_for(
+      depth.height ? depth.height - 1 : 0,  // the last row has no lower neighbours
+      [&](std::size_t begin, std::size_t end) {
+        for (auto y = static_cast<std::uint32_t>(begin); y < end; ++y)
+          for (std::uint32_t x = 0; x + 1 < depth.width; ++x) {
+            const std::size_t i = std::size_t{y} * depth.width + x;
+            const Eigen::Vector3f& v = map.vertices[i];
+            const Eigen::Vector3f& right = map.vertices[i + 1];
+            const Eigen::Vector3f& down = map.vertices[i + depth.width];
+            if (!(v.x() == v.x() && right.x() == right.x() && down.x() == down.x())) continue;
+            Eigen::Vector3f normal = (right - v).cross(down - v);
+            const float length = normal.norm();
+            if (!(length > 0.0f)) continue;
+            normal /= length;
+            if (normal.dot(v) > 0.0f) normal = -normal;  // face the camera, whatever the sign of fy
+            map.normals[i] = normal;
+          }
+      },
+      rows(threads, "slam.normal_map"));
   return map;
 }
 
-VertexMap halve_vertex_map(const VertexMap& map) {
+VertexMap halve_vertex_map(const VertexMap& map, unsigned threads) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   VertexMap out;
   out.width = map.width / 2;
@@ -151,23 +171,28 @@ VertexMap halve_vertex_map(const VertexMap& map) {
   const std::size_t n = std::size_t{out.width} * out.height;
   out.vertices.assign(n, Eigen::Vector3f::Constant(nan));
   out.normals.assign(n, Eigen::Vector3f::Constant(nan));
-  for (std::uint32_t y = 0; y < out.height; ++y)
-    for (std::uint32_t x = 0; x < out.width; ++x) {
-      Eigen::Vector3f v = Eigen::Vector3f::Zero(), nsum = Eigen::Vector3f::Zero();
-      int count = 0;
-      for (std::uint32_t dy = 0; dy < 2; ++dy)
-        for (std::uint32_t dx = 0; dx < 2; ++dx) {
-          const std::size_t i = std::size_t{2 * y + dy} * map.width + 2 * x + dx;
-          if (!map.valid(i)) continue;
-          v += map.vertices[i];
-          nsum += map.normals[i];
-          ++count;
-        }
-      const float length = nsum.norm();
-      if (count == 0 || !(length > 0.0f)) continue;
-      out.vertices[std::size_t{y} * out.width + x] = v / static_cast<float>(count);
-      out.normals[std::size_t{y} * out.width + x] = nsum / length;
-    }
+  parallel_for(
+      out.height,
+      [&](std::size_t begin, std::size_t end) {
+        for (auto y = static_cast<std::uint32_t>(begin); y < end; ++y)
+          for (std::uint32_t x = 0; x < out.width; ++x) {
+            Eigen::Vector3f v = Eigen::Vector3f::Zero(), nsum = Eigen::Vector3f::Zero();
+            int count = 0;
+            for (std::uint32_t dy = 0; dy < 2; ++dy)
+              for (std::uint32_t dx = 0; dx < 2; ++dx) {
+                const std::size_t i = std::size_t{2 * y + dy} * map.width + 2 * x + dx;
+                if (!map.valid(i)) continue;
+                v += map.vertices[i];
+                nsum += map.normals[i];
+                ++count;
+              }
+            const float length = nsum.norm();
+            if (count == 0 || !(length > 0.0f)) continue;
+            out.vertices[std::size_t{y} * out.width + x] = v / static_cast<float>(count);
+            out.normals[std::size_t{y} * out.width + x] = nsum / length;
+          }
+      },
+      rows(threads, "slam.halve_vertex_map"));
   return out;
 }
 

@@ -209,6 +209,7 @@ class Fusion {
   FeatureParams weak_feature_params() const;
   DepthImage clipped(const DepthImage& raw, const RgbImage* rgb) const;
   DepthImage filtered(const DepthImage& depth) const;
+  std::array<VertexMap, kPyramidLevels> frame_maps(const DepthImage& depth) const;
   void integrate_and_predict(const DepthImage& depth, const RgbImage* rgb);
   void integrate(const DepthImage& depth, const RgbImage* rgb, const Pose& pose);
 

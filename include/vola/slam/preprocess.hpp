@@ -24,11 +24,13 @@ DepthImage bilateral_filter(const DepthImage& depth, int radius, double sigma_sp
                             unsigned threads);
 // Half-size depth: the mean of the 2x2 block's valid samples within 3 sigma_depth of its
 // top-left sample (invalid when that one is).
-DepthImage halve_depth(const DepthImage& depth, double sigma_depth);
+DepthImage halve_depth(const DepthImage& depth, double sigma_depth, unsigned threads = 0);
 // Back-projects every valid pixel; the normal is the cross product of the differences
 // to the right and lower neighbours, turned to face the camera.
-VertexMap vertex_normal_map(const DepthImage& depth, const Intrinsics& k);
+VertexMap vertex_normal_map(const DepthImage& depth, const Intrinsics& k, unsigned threads = 0);
 // Half-size vertex map: the mean of a 2x2 block's valid vertices and normals.
-VertexMap halve_vertex_map(const VertexMap& map);
+VertexMap halve_vertex_map(const VertexMap& map, unsigned threads = 0);
+// (Rows in parallel on `threads` threads, 0 = vola::thread_count(); every pixel is
+// computed on its own, so the result does not depend on the count.)
 
 }  // namespace vola::slam
