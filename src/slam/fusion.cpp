@@ -52,6 +52,8 @@ namespace {
 constexpr std::size_t kRowsPerChunk = 4;
 constexpr std::size_t kBricksPerChunk = 16;
 constexpr std::size_t kTrackBands = 16;  // partial sums of the ICP and photometric terms
+constexpr int kRecentBricksLog2 = 12;    // bricks_in_band's table of recently seen keys
+constexpr std::size_t kRecentBricks = std::size_t{1} << kRecentBricksLog2;
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -109,7 +111,9 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
   // division per step.
   const Eigen::Vector3d go = (o - geometry.origin) / vs, dg = d / vs;
   const Eigen::Vector3d inverse_d(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
-  auto grid_at = [&](double t) -> Eigen::Vector3d { return go + dg * t; };
+  auto grid_at = [&](double t) {  // component-wise: Eigen's expression did not inline here
+    return Eigen::Vector3d(go.x() + dg.x() * t, go.y() + dg.y() * t, go.z() + dg.z() * t);
+  };
   double t = t_near, t_prev = 0.0, f_prev = 0.0;
   bool prev_valid = false;
   // The brick of the last step, looked up again only when a step leaves it (most steps
@@ -366,7 +370,10 @@ std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics
       depth.height,
       [&](const Chunk& chunk) {
         std::vector<std::uint64_t>& keys = band_keys[chunk.index];
-        std::uint64_t last = ~std::uint64_t{0};
+        // The keys seen recently, direct-mapped: neighbouring pixels and rows name the
+        // same few bricks, so most samples are dropped here instead of being pushed and
+        // sorted (the band's list was a quarter of a million keys at 640 x 480).
+        std::vector<std::uint64_t> recent(kRecentBricks, ~std::uint64_t{0});
         for (auto y = static_cast<std::uint32_t>(chunk.begin); y < chunk.end; ++y)
           for (std::uint32_t x = 0; x < depth.width; ++x) {
             const double d = depth.at(x, y);
@@ -384,8 +391,10 @@ std::vector<BrickCoord> bricks_in_band(const DepthImage& depth, const Intrinsics
               if (!(bx >= 0 && by >= 0 && bz >= 0 && bx < side && by < side && bz < side)) continue;
               const std::uint64_t key = static_cast<std::uint64_t>(bz) << 42 | static_cast<std::uint64_t>(by) << 21 |
                                         static_cast<std::uint64_t>(bx);
-              if (key != last) keys.push_back(key);
-              last = key;
+              std::uint64_t& slot = recent[(key * 0x9E3779B97F4A7C15ull) >> (64 - kRecentBricksLog2)];
+              if (slot == key) continue;
+              slot = key;
+              keys.push_back(key);
             }
           }
         std::sort(keys.begin(), keys.end());
