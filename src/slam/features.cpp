@@ -16,6 +16,11 @@ bool features_available() noexcept { return VOLA_SLAM_WITH_OPENCV != 0; }
 
 namespace {
 
+// RANSAC draws at least this many samples whatever the consensus: on the Kinect frames,
+// whose pairs share few matches, the adaptive bound alone (or a floor of 300) ended at
+// other consensus sets and an ATE of 2.25 cm instead of 2.04 cm.
+constexpr int kMinRansacSamples = 1000;
+
 std::vector<std::uint8_t> grey_of(const RgbImage& rgb) {
   std::vector<std::uint8_t> grey(std::size_t{rgb.width} * rgb.height);
   for (std::size_t i = 0; i < grey.size(); ++i) {
@@ -288,7 +293,8 @@ std::optional<FeatureRegistration> register_features(const FeatureFrame& referen
   std::uniform_int_distribution<int> pick(0, matches - 1);
   Eigen::Isometry3d best = Eigen::Isometry3d::Identity();
   int best_count = -1;
-  for (int iteration = 0; iteration < params.ransac_iterations; ++iteration) {
+  double needed = params.ransac_iterations;  // samples, lowered as the consensus grows
+  for (int iteration = 0; iteration < params.ransac_iterations && iteration < needed; ++iteration) {
     const int a = pick(rng), b = pick(rng), c = pick(rng);
     if (a == b || b == c || a == c) continue;
     // A rigid motion keeps the triangle's sides; a sample that does not is an outlier.
@@ -307,6 +313,12 @@ std::optional<FeatureRegistration> register_features(const FeatureFrame& referen
     if (count > best_count) {
       best_count = count;
       best = t;
+      const double all_three = std::pow(static_cast<double>(count) / matches, 3);
+      if (all_three >= 1.0)
+        needed = kMinRansacSamples;
+      else if (all_three > 0.0)
+        needed = std::max<double>(kMinRansacSamples,
+                                  std::log(1.0 - params.ransac_confidence) / std::log(1.0 - all_three));
     }
   }
   if (best_count < params.min_inliers) return std::nullopt;

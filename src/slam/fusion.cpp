@@ -37,7 +37,8 @@ void FusionParams::check() const {
   if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) throw InvalidArgument("minimum overlap must be in [0, 1]");
   if (relocalisation_min_inliers < 3) throw InvalidArgument("relocalisation needs at least 3 feature inliers");
   if (feature.max_features < 10 || feature.min_inliers < 3 || feature.ransac_iterations < 1 ||
-      !(feature.ratio > 0.0 && feature.ratio <= 1.0) || feature.max_hamming < 0 || feature.max_hamming > 256)
+      !(feature.ratio > 0.0 && feature.ratio <= 1.0) || feature.max_hamming < 0 || feature.max_hamming > 256 ||
+      !(feature.ransac_confidence > 0.0 && feature.ransac_confidence <= 1.0))
     throw InvalidArgument("feature parameters out of range");
   if (refine_level < 0 || refine_level >= kPyramidLevels)
     throw InvalidArgument("keyframe refinement level must be 0 .. " + std::to_string(kPyramidLevels - 1));
@@ -65,11 +66,15 @@ struct RayHitSample {
 
 // The zero crossing between t_a (positive nearest-voxel value fa) and t_b (negative
 // fb): with trilinear values, a bracket grown by up to a voxel on each side (nearest
-// values change sign up to half a voxel away from the interpolated ones) and three
-// regula falsi steps; without them, the nearest values' linear interpolation.
+// values change sign up to half a voxel away from the interpolated ones) and up to three
+// regula falsi steps, stopping early once the value at the estimate is within 0.1 mm of
+// the surface (values are distances / truncation; the TSDF is nearly linear across a
+// voxel, so most rays stop after one step); without trilinear values, the nearest
+// values' linear interpolation.
 template <class Store, class GridAt>
 double refine_crossing(TsdfReader<Store>& reader, const GridAt& grid_at, double t_a, double fa, double t_b, double fb,
-                       double voxel) {
+                       double voxel, double truncation) {
+  const double close_enough = 1e-4 / truncation;  // 0.1 mm, a tenth of the depth noise at 1 m
   const double fallback = t_a + (t_b - t_a) * fa / (fa - fb);
   double ia = 0.0, ib = 0.0;
   if (!reader.trilinear(grid_at(t_a), ia) || !reader.trilinear(grid_at(t_b), ib)) return fallback;
@@ -85,7 +90,7 @@ double refine_crossing(TsdfReader<Store>& reader, const GridAt& grid_at, double 
     const double t = t_a + (t_b - t_a) * ia / (ia - ib);
     double f = 0.0;
     if (!reader.trilinear(grid_at(t), f)) return t;
-    if (f == 0.0) return t;
+    if (std::abs(f) <= close_enough) return t;
     if (f > 0.0) {
       t_a = t;
       ia = f;
@@ -153,7 +158,7 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
     const double f = v->tsdf;
     if (f < 0.0) {
       if (!prev_valid || f_prev <= 0.0) return std::nullopt;  // entered from behind or from unknown space
-      const double t_hit = refine_crossing(reader, grid_at, t_prev, f_prev, t, f, vs);
+      const double t_hit = refine_crossing(reader, grid_at, t_prev, f_prev, t, f, vs, truncation);
       const Eigen::Vector3d gh = grid_at(t_hit);
       const auto hx = static_cast<std::int64_t>(std::floor(gh.x())), hy = static_cast<std::int64_t>(std::floor(gh.y())),
                  hz = static_cast<std::int64_t>(std::floor(gh.z()));

@@ -45,24 +45,28 @@ class TsdfReader {
     const double fx = std::floor(s.x()), fy = std::floor(s.y()), fz = std::floor(s.z());
     const auto x = static_cast<std::int64_t>(fx), y = static_cast<std::int64_t>(fy), z = static_cast<std::int64_t>(fz);
     const double ax = s.x() - fx, ay = s.y() - fy, az = s.z() - fz;
-    double sum = 0.0;
     if ((x & 7) != 7 && (y & 7) != 7 && (z & 7) != 7) {
       // All eight in one brick (7 cells in 8 per axis): one brick lookup, not eight.
       const TsdfVoxel* b = brick_at(x >> 3, y >> 3, z >> 3);
       if (!b) return false;
       const TsdfVoxel* base = b + local_index(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
                                               static_cast<std::uint32_t>(z));
-      constexpr int kOffsets[8] = {0, 1, kBrickSide, kBrickSide + 1, kBrickSide * kBrickSide,
-                                   kBrickSide * kBrickSide + 1, kBrickSide * kBrickSide + kBrickSide,
-                                   kBrickSide * kBrickSide + kBrickSide + 1};
-      for (int c = 0; c < 8; ++c) {
-        const TsdfVoxel& v = base[kOffsets[c]];
-        if (!(v.weight > 0.0f)) return false;
-        sum += ((c & 1) ? ax : 1 - ax) * ((c & 2) ? ay : 1 - ay) * ((c & 4) ? az : 1 - az) * v.tsdf;
-      }
-      f = sum;
+      // Straight-line: all eight weights tested at once, then seven lerps (a loop with
+      // a test and three selects per corner was a sixth of vola fuse's time).
+      constexpr int kY = kBrickSide, kZ = kBrickSide * kBrickSide;
+      const TsdfVoxel *v000 = base, *v100 = base + 1, *v010 = base + kY, *v110 = base + kY + 1, *v001 = base + kZ,
+                      *v101 = base + kZ + 1, *v011 = base + kZ + kY, *v111 = base + kZ + kY + 1;
+      const bool observed = (v000->weight > 0.0f) & (v100->weight > 0.0f) & (v010->weight > 0.0f) &
+                            (v110->weight > 0.0f) & (v001->weight > 0.0f) & (v101->weight > 0.0f) &
+                            (v011->weight > 0.0f) & (v111->weight > 0.0f);
+      if (!observed) return false;
+      const auto lerp = [](double from, double to, double t) { return from + (to - from) * t; };
+      const double y0 = lerp(lerp(v000->tsdf, v100->tsdf, ax), lerp(v010->tsdf, v110->tsdf, ax), ay);
+      const double y1 = lerp(lerp(v001->tsdf, v101->tsdf, ax), lerp(v011->tsdf, v111->tsdf, ax), ay);
+      f = lerp(y0, y1, az);
       return true;
     }
+    double sum = 0.0;
     for (int c = 0; c < 8; ++c) {
       const TsdfVoxel* v = voxel(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
       if (!v) return false;

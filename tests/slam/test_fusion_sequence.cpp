@@ -162,6 +162,11 @@ TEST(SlamMotionPrior, OutOfRangeWeightsAreRefused) {
   EXPECT_THROW(p.check(), vola::InvalidArgument);
   p.motion_prior = 0.0;
   EXPECT_NO_THROW(p.check());
+  for (const double confidence : {0.0, -0.5, 1.5}) {
+    FusionParams q;
+    q.feature.ransac_confidence = confidence;
+    EXPECT_THROW(q.check(), vola::InvalidArgument) << confidence;
+  }
 }
 
 }  // namespace

@@ -39,7 +39,11 @@ struct FeatureParams {
   int fast_threshold = 7;      // grey levels; low, so that weakly textured views still have features
   double ratio = 0.9;          // Lowe's ratio: best / second best Hamming distance
   int max_hamming = 80;        // of 256 bits
-  int ransac_iterations = 3000;  // samples; most fail the cheap side-length test
+  int ransac_iterations = 3000;  // samples at most; most fail the cheap side-length test
+  // Sampling stops once a sample of three inliers would have been drawn with this
+  // probability at the best consensus's inlier ratio (the usual adaptive bound): a few
+  // dozen samples when most matches agree, ransac_iterations when few do.
+  double ransac_confidence = 0.9999;
   int min_inliers = 12;        // a registration with fewer is refused
   double max_reprojection = 4.0;  // pixels, an inlier's error in both images
   std::uint64_t seed = 1;      // RANSAC sampling (deterministic)
