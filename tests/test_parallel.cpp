@@ -1,16 +1,21 @@
 // vola::parallel_for, the library's one parallel loop: every index once whatever the
 // counts, chunking and threads; a worker's exception reaches the caller unchanged; after
-// a throw the other workers stop taking chunks; the thread-count setting is honoured.
+// a throw the other workers stop taking chunks; the thread-count setting is honoured;
+// worker threads are kept between calls, and nested, concurrent and forked calls work.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <set>
 #include <thread>
 #include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "parallel_fault.hpp"
 #include "vola/error.hpp"
@@ -280,7 +285,7 @@ TEST(ParallelFor, TheTestHookSeesEveryChunkWithItsStage) {
   static std::atomic<std::size_t> calls{0};
   static std::atomic<bool> wrong_name{false};
   vola::detail::set_parallel_hook([](const char* name, const vola::Chunk&) {
-    if (std::string(name) != "test.hooked") wrong_name = true;
+    if (std::strcmp(name, "test.hooked") != 0) wrong_name = true;
     ++calls;
   });
   vola::ParallelOptions o;
@@ -293,6 +298,96 @@ TEST(ParallelFor, TheTestHookSeesEveryChunkWithItsStage) {
   vola::parallel_for(95, nothing, o);
   EXPECT_EQ(calls, 10u);
   EXPECT_FALSE(wrong_name);
+}
+
+// The worker threads are kept: two calls in a row see the same worker thread.
+TEST(ParallelFor, WorkerThreadsAreKeptBetweenCalls) {
+  const auto worker_thread = [] {
+    std::atomic<bool> worker_ran{false};
+    std::thread::id id;
+    vola::ParallelOptions o;
+    o.threads = 2;
+    o.grain = 1;
+    vola::parallel_for(
+        8,
+        [&](const vola::Chunk& c) {
+          if (c.worker == 0) {
+            wait_for(worker_ran);
+            return;
+          }
+          id = std::this_thread::get_id();
+          worker_ran = true;
+        },
+        o);
+    return id;
+  };
+  const std::thread::id first = worker_thread();
+  EXPECT_NE(first, std::thread::id());
+  EXPECT_NE(first, std::this_thread::get_id());
+  EXPECT_EQ(worker_thread(), first);
+}
+
+// A parallel_for inside a body (the pool is in use) and one on another thread at the
+// same time both run every index once, with threads of their own.
+TEST(ParallelFor, NestedAndConcurrentCallsRunEveryIndexOnce) {
+  vola::ParallelOptions o;
+  o.threads = 2;
+  o.grain = 3;
+  std::vector<std::atomic<int>> hits(40 * 50);
+  vola::parallel_for(
+      40,
+      [&](const vola::Chunk& outer) {
+        for (std::size_t i = outer.begin; i < outer.end; ++i)
+          vola::parallel_for(
+              50,
+              [&](std::size_t b, std::size_t e) {
+                for (std::size_t j = b; j < e; ++j) ++hits[i * 50 + j];
+              },
+              o);
+      },
+      o);
+  for (const auto& h : hits) EXPECT_EQ(h.load(), 1);
+  std::vector<std::atomic<int>> a(5000), b(5000);
+  const auto count_into = [&](std::vector<std::atomic<int>>& into) {
+    for (int round = 0; round < 20; ++round)
+      vola::parallel_for(
+          into.size(),
+          [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) ++into[i];
+          },
+          o);
+  };
+  std::thread other([&] { count_into(b); });
+  count_into(a);
+  other.join();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].load(), 20);
+    EXPECT_EQ(b[i].load(), 20);
+  }
+}
+
+// A child forked after the workers started has none of them: its calls must not wait
+// for threads that are not there.
+TEST(ParallelFor, AForkedChildRunsItsOwnLoops) {
+  vola::ParallelOptions o;
+  o.threads = 2;
+  vola::parallel_for(10, [](std::size_t, std::size_t) {}, o);  // the workers exist
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::atomic<std::size_t> sum{0};
+    vola::parallel_for(
+        1000,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t i = begin; i < end; ++i) sum += i;
+        },
+        o);
+    ::_exit(sum == 999 * 1000 / 2 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
 }  // namespace

@@ -13,9 +13,11 @@
 // that wants the same result whatever the threads writes its results per index or per
 // chunk and combines per-chunk results in chunk order.
 //
-// Threads are started per call and joined before it returns (no pool): chunks should be
-// coarse enough to pay for that (tens of microseconds). The library's own implementation
-// is src/parallel (the static library vola_parallel; the core library has no threads).
+// Worker threads are kept between calls (asleep in between); a call that finds them in
+// use (a parallel_for inside a body, or one on another thread) starts and joins threads
+// of its own. Chunks should still be coarse (a wake-up costs microseconds). The library's
+// own implementation is src/parallel (the static library vola_parallel; the core library
+// has no threads).
 #pragma once
 
 #include <cstddef>
