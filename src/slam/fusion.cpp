@@ -67,14 +67,14 @@ struct RayHitSample {
 // The zero crossing between t_a (positive nearest-voxel value fa) and t_b (negative
 // fb): with trilinear values, a bracket grown by up to a voxel on each side (nearest
 // values change sign up to half a voxel away from the interpolated ones) and up to three
-// regula falsi steps, stopping early once the value at the estimate is within 0.1 mm of
-// the surface (values are distances / truncation; the TSDF is nearly linear across a
-// voxel, so most rays stop after one step); without trilinear values, the nearest
-// values' linear interpolation.
+// regula falsi steps, stopping early once the value at the estimate is within 10 um of
+// the surface (values are distances / truncation); without trilinear values, the
+// nearest values' linear interpolation. (At 0.1 mm the Kinect frames' ATE moved from
+// 2.07 to 2.27 cm for no measurable speed.)
 template <class Store, class GridAt>
 double refine_crossing(TsdfReader<Store>& reader, const GridAt& grid_at, double t_a, double fa, double t_b, double fb,
                        double voxel, double truncation) {
-  const double close_enough = 1e-4 / truncation;  // 0.1 mm, a tenth of the depth noise at 1 m
+  const double close_enough = 1e-5 / truncation;  // 10 um, far below the depth noise
   const double fallback = t_a + (t_b - t_a) * fa / (fa - fb);
   double ia = 0.0, ib = 0.0;
   if (!reader.trilinear(grid_at(t_a), ia) || !reader.trilinear(grid_at(t_b), ib)) return fallback;
