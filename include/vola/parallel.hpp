@@ -5,7 +5,7 @@
 //  - an exception thrown by the body on any thread reaches the caller of parallel_for,
 //    unchanged (the same type and message: a vola::Error stays that vola::Error);
 //  - once a body has thrown, no thread starts another chunk (the chunks already running
-//    finish), every thread is joined, and only then the first exception is rethrown;
+//    finish), every thread is done with the call, and only then the first exception is rethrown;
 //  - how many threads is one setting, set_thread_count(), unless a call asks for a count.
 //
 // Chunks are handed out in order from a shared counter (dynamic scheduling); the calling
