@@ -159,11 +159,12 @@ std::optional<RayHitSample> march(TsdfReader<Store>& reader, const VolumeGeometr
     if (f < 0.0) {
       if (!prev_valid || f_prev <= 0.0) return std::nullopt;  // entered from behind or from unknown space
       const double t_hit = refine_crossing(reader, grid_at, t_prev, f_prev, t, f, vs, truncation);
+      // Without the normal (the tracking raycast), neither is the hit's own voxel needed.
+      if (!with_normal) return RayHitSample{o + d * t_hit, Eigen::Vector3d::Zero(), v};
       const Eigen::Vector3d gh = grid_at(t_hit);
       const auto hx = static_cast<std::int64_t>(std::floor(gh.x())), hy = static_cast<std::int64_t>(std::floor(gh.y())),
                  hz = static_cast<std::int64_t>(std::floor(gh.z()));
       const TsdfVoxel* at = reader.voxel(hx, hy, hz);
-      if (!with_normal) return RayHitSample{o + d * t_hit, Eigen::Vector3d::Zero(), at ? at : v};
       Eigen::Vector3d gradient;
       for (int a = 0; a < 3; ++a) {
         Eigen::Vector3d lo = gh, hi = gh;
