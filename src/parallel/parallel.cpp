@@ -53,8 +53,15 @@ class WorkerPool {
   // Runs work(1 .. threads - 1) on workers and work(0) on this thread, and returns when
   // all have; false (nothing run) when the pool cannot be used. work must not throw.
   bool run(unsigned threads, const std::function<void(unsigned)>& work) {
-    std::unique_lock busy(busy_, std::try_to_lock);
-    if (!busy.owns_lock() || ::getpid() != pid_) return false;
+    // A flag, not a mutex: a nested call comes from the thread that holds the pool, and
+    // try_lock on a mutex the thread owns is undefined.
+    bool free = false;
+    if (!busy_.compare_exchange_strong(free, true, std::memory_order_acquire)) return false;
+    struct Release {
+      std::atomic<bool>& flag;
+      ~Release() { flag.store(false, std::memory_order_release); }
+    } release{busy_};
+    if (::getpid() != pid_) return false;
     const unsigned helpers = grow(threads - 1);
     {
       const std::lock_guard lock(mutex_);
@@ -103,7 +110,7 @@ class WorkerPool {
   }
 
   const pid_t pid_;
-  std::mutex busy_;  // held by the call using the pool
+  std::atomic<bool> busy_{false};  // set by the call using the pool
   std::mutex mutex_;
   std::condition_variable wake_, done_;
   std::vector<std::thread> workers_;
