@@ -365,7 +365,9 @@ std::size_t classify_ground(PointCloud& cloud, const SmrfOptions& options, const
   auto& values = cloud.attributes[cls].values;
   std::size_t found = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (values[i] == 7 || values[i] == 18) continue;
+    // Noise stays noise. Overlap points (class 12 of LAS 1.1-1.3: the survey marked them
+    // to be left out of its products) helped to find the surface but keep their mark.
+    if (values[i] == 7 || values[i] == 18 || values[i] == 12) continue;
     values[i] = ground[i] ? 2.0 : 1.0;
     found += ground[i];
   }

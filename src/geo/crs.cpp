@@ -53,6 +53,13 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
   return epsg;
 }
 
+std::string projected_crs_in_unit(std::uint32_t epsg, std::uint32_t unit) {
+  std::string wkt;
+  run("EPSG:" + std::to_string(epsg) + " in unit EPSG:" + std::to_string(unit),
+      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.projected_crs_in_unit(epsg, unit, wkt, f); });
+  return wkt;
+}
+
 std::optional<std::string> crs_definition(const Georef& georef) {
   if (!georef.crs_wkt.empty()) return georef.crs_wkt;
   if (georef.epsg != kUnsetEpsg) return "EPSG:" + std::to_string(georef.epsg);

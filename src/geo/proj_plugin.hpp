@@ -36,6 +36,7 @@ struct ProjEntries {
   void (*reprojection_transform)(void* state, double* xyz, std::size_t points, PluginFailure& failure);
   void (*reprojection_close)(void* state);
   void (*crs_wkt_of)(const std::string& definition, std::string& out, PluginFailure& failure);
+  void (*projected_crs_in_unit)(std::uint32_t epsg, std::uint32_t unit, std::string& out, PluginFailure& failure);
 };
 
 using ProjEntriesEntry = const ProjEntries* (*)();

@@ -9,6 +9,7 @@
 
 #include "las_format.hpp"
 #include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/io/las.hpp"
 
 namespace vola::io {
@@ -169,8 +170,9 @@ void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::u
 }
 
 // GeoKeyDirectoryTag: the projected CRS code, else the geographic one (none when
-// user-defined).
-void parse_geokeys(const LasVlr& vlr, LasHeader& hd) {
+// user-defined), and the linear unit key (ProjLinearUnitsGeoKey), which may override the
+// projected CRS's own unit.
+void parse_geokeys(const LasVlr& vlr, LasHeader& hd, std::optional<std::uint32_t>& linear_unit) {
   const std::size_t keys = load_le<std::uint16_t>(&vlr.data[6]);
   std::optional<std::uint32_t> projected, geographic;
   for (std::size_t k = 0; k < keys && 8 + 8 * k + 8 <= vlr.data.size(); ++k) {
@@ -180,9 +182,27 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd) {
     if (location != 0) continue;
     if (id == 3072) projected = value;
     if (id == 2048) geographic = value;
+    if (id == 3076) linear_unit = value;
   }
   if (projected && *projected != las::kUserDefined && *projected != 0) hd.epsg = *projected;
   else if (geographic && *geographic != las::kUserDefined && *geographic != 0) hd.epsg = *geographic;
+}
+
+// A projected CRS code whose linear unit key names another unit (NAD83 / Mississippi
+// West, a metre CRS, with US survey feet: pdal_mvk-thin.las) is that CRS in that unit, as
+// GDAL and PDAL read it; the coordinates are in the key's unit. It becomes the header's
+// WKT (unless the file has a WKT record, which wins) and its code whatever PROJ
+// identifies it as (EPSG:2255 here), or none.
+void apply_linear_unit(LasHeader& hd, std::uint32_t unit) {
+  if (!hd.epsg || !hd.wkt.empty()) return;
+  try {
+    const std::string wkt = geo::projected_crs_in_unit(*hd.epsg, unit);
+    if (wkt.empty()) return;
+    hd.wkt = wkt;
+    hd.epsg = geo::epsg_from_wkt(wkt);
+  } catch (const Error&) {
+    // PROJ cannot be loaded: the code alone, as before the unit key was read.
+  }
 }
 
 // The extra-bytes VLR: one field per value after the point format's own bytes.
@@ -221,11 +241,14 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
 
 // The CRS (GeoKeys, WKT) and the extra-bytes fields, from the (E)VLRs read.
 void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
+  std::optional<std::uint32_t> linear_unit;
   for (const auto& vlr : hd.vlrs) {
-    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8) parse_geokeys(vlr, hd);
+    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8)
+      parse_geokeys(vlr, hd, linear_unit);
     else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
     else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
   }
+  if (linear_unit) apply_linear_unit(hd, *linear_unit);
 }
 
 }  // namespace

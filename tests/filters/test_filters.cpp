@@ -241,6 +241,41 @@ TEST(Smrf, SeparatesGroundFromABuildingTreesAndALowOutlier) {
   EXPECT_EQ(cls.back(), 1.0);  // the outlier is not ground
 }
 
+// Half of a survey is flight-line overlap (class 12), a 20 x 20 m roof 8 m high among it:
+// the overlap points keep their class, yet they are the surface that the few other
+// points there are judged against (one point in 50 of the overlap half is class 1).
+TEST(Smrf, OverlapPointsKeepTheirClassAndStillShapeTheSurface) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 100.0);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  vola::PointCloud cloud;
+  std::vector<int> kind;  // 0 ground, 1 roof
+  std::vector<double> classes;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = u(rng), y = u(rng);
+    const bool roof = x > 70 && x < 90 && y > 40 && y < 60;
+    cloud.xyz.insert(cloud.xyz.end(), {x, y, 50.0 + 0.03 * x + (roof ? 8.0 : 0.0) + noise(rng)});
+    kind.push_back(roof ? 1 : 0);
+    classes.push_back(x > 50 && i % 50 != 0 ? 12.0 : 1.0);
+  }
+  cloud.attributes.push_back({"classification", vola::ValueType::u8, vola::Reduction::majority, classes});
+  classify_ground(cloud, SmrfOptions{}, Units{});
+  const auto& cls = cloud.attributes[0].values;
+  std::size_t kept = 0, others_right = 0, others = 0;
+  for (std::size_t i = 0; i < kind.size(); ++i) {
+    if (classes[i] == 12) {
+      kept += cls[i] == 12;
+      continue;
+    }
+    if (cloud.xyz[3 * i] <= 50) continue;
+    ++others;
+    others_right += cls[i] == (kind[i] == 1 ? 1.0 : 2.0);
+  }
+  EXPECT_EQ(kept, static_cast<std::size_t>(std::count(classes.begin(), classes.end(), 12.0)));
+  ASSERT_GT(others, 100u);
+  EXPECT_EQ(others_right, others);  // ground among the overlap is ground, the roof is not
+}
+
 // Ground at one point per m2 (a third of the 1 m cells empty) with echoes scattered 5 to
 // 60 m below it over a 20 x 20 m patch, in three cells of ten: each lies below cells
 // that hold ground, and no cell nearby continues it. The negated opening alone keeps

@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "io_test_data.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/io/las.hpp"
 
 namespace {
@@ -58,7 +59,16 @@ TEST(Las, EveryFileReadsAsTheIndependentReaderFound) {
     std::smatch version;
     ASSERT_TRUE(std::regex_search(line, version, std::regex(R"(LAS (\d)\.(\d))")));
     EXPECT_EQ(h.version_minor, std::stoi(version[2]));
-    EXPECT_EQ(h.epsg, expected_epsg(line));
+    const auto code = expected_epsg(line);
+    if (code && !h.epsg && !h.wkt.empty()) {
+      // The keys' linear unit overrides the code's own (pdal_mvk-thin.las: EPSG:26995, a
+      // metre CRS, in US survey feet), as GDAL reads them: the code's CRS in another unit.
+      const auto crs = vola::geo::describe_crs(h.wkt), own = vola::geo::describe_crs("EPSG:" + std::to_string(*code));
+      EXPECT_EQ(crs.name, own.name);
+      EXPECT_NE(crs.horizontal_unit, own.horizontal_unit);
+    } else {
+      EXPECT_EQ(h.epsg, code);
+    }
 
     std::map<int, std::uint64_t> classes;
     vola::Box box{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
@@ -197,3 +207,28 @@ TEST(Las, ScalesAndOffsetsThatMakeNoCoordinateAreRefusedWithTheirOffset) {
 }
 
 }  // namespace
+
+// GeoTIFF keys name a projected CRS and a linear unit: a unit other than the code's own
+// makes the code's CRS in that unit, as GDAL reads it (tests/io/geokeys_vs_gdal.py
+// compares with GDAL on every shared file).
+TEST(Las, AUnitKeyOtherThanTheCodesMakesTheCrsInThatUnit) {
+  using vola::geo::projected_crs_in_unit;
+  const std::string feet = projected_crs_in_unit(26995, 9003);  // NAD83 / Mississippi West in US survey feet
+  ASSERT_FALSE(feet.empty());
+  const auto crs = vola::geo::describe_crs(feet, vola::geo::EpsgLookup::own_id_only);
+  EXPECT_EQ(crs.name, "NAD83 / Mississippi West");
+  EXPECT_EQ(crs.horizontal_unit, "US survey foot");
+  EXPECT_FALSE(crs.epsg.has_value());  // no longer EPSG:26995
+  // The same place in feet: EPSG:2255 is Mississippi West (ftUS).
+  EXPECT_TRUE(vola::geo::same_crs(feet, "EPSG:2255"));
+  EXPECT_EQ(projected_crs_in_unit(26995, 9001), "");  // metres: the code's own unit
+  EXPECT_EQ(projected_crs_in_unit(26995, 9102), "");  // degrees: not a length
+  EXPECT_EQ(projected_crs_in_unit(26995, 32632), ""); // a CRS code where a unit belongs (laspy_simple1_3.las)
+  EXPECT_EQ(projected_crs_in_unit(4326, 9003), "");   // not a projected CRS
+  EXPECT_EQ(projected_crs_in_unit(65000, 9003), "");  // no such code
+
+  VOLA_REQUIRE_DATA(data);
+  vola::io::LasReader reader((data / "las" / "pdal_mvk-thin.las").string());
+  EXPECT_FALSE(reader.header().epsg.has_value());
+  EXPECT_TRUE(vola::geo::same_crs(reader.header().wkt, feet));
+}

@@ -19,7 +19,8 @@
 //
 // As PDAL's filters.smrf does by default, only last returns (and single ones) can be
 // ground, and points classified noise (7 low, 18 high) are left out of the surface and
-// never ground. Parameters are metres whatever the data's units (Units converts).
+// never ground. Overlap points (class 12 of LAS 1.1-1.3, marked by the survey to be left
+// out of its products) help to find the surface but keep their class. Parameters are metres whatever the data's units (Units converts).
 #pragma once
 
 #include <span>
@@ -73,7 +74,7 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
                               const SmrfOptions& options, const Units& units);
 
 // On a cloud: classification 2 on ground points, 1 on the others (the column is added
-// when missing), noise (7, 18) kept. Returns the number of ground points.
+// when missing), noise (7, 18) and overlap (12) kept. Returns the number of ground points.
 std::size_t classify_ground(PointCloud& cloud, const SmrfOptions& options, const Units& units);
 
 }  // namespace vola::filters

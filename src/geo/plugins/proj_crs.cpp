@@ -1,6 +1,7 @@
 // libvola_proj.so: coordinate reference systems through PROJ, behind the entry points of
 // proj_plugin.hpp (vola/geo/crs.hpp documents what each does).
 #include <proj.h>
+#include <proj_experimental.h>  // proj_crs_alter_cs_linear_unit
 
 #include <sys/types.h>
 
@@ -335,6 +336,33 @@ std::string crs_wkt_of(const std::string& definition) {
   return wkt;
 }
 
+// EPSG:`epsg` with its axes in EPSG unit `unit` (GeoTIFF's ProjLinearUnitsGeoKey beside a
+// ProjectedCSTypeGeoKey, as GDAL reads the pair: the projection's parameters keep their
+// meaning, the coordinates are in the new unit), as WKT2 2019; empty when the CRS is not a
+// projected one PROJ knows, `unit` is not a linear unit, or it is the CRS's own.
+std::string projected_crs_in_unit(std::uint32_t epsg, std::uint32_t unit) {
+  Context ctx = make_context();
+  const std::string code = std::to_string(epsg), unit_code = std::to_string(unit);
+  const Pj crs(proj_create_from_database(ctx.get(), "EPSG", code.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
+  if (!crs || proj_get_type(crs.get()) != PJ_TYPE_PROJECTED_CRS) return {};
+  const char* unit_name = nullptr;
+  const char* category = nullptr;
+  double metres = 0;
+  if (!proj_uom_get_info_from_database(ctx.get(), "EPSG", unit_code.c_str(), &unit_name, &metres, &category) ||
+      !category || std::string(category) != "linear" || !unit_name || !(metres > 0))
+    return {};
+  const Pj cs(proj_crs_get_coordinate_system(ctx.get(), crs.get()));
+  double own_metres = 0;
+  if (!cs || !proj_cs_get_axis_info(ctx.get(), cs.get(), 0, nullptr, nullptr, nullptr, &own_metres, nullptr, nullptr,
+                                    nullptr) ||
+      std::abs(own_metres - metres) <= 1e-12 * metres)
+    return {};
+  const Pj altered(proj_crs_alter_cs_linear_unit(ctx.get(), crs.get(), unit_name, metres, "EPSG", unit_code.c_str()));
+  if (!altered) return {};
+  const char* wkt = proj_as_wkt(ctx.get(), altered.get(), PJ_WKT2_2019, nullptr);
+  return wkt ? wkt : "";
+}
+
 using plugin::PluginFailure;
 using vola::plugin::capture_failure;
 
@@ -373,6 +401,9 @@ const plugin::ProjEntries kEntries{
     [](void* state) { delete static_cast<Reprojection*>(state); },
     [](const std::string& definition, std::string& out, PluginFailure& failure) {
       capture_failure(failure, [&] { out = crs_wkt_of(definition); });
+    },
+    [](std::uint32_t epsg, std::uint32_t unit, std::string& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = projected_crs_in_unit(epsg, unit); });
     },
 };
 
