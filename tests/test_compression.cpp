@@ -1,13 +1,18 @@
 // Compressed files (--compress): the context-coded occupancy levels (levels flags 3) and
-// the predicted attribute encodings (2 delta planes, 3 quantized floats) round-trip bit
+// the predicted attribute encodings (2 delta planes, 3 quantized floats, 4 delta planes
+// against an earlier column) round-trip bit
 // for bit on random trees and every value type, NaN payloads, infinities and -0.0
 // included; corrupt and cut compressed records are FormatErrors, never a crash; a lying
 // size is refused before anything is allocated.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -271,6 +276,80 @@ TEST(Compression, QuantizedColumnWithLyingExceptionsIsAFormatError) {
     }
     at += 16 + ((length + 7) / 8) * 8;
   }
+}
+
+
+// Colour channels: green's steps follow red's, blue's follow green's (as in a LAS survey's
+// RGB). Green and blue are coded against an earlier channel (encoding 4) and come back bit
+// for bit; a partner index that is not an earlier column, or names one of another type,
+// is a FormatError at the partner index's offset.
+TEST(Compression, ColourChannelsArePredictedFromAnEarlierChannel) {
+  if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
+  std::mt19937_64 rng(17);
+  vola::Tree tree;
+  for (std::uint64_t seed : seeds_for(Shape::clustered, 1)) {
+    const Scenario s = make_scenario(seed);
+    tree = vola::build_from_voxels(to_voxels(s.unique()), s.depth);
+    if (tree.voxel_count() > 2000) break;
+  }
+  const std::size_t n = tree.voxel_count();
+  vola::AttributeColumn classes("classification", vola::ValueType::u8, vola::Reduction::majority, n);
+  vola::AttributeColumn red("red", vola::ValueType::u16, vola::Reduction::mean, n);
+  vola::AttributeColumn green("green", vola::ValueType::u16, vola::Reduction::mean, n);
+  vola::AttributeColumn blue("blue", vola::ValueType::u16, vola::Reduction::mean, n);
+  double r = 30000;
+  for (std::size_t i = 0; i < n; ++i) {
+    r = std::clamp(r + static_cast<double>(static_cast<int>(rng() % 4001) - 2000), 2000.0, 60000.0);
+    const double g = r + static_cast<double>(rng() % 300), b = g + static_cast<double>(rng() % 300);
+    classes.set(i, static_cast<double>(rng() % 3));
+    red.set(i, r);
+    green.set(i, g);
+    blue.set(i, b);
+  }
+  tree.attributes().add(std::move(classes));
+  tree.attributes().add(std::move(red));
+  tree.attributes().add(std::move(green));
+  tree.attributes().add(std::move(blue));
+  const auto bytes = vola::serialize(tree, {.compress = true});
+  expect_same(tree, vola::parse(bytes, "colours"));
+  const auto encodings = attribute_encodings(bytes);
+  EXPECT_NE(encodings.at("red"), 4);  // no earlier u16 column to lean on
+  EXPECT_EQ(encodings.at("green"), 4);
+  EXPECT_EQ(encodings.at("blue"), 4);
+
+  // Lying partner indices in green's record: its own index, one past the end, the u8 column.
+  std::size_t at = 96;
+  const auto records = get_le<std::uint32_t>(bytes, 92);
+  bool found = false;
+  for (std::uint32_t k = 0; k < records; ++k) {
+    const auto length = get_le<std::uint64_t>(bytes, at + 8);
+    const auto name_length = get_le<std::uint32_t>(bytes, at + 20);
+    const std::string name(bytes.begin() + static_cast<std::ptrdiff_t>(at + 32),
+                           bytes.begin() + static_cast<std::ptrdiff_t>(at + 32 + name_length));
+    if (get_le<std::uint32_t>(bytes, at) == 3 && name == "green") {
+      found = true;
+      const std::size_t data = at + 32 + name_length;
+      EXPECT_EQ(get_le<std::uint32_t>(bytes, data), 1u);  // red, after classification
+      for (const auto& [index, cause] : std::vector<std::pair<std::uint32_t, std::string>>{
+               {2, "is not one of the 2 columns before 'green'"},
+               {~std::uint32_t{0}, "is not one of the 2 columns before 'green'"},
+               {0, "partner column 'classification' holds"}}) {
+        auto changed = bytes;
+        put_le<std::uint32_t>(changed, data, index);
+        reseal_extension(changed, 80);
+        const auto error = format_error_of([&] { (void)vola::parse(changed, "partner"); });
+        ASSERT_TRUE(error.has_value()) << index;
+        EXPECT_THAT(error->cause(), HasSubstr(cause));
+        EXPECT_EQ(error->offset(), data);
+      }
+      auto changed = bytes;
+      changed[data + 5] = 1;  // reserved
+      reseal_extension(changed, 80);
+      EXPECT_THROW((void)vola::parse(changed, "reserved"), vola::FormatError);
+    }
+    at += 16 + ((length + 7) / 8) * 8;
+  }
+  EXPECT_TRUE(found);
 }
 
 }  // namespace

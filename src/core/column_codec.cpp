@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "bytes.hpp"
 #include "codec.hpp"
@@ -268,6 +269,107 @@ void decode_delta_planes(std::span<const std::uint8_t> data, AttributeColumn& co
   }
 }
 
+// Encoding 4: each value's step from the previous one minus the partner column's step at
+// the same rank (green's step predicted by red's, as LAZ predicts colour channels), then
+// as encoding 2.
+std::vector<std::uint64_t> partner_residuals(const AttributeColumn& column, const AttributeColumn& partner) {
+  const unsigned width = static_cast<unsigned>(size_of(column.type()));
+  const std::size_t n = column.size();
+  std::vector<std::uint64_t> residuals(n);
+  std::uint64_t previous = 0, partner_previous = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t v = load(column.bytes().data(), i, width);
+    const std::uint64_t p = load(partner.bytes().data(), i, width);
+    residuals[i] = zigzag(sign_extend((v - previous) - (p - partner_previous), width));
+    previous = v;
+    partner_previous = p;
+  }
+  return residuals;
+}
+
+// Bytes an order-0 coder would need for the byte planes of `residuals`: a cheap stand-in
+// for zstd when choosing a partner.
+double plane_entropy_bytes(std::span<const std::uint64_t> residuals, unsigned width) {
+  double bits = 0;
+  for (unsigned k = 0; k < width; ++k) {
+    std::uint64_t counts[256] = {};
+    for (const std::uint64_t r : residuals) ++counts[(r >> (8 * k)) & 0xffu];
+    const double n = static_cast<double>(residuals.size());
+    for (const std::uint64_t c : counts)
+      if (c) bits -= static_cast<double>(c) * std::log2(static_cast<double>(c) / n);
+  }
+  return bits / 8;
+}
+
+std::vector<std::uint64_t> delta_residuals(const AttributeColumn& column) {
+  const unsigned width = static_cast<unsigned>(size_of(column.type()));
+  std::vector<std::uint64_t> residuals(column.size());
+  std::uint64_t previous = 0;
+  for (std::size_t i = 0; i < column.size(); ++i) {
+    const std::uint64_t v = load(column.bytes().data(), i, width);
+    residuals[i] = zigzag(sign_extend(v - previous, width));
+    previous = v;
+  }
+  return residuals;
+}
+
+std::vector<std::uint8_t> compress_planes(std::span<const std::uint64_t> residuals, unsigned width, int level) {
+  std::vector<std::uint8_t> raw(residuals.size() * width);
+  put_planes(residuals, width, raw.data());
+  return zstd_compress(raw, level);
+}
+
+// The earlier integer column of the same type whose steps best predict this one's, if
+// any predicts them better than nothing (by plane_entropy_bytes).
+struct PartnerChoice {
+  std::uint32_t index = 0;
+  std::vector<std::uint64_t> residuals;
+};
+std::optional<PartnerChoice> choose_partner(const AttributeColumn& column, std::span<const AttributeColumn> earlier) {
+  if (is_float(column.type())) return std::nullopt;
+  const unsigned width = static_cast<unsigned>(size_of(column.type()));
+  double best = plane_entropy_bytes(delta_residuals(column), width);
+  std::optional<PartnerChoice> choice;
+  for (std::size_t j = 0; j < earlier.size(); ++j) {
+    if (earlier[j].type() != column.type() || earlier[j].size() != column.size()) continue;
+    auto residuals = partner_residuals(column, earlier[j]);
+    const double bytes = plane_entropy_bytes(residuals, width);
+    if (bytes < best) {
+      best = bytes;
+      choice = PartnerChoice{static_cast<std::uint32_t>(j), std::move(residuals)};
+    }
+  }
+  return choice;
+}
+
+void decode_partner_delta(std::span<const std::uint8_t> data, AttributeColumn& column,
+                          std::span<const AttributeColumn> earlier, const std::string& name, std::uint64_t offset) {
+  ByteReader r(data, name, offset);
+  const auto index = r.get<std::uint32_t>("partner column");
+  if (r.get<std::uint32_t>("reserved") != 0) r.fail_at(offset + 4, "reserved bytes of a partner coding are not 0");
+  if (index >= earlier.size())
+    r.fail_at(offset, "partner column " + std::to_string(index) + " is not one of the " + std::to_string(earlier.size()) +
+                          " columns before '" + column.name() + "'");
+  const AttributeColumn& partner = earlier[index];
+  if (partner.type() != column.type() || partner.size() != column.size())
+    r.fail_at(offset, "partner column '" + partner.name() + "' holds " + std::to_string(partner.size()) + " " +
+                          std::string(name_of(partner.type())) + " values, not " + std::to_string(column.size()) + " " +
+                          std::string(name_of(column.type())) + " like '" + column.name() + "'");
+  const unsigned width = static_cast<unsigned>(size_of(column.type()));
+  const std::size_t n = column.size();
+  const auto raw = zstd_decompress(r.take(r.remaining(), "partner-coded values"), static_cast<std::uint64_t>(n) * width,
+                                   name, offset + 8);
+  std::uint64_t previous = 0, partner_previous = 0;
+  std::byte* out = column.bytes().data();
+  const std::byte* from = partner.bytes().data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t p = load(from, i, width);
+    previous += unzigzag(get_plane_value(raw.data(), n, i, width)) + (p - partner_previous);
+    partner_previous = p;
+    store(out, i, width, previous);
+  }
+}
+
 }  // namespace
 
 std::span<const double> VoxelCorners::along(unsigned axis) {
@@ -285,7 +387,8 @@ std::span<const double> VoxelCorners::along(unsigned axis) {
   return corners_[axis];
 }
 
-EncodedColumn encode_column(const AttributeColumn& column, VoxelCorners& corners, int level) {
+EncodedColumn encode_column(const AttributeColumn& column, std::span<const AttributeColumn> earlier,
+                            VoxelCorners& corners, int level) {
   const auto bytes = column.bytes();
   EncodedColumn best{kEncodingZstd,
                      zstd_compress({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, level)};
@@ -294,14 +397,23 @@ EncodedColumn encode_column(const AttributeColumn& column, VoxelCorners& corners
   };
   if (column.size() == 0) return best;
   consider(kEncodingDeltaPlanes, encode_delta_planes(column, level));
+  if (auto partner = choose_partner(column, earlier)) {
+    std::vector<std::uint8_t> data(8, 0);
+    std::memcpy(data.data(), &partner->index, 4);  // little-endian, as every integer in the file
+    const auto frame = compress_planes(partner->residuals, static_cast<unsigned>(size_of(column.type())), level);
+    data.insert(data.end(), frame.begin(), frame.end());
+    consider(kEncodingPartnerDelta, std::move(data));
+  }
   if (column.type() == ValueType::f32) consider(kEncodingQuantized, encode_quantized<float>(column, corners, level));
   if (column.type() == ValueType::f64) consider(kEncodingQuantized, encode_quantized<double>(column, corners, level));
   return best;
 }
 
 void decode_column(std::uint8_t encoding, std::span<const std::uint8_t> data, AttributeColumn& column,
-                   VoxelCorners& corners, const std::string& name, std::uint64_t offset) {
+                   std::span<const AttributeColumn> earlier, VoxelCorners& corners, const std::string& name,
+                   std::uint64_t offset) {
   if (encoding == kEncodingDeltaPlanes) return decode_delta_planes(data, column, name, offset);
+  if (encoding == kEncodingPartnerDelta) return decode_partner_delta(data, column, earlier, name, offset);
   ByteReader r(data, name, offset);
   if (!is_float(column.type()))
     r.fail("quantized coding (encoding 3) of a column of " + std::string(name_of(column.type())) +

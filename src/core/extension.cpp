@@ -127,11 +127,13 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
   }
 
   VoxelCorners corners(tree, frame);
-  for (const auto& column : tree.attributes().columns()) {
+  const auto& columns = tree.attributes().columns();
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    const AttributeColumn& column = columns[c];
     const auto raw = column.bytes();
     EncodedColumn encoded;
     const bool compress = compress_levels && zstd_available();
-    if (compress) encoded = encode_column(column, corners, level);
+    if (compress) encoded = encode_column(column, std::span(columns.data(), c), corners, level);
     const std::vector<std::uint8_t>& packed = encoded.data;
     const std::uint64_t data_size = compress ? packed.size() : raw.size();
     begin_record(w, RecordTag::attribute, 0, 16 + column.name().size() + data_size);
@@ -215,7 +217,7 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
     const auto column_name = body.take(name_length, "attribute name");
     if (type > 9) body.fail_at(record_offset + 16, "unknown attribute value type " + std::to_string(type));
     if (reduction > 4) body.fail_at(record_offset + 17, "unknown attribute reduction " + std::to_string(reduction));
-    if (encoding > kEncodingQuantized)
+    if (encoding > kEncodingPartnerDelta)
       body.fail_at(record_offset + 18, "unknown attribute encoding " + std::to_string(encoding));
     AttributeColumn column(std::string(column_name.begin(), column_name.end()), static_cast<ValueType>(type),
                            static_cast<Reduction>(reduction));
@@ -363,7 +365,7 @@ void decode_pending_columns(ExtensionContents& ext, const Tree& tree, const std:
                              "attribute '" + column.name() + "' has " + std::to_string(values) + " values for " +
                                  std::to_string(tree.voxel_count()) + " voxels"));
     column.resize(values);
-    decode_column(p.encoding, p.data, column, corners, name, p.offset);
+    decode_column(p.encoding, p.data, column, std::span(ext.attributes.data(), p.index), corners, name, p.offset);
   }
   ext.pending.clear();
 }

@@ -79,17 +79,20 @@ std::vector<Seed> synthetic_seeds() {
     seeds.push_back({"compressed", vola::serialize(vola::build(cloud, {.depth = 4}), {.compress = true})});
     seeds.push_back({"compressed_attributes", vola::serialize(attribute_tree, {.compress = true})});
     seeds.push_back({"compressed_payload", vola::serialize(payload_tree, {.compress = true})});
-    // Heights in centimetres (quantized floats, attribute encoding 3) and a smooth
-    // integer column (delta planes, encoding 2).
+    // Heights in centimetres (quantized floats, attribute encoding 3), a smooth integer
+    // column (delta planes, encoding 2) and one that follows it (delta planes against it,
+    // encoding 4).
     vola::PointCloud surveyed = cube_cloud(2000, 20.0);
     vola::PointAttribute height{"height", vola::ValueType::f32, vola::Reduction::last, {}};
     vola::PointAttribute smooth{"smooth", vola::ValueType::u16, vola::Reduction::last, {}};
+    vola::PointAttribute follower{"follower", vola::ValueType::u16, vola::Reduction::last, {}};
     for (std::size_t i = 0; i < surveyed.size(); ++i) {
       surveyed.xyz[3 * i + 2] = std::round(surveyed.xyz[3 * i + 2] * 100.0) / 100.0;
       height.values.push_back(surveyed.xyz[3 * i + 2]);
       smooth.values.push_back(static_cast<double>(1000 + i % 13));
+      follower.values.push_back(smooth.values.back() + static_cast<double>(i % 3));
     }
-    surveyed.attributes = {height, smooth};
+    surveyed.attributes = {height, smooth, follower};
     seeds.push_back({"compressed_predicted", vola::serialize(vola::build(surveyed, {.quantization = vola::Quantization::grid,
                                                                                .depth = 4, .voxel_size = 0.5,
                                                                                .origin = vola::Point{-1, -1, -1}}),
