@@ -283,8 +283,9 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
       const auto frame = body.take(packed, "level part");
       const auto words = std::span<std::uint64_t>(out.levels).subspan(at, raw / 8);
       if (coded && (!with_payload || p % 2 == 0)) {
-        const bool last = p + (with_payload ? 2 : 1) >= parts;
-        occupancy.decode(frame, words, last, name, frame_offset);
+        const std::uint32_t next = p + (with_payload ? 2 : 1);
+        const bool last = next >= parts;
+        occupancy.decode(frame, words, last, last ? 0 : sizes[next].first / 8, name, frame_offset);
       } else {
         const auto lanes = zstd_decompress(frame, raw, name, frame_offset);
         words_from_lanes16(lanes, words);

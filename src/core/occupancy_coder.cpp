@@ -6,7 +6,6 @@
 #include <type_traits>
 
 #include "range_coder.hpp"
-#include "vola/key.hpp"
 #include "vola/error.hpp"
 
 namespace vola {
@@ -14,8 +13,6 @@ VOLA_INLINE_NAMESPACE_BEGIN
 namespace detail {
 
 namespace {
-
-using Cell = OccupancyCoder::Cell;
 
 // Bit of cell (x, y, z) of a block: x + 4y + 16z.
 constexpr unsigned bit_of(unsigned x, unsigned y, unsigned z) noexcept { return x + 4 * y + 16 * z; }
@@ -40,90 +37,32 @@ std::uint8_t octants_of(std::uint64_t word) noexcept {
   return m;
 }
 
-// Finds a block of the level by its coordinates. The blocks are in key order, so their
-// keys are sorted, and a neighbour of block b is usually a few blocks before or after it:
-// an exponential search from b, then a binary one, touches memory near b (a hash table
-// of a few million blocks cost a cache miss per lookup, 1.7 us per voxel at depth 7).
-class BlockIndex {
- public:
-  explicit BlockIndex(std::span<const Cell> blocks) : keys_(blocks.size()) {
-    for (std::size_t i = 0; i < blocks.size(); ++i) keys_[i] = encode(blocks[i].x, blocks[i].y, blocks[i].z);
-  }
-  // The index of the block at (x, y, z), or kNone; `near` = where to start looking.
-  std::uint32_t find(std::uint32_t x, std::uint32_t y, std::uint32_t z, std::size_t near) const noexcept {
-    if (((x | y | z) >> 20) != 0) return kNone;  // beyond any grid
-    const Key key = encode(x, y, z);
-    const std::size_t n = keys_.size();
-    std::size_t lo, hi;  // the key is in [lo, hi) if anywhere
-    if (keys_[near] < key) {
-      std::size_t step = 1;
-      lo = near + 1;
-      while (lo + step <= n && keys_[lo + step - 1] < key) {
-        lo += step;
-        step *= 2;
-      }
-      hi = std::min(n, lo + step);
-    } else {
-      std::size_t step = 1;
-      hi = near + 1;
-      while (hi > step && keys_[hi - step - 1] >= key) {
-        hi -= step;
-        step *= 2;
-      }
-      lo = hi > step ? hi - step - 1 : 0;
-    }
-    const auto it = std::lower_bound(keys_.begin() + static_cast<std::ptrdiff_t>(lo),
-                                     keys_.begin() + static_cast<std::ptrdiff_t>(hi), key);
-    return it != keys_.end() && *it == key ? static_cast<std::uint32_t>(it - keys_.begin()) : kNone;
-  }
-  static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+using Neighbours = OccupancyCoder::Neighbours;
+constexpr std::uint32_t kNoBlock = OccupancyCoder::kNoBlock;
 
- private:
-  std::vector<Key> keys_;
-};
+// The directions of Neighbours::block: the six faces, then the three lower edges.
+constexpr int kDirection[9][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1},
+                                  {0, 0, 1},  {-1, -1, 0}, {-1, 0, -1}, {0, -1, -1}};
+// The direction (index into kDirection, 9 = the block itself) of the block below along
+// the axes of `axes` (bit 0 x, 1 y, 2 z); 7 (all three) is never asked for.
+constexpr unsigned kLowerDirection[8] = {9, 0, 2, 6, 4, 7, 8, 9};
+// The direction index of an offset with components in {-1, 0, 1} that is one of them (or 9).
+constexpr unsigned direction_of(int dx, int dy, int dz) noexcept {
+  for (unsigned d = 0; d < 9; ++d)
+    if (kDirection[d][0] == dx && kDirection[d][1] == dy && kDirection[d][2] == dz) return d;
+  return 9;
+}
 
 constexpr std::size_t kOctantContexts = 8 * 64 * 4 * 4;
 constexpr std::size_t kCellContexts = 8 * 8 * 8 * 8 * 4 * 3;
 
 // Both passes over one level; the encoder reads `words`, the decoder fills them (they
-// start at 0). Every context reads only what the decoder has by then.
+// start at 0). Every context reads only what the decoder has by then. `near`: each
+// block's neighbours (advance() derives them from the level above).
 template <class Coder>
-void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint64_t> words) {
+void code_level(Coder& coder, std::span<const Neighbours> near, std::span<std::uint64_t> words) {
   constexpr bool kEncoding = std::is_same_v<Coder, RangeEncoder>;
-  const std::size_t n = blocks.size();
-  const BlockIndex index(blocks);
-  // Face neighbours of every block: -x, +x, -y, +y, -z, +z (kNone: no such block), and
-  // the blocks below it along two or three axes (index = which axes: 3 xy, 5 xz, 6 yz,
-  // 7 xyz; the others unused).
-  std::vector<std::array<std::uint32_t, 6>> near(n);
-  std::vector<std::array<std::uint32_t, 8>> lower(n);
-  for (std::size_t b = 0; b < n; ++b) {
-    const Cell c = blocks[b];
-    near[b][0] = c.x ? index.find(c.x - 1, c.y, c.z, b) : BlockIndex::kNone;
-    near[b][1] = index.find(c.x + 1, c.y, c.z, b);
-    near[b][2] = c.y ? index.find(c.x, c.y - 1, c.z, b) : BlockIndex::kNone;
-    near[b][3] = index.find(c.x, c.y + 1, c.z, b);
-    near[b][4] = c.z ? index.find(c.x, c.y, c.z - 1, b) : BlockIndex::kNone;
-    near[b][5] = index.find(c.x, c.y, c.z + 1, b);
-    lower[b][0] = static_cast<std::uint32_t>(b);
-    lower[b][1] = near[b][0];
-    lower[b][2] = near[b][2];
-    lower[b][4] = near[b][4];
-    for (unsigned axes : {3u, 5u, 6u, 7u}) {
-      const bool ok = (!(axes & 1u) || c.x) && (!(axes & 2u) || c.y) && (!(axes & 4u) || c.z);
-      lower[b][axes] = ok ? index.find(c.x - (axes & 1u), c.y - ((axes >> 1) & 1u), c.z - ((axes >> 2) & 1u), b)
-                          : BlockIndex::kNone;
-    }
-  }
-  // A cell at or below (x, y, z) of block b, offsets -1 or 0 per axis: coded already.
-  auto below_cell = [&](std::size_t b, std::uint64_t word, int x, int y, int z) -> unsigned {
-    const unsigned axes = (x < 0 ? 1u : 0u) | (y < 0 ? 2u : 0u) | (z < 0 ? 4u : 0u);
-    const unsigned bit = bit_of(static_cast<unsigned>(x & 3), static_cast<unsigned>(y & 3), static_cast<unsigned>(z & 3));
-    if (axes == 0) return static_cast<unsigned>((word >> bit) & 1u);
-    const std::uint32_t nb = lower[b][axes];
-    return nb != BlockIndex::kNone ? static_cast<unsigned>((words[nb] >> bit) & 1u) : 0u;
-  };
-
+  const std::size_t n = near.size();
   // Pass A: octants.
   std::vector<std::uint8_t> octants(n, 0);
   std::vector<BitModel> octant_models(kOctantContexts);
@@ -138,22 +77,22 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
       unsigned ctx = 0;
       for (unsigned a = 0; a < 3; ++a) {
         const unsigned axis_bit = 1u << a;
-        const std::uint32_t below = near[b][2 * a], above = near[b][2 * a + 1];
+        const std::uint32_t below = near[b].block[2 * a], above = near[b].block[2 * a + 1];
         unsigned near_octant, far_block;
         if (!(o & axis_bit)) {  // lower half: the octant beyond, in the block below, is coded
-          near_octant = below != BlockIndex::kNone ? (octants[below] >> (o | axis_bit)) & 1u : 0u;
+          near_octant = below != kNoBlock ? (octants[below] >> (o | axis_bit)) & 1u : 0u;
         } else {  // upper half: the sibling below is coded
           near_octant = (mask >> (o ^ axis_bit)) & 1u;
         }
-        far_block = above != BlockIndex::kNone ? 1u : 0u;
+        far_block = above != kNoBlock ? 1u : 0u;
         ctx |= (near_octant | far_block << 1) << (2 * a);
       }
       const unsigned count = std::min<unsigned>(static_cast<unsigned>(std::popcount(mask)), 3u);
       // The same octant of the blocks below along x and y (two octants away).
       unsigned farther = 0;
       for (unsigned a = 0; a < 2; ++a) {
-        const std::uint32_t nb = near[b][2 * a];
-        farther |= (nb != BlockIndex::kNone ? (octants[nb] >> o) & 1u : 0u) << a;
+        const std::uint32_t nb = near[b].block[2 * a];
+        farther |= (nb != kNoBlock ? (octants[nb] >> o) & 1u : 0u) << a;
       }
       BitModel& m = octant_models[o | ctx << 3 | count << 9 | farther << 11];
       if (coder.code(m, (actual >> o) & 1u)) mask |= 1u << o;
@@ -166,6 +105,21 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint64_t actual = kEncoding ? words[b] : 0;
     std::uint64_t word = 0;
+    // The words of the blocks below along each set of axes (bit 0 x, 1 y, 2 z; 0 where
+    // there is no such block), coded already: a cell's context reads them without a
+    // branch. Entry 0 is this block's own word so far.
+    std::array<std::uint64_t, 8> below_words{};
+    for (unsigned axes = 1; axes < 7; ++axes) {
+      const std::uint32_t nb = near[b].block[kLowerDirection[axes]];
+      below_words[axes] = nb != kNoBlock ? words[nb] : 0;
+    }
+    // The cell at (x, y, z) with offsets of -1 or 0 per axis from this block (-2 along x
+    // or y alone): coded already.
+    const auto below_cell = [&](int x, int y, int z) -> unsigned {
+      const unsigned axes = (x < 0 ? 1u : 0u) | (y < 0 ? 2u : 0u) | (z < 0 ? 4u : 0u);
+      const unsigned bit = bit_of(static_cast<unsigned>(x & 3), static_cast<unsigned>(y & 3), static_cast<unsigned>(z & 3));
+      return static_cast<unsigned>(((axes ? below_words[axes] : word) >> bit) & 1u);
+    };
     for (unsigned o = 0; o < 8; ++o) {
       if (!((octants[b] >> o) & 1u)) continue;
       // The octant beyond this one along each axis (in this block or the next one).
@@ -176,8 +130,8 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
         if (!(o & axis_bit)) {
           occupied = (octants[b] >> (o | axis_bit)) & 1u;
         } else {
-          const std::uint32_t above = near[b][2 * a + 1];
-          occupied = above != BlockIndex::kNone ? (octants[above] >> (o ^ axis_bit)) & 1u : 0u;
+          const std::uint32_t above = near[b].block[2 * a + 1];
+          occupied = above != kNoBlock ? (octants[above] >> (o ^ axis_bit)) & 1u : 0u;
         }
         beyond |= occupied << a;
       }
@@ -191,11 +145,10 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
           break;
         }
         const int x = static_cast<int>(p[0]), y = static_cast<int>(p[1]), z = static_cast<int>(p[2]);
-        const unsigned below = below_cell(b, word, x - 1, y, z) | below_cell(b, word, x, y - 1, z) << 1 |
-                               below_cell(b, word, x, y, z - 1) << 2;
-        const unsigned diagonal = below_cell(b, word, x - 1, y - 1, z) | below_cell(b, word, x - 1, y, z - 1) << 1 |
-                                  below_cell(b, word, x, y - 1, z - 1) << 2;
-        const unsigned farther = below_cell(b, word, x - 2, y, z) | below_cell(b, word, x, y - 2, z) << 1;
+        const unsigned below = below_cell(x - 1, y, z) | below_cell(x, y - 1, z) << 1 | below_cell(x, y, z - 1) << 2;
+        const unsigned diagonal =
+            below_cell(x - 1, y - 1, z) | below_cell(x - 1, y, z - 1) << 1 | below_cell(x, y - 1, z - 1) << 2;
+        const unsigned farther = below_cell(x - 2, y, z) | below_cell(x, y - 2, z) << 1;
         BitModel& m = cell_models[c | below << 3 | beyond << 6 | diagonal << 9 | farther << 12 | std::min(set, 2u) << 14];
         if (coder.code(m, (actual >> bit) & 1u)) {
           word |= std::uint64_t{1} << bit;
@@ -209,46 +162,69 @@ void code_level(Coder& coder, std::span<const Cell> blocks, std::span<std::uint6
 
 }  // namespace
 
-OccupancyCoder::OccupancyCoder() : blocks_{Cell{0, 0, 0}} {}
+OccupancyCoder::OccupancyCoder() : near_(1) { near_[0].block.fill(kNoBlock); }
 
 void OccupancyCoder::advance(std::span<const std::uint64_t> words, bool last) {
-  std::vector<Cell> next;
+  std::vector<Neighbours> next;
   if (!last) {
-    std::uint64_t cells = 0;
-    for (std::uint64_t w : words) cells += static_cast<std::uint64_t>(std::popcount(w));
-    next.reserve(cells);
-    for (std::size_t b = 0; b < words.size(); ++b) {
-      std::uint64_t w = words[b];
-      const Cell c = blocks_[b];
+    // first[p]: the index of parent p's first child.
+    std::vector<std::uint64_t> first(words.size() + 1, 0);
+    for (std::size_t p = 0; p < words.size(); ++p)
+      first[p + 1] = first[p] + static_cast<std::uint64_t>(std::popcount(words[p]));
+    if (first.back() > 0xFFFFFFFEu) VOLA_THROW(Error("occupancy coder: a level of 2^32 blocks or more"));
+    next.resize(first.back());
+    std::size_t child = 0;
+    for (std::size_t p = 0; p < words.size(); ++p) {
+      std::uint64_t w = words[p];
       while (w) {
-        const unsigned i = static_cast<unsigned>(std::countr_zero(w));
+        const auto i = static_cast<unsigned>(std::countr_zero(w));
         w &= w - 1;
-        next.push_back({4 * c.x + (i & 3u), 4 * c.y + ((i >> 2) & 3u), 4 * c.z + (i >> 4)});
+        const int x = static_cast<int>(i & 3u), y = static_cast<int>((i >> 2) & 3u), z = static_cast<int>(i >> 4);
+        Neighbours& out = next[child++];
+        out.block[9] = kNoBlock;
+        for (unsigned d = 0; d < 9; ++d) {
+          const int nx = x + kDirection[d][0], ny = y + kDirection[d][1], nz = z + kDirection[d][2];
+          // The parent holding the neighbour: this one, or its neighbour across the edge crossed.
+          const unsigned across = direction_of(nx < 0 ? -1 : (nx > 3 ? 1 : 0), ny < 0 ? -1 : (ny > 3 ? 1 : 0),
+                                               nz < 0 ? -1 : (nz > 3 ? 1 : 0));
+          const std::uint32_t parent = across == 9 ? static_cast<std::uint32_t>(p) : near_[p].block[across];
+          if (parent == kNoBlock) {
+            out.block[d] = kNoBlock;
+            continue;
+          }
+          const unsigned bit = bit_of(static_cast<unsigned>(nx & 3), static_cast<unsigned>(ny & 3),
+                                      static_cast<unsigned>(nz & 3));
+          const std::uint64_t pw = words[parent];
+          out.block[d] = (pw >> bit) & 1u ? static_cast<std::uint32_t>(
+                                                first[parent] + static_cast<std::uint64_t>(std::popcount(
+                                                                    pw & ((std::uint64_t{1} << bit) - 1))))
+                                          : kNoBlock;
+        }
       }
     }
   }
-  blocks_ = std::move(next);
+  near_ = std::move(next);
 }
 
 std::vector<std::uint8_t> OccupancyCoder::encode(std::span<const std::uint64_t> words, bool last) {
-  if (words.size() != blocks_.size())
+  if (words.size() != near_.size())
     VOLA_THROW(Error("occupancy coder: the level has " + std::to_string(words.size()) + " words, the level above " +
-                     std::to_string(blocks_.size()) + " cells"));
+                     std::to_string(near_.size()) + " cells"));
   for (std::uint64_t w : words)
-    if (w == 0 && blocks_.size() > 1) VOLA_THROW(Error("occupancy coder: an empty block below the root"));
+    if (w == 0 && near_.size() > 1) VOLA_THROW(Error("occupancy coder: an empty block below the root"));
   std::vector<std::uint8_t> out;
   RangeEncoder coder(out);
-  if (blocks_.size() == 1 && words[0] == 0) {
+  if (near_.size() == 1 && words[0] == 0) {
     // The root of an empty tree: the one word that may be 0 (the passes assume none is).
     std::vector<BitModel> flag(1);
     coder.code(flag[0], true);
   } else {
-    if (blocks_.size() == 1) {
+    if (near_.size() == 1) {
       std::vector<BitModel> flag(1);
       coder.code(flag[0], false);
     }
     std::vector<std::uint64_t> copy(words.begin(), words.end());
-    code_level(coder, blocks_, std::span<std::uint64_t>(copy));
+    code_level(coder, std::span<const Neighbours>(near_), std::span<std::uint64_t>(copy));
   }
   coder.finish();
   advance(words, last);
@@ -256,25 +232,32 @@ std::vector<std::uint8_t> OccupancyCoder::encode(std::span<const std::uint64_t> 
 }
 
 void OccupancyCoder::decode(std::span<const std::uint8_t> stream, std::span<std::uint64_t> words, bool last,
-                            const std::string& name, std::uint64_t offset) {
-  if (words.size() != blocks_.size())
+                            std::uint64_t next_words, const std::string& name, std::uint64_t offset) {
+  if (words.size() != near_.size())
     VOLA_THROW(FormatError(name, offset, "occupancy level of " + std::to_string(words.size()) +
-                                             " words below a level of " + std::to_string(blocks_.size()) + " cells"));
-  if (blocks_.size() > 0xFFFFFFFEu)
+                                             " words below a level of " + std::to_string(near_.size()) + " cells"));
+  if (near_.size() > 0xFFFFFFFEu)
     VOLA_THROW(FormatError(name, offset, "an occupancy level of 2^32 blocks or more"));
   if (stream.empty() || stream[0] != 0)  // the encoder's first byte is always 0
     VOLA_THROW(FormatError(name, offset, "the coded occupancy level is corrupt (it does not start with a 0 byte)"));
   std::fill(words.begin(), words.end(), 0);
   RangeDecoder coder(stream);
   bool empty_root = false;
-  if (blocks_.size() == 1) {
+  if (near_.size() == 1) {
     std::vector<BitModel> flag(1);
     empty_root = coder.code(flag[0]);
   }
-  if (!empty_root) code_level(coder, blocks_, words);
+  if (!empty_root) code_level(coder, std::span<const Neighbours>(near_), words);
   if (!coder.consumed_exactly())
     VOLA_THROW(FormatError(name, offset, "the coded occupancy level is corrupt (it does not decode to its own " +
                                              std::to_string(stream.size()) + " bytes)"));
+  if (!last) {
+    std::uint64_t cells = 0;
+    for (std::uint64_t w : words) cells += static_cast<std::uint64_t>(std::popcount(w));
+    if (cells != next_words)
+      VOLA_THROW(FormatError(name, offset, "occupancy level with " + std::to_string(cells) + " cells above a level of " +
+                                               std::to_string(next_words) + " words"));
+  }
   advance(words, last);
 }
 

@@ -11,8 +11,13 @@
 // last bit is implied when the others are 0. This is how octree geometry coders of point
 // clouds work (occupancy of a node coded in the context of its neighbours' occupancy);
 // a VOLA block is two octree levels.
+//
+// A block's neighbours come from the level above, as VOLA finds children: the block next
+// to a child is a sibling (a bit of the same parent word) or a child of the parent's
+// neighbour, and its index is that parent's first child plus a popcount.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -29,22 +34,28 @@ class OccupancyCoder {
   OccupancyCoder();  // before level 0: one block, at (0, 0, 0)
 
   // Blocks (words) of the next level.
-  std::uint64_t blocks() const noexcept { return blocks_.size(); }
+  std::uint64_t blocks() const noexcept { return near_.size(); }
   // Codes the next level's words (words.size() == blocks()); `last` = no level follows.
   std::vector<std::uint8_t> encode(std::span<const std::uint64_t> words, bool last);
   // Decodes the next level into `words` (words.size() == blocks()); a stream that does
-  // not decode to exactly its own bytes is a FormatError naming `name` and `offset`.
+  // not decode to exactly its own bytes, or (unless `last`) to words whose set bits are
+  // not the `next_words` blocks the file gives the level after it, is a FormatError naming
+  // `name` and `offset` (before anything is allocated for that level).
   void decode(std::span<const std::uint8_t> stream, std::span<std::uint64_t> words, bool last,
-              const std::string& name, std::uint64_t offset);
+              std::uint64_t next_words, const std::string& name, std::uint64_t offset);
 
-  struct Cell {
-    std::uint32_t x, y, z;
+  // The blocks next to a block of a level, by index in the level (kNoBlock: none): along
+  // -x, +x, -y, +y, -z, +z, then below along x and y, x and z, y and z; the last entry is
+  // always kNoBlock.
+  static constexpr std::uint32_t kNoBlock = 0xFFFFFFFFu;
+  struct Neighbours {
+    std::array<std::uint32_t, 10> block;
   };
 
  private:
   void advance(std::span<const std::uint64_t> words, bool last);
 
-  std::vector<Cell> blocks_;  // block coordinates of the next level, in file order
+  std::vector<Neighbours> near_;  // of the next level's blocks, in file order
 };
 
 }  // namespace detail

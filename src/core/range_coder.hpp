@@ -29,12 +29,11 @@ struct BitModel {
     static constexpr std::uint8_t kShift[16] = {1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5};
     const unsigned shift = kShift[seen];
     if (seen < 15) ++seen;
-    int q = p;
-    if (bit)
-      q -= q >> shift;
-    else
-      q += (65536 - q) >> shift;
-    p = static_cast<std::uint16_t>(q < 32 ? 32 : (q > 65504 ? 65504 : q));
+    // Both moves, then a select: the bit is as unpredictable as the data.
+    const int q = p;
+    const int down = q - (q >> shift), up = q + ((65536 - q) >> shift);
+    const int moved = bit ? down : up;
+    p = static_cast<std::uint16_t>(moved < 32 ? 32 : (moved > 65504 ? 65504 : moved));
   }
 };
 
@@ -91,15 +90,10 @@ class RangeDecoder {
   // Decodes a bit; the argument is ignored (see RangeEncoder::code).
   bool code(BitModel& m, bool = false) {
     const std::uint32_t bound = (range_ >> 16) * m.p;
-    bool bit;
-    if (code_ < bound) {
-      range_ = bound;
-      bit = false;
-    } else {
-      code_ -= bound;
-      range_ -= bound;
-      bit = true;
-    }
+    const bool bit = code_ >= bound;
+    // Selects rather than branches, as in update().
+    code_ = bit ? code_ - bound : code_;
+    range_ = bit ? range_ - bound : bound;
     m.update(bit);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
