@@ -53,10 +53,12 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
   return epsg;
 }
 
-std::string projected_crs_in_unit(std::uint32_t epsg, std::uint32_t unit) {
+std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit) {
   std::string wkt;
-  run("EPSG:" + std::to_string(epsg) + " in unit EPSG:" + std::to_string(unit),
-      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.projected_crs_in_unit(epsg, unit, wkt, f); });
+  run("EPSG:" + std::to_string(epsg) + " as GeoTIFF keys qualify it",
+      [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) {
+        p.keyed_projected_crs(epsg, linear_unit, vertical_unit, wkt, f);
+      });
   return wkt;
 }
 

@@ -36,7 +36,8 @@ struct ProjEntries {
   void (*reprojection_transform)(void* state, double* xyz, std::size_t points, PluginFailure& failure);
   void (*reprojection_close)(void* state);
   void (*crs_wkt_of)(const std::string& definition, std::string& out, PluginFailure& failure);
-  void (*projected_crs_in_unit)(std::uint32_t epsg, std::uint32_t unit, std::string& out, PluginFailure& failure);
+  void (*keyed_projected_crs)(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit,
+                              std::string& out, PluginFailure& failure);
 };
 
 using ProjEntriesEntry = const ProjEntries* (*)();

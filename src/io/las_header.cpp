@@ -169,12 +169,18 @@ void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::u
   }
 }
 
+// The unit keys of a GeoKeyDirectory, which may qualify its projected CRS code.
+struct UnitKeys {
+  std::uint32_t linear = 0;    // ProjLinearUnitsGeoKey
+  std::uint32_t vertical = 0;  // VerticalUnitsGeoKey, when no VerticalCSTypeGeoKey names a vertical CRS
+};
+
 // GeoKeyDirectoryTag: the projected CRS code, else the geographic one (none when
-// user-defined), and the linear unit key (ProjLinearUnitsGeoKey), which may override the
-// projected CRS's own unit.
-void parse_geokeys(const LasVlr& vlr, LasHeader& hd, std::optional<std::uint32_t>& linear_unit) {
+// user-defined), and the unit keys.
+void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
   const std::size_t keys = load_le<std::uint16_t>(&vlr.data[6]);
   std::optional<std::uint32_t> projected, geographic;
+  bool vertical_crs = false;
   for (std::size_t k = 0; k < keys && 8 + 8 * k + 8 <= vlr.data.size(); ++k) {
     const std::uint8_t* e = &vlr.data[8 + 8 * k];
     const std::uint16_t id = load_le<std::uint16_t>(e), location = load_le<std::uint16_t>(e + 2);
@@ -182,26 +188,30 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd, std::optional<std::uint32_t
     if (location != 0) continue;
     if (id == 3072) projected = value;
     if (id == 2048) geographic = value;
-    if (id == 3076) linear_unit = value;
+    if (id == 3076) units.linear = value;
+    if (id == 4099) units.vertical = value;
+    if (id == 4096 && value != 0 && value != las::kUserDefined) vertical_crs = true;
   }
+  // A named vertical CRS has a unit of its own; GDAL then reads no vertical part at all
+  // by default, and neither does vola (heights in the unit of x and y).
+  if (vertical_crs) units.vertical = 0;
   if (projected && *projected != las::kUserDefined && *projected != 0) hd.epsg = *projected;
   else if (geographic && *geographic != las::kUserDefined && *geographic != 0) hd.epsg = *geographic;
 }
 
-// A projected CRS code whose linear unit key names another unit (NAD83 / Mississippi
-// West, a metre CRS, with US survey feet: pdal_mvk-thin.las) is that CRS in that unit, as
-// GDAL and PDAL read it; the coordinates are in the key's unit. It becomes the header's
-// WKT (unless the file has a WKT record, which wins) and its code whatever PROJ
-// identifies it as (EPSG:2255 here), or none.
-void apply_linear_unit(LasHeader& hd, std::uint32_t unit) {
-  if (!hd.epsg || !hd.wkt.empty()) return;
+// A projected CRS code whose unit keys say more than the code (geo::keyed_projected_crs:
+// pdal_mvk-thin.las is EPSG:26995, a metre CRS, in US survey feet) is the CRS GDAL and
+// PDAL read from them. It becomes the header's WKT (unless the file has a WKT record,
+// which wins), and the header's code is what PROJ identifies it as, or none.
+void apply_unit_keys(LasHeader& hd, const UnitKeys& units) {
+  if (!hd.epsg || !hd.wkt.empty() || (units.linear == 0 && units.vertical == 0)) return;
   try {
-    const std::string wkt = geo::projected_crs_in_unit(*hd.epsg, unit);
+    const std::string wkt = geo::keyed_projected_crs(*hd.epsg, units.linear, units.vertical);
     if (wkt.empty()) return;
     hd.wkt = wkt;
     hd.epsg = geo::epsg_from_wkt(wkt);
   } catch (const Error&) {
-    // PROJ cannot be loaded: the code alone, as before the unit key was read.
+    // PROJ cannot be loaded: the code alone, as before the unit keys were read.
   }
 }
 
@@ -241,14 +251,14 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
 
 // The CRS (GeoKeys, WKT) and the extra-bytes fields, from the (E)VLRs read.
 void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
-  std::optional<std::uint32_t> linear_unit;
+  UnitKeys units;
   for (const auto& vlr : hd.vlrs) {
     if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8)
-      parse_geokeys(vlr, hd, linear_unit);
+      parse_geokeys(vlr, hd, units);
     else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
     else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
   }
-  if (linear_unit) apply_linear_unit(hd, *linear_unit);
+  apply_unit_keys(hd, units);
 }
 
 }  // namespace

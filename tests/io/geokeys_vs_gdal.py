@@ -8,7 +8,10 @@ West, a metre CRS, with US survey feet; its coordinates are feet). For every sha
 LAS and LAZ file whose keys state a projected CRS and which has no WKT record (the WKT
 wins in vola, as the LAS 1.4 specification says), this test copies the three key records
 into the tags of a 1 x 1 GeoTIFF, has GDAL read its CRS, and requires `vola info --json`
-to give the same CRS name and linear unit.
+to give the same CRS name and linear unit. Then made-up key directories in a one-point
+LAS file: a projected code with a linear unit key, and with a vertical unit key other than
+the horizontal one (no vertical CRS named), where GDAL (asked to report compound CRSs,
+GTIFF_REPORT_COMPD_CS) gives heights in the vertical key's unit and so must vola.
 
 Usage: geokeys_vs_gdal.py VOLA SHARED_DIR
 Exit 77 (skip) without the shared data, unless CI is set (then 1).
@@ -79,6 +82,56 @@ def geotiff_with_keys(records, out):
     out.write_bytes(b"II*\0" + struct.pack("<I", 8) + ifd + struct.pack("<I", 0) + blobs + b"\0")
 
 
+def las_with_keys(keys, out):
+    """A LAS 1.2 file of one point (format 0) whose only VLR is a GeoKeyDirectory of
+    (key, value) pairs."""
+    directory = [1, 1, 0, len(keys)]
+    for key, value in keys:
+        directory += [key, 0, 1, value]
+    vlr_data = struct.pack(f"<{len(directory)}H", *directory)
+    vlr = struct.pack("<H16sHH32s", 0, b"LASF_Projection", 34735, len(vlr_data), b"") + vlr_data
+    header_size, record_length = 227, 20
+    offset = header_size + len(vlr)
+    header = bytearray(header_size)
+    header[0:4] = b"LASF"
+    header[24], header[25] = 1, 2
+    struct.pack_into("<H", header, 94, header_size)
+    struct.pack_into("<IIBHI", header, 96, offset, 1, 0, record_length, 1)
+    struct.pack_into("<3d", header, 131, 0.01, 0.01, 0.01)
+    struct.pack_into("<6d", header, 179, 500001.0, 500000.0, 5000001.0, 5000000.0, 101.0, 100.0)
+    point = struct.pack("<3iH", 50000000, 500000000, 10000, 0) + bytes(6)
+    out.write_bytes(bytes(header) + vlr + point)
+
+
+def made_up_keys(vola, tmp, failures):
+    """Unit keys GDAL reads as units: (keys, what GDAL's reading must equal in vola's)."""
+    checked = 0
+    for keys in ([(1024, 1), (3072, 26995), (3076, 9003)],
+                 [(1024, 1), (3072, 26910), (4099, 9003)],
+                 [(1024, 1), (3072, 26910), (3076, 9002), (4099, 9003)]):
+        las, tiff = Path(tmp) / "keys.las", Path(tmp) / "made_up.tif"
+        las_with_keys(keys, las)
+        geotiff_with_keys({34735: las.read_bytes()[227 + 54:227 + 54 + 8 + 8 * len(keys)]}, tiff)
+        gdal.SetConfigOption("GTIFF_REPORT_COMPD_CS", "YES")
+        srs = gdal.Open(str(tiff)).GetSpatialRef()
+        gdal.SetConfigOption("GTIFF_REPORT_COMPD_CS", None)
+        horizontal = srs.GetLinearUnits()
+        vertical = srs.GetTargetLinearUnits("VERT_CS") if srs.IsCompound() else horizontal
+        crs = json.loads(subprocess.run([vola, "info", "--json", str(las)], check=True, capture_output=True,
+                                        text=True).stdout).get("crs") or {}
+        got_h = METRES.get(crs.get("unit"))
+        got_v = METRES.get(crs.get("vertical_unit") or crs.get("unit"))
+        print(f"keys {keys}: GDAL metres per unit {horizontal:.10g} / {vertical:.10g}, vola {got_h} / {got_v}")
+        checked += 1
+        if got_h is None or got_v is None or abs(got_h - horizontal) > 1e-9 or abs(got_v - vertical) > 1e-9:
+            failures.append(f"keys {keys}: GDAL reads units {horizontal} / {vertical} m, vola {crs.get('unit')} / "
+                            f"{crs.get('vertical_unit')}")
+    return checked
+
+
+METRES = {"metre": 1.0, "foot": 0.3048, "US survey foot": 1200 / 3937}
+
+
 def main():
     vola, shared = sys.argv[1], Path(sys.argv[2])
     data = Path(os.environ.get("VOLA_SHARED", shared)) / "data"
@@ -105,12 +158,13 @@ def main():
             checked += 1
             if got != want:
                 failures.append(f"{path.name}: GDAL reads {want}, vola {got}")
+        made_up = made_up_keys(vola, tmp, failures)
     if checked < 3:
         failures.append(f"only {checked} files with projected GeoKeys and no WKT were found (expected at least 3)")
     if failures:
         print("FAIL:\n  " + "\n  ".join(failures), file=sys.stderr)
         sys.exit(1)
-    print(f"OK: {checked} files")
+    print(f"OK: {checked} files, {made_up} made-up key directories")
 
 
 if __name__ == "__main__":

@@ -208,12 +208,13 @@ TEST(Las, ScalesAndOffsetsThatMakeNoCoordinateAreRefusedWithTheirOffset) {
 
 }  // namespace
 
-// GeoTIFF keys name a projected CRS and a linear unit: a unit other than the code's own
-// makes the code's CRS in that unit, as GDAL reads it (tests/io/geokeys_vs_gdal.py
-// compares with GDAL on every shared file).
-TEST(Las, AUnitKeyOtherThanTheCodesMakesTheCrsInThatUnit) {
-  using vola::geo::projected_crs_in_unit;
-  const std::string feet = projected_crs_in_unit(26995, 9003);  // NAD83 / Mississippi West in US survey feet
+// GeoTIFF keys name a projected CRS and units: a linear unit other than the code's own
+// makes the code's CRS in that unit, and a vertical unit other than the horizontal one a
+// compound CRS with heights in it, as GDAL reads them (tests/io/geokeys_vs_gdal.py
+// compares with GDAL on every shared file and on made-up keys).
+TEST(Las, UnitKeysOtherThanTheCodesQualifyTheCrs) {
+  using vola::geo::keyed_projected_crs;
+  const std::string feet = keyed_projected_crs(26995, 9003);  // NAD83 / Mississippi West in US survey feet
   ASSERT_FALSE(feet.empty());
   const auto crs = vola::geo::describe_crs(feet, vola::geo::EpsgLookup::own_id_only);
   EXPECT_EQ(crs.name, "NAD83 / Mississippi West");
@@ -221,11 +222,20 @@ TEST(Las, AUnitKeyOtherThanTheCodesMakesTheCrsInThatUnit) {
   EXPECT_FALSE(crs.epsg.has_value());  // no longer EPSG:26995
   // The same place in feet: EPSG:2255 is Mississippi West (ftUS).
   EXPECT_TRUE(vola::geo::same_crs(feet, "EPSG:2255"));
-  EXPECT_EQ(projected_crs_in_unit(26995, 9001), "");  // metres: the code's own unit
-  EXPECT_EQ(projected_crs_in_unit(26995, 9102), "");  // degrees: not a length
-  EXPECT_EQ(projected_crs_in_unit(26995, 32632), ""); // a CRS code where a unit belongs (laspy_simple1_3.las)
-  EXPECT_EQ(projected_crs_in_unit(4326, 9003), "");   // not a projected CRS
-  EXPECT_EQ(projected_crs_in_unit(65000, 9003), "");  // no such code
+  EXPECT_TRUE(vola::geo::same_crs(keyed_projected_crs(26995, 9003, 9003), feet));  // heights in feet too: as x, y
+  EXPECT_EQ(keyed_projected_crs(26995, 9001), "");   // metres: the code's own unit
+  EXPECT_EQ(keyed_projected_crs(26995, 9102), "");   // degrees: not a length
+  EXPECT_EQ(keyed_projected_crs(26995, 32632), "");  // a CRS code where a unit belongs (laspy_simple1_3.las)
+  EXPECT_EQ(keyed_projected_crs(4326, 9003), "");    // not a projected CRS
+  EXPECT_EQ(keyed_projected_crs(65000, 9003), "");   // no such code
+  EXPECT_EQ(keyed_projected_crs(26910, 9001, 9001), "");
+
+  // UTM in metres with heights in US survey feet: a compound CRS.
+  const auto utm_feet = vola::geo::describe_crs(keyed_projected_crs(26910, 0, 9003));
+  EXPECT_EQ(utm_feet.kind, "compound");
+  EXPECT_EQ(utm_feet.horizontal_unit, "metre");
+  EXPECT_EQ(utm_feet.vertical_unit, "US survey foot");
+  EXPECT_EQ(utm_feet.epsg, std::optional<std::uint32_t>(26910));
 
   VOLA_REQUIRE_DATA(data);
   vola::io::LasReader reader((data / "las" / "pdal_mvk-thin.las").string());

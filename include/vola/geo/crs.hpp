@@ -23,14 +23,20 @@ std::pair<double, double> centre_lat_lon(const std::string& crs, const Box& bbox
 // The CRS as WKT2 (2019), or throws vola::Error for an unknown code.
 std::string crs_wkt(std::uint32_t epsg);
 
-// The projected CRS EPSG:`epsg` with its coordinates in the EPSG length unit `unit`
-// instead of its own (the parameters keep their meaning: a false easting of 700000 m is
-// 2296583.33 US survey feet), as WKT2 (2019). This is how GDAL and PDAL read a GeoTIFF key
-// directory (LAS files carry one) whose ProjLinearUnitsGeoKey differs from the unit of its
-// ProjectedCSTypeGeoKey: e.g. NAD83 / Mississippi West (EPSG:26995, metres) with US survey
-// feet. Empty when `epsg` is not a projected CRS PROJ knows, `unit` is not a length unit
-// or is the CRS's own. Throws vola::Error only when PROJ cannot be loaded.
-std::string projected_crs_in_unit(std::uint32_t epsg, std::uint32_t unit);
+// The projected CRS EPSG:`epsg` as a GeoTIFF key directory (LAS files carry one)
+// qualifies it, as GDAL reads the keys, in WKT2 (2019); empty when the code alone says it
+// all (or is not a projected CRS PROJ knows). Unit arguments are EPSG unit codes (0 or
+// anything that is not a length unit: none):
+//  - `linear_unit` (ProjLinearUnitsGeoKey) other than the code's own: the code's CRS with
+//    its coordinates in that unit (the parameters keep their meaning: a false easting of
+//    700000 m is 2296583.33 US survey feet). pdal_mvk-thin.las is NAD83 / Mississippi West
+//    (EPSG:26995, metres) in US survey feet.
+//  - `vertical_unit` (VerticalUnitsGeoKey, for files that name no vertical CRS) other than
+//    the horizontal unit: a compound CRS whose vertical part, of unknown datum, is in that
+//    unit (GDAL's reading with GTIFF_REPORT_COMPD_CS), so that heights are not taken in
+//    the unit of x and y.
+// Throws vola::Error only when PROJ cannot be loaded.
+std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit = 0);
 
 // The EPSG code of a CRS given as WKT (the horizontal part of a compound CRS), from
 // its own identifier or, failing that, PROJ's identification with confidence >= 70%.

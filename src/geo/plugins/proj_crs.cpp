@@ -336,30 +336,57 @@ std::string crs_wkt_of(const std::string& definition) {
   return wkt;
 }
 
-// EPSG:`epsg` with its axes in EPSG unit `unit` (GeoTIFF's ProjLinearUnitsGeoKey beside a
-// ProjectedCSTypeGeoKey, as GDAL reads the pair: the projection's parameters keep their
-// meaning, the coordinates are in the new unit), as WKT2 2019; empty when the CRS is not a
-// projected one PROJ knows, `unit` is not a linear unit, or it is the CRS's own.
-std::string projected_crs_in_unit(std::uint32_t epsg, std::uint32_t unit) {
-  Context ctx = make_context();
-  const std::string code = std::to_string(epsg), unit_code = std::to_string(unit);
-  const Pj crs(proj_create_from_database(ctx.get(), "EPSG", code.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
-  if (!crs || proj_get_type(crs.get()) != PJ_TYPE_PROJECTED_CRS) return {};
-  const char* unit_name = nullptr;
+// An EPSG length unit: its name and metres, or nothing (unknown code, not a length).
+std::optional<std::pair<std::string, double>> length_unit(PJ_CONTEXT* ctx, std::uint32_t code) {
+  const std::string text = std::to_string(code);
+  const char* name = nullptr;
   const char* category = nullptr;
   double metres = 0;
-  if (!proj_uom_get_info_from_database(ctx.get(), "EPSG", unit_code.c_str(), &unit_name, &metres, &category) ||
-      !category || std::string(category) != "linear" || !unit_name || !(metres > 0))
-    return {};
-  const Pj cs(proj_crs_get_coordinate_system(ctx.get(), crs.get()));
-  double own_metres = 0;
-  if (!cs || !proj_cs_get_axis_info(ctx.get(), cs.get(), 0, nullptr, nullptr, nullptr, &own_metres, nullptr, nullptr,
-                                    nullptr) ||
-      std::abs(own_metres - metres) <= 1e-12 * metres)
-    return {};
-  const Pj altered(proj_crs_alter_cs_linear_unit(ctx.get(), crs.get(), unit_name, metres, "EPSG", unit_code.c_str()));
-  if (!altered) return {};
-  const char* wkt = proj_as_wkt(ctx.get(), altered.get(), PJ_WKT2_2019, nullptr);
+  if (!proj_uom_get_info_from_database(ctx, "EPSG", text.c_str(), &name, &metres, &category) || !category ||
+      std::string(category) != "linear" || !name || !(metres > 0))
+    return std::nullopt;
+  return std::make_pair(std::string(name), metres);
+}
+
+// Metres per unit of a CRS's first axis (0 when PROJ cannot say).
+double axis_metres(PJ_CONTEXT* ctx, const PJ* crs) {
+  const Pj cs(proj_crs_get_coordinate_system(ctx, crs));
+  double metres = 0;
+  if (!cs || !proj_cs_get_axis_info(ctx, cs.get(), 0, nullptr, nullptr, nullptr, &metres, nullptr, nullptr, nullptr))
+    return 0;
+  return metres;
+}
+
+bool same_length(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(a, b); }
+
+// The projected CRS EPSG:`epsg` as GeoTIFF keys qualify it (geo::keyed_projected_crs).
+std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit) {
+  Context ctx = make_context();
+  const std::string code = std::to_string(epsg);
+  Pj crs(proj_create_from_database(ctx.get(), "EPSG", code.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
+  if (!crs || proj_get_type(crs.get()) != PJ_TYPE_PROJECTED_CRS) return {};
+  bool changed = false;
+  if (const auto unit = length_unit(ctx.get(), linear_unit); unit && !same_length(axis_metres(ctx.get(), crs.get()), unit->second)) {
+    const std::string unit_code = std::to_string(linear_unit);
+    Pj altered(proj_crs_alter_cs_linear_unit(ctx.get(), crs.get(), unit->first.c_str(), unit->second, "EPSG",
+                                             unit_code.c_str()));
+    if (!altered) return {};
+    crs = std::move(altered);
+    changed = true;
+  }
+  if (const auto unit = length_unit(ctx.get(), vertical_unit); unit && !same_length(axis_metres(ctx.get(), crs.get()), unit->second)) {
+    // Heights in another unit than x and y, with no vertical CRS named: a vertical CRS of
+    // unknown datum in that unit, as GDAL reads such keys (GTIFF_REPORT_COMPD_CS).
+    const Pj vertical(proj_create_vertical_crs(ctx.get(), "unknown", "unknown", unit->first.c_str(), unit->second));
+    if (!vertical) return {};
+    const std::string name = std::string(proj_get_name(crs.get())) + " + unknown";
+    Pj compound(proj_create_compound_crs(ctx.get(), name.c_str(), crs.get(), vertical.get()));
+    if (!compound) return {};
+    crs = std::move(compound);
+    changed = true;
+  }
+  if (!changed) return {};
+  const char* wkt = proj_as_wkt(ctx.get(), crs.get(), PJ_WKT2_2019, nullptr);
   return wkt ? wkt : "";
 }
 
@@ -402,8 +429,8 @@ const plugin::ProjEntries kEntries{
     [](const std::string& definition, std::string& out, PluginFailure& failure) {
       capture_failure(failure, [&] { out = crs_wkt_of(definition); });
     },
-    [](std::uint32_t epsg, std::uint32_t unit, std::string& out, PluginFailure& failure) {
-      capture_failure(failure, [&] { out = projected_crs_in_unit(epsg, unit); });
+    [](std::uint32_t epsg, std::uint32_t unit, std::uint32_t vertical_unit, std::string& out, PluginFailure& failure) {
+      capture_failure(failure, [&] { out = keyed_projected_crs(epsg, unit, vertical_unit); });
     },
 };
 
