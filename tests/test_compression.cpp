@@ -216,6 +216,36 @@ TEST(Compression, CorruptAndCutRecordsAreFormatErrors) {
   RecordProperty("resealed_read", static_cast<int>(read));
 }
 
+// A levels record claiming more parts than the header's depth allows (each coded level
+// costs its context models however small its part) is refused before any is decoded.
+TEST(Compression, MoreLevelPartsThanTheDepthAreRefused) {
+  if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
+  const Scenario s = make_scenario(seeds_for(Shape::clustered, 1)[0]);
+  const vola::Tree tree = vola::build_from_voxels(to_voxels(s.unique()), s.depth);
+  const auto bytes = vola::serialize(tree, {.compress = true});
+  std::size_t at = 96;
+  const auto records = get_le<std::uint32_t>(bytes, 92);
+  bool found = false;
+  for (std::uint32_t r = 0; r < records; ++r) {
+    const auto length = get_le<std::uint64_t>(bytes, at + 8);
+    if (get_le<std::uint32_t>(bytes, at) == 4) {
+      found = true;
+      ASSERT_EQ(get_le<std::uint32_t>(bytes, at + 16), static_cast<std::uint32_t>(tree.depth()));
+      for (std::uint32_t parts : {static_cast<std::uint32_t>(tree.depth() + 1), std::uint32_t{1} << 20}) {
+        auto lying = bytes;
+        put_le<std::uint32_t>(lying, at + 16, parts);
+        reseal_extension(lying, 80);
+        const auto error = format_error_of([&] { (void)vola::parse(lying, "parts"); });
+        ASSERT_TRUE(error.has_value()) << parts;
+        EXPECT_THAT(error->cause(), HasSubstr("level parts for a tree of depth"));
+        EXPECT_EQ(error->offset(), at + 16);
+      }
+    }
+    at += 16 + ((length + 7) / 8) * 8;
+  }
+  EXPECT_TRUE(found);
+}
+
 TEST(Compression, LyingSizesAreRefusedBeforeAllocating) {
   if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
   std::mt19937_64 rng(9);

@@ -287,30 +287,30 @@ std::vector<std::uint64_t> partner_residuals(const AttributeColumn& column, cons
   return residuals;
 }
 
-// Bytes an order-0 coder would need for the byte planes of `residuals`: a cheap stand-in
-// for zstd when choosing a partner.
-double plane_entropy_bytes(std::span<const std::uint64_t> residuals, unsigned width) {
-  double bits = 0;
-  for (unsigned k = 0; k < width; ++k) {
-    std::uint64_t counts[256] = {};
-    for (const std::uint64_t r : residuals) ++counts[(r >> (8 * k)) & 0xffu];
-    const double n = static_cast<double>(residuals.size());
-    for (const std::uint64_t c : counts)
-      if (c) bits -= static_cast<double>(c) * std::log2(static_cast<double>(c) / n);
-  }
-  return bits / 8;
-}
-
-std::vector<std::uint64_t> delta_residuals(const AttributeColumn& column) {
+// Bytes an order-0 coder would need for the byte planes of the column's residuals
+// (steps, minus `partner`'s steps when given): a cheap stand-in for zstd when choosing a
+// partner, counted as the residuals come, without keeping them.
+double residual_entropy_bytes(const AttributeColumn& column, const AttributeColumn* partner) {
   const unsigned width = static_cast<unsigned>(size_of(column.type()));
-  std::vector<std::uint64_t> residuals(column.size());
-  std::uint64_t previous = 0;
+  std::vector<std::uint64_t> counts(std::size_t{width} * 256, 0);
+  std::uint64_t previous = 0, partner_previous = 0;
   for (std::size_t i = 0; i < column.size(); ++i) {
     const std::uint64_t v = load(column.bytes().data(), i, width);
-    residuals[i] = zigzag(sign_extend(v - previous, width));
+    std::uint64_t step = v - previous;
     previous = v;
+    if (partner) {
+      const std::uint64_t p = load(partner->bytes().data(), i, width);
+      step -= p - partner_previous;
+      partner_previous = p;
+    }
+    const std::uint64_t r = zigzag(sign_extend(step, width));
+    for (unsigned k = 0; k < width; ++k) ++counts[k * 256 + ((r >> (8 * k)) & 0xffu)];
   }
-  return residuals;
+  double bits = 0;
+  const double n = static_cast<double>(column.size());
+  for (const std::uint64_t c : counts)
+    if (c) bits -= static_cast<double>(c) * std::log2(static_cast<double>(c) / n);
+  return bits / 8;
 }
 
 std::vector<std::uint8_t> compress_planes(std::span<const std::uint64_t> residuals, unsigned width, int level) {
@@ -320,23 +320,17 @@ std::vector<std::uint8_t> compress_planes(std::span<const std::uint64_t> residua
 }
 
 // The earlier integer column of the same type whose steps best predict this one's, if
-// any predicts them better than nothing (by plane_entropy_bytes).
-struct PartnerChoice {
-  std::uint32_t index = 0;
-  std::vector<std::uint64_t> residuals;
-};
-std::optional<PartnerChoice> choose_partner(const AttributeColumn& column, std::span<const AttributeColumn> earlier) {
+// any predicts them better than nothing (by residual_entropy_bytes).
+std::optional<std::uint32_t> choose_partner(const AttributeColumn& column, std::span<const AttributeColumn> earlier) {
   if (is_float(column.type())) return std::nullopt;
-  const unsigned width = static_cast<unsigned>(size_of(column.type()));
-  double best = plane_entropy_bytes(delta_residuals(column), width);
-  std::optional<PartnerChoice> choice;
+  double best = residual_entropy_bytes(column, nullptr);
+  std::optional<std::uint32_t> choice;
   for (std::size_t j = 0; j < earlier.size(); ++j) {
     if (earlier[j].type() != column.type() || earlier[j].size() != column.size()) continue;
-    auto residuals = partner_residuals(column, earlier[j]);
-    const double bytes = plane_entropy_bytes(residuals, width);
+    const double bytes = residual_entropy_bytes(column, &earlier[j]);
     if (bytes < best) {
       best = bytes;
-      choice = PartnerChoice{static_cast<std::uint32_t>(j), std::move(residuals)};
+      choice = static_cast<std::uint32_t>(j);
     }
   }
   return choice;
@@ -397,10 +391,11 @@ EncodedColumn encode_column(const AttributeColumn& column, std::span<const Attri
   };
   if (column.size() == 0) return best;
   consider(kEncodingDeltaPlanes, encode_delta_planes(column, level));
-  if (auto partner = choose_partner(column, earlier)) {
+  if (const auto partner = choose_partner(column, earlier)) {
     std::vector<std::uint8_t> data(8, 0);
-    std::memcpy(data.data(), &partner->index, 4);  // little-endian, as every integer in the file
-    const auto frame = compress_planes(partner->residuals, static_cast<unsigned>(size_of(column.type())), level);
+    std::memcpy(data.data(), &*partner, 4);  // little-endian, as every integer in the file
+    const auto frame = compress_planes(partner_residuals(column, earlier[*partner]),
+                                       static_cast<unsigned>(size_of(column.type())), level);
     data.insert(data.end(), frame.begin(), frame.end());
     consider(kEncodingPartnerDelta, std::move(data));
   }

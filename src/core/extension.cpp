@@ -1,5 +1,7 @@
 #include "extension.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstring>
 
@@ -247,10 +249,17 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
 
 // The zstd-compressed levels record: parts of 16-bit lanes, into out.levels.
 void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t flags, const std::string& name,
-                   bool payload, ExtensionContents& out) {
+                   int depth, bool payload, ExtensionContents& out) {
     if (flags != kLanes16PerPart && flags != kCodedOccupancy)
       body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
     const auto parts = body.get<std::uint32_t>("level part count");
+    // Each coded level costs its models' memory however small its part: a file may not
+    // claim more levels than its header's depth.
+    const std::uint64_t most = static_cast<std::uint64_t>(std::max(depth, 0)) * (payload ? 2 : 1);
+    if (parts > most)
+      body.fail_at(record_offset + 16, std::to_string(parts) + " level parts for a tree of depth " +
+                                           std::to_string(depth) + (payload ? " with payload" : "") + " (at most " +
+                                           std::to_string(most) + ")");
     body.get<std::uint32_t>("reserved");
     body.need(16 * std::uint64_t{parts}, "level part sizes");
     std::vector<std::pair<std::uint64_t, std::uint64_t>> sizes(parts);
@@ -299,7 +308,7 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
 }  // namespace
 
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   std::uint64_t base, bool payload) {
+                                   std::uint64_t base, int depth, bool payload) {
   ByteReader r(bytes, name, base);
   const auto magic = r.take(8, "extension magic");
   if (std::memcmp(magic.data(), kExtensionMagic, 8) != 0)
@@ -335,7 +344,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
         break;
       }
       case RecordTag::levels:
-        decode_levels(body, record_offset, flags, name, payload, out);
+        decode_levels(body, record_offset, flags, name, depth, payload, out);
         break;
       case RecordTag::payload_meaning: {
         const auto meaning = body.get<std::uint8_t>("payload meaning");

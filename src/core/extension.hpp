@@ -35,8 +35,9 @@ struct ExtensionContents {
   PayloadMeaning payload_meaning = PayloadMeaning::reference;
   std::uint64_t payload_meaning_offset = 0;  // of its record, for errors
   std::vector<AttributeColumn> attributes;
-  // Columns of attribute encodings 2 and 3 (predicted from the voxels), decoded once the
-  // tree is known (decode_pending_columns): attributes[index] is named and typed but empty.
+  // Columns of attribute encodings 2, 3 and 4 (predicted from the voxels or an earlier
+  // column), decoded in file order once the tree is known (decode_pending_columns):
+  // attributes[index] is named and typed but empty.
   struct PendingColumn {
     std::size_t index;
     std::uint8_t encoding;
@@ -78,9 +79,11 @@ bool starts_extension(std::span<const std::uint8_t> bytes) noexcept;
 // The tree's columns must outlive `out` (their bytes are borrowed, not copied).
 void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out);
 // `base` = file offset of bytes[0]; `payload` = the header's nbits > 0 (compressed
-// levels then hold payload parts). Checks every length against what is there.
+// levels then hold payload parts); `depth` = the header's, which bounds the level parts
+// (one per level, two with payload) before any is decoded. Checks every length against
+// what is there.
 ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const std::string& name,
-                                   std::uint64_t base, bool payload = false);
+                                   std::uint64_t base, int depth, bool payload = false);
 // Decodes the pending columns of `ext` for `tree` (its frame set); a column of another
 // length than the tree's voxels is a FormatError.
 void decode_pending_columns(ExtensionContents& ext, const Tree& tree, const std::string& name);

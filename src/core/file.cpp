@@ -133,7 +133,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
   if (h.version == kVersionCompressed) {
     if (h.layout == Layout::dense)
       VOLA_THROW(FormatError(name, 6, "a compressed (version 2) file must be sparse"));
-    auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize, payload);
+    auto ext = detail::decode_extension(bytes.subspan(kHeaderSize), name, kHeaderSize, h.depth, payload);
     if (!ext.has_levels)
       VOLA_THROW(FormatError(name, kHeaderSize, "a version-2 file must hold its levels in the extension"));
     tree = Tree::from_levels(h.depth, payload, std::move(ext.levels), name + " (compressed levels)");
@@ -182,7 +182,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
       VOLA_THROW(FormatError(name, extension_at,
                         std::to_string(rest.size()) +
                             " bytes follow the last level and are not a vola extension (trailing garbage)"));
-    auto ext = detail::decode_extension(rest, name, extension_at);
+    auto ext = detail::decode_extension(rest, name, extension_at, h.depth);
     if (ext.has_levels)
       VOLA_THROW(FormatError(name, extension_at, "compressed levels in the extension of a version-1 file"));
     apply_extension(tree, h, ext, name, extension_at);

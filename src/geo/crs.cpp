@@ -2,6 +2,9 @@
 // is needed: a run that never transforms a coordinate never loads PROJ.
 #include "vola/geo/crs.hpp"
 
+#include <array>
+#include <map>
+#include <mutex>
 #include <vector>
 
 #include "proj_plugin.hpp"
@@ -54,11 +57,22 @@ std::optional<std::uint32_t> epsg_from_wkt(const std::string& wkt) {
 }
 
 std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit) {
+  // Every LAS header with GeoKeys asks (most with the code's own units): once per process
+  // for each set of keys, rather than loading PROJ's database per file.
+  static std::mutex mutex;
+  static std::map<std::array<std::uint32_t, 3>, std::string> known;
+  const std::array<std::uint32_t, 3> keys{epsg, linear_unit, vertical_unit};
+  {
+    const std::lock_guard lock(mutex);
+    if (const auto it = known.find(keys); it != known.end()) return it->second;
+  }
   std::string wkt;
   run("EPSG:" + std::to_string(epsg) + " as GeoTIFF keys qualify it",
       [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) {
         p.keyed_projected_crs(epsg, linear_unit, vertical_unit, wkt, f);
       });
+  const std::lock_guard lock(mutex);
+  if (known.size() < 1024) known.emplace(keys, wkt);
   return wkt;
 }
 

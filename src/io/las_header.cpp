@@ -206,10 +206,11 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
 void apply_unit_keys(LasHeader& hd, const UnitKeys& units) {
   if (!hd.epsg || !hd.wkt.empty() || (units.linear == 0 && units.vertical == 0)) return;
   try {
-    const std::string wkt = geo::keyed_projected_crs(*hd.epsg, units.linear, units.vertical);
+    std::string wkt = geo::keyed_projected_crs(*hd.epsg, units.linear, units.vertical);
     if (wkt.empty()) return;
-    hd.wkt = wkt;
-    hd.epsg = geo::epsg_from_wkt(wkt);
+    const auto code = geo::epsg_from_wkt(wkt);  // both or neither: never the feet WKT with the metre code
+    hd.wkt = std::move(wkt);
+    hd.epsg = code;
   } catch (const Error&) {
     // PROJ cannot be loaded: the code alone, as before the unit keys were read.
   }

@@ -35,7 +35,7 @@ std::string crs_wkt(std::uint32_t epsg);
 //    the horizontal unit: a compound CRS whose vertical part, of unknown datum, is in that
 //    unit (GDAL's reading with GTIFF_REPORT_COMPD_CS), so that heights are not taken in
 //    the unit of x and y.
-// Throws vola::Error only when PROJ cannot be loaded.
+// Throws vola::Error when PROJ cannot be loaded or fails outside these rules.
 std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit = 0);
 
 // The EPSG code of a CRS given as WKT (the horizontal part of a compound CRS), from

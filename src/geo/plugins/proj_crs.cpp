@@ -379,7 +379,8 @@ std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, s
     // unknown datum in that unit, as GDAL reads such keys (GTIFF_REPORT_COMPD_CS).
     const Pj vertical(proj_create_vertical_crs(ctx.get(), "unknown", "unknown", unit->first.c_str(), unit->second));
     if (!vertical) return {};
-    const std::string name = std::string(proj_get_name(crs.get())) + " + unknown";
+    const char* horizontal_name = proj_get_name(crs.get());
+    const std::string name = std::string(horizontal_name ? horizontal_name : "unknown") + " + unknown";
     Pj compound(proj_create_compound_crs(ctx.get(), name.c_str(), crs.get(), vertical.get()));
     if (!compound) return {};
     crs = std::move(compound);
