@@ -176,12 +176,16 @@ void run_info(const InfoArgs& a) {
 
 void add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
-  auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree");
-  cmd->add_option("file", args->file, ".vol file, or a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()->check(CLI::ExistingFile);
-  cmd->add_flag("--json", args->json, "Print JSON instead of a table (.vol and point files)");
+  auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree; any other input's size, CRS and bounds");
+  cmd->add_option("file", args->file,
+                  ".vol file, a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI), a mesh (OBJ, STL, OFF, PLY, ...), a "
+                  "voxel grid or map (binvox, NPY occupancy, .bt/.ot, .vdb) or a DEM (GeoTIFF, ...)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--json", args->json, "Print JSON instead of a table (every kind of file)");
   cmd->add_flag("--summary", args->summary,
-                "Point files: read every point for their own bounds, column ranges and points per class (like pdal "
-                "info --summary)");
+                "Point files and DEMs: read every point (cell) for their own bounds, column ranges and points per class "
+                "(like pdal info --summary)");
   cmd->callback([args] { run_info(*args); });
 }
 

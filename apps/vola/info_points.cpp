@@ -1,6 +1,7 @@
-// vola info on point files: a LAS, LAZ or COPC file's header, (E)VLRs, compression and
+// vola info on input files: a LAS, LAZ or COPC file's header, (E)VLRs, compression and
 // COPC octree, read without decoding a point; any other point file's count, CRS and
-// columns; with --summary every point read; with --json the same as one JSON object.
+// columns; a mesh's triangles, a voxel grid's or map's cells, a DEM's cells with their
+// bounds; with --summary every point read; with --json the same as one JSON object.
 #include "info_points.hpp"
 
 #include <algorithm>
@@ -178,15 +179,79 @@ ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr
 
 void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2).c_str()); }
 
+// The inputs that are not point clouds, by what vola convert makes of them: a mesh's
+// triangles, a voxel grid's or map's cells (binvox, NPY occupancy, OctoMap, OpenVDB), a
+// height field's cells (DEM: one point per cell with a height). `summary` adds the height
+// field's column ranges; a mesh or grid has nothing more to read.
+void print_other_input_info(const std::string& path, const io::Input& in, bool summary, bool json) {
+  const char* kind = in.is_mesh() ? "mesh" : in.grid ? "voxel grid" : "height field";
+  Point lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  const auto extend = [&](const Point& p) {
+    for (std::size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  };
+  for (const io::Triangle& t : in.triangles)
+    for (const Point& p : t) extend(p);
+  ordered_json grid;
+  if (in.grid) {
+    const io::VoxelGrid& g = *in.grid;
+    Point far;
+    for (std::size_t a = 0; a < 3; ++a) far[a] = g.origin[a] + g.voxel_size * g.dims[a];
+    extend(g.origin);
+    extend(far);
+    ordered_json columns = ordered_json::array();
+    for (const auto& a : g.attributes) columns.push_back({{"name", a.name}, {"type", name_of(a.type)}});
+    grid = {{"dims", {g.dims[0], g.dims[1], g.dims[2]}},
+            {"voxel_size", g.voxel_size},
+            {"origin", xyz(g.origin.data())},
+            {"occupied", g.voxels.size()},
+            {"columns", std::move(columns)},
+            {"fixed_voxel_size", g.fixed_voxel_size}};
+  }
+  if (in.terrain && in.cloud.size() > 0) {
+    const Box b = in.cloud.bounds();
+    extend(b.min);
+    extend(b.max);
+  }
+  const bool bounded = lo[0] <= hi[0];
+  if (json) {
+    ordered_json doc = {{"file", path}, {"format", in.format}, {"kind", kind}, {"crs", crs_json(in.wkt, in.epsg)}};
+    if (in.is_mesh()) doc["triangles"] = in.triangles.size();
+    if (in.grid) doc["grid"] = std::move(grid);
+    if (in.terrain) doc["cells"] = in.cloud.size();
+    doc["bounds"] = bounded ? ordered_json({{"min", xyz(lo.data())}, {"max", xyz(hi.data())}}) : ordered_json(nullptr);
+    if (in.terrain && summary) doc["summary"] = summary_json(in.cloud);
+    print_json(doc);
+    return;
+  }
+  if (in.format == kind) std::printf("file:        %s (%s)\n", path.c_str(), kind);
+  else std::printf("file:        %s (%s, a %s)\n", path.c_str(), in.format.c_str(), kind);
+  if (in.is_mesh()) std::printf("triangles:   %zu\n", in.triangles.size());
+  if (in.grid) {
+    const io::VoxelGrid& g = *in.grid;
+    std::printf("grid:        %u x %u x %u cells of %.9g, origin (%.9g, %.9g, %.9g)%s\n", g.dims[0], g.dims[1], g.dims[2],
+                g.voxel_size, g.origin[0], g.origin[1], g.origin[2], g.fixed_voxel_size ? ", the map's own cells" : "");
+    std::printf("occupied:    %zu cells\n", g.voxels.size());
+    std::printf("columns:    ");
+    for (const auto& a : g.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
+    std::printf("%s\n", g.attributes.empty() ? " none" : "");
+  }
+  if (in.terrain) std::printf("cells:       %zu with a height\n", in.cloud.size());
+  std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());
+  if (bounded)
+    std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g)%s\n", lo[0], lo[1], lo[2],
+                hi[0], hi[1], hi[2], in.terrain ? " (cell centres)" : "");
+  // A grid's cells are its voxels; the others need a voxel size.
+  std::printf("to voxels:   vola convert %s OUT.vol%s\n", path.c_str(), in.grid ? "" : " --voxel-size S");
+  if (in.terrain && summary) print_summary(in.cloud);
+}
+
 }  // namespace
 
 void print_point_cloud_info(const std::string& path, bool summary, bool json) {
   io::InputOptions options;
   options.attributes = true;
   const io::Input in = io::read_input(path, "auto", options);
-  if (in.is_mesh() || in.grid || in.terrain)
-    throw InvalidArgument(path + ": vola info describes .vol and point files; this is " + in.format +
-                          " input (convert it with vola convert, then vola info the .vol)");
+  if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json);
   if (json) {
     ordered_json doc = {{"file", path}, {"format", in.format}, {"points", in.cloud.size()},
                         {"crs", crs_json(in.wkt, in.epsg)}};

@@ -10,9 +10,11 @@ bool is_point_file(const std::string& path);
 // The header, (E)VLRs, CRS, compression and COPC octree of a LAS/LAZ/COPC file; with
 // `summary`, every point read too (count, bounds, column ranges, points per class).
 void print_point_file_info(const std::string& path, bool summary, bool json);
-// Any other point file vola reads (PLY, PCD, XYZ, NPY, KITTI): count, CRS, columns; with
-// `summary`, bounds, column ranges and points per class. `json`: the same as one JSON
-// object on stdout (pdal info --summary's content).
+// Any other file vola reads: a point file (PLY, PCD, XYZ, NPY, KITTI): count, CRS,
+// columns; with `summary`, bounds, column ranges and points per class. A mesh (triangles),
+// a voxel grid or map (binvox, NPY occupancy, OctoMap, OpenVDB: dims, cell size, occupied
+// cells) or a DEM (cells with a height): what vola convert reads, with its CRS and bounds.
+// `json`: the same as one JSON object on stdout (pdal info --summary's content).
 void print_point_cloud_info(const std::string& path, bool summary, bool json);
 
 }  // namespace vola::cli

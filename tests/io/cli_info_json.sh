@@ -2,7 +2,8 @@
 # vola info --json on point files, checked against what an independent reader found in
 # them (EXPECTED.txt): for every LAS/LAZ/COPC file named there, the count, point format,
 # header bounds at the file's precision and the points per class (--summary reads them);
-# for PLY/PCD/KITTI files, the count. A file of the wrong kind gets a clear message.
+# for PLY/PCD/KITTI files, the count; for a mesh, a voxel grid and a DEM, their size and
+# bounds. A file of the wrong kind gets a clear message.
 # Usage: cli_info_json.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
 set -euo pipefail
 vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
@@ -52,9 +53,51 @@ done
 "${VOLA_PYTHON:-python3}" -c "import json,sys; assert json.load(open(sys.argv[1]))['points'] == 115384" "$tmp/other.json" ||
   fail "KITTI 000000.bin: not 115384 points"
 
+# Inputs that are not point clouds, against the files' own headers read here: a binary
+# STL's triangle count (bytes 80-83), a binvox file's dims, cube side and run-length
+# coded cells, a DEM's cells with a value and its cell centres (GDAL, when python3-gdal
+# is there; in CI it must be).
+stl=$data/mesh/stl/trimesh_teapot_bin.stl
+binvox=$data/binvox/binvoxrw_chair.binvox
+dem=$data/dem/pdal_gdal_int16_epsg26711.tif
+"$vola" info --json "$stl" > "$tmp/mesh.json" || fail "info --json on a mesh failed"
+"$vola" info --json "$binvox" > "$tmp/grid.json" || fail "info --json on a binvox file failed"
+"$vola" info --json --summary "$dem" > "$tmp/dem.json" || fail "info --json --summary on a DEM failed"
+"$vola" info "$stl" | grep -q "^triangles: " || fail "info on a mesh: no triangle count"
+"${VOLA_PYTHON:-python3}" - "$tmp" "$stl" "$binvox" "$dem" <<'PY' || fail "info on a mesh, a voxel grid or a DEM differs from the file"
+import json, os, struct, sys
+tmp, stl, binvox, dem = sys.argv[1:]
+mesh = json.load(open(os.path.join(tmp, "mesh.json")))
+assert mesh["kind"] == "mesh" and mesh["triangles"] == struct.unpack_from("<I", open(stl, "rb").read(), 80)[0], mesh
+assert all(a <= b for a, b in zip(mesh["bounds"]["min"], mesh["bounds"]["max"])), mesh
+grid = json.load(open(os.path.join(tmp, "grid.json")))
+raw = open(binvox, "rb").read()
+head, body = raw.split(b"data\n", 1)
+fields = {l.split()[0]: l.split()[1:] for l in head.decode().splitlines() if l.strip()}
+dims = [int(v) for v in fields["dim"]]
+occupied = sum(body[i + 1] for i in range(0, len(body) - 1, 2) if body[i] == 1)
+assert grid["kind"] == "voxel grid" and grid["grid"]["dims"] == dims and grid["grid"]["occupied"] == occupied, grid
+assert abs(grid["grid"]["voxel_size"] * max(dims) - float(fields["scale"][0])) < 1e-9, grid
+try:
+    from osgeo import gdal
+except ImportError:
+    if os.environ.get("CI"):
+        raise
+    sys.exit(0)
+d = json.load(open(os.path.join(tmp, "dem.json")))
+ds = gdal.Open(dem)
+band = ds.GetRasterBand(1)
+values = band.ReadAsArray()
+nodata = band.GetNoDataValue()
+cells = int((values != nodata).sum()) if nodata is not None else values.size
+x0, dx, _, y0, _, dy = ds.GetGeoTransform()
+assert d["kind"] == "height field" and d["cells"] == cells and d["summary"]["points_read"] == cells, (d["cells"], cells)
+assert abs(d["bounds"]["min"][0] - (x0 + dx / 2)) < 1e-6 and abs(d["bounds"]["max"][1] - (y0 + dy / 2)) < 1e-6, d["bounds"]
+assert d["bounds"]["min"][2] == float(values[values != nodata].min() if nodata is not None else values.min()), d["bounds"]
+assert d["crs"]["epsg"] == 26711, d["crs"]
+PY
+
 # The wrong kind of file: a message naming the file and what to do, exit 1, no crash.
-"$vola" info "$data/mesh/stl/trimesh_teapot_bin.stl" 2> "$tmp/err.txt" && fail "info on a mesh succeeded"
-grep -q "trimesh_teapot_bin.stl: vola info describes .vol and point files" "$tmp/err.txt" || fail "mesh: $(cat "$tmp/err.txt")"
 printf 'not a point file\n' > "$tmp/notes.md"
 "$vola" info "$tmp/notes.md" 2> "$tmp/err.txt" && fail "info on a .md succeeded"
 grep -q "notes.md: cannot tell the format" "$tmp/err.txt" || fail ".md: $(cat "$tmp/err.txt")"
