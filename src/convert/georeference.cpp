@@ -15,6 +15,13 @@ std::string result_definition(const ResolvedCrs& crs) {
 // Points voxelised in the CRS's own x and y (not voxel grids or meshes, which keep theirs).
 bool voxelises_points(const io::Input& input) { return !input.grid && !input.is_mesh(); }
 
+// How to get cubes from an input in degrees: `target_crs` reprojects points, not a DEM's
+// raster, which is warped first.
+std::string cubes_advice(const io::Input& input) {
+  return input.terrain ? "reproject the raster first (gdalwarp -t_srs with a projected CRS such as UTM)"
+                       : "give `target_crs` (a projected CRS such as UTM)";
+}
+
 std::string geographic_name(const std::string& definition) {
   try {
     return geo::describe_crs(definition, geo::EpsgLookup::own_id_only).name;
@@ -41,8 +48,8 @@ void refuse_geographic_grid(const std::string& path, const ConvertOptions& optio
   if (result.empty() || !is_geographic_crs(result)) return;
   throw OptionError("target_crs", path + " is in " + geographic_name(result) +
                                       ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
-                                      "units of height, not cubes; give `target_crs` (a projected CRS such as UTM), " +
-                                      "or `allow_geographic` to voxelise in degrees anyway");
+                                      "units of height, not cubes; " + cubes_advice(input) +
+                                      ", or `allow_geographic` to voxelise in degrees anyway");
 }
 
 std::vector<std::string> crs_warnings(const std::string& path, const ConvertOptions& options, const io::Input& input,
@@ -59,7 +66,7 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
     const std::string result = result_definition(crs);
     if (!result.empty() && voxelises_points(input) && is_geographic_crs(result))
       out.push_back("the CRS (" + geographic_name(result) + ") is geographic: voxels are degrees of longitude and " +
-                    "latitude by units of height, not cubes; give `target_crs` (a projected CRS such as UTM) for cubes");
+                    "latitude by units of height, not cubes; " + cubes_advice(input) + " for cubes");
   } catch (const Error&) {
     // A CRS PROJ cannot read draws no warning here; the conversion reports it if it matters.
   }

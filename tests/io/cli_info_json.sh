@@ -97,6 +97,18 @@ assert d["bounds"]["min"][2] == float(values[values != nodata].min() if nodata i
 assert d["crs"]["epsg"] == 26711, d["crs"]
 PY
 
+# A DEM in degrees: vola convert reprojects points only, so info suggests
+# --allow-geographic (which works as printed) or gdalwarp to WGS 84's UTM zone at its
+# centre (pysheds' DEM lies at 97.3 W, 32.7 N: zone 14 north).
+geo_dem=$data/dem/pysheds_dem_int16_tiled_epsg4326.tif
+"$vola" info "$geo_dem" > "$tmp/geo_dem.txt" || fail "info on a DEM in degrees failed"
+grep -q "^to voxels: .* --allow-geographic" "$tmp/geo_dem.txt" || fail "geographic DEM: $(cat "$tmp/geo_dem.txt")"
+grep -q "gdalwarp -t_srs EPSG:32614 " "$tmp/geo_dem.txt" || fail "geographic DEM: no UTM zone 14N: $(cat "$tmp/geo_dem.txt")"
+"$vola" convert "$geo_dem" "$tmp/dem.vol" --voxel-size 0.01 --allow-geographic -q || fail "the suggested convert line failed"
+! grep -q "allow-geographic\|gdalwarp" <("$vola" info "$dem") || fail "a DEM in metres got the degrees advice"
+"$vola" convert "$geo_dem" "$tmp/dem.vol" --voxel-size 0.01 2> "$tmp/err.txt" && fail "a DEM in degrees was voxelised"
+grep -q "reproject the raster first (gdalwarp" "$tmp/err.txt" || fail "DEM in degrees: $(cat "$tmp/err.txt")"
+
 # The wrong kind of file: a message naming the file and what to do, exit 1, no crash.
 printf 'not a point file\n' > "$tmp/notes.md"
 "$vola" info "$tmp/notes.md" 2> "$tmp/err.txt" && fail "info on a .md succeeded"

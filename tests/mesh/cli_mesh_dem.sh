@@ -93,7 +93,7 @@ dem_case "$data/dem/pysheds_dem_int16_tiled_epsg4326.tif" 0.000833333333333 4326
 # Without --allow-geographic, cells of degrees under heights of metres are refused, naming the way out.
 "$vola" convert "$data/dem/pysheds_dem_int16_tiled_epsg4326.tif" "$tmp/degrees.vol" --voxel-size 0.000833333333333 \
   2> "$tmp/degrees.err" && fail "a DEM in degrees became grid voxels without --allow-geographic"
-grep -q -- "geographic CRS.*--target-crs.*--allow-geographic" "$tmp/degrees.err" || fail "degrees: $(cat "$tmp/degrees.err")"
+grep -q -- "geographic CRS.*reproject the raster first (gdalwarp.*--allow-geographic" "$tmp/degrees.err" || fail "degrees: $(cat "$tmp/degrees.err")"
 [[ -e "$tmp/degrees.vol" ]] && fail "a refused conversion wrote its output"
 
 # Full columns: as many columns as cells, and more voxels than cells.
