@@ -180,12 +180,12 @@ ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr
 
 void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2).c_str()); }
 
-// WGS 84's UTM zone (its EPSG code) at the centre of a box in degrees, or 0 when the box
-// is not in degrees: vola convert refuses voxels of degrees and reprojects only points,
-// so a DEM or mesh in degrees is reprojected first (or voxelised with --allow-geographic).
-int utm_for_degrees(const io::Input& in, bool bounded, const Point& lo, const Point& hi) {
+// For a DEM in degrees, WGS 84's UTM zone (its EPSG code) at the centre of its cells;
+// otherwise 0. vola convert refuses voxels of degrees and reprojects only points, so such
+// a DEM is warped first (or voxelised with --allow-geographic).
+int utm_for_dem_in_degrees(const io::Input& in, bool bounded, const Point& lo, const Point& hi) {
   const std::string definition = crs_definition(in.wkt, in.epsg);
-  if (in.grid || !bounded || definition.empty() || !is_geographic_crs(definition)) return 0;
+  if (!in.terrain || !bounded || definition.empty() || !is_geographic_crs(definition)) return 0;
   const double lon = (lo[0] + hi[0]) / 2, lat = (lo[1] + hi[1]) / 2;
   const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
   return (lat >= 0 ? 32600 : 32700) + zone;
@@ -253,10 +253,10 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
     std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g)%s\n", lo[0], lo[1], lo[2],
                 hi[0], hi[1], hi[2], in.terrain ? " (cell centres)" : "");
   // A grid's cells are its voxels; the others need a voxel size.
-  const int utm = utm_for_degrees(in, bounded, lo, hi);
+  const int utm = utm_for_dem_in_degrees(in, bounded, lo, hi);
   std::printf("to voxels:   vola convert %s OUT.vol%s%s\n", path.c_str(), in.grid ? "" : " --voxel-size S",
               utm ? " --allow-geographic (voxels of degrees)" : "");
-  if (utm && in.terrain)
+  if (utm)
     std::printf("or in metres: gdalwarp -t_srs EPSG:%d %s OUT.tif, then vola convert OUT.tif\n", utm, path.c_str());
   if (in.terrain && summary) print_summary(in.cloud);
 }
