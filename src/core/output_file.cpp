@@ -19,23 +19,23 @@ namespace {
 // The table of live temporaries. A signal handler may read it at any instant on any
 // thread, so it is fixed-size and lock-free: a slot's path is written while its state
 // is `filling` and only read by the handler once the state is `live` (release/acquire).
-enum SlotState : int { kFree = 0, kFilling = 1, kLive = 2 };
-constexpr int kSlots = 64;
+enum TemporaryState : int { kTemporaryFree = 0, kTemporaryFilling = 1, kTemporaryLive = 2 };
+constexpr int kTemporarySlots = 64;
 constexpr std::size_t kPathBytes = 4096;
-struct Slot {
-  std::atomic<int> state{kFree};
+struct TemporarySlot {
+  std::atomic<int> state{kTemporaryFree};
   char path[kPathBytes];
 };
-Slot slots[kSlots];
+TemporarySlot temporaries[kTemporarySlots];
 std::atomic<unsigned> counter{0};
 
 int claim_slot(const std::string& path) noexcept {
   if (path.size() >= kPathBytes) return -1;
-  for (int i = 0; i < kSlots; ++i) {
-    int expected = kFree;
-    if (!slots[i].state.compare_exchange_strong(expected, kFilling, std::memory_order_acquire)) continue;
-    std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
-    slots[i].state.store(kLive, std::memory_order_release);
+  for (int i = 0; i < kTemporarySlots; ++i) {
+    int expected = kTemporaryFree;
+    if (!temporaries[i].state.compare_exchange_strong(expected, kTemporaryFilling, std::memory_order_acquire)) continue;
+    std::memcpy(temporaries[i].path, path.c_str(), path.size() + 1);
+    temporaries[i].state.store(kTemporaryLive, std::memory_order_release);
     return i;
   }
   return -1;  // full: this temporary is still removed on errors, just not on signals
@@ -43,8 +43,8 @@ int claim_slot(const std::string& path) noexcept {
 
 void release_slot(int i) noexcept {
   if (i < 0) return;
-  slots[i].state.store(kFilling, std::memory_order_relaxed);  // the handler skips it from now on
-  slots[i].state.store(kFree, std::memory_order_release);
+  temporaries[i].state.store(kTemporaryFilling, std::memory_order_relaxed);  // the handler skips it from now on
+  temporaries[i].state.store(kTemporaryFree, std::memory_order_release);
 }
 
 std::string directory_of(const std::string& path) {
@@ -80,8 +80,8 @@ void on_signal(int signal) {
 
 namespace detail {
 void remove_live_temporaries() noexcept {
-  for (Slot& s : slots)
-    if (s.state.load(std::memory_order_acquire) == kLive) ::unlink(s.path);
+  for (TemporarySlot& s : temporaries)
+    if (s.state.load(std::memory_order_acquire) == kTemporaryLive) ::unlink(s.path);
 }
 }  // namespace detail
 

@@ -66,16 +66,16 @@ struct Element {
 
 enum class Encoding { ascii, binary_little_endian, binary_big_endian };
 
-struct Header {
+struct PlyHeader {
   Encoding encoding = Encoding::ascii;
   std::vector<Element> elements;
   std::size_t body = 0;        // byte offset of the first element's data
   std::uint64_t body_line = 1;  // line number of that offset (ascii)
 };
 
-Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name) {
+PlyHeader parse_ply_header(std::span<const std::uint8_t> bytes, const std::string& name) {
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  Header h;
+  PlyHeader h;
   std::size_t at = 0;
   std::uint64_t line_number = 0;
   bool have_format = false;
@@ -279,7 +279,7 @@ struct Mesh {
 };
 
 template <class In>
-void read_body(In& in, const Header& h, const InputOptions& options, Input& out, Mesh& mesh,
+void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& out, Mesh& mesh,
                std::size_t remaining_bytes) {
   const Element* vertex = nullptr;
   const Element* face = nullptr;
@@ -367,7 +367,7 @@ void read_body(In& in, const Header& h, const InputOptions& options, Input& out,
 }  // namespace
 
 Input parse_ply(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options) {
-  const Header h = parse_header(bytes, name);
+  const PlyHeader h = parse_ply_header(bytes, name);
   const Element* vertex = nullptr;
   for (const auto& e : h.elements)
     if (e.name == "vertex") {

@@ -11,13 +11,13 @@
 namespace vola::slam {
 
 namespace {
-constexpr std::size_t kRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
+constexpr std::size_t kImageRowsPerChunk = 4;  // every pixel is written on its own: any chunking gives the same image
 
 // The parallel loop over rows that every per-pixel step here uses.
 ParallelOptions rows(unsigned threads, const char* name) {
   ParallelOptions options;
   options.threads = threads;
-  options.grain = kRowsPerChunk;
+  options.grain = kImageRowsPerChunk;
   options.name = name;
   return options;
 }

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crs_units.hpp"
+#include "json_point.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/error.hpp"
 #include "vola/map/state_map.hpp"
@@ -31,8 +32,6 @@ void put_u32(std::string& out, std::size_t at, std::uint32_t v) {
 void put_u64(std::string& out, std::size_t at, std::uint64_t v) {
   for (int i = 0; i < 8; ++i) out[at + i] = static_cast<char>((v >> (8 * i)) & 0xffu);
 }
-
-nlohmann::json json_point(const Point& p) { return nlohmann::json::array({p[0], p[1], p[2]}); }
 
 // The voxels shown: a state map's occupied or free part (copied out of the mapping,
 // which is checked after), any other file as mapped.

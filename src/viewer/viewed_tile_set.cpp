@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crs_units.hpp"
+#include "json_point.hpp"
 #include "vola/error.hpp"
 
 namespace vola::viewer {
@@ -32,8 +33,6 @@ bool inside(const fs::path& folder, const fs::path& path) {
   const auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
   return f == folder.end() && p != path.end();
 }
-
-nlohmann::json json_point(const Point& p) { return nlohmann::json::array({p[0], p[1], p[2]}); }
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr Box kEmpty{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};

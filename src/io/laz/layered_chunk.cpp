@@ -42,7 +42,7 @@ struct LayeredCoders {
 
 // As for point-wise chunks: the last layout's coders are kept per thread, so that the
 // many small chunks of a COPC file do not each allocate their models.
-LayeredCoders& coders_for(const RecordLayout& layout, bool decoding) {
+LayeredCoders& layered_coders_for(const RecordLayout& layout, bool decoding) {
   thread_local std::unique_ptr<LayeredCoders> cached[2];
   auto& coders = cached[decoding ? 1 : 0];
   if (!coders || !(coders->layout == layout)) coders = std::make_unique<LayeredCoders>(layout, decoding);
@@ -88,7 +88,7 @@ std::uint64_t decode_layered_chunk(const RecordLayout& layout, std::span<const s
   const auto spans = split_layers(layout, chunk, count, where, chunk_offset, source);
   std::memcpy(records, chunk.data(), n);
   if (count == 1) return 0;
-  LayeredCoders* coders = &coders_for(layout, true);
+  LayeredCoders* coders = &layered_coders_for(layout, true);
   coders->start(records);
   std::array<std::span<const std::uint8_t>, kLayers14> point_layers;
   std::copy(spans.begin(), spans.begin() + kLayers14, point_layers.begin());
@@ -129,7 +129,7 @@ void encode_layered_chunk(const RecordLayout& layout, std::span<const std::uint8
   const std::size_t n = layout.length;
   const std::size_t count = records.size() / n;
   if (count == 0) return;
-  LayeredCoders* coders = &coders_for(layout, false);
+  LayeredCoders* coders = &layered_coders_for(layout, false);
   coders->start(records.data());
   for (std::size_t i = 1; i < count; ++i) {
     const std::uint8_t* in = records.data() + i * n;

@@ -38,7 +38,7 @@ struct PointwiseCoders {
 // The coders of the last layout this thread used: a file's chunks share one set, so a
 // chunk costs a reset, not the allocation of its models (COPC files have many small
 // chunks). Held on the heap: the state is large and a decoder may run on a small stack.
-PointwiseCoders& coders_for(const RecordLayout& layout, bool decoding) {
+PointwiseCoders& pointwise_coders_for(const RecordLayout& layout, bool decoding) {
   thread_local std::unique_ptr<PointwiseCoders> cached[2];
   auto& coders = cached[decoding ? 1 : 0];
   if (!coders || !(coders->layout == layout)) coders = std::make_unique<PointwiseCoders>(layout, decoding);
@@ -54,7 +54,7 @@ std::uint64_t decode_pointwise_chunk(const RecordLayout& layout, std::span<const
   if (chunk.size() < n) return n - chunk.size();
   std::memcpy(records, chunk.data(), n);
   if (count == 1) return 0;
-  PointwiseCoders& coders = coders_for(layout, true);
+  PointwiseCoders& coders = pointwise_coders_for(layout, true);
   coders.start(records);
   ArithmeticDecoder d(chunk.subspan(n));
   Point10Coder& point = coders.point;
@@ -81,7 +81,7 @@ void encode_pointwise_chunk(const RecordLayout& layout, std::span<const std::uin
   const std::size_t count = records.size() / n;
   if (count == 0) return;
   out.insert(out.end(), records.begin(), records.begin() + static_cast<std::ptrdiff_t>(n));
-  PointwiseCoders& coders = coders_for(layout, false);
+  PointwiseCoders& coders = pointwise_coders_for(layout, false);
   coders.start(records.data());
   ArithmeticEncoder e;
   for (std::size_t i = 1; i < count; ++i) {
