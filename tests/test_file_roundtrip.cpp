@@ -9,6 +9,7 @@
 #include "vola/file.hpp"
 
 namespace vola_test {
+namespace test_file_roundtrip {
 namespace {
 
 vola::Tree build_tree(const Scenario& s) {
@@ -197,4 +198,5 @@ TEST(FileRead, HeaderFieldsComeBack) {
 }
 
 }  // namespace
+}  // namespace test_file_roundtrip
 }  // namespace vola_test

@@ -14,6 +14,7 @@
 #include "vola/audio/room_response.hpp"
 #include "vola/builder.hpp"
 
+namespace test_audio_room_images {
 namespace {
 
 using namespace vola;
@@ -190,3 +191,4 @@ TEST(AudioRoomImages, SecondOrderImagesOfAShoeboxAreTheMirroredMirrors) {
 }
 
 }  // namespace
+}  // namespace test_audio_room_images

@@ -9,6 +9,7 @@
 #include "vola/audio/room_response.hpp"
 #include "vola/builder.hpp"
 
+namespace test_audio_room_occlusion {
 namespace {
 
 using namespace vola;
@@ -91,3 +92,4 @@ TEST(AudioRoomOcclusion, ABoxOnTheFloorHidesTheFloorsReflection) {
 }
 
 }  // namespace
+}  // namespace test_audio_room_occlusion

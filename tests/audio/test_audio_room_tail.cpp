@@ -15,6 +15,7 @@
 #include "vola/audio/room_response.hpp"
 #include "vola/builder.hpp"
 
+namespace test_audio_room_tail {
 namespace {
 
 using namespace vola;
@@ -130,3 +131,4 @@ TEST(AudioRoomTail, OpenSceneDecaysWithoutRinging) {
 }
 
 }  // namespace
+}  // namespace test_audio_room_tail

@@ -9,6 +9,7 @@
 #include "mesh_test_support.hpp"
 #include "vola/mesh/triangle_box.hpp"
 
+namespace test_triangle_box {
 namespace {
 
 using vola::Box;
@@ -142,3 +143,4 @@ TEST(TriangleBox, AgreesWithClipping) {
 }
 
 }  // namespace
+}  // namespace test_triangle_box

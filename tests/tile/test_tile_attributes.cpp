@@ -16,6 +16,7 @@
 #include "vola/tile/tiler.hpp"
 #include "vola/vola.hpp"
 
+namespace test_tile_attributes {
 namespace {
 
 namespace fs = std::filesystem;
@@ -283,3 +284,4 @@ TEST(TileSources, ALasFileCutWhileTiledIsAnError) {
 }
 
 }  // namespace
+}  // namespace test_tile_attributes
