@@ -37,14 +37,68 @@ vola::Tree tree_of(const XyzSet& voxels, int depth) {
   return vola::build_from_voxels(v, depth);
 }
 
+namespace {
+
+// Membership of a voxel set: a flat array of cells where the grid is small enough (up to
+// 256^3: the dense random grids), the set itself otherwise. Only a faster lookup; the
+// models below stay the brute force they were.
+class Occupancy {
+ public:
+  static constexpr std::uint64_t kDenseSide = 256;
+  explicit Occupancy(std::uint64_t side) : side_(side) {
+    if (side_ <= kDenseSide) cells_.assign(side_ * side_ * side_, 0);
+  }
+  Occupancy(const XyzSet& voxels, std::uint64_t side) : Occupancy(side) {
+    for (const Xyz& v : voxels) insert(v);
+  }
+  bool dense() const { return !cells_.empty(); }
+  bool contains(const Xyz& v) const {
+    if (!dense()) return set_.count(v) != 0;
+    return v[0] < side_ && v[1] < side_ && v[2] < side_ && cells_[index(v)] != 0;
+  }
+  void insert(const Xyz& v) {
+    if (dense())
+      cells_[index(v)] = 1;
+    else
+      set_.insert(v);
+  }
+  // The members in XyzSet order (x, then y, then z).
+  XyzSet to_set() const {
+    if (!dense()) return set_;
+    XyzSet out;
+    for (std::uint32_t x = 0; x < side_; ++x)
+      for (std::uint32_t y = 0; y < side_; ++y)
+        for (std::uint32_t z = 0; z < side_; ++z)
+          if (cells_[index({x, y, z})]) out.insert(out.end(), {x, y, z});
+    return out;
+  }
+
+ private:
+  std::size_t index(const Xyz& v) const { return static_cast<std::size_t>((v[2] * side_ + v[1]) * side_ + v[0]); }
+  std::uint64_t side_;
+  std::vector<char> cells_;
+  XyzSet set_;
+};
+
+std::uint64_t side_around(const XyzSet& voxels) {
+  std::uint64_t top = 0;
+  for (const Xyz& v : voxels) top = std::max<std::uint64_t>({top, v[0], v[1], v[2]});
+  return top + 1;
+}
+
+}  // namespace
+
 std::map<Xyz, int> model_components(const XyzSet& voxels, int connectivity) {
+  const Occupancy occupied(voxels, side_around(voxels));
+  Occupancy labelled(side_around(voxels));
   std::map<Xyz, int> label;
   int next = 0;
   const int limit = connectivity == 6 ? 1 : connectivity == 18 ? 2 : 3;
   for (const Xyz& start : voxels) {
-    if (label.count(start)) continue;
+    if (labelled.contains(start)) continue;
     std::deque<Xyz> queue{start};
     label[start] = next;
+    labelled.insert(start);
     while (!queue.empty()) {
       const Xyz v = queue.front();
       queue.pop_front();
@@ -54,8 +108,9 @@ std::map<Xyz, int> model_components(const XyzSet& voxels, int connectivity) {
             const int nonzero = (dx != 0) + (dy != 0) + (dz != 0);
             if (nonzero == 0 || nonzero > limit) continue;
             const Xyz n{v[0] + dx, v[1] + dy, v[2] + dz};  // wraps below 0: never a voxel
-            if (voxels.count(n) && !label.count(n)) {
+            if (occupied.contains(n) && !labelled.contains(n)) {
               label[n] = next;
+              labelled.insert(n);
               queue.push_back(n);
             }
           }
@@ -87,29 +142,43 @@ bool shifted(const Xyz& v, const std::array<int, 3>& o, int depth, Xyz& out) {
 }  // namespace
 
 XyzSet model_dilate(const XyzSet& voxels, int depth, int radius, vola::analysis::Element element) {
-  XyzSet out;
   const auto offsets = element_offsets(radius, element);
+  const std::uint64_t side = vola::side_of(depth);
+  if (side <= Occupancy::kDenseSide) {
+    Occupancy out(side);
+    for (const Xyz& v : voxels)
+      for (const auto& o : offsets) {
+        Xyz n;
+        if (shifted(v, o, depth, n)) out.insert(n);
+      }
+    return out.to_set();
+  }
+  // Sparse sets in large grids: every shifted voxel, then sorted once.
+  std::vector<Xyz> out;
   for (const Xyz& v : voxels)
     for (const auto& o : offsets) {
       Xyz n;
-      if (shifted(v, o, depth, n)) out.insert(n);
+      if (shifted(v, o, depth, n)) out.push_back(n);
     }
-  return out;
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return XyzSet(out.begin(), out.end());
 }
 
 XyzSet model_erode(const XyzSet& voxels, int depth, int radius, vola::analysis::Element element) {
+  const Occupancy occupied(voxels, vola::side_of(depth));
   XyzSet out;
   const auto offsets = element_offsets(radius, element);
   for (const Xyz& v : voxels) {
     bool all = true;
     for (const auto& o : offsets) {
       Xyz n;
-      if (!shifted(v, o, depth, n) || !voxels.count(n)) {
+      if (!shifted(v, o, depth, n) || !occupied.contains(n)) {
         all = false;
         break;
       }
     }
-    if (all) out.insert(v);
+    if (all) out.insert(out.end(), v);
   }
   return out;
 }

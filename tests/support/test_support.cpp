@@ -88,7 +88,8 @@ std::vector<Xyz> voxel_sequence(const vola::Tree& tree) {
 }
 
 XyzSet voxel_set(const vola::Tree& tree) {
-  const auto seq = voxel_sequence(tree);
+  auto seq = voxel_sequence(tree);
+  std::sort(seq.begin(), seq.end());  // a sorted range builds the set in linear time
   return XyzSet(seq.begin(), seq.end());
 }
 
