@@ -42,7 +42,7 @@ Bytes shortened(const Bytes& wav, std::uint32_t keep) {
   for (std::size_t at = 12; at + 8 <= wav.size();) {
     const std::uint32_t size = le32(wav, at + 4);
     if (std::memcmp(wav.data() + at, "data", 4) == 0) {
-      const std::uint32_t n = std::min<std::uint32_t>(keep, std::min<std::uint64_t>(size, wav.size() - at - 8));
+      const auto n = static_cast<std::uint32_t>(std::min<std::uint64_t>({keep, size, wav.size() - at - 8}));
       Bytes out(wav.begin(), wav.begin() + static_cast<std::ptrdiff_t>(at + 8 + n));
       put32(out, at + 4, n);
       put32(out, 4, static_cast<std::uint32_t>(out.size() - 8));
