@@ -62,9 +62,8 @@ class Occupancy {
     else
       set_.insert(v);
   }
-  // The members in XyzSet order (x, then y, then z).
-  XyzSet to_set() const {
-    if (!dense()) return set_;
+  // The members of a dense occupancy in XyzSet order (x, then y, then z).
+  XyzSet dense_to_set() const {
     XyzSet out;
     for (std::uint32_t x = 0; x < side_; ++x)
       for (std::uint32_t y = 0; y < side_; ++y)
@@ -151,7 +150,7 @@ XyzSet model_dilate(const XyzSet& voxels, int depth, int radius, vola::analysis:
         Xyz n;
         if (shifted(v, o, depth, n)) out.insert(n);
       }
-    return out.to_set();
+    return out.dense_to_set();
   }
   // Sparse sets in large grids: every shifted voxel, then sorted once.
   std::vector<Xyz> out;
