@@ -130,7 +130,7 @@ class TriangleVoxelizer {
           for (std::uint32_t x = first_.x; x <= last_.x; ++x) try_voxel(test, {x, y, z});
       return;
     }
-    Polygon whole, slab, row;
+    Polygon whole, slab, row, exact_slab, exact_row;
     whole.size = 3;
     for (int i = 0; i < 3; ++i) whole.points[i] = triangle[i];
     for (std::uint32_t z = first_.z; z <= last_.z; ++z) {
@@ -138,13 +138,30 @@ class TriangleVoxelizer {
       if (!slab.size) continue;
       Voxel slab_first, slab_last;
       if (!quantizer_.voxel_range(widened(polygon_bounds(slab), slack), slab_first, slab_last)) continue;
+      clip_slab(whole, 2, face(2, z), face(2, z + 1), 0.0, exact_slab);
       for (std::uint32_t y = std::max(slab_first.y, first_.y); y <= std::min(slab_last.y, last_.y); ++y) {
         clip_slab(slab, 1, face(1, y), face(1, y + 1), slack, row);
         if (!row.size) continue;
         Voxel row_first, row_last;
         if (!quantizer_.voxel_range(widened(polygon_bounds(row), slack), row_first, row_last)) continue;
-        for (std::uint32_t x = std::max(row_first.x, first_.x); x <= std::min(row_last.x, last_.x); ++x)
-          try_voxel(test, {x, y, z});
+        // The triangle's part inside this row of cells, clipped without slack, is convex:
+        // every x between its lowest and highest is the x of one of its points, which lies
+        // in the row. A cell whose x range meets that interval by more than the rounding
+        // (slack) overlaps the triangle; only cells at its ends need the exact test.
+        double sure_low = INFINITY, sure_high = -INFINITY;
+        if (exact_slab.size) {
+          clip_slab(exact_slab, 1, face(1, y), face(1, y + 1), 0.0, exact_row);
+          if (exact_row.size) {
+            const Box bounds = polygon_bounds(exact_row);
+            sure_low = bounds.min[0] + slack, sure_high = bounds.max[0] - slack;
+          }
+        }
+        for (std::uint32_t x = std::max(row_first.x, first_.x); x <= std::min(row_last.x, last_.x); ++x) {
+          if (face(0, x) <= sure_high && face(0, x + 1) >= sure_low && sure_low <= sure_high)
+            sink_.add({x, y, z});
+          else
+            try_voxel(test, {x, y, z});
+        }
       }
     }
   }

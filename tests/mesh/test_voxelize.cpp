@@ -130,13 +130,18 @@ TEST(Voxelize, EverySampledPointOfATriangleIsInASetVoxel) {
   }
 }
 
-// Big triangles at depth 4 (256^3) take the slab-by-slab path with long rows.
+// Big triangles at depth 4 (256^3) take the slab-by-slab path with long rows, where the
+// cells inside a row's span are taken without the exact test: triangles on cell faces
+// (a z face, an x face, an edge along x on a y face) check that only its ends are.
 TEST(Voxelize, BigTrianglesMatchTheBruteForce) {
   const Quantizer q = Quantizer::toolkit({{0, 0, 0}, {10, 10, 10}}, 4);
   const double face = q.cell_box({0, 0, 100}).max[2];
+  const double x_face = q.cell_box({77, 0, 0}).min[0], y_face = q.cell_box({0, 140, 0}).min[1];
   const std::vector<Triangle> triangles = {
       {{{-1, 0.3, 0.2}, {11, 4, 9.7}, {3, 10.5, 5.1}}},
       {{{0.1, 0.1, face}, {9.9, 0.2, face}, {4, 9.8, face}}},
+      {{{x_face, 0.2, 0.3}, {x_face, 9.6, 1.1}, {x_face, 4.4, 9.9}}},
+      {{{0.7, y_face, 2.2}, {9.3, y_face, 2.2}, {5.1, 9.9, 8.4}}},
   };
   for (const Triangle& t : triangles)
     EXPECT_EQ(vola_mesh_test::key_set(vola::mesh::surface_keys({&t, 1}, q)),
