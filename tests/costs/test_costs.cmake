@@ -4,7 +4,7 @@
 # Included by ctest after every test is defined (tests/costs/CMakeLists.txt); a name that is
 # not defined in a build is ignored.
 set_tests_properties(convert_equivalence PROPERTIES COST 94)
-set_tests_properties(fuzz_wkt_read_replay PROPERTIES COST 70)
+set_tests_properties(fuzz_wkt_read_replay PROPERTIES COST 30)
 set_tests_properties(SlamLoopClosure.AGeneratedRoomLoopIsClosedAndTheMapIntegratedAgain PROPERTIES COST 65)
 set_tests_properties(find_package_consumer PROPERTIES COST 51)
 set_tests_properties(Morphology.DilateAndErodeMatchTheModel PROPERTIES COST 42)
