@@ -17,4 +17,21 @@ expect_suggestion inf info
 if "$vola" xyzzy 2> "$tmp/err.txt"; then fail "'xyzzy' ran"; fi
 grep -q "'xyzzy' is not a vola subcommand (vola --help" "$tmp/err.txt" || fail "xyzzy: $(cat "$tmp/err.txt")"
 "$vola" info --help > /dev/null || fail "vola info --help failed"
+
+# A number out of range is named with what the option wants, not with the bounds of a
+# double printed in full (CLI11's PositiveNumber); the voxel size in %g, not "0.000000".
+printf '0 0 0\n1000 0 0\n' > "$tmp/two.xyz"
+expect_refusal() {  # EXPECTED-TEXT ARGS...
+  local expected=$1
+  shift
+  if "$vola" "$@" 2> "$tmp/err.txt"; then fail "'$*' ran"; fi
+  grep -qF -- "$expected" "$tmp/err.txt" || fail "'$*': $(cat "$tmp/err.txt")"
+  if grep -q "179769313486" "$tmp/err.txt"; then fail "'$*' printed DBL_MAX: $(cat "$tmp/err.txt")"; fi
+}
+expect_refusal "--voxel-size: must be a positive finite number, not 0" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 0
+expect_refusal "--voxel-size: must be a positive finite number, not -2" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size -2
+expect_refusal "'abc' is not a number" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size abc
+"$vola" convert "$tmp/two.xyz" "$tmp/ok.vol" --voxel-size 10 -q || fail "a valid conversion failed"
+expect_refusal "--radius: must be a finite number of 0 or more, not -1" plan "$tmp/ok.vol" --from 0 0 0 --to 1 1 1 --radius -1
+expect_refusal "at voxel size 1e-09 needs 1e+12 voxels per axis" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 1e-9
 echo "cli usage: ok"

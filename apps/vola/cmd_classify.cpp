@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "png_writer.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
@@ -245,7 +246,7 @@ void run_evaluate(const ClassifyArgs& a) {
 
 void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
   cmd->add_option("--model", args.model, "Model file written by `vola train` (default: the committed small model)");
-  cmd->add_option("--threads", args.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", args.threads, "Threads (0: all cores)")->capture_default_str()->check(non_negative_number());
   args.votes_option = cmd->add_option("--votes", args.votes,
                   "Test-time voting: see each object turned about z by 360*k/N degrees (k = 0..N-1) and "
                   "average the N softmax outputs (for models trained with --max-rotation 180); with --segment: the "

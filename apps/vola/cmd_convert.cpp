@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "crs_flags.hpp"
 #include "filter_flags.hpp"
+#include "number_checks.hpp"
 #include "option_flags.hpp"
 #include "progress.hpp"
 #include "vola/convert.hpp"
@@ -136,7 +137,7 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--format", args->options.format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
   cmd->add_option("--depth", args->options.depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size")
       ->check(CLI::Range(1, 10));
-  cmd->add_option("--voxel-size", args->options.voxel_size, "Voxel edge in input units (grid mode)")->check(CLI::PositiveNumber);
+  cmd->add_option("--voxel-size", args->options.voxel_size, "Voxel edge in input units (grid mode)")->check(positive_number());
   cmd->add_option("--origin", args->origin, "World position of voxel (0,0,0)'s corner (grid mode); default: bbox min snapped to the voxel size")
       ->expected(3);
   cmd->add_option("--quantize", args->quantize, "toolkit or grid (default: grid with --voxel-size/--origin, else toolkit)")
@@ -156,7 +157,7 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--attribute", args->options.text_attributes,
                   "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "
                   "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean)");
-  cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(non_negative_number());
   cmd->add_flag("--no-attributes", args->no_attributes, "Keep occupancy only, no per-voxel attribute columns (LAS, PLY, PCD, .ot log-odds, .vdb values)");
   cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");

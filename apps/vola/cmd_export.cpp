@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "open_voxels.hpp"
 #include "vola/map/state_map.hpp"
 #include "vola/error.hpp"
@@ -245,7 +246,7 @@ void add_export(CLI::App& app) {
   cmd->add_option("--raster", args->raster, "GeoTIFF: dsm, dtm, intensity, density or count per cell")
       ->check(CLI::IsMember({"dsm", "dtm", "intensity", "density", "count"}));
   cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->each([args](const std::string&) { args->resolution_given = true; });
   cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb) from a plain tree: a .vol of the free voxels on the same grid (a state map from vola map holds its own)")
       ->check(CLI::ExistingFile);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -207,15 +208,15 @@ void add_fuse(CLI::App& app) {
   cmd->add_option("--trajectory", a->trajectory, "Estimated trajectory (TUM format)");
   cmd->add_option("--mesh", a->mesh, "Marching-cubes mesh (.ply)");
   cmd->add_option("--render", a->render, "Rendered view of the map (.png), from --render-frame's pose");
-  cmd->add_option("--render-frame", a->render_frame, "Frame (1-based) whose estimated pose --render uses")->check(CLI::PositiveNumber);
+  cmd->add_option("--render-frame", a->render_frame, "Frame (1-based) whose estimated pose --render uses")->check(positive_number());
   cmd->add_option("--render-pose", a->render_pose, "Render from this pose instead: TX TY TZ QX QY QZ QW")->expected(7);
   cmd->add_option("--intrinsics", a->intrinsics, "FX FY CX CY in pixels (default: intrinsics.txt, else 525 525 319.5 239.5)")->expected(4);
-  cmd->add_option("--depth-factor", a->depth_factor, "Stored depth units per metre (TUM 5000, Kinect mm 1000)")->check(CLI::PositiveNumber);
-  cmd->add_option("--voxel-size", a->voxel_size, "TSDF voxel size in metres")->check(CLI::PositiveNumber);
-  cmd->add_option("--truncation", a->truncation, "TSDF truncation in metres (default 4 voxels)")->check(CLI::PositiveNumber);
-  cmd->add_option("--max-weight", a->max_weight, "Integration weight cap (running-average window)")->check(CLI::PositiveNumber);
-  cmd->add_option("--min-depth", a->min_depth, "Ignore depths nearer than this (m)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--max-depth", a->max_depth, "Ignore depths farther than this (m)")->check(CLI::PositiveNumber);
+  cmd->add_option("--depth-factor", a->depth_factor, "Stored depth units per metre (TUM 5000, Kinect mm 1000)")->check(positive_number());
+  cmd->add_option("--voxel-size", a->voxel_size, "TSDF voxel size in metres")->check(positive_number());
+  cmd->add_option("--truncation", a->truncation, "TSDF truncation in metres (default 4 voxels)")->check(positive_number());
+  cmd->add_option("--max-weight", a->max_weight, "Integration weight cap (running-average window)")->check(positive_number());
+  cmd->add_option("--min-depth", a->min_depth, "Ignore depths nearer than this (m)")->check(non_negative_number());
+  cmd->add_option("--max-depth", a->max_depth, "Ignore depths farther than this (m)")->check(positive_number());
   cmd->add_option("--icp-iterations", a->icp_iterations, "ICP iterations at pyramid levels 0 (full size), 1, 2")->expected(3);
   cmd->add_option("--motion-prior", a->motion_prior,
                   "Constant-velocity prior in directions the depth barely constrains (ICP eigenvalues below this "
@@ -224,7 +225,7 @@ void add_fuse(CLI::App& app) {
   cmd->add_option("--photometric-weight", a->photometric_weight,
                   "Weight of the colour (intensity) residuals next to ICP's, in metres per intensity unit "
                   "squared (0 = geometry only)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   cmd->add_option("--frames", a->frames, "Process only the first N frames (0 = all)");
   cmd->add_option("--bricks", a->bricks, "Volume extent in bricks per side, centred on the first camera")->check(CLI::Range(1u, 1u << 17));

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "text_output.hpp"
 #include "vola/error.hpp"
@@ -57,7 +58,7 @@ void add_generate(CLI::App& app) {
   cmd->add_option("output", args->output, "Output .xyz")->required();
   cmd->add_option("--points", args->points, "Number of points")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
-  cmd->add_option("--size", args->size, "Side of the square area, metres")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--size", args->size, "Side of the square area, metres")->check(positive_number())->capture_default_str();
   cmd->callback([args] { run_generate(*args); });
 }
 

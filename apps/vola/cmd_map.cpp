@@ -9,6 +9,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -154,13 +155,13 @@ void add_map(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "Output .vol (state map: occupied and free voxels)")->required();
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge R in the points' unit")->required()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--from", args->from,
                   "Insert into this saved map (a state map from vola map, same --voxel-size) instead of an empty "
                   "one; -o may name the same file. The result equals inserting every scan at once")
       ->check(CLI::ExistingFile);
   cmd->add_option("--max-range", args->max_range, "Longest ray; farther points mark free space only (0: no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol as a plain tree");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_map(*args); });

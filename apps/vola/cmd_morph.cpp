@@ -6,6 +6,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "open_voxels.hpp"
 #include "vola/analysis/crop.hpp"
 #include "vola/analysis/downsample.hpp"
@@ -39,7 +40,7 @@ CLI::App* add_io(CLI::App& app, const char* name, const char* help, const std::s
 }
 
 void add_radius(CLI::App* cmd, const std::shared_ptr<MorphArgs>& args) {
-  cmd->add_option("--radius", args->radius, "Radius in voxels")->required()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--radius", args->radius, "Radius in voxels")->required()->check(non_negative_number());
   cmd->add_option("--element", args->element, "sphere (dx^2+dy^2+dz^2 <= r^2) or cube (max |d| <= r)")
       ->check(CLI::IsMember({"sphere", "cube"}));
 }
@@ -108,7 +109,7 @@ void add_morph(CLI::App& app) {
     cmd->footer(std::string("--min-voxels 1 gives the voxels of vola lod; the voxel size grows 4x per level.\n") +
                 "Attribute columns and payloads are dropped.");
     cmd->add_option("--depth", args->depth, "Depth of the result")->required()->check(CLI::Range(1, 10));
-    cmd->add_option("--min-voxels", args->min_voxels, "Voxels a coarse cell needs to be kept")->check(CLI::PositiveNumber);
+    cmd->add_option("--min-voxels", args->min_voxels, "Voxels a coarse cell needs to be kept")->check(positive_number());
     cmd->callback([args] {
       const Tree in = open_voxels(args->input);
       finish(*args, "downsample", in, analysis::downsample(in, args->depth, args->min_voxels));

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/map/state_map.hpp"
@@ -228,7 +229,7 @@ void add_plan(CLI::App& app) {
   cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--from", args->from, "Start X Y Z")->required()->expected(3);
   cmd->add_option("--to", args->to, "Goal X Y Z")->required()->expected(3);
-  cmd->add_option("--radius", args->radius, "Robot radius (obstacle inflation)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--radius", args->radius, "Robot radius (obstacle inflation)")->capture_default_str()->check(non_negative_number());
   cmd->add_option("--level", args->level, "Plan on this level (0 = coarsest; default: the voxels)");
   cmd->add_flag("--hierarchical", args->hierarchical,
                 "A coarse route over 4^3-voxel cells first, then the voxels near it (scales; cost within ~1%); "
@@ -237,18 +238,18 @@ void add_plan(CLI::App& app) {
   cmd->add_flag("--no-smooth", args->no_smooth, "Keep every cell of the A* path");
   cmd->add_option("--max-expansions", args->max_expansions, "Give up after expanding this many cells")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_flag("--solid-ground", args->solid_ground, "The space under the ground is an obstacle (maps made from points)");
   cmd->add_option("-o,--output", args->output, "CSV of waypoints (x,y,z)")->capture_default_str();
   cmd->add_option("--ply", args->ply, "Also write the path as a PLY polyline");
   cmd->add_flag("--avoid", args->avoid, "Fly a reactive obstacle-avoiding agent instead of A*");
   cmd->add_option("--speed", args->speed, "--avoid: distance per step (default: one voxel)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--look-ahead", args->look_ahead, "--avoid: length of the fan's rays (default: 24 voxels)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--max-steps", args->max_steps, "--avoid: give up after this many steps")->capture_default_str();
   cmd->add_option("--margin", args->margin, "Tile index: how far around the from-to box to search (default: one tile)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_flag("--grid", args->grid, "Points and radius are in voxel-grid coordinates");
   cmd->add_option("--unknown", args->unknown,
                   "State maps: is unknown space occupied (the default there) or free (optimistic)?")

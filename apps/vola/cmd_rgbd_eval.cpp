@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "vola/slam/trajectory_error.hpp"
 
 namespace vola::cli {
@@ -45,8 +46,8 @@ void add_rgbd_eval(CLI::App& app) {
       "  vola rgbd-eval frames/pose.txt est.txt --numbered    # 'tx ty tz qx qy qz qw' lines for frames 1, 2, ...");
   cmd->add_option("groundtruth", a->groundtruth, "Ground-truth trajectory")->required()->check(CLI::ExistingFile);
   cmd->add_option("estimate", a->estimate, "Estimated trajectory")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--max-difference", a->max_difference, "Timestamp association window (s)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--delta", a->delta, "RPE frame distance")->check(CLI::PositiveNumber);
+  cmd->add_option("--max-difference", a->max_difference, "Timestamp association window (s)")->check(non_negative_number());
+  cmd->add_option("--delta", a->delta, "RPE frame distance")->check(positive_number());
   cmd->add_flag("--numbered", a->numbered, "Ground truth has no timestamps: line i is frame i (timestamp i)");
   cmd->callback([a] { run_eval(*a); });
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -85,8 +86,8 @@ void add_rgbd_generate(CLI::App& app) {
   cmd->add_option("--width", a->width, "Image width")->check(CLI::Range(8u, 8192u));
   cmd->add_option("--height", a->height, "Image height")->check(CLI::Range(8u, 8192u));
   cmd->add_option("--intrinsics", a->intrinsics, "FX FY CX CY (default: 525 px focal at 640 wide, scaled)")->expected(4);
-  cmd->add_option("--depth-factor", a->depth_factor, "Stored units per metre")->check(CLI::PositiveNumber);
-  cmd->add_option("--frame-rate", a->frame_rate, "Frames per second (timestamps)")->check(CLI::PositiveNumber);
+  cmd->add_option("--depth-factor", a->depth_factor, "Stored units per metre")->check(positive_number());
+  cmd->add_option("--frame-rate", a->frame_rate, "Frames per second (timestamps)")->check(positive_number());
   cmd->add_option("--dropout", a->dropout, "Probability that a pixel has no depth")->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--no-noise", a->no_noise, "Exact depth (no noise, no dropout, no range limits)");
   cmd->add_flag("--no-colour", a->no_colour, "Depth only");

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "crs_flags.hpp"
 #include "filter_flags.hpp"
+#include "number_checks.hpp"
 #include "option_flags.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
@@ -163,7 +164,7 @@ void add_tile(CLI::App& app) {
   cmd->add_option("inputs", args->inputs, "Point files: LAS/LAZ/COPC (streamed in chunks), or any point format vola convert reads");
   cmd->add_option("-o,--output", args->output, "Output folder")->required();
   cmd->add_option("--tile-size", args->tile_size, "Tile edge in the CRS's units (metres, feet, ...)")->required()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--depth", args->depth, "Levels per tile: 4^DEPTH voxels per tile edge (1..10)")->required()
       ->check(CLI::Range(1, 10));
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
@@ -180,11 +181,11 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--generate-survey", args->generate,
                   "Also tile a generated survey of N points (city blocks of 200 m, streamed, never stored)");
   cmd->add_option("--survey-density", args->density, "Generated survey: points per square metre")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--seed", args->seed, "Generated survey: seed")->capture_default_str();
   cmd->add_option("--chunk-points", args->chunk_points,
                   "LAS points per work unit (default: 2^20, or fewer with attributes when --memory is small)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] { run_tile(*args); });
 }

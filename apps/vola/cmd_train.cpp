@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "number_checks.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
 #include "vola/output_stream.hpp"
@@ -149,8 +150,8 @@ void add_train(CLI::App& app) {
   cmd->add_option("--batch", args->options.batch_size, "Batch size")->capture_default_str()->check(CLI::Range(1, 4096));
   cmd->add_option("--lr", args->options.learning_rate, "Adam learning rate (a tenth of it for the last fifth of the epochs)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--weight-decay", args->options.weight_decay, "Adam weight decay")->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->check(positive_number());
+  cmd->add_option("--weight-decay", args->options.weight_decay, "Adam weight decay")->capture_default_str()->check(non_negative_number());
   cmd->add_option("--seed", args->options.seed, "Seed of weights, shuffling, rotations, dropout")->capture_default_str();
   cmd->add_option("--max-rotation", args->options.max_rotation_degrees, "Augmentation: largest turn about z, degrees")
       ->capture_default_str()
@@ -173,13 +174,13 @@ void add_train(CLI::App& app) {
                 "vola dataset --segment, aligned to the object's footprint up to a quarter turn)");
   cmd->add_flag("--balanced", args->options.balanced,
                 "Weigh the loss by 1/sqrt(class share) so rare classes count more");
-  cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(non_negative_number());
   cmd->add_option("--checkpoint", args->checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
   cmd->add_option("--json", args->json, "Run record (default OUTPUT.json)");
   cmd->add_flag("--resume", args->options.resume, "Continue from the checkpoint if it exists");
   cmd->add_option("--epochs-this-run", args->options.max_epochs_this_run, "Stop after this many epochs (0: all)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->callback([args] { run_train(*args); });
 }
 

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -10,6 +11,13 @@ namespace vola {
 VOLA_INLINE_NAMESPACE_BEGIN
 
 namespace {
+// A length as %g writes it: std::to_string prints a voxel size of 1e-9 as "0.000000".
+std::string short_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 void check_depth(int depth) {
   if (depth < kMinDepth || depth > kMaxDepth)
     VOLA_THROW(InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10"));
@@ -36,7 +44,7 @@ Quantizer Quantizer::toolkit(const Box& bbox, int depth) {
 Quantizer Quantizer::grid(const Point& origin, double voxel_size, int depth) {
   check_depth(depth);
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
-    VOLA_THROW(InvalidArgument("voxel size must be a positive number, got " + std::to_string(voxel_size)));
+    VOLA_THROW(InvalidArgument("voxel size must be a positive number, got " + short_number(voxel_size)));
   for (double o : origin)
     if (!std::isfinite(o)) VOLA_THROW(InvalidArgument("grid origin must be finite"));
   Quantizer q;
@@ -230,8 +238,9 @@ int depth_for_extent(double extent, double voxel_size) {
   if (!(voxel_size > 0.0)) VOLA_THROW(InvalidArgument("voxel size must be positive"));
   for (int depth = kMinDepth; depth <= kMaxDepth; ++depth)
     if (extent < static_cast<double>(side_of(depth)) * voxel_size) return depth;
-  VOLA_THROW(InvalidArgument("an extent of " + std::to_string(extent) + " at voxel size " +
-                        std::to_string(voxel_size) + " needs more than 4^10 voxels per axis"));
+  VOLA_THROW(InvalidArgument("an extent of " + short_number(extent) + " at voxel size " + short_number(voxel_size) +
+                             " needs " + short_number(std::ceil(extent / voxel_size)) +
+                             " voxels per axis, more than the 4^10 = 1048576 of depth 10"));
 }
 
 VOLA_INLINE_NAMESPACE_END
