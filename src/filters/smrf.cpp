@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <span>
 
@@ -17,16 +18,20 @@ namespace vola::filters {
 using detail::ElevationGrid;
 
 void SmrfOptions::check() const {
-  const auto positive = [](const char* name, double v) {
-    if (!(v > 0.0) || !std::isfinite(v))
-      throw OptionError(name, "must be a positive number (metres), not " + std::to_string(v));
+  const auto text = [](double v) {
+    char out[32];
+    std::snprintf(out, sizeof out, "%g", v);
+    return std::string(out);
+  };
+  const auto positive = [&](const char* name, double v) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw OptionError(name, "must be a positive number (metres), not " + text(v));
   };
   positive("cell", cell);
   positive("window", window);
   // Radii in cells become ints: a window of more than 100000 cells (or cells under a
   // millimetre) is a typo, not a survey.
-  if (cell < 1e-3) throw OptionError("cell", "must be at least 0.001 m, not " + std::to_string(cell));
-  if (window / cell > 1e5) throw OptionError("window", "is more than 100000 cells of " + std::to_string(cell) + " m");
+  if (cell < 1e-3) throw OptionError("cell", "must be at least 0.001 m, not " + text(cell));
+  if (window / cell > 1e5) throw OptionError("window", "is more than 100000 cells of " + text(cell) + " m");
   if (!(slope >= 0.0) || !std::isfinite(slope)) throw OptionError("slope", "must be 0 or more");
   if (!(threshold >= 0.0) || !std::isfinite(threshold)) throw OptionError("threshold", "must be 0 or more");
   if (!(scalar >= 0.0) || !std::isfinite(scalar)) throw OptionError("scalar", "must be 0 or more");

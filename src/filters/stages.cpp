@@ -111,8 +111,9 @@ Stage parse_stage(const std::string& spec) {
       refuse(spec, "no filter '" + spec.substr(0, colon) +
                        "' (where:EXPR, smrf, hag, outlier, voxel:R, poisson:R, crop:..., polygon:FILE)");
     }
-  } catch (const OptionError&) {
-    throw;
+  } catch (const OptionError& e) {
+    if (e.option() == "filters") throw;
+    refuse(spec, e.option() + " " + e.cause());  // a parameter's check: named as in the stage
   } catch (const Error& e) {
     refuse(spec, e.what());
   }

@@ -1,6 +1,7 @@
 // GeoTIFF rasters of a tree (vola/io/export.hpp): the cells computed here, the file
 // written by the gdal plugin (src/io/plugins/raster_gdal.cpp).
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -21,10 +22,11 @@ namespace {
 
 constexpr double kGroundClass = 2.0;  // ASPRS ground
 
+// The shortest text that reads back as the same double ("1e-09", not 1.0000000000000001e-09).
 std::string number(double value) {
   char text[64];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  return std::string(text, end);
 }
 
 }  // namespace

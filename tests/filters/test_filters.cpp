@@ -443,6 +443,10 @@ TEST(Stages, ParseTheirStringsAndRefuseUnknownOnes) {
   EXPECT_EQ(message("smrf:cells=2"), "filters: 'smrf:cells=2': smrf has no parameter 'cells' (cell, slope, window, threshold, scalar)");
   EXPECT_EQ(message("where:z >"), "filters: 'where:z >': where: at character 4: expected a dimension name or a number, found the end");
   EXPECT_EQ(message("crop:1,2,3"), "filters: 'crop:1,2,3': crop takes MINX,MINY,MAXX,MAXY or MINX,MINY,MINZ,MAXX,MAXY,MAXZ");
+  // A parameter's own check names it inside the stage (the CLI shows "filters" as --filter),
+  // not as a flag of its own ("--cell" is no option of any command).
+  EXPECT_EQ(message("smrf:cell=-1"), "filters: 'smrf:cell=-1': cell must be a positive number (metres), not -1");
+  EXPECT_EQ(message("outlier:multiplier=-2"), "filters: 'outlier:multiplier=-2': multiplier must be 0 or more");
 }
 
 TEST(Stages, RunInOrderAndReportTheInputIndexOfEveryPointLeft) {
