@@ -10,8 +10,11 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <span>
+#include <string>
 #include <string_view>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "file_bytes.hpp"
@@ -188,6 +191,14 @@ double field_value(const std::uint8_t* p, const Field& f) {
   }
 }
 
+// Any other scalar field, kept as an attribute column of its own type.
+struct OtherField {
+  const Field* field;
+  std::string name;
+  ValueType type;
+  Reduction reduction;
+};
+
 // The fields vola uses, found by (lower-case) name.
 struct Layout {
   const Field* xyz[3] = {nullptr, nullptr, nullptr};
@@ -195,7 +206,43 @@ struct Layout {
   const Field* channels[3] = {nullptr, nullptr, nullptr};  // red, green, blue fields
   std::optional<ColourScale> channel_scale;
   const Field* intensity = nullptr;
+  std::vector<OtherField> others;
 };
+
+ValueType field_value_type(const Field& f) {
+  switch (f.type) {
+    case 'F': return f.size == 4 ? ValueType::f32 : ValueType::f64;
+    case 'I': return f.size == 1 ? ValueType::i8 : f.size == 2 ? ValueType::i16 : f.size == 4 ? ValueType::i32 : ValueType::i64;
+    default: return f.size == 1 ? ValueType::u8 : f.size == 2 ? ValueType::u16 : f.size == 4 ? ValueType::u32 : ValueType::u64;
+  }
+}
+
+// A field's column name: LAS fields as PDAL's PCD writer spells them (ReturnNumber,
+// GpsTime, ...) under the names vola's LAS reader gives them, so that a survey exported
+// to PCD converts and filters as its LAS does; other names as they are (lower case).
+std::string pcd_column_name(const std::string& field) {
+  std::string key;
+  for (const char c : field)
+    if (c != '_') key += c;
+  static constexpr std::pair<std::string_view, std::string_view> kLasNames[] = {
+      {"returnnumber", "return_number"},     {"numberofreturns", "number_of_returns"},
+      {"scandirectionflag", "scan_direction_flag"}, {"edgeofflightline", "edge_of_flight_line"},
+      {"scananglerank", "scan_angle_rank"},  {"userdata", "user_data"},
+      {"pointsourceid", "point_source_id"},  {"gpstime", "gps_time"},
+  };
+  for (const auto& [pdal, vola] : kLasNames)
+    if (key == pdal) return std::string(vola);
+  return field;
+}
+
+// Classes take the majority of a voxel's points (as LAS classification and PLY labels
+// do), the number of returns the maximum (as LAS), the rest the mean.
+Reduction pcd_reduction_of(const std::string& column) {
+  if (column == "classification" || column == "class" || column == "label" || column == "scalar_classification")
+    return Reduction::majority;
+  if (column == "number_of_returns") return Reduction::max;
+  return Reduction::mean;
+}
 
 Layout find_layout(const Header& h, const std::string& name) {
   Layout l;
@@ -221,6 +268,22 @@ Layout find_layout(const Header& h, const std::string& name) {
         scale == colour_scale(kind(l.channels[2]), l.channels[2]->size))
       l.channel_scale = scale;
   }
+  // Every other scalar field (normals, curvature, labels, ring, time, ...); fields of
+  // COUNT > 1 (histograms, descriptors) and PCL's "_" padding are not read. A second
+  // field of a name already taken stays unread, as in PLY.
+  std::vector<std::string> taken = {"x", "y", "z"};
+  if (l.packed_rgb || l.channel_scale) taken.insert(taken.end(), {"red", "green", "blue"});
+  if (l.intensity) taken.push_back("intensity");
+  for (const Field& f : h.fields) {
+    const bool used = &f == l.xyz[0] || &f == l.xyz[1] || &f == l.xyz[2] || &f == l.packed_rgb || &f == l.intensity ||
+                      (l.channel_scale && (&f == l.channels[0] || &f == l.channels[1] || &f == l.channels[2]));
+    if (used || !scalar(f) || f.name.find_first_not_of('_') == std::string::npos) continue;
+    std::string column = pcd_column_name(f.name);
+    if (std::find(taken.begin(), taken.end(), column) != taken.end()) continue;
+    taken.push_back(column);
+    const Reduction reduction = pcd_reduction_of(column);
+    l.others.push_back({&f, std::move(column), field_value_type(f), reduction});
+  }
   return l;
 }
 
@@ -242,18 +305,29 @@ class PointSink {
       cloud.attributes.push_back({"intensity", ValueType::f32, Reduction::mean, {}});
       cloud.attributes.back().values.reserve(points);
     }
+    if (options.attributes) {
+      first_other_ = cloud.attributes.size();
+      others_ = layout.others.size();
+      for (const OtherField& o : layout.others) {
+        cloud.attributes.push_back({o.name, o.type, o.reduction, {}});
+        cloud.attributes.back().values.reserve(points);
+      }
+    }
   }
-  void add(const double (&xyz)[3], const double (&rgb)[3], double intensity) {
+  // `others`: the value of each of the layout's other fields.
+  void add(const double (&xyz)[3], const double (&rgb)[3], double intensity, std::span<const double> others) {
     if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) return;
     cloud_.xyz.insert(cloud_.xyz.end(), {xyz[0], xyz[1], xyz[2]});
     if (colours_) colours_->add(rgb[0], rgb[1], rgb[2]);
     if (intensity_column_) cloud_.attributes[*intensity_column_].values.push_back(intensity);
+    for (std::size_t k = 0; k < others_; ++k) cloud_.attributes[first_other_ + k].values.push_back(others[k]);
   }
 
  private:
   PointCloud& cloud_;
   std::optional<ColourColumns> colours_;
   std::optional<std::size_t> intensity_column_;
+  std::size_t first_other_ = 0, others_ = 0;  // columns of the other fields (none without attributes)
 };
 
 void unpack_rgb(std::uint32_t packed, double (&rgb)[3]) {
@@ -271,6 +345,7 @@ void read_records(const std::uint8_t* base, bool columns, const Header& h, const
     const std::uint64_t stride = columns ? f.count * static_cast<std::uint64_t>(f.size) : h.point_size;
     return base + f.offset * column_scale + i * stride;
   };
+  std::vector<double> others(l.others.size());
   for (std::uint64_t i = 0; i < h.points; ++i) {
     const double xyz[3] = {field_value(at(*l.xyz[0], i), *l.xyz[0]), field_value(at(*l.xyz[1], i), *l.xyz[1]),
                            field_value(at(*l.xyz[2], i), *l.xyz[2])};
@@ -282,12 +357,14 @@ void read_records(const std::uint8_t* base, bool columns, const Header& h, const
     } else if (l.channel_scale) {
       for (int c = 0; c < 3; ++c) rgb[c] = field_value(at(*l.channels[c], i), *l.channels[c]);
     }
-    sink.add(xyz, rgb, l.intensity ? field_value(at(*l.intensity, i), *l.intensity) : 0.0);
+    for (std::size_t k = 0; k < l.others.size(); ++k) others[k] = field_value(at(*l.others[k].field, i), *l.others[k].field);
+    sink.add(xyz, rgb, l.intensity ? field_value(at(*l.intensity, i), *l.intensity) : 0.0, others);
   }
 }
 
 void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSink& sink, const std::string& name) {
   std::vector<std::string_view> words;
+  std::vector<double> others(l.others.size());
   std::size_t at = h.body;
   std::uint64_t line = h.body_line - 1;
   for (std::uint64_t i = 0; i < h.points;) {
@@ -311,7 +388,8 @@ void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSi
       if (!w.empty() && w.front() == '+') w.remove_prefix(1);
       double v = 0.0;
       const auto r = std::from_chars(w.data(), w.data() + w.size(), v);
-      if (r.ec != std::errc() || r.ptr != w.data() + w.size()) fail("'" + std::string(w) + "' is not a number");
+      // (append, not "'" + string: GCC 12 warns falsely of overlapping copies when inlined)
+      if (r.ec != std::errc() || r.ptr != w.data() + w.size()) fail(std::string(1, '\'').append(w).append("' is not a number"));
       // As the binary kinds would store it: a SIZE 4 float field holds a float.
       return f.type == 'F' && f.size == 4 ? static_cast<double>(static_cast<float>(v)) : v;
     };
@@ -332,7 +410,8 @@ void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSi
     } else if (l.channel_scale) {
       for (int c = 0; c < 3; ++c) rgb[c] = number(*l.channels[c]);
     }
-    sink.add(xyz, rgb, l.intensity ? number(*l.intensity) : 0.0);
+    for (std::size_t k = 0; k < l.others.size(); ++k) others[k] = number(*l.others[k].field);
+    sink.add(xyz, rgb, l.intensity ? number(*l.intensity) : 0.0, others);
     ++i;
   }
 }

@@ -5,9 +5,13 @@
 #include <lzf.h>
 
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "io_test_data.hpp"
 #include "vola/io/input.hpp"
@@ -16,6 +20,26 @@
 namespace {
 
 using namespace vola_io_test;
+
+// EXPECTED.txt's "fields=['x', 'y', ...]" of a PCD line.
+std::optional<std::vector<std::string>> expected_fields(const std::string& line) {
+  const auto start = line.find("fields=[");
+  if (start == std::string::npos) return std::nullopt;
+  const auto end = line.find(']', start);
+  if (end == std::string::npos) return std::nullopt;
+  std::vector<std::string> fields;
+  for (std::size_t at = line.find('\'', start); at < end; at = line.find('\'', at + 1)) {
+    const auto close = line.find('\'', at + 1);
+    fields.push_back(line.substr(at + 1, close - at - 1));
+    at = close;
+  }
+  return fields;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
 
 TEST(Pcd, SharedFilesMatchExpected) {
   VOLA_REQUIRE_DATA(data);
@@ -38,10 +62,46 @@ TEST(Pcd, SharedFilesMatchExpected) {
         EXPECT_NEAR(box.max[a], (*max)[a], 5.1e-4) << "axis " << a;
       }
     }
-    const bool coloured = line.find("'rgb") != std::string::npos || line.find("'Red'") != std::string::npos;
-    EXPECT_EQ(in.cloud.attributes.size() >= 3, coloured);
+    // Colours make three columns (red, green, blue) of one or three fields; every other
+    // field but x, y, z is a column of its own.
+    const auto fields = expected_fields(line);
+    ASSERT_TRUE(fields) << line;
+    std::size_t columns = 0;
+    for (const std::string& f : *fields) {
+      const std::string key = lower(f);
+      if (key == "x" || key == "y" || key == "z" || key == "green" || key == "blue") continue;
+      columns += key == "rgb" || key == "rgba" || key == "red" ? 3 : 1;
+    }
+    EXPECT_EQ(in.cloud.attributes.size(), columns);
     for (const auto& a : in.cloud.attributes) EXPECT_EQ(a.values.size(), in.cloud.size()) << a.name;
   }
+}
+
+// PDAL's PCD writer spells LAS fields its way: they come out under the LAS reader's
+// column names, with its reductions, and equal to the LAS file's values.
+TEST(Pcd, PdalsLasFieldsComeOutAsTheLasReadersColumns) {
+  VOLA_REQUIRE_DATA(data);
+  const auto pcd = vola::io::read_input((data / "pcd" / "pdal_autzen-utm.pcd").string(), "auto", {});
+  const auto find = [&](const std::string& name) -> const vola::PointAttribute* {
+    for (const auto& a : pcd.cloud.attributes)
+      if (a.name == name) return &a;
+    return nullptr;
+  };
+  for (const char* name : {"intensity", "return_number", "number_of_returns", "scan_direction_flag",
+                           "edge_of_flight_line", "classification", "scan_angle_rank", "user_data", "point_source_id",
+                           "gps_time", "red", "green", "blue"})
+    EXPECT_TRUE(find(name)) << name;
+  ASSERT_TRUE(find("classification") && find("number_of_returns"));
+  EXPECT_EQ(find("classification")->reduction, vola::Reduction::majority);
+  EXPECT_EQ(find("number_of_returns")->reduction, vola::Reduction::max);
+  // The same survey as LAS (EXPECTED.txt: both 1065 points): classes point for point.
+  const auto las = vola::io::read_input((data / "las" / "pdal_autzen-utm.las").string(), "auto", {});
+  ASSERT_EQ(las.cloud.size(), pcd.cloud.size());
+  const vola::PointAttribute* las_class = nullptr;
+  for (const auto& a : las.cloud.attributes)
+    if (a.name == "classification") las_class = &a;
+  ASSERT_TRUE(las_class);
+  EXPECT_EQ(find("classification")->values, las_class->values);
 }
 
 TEST(Pcd, OrganizedCloudDropsItsNaNPoints) {
@@ -143,8 +203,12 @@ Bytes pcd_bytes(const Sample& s, const std::string& data_kind, bool doubles, boo
 
 void expect_sample(const vola::PointCloud& cloud, const Sample& s, bool doubles) {
   std::size_t k = 0;
-  ASSERT_EQ(cloud.attributes.size(), 4u);
+  // red, green, blue, intensity, then label (I8, a class: majority); normal has COUNT 3.
+  ASSERT_EQ(cloud.attributes.size(), 5u);
   EXPECT_EQ(cloud.attributes[3].name, "intensity");
+  EXPECT_EQ(cloud.attributes[4].name, "label");
+  EXPECT_EQ(cloud.attributes[4].type, vola::ValueType::i64);
+  EXPECT_EQ(cloud.attributes[4].reduction, vola::Reduction::majority);
   for (std::size_t i = 0; i < s.xyz.size(); ++i) {
     if (!std::isfinite(s.xyz[i][0]) || !std::isfinite(s.xyz[i][1]) || !std::isfinite(s.xyz[i][2])) continue;
     ASSERT_LT(k, cloud.size());
@@ -154,6 +218,7 @@ void expect_sample(const vola::PointCloud& cloud, const Sample& s, bool doubles)
                            static_cast<double>(s.rgb[i] & 255)};
     for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(cloud.attributes[c].values[k], rgb[c]) << "point " << i;
     EXPECT_EQ(cloud.attributes[3].values[k], s.intensity[i]);
+    EXPECT_EQ(cloud.attributes[4].values[k], static_cast<double>(-static_cast<std::int64_t>(i) * 1000000007));
     EXPECT_EQ(cloud.payload[k], std::uint64_t{s.rgb[i] >> 16} | std::uint64_t{(s.rgb[i] >> 8) & 255} << 8 |
                                     std::uint64_t{s.rgb[i] & 255} << 16);
     ++k;
