@@ -80,6 +80,9 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
   columns.y = options.columns[1] - 1;
   columns.z = options.columns[2] - 1;
   columns.skip_lines = options.skip_lines;
+  // A header line lays the columns out unless the options do.
+  columns.from_header = options.columns == std::array<int, 3>{1, 2, 3} && options.payload_columns.empty() &&
+                        options.text_attributes.empty() && options.nbits == 0;
   if (options.nbits > 0) {
     if (!options.payload_columns.empty()) {
       for (int c : options.payload_columns) columns.payload.push_back(c - 1);

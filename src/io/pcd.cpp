@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "column_names.hpp"
 #include "file_bytes.hpp"
 #include "point_colours.hpp"
 #include "header_words.hpp"
@@ -217,32 +218,6 @@ ValueType field_value_type(const Field& f) {
   }
 }
 
-// A field's column name: LAS fields as PDAL's PCD writer spells them (ReturnNumber,
-// GpsTime, ...) under the names vola's LAS reader gives them, so that a survey exported
-// to PCD converts and filters as its LAS does; other names as they are (lower case).
-std::string pcd_column_name(const std::string& field) {
-  std::string key;
-  for (const char c : field)
-    if (c != '_') key += c;
-  static constexpr std::pair<std::string_view, std::string_view> kLasNames[] = {
-      {"returnnumber", "return_number"},     {"numberofreturns", "number_of_returns"},
-      {"scandirectionflag", "scan_direction_flag"}, {"edgeofflightline", "edge_of_flight_line"},
-      {"scananglerank", "scan_angle_rank"},  {"userdata", "user_data"},
-      {"pointsourceid", "point_source_id"},  {"gpstime", "gps_time"},
-  };
-  for (const auto& [pdal, vola] : kLasNames)
-    if (key == pdal) return std::string(vola);
-  return field;
-}
-
-// Classes take the majority of a voxel's points (as LAS classification and PLY labels
-// do), the number of returns the maximum (as LAS), the rest the mean.
-Reduction pcd_reduction_of(const std::string& column) {
-  if (column == "classification" || column == "class" || column == "label" || column == "scalar_classification")
-    return Reduction::majority;
-  if (column == "number_of_returns") return Reduction::max;
-  return Reduction::mean;
-}
 
 Layout find_layout(const Header& h, const std::string& name) {
   Layout l;
@@ -278,10 +253,10 @@ Layout find_layout(const Header& h, const std::string& name) {
     const bool used = &f == l.xyz[0] || &f == l.xyz[1] || &f == l.xyz[2] || &f == l.packed_rgb || &f == l.intensity ||
                       (l.channel_scale && (&f == l.channels[0] || &f == l.channels[1] || &f == l.channels[2]));
     if (used || !scalar(f) || f.name.find_first_not_of('_') == std::string::npos) continue;
-    std::string column = pcd_column_name(f.name);
+    std::string column = point_column_name(f.name);
     if (std::find(taken.begin(), taken.end(), column) != taken.end()) continue;
     taken.push_back(column);
-    const Reduction reduction = pcd_reduction_of(column);
+    const Reduction reduction = point_column_reduction(column);
     l.others.push_back({&f, std::move(column), field_value_type(f), reduction});
   }
   return l;

@@ -1,11 +1,14 @@
 #include "vola/io/text_points.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <string_view>
 
+#include "column_names.hpp"
 #include "vola/error.hpp"
 
 namespace vola::io {
@@ -16,8 +19,9 @@ bool is_separator(char c) { return c == ' ' || c == '\t' || c == ',' || c == ';'
 
 class LineParser {
  public:
-  LineParser(const std::string& path, const TextColumns& columns, PointCloud& cloud)
-      : path_(path), columns_(columns), cloud_(cloud) {
+  // `header_line`: a line of column names to pass over (0: none).
+  LineParser(const std::string& path, const TextColumns& columns, PointCloud& cloud, std::uint64_t header_line)
+      : path_(path), columns_(columns), cloud_(cloud), header_line_(header_line) {
     max_column_ = std::max({columns.x, columns.y, columns.z});
     for (int c : columns.payload) max_column_ = std::max(max_column_, c);
     for (int c : columns.attribute_columns) max_column_ = std::max(max_column_, c);
@@ -33,7 +37,7 @@ class LineParser {
     std::size_t i = 0;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
     if (i == line.size() || line[i] == '#' || line.substr(i, 2) == "//") return;
-    if (line_number <= static_cast<std::uint64_t>(columns_.skip_lines)) return;
+    if (line_number <= static_cast<std::uint64_t>(columns_.skip_lines) || line_number == header_line_) return;
     int column = 0;
     while (i < line.size() && column <= max_column_) {
       std::size_t end = i;
@@ -80,11 +84,110 @@ class LineParser {
   const std::string& path_;
   const TextColumns& columns_;
   PointCloud& cloud_;
+  std::uint64_t header_line_;
   int max_column_ = 2;
   std::vector<double> values_;
 };
 
+std::string_view unquoted(std::string_view w) {
+  if (w.size() >= 2 && (w.front() == '"' || w.front() == '\'') && w.back() == w.front()) return w.substr(1, w.size() - 2);
+  return w;
+}
+
+bool is_number(std::string_view w) {
+  if (!w.empty() && w.front() == '+') w.remove_prefix(1);
+  double v = 0;
+  const auto r = std::from_chars(w.data(), w.data() + w.size(), v);
+  return r.ec == std::errc() && r.ptr == w.data() + w.size();
+}
+
+// The column of each of x, y, z among the names (any case), or nothing.
+std::optional<std::array<int, 3>> xyz_columns(const std::vector<std::string>& names) {
+  std::array<int, 3> at{-1, -1, -1};
+  for (std::size_t c = 0; c < names.size(); ++c)
+    for (int a = 0; a < 3; ++a)
+      if (names[c].size() == 1 && std::tolower(static_cast<unsigned char>(names[c][0])) == 'x' + a && at[a] < 0)
+        at[a] = static_cast<int>(c);
+  if (at[0] < 0 || at[1] < 0 || at[2] < 0) return std::nullopt;
+  return at;
+}
+
+// Red, green and blue from a header hold 8-bit or 16-bit colours: the narrowest type
+// that holds every value (u8 is what the LAS writer scales to 16 bits), else f64.
+void type_colours(PointCloud& cloud) {
+  for (PointAttribute& a : cloud.attributes) {
+    if (a.name != "red" && a.name != "green" && a.name != "blue") continue;
+    double most = 0;
+    bool whole = true;
+    for (const double v : a.values) {
+      whole = whole && v >= 0 && v == std::floor(v);
+      most = std::max(most, v);
+    }
+    a.type = !whole || most > 65535 ? ValueType::f64 : most > 255 ? ValueType::u16 : ValueType::u8;
+  }
+}
+
 }  // namespace
+
+std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open");
+  std::string line;
+  std::uint64_t number = 0;
+  std::vector<std::string> names;
+  // Leading comment lines may carry the names (CloudCompare, vola export); the first
+  // other line ends the search, and is a header itself when it holds names only.
+  while (std::getline(in, line)) {
+    if (++number <= static_cast<std::uint64_t>(skip_lines)) continue;
+    std::string_view rest(line);
+    while (!rest.empty() && is_separator(rest.front())) rest.remove_prefix(1);
+    if (rest.empty()) continue;
+    TextHeader header;
+    header.line = number;
+    if (rest.substr(0, 2) == "//") header.comment = true, rest.remove_prefix(2);
+    else if (rest.front() == '#') header.comment = true, rest.remove_prefix(1);
+    names.clear();
+    bool all_names = true;
+    for (std::size_t i = 0; i < rest.size();) {
+      while (i < rest.size() && is_separator(rest[i])) ++i;
+      std::size_t end = i;
+      while (end < rest.size() && !is_separator(rest[end])) ++end;
+      if (end > i) {
+        const std::string_view word = unquoted(rest.substr(i, end - i));
+        all_names = all_names && !word.empty() && !is_number(word);
+        names.emplace_back(word);
+      }
+      i = end;
+    }
+    const bool named = all_names && !names.empty();
+    if (header.comment) {
+      if (named && xyz_columns(names)) return TextHeader{names, header.line, true};
+      continue;
+    }
+    if (named) return TextHeader{names, header.line, false};
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+TextColumns text_columns_of(const TextHeader& header) {
+  TextColumns columns;
+  const auto xyz = xyz_columns(header.names);
+  if (!xyz) throw InvalidArgument("the header names no x, y and z columns");
+  columns.x = (*xyz)[0], columns.y = (*xyz)[1], columns.z = (*xyz)[2];
+  for (std::size_t c = 0; c < header.names.size(); ++c) {
+    const int column = static_cast<int>(c);
+    if (column == columns.x || column == columns.y || column == columns.z) continue;
+    std::string name = point_column_name(header.names[c]);
+    const bool taken = std::any_of(columns.attributes.begin(), columns.attributes.end(),
+                                   [&](const PointAttribute& a) { return a.name == name; });
+    if (taken || name.empty()) continue;  // a second column of one name stays unread, as in PLY
+    const Reduction reduction = point_column_reduction(name);
+    columns.attributes.push_back({std::move(name), ValueType::f64, reduction, {}});
+    columns.attribute_columns.push_back(column);
+  }
+  return columns;
+}
 
 int count_text_columns(const std::string& path, int skip_lines) {
   std::ifstream in(path, std::ios::binary);
@@ -114,8 +217,19 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
   in.seekg(0, std::ios::end);
   const std::uint64_t total = static_cast<std::uint64_t>(in.tellg());
   in.seekg(0);
+  // A header line is never a point; it lays the columns out when they are left to it.
+  const std::optional<TextHeader> header = read_text_header(path, columns.skip_lines);
+  TextColumns layout = columns;
+  const bool named = header && columns.from_header;
+  if (named) {
+    if (!xyz_columns(header->names))
+      throw FormatError(path, 0, "line " + std::to_string(header->line) + " names its columns but none of them x, y and z;"
+                                 " say which columns hold them (--columns X Y Z, counted from 1)");
+    layout = text_columns_of(*header);
+    layout.skip_lines = columns.skip_lines;
+  }
   PointCloud cloud;
-  LineParser parser(path, columns, cloud);
+  LineParser parser(path, layout, cloud, header && !header->comment ? header->line : 0);
   constexpr std::size_t kChunk = 8 << 20;
   std::string buffer;
   std::uint64_t consumed = 0;  // file offset of buffer[0]
@@ -145,6 +259,7 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     buffer.erase(0, kept);
     if (progress) progress(consumed, total);
   }
+  if (named) type_colours(cloud);
   return cloud;
 }
 

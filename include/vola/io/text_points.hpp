@@ -1,10 +1,15 @@
 // Points from text: XYZ/TXT/CSV, one point per line, columns separated by spaces,
 // tabs, commas or semicolons. Lines starting with '#' or '//' and empty lines are
-// skipped.
+// skipped. A first line of names (after `skip_lines`), as PDAL's writers.text
+// ("X","Y","Z","Intensity"), CloudCompare (//X,Y,Z,R,G,B) and vola export
+// (# x y z intensity) write it, is a header: never read as a point, and, when the
+// columns are left to it (TextColumns::from_header), it says which columns are x, y and
+// z and names every other column as an attribute.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,7 +26,27 @@ struct TextColumns {
   std::vector<PointAttribute> attributes;  // names/types/reductions; values filled in
   std::vector<int> attribute_columns;
   int skip_lines = 0;  // header lines to skip (txt2vola skips 1)
+  // Take x, y, z and the attributes from a header line naming x, y and z, when the file
+  // has one (the members above then describe a file without one).
+  bool from_header = true;
 };
+
+// The column names of a header line (see above), or none when the first line after
+// `skip_lines` holds values or does not name x, y and z. `line` is its number (1-based);
+// `comment` whether it began with '#' or '//'.
+struct TextHeader {
+  std::vector<std::string> names;  // as written, quotes removed
+  std::uint64_t line = 0;
+  bool comment = false;
+};
+std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines);
+
+// The columns a header names: x, y, z by name (any case) and every other column as an
+// attribute (f64; classification/class/label by majority, number_of_returns by maximum,
+// red/green/blue as u8 or u16 once their values are known, the rest by mean), PDAL's
+// spellings of LAS fields (ReturnNumber, GpsTime, ...) and CloudCompare's R, G, B under
+// the LAS reader's names.
+TextColumns text_columns_of(const TextHeader& header);
 
 // Number of columns on the first data line after `skip_lines` lines (0 for none).
 int count_text_columns(const std::string& path, int skip_lines);

@@ -1,0 +1,22 @@
+// Column names of point formats that name their own fields (PCD fields, text headers):
+// what vola calls them and how a voxel reduces them, so that a survey written by PDAL or
+// CloudCompare converts and filters as its LAS does.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "vola/builder.hpp"
+
+namespace vola::io {
+
+// Lower case; LAS fields as PDAL spells them (ReturnNumber, GpsTime, PointSourceId, ...)
+// under the LAS reader's names (return_number, gps_time, point_source_id, ...), and
+// CloudCompare's R, G, B as red, green, blue. Other names stay as they are, lower case.
+std::string point_column_name(std::string_view field);
+
+// Classes (classification, class, label) by majority, number_of_returns by maximum
+// (as the LAS reader keeps them), the rest by mean.
+Reduction point_column_reduction(const std::string& column);
+
+}  // namespace vola::io

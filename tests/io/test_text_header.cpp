@@ -1,0 +1,103 @@
+// Text points whose first line names the columns, as PDAL's writers.text, CloudCompare
+// and vola export write them: the header is never a point, and it lays the columns out
+// unless the caller does.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/io/text_points.hpp"
+
+namespace {
+
+using vola_test::TempDir;
+
+vola::PointCloud read_text(const TempDir& dir, const std::string& text, const vola::io::TextColumns& columns = {}) {
+  const auto path = dir / "points.txt";
+  std::ofstream(path, std::ios::binary) << text;
+  return vola::io::read_text_points(path.string(), columns);
+}
+
+const vola::PointAttribute& column(const vola::PointCloud& cloud, const std::string& name) {
+  for (const auto& a : cloud.attributes)
+    if (a.name == name) return a;
+  throw std::runtime_error("no column " + name);
+}
+
+std::vector<std::string> names(const vola::PointCloud& cloud) {
+  std::vector<std::string> out;
+  for (const auto& a : cloud.attributes) out.push_back(a.name);
+  return out;
+}
+
+TEST(TextHeader, PdalsQuotedCsvNamesEveryColumn) {
+  TempDir dir;
+  // writers.text's default: quoted names, commas; LAS fields in PDAL's spelling; x, y
+  // and z need not come first.
+  const auto cloud = read_text(dir,
+                               "\"Intensity\",\"Z\",\"X\",\"Y\",\"Classification\",\"ReturnNumber\",\"NumberOfReturns\","
+                               "\"Red\",\"Green\",\"Blue\",\"GpsTime\"\n"
+                               "10,3.5,1.25,2,2,1,2,65535,0,300,1000.5\n"
+                               "20,6,4,5,6,2,2,0,128,0,1001\n");
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.xyz, (std::vector<double>{1.25, 2, 3.5, 4, 5, 6}));
+  EXPECT_EQ(names(cloud), (std::vector<std::string>{"intensity", "classification", "return_number", "number_of_returns",
+                                                    "red", "green", "blue", "gps_time"}));
+  EXPECT_EQ(column(cloud, "classification").values, (std::vector<double>{2, 6}));
+  EXPECT_EQ(column(cloud, "classification").reduction, vola::Reduction::majority);
+  EXPECT_EQ(column(cloud, "number_of_returns").reduction, vola::Reduction::max);
+  EXPECT_EQ(column(cloud, "gps_time").values, (std::vector<double>{1000.5, 1001}));
+  // One colour beyond 255: 16-bit colours.
+  EXPECT_EQ(column(cloud, "red").type, vola::ValueType::u16);
+}
+
+TEST(TextHeader, CommentHeadersOfCloudCompareAndVolaExport) {
+  TempDir dir;
+  const auto cc = read_text(dir, "//X,Y,Z,R,G,B\n1,2,3,255,0,7\n4,5,6,0,10,0\n");
+  EXPECT_EQ(cc.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(names(cc), (std::vector<std::string>{"red", "green", "blue"}));
+  EXPECT_EQ(column(cc, "red").type, vola::ValueType::u8);  // 8-bit colours
+  EXPECT_EQ(column(cc, "blue").values, (std::vector<double>{7, 0}));
+  // vola export's XYZ, after a descriptive comment: the names are on the second line.
+  const auto own = read_text(dir, "# made by hand\n# x y z intensity classification\n0.5 1.5 2.5 7 2\n");
+  EXPECT_EQ(own.xyz, (std::vector<double>{0.5, 1.5, 2.5}));
+  EXPECT_EQ(names(own), (std::vector<std::string>{"intensity", "classification"}));
+  // A comment of numbers or of other words names nothing.
+  const auto plain = read_text(dir, "# 1 2 3\n# written by a scanner\n1 2 3 4\n");
+  EXPECT_EQ(plain.xyz, (std::vector<double>{1, 2, 3}));
+  EXPECT_TRUE(plain.attributes.empty());
+}
+
+TEST(TextHeader, NamesWithoutXyzAreRefusedUnlessTheColumnsAreGiven) {
+  TempDir dir;
+  try {
+    read_text(dir, "lat lon h\n1 2 3\n");
+    FAIL() << "a header without x, y and z was taken";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 1 names its columns but none of them x, y and z"), std::string::npos)
+        << e.what();
+  }
+  vola::io::TextColumns given;
+  given.from_header = false;
+  given.x = 1, given.y = 0, given.z = 2;
+  const auto cloud = read_text(dir, "lat lon h\n1 2 3\n", given);  // the names line is passed over
+  EXPECT_EQ(cloud.xyz, (std::vector<double>{2, 1, 3}));
+  // Columns given explicitly win over a header that names x, y and z too.
+  const auto explicit_columns = read_text(dir, "x y z a\n1 2 3 4\n", given);
+  EXPECT_EQ(explicit_columns.xyz, (std::vector<double>{2, 1, 3}));
+  EXPECT_TRUE(explicit_columns.attributes.empty());
+}
+
+TEST(TextHeader, FilesWithoutOneReadAsBefore) {
+  TempDir dir;
+  const auto cloud = read_text(dir, "1 2 3 9\n4 5 6 9\n");
+  EXPECT_EQ(cloud.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_TRUE(cloud.attributes.empty());
+  // A bad value on a later line is still a bad value, not a header.
+  EXPECT_THROW(read_text(dir, "1 2 3\nx y z\n"), vola::FormatError);
+}
+
+}  // namespace
