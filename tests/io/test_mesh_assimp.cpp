@@ -227,6 +227,28 @@ TEST(MeshAssimp, PolygonsAreTriangulatedLinesAndPointsKept) {
   EXPECT_EQ(segments, 1);
 }
 
+// An OBJ of vertices alone (a point cloud, as CloudCompare writes one): Assimp's
+// validation refuses its faceless mesh, so vola reads it again and keeps the vertices as
+// points; vertices of an object without faces beside one with faces stay out, as before.
+TEST(MeshAssimp, ObjOfVerticesAloneIsPoints) {
+  vola_test::TempDir dir;
+  write_file(dir / "points.obj", "# a scan\nv 1 2 3\nv 4 5 6.5\nv -1 0 0\n");
+  const auto points = vola::io::read_mesh_triangles((dir / "points.obj").string());
+  ASSERT_EQ(points.size(), 3u);
+  std::vector<Point> got;
+  for (const Triangle& t : points) {
+    EXPECT_TRUE(t[0] == t[1] && t[1] == t[2]);
+    got.push_back(t[0]);
+  }
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, (std::vector<Point>{{-1, 0, 0}, {1, 2, 3}, {4, 5, 6.5}}));
+  // A face naming a vertex that does not exist is still refused, not read as points.
+  write_file(dir / "mixed.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 5 5 5\n");
+  EXPECT_EQ(vola::io::read_mesh_triangles((dir / "mixed.obj").string()).size(), 1u);
+  write_file(dir / "bad.obj", "v 1 2 3\nf 1 2 9\n");
+  EXPECT_TRUE(vola_test::format_error_of([&] { vola::io::read_mesh_triangles((dir / "bad.obj").string()); }));
+}
+
 // glTF nodes: a parent scaled by 2 and moved by (10, 0, 0), a child moved by (0, 1, 0)
 // in the parent's frame, both placing one triangle (0,0,0) (1,0,0) (0,1,0).
 TEST(MeshAssimp, NodeTransformsAreApplied) {

@@ -97,7 +97,25 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   check_off_counts(path);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+  // Assimp's validation refuses a mesh of vertices alone: an OBJ point cloud ("v" lines,
+  // no faces, as CloudCompare and scanners write them). Such a file is read again without
+  // it and taken only when no mesh has a face; its vertices are then points (degenerate
+  // triangles, as points inside meshes are).
+  const bool points_only = !scene && std::string(importer.GetErrorString()).find("contains no faces") != std::string::npos;
+  if (points_only) {
+    const std::string refusal = importer.GetErrorString();
+    scene = importer.ReadFile(path, 0);
+    const auto vertices_alone = [](const aiScene* s) {
+      for (unsigned m = 0; m < s->mNumMeshes; ++m)
+        if (!s->mMeshes[m] || s->mMeshes[m]->mNumFaces != 0 || (s->mMeshes[m]->mNumVertices && !s->mMeshes[m]->mVertices))
+          return false;
+      return s->mMeshes || s->mNumMeshes == 0;
+    };
+    if (!scene || !scene->mRootNode || !vertices_alone(scene))
+      throw FormatError(path, std::nullopt, "Assimp: " + refusal);
+  }
   if (!scene || !scene->mRootNode) throw FormatError(path, std::nullopt, std::string("Assimp: ") + importer.GetErrorString());
+  const auto elements = [&](const aiMesh* mesh) -> std::uint64_t { return points_only ? mesh->mNumVertices : mesh->mNumFaces; };
 
   // Every (node, accumulated transform) pair, walked without recursion: a file can
   // nest nodes arbitrarily deep.
@@ -111,7 +129,7 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
       if (node->mMeshes[i] >= scene->mNumMeshes)
         throw FormatError(path, std::nullopt, "a node names mesh " + std::to_string(node->mMeshes[i]) + " of " +
                                                   std::to_string(scene->mNumMeshes));
-      faces += scene->mMeshes[node->mMeshes[i]]->mNumFaces;
+      faces += elements(scene->mMeshes[node->mMeshes[i]]);
     }
     if (faces > kMaxMeshTriangles)
       throw InvalidArgument(path + ": the scene places more than " + std::to_string(kMaxMeshTriangles) + " faces");
@@ -122,12 +140,19 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
 
   // Reserve for what the file holds; instances beyond that grow the vector as they come.
   std::uint64_t stored = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) stored += scene->mMeshes[m]->mNumFaces;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) stored += elements(scene->mMeshes[m]);
   std::vector<Triangle> triangles;
   triangles.reserve(std::min(faces, stored));
   for (const auto& [node, matrix] : placed) {
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+      if (points_only) {
+        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+          const Point p = transform(matrix, mesh->mVertices[v]);
+          triangles.push_back(Triangle{p, p, p});
+        }
+        continue;
+      }
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];
         // Triangulation leaves points (1), lines (2) and triangles (3); validation
