@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "text_output.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/map/state_map.hpp"
@@ -19,13 +20,6 @@
 namespace vola::cli {
 
 namespace {
-
-// A number as the user typed it: the shortest text that reads back as the same double.
-std::string shortest(double value) {
-  char text[64];
-  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
-  return std::string(text, end);
-}
 
 struct GetArgs {
   std::string file;
@@ -147,14 +141,14 @@ void run_get(const GetArgs& a) {
   Voxel v;
   if (a.world) {
     if (!tree.quantizer().to_voxel({a.position[0], a.position[1], a.position[2]}, v))
-      throw InvalidArgument("world point (" + shortest(a.position[0]) + ", " + shortest(a.position[1]) + ", " +
-                            shortest(a.position[2]) + ") is outside the grid");
+      throw InvalidArgument("world point (" + shortest_text(a.position[0]) + ", " + shortest_text(a.position[1]) + ", " +
+                            shortest_text(a.position[2]) + ") is outside the grid");
   } else {
     std::uint32_t c[3];
     for (int i = 0; i < 3; ++i) {
       const double p = a.position[i];
       if (!(p >= 0 && p < tree.side()) || p != static_cast<double>(static_cast<std::uint64_t>(p)))
-        throw InvalidArgument("voxel coordinate " + shortest(p) + " is not an integer in 0.." +
+        throw InvalidArgument("voxel coordinate " + shortest_text(p) + " is not an integer in 0.." +
                               std::to_string(tree.side() - 1) + " (use --world for CRS coordinates)");
       c[i] = static_cast<std::uint32_t>(p);
     }

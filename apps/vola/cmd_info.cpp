@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "info_points.hpp"
+#include "text_output.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
@@ -20,12 +21,6 @@ struct InfoArgs {
   bool json = false;
   bool summary = false;
 };
-
-std::string shortest(double v) {
-  char text[32];
-  const auto r = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, r.ptr);
-}
 
 std::string quoted(const std::string& s) {
   std::string out = "\"";
@@ -132,10 +127,10 @@ void run_info(const InfoArgs& a) {
   std::printf("header:      EPSG code %u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
   // Coordinates as the shortest text that reads back as the same double: the file's own
   // precision (636001.76, not 636001.76000000001, nor 6.36001760e+05 cut to 9 digits).
-  const auto triple = [](const Point& p) { return shortest(p[0]) + ", " + shortest(p[1]) + ", " + shortest(p[2]); };
+  const auto triple = [](const Point& p) { return shortest_text(p[0]) + ", " + shortest_text(p[1]) + ", " + shortest_text(p[2]); };
   std::printf("bbox:        min (%s)\n             max (%s)\n", triple(h.bbox.min).c_str(), triple(h.bbox.max).c_str());
   std::printf("grid:        %s quantization, voxel size %s, origin (%s)%s\n",
-              frame.quantization == Quantization::grid ? "grid" : "toolkit", shortest(frame.voxel_size).c_str(),
+              frame.quantization == Quantization::grid ? "grid" : "toolkit", shortest_text(frame.voxel_size).c_str(),
               triple(frame.origin).c_str(), tree.stored_frame() ? "" : " (from the header bbox)");
   if (states)
     std::printf("voxels:      state map (vola map): %llu known, %.2f bits per known voxel (whole file): %llu "

@@ -17,6 +17,13 @@
 
 namespace vola::cli {
 
+// The shortest text that reads back as the same double ("1e-09", "0.1").
+inline std::string shortest_text(double v) {
+  char text[32];
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
+
 class TextOutput {
  public:
   TextOutput() : TextOutput(stdout, "standard output") {}
