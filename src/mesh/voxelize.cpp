@@ -37,8 +37,8 @@ void clip(const Polygon& in, int axis, double bound, bool keep_above, Polygon& o
   }
 }
 
-// `out` = the part of `in` within [low - slack, high + slack] on `axis`; an infinite
-// bound (a toolkit border voxel) clips nothing.
+// `out` = the part of `in` within [low - slack, high + slack] on `axis` (a negative slack
+// shrinks the interval); an infinite bound (a toolkit border voxel) clips nothing.
 void clip_slab(const Polygon& in, int axis, double low, double high, double slack, Polygon& out) {
   if (!std::isfinite(low) && !std::isfinite(high)) {
     out = in;
@@ -130,7 +130,7 @@ class TriangleVoxelizer {
           for (std::uint32_t x = first_.x; x <= last_.x; ++x) try_voxel(test, {x, y, z});
       return;
     }
-    Polygon whole, slab, row, exact_slab, exact_row;
+    Polygon whole, slab, row, inner_slab, inner_row;
     whole.size = 3;
     for (int i = 0; i < 3; ++i) whole.points[i] = triangle[i];
     for (std::uint32_t z = first_.z; z <= last_.z; ++z) {
@@ -138,21 +138,22 @@ class TriangleVoxelizer {
       if (!slab.size) continue;
       Voxel slab_first, slab_last;
       if (!quantizer_.voxel_range(widened(polygon_bounds(slab), slack), slab_first, slab_last)) continue;
-      clip_slab(whole, 2, face(2, z), face(2, z + 1), 0.0, exact_slab);
+      clip_slab(whole, 2, face(2, z), face(2, z + 1), -slack, inner_slab);
       for (std::uint32_t y = std::max(slab_first.y, first_.y); y <= std::min(slab_last.y, last_.y); ++y) {
         clip_slab(slab, 1, face(1, y), face(1, y + 1), slack, row);
         if (!row.size) continue;
         Voxel row_first, row_last;
         if (!quantizer_.voxel_range(widened(polygon_bounds(row), slack), row_first, row_last)) continue;
-        // The triangle's part inside this row of cells, clipped without slack, is convex:
-        // every x between its lowest and highest is the x of one of its points, which lies
-        // in the row. A cell whose x range meets that interval by more than the rounding
-        // (slack) overlaps the triangle; only cells at its ends need the exact test.
+        // The triangle's part inside this row of cells shrunk by the rounding (slack) is
+        // convex and, rounding and all, inside the row: every x between its lowest and
+        // highest is the x of one of its points. A cell whose x range meets that interval
+        // by more than the rounding overlaps the triangle; only cells at its ends (and rows
+        // the triangle only grazes) need the exact test.
         double sure_low = INFINITY, sure_high = -INFINITY;
-        if (exact_slab.size) {
-          clip_slab(exact_slab, 1, face(1, y), face(1, y + 1), 0.0, exact_row);
-          if (exact_row.size) {
-            const Box bounds = polygon_bounds(exact_row);
+        if (inner_slab.size) {
+          clip_slab(inner_slab, 1, face(1, y), face(1, y + 1), -slack, inner_row);
+          if (inner_row.size) {
+            const Box bounds = polygon_bounds(inner_row);
             sure_low = bounds.min[0] + slack, sure_high = bounds.max[0] - slack;
           }
         }

@@ -148,6 +148,16 @@ TEST(Voxelize, BigTrianglesMatchTheBruteForce) {
               vola_mesh_test::brute_force_voxels({&t, 1}, q));
 }
 
+// A fuzz finding of the row fast path: this triangle lies in the plane y = z / 7 up to
+// rounding and so runs along the corner edges of many rows (y = 2/21, z = 2/3, ...). The
+// triangle clipped to such a row without margin is a sliver that rounding alone made;
+// the cells of those rows must go through the exact test, which finds no overlap.
+TEST(Voxelize, ATriangleGrazingTheEdgesOfRowsMatchesTheBruteForce) {
+  const Quantizer q = Quantizer::toolkit({{0, 0, 0}, {4, 4, 4}}, 3);
+  const Triangle t{{{0.5, 0.5, 3.5}, {3.5, 0.5, 3.5}, {3.5, 6.9844665281088063e-251, 6.983507489299645e-251}}};
+  EXPECT_EQ(vola_mesh_test::key_set(vola::mesh::surface_keys({&t, 1}, q)), vola_mesh_test::brute_force_voxels({&t, 1}, q));
+}
+
 TEST(Voxelize, UnusableTrianglesAreSkipped) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   const Quantizer q = Quantizer::toolkit({{0, 0, 0}, {1, 1, 1}}, 2);
