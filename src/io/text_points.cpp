@@ -133,17 +133,20 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
   std::string line;
-  std::uint64_t number = 0;
+  std::uint64_t number = 0, next_offset = 0;
   std::vector<std::string> names;
   // Leading comment lines may carry the names (CloudCompare, vola export); the first
   // other line ends the search, and is a header itself when it holds names only.
   while (std::getline(in, line)) {
+    const std::uint64_t offset = next_offset;
+    next_offset += line.size() + 1;
     if (++number <= static_cast<std::uint64_t>(skip_lines)) continue;
     std::string_view rest(line);
     while (!rest.empty() && is_separator(rest.front())) rest.remove_prefix(1);
     if (rest.empty()) continue;
     TextHeader header;
     header.line = number;
+    header.offset = offset;
     if (rest.substr(0, 2) == "//") header.comment = true, rest.remove_prefix(2);
     else if (rest.front() == '#') header.comment = true, rest.remove_prefix(1);
     names.clear();
@@ -161,10 +164,10 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     }
     const bool named = all_names && !names.empty();
     if (header.comment) {
-      if (named && xyz_columns(names)) return TextHeader{names, header.line, true};
+      if (named && xyz_columns(names)) return TextHeader{names, header.line, header.offset, true};
       continue;
     }
-    if (named) return TextHeader{names, header.line, false};
+    if (named) return TextHeader{names, header.line, header.offset, false};
     return std::nullopt;
   }
   return std::nullopt;
@@ -223,7 +226,7 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
   const bool named = header && columns.from_header;
   if (named) {
     if (!xyz_columns(header->names))
-      throw FormatError(path, 0, "line " + std::to_string(header->line) + " names its columns but none of them x, y and z;"
+      throw FormatError(path, header->offset, "line " + std::to_string(header->line) + " names its columns but none of them x, y and z;"
                                  " say which columns hold them (--columns X Y Z, counted from 1)");
     layout = text_columns_of(*header);
     layout.skip_lines = columns.skip_lines;

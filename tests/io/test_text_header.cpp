@@ -74,10 +74,11 @@ TEST(TextHeader, CommentHeadersOfCloudCompareAndVolaExport) {
 TEST(TextHeader, NamesWithoutXyzAreRefusedUnlessTheColumnsAreGiven) {
   TempDir dir;
   try {
-    read_text(dir, "lat lon h\n1 2 3\n");
+    read_text(dir, "# survey 7\nlat lon h\n1 2 3\n");
     FAIL() << "a header without x, y and z was taken";
   } catch (const vola::FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find("line 1 names its columns but none of them x, y and z"), std::string::npos)
+    EXPECT_EQ(e.offset(), std::optional<std::uint64_t>{11});  // the names line's first byte
+    EXPECT_NE(std::string(e.what()).find("line 2 names its columns but none of them x, y and z"), std::string::npos)
         << e.what();
   }
   vola::io::TextColumns given;

@@ -37,6 +37,7 @@ struct TextColumns {
 struct TextHeader {
   std::vector<std::string> names;  // as written, quotes removed
   std::uint64_t line = 0;
+  std::uint64_t offset = 0;  // the line's first byte in the file
   bool comment = false;
 };
 std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines);
