@@ -30,6 +30,7 @@ expect_refusal() {  # EXPECTED-TEXT ARGS...
 }
 expect_refusal "--voxel-size: must be a positive finite number, not 0" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 0
 expect_refusal "--voxel-size: must be a positive finite number, not -2" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size -2
+expect_refusal "--compress-max: compressed files are sparse, not --dense" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 1 --compress-max --dense
 expect_refusal "'abc' is not a number" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size abc
 "$vola" convert "$tmp/two.xyz" "$tmp/ok.vol" --voxel-size 10 -q || fail "a valid conversion failed"
 expect_refusal "--radius: must be a finite number of 0 or more, not -1" plan "$tmp/ok.vol" --from 0 0 0 --to 1 1 1 --radius -1

@@ -1,4 +1,4 @@
-// Compressed files (--compress): the context-coded occupancy levels (levels flags 3) and
+// Compressed files (--compress, --compress-max): the context-coded occupancy levels (levels flags 3; 4 with mixed models) and
 // the predicted attribute encodings (2 delta planes, 3 quantized floats, 4 delta planes
 // against an earlier column) round-trip bit
 // for bit on random trees and every value type, NaN payloads, infinities and -0.0
@@ -112,18 +112,51 @@ std::map<std::string, int> attribute_encodings(const std::vector<std::uint8_t>& 
   return out;
 }
 
+// The flags of the levels record (tag 4) of a version-2 file, walking its extension.
+std::uint32_t levels_flags(const std::vector<std::uint8_t>& bytes) {
+  const auto records = get_le<std::uint32_t>(bytes, 92);
+  std::size_t at = 96;
+  for (std::uint32_t r = 0; r < records; ++r) {
+    if (get_le<std::uint32_t>(bytes, at) == 4) return get_le<std::uint32_t>(bytes, at + 4);
+    at += 16 + ((get_le<std::uint64_t>(bytes, at + 8) + 7) / 8) * 8;
+  }
+  return 0;
+}
+
 TEST(Compression, LevelsRoundTripOnRandomTrees) {
   if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
-  for (Shape shape : kAllShapes)
-    for (std::uint64_t seed : seeds_for(shape, 1)) {
-      const Scenario s = make_scenario(seed);
-      SCOPED_TRACE(s.describe());
-      const vola::Tree tree = vola::build_from_voxels(to_voxels(s.unique()), s.depth);
-      vola::FileLayout layout;
-      const vola::Tree back = vola::parse(vola::serialize(tree, {.compress = true}), "random", &layout);
-      EXPECT_TRUE(layout.compressed_levels);
-      expect_same(tree, back);
-    }
+  for (bool mixed : {false, true})
+    for (Shape shape : kAllShapes)
+      for (std::uint64_t seed : seeds_for(shape, 1)) {
+        const Scenario s = make_scenario(seed);
+        SCOPED_TRACE(s.describe() + (mixed ? ", mixed models" : ", one context per bit"));
+        const vola::Tree tree = vola::build_from_voxels(to_voxels(s.unique()), s.depth);
+        vola::FileLayout layout;
+        const auto bytes = vola::serialize(tree, {.compress = true, .mix_occupancy_models = mixed});
+        EXPECT_EQ(levels_flags(bytes), mixed ? 4u : 3u);
+        const vola::Tree back = vola::parse(bytes, "random", &layout);
+        EXPECT_TRUE(layout.compressed_levels);
+        expect_same(tree, back);
+      }
+}
+
+// The mixed models code a surface (a rolling height field sampled sparsely, as an
+// airborne survey is) in fewer bytes than one context per bit.
+TEST(Compression, MixedOccupancyModelsAreSmallerOnASampledSurface) {
+  if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
+  std::mt19937_64 rng(11);
+  std::vector<vola::Voxel> voxels;
+  for (std::uint32_t x = 0; x < 400; ++x)
+    for (std::uint32_t y = 0; y < 400; ++y)
+      if (rng() % 5 == 0) {
+        const double z = 60 + 20 * std::sin(x / 40.0) * std::cos(y / 55.0) + static_cast<double>(rng() % 3);
+        voxels.push_back({x, y, static_cast<std::uint32_t>(z)});
+      }
+  const vola::Tree tree = vola::build_from_voxels(voxels, 5);
+  const auto contexts = vola::serialize(tree, {.compress = true});
+  const auto mixed = vola::serialize(tree, {.compress = true, .mix_occupancy_models = true});
+  expect_same(tree, vola::parse(mixed, "mixed"));
+  EXPECT_LT(mixed.size(), contexts.size() * 95 / 100) << mixed.size() << " against " << contexts.size();
 }
 
 TEST(Compression, LevelsWithPayloadRoundTrip) {
@@ -187,19 +220,18 @@ TEST(Compression, FilesReadMappedAndReadAlike) {
 // Every cut and (sampled) every changed byte of a compressed file: a FormatError, never
 // a crash or another exception; with the checksum resealed the decoders themselves see
 // the damage (then the file may also read, as some other tree).
-TEST(Compression, CorruptAndCutRecordsAreFormatErrors) {
-  if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
+void expect_damage_refused(bool mixed, std::size_t samples) {
   std::mt19937_64 rng(3);
   const Scenario s = make_scenario(seeds_for(Shape::clustered, 1)[4]);
   vola::Tree tree = vola::build_from_voxels(to_voxels(s.unique()), s.depth);
   add_columns(tree, rng);
-  const auto bytes = vola::serialize(tree, {.compress = true});
-  for (std::size_t cut = 0; cut < bytes.size(); cut += 1 + bytes.size() / 1500) {
+  const auto bytes = vola::serialize(tree, {.compress = true, .mix_occupancy_models = mixed});
+  for (std::size_t cut = 0; cut < bytes.size(); cut += 1 + bytes.size() / (samples / 2)) {
     const std::vector<std::uint8_t> part(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(cut));
     EXPECT_THROW((void)vola::parse(part, "cut"), vola::FormatError) << "cut at " << cut;
   }
   std::size_t refused = 0, read = 0;
-  for (std::size_t at = 80; at + 16 < bytes.size(); at += 1 + bytes.size() / 3000) {
+  for (std::size_t at = 80; at + 16 < bytes.size(); at += 1 + bytes.size() / samples) {
     auto changed = bytes;
     changed[at] ^= static_cast<std::uint8_t>(1u << (at % 8));
     EXPECT_THROW((void)vola::parse(changed, "flipped"), vola::FormatError) << "byte " << at;
@@ -212,8 +244,15 @@ TEST(Compression, CorruptAndCutRecordsAreFormatErrors) {
     }
   }
   EXPECT_GT(refused, 0u);
-  RecordProperty("resealed_refused", static_cast<int>(refused));
-  RecordProperty("resealed_read", static_cast<int>(read));
+  ::testing::Test::RecordProperty(mixed ? "mixed_resealed_refused" : "resealed_refused", static_cast<int>(refused));
+  ::testing::Test::RecordProperty(mixed ? "mixed_resealed_read" : "resealed_read", static_cast<int>(read));
+}
+
+TEST(Compression, CorruptAndCutRecordsAreFormatErrors) {
+  if (!vola::compression_available()) GTEST_SKIP() << "built without zstd";
+  expect_damage_refused(false, 3000);
+  // Each mixed level allocates its models (a few MB): fewer samples.
+  expect_damage_refused(true, 600);
 }
 
 // A levels record claiming more parts than the header's depth allows (each coded level

@@ -85,7 +85,8 @@ void run_convert(ConvertArgs& a) {
     std::fprintf(stderr, "vola: warning: %s\n", with_flags(warning).c_str());
   WriteOptions w;
   w.layout = options.dense ? Layout::dense : Layout::sparse;
-  w.compress = options.compress;
+  w.compress = options.compress || options.compress_max;
+  w.mix_occupancy_models = options.compress_max;
   write(tree, a.output, w);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!a.quiet) print_summary(a, tree, report, seconds);
@@ -160,6 +161,9 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(non_negative_number());
   cmd->add_flag("--no-attributes", args->no_attributes, "Keep occupancy only, no per-voxel attribute columns (LAS, PLY, PCD, .ot log-odds, .vdb values)");
   cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");
+  cmd->add_flag("--compress-max", args->options.compress_max,
+                "as --compress, with several context models mixed for every occupancy bit: about a tenth "
+                "smaller levels, several times slower to open (for archives and transfer)");
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");

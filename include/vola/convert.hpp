@@ -81,6 +81,9 @@ struct ConvertOptions {
   // ---- the file convert_file writes ----
   bool dense = false;     // the reference's dense layout (depth <= 5)
   bool compress = false;  // zstd levels and attributes (a file only vola reads)
+  // compress, with the occupancy coded by mixed context models (WriteOptions::
+  // mix_occupancy_models): the smallest files, several times slower to open.
+  bool compress_max = false;
 
   // Every rule above that needs no input; the rest (e.g. solid on a point file) is
   // checked once the reader has said what the input is. Throws OptionError.

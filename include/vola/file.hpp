@@ -56,6 +56,10 @@ struct WriteOptions {
   // (predicted, zstd); sparse only: a version-2 file only vola reads.
   bool compress = false;
   int compression_level = 19;
+  // With compress: code the occupancy by mixing several context models per bit (levels
+  // flags 4) instead of one: about a tenth smaller on surveys, several times slower to
+  // read (docs/FILE_FORMAT.md). Files without it read as before.
+  bool mix_occupancy_models = false;
   // Dense files hold 64^(depth-1) leaf words: refuse beyond this depth.
   int max_dense_depth = 5;
 };

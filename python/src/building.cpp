@@ -119,7 +119,7 @@ Tree convert(const std::filesystem::path& path, int depth,
              std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
              int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
              const std::string& target_crs, std::optional<int> level, const std::string& assign_crs,
-             bool allow_geographic, const std::string& grid, std::vector<std::string> filters) {
+             bool allow_geographic, const std::string& grid, std::vector<std::string> filters, bool compress_max) {
   vola::ConvertOptions options;
   options.filters = std::move(filters);
   options.format = format;
@@ -145,13 +145,15 @@ Tree convert(const std::filesystem::path& path, int depth,
   options.dem_surface_only = dem_surface_only;
   options.dense = dense;
   options.compress = compress;
+  options.compress_max = compress_max;
   py::gil_scoped_release release;
   return with_python_names([&] {
     Tree tree = vola::convert(path.string(), options);
     if (output) {
       vola::WriteOptions w;
       w.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
-      w.compress = compress;
+      w.compress = compress || compress_max;
+      w.mix_occupancy_models = compress_max;
       vola::write(tree, output->string(), w);
     }
     return tree;
@@ -205,11 +207,11 @@ void bind_building(py::module_& m) {
         py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
         py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
         py::arg("assign_crs") = "", py::arg("allow_geographic") = false, py::arg("grid") = "",
-        py::arg("filters") = std::vector<std::string>{},
+        py::arg("filters") = std::vector<std::string>{}, py::arg("compress_max") = false,
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
         "OpenVDB .vdb) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
-        "it (dense=, compress=). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
+        "it (dense=, compress=, compress_max=: smallest, slower to open). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
         "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
         "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"

@@ -140,7 +140,8 @@ void convert_file(const std::string& input, const std::string& output, const Con
   const Tree tree = convert(input, options, progress, report);
   WriteOptions write_options;
   write_options.layout = options.dense ? Layout::dense : Layout::sparse;
-  write_options.compress = options.compress;
+  write_options.compress = options.compress || options.compress_max;
+  write_options.mix_occupancy_models = options.compress_max;
   write(tree, output, write_options);
 }
 

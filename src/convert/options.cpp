@@ -108,6 +108,8 @@ void ConvertOptions::check() const {
     throw OptionError("assign_crs", "give the input's CRS once (`assign_crs` or `epsg`, not both)");
   if (nbits < 0 || nbits > 64) throw OptionError("nbits", std::to_string(nbits) + " is outside 0..64");
   if (dense && compress) throw OptionError("compress", "compressed files are sparse (dense and compress together)");
+  if (dense && compress_max)
+    throw OptionError("compress_max", "compressed files are sparse, not `dense`");
   for (int c : columns)
     if (c < 1) throw OptionError("columns", "column numbers count from 1");
   for (int c : payload_columns)

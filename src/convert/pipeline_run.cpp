@@ -27,7 +27,10 @@ ConvertOptions convert_options(const filters::PipelineWriter& writer, const std:
       options.depth = value.get<int>();
     } else {
       if (!value.is_boolean()) throw wrong("true or false");
-      (key == "compress" ? options.compress : key == "dense" ? options.dense : options.attributes) = value.get<bool>();
+      (key == "compress"       ? options.compress
+       : key == "compress_max" ? options.compress_max
+       : key == "dense"        ? options.dense
+                               : options.attributes) = value.get<bool>();
     }
   }
   return options;

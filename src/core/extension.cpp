@@ -24,8 +24,10 @@ constexpr std::uint64_t kRatioSlack = 1 << 20;
 // Levels record flags: the layout of the parts (each level's occupancy words, then its
 // payload words). 2: one zstd frame per part, in 16-bit lanes. 3: occupancy parts coded
 // by the context-modelled arithmetic coder (occupancy_coder.hpp), payload parts as in 2.
+// 4: as 3 with the models mixed (occupancy_mixed.hpp).
 constexpr std::uint32_t kLanes16PerPart = 2;
 constexpr std::uint32_t kCodedOccupancy = 3;
+constexpr std::uint32_t kMixedOccupancy = 4;
 
 void begin_record(ByteWriter& w, RecordTag tag, std::uint32_t flags, std::uint64_t length) {
   w.put(static_cast<std::uint32_t>(tag));
@@ -97,7 +99,7 @@ std::uint64_t ExtensionPieces::size() const noexcept {
   return bytes;
 }
 
-void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out) {
+void append_extension(const Tree& tree, bool compress_levels, int level, bool mix_occupancy, ExtensionPieces& out) {
   ByteWriter w(out.own);
   std::uint64_t borrowed_bytes = 0;  // so far: the file offset is own.size() + this
   w.put_bytes(kExtensionMagic);
@@ -166,7 +168,7 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
     }
     std::vector<std::vector<std::uint8_t>> frames;
     std::uint64_t length = 8;
-    OccupancyCoder occupancy;
+    OccupancyCoder occupancy(mix_occupancy ? OccupancyCoder::Modelling::mixed : OccupancyCoder::Modelling::contexts);
     for (std::size_t p = 0; p < parts.size(); ++p) {
       const bool is_occupancy = !tree.has_payload() || p % 2 == 0;
       if (is_occupancy)
@@ -175,7 +177,7 @@ void append_extension(const Tree& tree, bool compress_levels, int level, Extensi
         frames.push_back(zstd_compress(lanes16_from_words(parts[p]), level));
       length += 16 + frames.back().size();
     }
-    begin_record(w, RecordTag::levels, kCodedOccupancy, length);
+    begin_record(w, RecordTag::levels, mix_occupancy ? kMixedOccupancy : kCodedOccupancy, length);
     w.put(static_cast<std::uint32_t>(parts.size()));
     w.put(std::uint32_t{0});
     for (std::size_t p = 0; p < parts.size(); ++p) {
@@ -250,7 +252,7 @@ AttributeColumn decode_attribute(ByteReader& body, std::uint64_t record_offset, 
 // The zstd-compressed levels record: parts of 16-bit lanes, into out.levels.
 void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t flags, const std::string& name,
                    int depth, bool payload, ExtensionContents& out) {
-    if (flags != kLanes16PerPart && flags != kCodedOccupancy)
+    if (flags != kLanes16PerPart && flags != kCodedOccupancy && flags != kMixedOccupancy)
       body.fail_at(record_offset + 4, "compressed levels in an unknown layout (flags " + std::to_string(flags) + ")");
     const auto parts = body.get<std::uint32_t>("level part count");
     // Each coded level costs its models' memory however small its part: a file may not
@@ -279,13 +281,14 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
                 std::to_string(body.remaining()));
     // Coded occupancy: the parts alternate occupancy and payload when there is payload,
     // which only the header says; the part count tells (one part per level, or two).
-    const bool coded = flags == kCodedOccupancy;
+    const bool coded = flags == kCodedOccupancy || flags == kMixedOccupancy;
     const bool with_payload = coded && payload;
     if (with_payload && parts % 2 != 0)
       body.fail_at(record_offset + 16, "levels with payload in an odd number of parts (" + std::to_string(parts) + ")");
     out.levels.resize(raw_total / 8);
     std::size_t at = 0;
-    OccupancyCoder occupancy;
+    OccupancyCoder occupancy(flags == kMixedOccupancy ? OccupancyCoder::Modelling::mixed
+                                                      : OccupancyCoder::Modelling::contexts);
     for (std::uint32_t p = 0; p < parts; ++p) {
       const auto [raw, packed] = sizes[p];
       const std::uint64_t frame_offset = body.offset();

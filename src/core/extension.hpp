@@ -77,7 +77,8 @@ struct ExtensionPieces {
 bool needs_extension(const Tree& tree) noexcept;
 bool starts_extension(std::span<const std::uint8_t> bytes) noexcept;
 // The tree's columns must outlive `out` (their bytes are borrowed, not copied).
-void append_extension(const Tree& tree, bool compress_levels, int level, ExtensionPieces& out);
+// `mix_occupancy`: with compress_levels, the mixed occupancy coder (levels flags 4).
+void append_extension(const Tree& tree, bool compress_levels, int level, bool mix_occupancy, ExtensionPieces& out);
 // `base` = file offset of bytes[0]; `payload` = the header's nbits > 0 (compressed
 // levels then hold payload parts); `depth` = the header's, which bounds the level parts
 // (one per level, two with payload) before any is decoded. Checks every length against

@@ -61,7 +61,8 @@ Pieces assemble(const Tree& tree, const WriteOptions& options) {
     }
   }
   if (options.compress || detail::needs_extension(tree)) {
-    detail::append_extension(tree, options.compress, options.compression_level, p.extension);
+    detail::append_extension(tree, options.compress, options.compression_level, options.mix_occupancy_models,
+                             p.extension);
     h.extension = true;
   }
   encode_header(h, p.header);

@@ -5,6 +5,8 @@
 #include <bit>
 #include <type_traits>
 
+#include "occupancy_geometry.hpp"
+#include "occupancy_mixed.hpp"
 #include "range_coder.hpp"
 #include "vola/error.hpp"
 
@@ -14,44 +16,8 @@ namespace detail {
 
 namespace {
 
-// Bit of cell (x, y, z) of a block: x + 4y + 16z.
-constexpr unsigned bit_of(unsigned x, unsigned y, unsigned z) noexcept { return x + 4 * y + 16 * z; }
-
-// The cells of octant o (bit 0: upper x half, bit 1: y, bit 2: z) as a word mask.
-constexpr std::array<std::uint64_t, 8> make_octant_masks() {
-  std::array<std::uint64_t, 8> m{};
-  for (unsigned o = 0; o < 8; ++o)
-    for (unsigned c = 0; c < 8; ++c) {
-      const unsigned x = 2 * (o & 1u) + (c & 1u), y = 2 * ((o >> 1) & 1u) + ((c >> 1) & 1u),
-                     z = 2 * (o >> 2) + (c >> 2);
-      m[o] |= std::uint64_t{1} << bit_of(x, y, z);
-    }
-  return m;
-}
-constexpr auto kOctantMask = make_octant_masks();
-
-std::uint8_t octants_of(std::uint64_t word) noexcept {
-  std::uint8_t m = 0;
-  for (unsigned o = 0; o < 8; ++o)
-    if (word & kOctantMask[o]) m = static_cast<std::uint8_t>(m | (1u << o));
-  return m;
-}
-
 using Neighbours = OccupancyCoder::Neighbours;
 constexpr std::uint32_t kNoBlock = OccupancyCoder::kNoBlock;
-
-// The directions of Neighbours::block: the six faces, then the three lower edges.
-constexpr int kDirection[9][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1},
-                                  {0, 0, 1},  {-1, -1, 0}, {-1, 0, -1}, {0, -1, -1}};
-// The direction (index into kDirection, 9 = the block itself) of the block below along
-// the axes of `axes` (bit 0 x, 1 y, 2 z); 7 (all three) is never asked for.
-constexpr unsigned kLowerDirection[8] = {9, 0, 2, 6, 4, 7, 8, 9};
-// The direction index of an offset with components in {-1, 0, 1} that is one of them (or 9).
-constexpr unsigned direction_of(int dx, int dy, int dz) noexcept {
-  for (unsigned d = 0; d < 9; ++d)
-    if (kDirection[d][0] == dx && kDirection[d][1] == dy && kDirection[d][2] == dz) return d;
-  return 9;
-}
 
 constexpr std::size_t kOctantContexts = 8 * 64 * 4 * 4;
 constexpr std::size_t kCellContexts = 8 * 8 * 8 * 8 * 4 * 3;
@@ -162,7 +128,9 @@ void code_level(Coder& coder, std::span<const Neighbours> near, std::span<std::u
 
 }  // namespace
 
-OccupancyCoder::OccupancyCoder() : near_(1) { near_[0].block.fill(kNoBlock); }
+OccupancyCoder::OccupancyCoder(Modelling modelling) : modelling_(modelling), near_(1) {
+  near_[0].block.fill(kNoBlock);
+}
 
 void OccupancyCoder::advance(std::span<const std::uint64_t> words, bool last) {
   std::vector<Neighbours> next;
@@ -224,7 +192,10 @@ std::vector<std::uint8_t> OccupancyCoder::encode(std::span<const std::uint64_t> 
       coder.code(flag[0], false);
     }
     std::vector<std::uint64_t> copy(words.begin(), words.end());
-    code_level(coder, std::span<const Neighbours>(near_), std::span<std::uint64_t>(copy));
+    if (modelling_ == Modelling::mixed)
+      encode_level_mixed(coder, std::span<const Neighbours>(near_), std::span<std::uint64_t>(copy));
+    else
+      code_level(coder, std::span<const Neighbours>(near_), std::span<std::uint64_t>(copy));
   }
   coder.finish();
   advance(words, last);
@@ -247,7 +218,12 @@ void OccupancyCoder::decode(std::span<const std::uint8_t> stream, std::span<std:
     std::vector<BitModel> flag(1);
     empty_root = coder.code(flag[0]);
   }
-  if (!empty_root) code_level(coder, std::span<const Neighbours>(near_), words);
+  if (!empty_root) {
+    if (modelling_ == Modelling::mixed)
+      decode_level_mixed(coder, std::span<const Neighbours>(near_), words);
+    else
+      code_level(coder, std::span<const Neighbours>(near_), words);
+  }
   if (!coder.consumed_exactly())
     VOLA_THROW(FormatError(name, offset, "the coded occupancy level is corrupt (it does not decode to its own " +
                                              std::to_string(stream.size()) + " bytes)"));

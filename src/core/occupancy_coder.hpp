@@ -31,7 +31,11 @@ namespace detail {
 
 class OccupancyCoder {
  public:
-  OccupancyCoder();  // before level 0: one block, at (0, 0, 0)
+  // How the bits are modelled: one context per bit (levels flags 3), or several contexts
+  // mixed (flags 4, occupancy_mixed.hpp: smaller, slower).
+  enum class Modelling { contexts, mixed };
+
+  explicit OccupancyCoder(Modelling modelling = Modelling::contexts);  // before level 0: one block, at (0, 0, 0)
 
   // Blocks (words) of the next level.
   std::uint64_t blocks() const noexcept { return near_.size(); }
@@ -55,6 +59,7 @@ class OccupancyCoder {
  private:
   void advance(std::span<const std::uint64_t> words, bool last);
 
+  Modelling modelling_;
   std::vector<Neighbours> near_;  // of the next level's blocks, in file order
 };
 

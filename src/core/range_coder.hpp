@@ -18,16 +18,17 @@ namespace detail {
 
 // The probability that the next bit is 0, in 1/65536, and how often it was updated: the
 // first updates move it fast (1/2, 1/4, ... of the way to the bit seen), later ones by
-// 1/32. Kept within [32, 65504], so that no bit costs more than 11 bits or less than
+// 1/32 (or 1/2^kMaxShift, for models that must follow faster). Kept within [32, 65504], so that no bit costs more than 11 bits or less than
 // 1/1400 bit: a stream cannot claim more than ~1400 raw bits per stored bit, which keeps
 // the "8192 raw bytes per stored byte" rule of compressed records sound.
 struct BitModel {
   std::uint16_t p = 32768;
   std::uint8_t seen = 0;
 
+  template <unsigned kMaxShift = 5>
   void update(bool bit) noexcept {
     static constexpr std::uint8_t kShift[16] = {1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5};
-    const unsigned shift = kShift[seen];
+    const unsigned shift = kShift[seen] < kMaxShift ? kShift[seen] : kMaxShift;
     if (seen < 15) ++seen;
     // Both moves, then a select: the bit is as unpredictable as the data.
     const int q = p;
@@ -42,14 +43,19 @@ class RangeEncoder {
   explicit RangeEncoder(std::vector<std::uint8_t>& out) : out_(out) {}
   // Encodes `bit` and returns it (so that one templated coding routine serves both ways).
   bool code(BitModel& m, bool bit) {
-    const std::uint32_t bound = (range_ >> 16) * m.p;
+    code_with(m.p, bit);
+    m.update(bit);
+    return bit;
+  }
+  // Encodes `bit` with probability `p0` (of a 0, in 1/65536, within [32, 65504]).
+  bool code_with(std::uint32_t p0, bool bit) {
+    const std::uint32_t bound = (range_ >> 16) * p0;
     if (!bit) {
       range_ = bound;
     } else {
       low_ += bound;
       range_ -= bound;
     }
-    m.update(bit);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       shift_low();
@@ -89,12 +95,17 @@ class RangeDecoder {
   }
   // Decodes a bit; the argument is ignored (see RangeEncoder::code).
   bool code(BitModel& m, bool = false) {
-    const std::uint32_t bound = (range_ >> 16) * m.p;
+    const bool bit = code_with(m.p);
+    m.update(bit);
+    return bit;
+  }
+  // Decodes a bit of probability `p0` (see RangeEncoder::code_with).
+  bool code_with(std::uint32_t p0, bool = false) {
+    const std::uint32_t bound = (range_ >> 16) * p0;
     const bool bit = code_ >= bound;
     // Selects rather than branches, as in update().
     code_ = bit ? code_ - bound : code_;
     range_ = bit ? range_ - bound : bound;
-    m.update(bit);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       code_ = (code_ << 8) | next();

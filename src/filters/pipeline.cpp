@@ -168,7 +168,7 @@ void read_stage(const json& element, std::size_t index, Pipeline& pipeline) {
     PipelineWriter writer;
     writer.filename = stage.text("filename");
     if (type == "writers.vola" || writer.voxels()) {
-      stage.only({"filename", "voxel_size", "depth", "compress", "dense", "attributes"});
+      stage.only({"filename", "voxel_size", "depth", "compress", "compress_max", "dense", "attributes"});
       for (const auto& [key, value] : element.items())
         if (key != "type" && key != "tag" && key != "filename") writer.options[key] = value.dump();
     } else if (type == "writers.las" || type == "writers.ply" || type == "writers.text") {
