@@ -32,6 +32,16 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
+// How a compressed file's levels are coded (the levels record's flags).
+std::string level_coding(const FileLayout& layout) {
+  switch (layout.compressed_level_layout) {
+    case 2: return "zstd";
+    case 3: return "occupancy context-coded";
+    case 4: return "occupancy coded by mixed models";
+    default: return "levels layout " + std::to_string(layout.compressed_level_layout);
+  }
+}
+
 // The CRS as PROJ names it, from the file's WKT or its header code; nothing for a file
 // with neither (header code 2000 is the reference's placeholder, not Anguilla's grid).
 struct NamedCrs {
@@ -114,9 +124,11 @@ void run_info(const InfoArgs& a) {
       std::printf(",\n  \"state_map\": {\"occupied\": %llu, \"free\": %llu, \"unknown_in_bounds\": %llu}",
                   static_cast<unsigned long long>(states->occupied), static_cast<unsigned long long>(states->free),
                   static_cast<unsigned long long>(states->unknown_in_bounds));
-    std::printf(",\n  \"compressed\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
+    std::printf(",\n  \"compressed\": %s,\n  \"level_coding\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
                 "  \"crs_named\": %s\n}\n",
-                layout.compressed_levels ? "true" : "false", static_cast<unsigned long long>(layout.extension_bytes),
+                layout.compressed_levels ? "true" : "false",
+                layout.compressed_levels ? quoted(level_coding(layout)).c_str() : "null",
+                static_cast<unsigned long long>(layout.extension_bytes),
                 quoted(tree.georef().crs_wkt).c_str(), json_crs(crs).c_str());
     return;
   }
@@ -149,9 +161,10 @@ void run_info(const InfoArgs& a) {
                 static_cast<unsigned long long>(8 * blocks * (h.nbits ? 2 : 1)));
   }
   std::printf("level bytes: %llu%s\n", static_cast<unsigned long long>(layout.level_bytes),
-              layout.compressed_levels
-                  ? (" (compressed: " + std::to_string(layout.compressed_level_bytes) + " bytes in the file)").c_str()
-                  : "");
+              layout.compressed_levels ? (" (compressed: " + std::to_string(layout.compressed_level_bytes) +
+                                          " bytes in the file, " + level_coding(layout) + ")")
+                                             .c_str()
+                                       : "");
   if (layout.extension_bytes) {
     std::printf("extension:   %llu bytes, version %u\n", static_cast<unsigned long long>(layout.extension_bytes),
                 layout.extension_version);

@@ -48,6 +48,9 @@ struct FileLayout {
   std::uint32_t extension_version = 0;
   bool compressed_levels = false;
   std::uint64_t compressed_level_bytes = 0;
+  // How: 2 zstd of 16-bit lanes, 3 occupancy coded with one context per bit (--compress),
+  // 4 with mixed models (--compress-max); docs/FILE_FORMAT.md, levels record.
+  std::uint32_t compressed_level_layout = 0;
 };
 
 struct WriteOptions {

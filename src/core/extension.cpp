@@ -306,6 +306,7 @@ void decode_levels(ByteReader& body, std::uint64_t record_offset, std::uint32_t 
     }
   out.has_levels = true;
   out.compressed_level_bytes = packed_total;
+  out.level_layout = flags;
 }
 
 }  // namespace

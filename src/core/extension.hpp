@@ -49,6 +49,7 @@ struct ExtensionContents {
   bool has_levels = false;
   std::vector<std::uint64_t> levels;  // decompressed level words (version-2 files)
   std::uint64_t compressed_level_bytes = 0;
+  std::uint32_t level_layout = 0;  // the levels record's flags: 2, 3 or 4
 };
 
 // The extension as the writer emits it: the bytes it builds itself, with the attribute

@@ -140,6 +140,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     tree = Tree::from_levels(h.depth, payload, std::move(ext.levels), name + " (compressed levels)");
     info.compressed_levels = true;
     info.compressed_level_bytes = ext.compressed_level_bytes;
+    info.compressed_level_layout = ext.level_layout;
     info.level_bytes = 8 * tree.words().size();
     info.extension_offset = kHeaderSize;
     info.extension_bytes = bytes.size() - kHeaderSize;

@@ -79,6 +79,11 @@ std::vector<Seed> synthetic_seeds() {
     seeds.push_back({"compressed", vola::serialize(vola::build(cloud, {.depth = 4}), {.compress = true})});
     seeds.push_back({"compressed_attributes", vola::serialize(attribute_tree, {.compress = true})});
     seeds.push_back({"compressed_payload", vola::serialize(payload_tree, {.compress = true})});
+    // The occupancy coded by mixed models (levels flags 4, --compress-max).
+    seeds.push_back({"compressed_mixed", vola::serialize(vola::build(cloud, {.depth = 4}),
+                                                         {.compress = true, .mix_occupancy_models = true})});
+    seeds.push_back({"compressed_mixed_payload",
+                     vola::serialize(payload_tree, {.compress = true, .mix_occupancy_models = true})});
     // Heights in centimetres (quantized floats, attribute encoding 3), a smooth integer
     // column (delta planes, encoding 2) and one that follows it (delta planes against it,
     // encoding 4).

@@ -43,6 +43,10 @@ for size in 1 2 4; do
     fail "$size ft: the --compress-max file reads other voxels or values"
   "$vola" voxels "$tmp/max_occupancy$size.vol" | cmp -s - <("$vola" voxels "$tmp/plain$size.vol") ||
     fail "$size ft: the --compress-max occupancy reads other voxels"
+  "$vola" info "$tmp/max_occupancy$size.vol" | grep -q "occupancy coded by mixed models" ||
+    fail "$size ft: vola info does not say the levels are coded by mixed models"
+  "$vola" info --json "$tmp/occupancy$size.vol" | grep -q '"level_coding": "occupancy context-coded"' ||
+    fail "$size ft: vola info --json does not give the level coding"
   (( $(stat -c %s "$tmp/max_occupancy$size.vol") < $(stat -c %s "$tmp/occupancy$size.vol") )) ||
     fail "$size ft: --compress-max is not smaller than --compress"
 done
