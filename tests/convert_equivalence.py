@@ -67,6 +67,7 @@ SPECIFIC_CASES = [
     ("data/dem/pdal_gdal_int16_epsg26711.tif", {"voxel_size": 60.0, "dem_surface_only": True}),
     ("data/dem/pysheds_dem_int16_tiled_epsg4326.tif", {"voxel_size": 0.005, "allow_geographic": True}),
     ("data/bench/surface_points_1e6.npy", {"quantize": "toolkit", "depth": 5, "compress": True}),
+    ("data/las/pdal_autzen_trim.las", {"voxel_size": 3.0, "attributes": False, "compress_max": True}),
     ("golden/d2_sparse_n1/input.txt", {"quantize": "toolkit", "depth": 2, "nbits": 1}),
     ("golden/d2_dense_n1/input.txt", {"quantize": "toolkit", "depth": 2, "nbits": 1, "dense": True}),
     ("golden/d2_sparse_n1/input.txt",

@@ -99,7 +99,8 @@ VOLA_C_API void vola_tree_free(vola_tree *tree);
 typedef enum vola_write_flags {
   VOLA_WRITE_SPARSE = 0,
   VOLA_WRITE_DENSE = 1,     /* the reference's dense layout (depth <= 5) */
-  VOLA_WRITE_COMPRESS = 2   /* zstd-compressed levels (vola's version-2 files; sparse only) */
+  VOLA_WRITE_COMPRESS = 2,  /* zstd-compressed levels (vola's version-2 files; sparse only) */
+  VOLA_WRITE_COMPRESS_MAX = 4 /* as COMPRESS, the occupancy coded by mixed models: smaller, slower to open */
 } vola_write_flags;
 
 /* flags: a vola_write_flags value. Writes through a temporary file and a rename. */

@@ -140,12 +140,14 @@ vola_status vola_write(const vola_tree* tree, const char* path, int flags) {
   return guarded([&] {
     const vola::Tree& t = tree_of(tree);
     require(path != nullptr, "vola_write: path is NULL");
-    require((flags & ~(VOLA_WRITE_DENSE | VOLA_WRITE_COMPRESS)) == 0, "vola_write: unknown flags");
-    require(!((flags & VOLA_WRITE_DENSE) && (flags & VOLA_WRITE_COMPRESS)),
+    require((flags & ~(VOLA_WRITE_DENSE | VOLA_WRITE_COMPRESS | VOLA_WRITE_COMPRESS_MAX)) == 0,
+            "vola_write: unknown flags");
+    require(!((flags & VOLA_WRITE_DENSE) && (flags & (VOLA_WRITE_COMPRESS | VOLA_WRITE_COMPRESS_MAX))),
             "vola_write: compressed files are sparse (VOLA_WRITE_DENSE and VOLA_WRITE_COMPRESS together)");
     vola::WriteOptions options;
     options.layout = (flags & VOLA_WRITE_DENSE) ? vola::Layout::dense : vola::Layout::sparse;
-    options.compress = (flags & VOLA_WRITE_COMPRESS) != 0;
+    options.compress = (flags & (VOLA_WRITE_COMPRESS | VOLA_WRITE_COMPRESS_MAX)) != 0;
+    options.mix_occupancy_models = (flags & VOLA_WRITE_COMPRESS_MAX) != 0;
     vola::write(t, path, options);
   });
 }

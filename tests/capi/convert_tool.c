@@ -102,6 +102,8 @@ int main(int argc, char **argv) {
       if (atoi(value)) options.write_flags |= VOLA_WRITE_DENSE;
     } else if (strcmp(key, "compress") == 0) {
       if (atoi(value)) options.write_flags |= VOLA_WRITE_COMPRESS;
+    } else if (strcmp(key, "compress_max") == 0) {
+      if (atoi(value)) options.write_flags |= VOLA_WRITE_COMPRESS_MAX;
     } else {
       fprintf(stderr, "convert_tool: unknown option '%s'\n", key);
       return 2;

@@ -177,10 +177,11 @@ static void test_build_query_iterate(const char *scratch) {
     CHECK(lod_ok);
   }
 
-  /* Files: sparse, dense and compressed, read and mapped, all give the same voxels. */
+  /* Files: sparse, dense, compressed and compressed with mixed occupancy models, read and
+     mapped, all give the same voxels. */
   char path[4096];
-  const int flags[3] = {VOLA_WRITE_SPARSE, VOLA_WRITE_DENSE, VOLA_WRITE_COMPRESS};
-  for (int f = 0; f < 3; ++f) {
+  const int flags[4] = {VOLA_WRITE_SPARSE, VOLA_WRITE_DENSE, VOLA_WRITE_COMPRESS, VOLA_WRITE_COMPRESS_MAX};
+  for (int f = 0; f < 4; ++f) {
     snprintf(path, sizeof path, "%s/capi_%d.vol", scratch, f);
     CHECK_OK(vola_write(tree, path, flags[f]));
     for (int mode = 0; mode < 2; ++mode) {
@@ -298,6 +299,7 @@ static void test_errors(const char *scratch) {
   CHECK(vola_level_of_detail(tree, 3, &lod) == VOLA_ERROR_INVALID_ARGUMENT && lod == NULL);
   CHECK(vola_level_of_detail(tree, 0, &lod) == VOLA_ERROR_INVALID_ARGUMENT);
   CHECK(vola_write(tree, path, VOLA_WRITE_DENSE | VOLA_WRITE_COMPRESS) == VOLA_ERROR_INVALID_ARGUMENT);
+  CHECK(vola_write(tree, path, VOLA_WRITE_DENSE | VOLA_WRITE_COMPRESS_MAX) == VOLA_ERROR_INVALID_ARGUMENT);
   CHECK(vola_write(tree, path, 64) == VOLA_ERROR_INVALID_ARGUMENT);
   snprintf(path, sizeof path, "%s/no_such_dir/out.vol", scratch);
   CHECK(vola_write(tree, path, VOLA_WRITE_SPARSE) == VOLA_ERROR_IO);
