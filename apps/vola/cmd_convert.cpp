@@ -152,7 +152,8 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the file's first)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
-  cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1")->expected(3)->capture_default_str();
+  cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1 (default: found by name in a header line such as "
+                  "'x,y,z,intensity', which also keeps the other columns as attributes; else 1 2 3)")->expected(3)->capture_default_str();
   cmd->add_option("--payload-columns", args->options.payload_columns,
                   "Text with --nbits 1: columns holding payload bytes 0..7 (default: every column after x y z)");
   cmd->add_option("--attribute", args->options.text_attributes,
