@@ -76,14 +76,19 @@ class Mixer {
     return static_cast<int>(d > 2047 ? 2047 : (d < -2047 ? -2047 : d));
   }
   // Moves the weights along the gradient of the coding cost of `bit` (p1: the mixed
-  // probability in 1/4096). Learning rate ~0.003 in nats.
+  // probability in 1/4096). Learning rate ~0.003 in nats. Weights stay within +-64: far
+  // beyond what data drives them to, and no stream, however long, can overflow them.
   void update(bool bit, int p1) noexcept {
     const int error = ((bit ? 1 : 0) << 12) - p1;
-    for (int k = 0; k < K; ++k) weights_[set_][k] += (logits_[k] * error * 3) >> 14;
+    for (int k = 0; k < K; ++k) {
+      const int moved = weights_[set_][k] + ((logits_[k] * error * 3) >> 14);
+      weights_[set_][k] = moved > kWeightLimit ? kWeightLimit : (moved < -kWeightLimit ? -kWeightLimit : moved);
+    }
   }
 
  private:
   static constexpr int kInitialWeight = 13107;  // 0.2 in 16.16
+  static constexpr int kWeightLimit = 64 << 16;
   std::array<std::array<int, K>, Sets> weights_;
   std::array<int, K> logits_{};
   unsigned set_ = 0;
