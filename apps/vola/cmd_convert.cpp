@@ -164,7 +164,7 @@ void add_convert(CLI::App& app) {
   cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");
   cmd->add_flag("--compress-max", args->options.compress_max,
                 "as --compress, with several context models mixed for every occupancy bit: about a tenth "
-                "smaller levels, several times slower to open (for archives and transfer)");
+                "smaller levels, 2-6x slower to open (for archives and transfer)");
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");
