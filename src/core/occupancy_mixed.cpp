@@ -240,7 +240,7 @@ void code_cells(Coder& coder, std::span<const Neighbours> near, std::span<std::u
 }
 
 template <class Coder>
-void code_level(Coder& coder, std::span<const Neighbours> near, std::span<std::uint64_t> words) {
+void code_mixed_level(Coder& coder, std::span<const Neighbours> near, std::span<std::uint64_t> words) {
   std::vector<std::uint8_t> octants(near.size(), 0);
   code_octants(coder, near, words, octants);
   code_cells(coder, near, words, octants);
@@ -249,11 +249,11 @@ void code_level(Coder& coder, std::span<const Neighbours> near, std::span<std::u
 }  // namespace
 
 void encode_level_mixed(RangeEncoder& coder, std::span<const Neighbours> near, std::span<std::uint64_t> words) {
-  code_level(coder, near, words);
+  code_mixed_level(coder, near, words);
 }
 
 void decode_level_mixed(RangeDecoder& coder, std::span<const Neighbours> near, std::span<std::uint64_t> words) {
-  code_level(coder, near, words);
+  code_mixed_level(coder, near, words);
 }
 
 }  // namespace detail
