@@ -83,11 +83,7 @@ void run_convert(ConvertArgs& a) {
   progress.finish();
   for (const auto& warning : report.warnings)  // shown with -q too: they are about the result
     std::fprintf(stderr, "vola: warning: %s\n", with_flags(warning).c_str());
-  WriteOptions w;
-  w.layout = options.dense ? Layout::dense : Layout::sparse;
-  w.compress = options.compress || options.compress_max;
-  w.mix_occupancy_models = options.compress_max;
-  write(tree, a.output, w);
+  write(tree, a.output, write_options_of(options));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!a.quiet) print_summary(a, tree, report, seconds);
 }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/file.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -116,6 +117,10 @@ using ConvertProgress = std::function<void(std::uint64_t done, std::uint64_t tot
 // formats that can stream (LAS) are read in chunks, so memory follows voxels, not points.
 Tree convert(const std::string& input, const ConvertOptions& options, const ConvertProgress& progress = {},
              ConvertReport* report = nullptr);
+
+// How convert_file writes: the options' dense, compress and compress_max (every front end
+// that writes a converted tree itself takes its WriteOptions from here).
+WriteOptions write_options_of(const ConvertOptions& options);
 
 // convert(), then write the tree to `output` as the options say (dense, compress).
 void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,

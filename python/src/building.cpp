@@ -150,11 +150,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   return with_python_names([&] {
     Tree tree = vola::convert(path.string(), options);
     if (output) {
-      vola::WriteOptions w;
-      w.layout = dense ? vola::Layout::dense : vola::Layout::sparse;
-      w.compress = compress || compress_max;
-      w.mix_occupancy_models = compress_max;
-      vola::write(tree, output->string(), w);
+      vola::write(tree, output->string(), vola::write_options_of(options));
     }
     return tree;
   });

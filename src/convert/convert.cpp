@@ -134,14 +134,19 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   return tree;
 }
 
+WriteOptions write_options_of(const ConvertOptions& options) {
+  WriteOptions w;
+  w.layout = options.dense ? Layout::dense : Layout::sparse;
+  w.compress = options.compress || options.compress_max;
+  w.mix_occupancy_models = options.compress_max;
+  return w;
+}
+
 void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,
                   const ConvertProgress& progress, ConvertReport* report) {
   options.check();
   const Tree tree = convert(input, options, progress, report);
-  WriteOptions write_options;
-  write_options.layout = options.dense ? Layout::dense : Layout::sparse;
-  write_options.compress = options.compress || options.compress_max;
-  write_options.mix_occupancy_models = options.compress_max;
+  const WriteOptions write_options = write_options_of(options);
   write(tree, output, write_options);
 }
 
