@@ -74,7 +74,9 @@ TEST(LazDecode, CoordinatesAloneAreTheWholeDecodesCoordinates) {
       others_differ = others_differ || std::memcmp(coordinates.data() + i * n, whole.data() + i * n, n) != 0;
     }
     // The layers were skipped (a file whose other fields never change would not show it).
-    if (file.point_count > 100) EXPECT_TRUE(others_differ);
+    if (file.point_count > 100) {
+      EXPECT_TRUE(others_differ);
+    }
   }
   EXPECT_GE(layered, 3u);  // formats 6, 7 and 8 among the shared files
 }
