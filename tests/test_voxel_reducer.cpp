@@ -28,7 +28,7 @@ vola::PointCloud random_cloud(std::uint64_t seed, std::size_t n) {
       {vola::ValueType::u8, vola::Reduction::last},      {vola::ValueType::u8, vola::Reduction::majority},
       {vola::ValueType::f64, vola::Reduction::majority}, {vola::ValueType::f64, vola::Reduction::max}};
   for (std::size_t c = 0; c < columns.size(); ++c)
-    cloud.attributes.push_back({"a" + std::to_string(c), columns[c].first, columns[c].second, {}});
+    cloud.attributes.push_back({std::string("a").append(std::to_string(c)), columns[c].first, columns[c].second, {}});
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
     const bool nan = rng() % 7 == 0;
@@ -281,7 +281,7 @@ vola::PointCloud narrow_cloud(std::size_t n, std::uint64_t seed, double value_hi
       {vola::ValueType::u16, vola::Reduction::last},     {vola::ValueType::u8, vola::Reduction::majority},
       {vola::ValueType::u16, vola::Reduction::majority}, {vola::ValueType::i32, vola::Reduction::mean}};
   for (std::size_t c = 0; c < columns.size(); ++c)
-    cloud.attributes.push_back({"n" + std::to_string(c), columns[c].first, columns[c].second, {}});
+    cloud.attributes.push_back({std::string("n").append(std::to_string(c)), columns[c].first, columns[c].second, {}});
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
     for (auto& a : cloud.attributes) {

@@ -47,10 +47,11 @@ std::vector<Seed> golden_seeds(const std::filesystem::path& golden) {
     int k = 0;
     for (auto it = std::sregex_iterator(classes.begin(), classes.end(), class_re); it != std::sregex_iterator(); ++it, ++k) {
       const double c = 0.1 + 0.08 * (k % 10);
-      const std::string value = k % 2 ? "[" + std::to_string(c) + "," + std::to_string(c) + ",0.5,0.5," +
-                                            std::to_string(c / 2) + ",0]"
-                                      : std::to_string(c);
-      materials += (materials.empty() ? "" : ", ") + ("\"" + (*it)[1].str() + "\": " + value);
+      // Appended piece by piece: GCC 12 misreads `"literal" + std::string` (-Wrestrict).
+      std::string value = std::to_string(c);
+      if (k % 2) value = std::string("[") + value + "," + value + ",0.5,0.5," + std::to_string(c / 2) + ",0]";
+      if (!materials.empty()) materials += ", ";
+      materials.append("\"").append((*it)[1].str()).append("\": ").append(value);
     }
     seeds.push_back(text("classes_" + m[1].str() + ".json",
                          "{\"attribute\": \"classification\", \"default\": 0.3, \"materials\": {" + materials + "}}"));
