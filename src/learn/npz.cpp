@@ -142,7 +142,10 @@ LabelledGrids read_labelled_grids(const std::string& path, const std::string& sp
 
   if (x.shape.size() != 4 || x.shape[1] != x.shape[2] || x.shape[2] != x.shape[3] || x.shape[1] < 4 || x.shape[1] > 256) {
     std::string shape;
-    for (auto s : x.shape) shape += (shape.empty() ? "" : ",") + std::to_string(s);
+    for (auto s : x.shape) {
+      if (!shape.empty()) shape += ',';
+      shape += std::to_string(s);
+    }
     throw FormatError(x_where, std::nullopt, "shape (" + shape + "): expected (N, S, S, S) grids with 4 <= S <= 256");
   }
   if (x.kind != 'u' && x.kind != 'i' && x.kind != 'b' && x.kind != 'f')

@@ -91,7 +91,7 @@ std::string spill_folder_name(int rank) {
 }
 
 void remove_stale_spill(const fs::path& spill_root) {
-  const std::string mine = "-" + host_name() + "-";
+  const std::string mine = std::string("-").append(host_name()).append("-");
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(spill_root, ec)) {
     const std::string name = entry.path().filename().string();

@@ -147,7 +147,7 @@ std::vector<OverviewEntry> build_overviews(
     for (const Node& n : level) parents[parent_of(n.tile)].push_back(&n);
     std::vector<TileIndex> order;
     for (const auto& [p, children] : parents) order.push_back(p);
-    const fs::path folder = fs::path("overviews") / ("L" + std::to_string(L));
+    const fs::path folder = fs::path("overviews") / std::string("L").append(std::to_string(L));
     fs::create_directories(fs::path(c.output_dir) / folder);
     const double scale = static_cast<double>(std::uint64_t{1} << (2 * L));  // 4^L
     std::vector<std::uint64_t> voxels(order.size(), 0);
