@@ -156,38 +156,78 @@ TEST(BuildToolkit, VoxelCentresQuantizeBackToTheirVoxel) {
   }
 }
 
-TEST(BuildGrid, VoxelsAreFloorOfOffsetOverSizeAndOutsidePointsAreDropped) {
+TEST(BuildGrid, VoxelsAreFloorOfOffsetOverSize) {
   std::mt19937_64 rng(7);
   const vola::Point origin{-100.0, 50.0, 0.0};
   const double size = 0.25;
-  const int depth = 5;  // 1024 voxels of 0.25 per axis
-  std::uniform_real_distribution<double> coordinate(-400.0, 400.0);
+  const int depth = 5;  // 1024 voxels of 0.25 per axis: 256 units from the origin
   std::vector<vola::Point> points;
-  for (int i = 0; i < 5000; ++i) points.push_back({coordinate(rng), coordinate(rng), coordinate(rng)});
+  for (int i = 0; i < 5000; ++i) {
+    vola::Point p;
+    for (int a = 0; a < 3; ++a) p[a] = origin[a] + std::uniform_real_distribution<double>(0.0, 255.99)(rng);
+    points.push_back(p);
+  }
   vola::BuildReport report;
   const vola::Tree tree =
       vola::build(cloud_of(points),
                   {.quantization = vola::Quantization::grid, .depth = depth, .voxel_size = size, .origin = origin},
                   &report);
   XyzSet expected;
-  std::uint64_t outside = 0;
-  const double side = vola::side_of(depth);
   for (const auto& p : points) {
     Xyz v;
-    bool in = true;
-    for (int a = 0; a < 3; ++a) {
-      const double c = std::floor((p[a] - origin[a]) / size);
-      in = in && c >= 0 && c < side;
-      v[a] = in ? static_cast<std::uint32_t>(c) : 0;
-    }
-    if (in) expected.insert(v);
-    else ++outside;
+    for (int a = 0; a < 3; ++a) v[a] = static_cast<std::uint32_t>(std::floor((p[a] - origin[a]) / size));
+    expected.insert(v);
   }
   EXPECT_EQ(voxel_set(tree), expected);
-  EXPECT_EQ(report.points_outside, outside);
-  EXPECT_GT(outside, 0u);  // the cloud is larger than the grid on purpose
+  EXPECT_EQ(report.points_outside, 0u);
   ASSERT_TRUE(tree.stored_frame().has_value());
   EXPECT_EQ(*tree.stored_frame(), (vola::Frame{vola::Quantization::grid, origin, size}));
+}
+
+// A grid the options fix must hold the points: what lies outside it would be dropped
+// without a word (a user's --voxel-size with a --depth too small dropped 27% of a survey).
+TEST(BuildGrid, AGridThatDoesNotHoldThePointsIsRefused) {
+  const std::vector<vola::Point> points = {{0.5, 0.5, 0.5}, {300.0, 10.0, 10.0}};
+  const auto message_of = [&](const vola::BuildOptions& options) {
+    try {
+      vola::build(cloud_of(points), options);
+    } catch (const vola::OptionError& e) {
+      return std::string(e.option()) + ": " + e.what();
+    }
+    return std::string("no error");
+  };
+  // 256 voxels of 1 from the origin; the points reach 300 along x; depth 5 holds them.
+  const std::string deep = message_of({.quantization = vola::Quantization::grid, .depth = 4, .voxel_size = 1.0});
+  EXPECT_NE(deep.find("depth"), std::string::npos) << deep;
+  EXPECT_NE(deep.find("reaches 300 along x"), std::string::npos) << deep;
+  EXPECT_NE(deep.find("depth 5 holds it"), std::string::npos) << deep;
+  const std::string high = message_of(
+      {.quantization = vola::Quantization::grid, .voxel_size = 1.0, .origin = vola::Point{0.0, 1.0, 0.0}});
+  EXPECT_NE(high.find("origin"), std::string::npos) << high;
+  EXPECT_NE(high.find("y = 1 lies above the minimum 0.5"), std::string::npos) << high;
+  // Without a depth the smallest grid that holds them is chosen, and a bbox the grid
+  // holds crops as before.
+  EXPECT_EQ(vola::build(cloud_of(points), {.quantization = vola::Quantization::grid, .voxel_size = 1.0}).depth(), 5);
+  vola::BuildReport report;
+  const vola::Tree cropped =
+      vola::build(cloud_of(points),
+                  {.quantization = vola::Quantization::grid, .depth = 2, .voxel_size = 1.0,
+                   .origin = vola::Point{0.0, 0.0, 0.0}, .bbox = vola::Box{{0, 0, 0}, {15, 15, 15}}},
+                  &report);
+  EXPECT_EQ(cropped.voxel_count(), 1u);
+  EXPECT_EQ(report.points_outside, 1u);
+}
+
+// The snapped default origin may not round above the points' minimum (the minimum's
+// points were dropped: 470692.44 / 0.01 floors to 47069244, times 0.01 is 470692.44000000006).
+TEST(BuildGrid, DefaultOriginNeverRoundsAboveTheMinimum) {
+  const std::vector<vola::Point> points = {{470692.44, 10.0, 10.0}, {470692.5, 10.0, 10.0}};
+  vola::BuildReport report;
+  const vola::Tree tree = vola::build(cloud_of(points), {.quantization = vola::Quantization::grid, .voxel_size = 0.01},
+                                      &report);
+  EXPECT_EQ(report.points_outside, 0u);
+  EXPECT_EQ(tree.voxel_count(), 2u);
+  EXPECT_LE(tree.stored_frame()->origin[0], 470692.44);
 }
 
 TEST(BuildGrid, DefaultOriginSnapsToTheVoxelSizeAndDepthCoversTheCloud) {

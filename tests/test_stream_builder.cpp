@@ -50,7 +50,8 @@ TEST_P(StreamBuilderEqualsBuild, ForRandomChunks) {
     vola::BuildOptions options;
     options.quantization = mode;
     options.depth = 1 + static_cast<int>(seed % 4);  // coarse grids: many points per voxel
-    options.voxel_size = mode == vola::Quantization::grid ? 2.5 : 0.0;
+    // A grid that holds the points (-5..45): 80 units a side.
+    options.voxel_size = mode == vola::Quantization::grid ? 80.0 / vola::side_of(options.depth) : 0.0;
     options.payload = true;
     const vola::Tree expected = vola::build(p.cloud, options);
 

@@ -41,7 +41,9 @@ struct PointCloud {
 
 struct BuildOptions {
   Quantization quantization = Quantization::toolkit;
-  // Toolkit: required. Grid: 0 = the smallest depth that covers the points.
+  // Toolkit: required. Grid: 0 = the smallest depth that covers the points. A grid the
+  // options fix (depth, origin) must hold the bbox (the points' bounds by default), else
+  // OptionError: the points outside it would be dropped. A bbox crops.
   int depth = 0;
   // Grid: the voxel edge; 0 = derived from the depth so that the bbox fits.
   double voxel_size = 0.0;

@@ -4,8 +4,10 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
+#include <string>
 
 #include "vola/error.hpp"
 #include "emit.hpp"
@@ -245,6 +247,52 @@ void BuildOptions::check() const {
   }
 }
 
+namespace {
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+
+// A grid the options fix (an origin, a depth) must hold the box it quantizes against:
+// the points beyond it would otherwise be dropped without a word. A box with no finite
+// extent (no finite points) is left to the build, which says there are none.
+void check_grid_holds(const Quantizer& quantizer, const Box& box) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::isfinite(box.min[a]) && std::isfinite(box.max[a]) && box.min[a] <= box.max[a])) return;
+  const Frame frame = quantizer.frame();
+  // The streaming LAS path passes the points' own bounds as the bbox, so both are named.
+  const std::string what = "the data (the points' bounds, or the bbox given)";
+  static constexpr char kAxis[] = "xyz";
+  for (int a = 0; a < 3; ++a)
+    if (box.min[a] < frame.origin[a])
+      VOLA_THROW(OptionError("origin", std::string(1, kAxis[a]) + " = " + number_text(frame.origin[a]) +
+                                           " lies above the minimum " + number_text(box.min[a]) + " of " + what +
+                                           ": what lies below it would be dropped; give a lower origin or leave "
+                                           "it out (the minimum snapped to the voxel size)"));
+  const double side = static_cast<double>(side_of(quantizer.depth()));
+  for (int a = 0; a < 3; ++a) {
+    const double cells = std::floor((box.max[a] - frame.origin[a]) / frame.voxel_size);
+    if (cells < side) continue;
+    const double reach = box.max[a] - frame.origin[a];
+    std::string needed = "; no depth up to 10 holds it at this voxel size";
+    for (int d = quantizer.depth() + 1; d <= kMaxDepth; ++d)
+      if (std::floor(reach / frame.voxel_size) < static_cast<double>(side_of(d))) {
+        needed = "; depth " + std::to_string(d) + " holds it";
+        break;
+      }
+    VOLA_THROW(OptionError("depth", std::to_string(quantizer.depth()) + " makes a grid of " +
+                                        number_text(side) + " voxels of " + number_text(frame.voxel_size) +
+                                        " a side, " + number_text(side * frame.voxel_size) + " from the origin, but " +
+                                        what + " reaches " + number_text(reach) + " along " + kAxis[a] + needed +
+                                        ": give a larger depth, leave it out (the smallest grid that holds "
+                                        "it), or crop with a bbox inside the grid"));
+  }
+}
+
+}  // namespace
+
 Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   options.check();
   if (options.quantization == Quantization::toolkit) return Quantizer::toolkit(bbox, options.depth);
@@ -261,7 +309,12 @@ Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   }
   if (!origin) {
     Point o;
-    for (int a = 0; a < 3; ++a) o[a] = std::floor(bbox.min[a] / voxel_size) * voxel_size;
+    for (int a = 0; a < 3; ++a) {
+      const double cells = std::floor(bbox.min[a] / voxel_size);
+      o[a] = cells * voxel_size;
+      // cells x size can round above the minimum (470692.44 at 0.01): a voxel lower.
+      if (o[a] > bbox.min[a]) o[a] = (cells - 1.0) * voxel_size;
+    }
     origin = o;
   }
   int depth = options.depth;
@@ -269,8 +322,12 @@ Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
     double extent = 0.0;
     for (int a = 0; a < 3; ++a) extent = std::max(extent, bbox.max[a] - (*origin)[a]);
     depth = depth_for_extent(extent, voxel_size);
+    // The division's rounding must not put the farthest point one voxel past the side.
+    while (depth < kMaxDepth && std::floor(extent / voxel_size) >= static_cast<double>(side_of(depth))) ++depth;
   }
-  return Quantizer::grid(*origin, voxel_size, depth);
+  const Quantizer quantizer = Quantizer::grid(*origin, voxel_size, depth);
+  check_grid_holds(quantizer, bbox);
+  return quantizer;
 }
 
 Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* report) {
