@@ -35,4 +35,19 @@ expect_refusal "'abc' is not a number" convert "$tmp/two.xyz" "$tmp/o.vol" --vox
 "$vola" convert "$tmp/two.xyz" "$tmp/ok.vol" --voxel-size 10 -q || fail "a valid conversion failed"
 expect_refusal "--radius: must be a finite number of 0 or more, not -1" plan "$tmp/ok.vol" --from 0 0 0 --to 1 1 1 --radius -1
 expect_refusal "at voxel size 1e-09 needs 1e+12 voxels per axis" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 1e-9
+
+# A grid the flags fix must hold the points, never drop them without a word (a survey
+# lost 27% of its points to --voxel-size 1 --depth 5 with exit code 0).
+expect_refusal "--depth: 2 makes a grid of 16 voxels of 10 a side, 160 from the origin" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 10 --depth 2
+expect_refusal "reaches 1000 along x; depth 4 holds it" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 10 --depth 2
+expect_refusal "--origin: x = 5 lies above the minimum 0" convert "$tmp/two.xyz" "$tmp/o.vol" --voxel-size 10 --origin 5 0 0
+"$vola" convert "$tmp/two.xyz" "$tmp/crop.vol" --voxel-size 10 --depth 2 --origin 0 0 0 --bbox 0 0 0 100 100 100 -q ||
+  fail "a bbox inside the grid did not crop"
+
+# convert writes a .vol: not over its input, not under another format's name.
+cp "$tmp/two.xyz" "$tmp/same.xyz"
+expect_refusal "is the input: convert writes a new .vol file" convert "$tmp/same.xyz" "$tmp/same.xyz" --voxel-size 1
+cmp -s "$tmp/two.xyz" "$tmp/same.xyz" || fail "a refused conversion changed its input"
+expect_refusal "convert writes a .vol file, not las (.las); name it .vol, or write points with \`vola translate" convert "$tmp/two.xyz" "$tmp/o.las" --voxel-size 1
+if [[ -e $tmp/o.las ]]; then fail "a refused conversion wrote o.las"; fi
 echo "cli usage: ok"

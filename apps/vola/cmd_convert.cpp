@@ -73,6 +73,7 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
 }
 
 void run_convert(ConvertArgs& a) {
+  check_convert_output(a.input, a.output);
   const auto start = std::chrono::steady_clock::now();
   const ConvertOptions options = options_of(a);
   Progress progress("reading " + a.input);
@@ -130,7 +131,7 @@ void add_convert(CLI::App& app) {
       "  vola convert autzen.laz trees.vol --voxel-size 3 --filter smrf --filter hag --where \"HeightAboveGround > 6\"\n" +
       std::string(kFilterHelp));
   cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("output", args->output, "Output .vol file")->required();
+  cmd->add_option("output", args->output, "Output .vol file (not the input, nor a name with another format's extension)")->required();
   cmd->add_option("--format", args->options.format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
   cmd->add_option("--depth", args->options.depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size, and a depth given with it must hold the data (the error names the depth that does)")
       ->check(CLI::Range(1, 10));

@@ -122,7 +122,12 @@ Tree convert(const std::string& input, const ConvertOptions& options, const Conv
 // that writes a converted tree itself takes its WriteOptions from here).
 WriteOptions write_options_of(const ConvertOptions& options);
 
-// convert(), then write the tree to `output` as the options say (dense, compress).
+// Throws InvalidArgument when `output` is the input itself, or a name with another
+// format's extension (`a.las`: the bytes would be a .vol named .las).
+void check_convert_output(const std::string& input, const std::string& output);
+
+// check_convert_output, convert(), then write the tree to `output` as the options say
+// (dense, compress).
 void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,
                   const ConvertProgress& progress = {}, ConvertReport* report = nullptr);
 

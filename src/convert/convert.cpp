@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "filtering.hpp"
 #include "georeference.hpp"
@@ -142,8 +143,22 @@ WriteOptions write_options_of(const ConvertOptions& options) {
   return w;
 }
 
+void check_convert_output(const std::string& input, const std::string& output) {
+  std::error_code error;
+  if (std::filesystem::equivalent(input, output, error))
+    throw InvalidArgument(output + " is the input: convert writes a new .vol file; give it another name");
+  const std::string extension = io::lower_extension(output);
+  for (const auto& format : io::input_formats())
+    for (const auto& e : format.extensions)
+      if (e == extension && e != ".vol" && e != ".dvol")
+        throw InvalidArgument(output + ": convert writes a .vol file, not " + format.name + " (" + extension +
+                              "); name it .vol, or write points with `vola translate " + input + " " + output +
+                              "`, or voxels as points with `vola export FILE.vol " + output + "`");
+}
+
 void convert_file(const std::string& input, const std::string& output, const ConvertOptions& options,
                   const ConvertProgress& progress, ConvertReport* report) {
+  check_convert_output(input, output);
   options.check();
   const Tree tree = convert(input, options, progress, report);
   const WriteOptions write_options = write_options_of(options);
