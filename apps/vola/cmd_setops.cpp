@@ -7,7 +7,9 @@
 #include "commands.hpp"
 #include "open_voxels.hpp"
 #include "vola/analysis/change.hpp"
+#include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/setops.hpp"
 
 namespace vola::cli {
@@ -21,21 +23,37 @@ struct SetArgs {
   bool quiet = false;
 };
 
+// Voxel indices of one grid in two CRSs are not the same places: refuse, naming both
+// (as `vola tile` does), unless PROJ finds the two CRSs equivalent. A file that states
+// no CRS is taken to be in the other's, with a warning.
+void check_same_crs(const std::string& path_a, const Tree& a, const std::string& path_b, const Tree& b) {
+  const std::optional<std::string> crs_a = geo::crs_definition(a.georef()), crs_b = geo::crs_definition(b.georef());
+  if (crs_a.has_value() != crs_b.has_value())
+    std::fprintf(stderr, "vola: warning: %s states no CRS; taken to be %s's\n", (crs_a ? path_b : path_a).c_str(),
+                 (crs_a ? path_a : path_b).c_str());
+  if (const auto differ = geo::different_crs(a.georef(), b.georef()))
+    throw InvalidArgument(path_a + " is in " + differ->a + ", " + path_b + " in " + differ->b +
+                          ": the same voxel indices are different places. Convert both into one CRS "
+                          "(vola convert --target-crs) or relabel one (--assign-crs); --ignore-frame combines "
+                          "them anyway");
+}
+
 template <class Op>
 void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   auto args = std::make_shared<SetArgs>();
   auto* cmd = app.add_subcommand(name, help);
   cmd->footer(
-      "Both files must have the same depth and grid (origin and voxel size); payloads and\n"
-      "attributes are not carried into the result.");
+      "Both files must have the same depth, grid (origin and voxel size) and CRS (PROJ decides\n"
+      "whether two spellings name one CRS); payloads and attributes are not carried into the result.");
   cmd->add_option("a", args->a, "First .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("b", args->b, "Second .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol")->required();
-  cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids differ");
+  cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args, op, name] {
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);
+    if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
     const Tree result = op(a, b, args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal);
     write(result, args->output);
     if (!args->quiet)
@@ -52,17 +70,18 @@ void add_diff(CLI::App& app) {
       "With A the earlier survey and B the later one: added = B - A, removed = A - B,\n"
       "unchanged = both. OUTPUT (optional) receives A - B, the 'removed' set (swap A and B\n"
       "to get what was added). --outputs DIR writes added.vol, removed.vol, unchanged.vol.\n"
-      "Both files must have the same depth and grid; payloads and attributes are not carried.\n"
+      "Both files must have the same depth, grid and CRS; payloads and attributes are not carried.\n"
       "Example: vola diff before.vol after.vol --outputs change/");
   cmd->add_option("a", args->a, "First .vol (before)")->required()->check(CLI::ExistingFile);
   cmd->add_option("b", args->b, "Second .vol (after)")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol: A - B");
   cmd->add_option("--outputs", args->outputs_dir, "Write added.vol, removed.vol and unchanged.vol into this folder");
-  cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids differ");
+  cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->callback([args] {
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);
+    if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
     const FrameCheck check = args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal;
     const Tree removed = subtract(a, b, check);  // also checks depths and frames
     if (!args->output.empty()) write(removed, args->output);

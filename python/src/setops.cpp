@@ -2,6 +2,8 @@
 // `vola union | intersect | diff`, through the same library calls.
 #include "python_support.hpp"
 
+#include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/setops.hpp"
 
 namespace vola::python {
@@ -15,6 +17,11 @@ vola::FrameCheck frame_check(bool ignore_frame) {
 template <Tree (*Op)(const Tree&, const Tree&, vola::FrameCheck)>
 Tree combine(const Tree& a, const Tree& b, bool ignore_frame) {
   py::gil_scoped_release release;
+  if (!ignore_frame)
+    if (const auto differ = vola::geo::different_crs(a.georef(), b.georef()))
+      throw vola::InvalidArgument("a is in " + differ->a + ", b in " + differ->b +
+                                  ": the same voxel indices are different places; reproject one "
+                                  "(vola.convert(..., target_crs=...)) or pass ignore_frame=True");
   return Op(a, b, frame_check(ignore_frame));
 }
 
@@ -22,7 +29,7 @@ Tree combine(const Tree& a, const Tree& b, bool ignore_frame) {
 
 void bind_setops(py::module_& m, py::class_<Tree>& tree) {
   constexpr const char* kCarried =
-      "\nBoth trees must have the same depth and grid (origin and voxel size), else InvalidArgument, as the CLI\n"
+      "\nBoth trees must have the same depth, grid (origin and voxel size) and CRS, else InvalidArgument, as the CLI\n"
       "says; ignore_frame=True combines voxel indices anyway. The result keeps a's frame and CRS; payloads and\n"
       "attribute columns are not carried.";
   m.def("union", &combine<&vola::unite>, py::arg("a"), py::arg("b"), py::arg("ignore_frame") = false,

@@ -1,6 +1,7 @@
 """vola.union / intersect / difference (and |, &, -) against numpy's set operations on
 dense grids, and against the files `vola union | intersect | diff` write."""
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -48,3 +49,19 @@ def test_same_files_as_the_cli(vola_cli, tmp_path):
         out = tmp_path / f"{command}.vol"
         subprocess.run([vola_cli, command, str(tmp_path / "a.vol"), str(tmp_path / "b.vol"), str(out), "-q"], check=True)
         assert ours.to_bytes() == out.read_bytes(), command
+
+
+def test_crs_must_agree_as_the_cli_says(las_file):
+    # One grid of one survey, labelled UTM metres and (relabelled) Oregon feet: the same
+    # voxel indices are different places, so combining them is refused.
+    grid = dict(voxel_size=2.0, origin=(493000.0, 4877000.0, 100.0))
+    utm = vola.convert(str(las_file), **grid)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the relabelling's own warning
+        feet = vola.convert(str(las_file), assign_crs="EPSG:2994", **grid)
+    with pytest.raises(vola.InvalidArgument, match=r"a is in NAD83 / UTM zone 10N \(EPSG:26910\).*b in NAD83\(HARN\)"):
+        vola.union(utm, feet)
+    with pytest.raises(vola.InvalidArgument, match="different places"):
+        utm & feet
+    assert len(vola.union(utm, feet, ignore_frame=True)) == len(utm)
+    assert len(utm | utm) == len(utm)

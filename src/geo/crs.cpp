@@ -82,6 +82,26 @@ std::optional<std::string> crs_definition(const Georef& georef) {
   return std::nullopt;
 }
 
+std::optional<CrsPair> different_crs(const Georef& a, const Georef& b) {
+  const std::optional<std::string> crs_a = crs_definition(a), crs_b = crs_definition(b);
+  if (!crs_a || !crs_b || *crs_a == *crs_b) return std::nullopt;
+  bool same = false;
+  try {
+    same = same_crs(*crs_a, *crs_b);
+  } catch (const Error&) {
+    same = false;  // PROJ cannot read one of them: not provably the same
+  }
+  if (same) return std::nullopt;
+  const auto name = [](const std::string& definition) {
+    try {
+      return crs_summary(describe_crs(definition));
+    } catch (const Error&) {
+      return definition.substr(0, 80);
+    }
+  };
+  return CrsPair{name(*crs_a), name(*crs_b)};
+}
+
 std::string crs_wkt1(const std::string& definition) {
   std::string wkt;
   run("a CRS as WKT1", [&](const plugin::ProjEntries& p, plugin::PluginFailure& f) { p.crs_wkt1(definition, wkt, f); });

@@ -94,6 +94,16 @@ head -c 2000 "$tmp/a.vdb" >"$tmp/cut.vdb"
 expect_error "$tmp/cut.vdb" "$vola" convert "$tmp/cut.vdb" "$tmp/x.vol"
 [[ ! -e $tmp/x.vol ]] || fail "a failed conversion wrote its output"
 
+# Set operations refuse one grid in two CRSs (UTM metres and, relabelled, Oregon feet):
+# the same voxel indices are different places. --ignore-frame still combines them.
+"$vola" convert "$las" "$tmp/utm.vol" --voxel-size 2 --origin 493000 4877000 100 -q || fail "convert utm"
+"$vola" convert "$las" "$tmp/feet.vol" --voxel-size 2 --origin 493000 4877000 100 --assign-crs 2994 -q 2>/dev/null ||
+  fail "convert feet"
+expect_error "utm.vol is in NAD83 / UTM zone 10N (EPSG:26910)" "$vola" union "$tmp/utm.vol" "$tmp/feet.vol" "$tmp/u.vol"
+expect_error "feet.vol in NAD83(HARN) / Oregon GIC Lambert (ft) (EPSG:2994)" "$vola" intersect "$tmp/utm.vol" "$tmp/feet.vol" "$tmp/u.vol"
+expect_error "the same voxel indices are different places" "$vola" diff "$tmp/feet.vol" "$tmp/utm.vol"
+"$vola" union "$tmp/utm.vol" "$tmp/feet.vol" "$tmp/u.vol" --ignore-frame -q || fail "--ignore-frame did not combine two CRSs"
+
 if [[ $failures -ne 0 ]]; then
   echo "cli_maps: $failures failure(s)" >&2
   exit 1

@@ -104,6 +104,15 @@ class Reprojection {
   std::unique_ptr<State> state_;
 };
 
+// Two trees to be combined voxel for voxel (set operations): when both state a CRS and
+// they differ by meaning (not equal, and PROJ does not find them equivalent, or cannot
+// read one), what each is, for the error ("NAD83 / UTM zone 10N (EPSG:26910), projected,
+// metre"); nullopt when they agree or either states none (the caller may warn).
+struct CrsPair {
+  std::string a, b;
+};
+std::optional<CrsPair> different_crs(const Georef& a, const Georef& b);
+
 // The header's EPSG code when nobody said what the CRS is: the reference's default,
 // which names no real CRS of the data.
 inline constexpr std::uint32_t kUnsetEpsg = 2000;
