@@ -143,7 +143,8 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--nbits", args->options.nbits, "Payload words per block: 0 = occupancy only, 1 = one 64-bit payload word per block")
       ->check(CLI::Range(0, 64))->capture_default_str();
   cmd->add_flag("--dense", args->options.dense, "Write the reference's dense layout (depth <= 5)");
-  add_crs_options(*cmd, args->options.assign_crs, args->options.target_crs, args->options.allow_geographic);
+  add_crs_options(*cmd, args->options.assign_crs, args->options.target_crs, args->options.allow_geographic,
+                  "--voxel-size, --origin and --bbox");
   cmd->add_option("--level", args->options.level,
                   "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
   cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the file's first)");

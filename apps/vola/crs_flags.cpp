@@ -4,13 +4,15 @@
 
 namespace vola::cli {
 
-void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target_crs, bool& allow_geographic) {
+void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target_crs, bool& allow_geographic,
+                     const std::string& grid_flags) {
   cmd.add_option("--assign-crs", assign_crs,
-                 "The inputs' CRS (EPSG code, WKT or PROJ string), relabelling them without moving a point "
-                 "(default: what the inputs say; a warning when they say another)");
+                 "The inputs' CRS (EPSG code such as 32610 or EPSG:32610, AUTHORITY:CODE, WKT, PROJJSON or a PROJ "
+                 "string; not a name), relabelling them without moving a point (default: what the inputs say; a "
+                 "warning when they say another)");
   cmd.add_option("--target-crs", target_crs,
-                 "Reproject the points into this CRS (EPSG code, WKT or PROJ string) before voxelising; "
-                 "--voxel-size, --origin and --bbox are then in its units");
+                 "Reproject the points into this CRS (given as for --assign-crs) before voxelising; " + grid_flags +
+                     " are then in its units");
   cmd.add_flag("--allow-geographic", allow_geographic,
                "Voxelise in a geographic CRS anyway (voxels of degrees by units of height, not cubes; "
                "refused without it: give --target-crs)");

@@ -9,6 +9,8 @@
 
 namespace vola::cli {
 
-void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target_crs, bool& allow_geographic);
+// grid_flags: the flags that are then in the target CRS's units, for the help.
+void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target_crs, bool& allow_geographic,
+                     const std::string& grid_flags);
 
 }  // namespace vola::cli

@@ -29,6 +29,9 @@ std::string with_flags(std::string text) {
   return text;
 }
 
-std::string in_flags(const OptionError& error) { return flag_of(error.option()) + ": " + with_flags(error.cause()); }
+std::string in_flags(const OptionError& error) {
+  if (error.option().empty()) return with_flags(error.cause());
+  return flag_of(error.option()) + ": " + with_flags(error.cause());
+}
 
 }  // namespace vola::cli

@@ -26,11 +26,14 @@ class InvalidArgument : public Error {
 
 // One option of a library call that makes no sense. option() names the member of the
 // options struct (e.g. "voxel_size"), so that a front end can name its own spelling of it
-// (the CLI's --voxel-size, Python's voxel_size=); what() reads "<option>: <cause>".
+// (the CLI's --voxel-size, Python's voxel_size=); what() reads "<option>: <cause>". An
+// empty option is a refusal about no one option the caller gave (the cause still names
+// options in backticks, `allow_geographic`, for the front end to spell): what() is the cause.
 class OptionError : public InvalidArgument {
  public:
   OptionError(std::string option, std::string cause)
-      : InvalidArgument(option + ": " + cause), option_(std::move(option)), cause_(std::move(cause)) {}
+      : InvalidArgument(option.empty() ? cause : option + ": " + cause), option_(std::move(option)),
+        cause_(std::move(cause)) {}
   const std::string& option() const noexcept { return option_; }
   const std::string& cause() const noexcept { return cause_; }
 

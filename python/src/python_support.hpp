@@ -141,6 +141,7 @@ auto with_python_names(Body&& body) {
   try {
     return body();
   } catch (const vola::OptionError& e) {
+    if (e.option().empty()) throw vola::InvalidArgument(python_words(e.cause()));
     throw vola::InvalidArgument(python_keyword(e.option()) + ": " + python_words(e.cause()));
   }
 }

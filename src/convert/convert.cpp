@@ -69,8 +69,9 @@ bool maps_cell_for_cell(const std::string& path, const io::Input& input, const C
 }
 
 void check_target_crs(const std::string& target) {
+  const std::string definition = crs_definition_of(target);  // its own error for a name
   try {
-    geo::crs_wkt(crs_definition_of(target));
+    geo::crs_wkt(definition);
   } catch (const Error& e) {
     throw OptionError("target_crs", "'" + target.substr(0, 60) + "' is not a CRS PROJ knows: " + e.what());
   }

@@ -1,5 +1,7 @@
 #include "vola/crs_rules.hpp"
 
+#include <regex>
+
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 
@@ -40,9 +42,44 @@ bool same_meaning(const StatedCrs& a, const std::optional<std::uint32_t>& a_epsg
 
 }  // namespace
 
+namespace {
+
+// A definition, not a name: PROJ also takes CRS names and matches them loosely ("foo"
+// became Amersfoort, "wgs" WGS 72, "UTM zone 10N" a conversion), which relabels or
+// reprojects a survey into whatever it guessed.
+bool is_definition(const std::string& text) {
+  static const std::regex kForms(
+      R"(^\s*(?:)"
+      R"([A-Za-z][A-Za-z0-9_.-]*:[A-Za-z0-9_.+-]+)"  // AUTHORITY:CODE (EPSG:4326, ESRI:102100, EPSG:4326+5703)
+      R"(|urn:ogc:def:.*)"                          // OGC URN
+      R"(|.*\bproj=.*)"                             // PROJ string (+proj=utm +zone=10 ...)
+      R"(|\{[\s\S]*)"                               // PROJJSON
+      R"(|[A-Za-z_0-9]+\s*[\[(][\s\S]*)"              // WKT (PROJCS[, PROJCRS[, COMPD_CS[ ...)
+      R"()\s*$)",
+      std::regex::icase);
+  return std::regex_match(text, kForms);
+}
+
+}  // namespace
+
 std::string crs_definition_of(const std::string& given) {
   const bool digits = !given.empty() && given.find_first_not_of("0123456789") == std::string::npos;
-  return digits ? "EPSG:" + given : given;
+  if (digits) return "EPSG:" + given;
+  if (!is_definition(given)) {
+    std::string guess;
+    try {
+      guess = " (PROJ would guess " + geo::crs_summary(geo::describe_crs(given)) + ")";
+    } catch (const Error&) {
+    }
+    throw InvalidArgument("'" + given.substr(0, 60) +
+                          "' is not a CRS definition: give an EPSG code (32610 or EPSG:32610), AUTHORITY:CODE, "
+                          "WKT, PROJJSON or a PROJ string (+proj=...); names are not taken" +
+                          guess);
+  }
+  // A PROJ string without +type=crs is an operation to PROJ, not a CRS.
+  if (given.find("proj=") != std::string::npos && given.find("type=crs") == std::string::npos)
+    return given + " +type=crs";
+  return given;
 }
 
 std::optional<std::uint32_t> epsg_code_of(const std::string& given) {

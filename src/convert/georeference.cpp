@@ -46,7 +46,7 @@ void refuse_geographic_grid(const std::string& path, const ConvertOptions& optio
   if (options.allow_geographic || quantization != Quantization::grid || !voxelises_points(input)) return;
   const std::string result = result_definition(crs);
   if (result.empty() || !is_geographic_crs(result)) return;
-  throw OptionError("target_crs", path + " is in " + geographic_name(result) +
+  throw OptionError("", path + " is in " + geographic_name(result) +
                                       ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
                                       "units of height, not cubes; " + cubes_advice(input) +
                                       ", or `allow_geographic` to voxelise in degrees anyway");
@@ -87,7 +87,9 @@ std::uint32_t header_epsg(const std::optional<std::uint32_t>& known) { return kn
 
 ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io::Input& input) {
   if (input.is_mesh() || input.grid || input.terrain)
-    throw OptionError("target_crs", "reprojects points; " + path + " is " + input.format + " input");
+    throw OptionError("target_crs", "reprojects points; " + path + " is " + input.format + " input" +
+                                        (input.terrain ? ": warp the raster first (gdalwarp -t_srs CRS in.tif out.tif)"
+                                                       : ""));
   const ResolvedCrs source = input_crs(path, options, input);
   if (!source.epsg && source.wkt.empty())
     throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `assign_crs`");
