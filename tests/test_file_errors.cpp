@@ -89,6 +89,23 @@ TEST(FileErrors, HeaderSizeIsNot80) {
   expect_format_error(raw_file(h, {0}), 0, "header size 88 is not the 80");
 }
 
+// Other formats' files are named for what they are, with what to do instead ("header
+// size 1179861324 is not the 80 this format knows" was a LAS file).
+TEST(FileErrors, OtherFormatsAreNamed) {
+  const auto bytes_of = [](std::string_view text) {
+    std::vector<std::uint8_t> b(text.begin(), text.end());
+    b.resize(std::max<std::size_t>(b.size(), 200), 0);
+    return b;
+  };
+  expect_format_error(bytes_of("LASF"), 0, "not a .vol file: a LAS/LAZ point file: `vola convert` makes voxels");
+  expect_format_error(bytes_of("\x1f\x8b\x08"), 0, "not a .vol file: gzip-compressed: gunzip it first");
+  expect_format_error(bytes_of("ply\nformat ascii 1.0\n"), 0, "not a .vol file: a PLY file");
+  expect_format_error(bytes_of("\x93NUMPY"), 0, "not a .vol file: a NumPy array");
+  expect_format_error(bytes_of(std::string_view("II*\0", 4)), 0, "not a .vol file: a TIFF");
+  // Short ones too: the signature comes before the header's length.
+  expect_format_error({'L', 'A', 'S', 'F', 1, 2}, 0, "a LAS/LAZ point file");
+}
+
 TEST(FileErrors, UnknownVersion) {
   RawHeader h = header(1);
   h.version = 3;

@@ -10,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/io/input.hpp"
 #include "vola/map/state_map.hpp"
 
 namespace vola::cli {
@@ -49,9 +50,22 @@ struct NamedCrs {
   std::string problem;  // why PROJ could not name a CRS the file states
 };
 
-// A .vol file by its extension (the others are read as point files).
+// A .vol file by its extension (.vol; .dvol, the reference's dense files) or, under a name
+// no reader claims, by its first bytes: the 80 of the header size, or gzip's, which the
+// .vol reader then names (the others are read as point files).
 bool is_vol_file(const std::string& path) {
-  return path.size() >= 4 && (path.compare(path.size() - 4, 4, ".vol") == 0 || path.compare(path.size() - 4, 4, ".VOL") == 0);
+  const std::string extension = io::lower_extension(path);
+  if (extension == ".vol" || extension == ".dvol") return true;
+  for (const auto& format : io::input_formats())
+    for (const auto& e : format.extensions)
+      if (e == extension) return false;
+  unsigned char magic[4] = {};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  const bool whole = std::fread(magic, 1, 4, f) == 4;
+  std::fclose(f);
+  return whole && ((magic[0] == 80 && magic[1] == 0 && magic[2] == 0 && magic[3] == 0) ||
+                   (magic[0] == 0x1f && magic[1] == 0x8b));
 }
 
 NamedCrs name_crs(const Tree& tree) {

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <string_view>
 
 #include "bytes.hpp"
 #include "codec.hpp"
@@ -221,7 +222,34 @@ void encode_header(const Header& h, std::uint8_t* out) {
   std::memcpy(out, bytes.data(), kHeaderSize);
 }
 
+// What a file that is not a .vol is, from its first bytes, and what to do with it: "a
+// LAS file" was reported as "header size 1179861324 is not the 80 this format knows".
+const char* other_format(std::span<const std::uint8_t> bytes) {
+  struct Signature {
+    std::string_view magic;
+    const char* what;
+  };
+  using namespace std::string_view_literals;
+  static constexpr Signature kKnown[] = {
+      {"LASF"sv, "a LAS/LAZ point file: `vola convert` makes voxels of it, `vola translate` converts its points"},
+      {"\x1f\x8b"sv, "gzip-compressed: gunzip it first (gzip -dk FILE)"},
+      {"ply"sv, "a PLY file: `vola convert` makes voxels of it, `vola translate` converts its points"},
+      {"# .PCD"sv, "a PCD point file: `vola convert` makes voxels of it"},
+      {"\x93NUMPY"sv, "a NumPy array: `vola convert` makes voxels of its points"},
+      {"PK\x03\x04"sv, "a zip archive (an .npz?): unzip it first"},
+      {"# Octomap"sv, "an OctoMap file: `vola convert` reads it"},
+      {"II*\0"sv, "a TIFF (a DEM?): `vola convert` makes voxels of it"},
+      {"MM\0*"sv, "a TIFF (a DEM?): `vola convert` makes voxels of it"},
+      {"#binvox"sv, "a binvox grid: `vola convert` reads it"},
+      {" BDV"sv, "an OpenVDB file: `vola convert` reads it"},
+  };
+  for (const Signature& s : kKnown)
+    if (bytes.size() >= s.magic.size() && std::memcmp(bytes.data(), s.magic.data(), s.magic.size()) == 0) return s.what;
+  return nullptr;
+}
+
 Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name) {
+  if (const char* what = other_format(bytes)) VOLA_THROW(FormatError(name, 0, std::string("not a .vol file: ") + what));
   if (bytes.size() < kHeaderSize)
     VOLA_THROW(FormatError(name, bytes.size(),
                       "the file is " + std::to_string(bytes.size()) + " bytes, shorter than the 80-byte header"));
