@@ -1,6 +1,7 @@
 // The conversion pipeline: reader -> points, voxels or triangles -> builder -> tree.
 #include "vola/convert.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,8 +23,13 @@ using namespace convert_detail;
 
 io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
                const ConvertProgress& progress, std::vector<std::string>& filter_report) {
-  if (format.name != "text" && !options.text_attributes.empty())
-    throw OptionError("text_attributes", "apply to text input only (" + path + " is " + format.name + ")");
+  if (format.name != "text") {
+    const std::string why = "apply to text input only (" + path + " is " + format.name + ")";
+    if (!options.text_attributes.empty()) throw OptionError("text_attributes", why);
+    if (options.columns != std::array<int, 3>{1, 2, 3}) throw OptionError("columns", why);
+    if (!options.payload_columns.empty()) throw OptionError("payload_columns", why);
+    if (options.skip_lines != 0) throw OptionError("skip_lines", why);
+  }
   if (format.name != "dem" && (options.dem_base || options.dem_surface_only))
     throw OptionError(options.dem_base ? "dem_base" : "dem_surface_only",
                       "applies to DEM input only (" + path + " is " + format.name + ")");

@@ -297,6 +297,20 @@ TEST(Convert, VoxelGridsMapCellForCellAndPointsNeedAGrid) {
   solid.solid = true;
   solid.voxel_size = 1.0;
   EXPECT_EQ(refused_option([&] { vola::convert((data / "ply" / "pdal_simple_text.ply").string(), solid); }), "solid");
+  // The text reader's options are refused for other inputs, not ignored.
+  const std::string las = (data / "las" / "pdal_autzen_pf1.las").string();
+  vola::ConvertOptions columns;
+  columns.voxel_size = 1.0;
+  columns.columns = {4, 5, 6};
+  EXPECT_EQ(refused_option([&] { vola::convert(las, columns); }), "columns");
+  vola::ConvertOptions skip;
+  skip.voxel_size = 1.0;
+  skip.skip_lines = 1;
+  EXPECT_EQ(refused_option([&] { vola::convert(las, skip); }), "skip_lines");
+  vola::ConvertOptions payload;
+  payload.voxel_size = 1.0;
+  payload.payload_columns = {4};
+  EXPECT_EQ(refused_option([&] { vola::convert(las, payload); }), "payload_columns");
 }
 
 }  // namespace
