@@ -49,7 +49,7 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
 }
 
 std::vector<Voxel> voxels_from(const py::handle& input, int depth) {
-  const auto xyz = rows_of_three<std::int64_t>(input, "voxels");
+  const auto xyz = voxel_rows(input, "voxels");
   const std::int64_t side = vola::side_of(depth);
   std::vector<Voxel> voxels(static_cast<std::size_t>(xyz.shape(0)));
   const std::int64_t* p = xyz.data();

@@ -11,6 +11,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,21 @@ CArray<T> rows_of_three(const py::handle& input, const char* what) {
                           std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
                               array.shape(), array.shape() + array.ndim()))))));
   return array;
+}
+
+// (N, 3) voxel indices: an array of floats is taken only when every value is a whole
+// number, so world coordinates (or 62.9 for voxel 63) are not truncated without a word.
+inline CArray<std::int64_t> voxel_rows(const py::handle& input, const char* what) {
+  const py::array raw = py::array::ensure(input);
+  if (raw && raw.dtype().kind() == 'f') {
+    const auto values = CArray<double>::ensure(raw);
+    const double* v = values.data();
+    for (py::ssize_t i = 0; i < values.size(); ++i)
+      if (!(std::isfinite(v[i]) && v[i] == std::floor(v[i])))
+        throw py::value_error(std::string(what) + ": expects voxel indices (integers), got " + py::cast<std::string>(py::str(py::float_(v[i]))) +
+                              "; for world coordinates use tree.world_to_voxel(points) first");
+  }
+  return rows_of_three<std::int64_t>(input, what);
 }
 
 inline bool single_row(const py::handle& input) {

@@ -49,7 +49,7 @@ py::array_t<double> centers_of(const Tree& tree) {
 }
 
 py::object contains(const Tree& tree, const py::handle& input) {
-  const auto xyz = rows_of_three<std::int64_t>(input, "contains");
+  const auto xyz = voxel_rows(input, "contains");
   const auto n = xyz.shape(0);
   py::array_t<bool> out(n);
   bool* hit = out.mutable_data();
@@ -68,7 +68,7 @@ py::object contains(const Tree& tree, const py::handle& input) {
 }
 
 py::object rank_of(const Tree& tree, const py::handle& input) {
-  const auto xyz = rows_of_three<std::int64_t>(input, "rank");
+  const auto xyz = voxel_rows(input, "rank");
   const auto n = xyz.shape(0);
   py::array_t<std::int64_t> out(n);
   std::int64_t* rank = out.mutable_data();
@@ -228,7 +228,8 @@ py::class_<Tree> bind_tree(py::module_& m) {
           }, "Names of the per-voxel attribute columns.")
       .def("contains", &contains, py::arg("voxels"),
            "Occupancy of integer voxels: an (M, 3) array gives an (M,) bool array, one (3,) row gives a bool.\n"
-           "Voxels off the grid (negative, >= side) are False. Runs in C++ without the GIL.")
+           "Voxels off the grid (negative, >= side) are False; floats that are not whole numbers raise\n"
+           "ValueError (world coordinates go through world_to_voxel first). Runs in C++ without the GIL.")
       .def("rank", &rank_of, py::arg("voxels"),
            "Index of each voxel among all voxels in key order (its attribute row), -1 when empty.")
       .def("voxels", &voxels_of, py::arg("level") = -1,

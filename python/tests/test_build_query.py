@@ -66,6 +66,20 @@ def test_contains_and_rank_against_dense_reference(cloud):
     assert tree.rank(voxels[17]) == 17
 
 
+def test_contains_refuses_coordinates_that_are_not_voxel_indices():
+    tree = vola.build_from_voxels(np.array([[0, 281, 0], [63, 17, 10]]), depth=5)
+    # Whole floats are indices; anything else was truncated (-0.5 -> voxel 0, 62.9 -> 62).
+    assert tree.contains(np.array([[0.0, 281.0, 0.0], [63.0, 17.0, 10.0]])).tolist() == [True, True]
+    for bad in ([[-0.5, 281, 0]], [[62.9, 16.9, 9.9]], [[np.nan, 0, 0]]):
+        with pytest.raises(ValueError, match="expects voxel indices .*world_to_voxel"):
+            tree.contains(np.array(bad))
+    with pytest.raises(ValueError, match="expects voxel indices"):
+        tree.rank(np.array([[0.5, 0.0, 0.0]]))
+    placed = vola.build(np.array([[0.5, 281.5, 0.5], [63.5, 17.5, 10.5]]), voxel_size=1.0, origin=(0.0, 0.0, 0.0))
+    voxels, inside = placed.world_to_voxel(np.array([[0.7, 281.2, 0.1]]))
+    assert inside.all() and placed.contains(voxels).all()
+
+
 def test_build_from_voxels_and_dense_round_trip():
     rng = np.random.default_rng(3)
     voxels = rng.integers(0, 64, size=(3000, 3))
