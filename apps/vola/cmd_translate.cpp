@@ -39,14 +39,15 @@ void run_translate(const TranslateArgs& a) {
       reports = std::move(result.stages);
       return std::move(result.kept);
     };
-  io::translate_points(
+  const std::vector<std::string> warnings = io::translate_points(
       a.input, a.output,
       [&](std::uint64_t done, std::uint64_t total) {
         if (progress) progress->update(done, total);
       },
       edit);
+  if (progress) progress->finish();
+  for (const auto& warning : warnings) std::fprintf(stderr, "vola: warning: %s\n", warning.c_str());  // -q too
   if (!progress) return;
-  progress->finish();
   for (const auto& r : reports) {
     std::printf("filter:  %s: %llu -> %llu points", r.spec.c_str(), static_cast<unsigned long long>(r.points_in),
                 static_cast<unsigned long long>(r.points_out));
@@ -74,10 +75,11 @@ void add_translate(CLI::App& app) {
   cmd->footer(
       "Every point record is copied as it is, in order: coordinates, returns, classes, GPS time,\n"
       "colour, NIR, extra bytes; the header, the CRS and the other (E)VLRs too. A .laz output is\n"
-      "LASzip-compressed (compressor 2 for point formats 0-3, 3 for 6-8) in chunks of 50000 points.\n"
+      "LASzip-compressed (compressor 2 for point formats 0-5, 3 for 6-10) in chunks of 50000 points.\n"
       "A .ply (binary) or .xyz output holds x y z and every field as a named column, from any\n"
-      "point file vola reads (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI); LAS/LAZ outputs need\n"
-      "LAS/LAZ/COPC input.\n"
+      "point file vola reads (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI), but not the CRS (a\n"
+      "warning says so). Other inputs to LAS/LAZ become LAS 1.4 point format 6 or 7 records with\n"
+      "the fields LAS has (colour, intensity, classification, returns, GPS time, ...).\n"
       "Examples:\n"
       "  vola translate survey.laz survey.las     # decompress\n"
       "  vola translate survey.las survey.laz     # compress\n"

@@ -220,16 +220,21 @@ void bind_building(py::module_& m) {
         "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).");
   m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output,
                         const std::vector<std::string>& filters) {
-        py::gil_scoped_release release;
-        with_python_names([&] {
-          const auto stages = vola::filters::parse_stages(filters);
-          vola::io::PointEdit edit;
-          if (!stages.empty())
-            edit = [&](vola::io::PointTable& table) {
-              return vola::filters::run_stages(stages, table.cloud, table.epsg, table.wkt).kept;
-            };
-          vola::io::translate_points(input.string(), output.string(), {}, edit);
-        });
+        std::vector<std::string> warnings;
+        {
+          py::gil_scoped_release release;
+          with_python_names([&] {
+            const auto stages = vola::filters::parse_stages(filters);
+            vola::io::PointEdit edit;
+            if (!stages.empty())
+              edit = [&](vola::io::PointTable& table) {
+                return vola::filters::run_stages(stages, table.cloud, table.epsg, table.wkt).kept;
+              };
+            warnings = vola::io::translate_points(input.string(), output.string(), {}, edit);
+          });
+        }
+        for (const auto& w : warnings)  // what the output cannot hold (a PLY has no CRS)
+          if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) < 0) throw py::error_already_set();
       }, py::arg("input"), py::arg("output"), py::arg("filters") = std::vector<std::string>{},
       "Point file to point file, point by point, no voxels (`vola translate`): LAS, LAZ, COPC, PLY, PCD, XYZ,\n"
       "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.\n"

@@ -235,22 +235,35 @@ PointTable read_point_table(const std::string& input, const std::function<void(s
   return table;
 }
 
-void translate_points(const std::string& input, const std::string& output,
-                      const std::function<void(std::uint64_t, std::uint64_t)>& progress, const PointEdit& edit) {
+std::vector<std::string> translate_points(const std::string& input, const std::string& output,
+                                          const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                                          const PointEdit& edit) {
   const std::string out_ext = lower_extension(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";
   if (!las_out && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
     throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply and .xyz (or .txt)");
-  if (las_out && las_in && !edit) return translate_las(input, output, progress);
+  if (las_out && las_in && !edit) {
+    translate_las(input, output, progress);
+    return {};
+  }
   PointTable table = read_point_table(input, progress);
   if (edit) {
     const std::vector<std::uint64_t> kept = edit(table);
-    if (las_out && las_in) return translate_las(input, output, progress, LasRecordEdits{kept, table.cloud});
+    if (las_out && las_in) {
+      translate_las(input, output, progress, LasRecordEdits{kept, table.cloud});
+      return {};
+    }
   }
+  std::vector<std::string> warnings;
+  if (!las_out && (table.epsg || !table.wkt.empty()))
+    warnings.push_back(output + ": " + (out_ext == ".ply" ? "PLY" : "XYZ") + " has no place for the CRS of " + input +
+                       " (" + (table.epsg ? "EPSG:" + std::to_string(*table.epsg) : "a WKT with no EPSG code") +
+                       "): it is not kept; a .las or .laz output keeps it");
   if (out_ext == ".ply") write_ply_points(table.cloud, output);
   else if (las_out) write_las(table.cloud, output, table.epsg, table.wkt);
   else write_xyz_points(table.cloud, output, table.coordinate_digits);
+  return warnings;
 }
 
 }  // namespace vola::io

@@ -85,4 +85,12 @@ grep -q "no filter 'ground'" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt"
 echo '["a.las", {"type": "filters.smrf", "cells": 2}, "b.las"]' > "$tmp/bad.json"
 if "$vola" pipeline "$tmp/bad.json" 2> "$tmp/err.txt"; then fail "a misspelt stage option was accepted"; fi
 grep -q 'pipeline stage 1 (filters.smrf): no option "cells"' "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+# A PLY or XYZ output has no place for the CRS: a warning says so (-q too), a LAS keeps it.
+"$vola" translate "$autzen" "$tmp/crs.ply" -q 2> "$tmp/err.txt" || fail "translate to PLY failed"
+grep -q "PLY has no place for the CRS of .* (a WKT with no EPSG code): it is not kept" "$tmp/err.txt" ||
+  fail "no CRS warning for PLY: $(cat "$tmp/err.txt")"
+"$vola" translate "$autzen" "$tmp/crs.xyz" -q 2> "$tmp/err.txt" || fail "translate to XYZ failed"
+grep -q "XYZ has no place for the CRS" "$tmp/err.txt" || fail "no CRS warning for XYZ: $(cat "$tmp/err.txt")"
+"$vola" translate "$tmp/crs.ply" "$tmp/crs2.xyz" -q 2> "$tmp/err.txt" || fail "translate PLY to XYZ failed"
+[ ! -s "$tmp/err.txt" ] || fail "a warning for a file with no CRS: $(cat "$tmp/err.txt")"
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

@@ -47,8 +47,10 @@ using PointEdit = std::function<std::vector<std::uint64_t>(PointTable&)>;
 // the records of the points left, byte for byte but their classification (taken from the
 // column) and the header's counts and bounds; columns the record has no field for (a
 // new one such as height_above_ground) go to PLY and XYZ outputs only.
-void translate_points(const std::string& input, const std::string& output,
-                      const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
-                      const PointEdit& edit = {});
+// Returns warnings for the user: what the output cannot hold (a PLY or XYZ file has no
+// place for the input's CRS).
+std::vector<std::string> translate_points(const std::string& input, const std::string& output,
+                                          const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+                                          const PointEdit& edit = {});
 
 }  // namespace vola::io
