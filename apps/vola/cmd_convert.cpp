@@ -59,9 +59,12 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
   std::printf("voxels out:     %llu at depth %d (%u^3 grid, %s quantization, voxel %.6g)\n",
               static_cast<unsigned long long>(build.voxels), tree.depth(), tree.side(),
               frame.quantization == Quantization::grid ? "grid" : "toolkit", frame.voxel_size);
-  std::printf("file:           %llu bytes (%s), input %llu bytes: %.1fx smaller\n",
+  const bool smaller = out_bytes <= in_bytes;
+  const double ratio = smaller ? (out_bytes ? static_cast<double>(in_bytes) / static_cast<double>(out_bytes) : 0.0)
+                               : static_cast<double>(out_bytes) / static_cast<double>(in_bytes ? in_bytes : 1);
+  std::printf("file:           %llu bytes (%s), input %llu bytes: %.1fx %s\n",
               static_cast<unsigned long long>(out_bytes), a.output.c_str(), static_cast<unsigned long long>(in_bytes),
-              out_bytes ? static_cast<double>(in_bytes) / static_cast<double>(out_bytes) : 0.0);
+              ratio, smaller ? "smaller" : "larger");
   if (report.bytes_read && *report.bytes_read < in_bytes)
     std::printf("input read:     %llu of its %llu bytes (COPC nodes outside the level or grid skipped)\n",
                 static_cast<unsigned long long>(*report.bytes_read), static_cast<unsigned long long>(in_bytes));

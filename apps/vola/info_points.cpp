@@ -83,7 +83,7 @@ void print_compression(const io::LasHeader& hd) {
               z.version_major, z.version_minor, z.revision);
   if (z.chunk_size == io::laz::kVariableChunkSize) std::printf("variable chunks");
   else std::printf("chunks of %u points", z.chunk_size);
-  std::printf(", %zu chunks\nitems:      ", hd.laz_chunks.size());
+  std::printf(", %zu chunk%s\nitems:      ", hd.laz_chunks.size(), hd.laz_chunks.size() == 1 ? "" : "s");
   for (const auto& item : z.items) std::printf(" %s", io::laz::describe_item(item).c_str());
   std::printf("\n");
 }

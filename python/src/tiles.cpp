@@ -83,6 +83,14 @@ void bind_tiles(py::module_& m) {
       })
       .def_property_readonly("tiles_opened", &vola::tile::TileSet::tiles_opened, "How many tiles queries have mapped so far.")
       .def("__len__", [](const vola::tile::TileSet& t) { return t.index().tiles.size(); })
+      .def("__repr__",
+           [](const vola::tile::TileSet& t) {
+             std::string crs = t.index().epsg ? " EPSG:" + std::to_string(*t.index().epsg) : "";
+             return "<vola.TileSet tiles=" + std::to_string(t.index().tiles.size()) +
+                    " tile_size=" + py::cast<std::string>(py::repr(py::float_(t.grid().tile_size))) +
+                    " depth=" + std::to_string(t.grid().depth) +
+                    " voxel_size=" + py::cast<std::string>(py::repr(py::float_(t.grid().voxel_size()))) + crs + ">";
+           })
       .def_property_readonly("attributes", [](const vola::tile::TileSet& t) { return t.index().attributes; },
                              "The attribute columns every tile carries (e.g. ['red', ..., 'classification']).")
       .def("values", &tiles_values, py::arg("points"), py::arg("name"),

@@ -27,6 +27,7 @@ def test_tile_set_opens_lazily_and_answers_in_world_coordinates(tile_index: path
     tiles = vola.open_tiles(tile_index)
     index = json.loads(tile_index.read_text())
     assert len(tiles) == index["vola"]["tiles"] == len(tiles.tiles())
+    assert repr(tiles).startswith(f"<vola.TileSet tiles={len(tiles)} tile_size=")
     assert tiles.tiles_opened == 0
     assert tiles.tile_size == 256.0 and tiles.depth == 4 and tiles.voxel_size == 1.0
 

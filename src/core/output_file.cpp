@@ -185,7 +185,7 @@ void OutputFile::commit() {
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     e = errno;
     discard();
-    VOLA_THROW(IoError(path_ + ": cannot rename " + temporary_ + " onto it: " + std::strerror(e)));
+    VOLA_THROW(IoError(path_ + ": cannot replace it with the file written: " + std::strerror(e)));
   }
   release_slot(slot_);
   slot_ = -1;

@@ -50,7 +50,7 @@ std::string resolve_export_format(const ExportRequest& r) {
                                                    "intensity, density, count)"
                                                  : ""));
   if (r.raster && automatic && ext != ".tif" && ext != ".tiff")
-    throw OptionError("raster", "`raster` writes a GeoTIFF: name " + r.output + " .tif");
+    throw OptionError("raster", "writes a GeoTIFF: name the output .tif, not " + r.output);
   if (format == "png" && !images)
     throw OptionError("format", "PNG export needs `slices` (the output is a folder), `map` or `occupancy_above` Z");
   if (format == "tif" && !r.raster)

@@ -314,7 +314,7 @@ PY
 expect_error "--raster dsm" "$vola" export "$tmp/a.vol" "$tmp/m.tif" --map
 expect_error "name it .png" "$vola" export "$tmp/a.vol" "$tmp/m.jpg" --occupancy-above 3
 expect_error "needs --raster" "$vola" export "$tmp/a.vol" "$tmp/m.tif"
-expect_error "writes a GeoTIFF: name $tmp/m.png .tif" "$vola" export "$tmp/a.vol" "$tmp/m.png" --raster dsm
+expect_error "writes a GeoTIFF: name the output .tif, not $tmp/m.png" "$vola" export "$tmp/a.vol" "$tmp/m.png" --raster dsm
 expect_error "finer than the voxels" "$vola" export "$tmp/a.vol" "$tmp/m.tif" --raster dsm --resolution 2
 expect_error "no intensity column" "$vola" export "$tmp/b.vol" "$tmp/m.tif" --raster intensity
 expect_error "applies to --raster" "$vola" export "$tmp/a.vol" "$tmp/m.las" --resolution 6
