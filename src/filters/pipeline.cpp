@@ -171,7 +171,25 @@ void read_stage(const json& element, std::size_t index, Pipeline& pipeline) {
       stage.only({"filename", "voxel_size", "depth", "compress", "compress_max", "dense", "attributes"});
       for (const auto& [key, value] : element.items())
         if (key != "type" && key != "tag" && key != "filename") writer.options[key] = value.dump();
-    } else if (type == "writers.las" || type == "writers.ply" || type == "writers.text") {
+    } else if (type == "writers.las") {
+      // PDAL's two options most pipelines carry, where vola does what they ask anyway: the
+      // header and (E)VLRs of a LAS input are kept ("forward": "all"), and the extension
+      // says whether the points are compressed. Options vola would ignore are refused.
+      stage.only({"filename", "forward", "compression"});
+      if (element.contains("forward") && !(element.at("forward").is_string() && element.at("forward") == "all"))
+        stage.fail("\"forward\" takes \"all\" only (vola keeps a LAS input's header and VLRs whole)");
+      if (element.contains("compression")) {
+        const json& c = element.at("compression");
+        const bool compressed = c.is_boolean() ? c.get<bool>()
+                                : c.is_string() && (c == "laszip" || c == "lazperf" || c == "true");
+        const bool plain = c.is_boolean() ? !c.get<bool>() : c.is_string() && (c == "none" || c == "false");
+        const bool laz = lower_extension(writer.filename) == ".laz";
+        if (!(compressed || plain)) stage.fail("\"compression\" takes \"laszip\", \"lazperf\", \"none\", true or false");
+        if (compressed != laz)
+          stage.fail("\"compression\" disagrees with the name " + writer.filename +
+                     " (vola compresses exactly the .laz outputs)");
+      }
+    } else if (type == "writers.ply" || type == "writers.text") {
       stage.only({"filename"});
     } else {
       stage.fail("unknown writer (writers.las for .las/.laz, writers.ply, writers.text, writers.vola for .vol)");

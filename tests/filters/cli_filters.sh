@@ -61,6 +61,17 @@ JSON
 "$vola" convert "$autzen" "$tmp/flags.vol" --voxel-size 3 --filter smrf --where "Classification == 2" -q
 cmp "$tmp/pipe.las" "$tmp/flags.las" || fail "pipeline LAS differs from the flags'"
 cmp "$tmp/pipe.vol" "$tmp/flags.vol" || fail "pipeline .vol differs from the flags'"
+# PDAL's usual writer options where vola does what they ask anyway; a contradiction is refused.
+cat > "$tmp/pdal.json" <<JSON
+{"pipeline": ["$autzen", {"type": "writers.las", "filename": "$tmp/pdal.laz", "forward": "all", "compression": "laszip"}]}
+JSON
+"$vola" pipeline "$tmp/pdal.json" -q || fail "a PDAL pipeline with forward and compression failed"
+echo "[\"$autzen\", \"$tmp/plain.laz\"]" > "$tmp/plain.json"
+"$vola" pipeline "$tmp/plain.json" -q
+cmp "$tmp/pdal.laz" "$tmp/plain.laz" || fail "forward/compression changed the LAZ"
+echo "[\"$autzen\", {\"type\": \"writers.las\", \"filename\": \"$tmp/x.las\", \"compression\": \"laszip\"}]" > "$tmp/bad.json"
+if "$vola" pipeline "$tmp/bad.json" 2> "$tmp/err.txt"; then fail "compression to a .las name was accepted"; fi
+grep -q '"compression" disagrees with the name' "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
 
 # Height above ground as a dimension for --where, to PLY.
 "$vola" translate "$autzen" "$tmp/high.xyz" --filter smrf --filter hag --where "HeightAboveGround > 2" -q
