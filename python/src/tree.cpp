@@ -30,11 +30,26 @@ py::array_t<std::uint32_t> voxels_of(const Tree& tree, int level) {
   return out;
 }
 
+// The tree's world placement, for centres and world points. A tree with no grid frame
+// and a bbox of no extent (built from voxel indices) has none: the toolkit's rule would
+// put every voxel at one point and every world point in voxel 0.
+vola::Quantizer placed_quantizer(const Tree& tree, const char* what) {
+  const auto frame = tree.stored_frame();
+  const vola::Box& box = tree.georef().bbox;
+  const bool no_extent = box.max[0] <= box.min[0] && box.max[1] <= box.min[1] && box.max[2] <= box.min[2];
+  if ((!frame || frame->quantization != vola::Quantization::grid) && no_extent && tree.voxel_count() > 1)
+    throw vola::InvalidArgument(std::string(what) +
+                                ": this tree has no world placement (built from voxel indices, with no grid frame "
+                                "and an empty bbox); its voxel indices are its only coordinates. Give it one with "
+                                "vola.from_dense(grid, origin=..., voxel_size=...) or vola.build(points, ...)");
+  return tree.quantizer();
+}
+
 py::array_t<double> centers_of(const Tree& tree) {
   const auto n = static_cast<py::ssize_t>(tree.voxel_count());
   py::array_t<double> out({n, py::ssize_t{3}});
   double* p = out.mutable_data();
-  const vola::Quantizer quantizer = tree.quantizer();
+  const vola::Quantizer quantizer = placed_quantizer(tree, "centers");
   {
     py::gil_scoped_release release;
     tree.for_each_voxel([&](const Voxel& v) {
@@ -96,7 +111,7 @@ py::tuple world_to_voxel(const Tree& tree, const py::handle& input) {
   std::int64_t* v = voxels.mutable_data();
   bool* ok = inside.mutable_data();
   const double* p = xyz.data();
-  const vola::Quantizer quantizer = tree.quantizer();
+  const vola::Quantizer quantizer = placed_quantizer(tree, "world_to_voxel");
   {
     py::gil_scoped_release release;
     for (py::ssize_t i = 0; i < n; ++i, p += 3, v += 3) {

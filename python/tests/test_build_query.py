@@ -75,6 +75,10 @@ def test_contains_refuses_coordinates_that_are_not_voxel_indices():
             tree.contains(np.array(bad))
     with pytest.raises(ValueError, match="expects voxel indices"):
         tree.rank(np.array([[0.5, 0.0, 0.0]]))
+    with pytest.raises(vola.InvalidArgument, match="no world placement"):
+        tree.world_to_voxel(np.array([[0.5, 281.5, 0.5]]))
+    with pytest.raises(vola.InvalidArgument, match="no world placement"):
+        tree.centers()
     placed = vola.build(np.array([[0.5, 281.5, 0.5], [63.5, 17.5, 10.5]]), voxel_size=1.0, origin=(0.0, 0.0, 0.0))
     voxels, inside = placed.world_to_voxel(np.array([[0.7, 281.2, 0.1]]))
     assert inside.all() and placed.contains(voxels).all()
