@@ -139,7 +139,7 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--depth", args->options.depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size, and a depth given with it must hold the data (the error names the depth that does)")
       ->check(CLI::Range(1, 10));
   cmd->add_option("--voxel-size", args->options.voxel_size, "Voxel edge in input units (grid mode)")->check(positive_number());
-  cmd->add_option("--origin", args->origin, "World position of voxel (0,0,0)'s corner (grid mode), at or below the data's minimum; default: bbox min snapped to the voxel size")
+  cmd->add_option("--origin", args->origin, "World position of voxel (0,0,0)'s corner (grid mode), at or below the data's minimum; default: bbox min snapped to the voxel size (a DEM: to its own cells)")
       ->expected(3);
   cmd->add_option("--quantize", args->quantize, "toolkit or grid (default: grid with --voxel-size/--origin, else toolkit)")
       ->check(CLI::IsMember({"toolkit", "grid"}));

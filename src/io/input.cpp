@@ -87,6 +87,7 @@ Input read_dem_input(const std::string& path, const InputOptions& options) {
   in.terrain = true;
   in.terrain_base = options.dem_base.value_or(dem.minimum);
   in.terrain_surface_only = options.dem_surface_only;
+  in.terrain_lattice = dem.lattice;
   return in;
 }
 

@@ -324,6 +324,31 @@ ls "$tmp" | grep -q '\.part$' && fail "a temporary .part file was left"
 # GDAL writes in memory only: no .aux.xml or overview files beside the output.
 ls "$tmp" | grep -q -e '\.aux\.xml$' -e '\.ovr$' && fail "GDAL left side files: $(ls "$tmp" | grep -e aux -e ovr)"
 
+# A DEM at its own cell size comes back on its own cells: same geotransform, the same
+# heights where the source has data (the default origin follows the raster's lattice,
+# not multiples of the voxel size, which moved this one 20 m west).
+dem=$shared/data/dem/pdal_gdal_int16_epsg26711.tif
+if [[ -f $dem ]]; then
+  "$vola" convert "$dem" "$tmp/dem.vol" --voxel-size 60 --dem-surface-only -q || fail "convert the DEM"
+  "$vola" export "$tmp/dem.vol" "$tmp/dem.tif" --raster dsm -q || fail "export the DEM's DSM"
+  "$python" - "$dem" "$tmp/dem.tif" <<'PY' || fail "the DEM's DSM is not on the DEM's cells"
+import sys
+import numpy as np
+from osgeo import gdal
+src, out = gdal.Open(sys.argv[1]), gdal.Open(sys.argv[2])
+assert src.GetGeoTransform() == out.GetGeoTransform(), (src.GetGeoTransform(), out.GetGeoTransform())
+a = src.GetRasterBand(1).ReadAsArray().astype(float)
+b = out.GetRasterBand(1).ReadAsArray().astype(float)
+assert a.shape == b.shape, (a.shape, b.shape)
+# The DSM holds the top of each cell's voxel: within one 60-unit voxel above the height.
+ok = b != out.GetRasterBand(1).GetNoDataValue()
+assert ok.all(), ok.sum()
+assert ((b - a >= 0) & (b - a <= 60)).all(), np.abs(b - a).max()
+PY
+else
+  fail "$dem is missing"
+fi
+
 if ((failures)); then
   echo "$failures failure(s)" >&2
   exit 1

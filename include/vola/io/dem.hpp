@@ -2,6 +2,7 @@
 // one point per valid cell at its centre and height.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -21,6 +22,9 @@ struct DemRaster {
   double minimum = 0.0;               // lowest valid height (0 when none)
   std::optional<std::uint32_t> epsg;  // when GDAL identifies the CRS as an EPSG code
   std::string wkt;                    // the raster's CRS, empty when it has none
+  // A corner of the cells of a north-up raster (the geotransform's origin), so that a grid
+  // of voxels can line up with them; nullopt for a rotated raster.
+  std::optional<std::array<double, 2>> lattice;
 };
 
 // Cell centres through the geotransform (rotation terms included), heights through the

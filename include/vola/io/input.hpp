@@ -62,6 +62,9 @@ struct Input {
   bool terrain = false;
   double terrain_base = 0.0;
   bool terrain_surface_only = false;
+  // A corner of the raster's cells (north-up rasters): the default grid origin lines up
+  // with the cells rather than with multiples of the voxel size.
+  std::optional<std::array<double, 2>> terrain_lattice;
   bool is_mesh() const noexcept { return !triangles.empty(); }
 };
 

@@ -62,6 +62,8 @@ DemRaster read_dem_with_gdal(const std::string& path,
   double gt[6];
   // Without a geotransform GDAL fills the identity: cell (i, j) is at (i, j).
   (void)dataset->GetGeoTransform(gt);
+  if (gt[2] == 0.0 && gt[4] == 0.0 && std::isfinite(gt[0]) && std::isfinite(gt[3]))
+    dem.lattice = std::array<double, 2>{gt[0], gt[3]};
 
   GDALRasterBand* band = dataset->GetRasterBand(1);
   int has_scale = 0, has_offset = 0;
