@@ -6,7 +6,9 @@ named once (the Python keyword names) and spelled for each front end by the tabl
 FRONT_END_SPELLING below. The manifest (tests/convert_equivalence.sha256) holds the SHA-256
 of the .vol that `vola convert` wrote for each case before the conversion pipeline was
 consolidated; this script checks that today's CLI, Python's vola.convert and the C API's
-vola_convert still write exactly those bytes.
+vola_convert still write exactly those bytes. The three DEM cases with a voxel size were
+recorded again on 2026-11-28, when a DEM's default grid origin began to follow the
+raster's own cells (before, it snapped to multiples of the voxel size and moved the cells).
 
   convert_equivalence.py --vola build/apps/vola/vola --c-tool build/tests/capi_convert_tool \
       --python-path build/python [--front-ends cli,python,c] [--write-manifest]
