@@ -1,6 +1,7 @@
 #include "vola/crs_rules.hpp"
 
-#include <regex>
+#include <cctype>
+#include <string_view>
 
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
@@ -48,16 +49,30 @@ namespace {
 // became Amersfoort, "wgs" WGS 72, "UTM zone 10N" a conversion), which relabels or
 // reprojects a survey into whatever it guessed.
 bool is_definition(const std::string& text) {
-  static const std::regex kForms(
-      R"(^\s*(?:)"
-      R"([A-Za-z][A-Za-z0-9_.-]*:[A-Za-z0-9_.+-]+)"  // AUTHORITY:CODE (EPSG:4326, ESRI:102100, EPSG:4326+5703)
-      R"(|urn:ogc:def:.*)"                          // OGC URN
-      R"(|.*\bproj=.*)"                             // PROJ string (+proj=utm +zone=10 ...)
-      R"(|\{[\s\S]*)"                               // PROJJSON
-      R"(|[A-Za-z_0-9]+\s*[\[(][\s\S]*)"              // WKT (PROJCS[, PROJCRS[, COMPD_CS[ ...)
-      R"()\s*$)",
-      std::regex::icase);
-  return std::regex_match(text, kForms);
+  // Scanned by hand: std::regex recurses per character, and a WKT may be long.
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; };
+  const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  std::string_view t(text);
+  while (!t.empty() && space(t.front())) t.remove_prefix(1);
+  while (!t.empty() && space(t.back())) t.remove_suffix(1);
+  if (t.empty()) return false;
+  if (t.front() == '{') return true;                              // PROJJSON
+  if (t.find("proj=") != std::string_view::npos) return true;     // PROJ string (+proj=utm +zone=10 ...)
+  if (t.size() > 12 && (t.substr(0, 12) == "urn:ogc:def:" || t.substr(0, 12) == "URN:OGC:DEF:")) return true;
+  std::size_t i = 0;
+  while (i < t.size() && word(t[i])) ++i;
+  std::size_t j = i;
+  while (j < t.size() && space(t[j])) ++j;
+  if (i > 0 && j < t.size() && (t[j] == '[' || t[j] == '(')) return true;  // WKT: PROJCS[, PROJCRS[ ...
+  // AUTHORITY:CODE (EPSG:4326, ESRI:102100, IGNF:LAMB93, EPSG:4326+5703).
+  if (!std::isalpha(static_cast<unsigned char>(t.front()))) return false;
+  const std::size_t colon = t.find(':');
+  if (colon == std::string_view::npos || colon + 1 == t.size()) return false;
+  for (std::size_t k = 0; k < colon; ++k)
+    if (!word(t[k]) && t[k] != '.' && t[k] != '-') return false;
+  for (std::size_t k = colon + 1; k < t.size(); ++k)
+    if (!word(t[k]) && t[k] != '.' && t[k] != '+' && t[k] != '-') return false;
+  return true;
 }
 
 }  // namespace
