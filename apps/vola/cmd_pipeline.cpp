@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "option_flags.hpp"
 #include "vola/error.hpp"
 #include "vola/pipeline.hpp"
 
@@ -34,6 +35,8 @@ void run_pipeline_command(const PipelineArgs& a) {
   std::stringstream text;
   text << in.rdbuf();
   for (const PipelineOutputReport& out : vola::run_pipeline(text.str(), a.file)) {
+    for (const auto& warning : out.warnings)  // shown with -q too: they are about the result
+      std::fprintf(stderr, "vola: warning: %s\n", with_flags(warning).c_str());
     if (a.quiet) continue;
     if (out.voxels) {
       std::printf("%s -> %s: %llu voxels\n", out.input.c_str(), out.output.c_str(),

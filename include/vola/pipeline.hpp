@@ -19,6 +19,7 @@ struct PipelineOutputReport {
   std::uint64_t voxel_count = 0;   // .vol outputs
   std::vector<std::string> filter_lines;          // .vol outputs: ConvertReport::filters
   std::vector<filters::StageReport> stages;       // point outputs: each stage's counts
+  std::vector<std::string> warnings;              // for the user: CRS relabelled, CRS not kept, ...
 };
 
 // `json` is the pipeline's text; `name` (its file name, or "<string>") names it in errors.

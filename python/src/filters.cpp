@@ -61,7 +61,7 @@ py::list run_pipeline(const std::string& json, const std::string& name) {
     for (const auto& s : r.stages) stages.append(stage_dict(s));
     out.append(py::dict(py::arg("input") = r.input, py::arg("output") = r.output, py::arg("voxels") = r.voxels,
                         py::arg("voxel_count") = r.voxel_count, py::arg("filters") = r.filter_lines,
-                        py::arg("stages") = stages));
+                        py::arg("stages") = stages, py::arg("warnings") = r.warnings));
   }
   return out;
 }

@@ -56,6 +56,7 @@ def test_pipeline_from_a_file_text_or_lists_writes_what_the_cli_writes(shared_da
         points, voxels = reports
         assert not points["voxels"] and voxels["voxels"]
         assert [s["spec"].split(":")[0] for s in points["stages"]] == ["smrf", "where"]
+        assert points["warnings"] == [] and voxels["warnings"] == []  # LAZ and .vol keep the CRS
         smrf, where = points["stages"]
         assert smrf["points_in"] == smrf["points_out"] == 110000 and 0 < smrf["ground"] < 110000
         assert where["points_out"] == smrf["ground"]
@@ -64,3 +65,9 @@ def test_pipeline_from_a_file_text_or_lists_writes_what_the_cli_writes(shared_da
         vola.pipeline([str(autzen), {"type": "filters.nothing"}, str(tmp_path / "x.las")])
     with pytest.raises(vola.IoError, match="no_such.json: cannot open"):
         vola.pipeline(tmp_path / "no_such.json")
+
+
+def test_pipeline_reports_what_a_point_file_cannot_keep(shared_data, tmp_path):
+    autzen = shared_data / "las" / "pdal_autzen_trim.las"
+    (report,) = vola.pipeline([str(autzen), str(tmp_path / "a.ply")])
+    assert len(report["warnings"]) == 1 and "PLY has no place for the CRS" in report["warnings"][0]

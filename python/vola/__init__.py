@@ -172,7 +172,8 @@ def pipeline(spec: Union[PathLike, list, dict]) -> list:
     as Python lists and dicts, e.g. ["autzen.laz", {"type": "filters.smrf"},
     {"type": "filters.range", "limits": "Classification[2:2]"}, "ground.laz"]. Returns one
     dict per writer: input, output, voxels (a .vol written), voxel_count, filters (the
-    conversion's filter lines), stages (per stage: spec, points_in, points_out, ground)."""
+    conversion's filter lines), stages (per stage: spec, points_in, points_out, ground),
+    warnings (what the user should know: a CRS relabelled, a CRS a PLY cannot keep)."""
     if isinstance(spec, (list, dict)):
         return _run_pipeline(json.dumps(spec), "<pipeline>")
     text = os.fspath(spec)

@@ -52,8 +52,9 @@ std::vector<PipelineOutputReport> run_pipeline(const std::string& json, const st
       convert_file(pipeline.input, writer.filename, convert_options(writer, pipeline.stages), {}, &report);
       out.voxel_count = report.build.voxels;
       out.filter_lines = std::move(report.filters);
+      out.warnings = std::move(report.warnings);
     } else {
-      io::translate_points(pipeline.input, writer.filename, {}, [&](io::PointTable& table) {
+      out.warnings = io::translate_points(pipeline.input, writer.filename, {}, [&](io::PointTable& table) {
         filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
         out.stages = std::move(result.stages);
         return std::move(result.kept);
