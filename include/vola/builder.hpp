@@ -94,5 +94,10 @@ void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int k
 // voxel size the options leave open are derived from the box. Checks the options first.
 Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options);
 
+// The largest anchor + k x step (k whole) at or below `value`: a grid line of a lattice
+// through `anchor`. floor(value / step) x step alone can round above the value
+// (470692.44 at 0.01), which drops the points at the minimum.
+double grid_line_below(double value, double step, double anchor = 0.0);
+
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola

@@ -1,7 +1,6 @@
 #include "shapes.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include "vola/error.hpp"
@@ -78,15 +77,10 @@ BuildOptions on_the_cells(const io::Input& input, const Box& bbox, BuildOptions 
   if (options.origin || !input.terrain_lattice || options.quantization != Quantization::grid ||
       !(options.voxel_size > 0.0))
     return options;
-  const double v = options.voxel_size;
-  Point origin;
-  for (int a = 0; a < 3; ++a) {
-    const double anchor = a < 2 ? (*input.terrain_lattice)[static_cast<std::size_t>(a)] : 0.0;
-    const double cells = std::floor((bbox.min[a] - anchor) / v);
-    origin[a] = anchor + cells * v;
-    if (origin[a] > bbox.min[a]) origin[a] = anchor + (cells - 1.0) * v;  // rounding above the minimum
-  }
-  options.origin = origin;
+  const auto& [x, y] = *input.terrain_lattice;
+  options.origin = Point{grid_line_below(bbox.min[0], options.voxel_size, x),
+                         grid_line_below(bbox.min[1], options.voxel_size, y),
+                         grid_line_below(bbox.min[2], options.voxel_size)};
   return options;
 }
 

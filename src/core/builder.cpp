@@ -293,6 +293,12 @@ void check_grid_holds(const Quantizer& quantizer, const Box& box) {
 
 }  // namespace
 
+double grid_line_below(double value, double step, double anchor) {
+  const double cells = std::floor((value - anchor) / step);
+  const double line = anchor + cells * step;
+  return line > value ? anchor + (cells - 1.0) * step : line;
+}
+
 Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   options.check();
   if (options.quantization == Quantization::toolkit) return Quantizer::toolkit(bbox, options.depth);
@@ -309,12 +315,7 @@ Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   }
   if (!origin) {
     Point o;
-    for (int a = 0; a < 3; ++a) {
-      const double cells = std::floor(bbox.min[a] / voxel_size);
-      o[a] = cells * voxel_size;
-      // cells x size can round above the minimum (470692.44 at 0.01): a voxel lower.
-      if (o[a] > bbox.min[a]) o[a] = (cells - 1.0) * voxel_size;
-    }
+    for (int a = 0; a < 3; ++a) o[a] = grid_line_below(bbox.min[a], voxel_size);
     origin = o;
   }
   int depth = options.depth;
