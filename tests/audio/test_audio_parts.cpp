@@ -27,9 +27,9 @@ using namespace vola;
 using namespace vola::audio;
 namespace fs = std::filesystem;
 
+// A file in this process's scratch folder, removed with it at exit.
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("vola_audio_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  static const vola_test::TempDir dir;
   return dir / name;
 }
 

@@ -6,14 +6,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <string>
-#include <unistd.h>
 #include <span>
 #include <vector>
 
 #include "fuzz_seeds.hpp"
+#include "scratch_file.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
@@ -44,15 +42,6 @@ void check_grid(const vola::io::VoxelGrid& grid) {
   check(vola::build_from_voxels(back.voxels, 3).keys() == tree.keys());
 }
 
-// Writes `bytes` to this process's scratch file and returns its path.
-std::string temporary_text_file(std::span<const std::uint8_t> bytes) {
-  static const std::string path = (std::filesystem::temp_directory_path() /
-                                   ("vola_fuzz_text_" + std::to_string(::getpid()) + ".xyz")).string();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  return path;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -79,7 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 6: {
         // The text reader reads files: one temporary file per input, columns chosen so
         // that payload bytes and an attribute are parsed too.
-        const std::string path = temporary_text_file(file);
+        const std::string path = vola_fuzz::scratch_file("text", "xyz", file);
         vola::io::TextColumns columns;
         columns.payload = {3};
         columns.attributes.push_back({"a", vola::ValueType::f32, vola::Reduction::mean, {}});

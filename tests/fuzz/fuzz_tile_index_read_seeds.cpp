@@ -29,6 +29,7 @@ Bytes bytes_of(const tile::TileIndexFile& index) {
   std::ifstream in(path, std::ios::binary);
   Bytes b{std::istreambuf_iterator<char>(in), {}};
   std::filesystem::remove(path);
+  std::filesystem::remove(std::filesystem::path(path).replace_extension(".gpkg"));  // the index's native-CRS twin
   return b;
 }
 
