@@ -55,6 +55,11 @@ typedef struct vola_tree vola_tree;
 /* The message of this thread's last failure ("" when there was none). Valid until the
  * next failing call in this thread. */
 VOLA_C_API const char *vola_last_error(void);
+/* What this thread's last call of vola_convert, vola_convert_file or vola_translate warned
+ * about, one warning a line, as the CLI prints them (e.g. "out.xyz: XYZ has no place for the
+ * CRS of in.las ..."); "" when it warned about nothing or failed. Valid until the next of
+ * those calls in this thread. */
+VOLA_C_API const char *vola_last_warnings(void);
 /* "ok", "invalid argument", "format error", "io error", "out of memory", "internal error". */
 VOLA_C_API const char *vola_status_string(vola_status status);
 /* The library version, e.g. "0.1.0". */

@@ -61,9 +61,22 @@ std::string& vola::capi::last_error() noexcept {
   return message;
 }
 
+std::string& vola::capi::last_warnings() noexcept {
+  thread_local std::string lines;
+  return lines;
+}
+
+void vola::capi::set_last_warnings(const std::vector<std::string>& warnings) {
+  std::string& lines = last_warnings();
+  lines.clear();
+  for (const auto& w : warnings) lines += w + '\n';
+}
+
 extern "C" {
 
 const char* vola_last_error(void) { return vola::capi::last_error().c_str(); }
+
+const char* vola_last_warnings(void) { return vola::capi::last_warnings().c_str(); }
 
 const char* vola_status_string(vola_status status) {
   switch (status) {

@@ -88,6 +88,7 @@ void vola_convert_options_init(vola_convert_options* options) {
 vola_status vola_convert(const char* input, const vola_convert_options* options, vola_tree** out,
                          vola_convert_report* report) {
   return vola::capi::guarded([&] {
+    vola::capi::set_last_warnings({});
     vola::capi::require(input != nullptr && options != nullptr && out != nullptr,
                         "vola_convert: input, options and out must not be NULL");
 #ifdef VOLA_C_HAS_CONVERT
@@ -95,6 +96,7 @@ vola_status vola_convert(const char* input, const vola_convert_options* options,
     auto* handle = new vola_tree{vola::convert(input, convert_options(*options), progress_of(*options), &r)};
     *out = handle;
     fill(report, r);
+    vola::capi::set_last_warnings(r.warnings);
 #else
     (void)report;
     throw vola::InvalidArgument("vola_convert: this library was built without readers (VOLA_BUILD_MODULES=OFF)");
@@ -105,12 +107,14 @@ vola_status vola_convert(const char* input, const vola_convert_options* options,
 vola_status vola_convert_file(const char* input, const char* output, const vola_convert_options* options,
                               vola_convert_report* report) {
   return vola::capi::guarded([&] {
+    vola::capi::set_last_warnings({});
     vola::capi::require(input != nullptr && output != nullptr && options != nullptr,
                         "vola_convert_file: input, output and options must not be NULL");
 #ifdef VOLA_C_HAS_CONVERT
     vola::ConvertReport r;
     vola::convert_file(input, output, convert_options(*options), progress_of(*options), &r);
     fill(report, r);
+    vola::capi::set_last_warnings(r.warnings);
 #else
     (void)report;
     throw vola::InvalidArgument("vola_convert_file: this library was built without readers (VOLA_BUILD_MODULES=OFF)");

@@ -5,6 +5,7 @@
 
 #include <new>
 #include <string>
+#include <vector>
 
 #include "vola/error.hpp"
 #include "vola/tree.hpp"
@@ -18,6 +19,14 @@ namespace vola::capi {
 
 // This thread's last error message (vola_last_error).
 std::string& last_error() noexcept;
+
+// What this thread's last conversion or translation warned about, one warning a line
+// (vola_last_warnings).
+std::string& last_warnings() noexcept;
+
+// Records a call's warnings for vola_last_warnings (called by every entry point that has
+// warnings to give, before its work, with none, and after it with what it returned).
+void set_last_warnings(const std::vector<std::string>& warnings);
 
 inline vola_status fail(vola_status status, const std::string& message) noexcept {
   try {

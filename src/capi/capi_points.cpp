@@ -24,9 +24,10 @@ vola_status vola_export_las(const vola_tree* tree, const char* path) {
 
 vola_status vola_translate(const char* input, const char* output) {
   return vola::capi::guarded([&] {
+    vola::capi::set_last_warnings({});
     vola::capi::require(input != nullptr && output != nullptr, "vola_translate: input and output must not be NULL");
 #ifdef VOLA_C_HAS_CONVERT
-    vola::io::translate_points(input, output);
+    vola::capi::set_last_warnings(vola::io::translate_points(input, output));
 #else
     throw vola::InvalidArgument("vola_translate: this library was built without readers (VOLA_BUILD_MODULES=OFF)");
 #endif

@@ -7,6 +7,7 @@ data=${data:-$3}  # VOLA_SHARED wins over the configured default
 source "$(dirname "$0")/../lib/cli_test.sh"
 scratch=$tmp
 las=$data/las/pdal_1.2-with-color.las
-[ -f "$las" ] || skip "$las missing (set VOLA_SHARED)"
+las_with_crs=$data/las/pdal_autzen-utm.las
+[ -f "$las" ] && [ -f "$las_with_crs" ] || skip "$las or $las_with_crs missing (set VOLA_SHARED)"
 "$vola" convert "$las" "$scratch/survey.vol" --voxel-size 5 --quiet
-"$test_capi" "$scratch" "$scratch/survey.vol"
+"$test_capi" "$scratch" "$scratch/survey.vol" "$las_with_crs"

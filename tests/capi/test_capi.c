@@ -354,20 +354,37 @@ static void test_points_out(const char *scratch, const char *vol) {
   CHECK(a && b && a_size > 0 && a_size == b_size && memcmp(a, b, a_size) == 0);
   free(a);
   free(b);
+  CHECK(strcmp(vola_last_warnings(), "") == 0); /* LAZ to LAS keeps everything */
   CHECK(vola_translate(laz, NULL) == VOLA_ERROR_INVALID_ARGUMENT);
   CHECK(vola_translate(vol, back) == VOLA_ERROR_INVALID_ARGUMENT);  /* a .vol is not a point file */
   vola_tree_free(tree);
 }
 
+/* A survey with a CRS to XYZ, which has no place for it: said through vola_last_warnings,
+ * as the CLI says it; a LAS output keeps the CRS and warns about nothing. */
+static void test_translate_warnings(const char *scratch, const char *las_with_crs) {
+  char xyz[4096], las[4096];
+  snprintf(xyz, sizeof xyz, "%s/crs.xyz", scratch);
+  snprintf(las, sizeof las, "%s/crs.las", scratch);
+  CHECK_OK(vola_translate(las_with_crs, xyz));
+  CHECK(strstr(vola_last_warnings(), "crs.xyz: XYZ has no place for the CRS") != NULL);
+  CHECK(vola_translate(las_with_crs, NULL) == VOLA_ERROR_INVALID_ARGUMENT);
+  CHECK(strcmp(vola_last_warnings(), "") == 0); /* a failed call leaves no warnings behind */
+  CHECK_OK(vola_translate(las_with_crs, xyz));
+  CHECK_OK(vola_translate(las_with_crs, las));
+  CHECK(strcmp(vola_last_warnings(), "") == 0);
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
-    fprintf(stderr, "usage: test_capi SCRATCH_DIR [FILE_WITH_ATTRIBUTES.vol]\n");
+    fprintf(stderr, "usage: test_capi SCRATCH_DIR [FILE_WITH_ATTRIBUTES.vol [LAS_WITH_CRS]]\n");
     return 2;
   }
   test_build_query_iterate(argv[1]);
   test_points_and_attributes();
   if (argc > 2) test_shared_file(argv[2]);
   if (argc > 2) test_points_out(argv[1], argv[2]);
+  if (argc > 3) test_translate_warnings(argv[1], argv[3]);
   test_errors(argv[1]);
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
