@@ -15,7 +15,54 @@ namespace vola::io {
 
 namespace {
 
-bool is_separator(char c) { return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r'; }
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// Whether a line is written with decimal commas, as spreadsheets in most of Europe write
+// it: "1,5;2,25;3" (their CSV separates fields by semicolons for this reason) or
+// "1,5<TAB>2,25 3". A line with a semicolon is; a line whose fields are separated by
+// spaces or tabs is when its commas each stand alone in a field, between digits. Plain
+// CSV ("1.5,2.25,3", "1, 2, 3") is not.
+bool uses_decimal_comma(std::string_view line) {
+  if (line.find(';') != std::string_view::npos) return true;
+  int fields = 0;
+  bool comma = false;
+  for (std::size_t i = 0; i < line.size();) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    if (i == line.size()) break;
+    ++fields;
+    int commas = 0;
+    for (; i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r'; ++i) {
+      if (line[i] != ',') continue;
+      if (++commas > 1 || i == 0 || i + 1 == line.size() || !is_digit(line[i - 1]) || !is_digit(line[i + 1]))
+        return false;
+      comma = true;
+    }
+  }
+  return comma && fields >= 2;
+}
+
+// Field separators: spaces, tabs, semicolons and, unless it is the decimal mark, commas.
+bool is_separator(char c, bool decimal_comma) {
+  return c == ' ' || c == '\t' || c == ';' || c == '\r' || (c == ',' && !decimal_comma);
+}
+
+bool is_data_line(std::string_view line) {
+  std::size_t i = 0;
+  while (i < line.size() && is_separator(line[i], false)) ++i;
+  return i < line.size() && line[i] != '#' && line.substr(i, 2) != "//";
+}
+
+// A number as from_chars reads it, a leading '+' allowed, a decimal comma read as a point.
+bool parse_number(std::string_view text, bool decimal_comma, double& value) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  std::array<char, 64> copy;
+  if (decimal_comma && text.find(',') != std::string_view::npos && text.size() <= copy.size()) {
+    std::replace_copy(text.begin(), text.end(), copy.begin(), ',', '.');
+    text = std::string_view(copy.data(), text.size());
+  }
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+  return result.ec == std::errc() && result.ptr == text.data() + text.size();
+}
 
 class LineParser {
  public:
@@ -38,22 +85,20 @@ class LineParser {
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
     if (i == line.size() || line[i] == '#' || line.substr(i, 2) == "//") return;
     if (line_number <= static_cast<std::uint64_t>(columns_.skip_lines) || line_number == header_line_) return;
+    // The file's first data line says whether its decimal mark is a comma, for every line.
+    if (!decimal_comma_) decimal_comma_ = uses_decimal_comma(line);
     int column = 0;
     while (i < line.size() && column <= max_column_) {
       std::size_t end = i;
-      while (end < line.size() && !is_separator(line[end])) ++end;
-      const char* first = line.data() + i;
-      const char* last = line.data() + end;
-      if (*first == '+') ++first;
+      while (end < line.size() && !is_separator(line[end], *decimal_comma_)) ++end;
       double v = 0;
-      const auto result = std::from_chars(first, last, v);
-      if (result.ec != std::errc() || result.ptr != last)
+      if (!parse_number(line.substr(i, end - i), *decimal_comma_, v))
         fail(line_number, offset + i, "column " + std::to_string(column + 1) + " '" +
                                           std::string(line.substr(i, end - i)) + "' is not a number");
       values_[static_cast<std::size_t>(column)] = v;
       ++column;
       i = end;
-      while (i < line.size() && is_separator(line[i])) ++i;
+      while (i < line.size() && is_separator(line[i], *decimal_comma_)) ++i;
     }
     if (column <= max_column_)
       fail(line_number, offset, "has " + std::to_string(column) + " columns, column " +
@@ -87,6 +132,7 @@ class LineParser {
   std::uint64_t header_line_;
   int max_column_ = 2;
   std::vector<double> values_;
+  std::optional<bool> decimal_comma_;
 };
 
 std::string_view unquoted(std::string_view w) {
@@ -94,11 +140,9 @@ std::string_view unquoted(std::string_view w) {
   return w;
 }
 
-bool is_number(std::string_view w) {
-  if (!w.empty() && w.front() == '+') w.remove_prefix(1);
+bool is_number(std::string_view w, bool decimal_comma) {
   double v = 0;
-  const auto r = std::from_chars(w.data(), w.data() + w.size(), v);
-  return r.ec == std::errc() && r.ptr == w.data() + w.size();
+  return parse_number(w, decimal_comma, v);
 }
 
 // The column of each of x, y, z among the names (any case), or nothing.
@@ -142,7 +186,7 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     next_offset += line.size() + 1;
     if (++number <= static_cast<std::uint64_t>(skip_lines)) continue;
     std::string_view rest(line);
-    while (!rest.empty() && is_separator(rest.front())) rest.remove_prefix(1);
+    while (!rest.empty() && is_separator(rest.front(), false)) rest.remove_prefix(1);
     if (rest.empty()) continue;
     TextHeader header;
     header.line = number;
@@ -151,13 +195,14 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     else if (rest.front() == '#') header.comment = true, rest.remove_prefix(1);
     names.clear();
     bool all_names = true;
+    const bool decimal_comma = uses_decimal_comma(rest);
     for (std::size_t i = 0; i < rest.size();) {
-      while (i < rest.size() && is_separator(rest[i])) ++i;
+      while (i < rest.size() && is_separator(rest[i], decimal_comma)) ++i;
       std::size_t end = i;
-      while (end < rest.size() && !is_separator(rest[end])) ++end;
+      while (end < rest.size() && !is_separator(rest[end], decimal_comma)) ++end;
       if (end > i) {
         const std::string_view word = unquoted(rest.substr(i, end - i));
-        all_names = all_names && !word.empty() && !is_number(word);
+        all_names = all_names && !word.empty() && !is_number(word, decimal_comma);
         names.emplace_back(word);
       }
       i = end;
@@ -199,14 +244,15 @@ int count_text_columns(const std::string& path, int skip_lines) {
   int line_number = 0;
   while (std::getline(in, line)) {
     if (++line_number <= skip_lines) continue;
+    if (!is_data_line(line)) continue;
+    const bool decimal_comma = uses_decimal_comma(line);
     std::size_t i = 0;
-    while (i < line.size() && is_separator(line[i])) ++i;
-    if (i == line.size() || line[i] == '#' || line.compare(i, 2, "//") == 0) continue;
+    while (i < line.size() && is_separator(line[i], decimal_comma)) ++i;
     int columns = 0;
     while (i < line.size()) {
       ++columns;
-      while (i < line.size() && !is_separator(line[i])) ++i;
-      while (i < line.size() && is_separator(line[i])) ++i;
+      while (i < line.size() && !is_separator(line[i], decimal_comma)) ++i;
+      while (i < line.size() && is_separator(line[i], decimal_comma)) ++i;
     }
     return columns;
   }

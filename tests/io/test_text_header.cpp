@@ -102,3 +102,38 @@ TEST(TextHeader, FilesWithoutOneReadAsBefore) {
 }
 
 }  // namespace
+
+// Spreadsheets in most of Europe write decimal commas and separate fields by semicolons
+// (or tabs): the commas are decimal marks there, not separators. Read as separators, the
+// first line below gave the point (1, 5, 2) with exit 0.
+TEST(TextDecimalComma, SemicolonAndTabFilesReadTheirCommasAsDecimalMarks) {
+  TempDir dir;
+  const auto semicolons = read_text(dir, "x;y;z;intensity\n1,5;2,25;-3,5;10\n4;5,75;6,0;20,5\n");
+  EXPECT_EQ(semicolons.xyz, (std::vector<double>{1.5, 2.25, -3.5, 4, 5.75, 6}));
+  EXPECT_EQ(column(semicolons, "intensity").values, (std::vector<double>{10, 20.5}));
+  const auto tabs = read_text(dir, "1,5\t2,25\t3\n+4,125 5 6,5\n");
+  EXPECT_EQ(tabs.xyz, (std::vector<double>{1.5, 2.25, 3, 4.125, 5, 6.5}));
+  EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 3);
+  // Decided by the first data line: a later "1,5" in a decimal-comma file is never split.
+  const auto later = read_text(dir, "1;2;3\n1,5;2;3\n");
+  EXPECT_EQ(later.xyz, (std::vector<double>{1, 2, 3, 1.5, 2, 3}));
+}
+
+TEST(TextDecimalComma, PlainCsvKeepsCommasAsSeparators) {
+  TempDir dir;
+  EXPECT_EQ(read_text(dir, "1.5,2.25,3\n").xyz, (std::vector<double>{1.5, 2.25, 3}));
+  EXPECT_EQ(read_text(dir, "1, 2, 3\n4 ,5 ,6\n").xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(read_text(dir, "1,2,3\n").xyz, (std::vector<double>{1, 2, 3}));
+  EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 3);
+  EXPECT_EQ(read_text(dir, "10,20,30 40\n").xyz, (std::vector<double>{10, 20, 30}));  // two commas in a field
+}
+
+TEST(TextDecimalComma, AThousandsSeparatorIsAnErrorNotANumber) {
+  TempDir dir;
+  try {
+    read_text(dir, "1.234,5;2;3\n");
+    FAIL() << "1.234,5 was read as a number";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 1: column 1 '1.234,5' is not a number"), std::string::npos) << e.what();
+  }
+}

@@ -1,5 +1,8 @@
 // Points from text: XYZ/TXT/CSV, one point per line, columns separated by spaces,
-// tabs, commas or semicolons. Lines starting with '#' or '//' and empty lines are
+// tabs, commas or semicolons. A file whose first data line has a semicolon, or commas
+// standing alone between digits in fields separated by spaces or tabs ("1,5;2,25;3",
+// "1,5 2,25 3"), has decimal commas, as spreadsheets in most of Europe write them: its
+// commas are decimal marks, not separators. Lines starting with '#' or '//' and empty lines are
 // skipped. A first line of names (after `skip_lines`), as PDAL's writers.text
 // ("X","Y","Z","Intensity"), CloudCompare (//X,Y,Z,R,G,B) and vola export
 // (# x y z intensity) write it, is a header: never read as a point, and, when the
