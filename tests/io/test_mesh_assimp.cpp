@@ -9,6 +9,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "../mesh/mesh_test_support.hpp"
 #include "memory_cap.hpp"
@@ -334,6 +335,41 @@ TEST(MeshAssimp, OffCountsAreCheckedAsAssimpReadsThem) {
     EXPECT_NE(outcome.find("536870911 faces (as 32-bit counts), more than the file's"), std::string::npos)
         << name << ": " << outcome;
   }
+}
+
+// A scene that names other files (a glTF buffer's URI, an OBJ's material library) made
+// Assimp open them: the bytes of any local file became vertices, a FIFO blocked forever, a
+// large file was read whole. Only the given file is read now; the triangle below is the
+// other file's floats, so reading it would show.
+TEST(MeshAssimp, ScenesCannotReadOtherFiles) {
+  vola_test::TempDir dir;
+  const float positions[9] = {11, 12, 13, 21, 22, 23, 31, 32, 33};
+  write_file(dir / "secret.bin", std::string(reinterpret_cast<const char*>(positions), sizeof positions));
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  const auto gltf = [](const std::string& uri) {
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[11,12,13],"max":[31,32,33]}],
+    "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36}],
+    "buffers":[{"byteLength":36,"uri":")" + uri + R"("}]})";
+  };
+  fs::create_directories(dir / "sub");
+  const std::pair<fs::path, std::string> scenes[] = {
+      {dir / "absolute.gltf", (dir / "secret.bin").string()},
+      {dir / "sub" / "parent.gltf", "../secret.bin"},
+      {dir / "beside.gltf", "secret.bin"},
+      {dir / "fifo.gltf", (dir / "fifo").string()},
+  };
+  for (const auto& [path, uri] : scenes) {
+    write_file(path, gltf(uri));
+    const auto error = vola_test::format_error_of([&] { vola::io::read_mesh_triangles(path.string()); });
+    ASSERT_TRUE(error.has_value()) << path;
+    EXPECT_NE(error->cause().find("the scene's data lies in another file, '"), std::string::npos) << error->cause();
+    EXPECT_NE(error->cause().find(uri.substr(uri.rfind('/') + 1) + "'"), std::string::npos) << error->cause();
+  }
+  // An OBJ's material library is not geometry: the triangle is read, the library never opened.
+  write_file(dir / "fifo_mtl.obj", "mtllib " + (dir / "fifo").string() + "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(vola::io::read_mesh_triangles((dir / "fifo_mtl.obj").string()).size(), 1u);
 }
 
 TEST(MeshAssimp, OnlyTheDocumentedMeshFormatsReachAssimp) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string_view>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -90,13 +91,52 @@ void check_off_counts(const std::string& path) {
                           std::to_string(bytes) + " bytes can hold");
 }
 
+// Assimp opens whatever files a scene names: a glTF buffer's URI (an absolute path, a
+// "../" path, a FIFO that blocks forever, a 500 MB library read whole into memory) and an
+// OBJ's `mtllib`. vola reads the file it is given and nothing else (docs/SECURITY.md), so
+// the importer sees every other path as absent; the first one asked for is kept for the
+// error. A missing material file is only a warning to Assimp; a missing glTF buffer fails
+// the import.
+class ConfinedIOSystem : public Assimp::DefaultIOSystem {
+ public:
+  explicit ConfinedIOSystem(std::filesystem::path input) : input_(std::move(input)) {}
+
+  bool Exists(const char* file) const override { return allowed(file) && DefaultIOSystem::Exists(file); }
+
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    return allowed(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+  }
+
+  // The first other file the scene named ("" when none).
+  const std::string& refused() const noexcept { return refused_; }
+
+ private:
+  bool allowed(const char* file) const {
+    std::error_code error;
+    if (file && std::filesystem::is_regular_file(file, error) && std::filesystem::equivalent(file, input_, error))
+      return true;
+    if (refused_.empty()) refused_ = file ? file : "";
+    return false;
+  }
+
+  std::filesystem::path input_;
+  mutable std::string refused_;
+};
+
 }  // namespace
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   check_mesh_extension(path);
   check_off_counts(path);
   Assimp::Importer importer;
+  auto* io = new ConfinedIOSystem(path);
+  importer.SetIOHandler(io);  // the importer owns it
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+  if (!scene && !io->refused().empty())
+    throw FormatError(path, std::nullopt,
+                      "the scene's data lies in another file, '" + io->refused() +
+                          "', and vola reads only the file it is given (a glTF with its buffers embedded, "
+                          "such as a .glb, holds everything)");
   // Assimp's validation refuses a mesh of vertices alone: an OBJ point cloud ("v" lines,
   // no faces, as CloudCompare and scanners write them). Such a file is read again without
   // it and taken only when no mesh has a face; its vertices are then points (degenerate
