@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "filtering.hpp"
 #include "georeference.hpp"
@@ -108,6 +110,21 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
 }
 
+// A grid the points cannot be put on (an extent beyond a double or beyond depth 10, a
+// file's grid too large) is said by the core without the file's name; an option's
+// error already names what to change.
+template <class Build>
+Tree name_input_in_errors(const std::string& path, Build&& build) {
+  try {
+    return build();
+  } catch (const OptionError&) {
+    throw;
+  } catch (const InvalidArgument& e) {
+    if (std::string_view(e.what()).starts_with(path)) throw;
+    throw InvalidArgument(path + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 Tree convert(const std::string& path, const ConvertOptions& options, const ConvertProgress& progress,
@@ -126,7 +143,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
 
   CentreLatLon centre(crs.epsg, crs.wkt.empty() ? input.wkt : crs.wkt);  // PROJ gets ready while the tree is built
   ConvertReport report;
-  Tree tree = build_tree(path, input, options, build, report.build);
+  Tree tree = name_input_in_errors(path, [&] { return build_tree(path, input, options, build, report.build); });
   georeference(tree, crs, tree.frame().quantization, centre);
   if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
   if (report_out) {

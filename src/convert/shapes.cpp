@@ -15,9 +15,12 @@ Tree tree_from_grid_cells(const io::VoxelGrid& grid, int requested_depth, BuildR
   if (depth == 0)
     for (depth = 1; depth < kMaxDepth && side_of(depth) < largest; ++depth) {
     }
-  if (side_of(depth) < largest)
-    throw OptionError("depth", "a " + std::to_string(largest) + "-cell grid does not fit depth " + std::to_string(depth) +
-                                   " (" + std::to_string(side_of(depth)) + " voxels per axis)");
+  if (side_of(depth) < largest) {
+    const std::string cause = "a " + std::to_string(largest) + "-cell grid does not fit depth " + std::to_string(depth) +
+                              " (" + std::to_string(side_of(depth)) + " voxels per axis)";
+    if (requested_depth != 0) throw OptionError("depth", cause);
+    throw InvalidArgument(cause + ", the deepest a tree has");
+  }
   Tree tree;
   if (grid.attributes.empty()) {
     tree = build_from_voxels(grid.voxels, depth);

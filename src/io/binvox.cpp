@@ -126,6 +126,9 @@ VoxelGrid parse_binvox(std::span<const std::uint8_t> bytes, const std::string& n
   grid.dims = {static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(b)};
   grid.origin = translate;
   grid.voxel_size = scale / static_cast<double>(std::max({a, b, c}));
+  if (!(grid.voxel_size > 0))  // a denormal scale over a large dim rounds to 0
+    throw FormatError(name, at, "scale " + number_text(scale) + " over " + std::to_string(std::max({a, b, c})) +
+                                    " cells makes a voxel size of 0");
   // First the runs alone: how many voxels they set, before storing any.
   const std::uint64_t occupied = walk_runs(bytes, at, cells, name, [](std::uint8_t, std::uint64_t, std::uint64_t) {});
   const std::uint64_t limit = kBinvoxVoxelAllowance + kBinvoxVoxelsPerByte * bytes.size();

@@ -424,3 +424,52 @@ TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
   EXPECT_TRUE(vola::is_geographic_crs("EPSG:4979"));
   EXPECT_FALSE(vola::is_geographic_crs("EPSG:32610"));
 }
+
+namespace {
+
+std::string convert_error(const std::string& path, const vola::ConvertOptions& options) {
+  try {
+    vola::convert(path, options);
+  } catch (const vola::OptionError& e) {
+    return std::string("OptionError ") + e.what();
+  } catch (const vola::InvalidArgument& e) {
+    return e.what();
+  }
+  return "(converted)";
+}
+
+// Finite points whose extent overflows a double (-1e308 .. 1e308) all fell into voxel 0
+// with NaN centres, exit 0, under toolkit quantization; a grid too large for any depth
+// blamed --depth, which was not given. Each is refused naming the file.
+TEST(Convert, GridsThePointsCannotBePutOnAreRefusedNamingTheFile) {
+  vola_test::TempDir dir;
+  const std::string overflow = (dir / "overflow.xyz").string();
+  const std::string text = "-1e308 0 0\n1e308 1 1\n4 5 6\n";
+  vola_test::write_bytes(overflow, std::vector<std::uint8_t>(text.begin(), text.end()));
+  vola::ConvertOptions toolkit;
+  toolkit.quantization = vola::Quantization::toolkit;
+  toolkit.depth = 2;
+  EXPECT_EQ(convert_error(overflow, toolkit).rfind(overflow + ": toolkit quantization cannot scale", 0), 0u)
+      << convert_error(overflow, toolkit);
+  vola::ConvertOptions grid;
+  grid.voxel_size = 1;
+  EXPECT_EQ(convert_error(overflow, grid).rfind(overflow + ": an extent of", 0), 0u) << convert_error(overflow, grid);
+  // The same extent lost beside its coordinates: 1e300 + 1e-10 is 1e300.
+  const std::string lost = (dir / "lost.xyz").string();
+  const std::string close = "1e300 0 0\n1e300 1e-10 0\n";
+  vola_test::write_bytes(lost, std::vector<std::uint8_t>(close.begin(), close.end()));
+  EXPECT_NE(convert_error(lost, toolkit).find("its extent is lost beside its coordinates"), std::string::npos);
+  // A binvox grid wider than depth 10's 4^10 cells, without --depth.
+  const std::string wide = (dir / "wide.binvox").string();
+  const std::string binvox = "#binvox 1\ndim 1048577 1 1\ntranslate 0 0 0\nscale 1\ndata\n";
+  std::vector<std::uint8_t> bytes(binvox.begin(), binvox.end());
+  for (int run = 0; run < 4112; ++run) bytes.insert(bytes.end(), {1, 255});
+  bytes.insert(bytes.end(), {1, 17});  // 4112 * 255 + 17 = 1048577 cells
+  vola_test::write_bytes(wide, bytes);
+  EXPECT_EQ(convert_error(wide, {}), wide + ": a 1048577-cell grid does not fit depth 10 (1048576 voxels per axis), the deepest a tree has");
+  vola::ConvertOptions depth3;
+  depth3.depth = 3;
+  EXPECT_EQ(convert_error(wide, depth3).rfind("OptionError depth: a 1048577-cell grid does not fit depth 3", 0), 0u);
+}
+
+}  // namespace

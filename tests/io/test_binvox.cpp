@@ -186,6 +186,9 @@ TEST(Binvox, CorruptedInputIsAFormatErrorNamingTheProblem) {
       {binvox_text("#binvox 1\ndim 4000000000 4000000000 4000000000\ndata\n", {}), "more cells than 64 bits"},
       {binvox_text("#binvox 1\nscale -1\ndim 2 2 2\ndata\n", {1, 8}), "positive"},
       {binvox_text("#binvox 1\ntranslate 0 nan 0\ndim 2 2 2\ndata\n", {1, 8}), "finite"},
+      // A denormal scale over 1000 cells: a voxel size of 0, which the .vol reader refuses.
+      {binvox_text("#binvox 1\ndim 1000 1 1\nscale 4.9e-324\ndata\n", {1, 255, 1, 255, 1, 255, 1, 235}),
+       "makes a voxel size of 0"},
       {binvox_text("#binvox 1\ncolour red\ndata\n", {}), "unknown header keyword"},
       {binvox_text("#binvox 1\ndata\n", {1, 8}), "no 'dim' line"},
       {binvox_text(head, {1, 4, 2, 4}), "run value 2"},
