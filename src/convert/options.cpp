@@ -3,7 +3,9 @@
 #include "options.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 
 #include "vola/attributes.hpp"
 #include "vola/error.hpp"
@@ -80,17 +82,27 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
   columns.y = options.columns[1] - 1;
   columns.z = options.columns[2] - 1;
   columns.skip_lines = options.skip_lines;
-  // A header line lays the columns out unless the options do.
-  columns.from_header = options.columns == std::array<int, 3>{1, 2, 3} && options.payload_columns.empty() &&
-                        options.text_attributes.empty() && options.nbits == 0;
+  // A header line lays the columns out unless the options do: all of them when no column
+  // option is given, x, y and z (--columns 1 2 3 being the default) when only payload or
+  // attribute columns are.
+  const bool xyz_given = options.columns != std::array<int, 3>{1, 2, 3};
+  columns.from_header = !xyz_given && options.payload_columns.empty() && options.text_attributes.empty() &&
+                        options.nbits == 0;
+  columns.named_attributes = options.attributes;
+  std::optional<std::array<int, 3>> named;
+  if (!xyz_given && !columns.from_header)
+    if (const auto header = io::read_text_header(input, options.skip_lines)) named = io::named_xyz_columns(*header);
+  if (named) columns.x = (*named)[0], columns.y = (*named)[1], columns.z = (*named)[2];
   if (options.nbits > 0) {
     if (!options.payload_columns.empty()) {
       for (int c : options.payload_columns) columns.payload.push_back(c - 1);
     } else {
-      // The reference's xyz2vola: every column after x y z is a payload byte.
+      // The reference's xyz2vola: every column after x y z is a payload byte (with a
+      // header naming x, y and z: every other column).
       const int n = io::count_text_columns(input, options.skip_lines);
       const int last_xyz = std::max({columns.x, columns.y, columns.z});
-      for (int c = last_xyz + 1; c < n && columns.payload.size() < 8; ++c) columns.payload.push_back(c);
+      for (int c = named ? 0 : last_xyz + 1; c < n && columns.payload.size() < 8; ++c)
+        if (c != columns.x && c != columns.y && c != columns.z) columns.payload.push_back(c);
     }
   }
   for (const auto& spec : options.text_attributes) {

@@ -301,7 +301,16 @@ double grid_line_below(double value, double step, double anchor) {
 
 Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   options.check();
-  if (options.quantization == Quantization::toolkit) return Quantizer::toolkit(bbox, options.depth);
+  if (options.quantization == Quantization::toolkit) {
+    // Finite points whose extent overflows a double (-1e308 .. 1e308) have no scale:
+    // every point fell into voxel 0 with NaN centres.
+    for (int a = 0; a < 3; ++a)
+      if (std::isinf(bbox.max[a] - bbox.min[a]))
+        VOLA_THROW(InvalidArgument("toolkit quantization cannot scale the points' bounding box onto a grid: from " +
+                                   number_text(bbox.min[a]) + " to " + number_text(bbox.max[a]) + " along " +
+                                   std::string(1, "xyz"[a]) + " is beyond a double"));
+    return Quantizer::toolkit(bbox, options.depth);
+  }
   double extent_from_min = 0.0;
   for (int a = 0; a < 3; ++a) extent_from_min = std::max(extent_from_min, bbox.max[a] - bbox.min[a]);
   double voxel_size = options.voxel_size;

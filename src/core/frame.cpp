@@ -38,16 +38,6 @@ Quantizer Quantizer::toolkit(const Box& bbox, int depth) {
     q.scale_[a] = (bbox.min[a] + longest) - bbox.min[a];
   }
   q.degenerate_ = !(longest > 0.0);
-  // Finite points whose extent overflows a double (-1e308 .. 1e308), or so small beside
-  // their coordinates that min + extent rounds back to min, have no scale: every point
-  // would fall into voxel 0 with NaN centres.
-  for (int a = 0; a < 3 && !q.degenerate_; ++a)
-    if (!std::isfinite(longest) || !std::isfinite(q.scale_[a]) || !(q.scale_[a] > 0.0))
-      VOLA_THROW(InvalidArgument("toolkit quantization cannot scale the points' bounding box " + short_number(bbox.min[0]) +
-                                 " " + short_number(bbox.min[1]) + " " + short_number(bbox.min[2]) + " .. " +
-                                 short_number(bbox.max[0]) + " " + short_number(bbox.max[1]) + " " +
-                                 short_number(bbox.max[2]) + " onto a grid: its extent is " +
-                                 (std::isfinite(longest) ? "lost beside its coordinates" : "beyond a double")));
   return q;
 }
 

@@ -4,9 +4,11 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string_view>
+#include <unordered_set>
 
 #include "column_names.hpp"
 #include "vola/error.hpp"
@@ -46,6 +48,37 @@ bool is_separator(char c, bool decimal_comma) {
   return c == ' ' || c == '\t' || c == ';' || c == '\r' || (c == ',' && !decimal_comma);
 }
 
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";  // UTF-8's, as Excel's "CSV UTF-8" begins
+
+// A file's first line without the UTF-8 byte order mark, and how many bytes that took.
+std::size_t byte_order_mark(std::string_view line, std::uint64_t line_number) {
+  return line_number == 1 && line.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
+}
+
+// How the file ends its lines: '\n' (with or without '\r' before it), or '\r' alone as
+// classic Mac OS and some instruments write, told from the first 64 KiB.
+char line_end_of(std::ifstream& in) {
+  std::array<char, 1 << 16> head;
+  in.read(head.data(), head.size());
+  const std::string_view bytes(head.data(), static_cast<std::size_t>(in.gcount()));
+  in.clear();
+  in.seekg(0);
+  return bytes.find('\n') == std::string_view::npos && bytes.find('\r') != std::string_view::npos ? '\r' : '\n';
+}
+
+// Leica's PTS begins each scan with a line holding its point count alone.
+bool has_count_lines(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".pts";
+}
+
+bool is_count_line(std::string_view line) {
+  while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\t' || line.back() == '\r')) line.remove_suffix(1);
+  return !line.empty() && std::all_of(line.begin(), line.end(), is_digit);
+}
+
 bool is_data_line(std::string_view line) {
   std::size_t i = 0;
   while (i < line.size() && is_separator(line[i], false)) ++i;
@@ -67,8 +100,10 @@ bool parse_number(std::string_view text, bool decimal_comma, double& value) {
 class LineParser {
  public:
   // `header_line`: a line of column names to pass over (0: none).
-  LineParser(const std::string& path, const TextColumns& columns, PointCloud& cloud, std::uint64_t header_line)
-      : path_(path), columns_(columns), cloud_(cloud), header_line_(header_line) {
+  // `count_lines`: lines of one integer are a PTS file's point counts, passed over.
+  LineParser(const std::string& path, const TextColumns& columns, PointCloud& cloud, std::uint64_t header_line,
+             bool count_lines)
+      : path_(path), columns_(columns), cloud_(cloud), header_line_(header_line), count_lines_(count_lines) {
     max_column_ = std::max({columns.x, columns.y, columns.z});
     for (int c : columns.payload) max_column_ = std::max(max_column_, c);
     for (int c : columns.attribute_columns) max_column_ = std::max(max_column_, c);
@@ -81,28 +116,49 @@ class LineParser {
   }
 
   void parse(std::string_view line, std::uint64_t line_number, std::uint64_t offset) {
+    const std::size_t mark = byte_order_mark(line, line_number);
+    line.remove_prefix(mark);
+    offset += mark;
     std::size_t i = 0;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
     if (i == line.size() || line[i] == '#' || line.substr(i, 2) == "//") return;
     if (line_number <= static_cast<std::uint64_t>(columns_.skip_lines) || line_number == header_line_) return;
-    // The file's first data line says whether its decimal mark is a comma, for every line.
-    if (!decimal_comma_) decimal_comma_ = uses_decimal_comma(line);
+    if (count_lines_ && is_count_line(line)) return;
+    // Each line says whether its decimal mark is a comma: a file whose first point has
+    // whole numbers may write "1,5" further down.
+    const bool decimal_comma = uses_decimal_comma(line);
     int column = 0;
-    while (i < line.size() && column <= max_column_) {
+    while (i < line.size()) {
       std::size_t end = i;
-      while (end < line.size() && !is_separator(line[end], *decimal_comma_)) ++end;
-      double v = 0;
-      if (!parse_number(line.substr(i, end - i), *decimal_comma_, v))
-        fail(line_number, offset + i, "column " + std::to_string(column + 1) + " '" +
-                                          std::string(line.substr(i, end - i)) + "' is not a number");
-      values_[static_cast<std::size_t>(column)] = v;
+      while (end < line.size() && !is_separator(line[end], decimal_comma)) ++end;
+      if (column <= max_column_) {
+        double v = 0;
+        if (!parse_number(line.substr(i, end - i), decimal_comma, v)) {
+          const std::string word(line.substr(i, end - i));
+          // An ESRI ASCII grid (.asc, as the text points are) begins "ncols N".
+          const bool grid = column == 0 && (word == "ncols" || word == "NCOLS" || word == "nrows" || word == "NROWS");
+          fail(line_number, offset + i,
+               "column " + std::to_string(column + 1) + " '" + word + "' is not a number" +
+                   (grid ? " (an ESRI ASCII grid? read it as an elevation raster with --format dem)" : ""));
+        }
+        values_[static_cast<std::size_t>(column)] = v;
+      }
       ++column;
       i = end;
-      while (i < line.size() && is_separator(line[i], *decimal_comma_)) ++i;
+      while (i < line.size() && is_separator(line[i], decimal_comma)) ++i;
     }
     if (column <= max_column_)
       fail(line_number, offset, "has " + std::to_string(column) + " columns, column " +
                                     std::to_string(max_column_ + 1) + " is needed");
+    // Every point has the columns of the first: a line with more is not read in part
+    // (a file of lines ended by something else, commas that are decimal marks).
+    if (columns_per_line_ == 0) {
+      columns_per_line_ = column;
+      first_line_ = line_number;
+    } else if (column != columns_per_line_) {
+      fail(line_number, offset, "has " + std::to_string(column) + " columns where line " + std::to_string(first_line_) +
+                                    ", the first point, has " + std::to_string(columns_per_line_));
+    }
     cloud_.xyz.push_back(values_[static_cast<std::size_t>(columns_.x)]);
     cloud_.xyz.push_back(values_[static_cast<std::size_t>(columns_.y)]);
     cloud_.xyz.push_back(values_[static_cast<std::size_t>(columns_.z)]);
@@ -130,9 +186,11 @@ class LineParser {
   const TextColumns& columns_;
   PointCloud& cloud_;
   std::uint64_t header_line_;
+  bool count_lines_;
   int max_column_ = 2;
   std::vector<double> values_;
-  std::optional<bool> decimal_comma_;
+  int columns_per_line_ = 0;  // the first point's
+  std::uint64_t first_line_ = 0;
 };
 
 std::string_view unquoted(std::string_view w) {
@@ -176,16 +234,20 @@ void type_colours(PointCloud& cloud) {
 std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
+  const char line_end = line_end_of(in);
   std::string line;
   std::uint64_t number = 0, next_offset = 0;
   std::vector<std::string> names;
   // Leading comment lines may carry the names (CloudCompare, vola export); the first
   // other line ends the search, and is a header itself when it holds names only.
-  while (std::getline(in, line)) {
-    const std::uint64_t offset = next_offset;
+  while (std::getline(in, line, line_end)) {
+    std::uint64_t offset = next_offset;
     next_offset += line.size() + 1;
     if (++number <= static_cast<std::uint64_t>(skip_lines)) continue;
     std::string_view rest(line);
+    const std::size_t mark = byte_order_mark(rest, number);
+    rest.remove_prefix(mark);
+    offset += mark;
     while (!rest.empty() && is_separator(rest.front(), false)) rest.remove_prefix(1);
     if (rest.empty()) continue;
     TextHeader header;
@@ -218,18 +280,19 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
   return std::nullopt;
 }
 
+std::optional<std::array<int, 3>> named_xyz_columns(const TextHeader& header) { return xyz_columns(header.names); }
+
 TextColumns text_columns_of(const TextHeader& header) {
   TextColumns columns;
   const auto xyz = xyz_columns(header.names);
   if (!xyz) throw InvalidArgument("the header names no x, y and z columns");
   columns.x = (*xyz)[0], columns.y = (*xyz)[1], columns.z = (*xyz)[2];
+  std::unordered_set<std::string> taken;  // a header of 80,000 names took seconds with a search per name
   for (std::size_t c = 0; c < header.names.size(); ++c) {
     const int column = static_cast<int>(c);
     if (column == columns.x || column == columns.y || column == columns.z) continue;
     std::string name = point_column_name(header.names[c]);
-    const bool taken = std::any_of(columns.attributes.begin(), columns.attributes.end(),
-                                   [&](const PointAttribute& a) { return a.name == name; });
-    if (taken || name.empty()) continue;  // a second column of one name stays unread, as in PLY
+    if (name.empty() || !taken.insert(name).second) continue;  // a second column of one name stays unread, as in PLY
     const Reduction reduction = point_column_reduction(name);
     columns.attributes.push_back({std::move(name), ValueType::f64, reduction, {}});
     columns.attribute_columns.push_back(column);
@@ -240,11 +303,14 @@ TextColumns text_columns_of(const TextHeader& header) {
 int count_text_columns(const std::string& path, int skip_lines) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
+  const char line_end = line_end_of(in);
+  const bool count_lines = has_count_lines(path);
   std::string line;
   int line_number = 0;
-  while (std::getline(in, line)) {
+  while (std::getline(in, line, line_end)) {
     if (++line_number <= skip_lines) continue;
-    if (!is_data_line(line)) continue;
+    if (line_number == 1) line.erase(0, byte_order_mark(line, 1));
+    if (!is_data_line(line) || (count_lines && is_count_line(line))) continue;
     const bool decimal_comma = uses_decimal_comma(line);
     std::size_t i = 0;
     while (i < line.size() && is_separator(line[i], decimal_comma)) ++i;
@@ -266,6 +332,7 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
   in.seekg(0, std::ios::end);
   const std::uint64_t total = static_cast<std::uint64_t>(in.tellg());
   in.seekg(0);
+  const char line_end = line_end_of(in);
   // A header line is never a point; it lays the columns out when they are left to it.
   const std::optional<TextHeader> header = read_text_header(path, columns.skip_lines);
   TextColumns layout = columns;
@@ -276,9 +343,10 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
                                  " say which columns hold them (--columns X Y Z, counted from 1)");
     layout = text_columns_of(*header);
     layout.skip_lines = columns.skip_lines;
+    if (!columns.named_attributes) layout.attributes.clear(), layout.attribute_columns.clear();
   }
   PointCloud cloud;
-  LineParser parser(path, layout, cloud, header && !header->comment ? header->line : 0);
+  LineParser parser(path, layout, cloud, header && !header->comment ? header->line : 0, has_count_lines(path));
   constexpr std::size_t kChunk = 8 << 20;
   std::string buffer;
   std::uint64_t consumed = 0;  // file offset of buffer[0]
@@ -292,7 +360,7 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     buffer.append(chunk.data(), got);
     std::size_t start = 0;
     for (;;) {
-      std::size_t newline = buffer.find('\n', start);
+      std::size_t newline = buffer.find(line_end, start);
       if (newline == std::string::npos) {
         if (!eof) break;
         if (start == buffer.size()) break;

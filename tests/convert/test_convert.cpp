@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -454,11 +455,6 @@ TEST(Convert, GridsThePointsCannotBePutOnAreRefusedNamingTheFile) {
   vola::ConvertOptions grid;
   grid.voxel_size = 1;
   EXPECT_EQ(convert_error(overflow, grid).rfind(overflow + ": an extent of", 0), 0u) << convert_error(overflow, grid);
-  // The same extent lost beside its coordinates: 1e300 + 1e-10 is 1e300.
-  const std::string lost = (dir / "lost.xyz").string();
-  const std::string close = "1e300 0 0\n1e300 1e-10 0\n";
-  vola_test::write_bytes(lost, std::vector<std::uint8_t>(close.begin(), close.end()));
-  EXPECT_NE(convert_error(lost, toolkit).find("its extent is lost beside its coordinates"), std::string::npos);
   // A binvox grid wider than depth 10's 4^10 cells, without --depth.
   const std::string wide = (dir / "wide.binvox").string();
   const std::string binvox = "#binvox 1\ndim 1048577 1 1\ntranslate 0 0 0\nscale 1\ndata\n";
@@ -470,6 +466,60 @@ TEST(Convert, GridsThePointsCannotBePutOnAreRefusedNamingTheFile) {
   vola::ConvertOptions depth3;
   depth3.depth = 3;
   EXPECT_EQ(convert_error(wide, depth3).rfind("OptionError depth: a 1048577-cell grid does not fit depth 3", 0), 0u);
+}
+
+}  // namespace
+
+namespace {
+
+std::vector<std::array<double, 3>> centres(const vola::Tree& tree) {
+  std::vector<std::array<double, 3>> out;
+  const vola::Frame frame = tree.frame();
+  tree.for_each_voxel([&](const vola::Voxel& v) {
+    out.push_back({frame.origin[0] + (v.x + 0.5) * frame.voxel_size, frame.origin[1] + (v.y + 0.5) * frame.voxel_size,
+                   frame.origin[2] + (v.z + 0.5) * frame.voxel_size});
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A header naming x, y and z placed them only when no column option was given: with
+// --attribute or --nbits, x and z of "z,y,x" were swapped (exit 0). --no-attributes kept
+// the header's other columns.
+TEST(Convert, TextHeadersPlaceXyzWhateverColumnsAreKept) {
+  vola_test::TempDir dir;
+  const std::string zyx = (dir / "zyx.csv").string();
+  const std::string text = "z,y,x,intensity\n3,2,1,7\n6,5,4,9\n";
+  vola_test::write_bytes(zyx, std::vector<std::uint8_t>(text.begin(), text.end()));
+  vola::ConvertOptions options;
+  options.voxel_size = 1;
+  const auto expected = std::vector<std::array<double, 3>>{{1.5, 2.5, 3.5}, {4.5, 5.5, 6.5}};
+  EXPECT_EQ(centres(vola::convert(zyx, options)), expected);
+  options.text_attributes = {"intensity=4"};
+  const vola::Tree kept = vola::convert(zyx, options);
+  EXPECT_EQ(centres(kept), expected);
+  EXPECT_EQ(kept.attributes().size(), 1u);
+  options.text_attributes.clear();
+  options.attributes = false;
+  const vola::Tree bare = vola::convert(zyx, options);
+  EXPECT_EQ(centres(bare), expected);
+  EXPECT_EQ(bare.attributes().size(), 0u);
+  // Columns given explicitly still win over the header.
+  options.attributes = true;
+  options.columns = {3, 2, 4};
+  EXPECT_EQ(centres(vola::convert(zyx, options)),
+            (std::vector<std::array<double, 3>>{{1.5, 2.5, 7.5}, {4.5, 5.5, 9.5}}));
+  // --nbits 1: the payload bytes are the columns other than x, y and z.
+  const std::string rgbxyz = (dir / "rgbxyz.xyz").string();
+  const std::string coloured = "r g b x y z\n10 20 30 1 1 1\n40 50 60 5 5 5\n";
+  vola_test::write_bytes(rgbxyz, std::vector<std::uint8_t>(coloured.begin(), coloured.end()));
+  vola::ConvertOptions payload;
+  payload.voxel_size = 1;
+  payload.nbits = 1;
+  const vola::Tree with_payload = vola::convert(rgbxyz, payload);
+  EXPECT_EQ(centres(with_payload), (std::vector<std::array<double, 3>>{{1.5, 1.5, 1.5}, {5.5, 5.5, 5.5}}));
+  ASSERT_EQ(with_payload.voxel_payloads().size(), 2u);
+  EXPECT_EQ(with_payload.voxel_payloads()[0], 0x1e140aull);  // 10, 20, 30
 }
 
 }  // namespace

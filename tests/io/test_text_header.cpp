@@ -3,6 +3,7 @@
 // unless the caller does.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -114,9 +115,11 @@ TEST(TextDecimalComma, SemicolonAndTabFilesReadTheirCommasAsDecimalMarks) {
   const auto tabs = read_text(dir, "1,5\t2,25\t3\n+4,125 5 6,5\n");
   EXPECT_EQ(tabs.xyz, (std::vector<double>{1.5, 2.25, 3, 4.125, 5, 6.5}));
   EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 3);
-  // Decided by the first data line: a later "1,5" in a decimal-comma file is never split.
+  // Decided line by line: a first point of whole numbers says nothing about the next.
   const auto later = read_text(dir, "1;2;3\n1,5;2;3\n");
   EXPECT_EQ(later.xyz, (std::vector<double>{1, 2, 3, 1.5, 2, 3}));
+  const auto tab_later = read_text(dir, "0\t0\t0\n1,5\t2,25\t3,75\n");  // was read as 1 5 2, exit 0
+  EXPECT_EQ(tab_later.xyz, (std::vector<double>{0, 0, 0, 1.5, 2.25, 3.75}));
 }
 
 TEST(TextDecimalComma, PlainCsvKeepsCommasAsSeparators) {
@@ -136,4 +139,65 @@ TEST(TextDecimalComma, AThousandsSeparatorIsAnErrorNotANumber) {
   } catch (const vola::FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("line 1: column 1 '1.234,5' is not a number"), std::string::npos) << e.what();
   }
+}
+
+// A line with more columns than the first point's was read in part: the file's other
+// points are not silently dropped or mixed up.
+TEST(TextLines, EveryPointHasTheFirstPointsColumns) {
+  TempDir dir;
+  try {
+    read_text(dir, "1 2 3\n4 5 6 7\n");
+    FAIL() << "a line of four columns after one of three was read";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2: has 4 columns where line 1, the first point, has 3"), std::string::npos)
+        << e.what();
+  }
+  // Separators at the ends and doubled separators are no columns.
+  EXPECT_EQ(read_text(dir, "1 2 3\n 4  5 6 \n7,8,9,\n").xyz, (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+}
+
+// Lines ended by a carriage return alone (classic Mac OS, some instruments) were one line
+// of every point's columns, read as the first point alone.
+TEST(TextLines, CarriageReturnsAloneEndLines) {
+  TempDir dir;
+  EXPECT_EQ(read_text(dir, "1 2 3\r4 5 6\r7 8 9\r").xyz, (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  const auto named = read_text(dir, "x,y,z,intensity\r1,2,3,10\r4,5,6,20");
+  EXPECT_EQ(named.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(column(named, "intensity").values, (std::vector<double>{10, 20}));
+  EXPECT_EQ(read_text(dir, "1 2 3\r\n4 5 6\r\n").xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 3);
+}
+
+// Excel's "CSV UTF-8" begins with a byte order mark: "x" was read as "\xEF\xBB\xBFx",
+// and a first number as no number.
+TEST(TextLines, AByteOrderMarkIsPassedOver) {
+  TempDir dir;
+  const auto named = read_text(dir, "\xEF\xBB\xBF" "x,y,z\n1,2,3\n");
+  EXPECT_EQ(named.xyz, (std::vector<double>{1, 2, 3}));
+  EXPECT_EQ(read_text(dir, "\xEF\xBB\xBF" "1 2 3\n4 5 6\n").xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 3);
+}
+
+// Leica PTS: each scan begins with its point count on a line of its own.
+TEST(TextLines, PtsCountLinesArePassedOver) {
+  TempDir dir;
+  const auto path = dir / "scan.pts";
+  std::ofstream(path, std::ios::binary) << "2\n1.0 2.0 3.0 -1200 255 0 0\n4 5 6 -900 0 255 0\n1\n7 8 9 0 0 0 255\n";
+  EXPECT_EQ(vola::io::read_text_points(path.string(), {}).xyz, (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  EXPECT_EQ(vola::io::count_text_columns(path.string(), 0), 7);
+  // Elsewhere a lone number is a short line, as before.
+  EXPECT_THROW(read_text(dir, "2\n1 2 3\n"), vola::FormatError);
+}
+
+// Each name of a header was looked for among the names before it: 80,000 columns took
+// seconds. Bounded here at a second for 100,000, far above what a hash set needs.
+TEST(TextHeader, ManyColumnsAreNamedInLinearTime) {
+  TempDir dir;
+  std::string header = "x,y,z", values = "1,2,3";
+  for (int c = 0; c < 100000; ++c) header += ",c" + std::to_string(c), values += ",0";
+  const auto start = std::chrono::steady_clock::now();
+  const auto cloud = read_text(dir, header + "\n" + values + "\n");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(cloud.attributes.size(), 100000u);
+  EXPECT_LT(seconds, 1.0);
 }

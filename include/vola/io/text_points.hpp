@@ -1,8 +1,11 @@
 // Points from text: XYZ/TXT/CSV, one point per line, columns separated by spaces,
-// tabs, commas or semicolons. A file whose first data line has a semicolon, or commas
-// standing alone between digits in fields separated by spaces or tabs ("1,5;2,25;3",
-// "1,5 2,25 3"), has decimal commas, as spreadsheets in most of Europe write them: its
-// commas are decimal marks, not separators. Lines starting with '#' or '//' and empty lines are
+// tabs, commas or semicolons; every point line has as many columns as the first. A line
+// with a semicolon, or with commas standing alone between digits in fields separated by
+// spaces or tabs ("1,5;2,25;3", "1,5 2,25 3"), has decimal commas, as spreadsheets in
+// most of Europe write them: its commas are decimal marks, not separators. Lines end with
+// "\n" ("\r\n" too), or with "\r" alone when the file's first 64 KiB hold no "\n"; a
+// UTF-8 byte order mark is passed over; in a .pts file (Leica), a line holding one
+// integer is a scan's point count, passed over. Lines starting with '#' or '//' and empty lines are
 // skipped. A first line of names (after `skip_lines`), as PDAL's writers.text
 // ("X","Y","Z","Intensity"), CloudCompare (//X,Y,Z,R,G,B) and vola export
 // (# x y z intensity) write it, is a header: never read as a point, and, when the
@@ -10,6 +13,7 @@
 // z and names every other column as an attribute.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -32,6 +36,8 @@ struct TextColumns {
   // Take x, y, z and the attributes from a header line naming x, y and z, when the file
   // has one (the members above then describe a file without one).
   bool from_header = true;
+  // With from_header: keep the header's other columns as attributes (false: x, y, z only).
+  bool named_attributes = true;
 };
 
 // The column names of a header line (see above), or none when the first line after
@@ -51,6 +57,8 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
 // spellings of LAS fields (ReturnNumber, GpsTime, ...) and CloudCompare's R, G, B under
 // the LAS reader's names.
 TextColumns text_columns_of(const TextHeader& header);
+// The columns (0-based) a header names x, y and z, or none when it does not name all three.
+std::optional<std::array<int, 3>> named_xyz_columns(const TextHeader& header);
 
 // Number of columns on the first data line after `skip_lines` lines (0 for none).
 int count_text_columns(const std::string& path, int skip_lines);
