@@ -86,7 +86,8 @@ void bind_tiling(py::module_& m) {
         py::arg("filters") = std::vector<std::string>{},
         "Point files into a grid of georeferenced .vol tiles (`vola tile INPUTS -o OUTPUT --tile-size S --depth D`):\n"
         "tile (i, j, k) covers origin + [i, i+1) * tile_size per axis with 4**depth voxels per edge; output gets\n"
-        "tile_I_J_K.vol files, index.geojson (open it with vola.open_tiles) and overviews/ (overviews=False: none).\n"
+        "index.geojson (open it with vola.open_tiles) and, in .generation-N/, tile_I_J_K.vol files and overviews/\n"
+        "(overviews=False: none).\n"
         "inputs: LAS/LAZ/COPC (streamed) or any point file vola.convert reads; assign_crs relabels, target_crs\n"
         "reprojects, allow_geographic tiles in degrees; memory_budget in bytes (the CLI's --memory); spill_dir\n"
         "(default output/.spill); attributes=False: occupancy only; generate_survey=N adds a generated survey\n"

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
+#include <set>
 
 #include "vola/error.hpp"
 #include "vola/tile/tile_index.hpp"
@@ -78,12 +79,17 @@ void retire_previous(const Generation& current) {
     fs::remove_all(current.output_dir / current.previous_name, ec);
     return;
   }
-  // The older layout: tiles straight in OUTDIR, overviews in OUTDIR/overviews/L<n>.
-  for (const std::string& file : current.previous_files)
-    if (generation_number(file) == 0) fs::remove(current.output_dir / file, ec);
-  const fs::path overviews = current.output_dir / "overviews";
-  for (const auto& level : fs::directory_iterator(overviews, ec)) fs::remove(level.path(), ec);  // if empty
-  fs::remove(overviews, ec);
+  // The older layout: tiles straight in OUTDIR, overviews in OUTDIR/overviews/L<n>. Only
+  // the files its index named go, then the folders they leave empty (fs::remove keeps a
+  // folder that is not): the user's own files there stay.
+  std::set<fs::path> folders;
+  for (const std::string& file : current.previous_files) {
+    if (generation_number(file) != 0) continue;
+    fs::remove(current.output_dir / file, ec);
+    for (fs::path up = fs::path(file).parent_path(); !up.empty(); up = up.parent_path()) folders.insert(up);
+  }
+  for (auto folder = folders.rbegin(); folder != folders.rend(); ++folder)  // deeper ones first
+    fs::remove(current.output_dir / *folder, ec);
 }
 
 std::string spill_folder_name(int rank) {

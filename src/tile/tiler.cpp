@@ -569,11 +569,16 @@ std::vector<AttributeSpec> common_attributes(const std::vector<const PointSource
 }
 
 // A folder that is removed with everything in it when this goes out of scope.
+// This run's spill folder, removed with its files; its parent too when it is vola's own
+// (OUTDIR/.spill, or a --tmp folder this run made) and left empty (other ranks' folders
+// keep it).
 struct RemovedFolder {
   fs::path dir;
+  bool made_parent = false;
   ~RemovedFolder() {
     std::error_code ec;
     fs::remove_all(dir, ec);
+    if (made_parent) fs::remove(dir.parent_path(), ec);  // fails, as it should, unless empty
   }
 };
 
@@ -600,7 +605,9 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   detail::remove_stale_spill(spill_root);
   // Declared before the run, so that the spill files close before their folder goes, on
   // every exit but a kill (which the next run's remove_stale_spill covers).
-  const RemovedFolder spill{spill_root / detail::spill_folder_name(comm.rank())};
+  std::error_code absent;
+  const RemovedFolder spill{spill_root / detail::spill_folder_name(comm.rank()),
+                            options.spill_dir.empty() || !fs::exists(spill_root, absent)};
   fs::create_directories(spill.dir);
   Tiling run(options, comm, workers);
   run.tile_dir = generation.dir();

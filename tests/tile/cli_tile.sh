@@ -23,7 +23,14 @@ some_overview=$(ls "$tmp/one/.generation-1/overviews/L1/"*.vol | head -1)
 for f in "$some_tile" "$some_overview"; do
   "$vola" info "$f" | grep -q '^attribute: *intensity (u16, mean' || fail "$f has no intensity column"
 done
+# The user's own files in OUTDIR stay, even in a folder named overviews (every file there
+# was deleted as if it were an overview of the older layout).
+mkdir -p "$tmp/bare/overviews"
+echo mine > "$tmp/bare/overviews/notes.txt"
+echo mine > "$tmp/bare/notes.txt"
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/bare" --no-attributes --no-overviews > "$tmp/bare.txt"
+[ -f "$tmp/bare/overviews/notes.txt" ] && [ -f "$tmp/bare/notes.txt" ] || fail "vola tile deleted the user's files in OUTDIR"
+[ -e "$tmp/bare/.spill" ] && fail "the spill folder is left behind: $(ls -a "$tmp/bare/.spill")"
 grep -q '^attributes: *none' "$tmp/bare.txt" || fail "--no-attributes summary: $(cat "$tmp/bare.txt")"
 "$vola" info "$(ls "$tmp/bare/.generation-1/"tile_*.vol | head -1)" | grep -q '^attribute:' && fail "--no-attributes tile has columns"
 
