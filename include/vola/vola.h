@@ -69,10 +69,14 @@ VOLA_C_API const char *vola_version(void);
 
 typedef enum vola_open_mode {
   VOLA_OPEN_READ = 0,  /* read the file into memory */
-  VOLA_OPEN_MAPPED = 1 /* memory-map it: a sparse uncompressed file's levels are used in place */
+  VOLA_OPEN_MAPPED = 1, /* memory-map it: a sparse uncompressed file's levels are used in place */
+  VOLA_OPEN_STATES = 2  /* or-ed with either: a state map as it is (see vola_open) */
 } vola_open_mode;
 
-VOLA_C_API vola_status vola_open(const char *path, vola_open_mode mode, vola_tree **out);
+/* A state map (`vola map`: occupied, free and unknown voxels) opens as its occupied voxels,
+ * as every vola command reads it, unless VOLA_OPEN_STATES is or-ed into the mode: then
+ * every known voxel, free ones too, is a voxel of the tree. */
+VOLA_C_API vola_status vola_open(const char *path, int mode, vola_tree **out);
 
 typedef enum vola_quantization {
   VOLA_QUANTIZE_TOOLKIT = 0, /* the reference's rounding against the bbox; needs a depth */

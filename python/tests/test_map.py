@@ -45,8 +45,15 @@ def test_a_saved_map_answers_as_the_map(tmp_path: pathlib.Path):
         m.insert(points, origin)
     path = tmp_path / "map.vol"
     m.save(path)
-    tree = vola.open(path)
+    tree = vola.open(path, states=True)
     assert tree.is_state_map and len(tree) == len(m)
+    # Opened plainly, as every CLI command reads it: the obstacles alone. Free voxels were
+    # obstacles to contains, collide, plan and render here.
+    obstacles = vola.open(path)
+    assert not obstacles.is_state_map
+    assert len(obstacles) == len(vola.occupied_tree(tree)) < len(tree)
+    free_voxels = vola.free_tree(tree).voxels()
+    assert not obstacles.contains(free_voxels).any()
     queries = _centres(m, -14, 14)
     want = m.state(queries)
     assert set(np.unique(want).tolist()) == {vola.UNKNOWN, vola.FREE, vola.OCCUPIED}

@@ -27,10 +27,11 @@ it passes free):
     >>> m.save("map.vol")         # a state map, the bytes `vola map` writes
 
 A state map file (tree.is_state_map) holds every known voxel with a state bit (occupied
-or free) and a "log_odds" column; vola.state(tree, points) and vola.probability(tree,
-points) query it in world coordinates, vola.occupied_tree(tree) and vola.free_tree(tree)
-give plain trees of either part (the analysis methods count every voxel of the tree they
-are called on: take occupied_tree(tree) for the obstacles).
+or free) and a "log_odds" column. vola.open gives its occupied voxels, as the CLI reads
+it; vola.open(path, states=True) gives the state map itself, which vola.state(tree,
+points) and vola.probability(tree, points) query in world coordinates and
+vola.occupied_tree(tree) and vola.free_tree(tree) split into plain trees (the analysis
+methods count every voxel of the tree they are called on).
 
 Every CLI subcommand that works on voxels is a call here, through the same library
 function and with the same errors:
@@ -157,10 +158,18 @@ __all__ = [
 ]
 
 
-def open(path: Union[str, os.PathLike], mapped: bool = True) -> Tree:  # noqa: A001 (vola.open, like io.open)
+def open(path: Union[str, os.PathLike], mapped: bool = True, states: bool = False) -> Tree:  # noqa: A001 (vola.open, like io.open)
     """Opens a .vol file: memory-mapped by default (the level words stay in the page
-    cache and numpy views of them read the mapping), or read into memory."""
-    return open_mapped(path) if mapped else read(path)
+    cache and numpy views of them read the mapping), or read into memory. A state map
+    (`vola map`, Map.save: occupied, free and unknown voxels) opens as its occupied voxels,
+    as every vola command reads it, so that contains, collide, plan, render and the rest
+    see obstacles only; states=True keeps every known voxel, free ones too, for
+    vola.state, vola.probability and vola.free_tree. (vola.read and vola.open_mapped give
+    the file as it is.)"""
+    tree = open_mapped(path) if mapped else read(path)
+    if tree.is_state_map and not states:
+        return occupied_tree(tree)
+    return tree
 
 
 PathLike = Union[str, os.PathLike]

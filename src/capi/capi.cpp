@@ -12,6 +12,7 @@
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/tree.hpp"
 #include "capi_guard.hpp"
 
@@ -92,11 +93,23 @@ const char* vola_status_string(vola_status status) {
 
 const char* vola_version(void) { return VOLA_C_VERSION; }
 
-vola_status vola_open(const char* path, vola_open_mode mode, vola_tree** out) {
+vola_status vola_open(const char* path, int mode, vola_tree** out) {
   return guarded([&] {
     require(path != nullptr && out != nullptr, "vola_open: path and out must not be NULL");
-    require(mode == VOLA_OPEN_READ || mode == VOLA_OPEN_MAPPED, "vola_open: mode is not VOLA_OPEN_READ or VOLA_OPEN_MAPPED");
-    *out = new vola_tree{mode == VOLA_OPEN_MAPPED ? vola::open_mapped(path) : vola::read(path)};
+    require((mode & ~(VOLA_OPEN_MAPPED | VOLA_OPEN_STATES)) == 0,
+            "vola_open: mode is not VOLA_OPEN_READ or VOLA_OPEN_MAPPED, or-ed with VOLA_OPEN_STATES or not");
+    vola::Tree tree = (mode & VOLA_OPEN_MAPPED) ? vola::open_mapped(path) : vola::read(path);
+    if (!(mode & VOLA_OPEN_STATES) && vola::map::is_state_map(tree)) {
+#ifdef VOLA_C_HAS_MAP
+      vola::Tree occupied = vola::map::occupied_tree(tree);
+      vola::check_mapped(tree);  // the copy was read from the mapping: the file was whole meanwhile
+      tree = std::move(occupied);
+#else
+      throw vola::InvalidArgument(std::string(path) + " is a state map (vola map): open it with VOLA_OPEN_STATES, "
+                                  "this library was built without the map module that gives its occupied voxels");
+#endif
+    }
+    *out = new vola_tree{std::move(tree)};
   });
 }
 

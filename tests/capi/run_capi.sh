@@ -10,4 +10,9 @@ las=$data/las/pdal_1.2-with-color.las
 las_with_crs=$data/las/pdal_autzen-utm.las
 [ -f "$las" ] && [ -f "$las_with_crs" ] || skip "$las or $las_with_crs missing (set VOLA_SHARED)"
 "$vola" convert "$las" "$scratch/survey.vol" --voxel-size 5 --quiet
-"$test_capi" "$scratch" "$scratch/survey.vol" "$las_with_crs"
+# A state map of one scan: a wall 2 m ahead seen from the origin (free voxels before it).
+for y in 0 0.1 0.2 0.3; do for z in 0 0.1 0.2; do echo "2.0 $y $z"; done; done > "$scratch/wall.xyz"
+echo "$scratch/wall.xyz 0 0 0 0 0 0 1" > "$scratch/scans.txt"
+"$vola" map "$scratch/scans.txt" -o "$scratch/map.vol" --voxel-size 0.1 -q
+occupied=$("$vola" voxels "$scratch/map.vol" | grep -vc '^#')
+"$test_capi" "$scratch" "$scratch/survey.vol" "$las_with_crs" "$scratch/map.vol" "$occupied"

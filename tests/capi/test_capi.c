@@ -375,9 +375,29 @@ static void test_translate_warnings(const char *scratch, const char *las_with_cr
   CHECK(strcmp(vola_last_warnings(), "") == 0);
 }
 
+/* A state map (vola map) opens as its occupied voxels, as the CLI reads it; with
+ * VOLA_OPEN_STATES as every known voxel (free ones were obstacles to C callers). */
+static void test_state_map(const char *map, uint64_t occupied) {
+  for (int mode = 0; mode < 2; ++mode) {
+    vola_tree *obstacles = NULL, *states = NULL;
+    CHECK_OK(vola_open(map, mode ? VOLA_OPEN_MAPPED : VOLA_OPEN_READ, &obstacles));
+    CHECK_OK(vola_open(map, (mode ? VOLA_OPEN_MAPPED : VOLA_OPEN_READ) | VOLA_OPEN_STATES, &states));
+    if (!obstacles || !states) return;
+    vola_info a, b;
+    CHECK_OK(vola_get_info(obstacles, &a));
+    CHECK_OK(vola_get_info(states, &b));
+    CHECK(a.voxel_count == occupied && occupied > 0);
+    CHECK(b.voxel_count > a.voxel_count);
+    vola_tree_free(obstacles);
+    vola_tree_free(states);
+  }
+  vola_tree *none = NULL;
+  CHECK(vola_open(map, 4, &none) == VOLA_ERROR_INVALID_ARGUMENT && none == NULL);
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
-    fprintf(stderr, "usage: test_capi SCRATCH_DIR [FILE_WITH_ATTRIBUTES.vol [LAS_WITH_CRS]]\n");
+    fprintf(stderr, "usage: test_capi SCRATCH_DIR [FILE_WITH_ATTRIBUTES.vol [LAS_WITH_CRS [STATE_MAP.vol OCCUPIED_VOXELS]]]\n");
     return 2;
   }
   test_build_query_iterate(argv[1]);
@@ -385,6 +405,7 @@ int main(int argc, char **argv) {
   if (argc > 2) test_shared_file(argv[2]);
   if (argc > 2) test_points_out(argv[1], argv[2]);
   if (argc > 3) test_translate_warnings(argv[1], argv[3]);
+  if (argc > 5) test_state_map(argv[4], strtoull(argv[5], NULL, 10));
   test_errors(argv[1]);
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
