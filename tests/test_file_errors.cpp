@@ -102,6 +102,10 @@ TEST(FileErrors, OtherFormatsAreNamed) {
   expect_format_error(bytes_of("ply\nformat ascii 1.0\n"), 0, "not a .vol file: a PLY file");
   expect_format_error(bytes_of("\x93NUMPY"), 0, "not a .vol file: a NumPy array");
   expect_format_error(bytes_of(std::string_view("II*\0", 4)), 0, "not a .vol file: a TIFF");
+  // A tile index given to collide, components, coords, export or sonify.
+  expect_format_error(bytes_of("{\n\"type\": \"FeatureCollection\",\n\"vola\": { \"format\": \"vola-tile-index\""), 0,
+                      "not a .vol file: a vola tile index: this command takes one .vol file");
+  expect_format_error(bytes_of("  {\"type\": \"Feature\"}"), 0, "not a .vol file: JSON text");
   // Short ones too: the signature comes before the header's length.
   expect_format_error({'L', 'A', 'S', 'F', 1, 2}, 0, "a LAS/LAZ point file");
 }

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "progress.hpp"
+#include "text_output.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/io/input.hpp"
@@ -63,7 +64,7 @@ void add_up(map::ScanReport& total, const map::ScanReport& r) {
 
 void print_summary(const MapArgs& a, const map::OccupancyMap& m, const map::ScanReport& total, std::size_t scans,
                    const map::StateCounts& states, double seconds, double insert_seconds) {
-  std::printf("scans:   %zu, %llu points (%llu not finite, %llu outside the index range skipped; %llu beyond "
+  std::printf("scans:   %zu, %llu points (%llu not finite, %llu more than 2^20 voxels from the world origin skipped; %llu beyond "
               "--max-range, free up to it)\n",
               scans, static_cast<unsigned long long>(total.points), static_cast<unsigned long long>(total.not_finite),
               static_cast<unsigned long long>(total.outside), static_cast<unsigned long long>(total.cut));
@@ -111,6 +112,13 @@ void run_map(const MapArgs& a) {
     if (progress) progress->update(n + 1, scans.size());
   }
   if (progress) progress->finish();
+  // A map of nothing is a mistake (points in survey coordinates with a pose near 0, a
+  // voxel size in the wrong unit), not a result.
+  if (m.size() == 0)
+    throw InvalidArgument(a.list + ": no point of the " + std::to_string(total.points) + " made a known voxel (" +
+                          std::to_string(total.not_finite) + " not finite, " + std::to_string(total.outside) +
+                          " more than " + std::to_string(map::kIndexLimit) + " voxels of " + shortest_text(a.voxel_size) +
+                          " from the world origin); no map written");
   // Both trees are built before either file is written, so a failure leaves neither.
   const Tree states = map::freeze(m);
   if (a.free) {

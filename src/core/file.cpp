@@ -2,6 +2,8 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <string_view>
 
@@ -245,6 +247,16 @@ const char* other_format(std::span<const std::uint8_t> bytes) {
   };
   for (const Signature& s : kKnown)
     if (bytes.size() >= s.magic.size() && std::memcmp(bytes.data(), s.magic.data(), s.magic.size()) == 0) return s.what;
+  // A tile index (GeoJSON) given to a command that takes one .vol file.
+  std::size_t first = 0;
+  while (first < bytes.size() && first < 64 && std::isspace(bytes[first])) ++first;
+  if (first < bytes.size() && bytes[first] == '{') {
+    const std::string_view head(reinterpret_cast<const char*>(bytes.data()), std::min<std::size_t>(bytes.size(), 4096));
+    if (head.find("vola-tile-index") != std::string_view::npos)
+      return "a vola tile index: this command takes one .vol file (get, render, plan, view and vola.open_tiles "
+             "take tile indexes; or give one of the tiles it names)";
+    return "JSON text (a GeoJSON?), not a .vol file";
+  }
   return nullptr;
 }
 

@@ -24,6 +24,15 @@ grep -q '^scans:   2, 2 points' "$tmp/out" || fail "summary: $(cat "$tmp/out")"
 printf '0.125 1.125 0.125\n1.125 0.125 0.125\n' | diff - "$tmp/occupied" || fail "occupied voxels differ"
 [ "$("$vola" coords "$tmp/map.free.vol" | wc -l)" -eq 7 ] || fail "expected 7 free voxels: $("$vola" coords "$tmp/map.free.vol")"
 
+# Points no voxel of the map can hold (survey coordinates with a pose at 0, voxels far too
+# small) made an empty map with exit 0: now an error, and no file.
+printf '5000000 0 0\n' > "$tmp/scans/far.xyz"
+echo "scans/far.xyz 0 0 0 0 0 0 1" > "$tmp/far.txt"
+"$vola" map "$tmp/far.txt" -o "$tmp/far.vol" --voxel-size 1 > "$tmp/far.out" 2>&1 && fail "a map of nothing succeeded"
+grep -q 'no point of the 1 made a known voxel (0 not finite, 1 more than 1048576 voxels of 1 from the world origin)' \
+  "$tmp/far.out" || fail "far: $(cat "$tmp/far.out")"
+[ -e "$tmp/far.vol" ] && fail "a map of nothing was written"
+
 # The state map: 9 known voxels; commands see the 2 occupied ones.
 "$vola" info "$tmp/map.vol" > "$tmp/info"
 grep -q 'state map (vola map): 9 known, .* 2 occupied, 7 free' "$tmp/info" || fail "info: $(cat "$tmp/info")"
