@@ -376,3 +376,13 @@ TEST(FileErrors, CompressedRecordClaimingAHugeSizeIsRefusedBeforeAllocating) {
 
 }  // namespace
 }  // namespace vola_test
+
+// A hostile file's bytes quoted in an error (a PLY header keyword, a text value) put an
+// escape sequence on the user's terminal: control characters are written as \xNN.
+TEST(FileErrors, ControlCharactersInCausesAreEscaped) {
+  const vola::FormatError e("bad.ply", 12, "unknown header keyword '\x1b[31mevil\x1b[0m\r\x7f\x01'");
+  EXPECT_EQ(e.cause(), "unknown header keyword '\\x1b[31mevil\\x1b[0m\\x0d\\x7f\\x01'");
+  EXPECT_STREQ(e.what(), "bad.ply: byte 12: unknown header keyword '\\x1b[31mevil\\x1b[0m\\x0d\\x7f\\x01'");
+  // Tabs, newlines and UTF-8 stay as they are.
+  EXPECT_EQ(vola::FormatError("f", std::nullopt, "H\xc3\xb6he\tline\n").cause(), "H\xc3\xb6he\tline\n");
+}

@@ -132,7 +132,7 @@ void run_census(const CensusArgs& a) {
     j["regions"] = nlohmann::json::array();
     for (std::size_t i = 0; i < options.regions.size(); ++i)
       j["regions"].push_back({{"region", options.regions[i].label}, {"voxels", c.region_voxels[i]}});
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
 

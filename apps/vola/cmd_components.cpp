@@ -86,7 +86,7 @@ void per_class(const Tree& tree, const ComponentsArgs& a, analysis::Connectivity
       std::printf("%5d %-38s %12zu %11zu %12llu\n", code, name.c_str(), k.size(), kept,
                   static_cast<unsigned long long>(largest));
   }
-  if (a.json) std::printf("%s\n", j.dump(2).c_str());
+  if (a.json) std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
 }
 
 void run_components(const ComponentsArgs& a) {
@@ -107,7 +107,7 @@ void run_components(const ComponentsArgs& a) {
                            {"centroid", {k.centroid[0], k.centroid[1], k.centroid[2]}},
                            {"centroid_world", {world(k.centroid[0], 0), world(k.centroid[1], 1), world(k.centroid[2], 2)}}});
     }
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("%s: %llu voxels, %zu components (%d-connected), %zu kept\n", a.file.c_str(),
                 static_cast<unsigned long long>(tree.voxel_count()), r.components.size(), a.connectivity, kept);

@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.hpp"
 #include "info_points.hpp"
 #include "text_output.hpp"
@@ -23,14 +25,10 @@ struct InfoArgs {
   bool summary = false;
 };
 
+// A JSON string: control characters escaped, bytes that are not UTF-8 (a name from a
+// hostile or Latin-1 file) replaced by U+FFFD, so that the output always parses.
 std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (c == '\n') { out += "\\n"; continue; }
-    out += c;
-  }
-  return out + "\"";
+  return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 // How a compressed file's levels are coded (the levels record's flags).

@@ -178,7 +178,7 @@ ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr
   return out;
 }
 
-void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2).c_str()); }
+void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str()); }
 
 // For a DEM in degrees, WGS 84's UTM zone (its EPSG code) at the centre of its cells;
 // otherwise 0. vola convert refuses voxels of degrees and reprojects only points, so such

@@ -47,4 +47,11 @@ ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, const std::string& gi
 // what PROJ cannot read.
 bool is_geographic_crs(const std::string& definition);
 
+// PROJ (and PDAL) leave z alone between two CRSs without vertical axes: a survey in feet
+// reprojected to UTM keeps its heights in feet under a CRS in metres. When reprojecting
+// `source` to `target` (definitions as crs_definition_of reads them) does that (neither
+// has a vertical axis, their units differ, the source is not in degrees), the sentence to
+// tell the user; else "". "" too for what PROJ cannot read.
+std::string unconverted_heights(const std::string& source, const std::string& target);
+
 }  // namespace vola

@@ -53,16 +53,34 @@ class IoError : public Error {
 class FormatError : public Error {
  public:
   FormatError(std::string file, std::optional<std::uint64_t> offset, std::string cause)
-      : Error(compose(file, offset, cause)),
+      : Error(compose(file, offset, printable(cause))),
         file_(std::move(file)),
         offset_(offset),
-        cause_(std::move(cause)) {}
+        cause_(printable(cause)) {}
 
   const std::string& file() const noexcept { return file_; }
   std::optional<std::uint64_t> offset() const noexcept { return offset_; }
   const std::string& cause() const noexcept { return cause_; }
 
  private:
+  // A cause quotes bytes of the file ("unknown keyword '...'"): control characters (an
+  // escape sequence would reach the user's terminal) are written as \xNN.
+  static std::string printable(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    for (const char ch : text) {
+      const auto c = static_cast<unsigned char>(ch);
+      if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
+        static constexpr char kHex[] = "0123456789abcdef";
+        out += "\\x";
+        out += kHex[c >> 4];
+        out += kHex[c & 15];
+      } else {
+        out += ch;
+      }
+    }
+    return out;
+  }
   static std::string compose(const std::string& file, std::optional<std::uint64_t> offset,
                              const std::string& cause) {
     std::string s = file.empty() ? std::string("<memory>") : file;

@@ -237,8 +237,15 @@ py::class_<Tree> bind_tree(py::module_& m) {
       .def_property_readonly("lat_lon", [](const Tree& t) { return py::make_tuple(t.georef().lat, t.georef().lon); },
                              "WGS84 latitude and longitude of the bbox centre (0, 0 when unknown).")
       .def_property_readonly("attribute_names", [](const Tree& t) {
-            std::vector<std::string> names;
-            for (const auto& c : t.attributes().columns()) names.push_back(c.name());
+            // Bytes that are not UTF-8 (a name in a hostile file) become U+FFFD rather than
+            // a UnicodeDecodeError; the readers write UTF-8 names.
+            py::list names;
+            for (const auto& c : t.attributes().columns()) {
+              const std::string& n = c.name();
+              PyObject* text = PyUnicode_DecodeUTF8(n.data(), static_cast<Py_ssize_t>(n.size()), "replace");
+              if (!text) throw py::error_already_set();
+              names.append(py::reinterpret_steal<py::str>(text));
+            }
             return names;
           }, "Names of the per-voxel attribute columns.")
       .def("contains", &contains, py::arg("voxels"),

@@ -148,4 +148,19 @@ bool is_geographic_crs(const std::string& definition) {
   }
 }
 
+std::string unconverted_heights(const std::string& source, const std::string& target) {
+  try {
+    const geo::CrsDescription from = geo::describe_crs(crs_definition_of(source), geo::EpsgLookup::own_id_only);
+    const geo::CrsDescription to = geo::describe_crs(crs_definition_of(target), geo::EpsgLookup::own_id_only);
+    if (!from.vertical_name.empty() || !to.vertical_name.empty() || from.horizontal_unit == "degree" ||
+        from.horizontal_unit == to.horizontal_unit)
+      return "";
+    return "heights (z) stay in " + from.horizontal_unit + " while x and y go to " + to.horizontal_unit +
+           ": neither CRS has a vertical axis to convert them by (PROJ and PDAL do the same); give both a "
+           "vertical part (a compound CRS such as EPSG:32610+5703) to convert them";
+  } catch (const Error&) {
+    return "";
+  }
+}
+
 }  // namespace vola

@@ -30,6 +30,11 @@ std::string geographic_name(const std::string& definition) {
   }
 }
 
+// The CRS the input is read in: what its file states, else what the options give.
+std::string stated_or_given(const std::string& stated, const std::string& given) {
+  return !stated.empty() ? stated : given.empty() ? std::string() : crs_definition_of(given);
+}
+
 }  // namespace
 
 std::string given_crs(const ConvertOptions& options) {
@@ -63,6 +68,10 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
       out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `assign_crs` " +
                     given.substr(0, 60) + " relabels its coordinates without moving them (to move them, " +
                     "give `target_crs`)");
+    if (!options.target_crs.empty() && !stated_or_given(stated, given).empty())
+      if (const std::string heights = unconverted_heights(stated_or_given(stated, given), options.target_crs);
+          !heights.empty())
+        out.push_back(path + ": " + heights);
     const std::string result = result_definition(crs);
     if (!result.empty() && voxelises_points(input) && is_geographic_crs(result))
       out.push_back("the CRS (" + geographic_name(result) + ") is geographic: voxels are degrees of longitude and " +

@@ -1,11 +1,54 @@
 #include "column_names.hpp"
 
+#include <cstdint>
+
 #include <cctype>
 #include <utility>
 
 namespace vola::io {
 
-std::string point_column_name(std::string_view field) {
+namespace {
+
+// Whether `text` is well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, at
+// most U+10FFFF).
+bool is_utf8(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const int length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+    if (length == 0 || i + length > text.size()) return false;
+    std::uint32_t point = length == 1 ? c : c & (0x7fu >> length);
+    for (int k = 1; k < length; ++k) {
+      const auto t = static_cast<unsigned char>(text[i + k]);
+      if ((t >> 6) != 0x2) return false;
+      point = (point << 6) | (t & 0x3fu);
+    }
+    static constexpr std::uint32_t kLeast[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (point < kLeast[length] || point > 0x10ffff || (point >= 0xd800 && point <= 0xdfff)) return false;
+    i += static_cast<std::size_t>(length);
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string utf8_name(std::string_view name) {
+  if (is_utf8(name)) return std::string(name);
+  std::string out;
+  for (const char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x80) {
+      out += ch;
+    } else {
+      out += static_cast<char>(0xc0 | (c >> 6));
+      out += static_cast<char>(0x80 | (c & 0x3f));
+    }
+  }
+  return out;
+}
+
+std::string point_column_name(std::string_view raw) {
+  const std::string utf8 = utf8_name(raw);
+  const std::string_view field = utf8;
   std::string lower, key;
   for (const char c : field) {
     const char l = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

@@ -10,9 +10,15 @@
 
 namespace vola::io {
 
+// A field name as UTF-8: as it is when it is valid UTF-8, else each byte read as Latin-1
+// (Windows-1252 spreadsheets write "Höhe" as "H\xf6he"), so that JSON reports, Python
+// and the .vol's attribute names hold text, not bytes no decoder takes.
+std::string utf8_name(std::string_view name);
+
 // Lower case; LAS fields as PDAL spells them (ReturnNumber, GpsTime, PointSourceId, ...)
 // under the LAS reader's names (return_number, gps_time, point_source_id, ...), and
-// CloudCompare's R, G, B as red, green, blue. Other names stay as they are, lower case.
+// CloudCompare's R, G, B as red, green, blue. Other names stay as they are, lower case
+// (and UTF-8, as utf8_name makes them).
 std::string point_column_name(std::string_view field);
 
 // Classes (classification, class, label) by majority, number_of_returns by maximum

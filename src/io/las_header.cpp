@@ -7,6 +7,7 @@
 #include <functional>
 #include <optional>
 
+#include "column_names.hpp"
 #include "las_format.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
@@ -222,7 +223,7 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
   for (std::size_t d = 0; d + 192 <= vlr.data.size(); d += 192) {
     const std::uint8_t* e = &vlr.data[d];
     const std::uint8_t type = e[2], options = e[3];
-    const std::string name = text(e + 4, 32);
+    const std::string name = utf8_name(text(e + 4, 32));
     if (type == 0) {  // undocumented bytes: options holds their count
       offset += options;
       continue;

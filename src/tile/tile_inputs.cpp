@@ -56,10 +56,24 @@ void resolve_tile_crs(const std::string& assign, bool allow_geographic,
   options.crs_wkt = crs.wkt;
 }
 
-// assign_crs on an input that says another CRS relabels its coordinates: say so.
-std::vector<std::string> relabel_warnings(const TileInputs& in, const std::vector<std::unique_ptr<PointSource>>& sources) {
+// What the user should know about the inputs' CRSs: with target_crs, heights it leaves in
+// another unit than x and y; else assign_crs on an input that says another CRS relabels
+// its coordinates.
+std::vector<std::string> crs_warnings(const TileInputs& in, const std::vector<std::unique_ptr<PointSource>>& sources) {
   std::vector<std::string> warnings;
-  if (in.assign_crs.empty() || !in.target_crs.empty()) return warnings;
+  if (!in.target_crs.empty()) {  // heights a reprojection leaves in another unit
+    for (const auto& s : sources) {
+      const std::string said = !in.assign_crs.empty() ? in.assign_crs
+                               : !s->wkt.empty()       ? s->wkt
+                               : s->epsg               ? "EPSG:" + std::to_string(*s->epsg)
+                                                       : "";
+      if (said.empty()) continue;
+      if (const std::string heights = unconverted_heights(said, in.target_crs); !heights.empty())
+        warnings.push_back(s->name() + ": " + heights);
+    }
+    return warnings;
+  }
+  if (in.assign_crs.empty()) return warnings;
   for (const auto& s : sources) {
     const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
     try {
@@ -96,7 +110,7 @@ OpenedInputs open_inputs(const TileInputs& in, TileOptions& options) {
   }
   if (!in.filters.empty())
     for (auto& s : out.sources) s = filtered(std::move(s), in.filters);
-  out.warnings = relabel_warnings(in, out.sources);
+  out.warnings = crs_warnings(in, out.sources);
   reproject_sources(in, out.sources);
   // After a reprojection every source states the target.
   resolve_tile_crs(in.target_crs.empty() ? in.assign_crs : std::string(), in.allow_geographic, out.sources, options);

@@ -274,7 +274,17 @@ TEST(Convert, ReprojectedHeightsAreInTheTargetsUnits) {
   vola::ConvertOptions options;
   options.target_crs = "EPSG:32610";
   options.voxel_size = 2.0;
-  const vola::Tree tree = vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options);
+  vola::ConvertReport report;
+  const vola::Tree tree = vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &report);
+  // Neither CRS has a vertical axis: z stays in feet under a CRS in metres, as PROJ and
+  // PDAL leave it, and the user is told so (the tiled survey mixed 124 m with 406 "m").
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("heights (z) stay in foot while x and y go to metre"), std::string::npos)
+      << report.warnings[0];
+  options.target_crs = "EPSG:2994";  // the file's own unit: nothing to say
+  vola::ConvertReport same_unit;
+  vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &same_unit);
+  EXPECT_TRUE(same_unit.warnings.empty()) << same_unit.warnings[0];
   const vola::AttributeColumn* height = tree.attributes().find("height");
   ASSERT_NE(height, nullptr);
   const vola::Frame frame = tree.frame();

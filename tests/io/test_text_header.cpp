@@ -201,3 +201,15 @@ TEST(TextHeader, ManyColumnsAreNamedInLinearTime) {
   EXPECT_EQ(cloud.attributes.size(), 100000u);
   EXPECT_LT(seconds, 1.0);
 }
+
+// A German spreadsheet's CSV in Windows-1252 names its height "H\xf6he": the raw byte
+// became the attribute's name, which JSON reports and Python could not decode. Names
+// that are not UTF-8 are read as Latin-1.
+TEST(TextHeader, NamesThatAreNotUtf8AreReadAsLatin1) {
+  TempDir dir;
+  const auto latin1 = read_text(dir, "x;y;z;H\xf6he\n1;2;3;4,5\n");
+  EXPECT_EQ(names(latin1), (std::vector<std::string>{"h\xc3\xb6he"}));
+  EXPECT_EQ(column(latin1, "h\xc3\xb6he").values, (std::vector<double>{4.5}));
+  const auto utf8 = read_text(dir, "x;y;z;H\xc3\xb6he\n1;2;3;4,5\n");  // already UTF-8: kept
+  EXPECT_EQ(names(utf8), (std::vector<std::string>{"h\xc3\xb6he"}));
+}
