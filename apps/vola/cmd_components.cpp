@@ -57,12 +57,16 @@ void write_split(const Tree& tree, const analysis::ComponentLabels& r, std::size
   }
 }
 
-void write_labels(const Tree& tree, const analysis::ComponentLabels& r, const std::string& path) {
+// Each voxel's component, the `kept` ones by their number and the rest (filtered out by
+// --min-voxels or --largest) as kNotKept, as --split leaves them out.
+constexpr std::uint32_t kNotKept = 4294967295u;
+
+void write_labels(const Tree& tree, const analysis::ComponentLabels& r, std::size_t kept, const std::string& path) {
   Tree labelled = tree;
   if (labelled.attributes().find("component"))
     throw InvalidArgument("the file already has a 'component' column");
   AttributeColumn column("component", ValueType::u32, Reduction::majority, r.label.size());
-  for (std::size_t i = 0; i < r.label.size(); ++i) column.set(i, r.label[i]);
+  for (std::size_t i = 0; i < r.label.size(); ++i) column.set(i, r.label[i] < kept ? r.label[i] : kNotKept);
   labelled.attributes().add(std::move(column));
   write(labelled, path);
 }
@@ -123,7 +127,7 @@ void run_components(const ComponentsArgs& a) {
     if (kept > a.list) std::printf("... %zu more (--list N)\n", kept - a.list);
   }
   if (!a.split_dir.empty()) write_split(tree, r, kept, a.split_dir);
-  if (!a.labels_out.empty()) write_labels(tree, r, a.labels_out);
+  if (!a.labels_out.empty()) write_labels(tree, r, kept, a.labels_out);
 }
 
 }  // namespace
@@ -134,7 +138,7 @@ void add_components(CLI::App& app) {
   cmd->footer(
       "Components are numbered largest first. --split writes component_NNNNNN.vol per kept\n"
       "component (occupancy only, same grid); --labels writes the input with a u32 'component'\n"
-      "column. Example: vola components scan.vol --connectivity 26 --min-voxels 50 --split parts/");
+      "column (4294967295 for the voxels of components --min-voxels or --largest leave out). Example: vola components scan.vol --connectivity 26 --min-voxels 50 --split parts/");
   cmd->add_option("file", args->file, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("--connectivity", args->connectivity, "6 (faces), 18 (edges) or 26 (corners)")
       ->check(CLI::IsMember({6, 18, 26}));

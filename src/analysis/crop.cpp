@@ -1,15 +1,26 @@
 // Leaf blocks wholly inside the box are copied word by word, blocks that straddle it
 // are masked bit by bit, the rest skipped.
 #include <bit>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "same_frame.hpp"
 #include "vola/analysis/crop.hpp"
 #include "vola/builder.hpp"
+#include "vola/error.hpp"
 
 namespace vola::analysis {
 
 Tree crop(const Tree& tree, const Voxel& min, const Voxel& max) {
+  // A box whose max lies below its min on an axis (the corners swapped) holds nothing:
+  // refused rather than written as an empty file.
+  const std::uint32_t lo[3] = {min.x, min.y, min.z}, hi[3] = {max.x, max.y, max.z};
+  for (int a = 0; a < 3; ++a)
+    if (hi[a] < lo[a])
+      throw InvalidArgument("crop box: max " + std::string(1, "xyz"[a]) + " = " + std::to_string(hi[a]) +
+                            " is below min " + std::string(1, "xyz"[a]) + " = " + std::to_string(lo[a]) +
+                            " (min is the first voxel, max the last, both inclusive)");
   std::vector<Key> keys;
   if (!tree.empty())
     tree.for_each_block(tree.depth() - 1, [&](std::size_t, std::uint64_t word, std::uint32_t ox, std::uint32_t oy,

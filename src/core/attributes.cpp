@@ -102,7 +102,8 @@ AttributeColumn* Attributes::find(std::string_view name) noexcept {
 }
 
 AttributeColumn& Attributes::add(AttributeColumn column) {
-  if (find(column.name())) VOLA_THROW(InvalidArgument("attribute '" + column.name() + "' exists already"));
+  if (!names_.insert(column.name()).second)
+    VOLA_THROW(InvalidArgument("attribute '" + column.name() + "' exists already"));
   columns_.push_back(std::move(column));
   return columns_.back();
 }

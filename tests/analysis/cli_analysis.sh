@@ -50,6 +50,12 @@ set -- $kept
 sum=0
 for p in "$tmp"/parts/*.vol; do sum=$((sum + $("$vola" voxels "$p" | wc -l))); done
 [ "$sum" -eq "$2" ] || fail "split files hold $sum voxels, listed components $2"
+# --labels numbers the same kept components and marks the voxels of the others (their
+# filters were ignored: every component got its number).
+"$vola" components "$tmp/t.vol" --connectivity 26 --min-voxels 50 --labels "$tmp/labels.vol" > /dev/null
+labelled=$("$vola" voxels "$tmp/labels.vol" --attributes | grep -v '^#' | awk '$NF != 4294967295' | wc -l)
+distinct=$("$vola" voxels "$tmp/labels.vol" --attributes | grep -v '^#' | awk '$NF != 4294967295 {print $NF}' | sort -u | wc -l)
+[ "$labelled" -eq "$2" ] && [ "$distinct" -eq "$1" ] || fail "--labels: $labelled voxels in $distinct components, --split: $2 in $1"
 
 # Morphology keeps the grid; dilate then diff counts what was added.
 "$vola" dilate "$tmp/t.vol" --radius 1 --element cube "$tmp/d.vol" > /dev/null

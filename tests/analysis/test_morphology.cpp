@@ -175,6 +175,10 @@ TEST(Crop, MatchesTheModel) {
       EXPECT_EQ(vola_test::voxel_set(vola::analysis::crop(tree_of(g.voxels, g.depth), lo, hi)), model) << g.name;
     }
   }
+  // Corners swapped on one axis: refused (an empty file was written, exit 0).
+  const vola::Tree t = tree_of({{1, 1, 1}}, 2);
+  EXPECT_THROW(vola::analysis::crop(t, {0, 5, 0}, {3, 2, 3}), vola::InvalidArgument);
+  EXPECT_EQ(vola::analysis::crop(t, {2, 2, 2}, {2, 2, 2}).voxel_count(), 0u);  // a box of one empty voxel
 }
 
 TEST(Downsample, MatchesTheModelAndLevelOfDetail) {
