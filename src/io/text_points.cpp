@@ -50,7 +50,8 @@ bool is_separator(char c, bool decimal_comma) {
 
 constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";  // UTF-8's, as Excel's "CSV UTF-8" begins
 
-// A file's first line without the UTF-8 byte order mark, and how many bytes that took.
+// How many bytes at the start of a line are the UTF-8 byte order mark (only the file's
+// first line can begin with one).
 std::size_t byte_order_mark(std::string_view line, std::uint64_t line_number) {
   return line_number == 1 && line.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
 }
