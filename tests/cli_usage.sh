@@ -50,4 +50,7 @@ expect_refusal "is the input: convert writes a new .vol file" convert "$tmp/same
 cmp -s "$tmp/two.xyz" "$tmp/same.xyz" || fail "a refused conversion changed its input"
 expect_refusal "convert writes a .vol file, not las (.las); name it .vol, or write points with \`vola translate" convert "$tmp/two.xyz" "$tmp/o.las" --voxel-size 1
 if [[ -e $tmp/o.las ]]; then fail "a refused conversion wrote o.las"; fi
+# A PLY with faces is a mesh: translate says so (it said "this is ply input").
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > "$tmp/tri.ply"
+expect_refusal "this ply file holds a mesh of 1 face: \`vola convert\` makes voxels of it" translate "$tmp/tri.ply" "$tmp/tri.xyz"
 echo "cli usage: ok"

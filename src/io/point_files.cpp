@@ -226,7 +226,12 @@ PointTable read_point_table(const std::string& input, const std::function<void(s
   options.progress = progress;
   Input in = read_input(input, format, options);
   if (in.is_mesh() || in.grid || in.terrain)
-    throw InvalidArgument(input + ": point filters and vola translate take point files; this is " + in.format + " input");
+    throw InvalidArgument(input + ": point filters and vola translate take point files; this " + in.format +
+                          " file holds " +
+                          (in.is_mesh() ? "a mesh of " + std::to_string(in.triangles.size()) + (in.triangles.size() == 1 ? " face" : " faces")
+                           : in.grid    ? std::string("a voxel grid")
+                                        : std::string("an elevation raster")) +
+                          ": `vola convert` makes voxels of it");
   PointTable table;
   table.format = in.format;
   table.cloud = std::move(in.cloud);
