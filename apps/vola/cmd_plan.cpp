@@ -139,6 +139,7 @@ void run_plan(const PlanArgs& a) {
   options.smooth = !a.no_smooth;
   if (scene.known) options.known = &*scene.known;
   if (!a.grid) {
+    options.world = &frame;
     from = raycast::world_to_grid(frame, from);
     to = raycast::world_to_grid(frame, to);
   }
@@ -199,7 +200,7 @@ void add_plan(CLI::App& app) {
       "--hierarchical is the search that scales to a city: a route over coarse cells of 4^3 voxels\n"
       "at least half free first, then the exact search only within one coarse cell of that route\n"
       "(wider, then along wholly free cells, if that holds no path). Its cost is not guaranteed\n"
-      "optimal: within 1% of it on the generated cities (docs/BENCHMARKS.md, Planning); a 200 m\n"
+      "optimal: 0.75% above it on a generated city (docs/BENCHMARKS.md, Planning); a 200 m\n"
       "city at 0.1 m plans in 1-2 s. It is the default when --from and --to are 1024 voxels apart or more\n"
       "on the finest level (a note says so); --exact forces the optimal search.\n"
       "Errors say whether the start or goal is outside the volume, inside an obstacle, or unreachable.\n"
@@ -232,7 +233,8 @@ void add_plan(CLI::App& app) {
   cmd->add_option("--radius", args->radius, "Robot radius (obstacle inflation)")->capture_default_str()->check(non_negative_number());
   cmd->add_option("--level", args->level, "Plan on this level (0 = coarsest; default: the voxels)");
   cmd->add_flag("--hierarchical", args->hierarchical,
-                "A coarse route over 4^3-voxel cells first, then the voxels near it (scales; cost within ~1%); "
+                "A coarse route over 4^3-voxel cells first, then the voxels near it (scales; not guaranteed optimal, "
+                "0.75% above it on a generated city); "
                 "the default when the points are 1024 voxels apart or more")
       ->excludes(cmd->add_flag("--exact", args->exact, "The optimal search, however far apart the points"));
   cmd->add_flag("--no-smooth", args->no_smooth, "Keep every cell of the A* path");

@@ -21,6 +21,8 @@
 #include "vola/audio/wav.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/filters/units.hpp"
+#include "vola/geo/crs.hpp"
 
 namespace vola::cli {
 
@@ -183,26 +185,13 @@ void write_responses(const std::string& path, const std::vector<std::vector<doub
   audio::write_wav(path, irs, audio::SampleFormat::float32);
 }
 
-void run_sonify(SonifyArgs& a) {
-  if (a.payload_coefficients && !a.materials.empty())
-    throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
+// The responses, the wet signal and the files, for a scene in metres (positions given in
+// the scene's units, `metres` per unit).
+void sonify_scene(const SonifyArgs& a, const Tree& tree, const audio::MaterialTable& table,
+                  const std::vector<audio::Sound>& dry, double metres) {
   const bool physical = a.model == "physical";
-  if (a.binaural && !physical) throw InvalidArgument("--binaural renders the physical model: drop --model paper");
-  if (a.binaural && a.channels != "mix")
-    throw InvalidArgument("--binaural writes two channels (left, right) with every source mixed: drop --channels per-source");
-  const audio::MaterialTable table = material_table(a);
-  const std::vector<audio::Sound> dry = read_dry(a);
-  a.response.sample_rate = dry[0].sample_rate;
-  a.response.check();
-  a.room.sample_rate = dry[0].sample_rate;
-  a.room.speed_of_sound = a.response.speed_of_sound;
-  a.room.threads = a.response.threads;
-  a.room.occlusion = !a.no_occlusion;
-  a.room.check();
-
-  const Tree tree = open_voxels(a.scene);
   const audio::AcousticScene scene(tree, table);
-  const Point listener{a.listener[0], a.listener[1], a.listener[2]};
+  const Point listener{a.listener[0] * metres, a.listener[1] * metres, a.listener[2] * metres};
   // Patches depend on the scene only: found once for every source.
   std::optional<audio::Room> room;
   if (physical) room.emplace(scene);
@@ -212,7 +201,7 @@ void run_sonify(SonifyArgs& a) {
   std::vector<std::vector<double>> responses, wet, wet_right;
   std::vector<PlotPanel> panels;
   for (std::size_t s = 0; s < a.sources.size(); ++s) {
-    const Point source{a.sources[s][0], a.sources[s][1], a.sources[s][2]};
+    const Point source{a.sources[s][0] * metres, a.sources[s][1] * metres, a.sources[s][2] * metres};
     const auto t0 = std::chrono::steady_clock::now();
     SourceResponse r = physical ? physical_response(*room, source, listener, a, hrtf ? &*hrtf : nullptr)
                                 : paper_response(scene, source, listener, a);
@@ -241,6 +230,64 @@ void run_sonify(SonifyArgs& a) {
     std::printf("wrote %s (%zu channel%s, %.3f s at %d Hz)%s%s%s%s\n", a.output.c_str(), out.channels.size(),
                 out.channels.size() == 1 ? "" : "s", static_cast<double>(out.frames()) / out.sample_rate,
                 out.sample_rate, a.ir.empty() ? "" : ", ", a.ir.c_str(), a.plot.empty() ? "" : ", ", a.plot.c_str());
+}
+
+// Sound is computed in metres (the speed of sound, amplitude 1 at 1 m, air absorption,
+// Fresnel zones): a scene whose CRS is in another length unit (a survey in feet) is
+// scaled to metres, its frame and the flags' positions alike, so the positions stay in
+// the file's own units. Returns the metres per unit (1 without a CRS).
+double scale_scene_to_metres(Tree& tree, const SonifyArgs& a) {
+  const Georef& georef = tree.georef();
+  const std::optional<std::uint32_t> epsg =
+      georef.epsg == geo::kUnsetEpsg ? std::nullopt : std::optional<std::uint32_t>(georef.epsg);
+  filters::Units units;
+  try {
+    units = filters::units_of_crs(epsg, georef.crs_wkt);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(a.scene + ": " + e.what() + " (vola convert --target-crs, to a CRS in metres or feet)");
+  }
+  if (units.vertical != units.horizontal)
+    throw InvalidArgument(a.scene + ": its CRS has heights in another unit than x and y (" +
+                          std::to_string(units.horizontal) + " and " + std::to_string(units.vertical) +
+                          " m per unit): sound needs one unit for all three axes (vola convert --target-crs)");
+  if (units.horizontal == 1.0) return 1.0;
+  Frame frame = tree.frame();
+  for (double& c : frame.origin) c *= units.horizontal;
+  frame.voxel_size *= units.horizontal;
+  tree.set_frame(frame);
+  if (!a.quiet)
+    std::printf("%s is in units of %.10g m (its CRS): positions are read in those units, distances reported in metres\n",
+                a.scene.c_str(), units.horizontal);
+  return units.horizontal;
+}
+
+void run_sonify(SonifyArgs& a) {
+  if (a.payload_coefficients && !a.materials.empty())
+    throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
+  const bool physical = a.model == "physical";
+  if (a.binaural && !physical) throw InvalidArgument("--binaural renders the physical model: drop --model paper");
+  if (a.binaural && a.channels != "mix")
+    throw InvalidArgument("--binaural writes two channels (left, right) with every source mixed: drop --channels per-source");
+  const audio::MaterialTable table = material_table(a);
+  const std::vector<audio::Sound> dry = read_dry(a);
+  a.response.sample_rate = dry[0].sample_rate;
+  a.response.check();
+  a.room.sample_rate = dry[0].sample_rate;
+  a.room.speed_of_sound = a.response.speed_of_sound;
+  a.room.threads = a.response.threads;
+  a.room.occlusion = !a.no_occlusion;
+  a.room.check();
+
+  Tree tree = open_voxels(a.scene);
+  const double metres = scale_scene_to_metres(tree, a);
+  try {
+    sonify_scene(a, tree, table, dry, metres);
+  } catch (const InvalidArgument& e) {
+    if (metres == 1.0) throw;
+    char units[160];
+    std::snprintf(units, sizeof units, " (positions in metres here: the scene's units times %.10g)", metres);
+    throw InvalidArgument(e.what() + std::string(units));
+  }
 }
 
 }  // namespace
@@ -281,7 +328,9 @@ void add_sonify(CLI::App& app) {
       "both ends are in front of, amplitude R * sqrt(A/pi) / (r1 * r2); paths binned by delay sample and\n"
       "attenuation (--bin-width), kept up to --window s after the direct time, --floor, --visibility.\n"
       "Its levels grow as the voxel size shrinks: it is the paper's timing reference, not physics.\n"
-      "World units are metres; the sample rate is the recording's.\n\n"
+      "Positions are in the scene's world units; a scene whose CRS is in feet is scaled to metres for the\n"
+      "sound (distances are reported in metres); without a CRS, world units are metres. The sample rate\n"
+      "is the recording's.\n\n"
       "Reflection coefficients R (pressure, 0..1): --reflection R or --absorption A (R = sqrt(1 - A)) for the\n"
       "whole scene, or --materials m.json (--absorption then sets the classes the table does not list):\n"
       "  {\"attribute\": \"classification\", \"default\": 0.3,\n"
@@ -296,7 +345,7 @@ void add_sonify(CLI::App& app) {
       "  vola sonify scan.vol --materials m.json --source 1 2 1 --source 5 2 1 --listener 3 3 1 \\\n"
       "      --in violin.wav --in cello.wav --out duo.wav --channels per-source");
   cmd->add_option("scene", args->scene, "The scene (.vol)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--source", args->sources, "Sound source X Y Z (world units, metres); repeat for more sources")
+  cmd->add_option("--source", args->sources, "Sound source X Y Z (the scene's world units); repeat for more sources")
       ->required()
       ->expected(3)
       ->take_all();

@@ -167,6 +167,7 @@ py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 
   options.hierarchical = hierarchical;
   options.max_expansions = max_expansions;
   options.solid_ground = solid_ground;
+  if (world) options.world = &frame;
   vola::raycast::PlannedPath path;
   {
     py::gil_scoped_release release;

@@ -14,6 +14,7 @@
 
 #include "vola/error.hpp"
 #include "vola/raycast/clearance_field.hpp"
+#include "vola/raycast/world.hpp"
 
 namespace vola::raycast {
 namespace {
@@ -21,10 +22,22 @@ namespace {
 using Cell = std::array<std::int64_t, 3>;
 constexpr std::int64_t kBrick = ClearanceField::kBrick;
 
-std::string show(const Point& p) {
-  char text[96];
-  std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
+std::string show_xyz(const Point& p) {
+  char text[128];
+  std::snprintf(text, sizeof text, "(%.10g, %.10g, %.10g)", p[0], p[1], p[2]);
   return text;
+}
+
+// A point as the caller gave it: in world coordinates when the options carry the frame.
+std::string show(const Point& grid, const PlanOptions& options) {
+  return show_xyz(options.world ? grid_to_world(*options.world, grid) : grid);
+}
+
+// The volume's extent, in the coordinates the caller uses.
+std::string show_volume(double side, const PlanOptions& options) {
+  if (!options.world) return "[0, " + std::to_string(static_cast<long long>(side)) + ")^3 (grid coordinates)";
+  return show_xyz(grid_to_world(*options.world, {0, 0, 0})) + " to " +
+         show_xyz(grid_to_world(*options.world, {side, side, side})) + " (world coordinates)";
 }
 
 double distance(const Point& a, const Point& b) {
@@ -418,10 +431,10 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
   const auto side = static_cast<double>(tree.side());
   for (const auto& [name, p, c] : {std::tuple{"start", start, from}, std::tuple{"goal", goal, to}}) {
     if (!field.inside(c[0], c[1], c[2]))
-      throw InvalidArgument(std::string("plan: the ") + name + " " + show(p) + " is outside the volume [0, " +
-                            std::to_string(static_cast<long long>(side)) + ")^3 (grid coordinates)");
+      throw InvalidArgument(std::string("plan: the ") + name + " " + show(p, options) + " is outside the volume " +
+                            show_volume(side, options));
     if (!field.free(c[0], c[1], c[2]))
-      throw InvalidArgument(std::string("plan: the ") + name + " " + show(p) + " is inside an obstacle" +
+      throw InvalidArgument(std::string("plan: the ") + name + " " + show(p, options) + " is inside an obstacle" +
                             (options.known ? " or unknown space" : "") + (options.solid_ground ? " or the ground" : "") +
                             (options.radius > 0 ? " or closer than the radius to one" : ""));
   }
@@ -453,11 +466,11 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
     cells = search.run(from, to, options.max_expansions, out.cost, out.expanded);
   }
   if (!cells && out.expanded > options.max_expansions)
-    throw InvalidArgument("plan: no path from " + show(start) + " to " + show(goal) + " found within the limit of " +
+    throw InvalidArgument("plan: no path from " + show(start, options) + " to " + show(goal, options) + " found within the limit of " +
                           std::to_string(options.max_expansions) + " expanded cells (a larger limit, or a hierarchical "
                           "search, may find one)");
   if (!cells)
-    throw InvalidArgument("plan: the goal " + show(goal) + " cannot be reached from " + show(start) + " (" +
+    throw InvalidArgument("plan: the goal " + show(goal, options) + " cannot be reached from " + show(start, options) + " (" +
                           std::to_string(out.expanded) + " cells searched)");
 
   std::vector<Cell> kept{cells->front()};

@@ -76,12 +76,17 @@ struct Server::Impl {
     return HostNames(std::move(all));
   }
 
+  // "files 0..2", or "no files" (a viewer of tile sets alone).
+  static std::string numbered(std::size_t count, const std::string& what) {
+    return count == 0 ? "no " + what : what + " 0.." + std::to_string(count - 1);
+  }
+
   const ViewedFile& file(const httplib::Request& req) const {
     const std::string& text = req.matches[1];
     std::size_t i = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), i);
     if (ec != std::errc{} || end != text.data() + text.size() || i >= files.size())
-      throw NotFound("no file " + text + " (this viewer serves files 0.." + std::to_string(files.size() - 1) + ")");
+      throw NotFound("no file " + text + " (this viewer serves " + numbered(files.size(), "files") + ")");
     return *files[i];
   }
 
@@ -96,8 +101,8 @@ struct Server::Impl {
     const ViewedTileSet& set = *tile_sets[s];
     const auto [piece_end, piece_ec] = std::from_chars(piece_text.data(), piece_text.data() + piece_text.size(), p);
     if (piece_ec != std::errc{} || piece_end != piece_text.data() + piece_text.size() || p >= set.pieces().size())
-      throw NotFound("no piece " + piece_text + " in tile set " + set_text + " (it has pieces 0.." +
-                     std::to_string(set.pieces().size() - 1) + ")");
+      throw NotFound("no piece " + piece_text + " in tile set " + set_text + " (it has " +
+                     numbered(set.pieces().size(), "pieces") + ")");
     return set.piece(p);
   }
 

@@ -11,10 +11,12 @@ las=$shared/data/las/pdal_autzen_trim.las wav=$shared/data/audio/alsa_Front_Cent
 [ -f "$las" ] && [ -f "$wav" ] || skip "no shared data at $shared"
 
 "$vola" convert "$las" "$tmp/autzen.vol" --voxel-size 3 -q
-# Feet: the speed of sound in ft/s. Source 45 ft from the listener, 6 ft above the ground.
+# The survey is in feet: positions in feet, sound in metres. Source 45 ft (13.716 m) from
+# the listener, 6 ft above the ground.
 "$vola" sonify "$tmp/autzen.vol" --source 636250.5 849217.5 435 --listener 636205.5 849217.5 435 \
-  --in "$wav" --out "$tmp/wet.wav" --ir "$tmp/ir.wav" --speed-of-sound 1125 --rays 8000 > "$tmp/out" \
+  --in "$wav" --out "$tmp/wet.wav" --ir "$tmp/ir.wav" --rays 8000 > "$tmp/out" \
   || fail "sonify failed: $(cat "$tmp/out")"
+grep -q "direct 13.716 m, 39.98 ms (sample 1919)" "$tmp/out" || fail "45 ft is not 13.716 m at 343 m/s: $(cat "$tmp/out")"
 /usr/bin/python3 - "$tmp/ir.wav" <<'PY' || fail "the open scene's response rings or does not decay"
 import sys
 import numpy as np

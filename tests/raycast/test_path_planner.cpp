@@ -306,6 +306,24 @@ TEST(PathPlanner, ClearErrors) {
         }
       },
       vola::InvalidArgument);
+  // Given the world frame, the errors speak in world coordinates, as the caller gave them.
+  const vola::Frame world{vola::Quantization::grid, {1000, 2000, 10}, 0.5};
+  PlanOptions in_world;
+  in_world.world = &world;
+  const auto world_message = [&](const Point& s, const Point& g) {
+    try {
+      plan_path(tree, s, g, in_world);
+    } catch (const vola::InvalidArgument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(world_message({-2, 0, 0}, {1, 1, 1}).find("start (999, 2000, 10) is outside the volume (1000, 2000, 10) to "
+                                                      "(1008, 2008, 18) (world coordinates)"),
+            std::string::npos)
+      << world_message({-2, 0, 0}, {1, 1, 1});
+  EXPECT_NE(world_message({1, 1, 1}, {4.5, 4.5, 4.5}).find("goal (1002.25, 2002.25, 12.25) is inside an obstacle"),
+            std::string::npos);
   EXPECT_THROW(plan_path(tree, {1, 1, 1}, {2, 2, 2}, PlanOptions{.level = 2}), vola::InvalidArgument);
   // The search's limit is not unreachability: the message says which it was.
   try {

@@ -217,6 +217,12 @@ TEST(ViewerTiles, BadSetAndPieceIdsAreRefused) {
     EXPECT_EQ(status_of(answer), status) << answer;
     EXPECT_TRUE(json::parse(body_of(answer))["error"].is_string());
   }
+  // A viewer of a tile set alone has no files: it says so (not "files 0..18446744073709551615").
+  const std::string no_file = server.get("/api/files/0/cells?level=0&first=0&count=1");
+  EXPECT_EQ(status_of(no_file), 404) << no_file;
+  EXPECT_EQ(json::parse(body_of(no_file))["error"], "no file 0 (this viewer serves no files)");
+  EXPECT_NE(server.get("/api/tilesets/0/pieces/3/cells?level=0&first=0&count=1").find("it has pieces 0..2"),
+            std::string::npos);
 }
 
 TEST(ViewerTiles, NoFileOutsideTheIndexsFolderIsOpened) {

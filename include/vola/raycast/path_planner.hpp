@@ -44,6 +44,7 @@ struct PlanOptions {
   std::uint64_t max_expansions = 20'000'000;  // then the goal counts as unreachable
   const Tree* known = nullptr;   // not owned; null: space outside the tree's voxels is free
   bool solid_ground = false;     // the space under each column's ground is an obstacle (ClearanceField)
+  const Frame* world = nullptr;  // not owned; non-null: errors show points and the volume in its world coordinates
 };
 
 struct PlannedPath {
