@@ -7,37 +7,29 @@
 #include "vola/parallel.hpp"
 
 namespace vola::raycast {
-namespace {
+VoxelColours::VoxelColours(const Tree& tree) : tree_(tree) {
+  const Attributes& a = tree.attributes();
+  channels_ = {a.find("red"), a.find("green"), a.find("blue")};
+  if (!channels_[0] || !channels_[1] || !channels_[2]) return;
+  double top = 0.0;
+  for (const AttributeColumn* c : channels_)
+    for (std::size_t i = 0; i < c->size(); ++i) top = std::max(top, c->get(i));
+  scale_ = top > 255.0 ? 1.0 / 257.0 : 1.0;  // LAS stores colours as 16 bits, most often
+  present_ = true;
+}
 
-// Per-voxel colour from the red/green/blue attribute columns (8- or 16-bit values).
-class VoxelColours {
- public:
-  explicit VoxelColours(const Tree& tree) : tree_(tree) {
-    const Attributes& a = tree.attributes();
-    channels_ = {a.find("red"), a.find("green"), a.find("blue")};
-    if (!channels_[0] || !channels_[1] || !channels_[2]) return;
-    double top = 0.0;
-    for (const AttributeColumn* c : channels_)
-      for (std::size_t i = 0; i < c->size(); ++i) top = std::max(top, c->get(i));
-    scale_ = top > 255.0 ? 1.0 / 257.0 : 1.0;  // LAS stores colours as 16 bits, most often
-    present_ = true;
-  }
-  std::array<double, 3> at(const Voxel& v) const {
-    if (!present_) return {200, 200, 200};
-    const auto rank = tree_.rank(v);
-    std::array<double, 3> c{};
-    for (int i = 0; i < 3; ++i) c[i] = rank && *rank < channels_[i]->size() ? channels_[i]->get(*rank) * scale_ : 0;
-    return c;
-  }
+std::array<double, 3> VoxelColours::at(const Voxel& v) const {
+  if (!present_) return {200, 200, 200};
+  const auto rank = tree_.rank(v);
+  std::array<double, 3> c{};
+  for (int i = 0; i < 3; ++i) c[i] = rank && *rank < channels_[i]->size() ? channels_[i]->get(*rank) * scale_ : 0;
+  return c;
+}
 
- private:
-  const Tree& tree_;
-  std::array<const AttributeColumn*, 3> channels_{};
-  double scale_ = 1.0;
-  bool present_ = false;
-};
-
-}  // namespace
+void shade_pixel(const std::array<double, 3>& colour, const std::array<int, 3>& normal, std::uint8_t* rgb) {
+  const double shade = lambert(normal);
+  for (int i = 0; i < 3; ++i) rgb[i] = static_cast<std::uint8_t>(std::clamp(colour[i] * shade, 0.0, 255.0));
+}
 
 double lambert(const std::array<int, 3>& normal) {
   constexpr std::array<double, 3> kLight{0.42426406871192851, 0.56568542494923801, 0.70710678118654757};
@@ -69,10 +61,7 @@ Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned 
       if (!hit) continue;
       ++local;
       out.depth[p] = hit->t;
-      const auto colour = colours.at(hit->voxel);
-      const double shade = lambert(hit->normal);
-      for (int i = 0; i < 3; ++i)
-        out.rgb[3 * p + i] = static_cast<std::uint8_t>(std::clamp(colour[i] * shade, 0.0, 255.0));
+      shade_pixel(colours.at(hit->voxel), hit->normal, &out.rgb[3 * p]);
     }
     hits += local;
   };

@@ -11,6 +11,7 @@
 #include "vola/file.hpp"
 #include "vola/parallel.hpp"
 #include "vola/raycast/ray_caster.hpp"
+#include "vola/raycast/render.hpp"
 #include "vola/raycast/world.hpp"
 
 namespace vola::tile {
@@ -19,7 +20,8 @@ namespace fs = std::filesystem;
 
 struct TileSet::Opened {
   Tree tree;
-  std::unique_ptr<raycast::RayCaster> caster;  // made on the first ray
+  std::unique_ptr<raycast::RayCaster> caster;      // made on the first ray
+  std::unique_ptr<raycast::VoxelColours> colours;  // made with the caster
   std::once_flag caster_once;
 };
 
@@ -66,6 +68,12 @@ const Tree* TileSet::tree(const TileIndex& tile) const {
 std::size_t TileSet::tiles_opened() const {
   const std::lock_guard lock(mutex_);
   return opened_.size();
+}
+
+std::array<double, 3> TileSet::colour(const TileHit& hit) const {
+  const Opened* opened = open(hit.tile);
+  if (!opened || !opened->colours) throw InvalidArgument("TileSet::colour: give a hit cast() returned");
+  return opened->colours->at(hit.voxel);
 }
 
 TileLookup TileSet::locate(const Point& world) const {
@@ -124,6 +132,7 @@ std::optional<TileHit> TileSet::cast(const raycast::Ray& world_ray) const {
     if (const Opened* opened = open(t)) {
       std::call_once(const_cast<Opened*>(opened)->caster_once, [opened] {
         const_cast<Opened*>(opened)->caster = std::make_unique<raycast::RayCaster>(opened->tree);
+        const_cast<Opened*>(opened)->colours = std::make_unique<raycast::VoxelColours>(opened->tree);
       });
       raycast::Ray local = raycast::world_ray_to_grid(g.tile_frame(t), world_ray);
       const auto hit = opened->caster->cast(local);
@@ -197,8 +206,7 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
       if (!hit) continue;
       ++local;
       out.depth[p] = hit->t;
-      const auto grey = static_cast<std::uint8_t>(std::clamp(200.0 * raycast::lambert(hit->normal), 0.0, 255.0));
-      for (int i = 0; i < 3; ++i) out.rgb[3 * p + i] = grey;
+      raycast::shade_pixel(tiles.colour(*hit), hit->normal, &out.rgb[3 * p]);
     }
     hits += local;
   };

@@ -99,6 +99,20 @@ grep -Eq "^view.png|rays hit" "$tmp/render.txt" || fail "render: $(cat "$tmp/ren
 hits=$(sed -n 's/.*: \([0-9]*\) of 19200 rays hit/\1/p' "$tmp/render.txt")
 [ "${hits:-0}" -gt 1000 ] || fail "render hit only ${hits:-0} of 19200 rays"
 [ -s "$tmp/view.png" ] && [ -s "$tmp/view_depth.png" ] || fail "render wrote no images"
+# The tiles' colours and depths are the survey's: the same image as one file on the same
+# grid (tile set renders were grey, their red/green/blue columns ignored).
+origin=$(python3 -c "
+import json, sys
+v = json.load(open(sys.argv[1]))['vola']
+tiles = [f['properties']['tile'] for f in json.load(open(sys.argv[1]))['features']]
+print(*(v['origin'][a] + min(t[a] for t in tiles) * v['tile_size'] for a in range(3)))" "$index")
+# shellcheck disable=SC2086  # three numbers
+"$vola" convert "$las" "$tmp/whole.vol" --voxel-size 1 --origin $origin -q
+camera=(--camera 636800 848500 2500 637500 849700 450 --size 200x150 -q)
+"$vola" render "$index" "${camera[@]}" -o "$tmp/tiles_view.png"
+"$vola" render "$tmp/whole.vol" "${camera[@]}" -o "$tmp/whole_view.png"
+cmp -s "$tmp/tiles_view.png" "$tmp/whole_view.png" || fail "the tile set renders other colours than the survey as one file"
+cmp -s "$tmp/tiles_view_depth.png" "$tmp/whole_view_depth.png" || fail "the tile set renders other depths than one file"
 
 # plan: 150 ft above the ground, across two tiles; opens only the tiles around the path.
 "$vola" plan "$index" --from 636100 849000 560 --to 636400 849100 560 --radius 2 --margin 20 -o "$tmp/path.csv" \

@@ -51,6 +51,9 @@ class TileSet {
   TileLookup locate(const Point& world) const;
   // The first occupied voxel along a world ray, tiles visited in the ray's order.
   std::optional<TileHit> cast(const raycast::Ray& world_ray) const;
+  // The hit voxel's colour as raycast::VoxelColours gives it (its tile's red/green/blue
+  // columns; light grey without them). `hit` is one cast() returned.
+  std::array<double, 3> colour(const TileHit& hit) const;
   // One tree over the tiles that meet `world_box` (the grid of the lowest such tile),
   // for searches that need a single grid. Throws InvalidArgument when the region spans
   // more tiles per axis than depth 10 can hold.
@@ -69,7 +72,7 @@ class TileSet {
 };
 
 // A shaded and a depth image of a tile set through a world-coordinate camera (depth
-// in world units), shaded like raycast::render.
+// in world units), shaded and coloured like raycast::render.
 raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& world_camera, unsigned threads = 0);
 
 // The default view of a tile set (world coordinates), placed as raycast::overview_camera
