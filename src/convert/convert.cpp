@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -110,6 +112,66 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
 }
 
+template <class T>
+std::pair<double, double> limits_of() {
+  return {static_cast<double>(std::numeric_limits<T>::lowest()), static_cast<double>(std::numeric_limits<T>::max())};
+}
+
+// The values an integer attribute type holds; nothing for the floating-point types.
+std::optional<std::pair<double, double>> integer_range(ValueType type) {
+  switch (type) {
+    case ValueType::u8: return limits_of<std::uint8_t>();
+    case ValueType::u16: return limits_of<std::uint16_t>();
+    case ValueType::u32: return limits_of<std::uint32_t>();
+    case ValueType::u64: return limits_of<std::uint64_t>();
+    case ValueType::i8: return limits_of<std::int8_t>();
+    case ValueType::i16: return limits_of<std::int16_t>();
+    case ValueType::i32: return limits_of<std::int32_t>();
+    case ValueType::i64: return limits_of<std::int64_t>();
+    default: return std::nullopt;
+  }
+}
+
+// A value an integer column cannot hold is stored clamped to its type (NaN as 0), which
+// would pass unseen: --attribute a=4:u8 over values up to 300 reads 255. A mean of
+// values in range stays in range, so the points' own values are the ones to check.
+std::vector<std::string> clamped_value_warnings(const std::string& path, const PointCloud& cloud) {
+  std::vector<std::string> out;
+  for (const PointAttribute& a : cloud.attributes) {
+    const auto range = integer_range(a.type);
+    if (!range) continue;
+    std::uint64_t outside = 0, not_numbers = 0;
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const double v : a.values) {
+      if (std::isnan(v)) {
+        ++not_numbers;
+        continue;
+      }
+      const double stored = std::nearbyint(v);
+      if (stored >= range->first && stored <= range->second) continue;
+      ++outside;
+      low = std::min(low, v);
+      high = std::max(high, v);
+    }
+    char text[400];
+    if (outside > 0) {
+      std::snprintf(text, sizeof text,
+                    "%s: attribute %s: %llu of %zu values lie outside %s's range %.17g..%.17g (from %.6g to %.6g): "
+                    "they are stored clamped to it; give the attribute a wider TYPE (f32, i32, ...)",
+                    path.c_str(), a.name.c_str(), static_cast<unsigned long long>(outside), a.values.size(),
+                    std::string(name_of(a.type)).c_str(), range->first, range->second, low, high);
+      out.emplace_back(text);
+    }
+    if (not_numbers > 0) {
+      std::snprintf(text, sizeof text, "%s: attribute %s: %llu of %zu values are not numbers: %s stores them as 0",
+                    path.c_str(), a.name.c_str(), static_cast<unsigned long long>(not_numbers), a.values.size(),
+                    std::string(name_of(a.type)).c_str());
+      out.emplace_back(text);
+    }
+  }
+  return out;
+}
+
 // A grid the points cannot be put on (an extent beyond a double or beyond depth 10, a
 // file's grid too large) is said by the core without the file's name; an option's
 // error already names what to change.
@@ -136,6 +198,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   const io::InputFormat& format = io::find_input_format(path, options.format);
   std::vector<std::string> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
+  std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));
@@ -153,6 +216,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
     if (input.bytes_read) report.bytes_read = input.bytes_read();
     report.warnings = crs_warnings(path, options, input, crs);
+    report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
     report.filters = std::move(filter_report);
     *report_out = std::move(report);
   }

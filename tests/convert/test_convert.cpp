@@ -532,4 +532,29 @@ TEST(Convert, TextHeadersPlaceXyzWhateverColumnsAreKept) {
   EXPECT_EQ(with_payload.voxel_payloads()[0], 0x1e140aull);  // 10, 20, 30
 }
 
+TEST(Convert, ValuesAnIntegerAttributeCannotHoldAreSaid) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "values.xyz").string();
+  const std::string text = "0 0 0 300\n5 5 5 -4\n9 9 9 7\n3 3 3 nan\n";
+  vola_test::write_bytes(path, std::vector<std::uint8_t>(text.begin(), text.end()));
+  vola::ConvertOptions options;
+  options.voxel_size = 1;
+  options.text_attributes = {"a=4:u8"};
+  vola::ConvertReport report;
+  const vola::Tree tree = vola::convert(path, options, {}, &report);
+  const vola::AttributeColumn* a = tree.attributes().find("a");
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(a->get(*tree.rank({0, 0, 0})), 255);  // clamped, as the warning says
+  ASSERT_EQ(report.warnings.size(), 2u);
+  EXPECT_EQ(report.warnings[0], path + ": attribute a: 2 of 4 values lie outside u8's range 0..255 (from -4 to 300): "
+                                       "they are stored clamped to it; give the attribute a wider TYPE (f32, i32, ...)");
+  EXPECT_EQ(report.warnings[1], path + ": attribute a: 1 of 4 values are not numbers: u8 stores them as 0");
+  // The same values as i16, and as the default f32: nothing to say.
+  for (const std::string spec : {"a=4:i16", "a=4"}) {
+    options.text_attributes = {spec};
+    vola::convert(path, options, {}, &report);
+    EXPECT_EQ(report.warnings.size(), spec == "a=4" ? 0u : 1u) << spec;  // i16 still has no NaN
+  }
+}
+
 }  // namespace
