@@ -191,13 +191,21 @@ void translate_las(const std::string& input, const std::string& output,
     append_vlr(vlrs, v.user_id, v.record_id, v.description, v.data);
     ++vlr_count;
   }
+  // Bytes between the last VLR and the points (LAS 1.0's 0xDDCC signature, or user
+  // data a writer put there) stay between the VLRs and the points.
+  std::uint64_t vlrs_end = hd.header_size;
+  for (const LasVlr& v : hd.vlrs)
+    if (!v.extended) vlrs_end = std::max(vlrs_end, v.offset + v.length);
+  const std::vector<std::uint8_t> user_bytes =
+      hd.offset_to_points > vlrs_end ? read_bytes(in, input, vlrs_end, hd.offset_to_points - vlrs_end)
+                                     : std::vector<std::uint8_t>{};
   laz::LaszipInfo info;
   if (laz_out) {
     info = laz::laszip_info_for(hd.point_format, hd.record_length);
     append_vlr(vlrs, "laszip encoded", 22204, "vola LAZ", laz::laszip_vlr_payload(info));
     ++vlr_count;
   }
-  const std::uint64_t points_at = head.size() + vlrs.size();
+  const std::uint64_t points_at = head.size() + vlrs.size() + user_bytes.size();
   if (points_at > 0xFFFFFFFFu) throw FormatError(input, 96, "the VLRs do not fit a LAS header's 32-bit offset");
   head[104] = static_cast<std::uint8_t>(hd.point_format | (laz_out ? 0x80 : 0));
   store(head, 96, static_cast<std::uint32_t>(points_at));
@@ -207,6 +215,7 @@ void translate_las(const std::string& input, const std::string& output,
   OutputFile out(output);
   out.write(head.data(), head.size());
   out.write(vlrs.data(), vlrs.size());
+  out.write(user_bytes.data(), user_bytes.size());
   RecordSource source(reader, edits);
   const std::uint64_t point_bytes = laz_out ? write_laz_points(reader, source, info, out, points_at, progress)
                                             : write_las_points(reader, source, out, progress);
