@@ -39,7 +39,9 @@ std::string free_path(const std::string& output) {
 }
 
 // One scan's points in the world frame; errors name the list's line.
-std::vector<double> world_points(const map::ScanEntry& scan, const std::string& list) {
+// The scan's points in world coordinates; `left_out` gets the points the reader left out
+// for a coordinate that is not finite.
+std::vector<double> world_points(const map::ScanEntry& scan, const std::string& list, std::uint64_t& left_out) {
   const std::string where = list + ": line " + std::to_string(scan.line) + ": " + scan.file + ": ";
   io::Input input;
   try {
@@ -52,6 +54,7 @@ std::vector<double> world_points(const map::ScanEntry& scan, const std::string& 
   if (input.cloud.xyz.empty() && (input.grid || input.is_mesh() || input.build))
     throw InvalidArgument(where + "not a point file (" + input.format + "): a scan is points in the sensor frame");
   scan.pose.apply(input.cloud.xyz);
+  left_out = input.not_finite;
   return std::move(input.cloud.xyz);
 }
 
@@ -101,7 +104,10 @@ void run_map(const MapArgs& a) {
   map::ScanReport total;
   double insert_seconds = 0;
   for (std::size_t n = 0; n < scans.size(); ++n) {
-    const std::vector<double> xyz = world_points(scans[n], a.list);
+    std::uint64_t left_out = 0;
+    const std::vector<double> xyz = world_points(scans[n], a.list, left_out);
+    total.points += left_out;
+    total.not_finite += left_out;
     const auto insert_start = std::chrono::steady_clock::now();
     try {
       add_up(total, m.insert_scan(xyz, scans[n].pose.translation, a.max_range));

@@ -108,7 +108,10 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   }
   if (input.grid) input.cloud = grid_cell_centres(*input.grid);
   if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
-  if (input.cloud.size() == 0) throw InvalidArgument(path + ": no points");
+  if (input.cloud.size() == 0)
+    throw InvalidArgument(path + ": no points" +
+                          (input.not_finite ? " with finite coordinates (" + std::to_string(input.not_finite) + " without)"
+                                            : std::string()));
   return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
 }
 
@@ -207,6 +210,9 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   CentreLatLon centre(crs.epsg, crs.wkt.empty() ? input.wkt : crs.wkt);  // PROJ gets ready while the tree is built
   ConvertReport report;
   Tree tree = name_input_in_errors(path, [&] { return build_tree(path, input, options, build, report.build); });
+  // Points the reader left out count as the file's points, dropped as not finite.
+  report.build.points_in += input.not_finite;
+  report.build.points_outside += input.not_finite;
   georeference(tree, crs, tree.frame().quantization, centre);
   if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
   if (report_out) {

@@ -45,19 +45,4 @@ std::size_t ensure_column(PointCloud& cloud, const std::string& name, ValueType 
   return cloud.attributes.size() - 1;
 }
 
-void keep_points(PointCloud& cloud, const std::vector<bool>& keep) {
-  std::size_t out = 0;
-  const std::size_t n = cloud.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!keep[i]) continue;
-    for (int a = 0; a < 3; ++a) cloud.xyz[3 * out + a] = cloud.xyz[3 * i + a];
-    if (!cloud.payload.empty()) cloud.payload[out] = cloud.payload[i];
-    for (auto& column : cloud.attributes) column.values[out] = column.values[i];
-    ++out;
-  }
-  cloud.xyz.resize(3 * out);
-  if (!cloud.payload.empty()) cloud.payload.resize(out);
-  for (auto& column : cloud.attributes) column.values.resize(out);
-}
-
 }  // namespace vola::filters

@@ -8,6 +8,7 @@
 
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
+#include "vola/point_selection.hpp"
 
 namespace vola::filters {
 

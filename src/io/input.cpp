@@ -52,7 +52,7 @@ Input read_npy_input(const std::string& path, const InputOptions& options) {
 Input read_pcd_input(const std::string& path, const InputOptions& options) {
   Input in;
   in.format = "pcd";
-  in.cloud = read_pcd(path, options);
+  in.cloud = read_pcd(path, options, &in.not_finite);
   return in;
 }
 

@@ -262,7 +262,7 @@ Layout find_layout(const Header& h, const std::string& name) {
   return l;
 }
 
-// Appends the finite points with their colours and intensity.
+// Appends the finite points with their colours and intensity, and counts the others.
 class PointSink {
  public:
   PointSink(const Layout& layout, const InputOptions& options, PointCloud& cloud, std::uint64_t reservable)
@@ -291,18 +291,23 @@ class PointSink {
   }
   // `others`: the value of each of the layout's other fields.
   void add(const double (&xyz)[3], const double (&rgb)[3], double intensity, std::span<const double> others) {
-    if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) return;
+    if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) {
+      ++not_finite_;
+      return;
+    }
     cloud_.xyz.insert(cloud_.xyz.end(), {xyz[0], xyz[1], xyz[2]});
     if (colours_) colours_->add(rgb[0], rgb[1], rgb[2]);
     if (intensity_column_) cloud_.attributes[*intensity_column_].values.push_back(intensity);
     for (std::size_t k = 0; k < others_; ++k) cloud_.attributes[first_other_ + k].values.push_back(others[k]);
   }
+  std::uint64_t not_finite() const noexcept { return not_finite_; }
 
  private:
   PointCloud& cloud_;
   std::optional<ColourColumns> colours_;
   std::optional<std::size_t> intensity_column_;
   std::size_t first_other_ = 0, others_ = 0;  // columns of the other fields (none without attributes)
+  std::uint64_t not_finite_ = 0;
 };
 
 void unpack_rgb(std::uint32_t packed, double (&rgb)[3]) {
@@ -397,7 +402,8 @@ constexpr std::uint64_t kLzfMaxRatio = 88;
 
 }  // namespace
 
-PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options) {
+PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options,
+                     std::uint64_t* not_finite) {
   const Header h = parse_header(bytes, name);
   const Layout layout = find_layout(h, name);
   const std::uint64_t remaining = bytes.size() - h.body;
@@ -406,6 +412,7 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
     // Every point takes at least one character and a separator per value.
     PointSink sink(layout, options, cloud, std::min<std::uint64_t>(h.points, remaining / (2 * h.components)));
     read_ascii(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), h, layout, sink, name);
+    if (not_finite) *not_finite = sink.not_finite();
   } else if (h.data == DataKind::binary) {
     if (h.points > remaining / h.point_size)
       throw FormatError(name, h.body, std::to_string(h.points) + " points of " + std::to_string(h.point_size) +
@@ -413,6 +420,7 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
                                           " bytes after the header (truncated file)");
     PointSink sink(layout, options, cloud, h.points);
     read_records(bytes.data() + h.body, false, h, layout, sink);
+    if (not_finite) *not_finite = sink.not_finite();
   } else {
     if (remaining < 8) throw FormatError(name, h.body, "binary_compressed data lacks its two 32-bit sizes (truncated file)");
     std::uint32_t compressed = 0, raw = 0;
@@ -431,13 +439,14 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
       throw FormatError(name, h.body + 8, "the LZF data is corrupt (it does not decompress to " + std::to_string(raw) + " bytes)");
     PointSink sink(layout, options, cloud, h.points);
     read_records(columns.data(), true, h, layout, sink);
+    if (not_finite) *not_finite = sink.not_finite();
   }
   if (options.progress) options.progress(bytes.size(), bytes.size());
   return cloud;
 }
 
-PointCloud read_pcd(const std::string& path, const InputOptions& options) {
-  return parse_pcd(read_file_bytes(path), path, options);
+PointCloud read_pcd(const std::string& path, const InputOptions& options, std::uint64_t* not_finite) {
+  return parse_pcd(read_file_bytes(path), path, options, not_finite);
 }
 
 }  // namespace vola::io

@@ -11,6 +11,7 @@
 #include "export_columns.hpp"
 #include "las_format.hpp"
 #include "vola/output_file.hpp"
+#include "vola/point_selection.hpp"
 #include "vola/error.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
@@ -237,8 +238,29 @@ PointTable read_point_table(const std::string& input, const std::function<void(s
   table.cloud = std::move(in.cloud);
   table.epsg = in.epsg;
   table.wkt = std::move(in.wkt);
+  table.not_finite = in.not_finite;
   return table;
 }
+
+namespace {
+
+// LAS stores coordinates as integers: a point with a NaN or infinite coordinate (text
+// and PLY files hold them) has no record. Left out, and said.
+void drop_points_las_cannot_hold(const std::string& input, PointCloud& cloud, std::vector<std::string>& warnings) {
+  std::vector<bool> finite(cloud.size(), true);
+  std::uint64_t dropped = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (!std::isfinite(cloud.xyz[3 * i]) || !std::isfinite(cloud.xyz[3 * i + 1]) || !std::isfinite(cloud.xyz[3 * i + 2])) {
+      finite[i] = false;
+      ++dropped;
+    }
+  if (dropped == 0) return;
+  keep_points(cloud, finite);
+  warnings.push_back(input + ": " + std::to_string(dropped) +
+                     " points with a coordinate that is not finite are left out: LAS has no record for them");
+}
+
+}  // namespace
 
 std::vector<std::string> translate_points(const std::string& input, const std::string& output,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
@@ -261,6 +283,11 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
     }
   }
   std::vector<std::string> warnings;
+  if (table.not_finite > 0)
+    warnings.push_back(input + ": " + std::to_string(table.not_finite) +
+                       " points with a coordinate that is not finite (an organized cloud's missing points) are not "
+                       "read, so not written");
+  if (las_out) drop_points_las_cannot_hold(input, table.cloud, warnings);
   if (!las_out && (table.epsg || !table.wkt.empty()))
     warnings.push_back(output + ": " + (out_ext == ".ply" ? "PLY" : "XYZ") + " has no place for the CRS of " + input +
                        " (" + (table.epsg ? "EPSG:" + std::to_string(*table.epsg) : "a WKT with no EPSG code") +

@@ -109,9 +109,12 @@ TEST(Pcd, OrganizedCloudDropsItsNaNPoints) {
   const auto path = data / "pcd" / "pcl_table_scene_mug_stereo_textured.pcd";
   vola::io::InputOptions options;
   options.payload = true;
-  const auto cloud = vola::io::read_pcd(path.string(), options);
+  std::uint64_t not_finite = 0;
+  const auto cloud = vola::io::read_pcd(path.string(), options, &not_finite);
   // EXPECTED.txt: W=640 H=480 points=307200 finite=209280.
   EXPECT_EQ(cloud.size(), 209280u);
+  EXPECT_EQ(not_finite, 307200u - 209280u);  // counted, so that vola map and convert can say so
+  EXPECT_EQ(vola::io::read_input(path.string(), "auto", options).not_finite, not_finite);
   EXPECT_EQ(cloud.payload.size(), cloud.size());
   for (double v : cloud.xyz) ASSERT_TRUE(std::isfinite(v));
 }

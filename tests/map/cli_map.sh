@@ -33,6 +33,15 @@ grep -q 'no point of the 1 made a known voxel (0 not finite, 1 more than 1048576
   "$tmp/far.out" || fail "far: $(cat "$tmp/far.out")"
 [ -e "$tmp/far.vol" ] && fail "a map of nothing was written"
 
+# An organized PCD's missing points (NaN) count as points not finite: the reader leaves
+# them out, and the summary said "0 not finite".
+printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 0 0\nnan nan nan\n0 1 0\n' \
+  > "$tmp/scans/organized.pcd"
+echo "scans/organized.pcd 0.1 0.1 0.1 0 0 0 1" > "$tmp/organized.txt"
+"$vola" map "$tmp/organized.txt" -o "$tmp/organized.vol" --voxel-size 0.25 > "$tmp/organized.out" \
+  || fail "map of a PCD: $(cat "$tmp/organized.out")"
+grep -q '^scans:   1, 3 points (1 not finite' "$tmp/organized.out" || fail "organized PCD: $(cat "$tmp/organized.out")"
+
 # The state map: 9 known voxels; commands see the 2 occupied ones.
 "$vola" info "$tmp/map.vol" > "$tmp/info"
 grep -q 'state map (vola map): 9 known, .* 2 occupied, 7 free' "$tmp/info" || fail "info: $(cat "$tmp/info")"

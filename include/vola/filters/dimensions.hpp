@@ -35,7 +35,4 @@ inline double value_of(const PointCloud& cloud, const Dimension& d, std::size_t 
 // and zero values when the cloud has none; returns its index.
 std::size_t ensure_column(PointCloud& cloud, const std::string& name, ValueType type, Reduction reduction);
 
-// Keeps the points whose keep[i] is true, in order, in every column.
-void keep_points(PointCloud& cloud, const std::vector<bool>& keep);
-
 }  // namespace vola::filters

@@ -54,6 +54,9 @@ struct Input {
   std::function<Tree(const BuildOptions&, BuildReport*)> build;
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
+  // Points the reader left out for a coordinate that is not finite (a PCD organized
+  // cloud's missing points), so that counts of the file's points stay true.
+  std::uint64_t not_finite = 0;
   // Readers that can skip parts of a file (COPC) say how many bytes they read so far.
   std::function<std::uint64_t()> bytes_read;
   // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,

@@ -17,7 +17,9 @@ namespace vola::io {
 // rgb/rgba field or from red/green/blue fields, and intensity (f32, mean); with
 // `options.payload`: words R | G << 8 | B << 16 when the cloud has colours. Throws
 // FormatError with the file name and byte offset (and the line in ascii data).
-PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options = {});
-PointCloud read_pcd(const std::string& path, const InputOptions& options = {});
+// `not_finite`, when given, receives the number of points left out.
+PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options = {},
+                     std::uint64_t* not_finite = nullptr);
+PointCloud read_pcd(const std::string& path, const InputOptions& options = {}, std::uint64_t* not_finite = nullptr);
 
 }  // namespace vola::io

@@ -19,6 +19,7 @@ struct PointTable {
   std::optional<std::uint32_t> epsg;
   std::string wkt;
   int coordinate_digits = -1;  // LAS: decimals of the finest scale; -1 elsewhere
+  std::uint64_t not_finite = 0;  // points the reader left out (io::Input::not_finite)
 };
 // LAS/LAZ/COPC input gives intensity, return_number, number_of_returns, classification,
 // user_data, point_source_id, gps_time, red/green/blue and extra bytes by name; other
