@@ -2,7 +2,9 @@
 // occupancy map (OctoMap's insertion model), written as one state map (occupied, free and
 // unknown, vola/map/state_map.hpp) with every known voxel's log-odds; --free also writes
 // the free voxels as a plain tree, as before the state map.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -27,6 +29,7 @@ struct MapArgs {
   std::string list, output, from;
   double voxel_size = 0.0;
   double max_range = 0.0;
+  double max_ray_voxels = 2e8;  // per scan (at most ~8 GB of known voxels); 0: no limit
   bool free = false;
   bool quiet = false;
 };
@@ -56,6 +59,41 @@ std::vector<double> world_points(const map::ScanEntry& scan, const std::string& 
   scan.pose.apply(input.cloud.xyz);
   left_out = input.not_finite;
   return std::move(input.cloud.xyz);
+}
+
+// A scan whose rays cross too many voxels is a mistake more often than a scan: points in
+// survey coordinates with a sensor pose near 0, or the voxel size in the wrong unit. Each
+// voxel crossed may become a known voxel of ~40 bytes (20,000 points 1 km from the sensor
+// at 5 cm: 4e8 voxel steps, 260 M free voxels, 9.8 GB and a minute), so such a scan is
+// refused before it is inserted, saying what the distances were.
+void check_ray_lengths(const MapArgs& a, const map::ScanEntry& scan, std::span<const double> xyz) {
+  if (a.max_ray_voxels <= 0) return;
+  const Point& o = scan.pose.translation;
+  double steps = 0.0, longest = 0.0, sum = 0.0;
+  std::uint64_t finite = 0;
+  for (std::size_t n = 0; n + 2 < xyz.size(); n += 3) {
+    const double dx = xyz[n] - o[0], dy = xyz[n + 1] - o[1], dz = xyz[n + 2] - o[2];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (!std::isfinite(d)) continue;
+    ++finite;
+    sum += d;
+    longest = std::max(longest, d);
+    // A ray crosses at most |dx| + |dy| + |dz| voxel faces, fewer when --max-range cuts it.
+    const double scale = a.max_range > 0.0 && d > a.max_range ? a.max_range / d : 1.0;
+    steps += (std::abs(dx) + std::abs(dy) + std::abs(dz)) * scale / a.voxel_size;
+  }
+  if (steps <= a.max_ray_voxels) return;
+  char text[600];
+  std::snprintf(text, sizeof text,
+                "%s: line %llu: %s: its rays cross up to %.3g voxels of %s, more than --max-ray-voxels %.3g (each may "
+                "become a known voxel of ~40 bytes): its points lie %.6g on average and up to %.6g from the sensor at "
+                "(%.10g, %.10g, %.10g). Check that the pose's translation is the sensor's position in the points' "
+                "frame and the voxel size's unit; give --max-range, or a larger --max-ray-voxels for a scan that "
+                "is this large",
+                a.list.c_str(), static_cast<unsigned long long>(scan.line), scan.file.c_str(), steps,
+                shortest_text(a.voxel_size).c_str(), a.max_ray_voxels, finite ? sum / static_cast<double>(finite) : 0.0,
+                longest, o[0], o[1], o[2]);
+  throw InvalidArgument(text);
 }
 
 void add_up(map::ScanReport& total, const map::ScanReport& r) {
@@ -108,6 +146,7 @@ void run_map(const MapArgs& a) {
     const std::vector<double> xyz = world_points(scans[n], a.list, left_out);
     total.points += left_out;
     total.not_finite += left_out;
+    check_ray_lengths(a, scans[n], xyz);
     const auto insert_start = std::chrono::steady_clock::now();
     try {
       add_up(total, m.insert_scan(xyz, scans[n].pose.translation, a.max_range));
@@ -161,6 +200,11 @@ void add_map(CLI::App& app) {
       "plain tree (as vola map did before the state map).\n"
       "--from MAP.vol continues a saved map: only the blocks the new scans touch change, and the file\n"
       "equals the one all the scans would give at once.\n"
+      "A scan whose rays cross more than --max-ray-voxels voxels in all (2e8 by default: about 8 GB\n"
+      "of known voxels at worst) is refused before it is inserted, with its points' distances from\n"
+      "the sensor: most often the pose is not where the sensor was (survey coordinates, a pose at 0)\n"
+      "or the voxel size is in another unit. Give --max-range, or raise the limit for a scan that\n"
+      "is truly this large.\n"
       "Example:\n"
       "  printf 'velodyne/000000.bin 0 0 0 0 0 0 1\\n' > scans.txt\n"
       "  vola map scans.txt -o map.vol --voxel-size 0.2 --max-range 40 --free\n"
@@ -175,6 +219,11 @@ void add_map(CLI::App& app) {
                   "one; -o may name the same file. The result equals inserting every scan at once")
       ->check(CLI::ExistingFile);
   cmd->add_option("--max-range", args->max_range, "Longest ray; farther points mark free space only (0: no limit)")
+      ->check(non_negative_number());
+  cmd->add_option("--max-ray-voxels", args->max_ray_voxels,
+                  "Refuse a scan whose rays cross more voxels than this in all (a pose far from its points, a voxel "
+                  "size in the wrong unit; 0: no limit)")
+      ->capture_default_str()
       ->check(non_negative_number());
   cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol as a plain tree");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");

@@ -33,6 +33,21 @@ grep -q 'no point of the 1 made a known voxel (0 not finite, 1 more than 1048576
   "$tmp/far.out" || fail "far: $(cat "$tmp/far.out")"
 [ -e "$tmp/far.vol" ] && fail "a map of nothing was written"
 
+# A pose far from its points (a scan in survey coordinates, the sensor at 0): 20,000 rays
+# of 1 km at 5 cm would cross 4e8 voxels (a minute and 9.8 GB); refused before any work,
+# with the distances, unless --max-range bounds the rays.
+"${VOLA_PYTHON:-/usr/bin/python3}" -c "
+import numpy as np
+p = np.random.default_rng(1).uniform(-10, 10, (20000, 3)); p[:, 0] += 1000
+np.savetxt('$tmp/scans/distant.xyz', p, fmt='%.3f')"
+echo "scans/distant.xyz 0 0 0 0 0 0 1" > "$tmp/distant.txt"
+"$vola" map "$tmp/distant.txt" -o "$tmp/distant.vol" --voxel-size 0.05 > "$tmp/distant.out" 2>&1 \
+  && fail "a scan 1 km from its sensor at 5 cm was inserted"
+grep -q 'line 1: .*distant.xyz: its rays cross up to 4.04e+08 voxels of 0.05, more than --max-ray-voxels 2e+08' \
+  "$tmp/distant.out" || fail "distant scan message: $(cat "$tmp/distant.out")"
+grep -q 'lie 1000.* on average' "$tmp/distant.out" || fail "distant scan distances: $(cat "$tmp/distant.out")"
+"$vola" map "$tmp/distant.txt" -o "$tmp/distant.vol" --voxel-size 0.05 --max-range 5 -q || fail "--max-range did not bound the rays"
+
 # An organized PCD's missing points (NaN) count as points not finite: the reader leaves
 # them out, and the summary said "0 not finite".
 printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 0 0\nnan nan nan\n0 1 0\n' \
