@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "open_voxels.hpp"
+#include "progress.hpp"
 #include "vola/analysis/crop.hpp"
 #include "vola/analysis/downsample.hpp"
 #include "vola/analysis/fill.hpp"
@@ -45,6 +46,16 @@ void add_radius(CLI::App* cmd, const std::shared_ptr<MorphArgs>& args) {
       ->check(CLI::IsMember({"sphere", "cube"}));
 }
 
+// dilate or erode with a progress bar (a radius of tens of voxels takes minutes).
+template <Tree (*Op)(const Tree&, int, analysis::Element, const analysis::MorphProgress&)>
+Tree morph_with_progress(const MorphArgs& a, const Tree& in, analysis::Element element, const char* name) {
+  if (a.quiet) return Op(in, a.radius, element, {});
+  Progress progress(name);
+  Tree out = Op(in, a.radius, element, [&](std::uint64_t done, std::uint64_t total) { progress.update(done, total); });
+  progress.finish();
+  return out;
+}
+
 analysis::Element element_of(const std::string& name) {
   return name == "cube" ? analysis::Element::cube : analysis::Element::sphere;
 }
@@ -66,7 +77,8 @@ void add_morph(CLI::App& app) {
     add_radius(cmd, args);
     cmd->callback([args] {
       const Tree in = open_voxels(args->input);
-      finish(*args, "dilate", in, analysis::dilate(in, args->radius, element_of(args->element)));
+      finish(*args, "dilate", in,
+             morph_with_progress<&analysis::dilate>(*args, in, element_of(args->element), "dilating"));
     });
   }
   {
@@ -76,7 +88,8 @@ void add_morph(CLI::App& app) {
     add_radius(cmd, args);
     cmd->callback([args] {
       const Tree in = open_voxels(args->input);
-      finish(*args, "erode", in, analysis::erode(in, args->radius, element_of(args->element)));
+      finish(*args, "erode", in,
+             morph_with_progress<&analysis::erode>(*args, in, element_of(args->element), "eroding"));
     });
   }
   {

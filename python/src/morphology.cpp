@@ -21,11 +21,11 @@ vola::analysis::Element element_of(const std::string& name) {
   throw vola::InvalidArgument("element '" + name + "': expected 'sphere' or 'cube'");
 }
 
-template <Tree (*Op)(const Tree&, int, vola::analysis::Element)>
+template <Tree (*Op)(const Tree&, int, vola::analysis::Element, const vola::analysis::MorphProgress&)>
 Tree morph(const Tree& tree, int radius, const std::string& element) {
   const auto kind = element_of(element);
   py::gil_scoped_release release;
-  return Op(tree, radius, kind);
+  return Op(tree, radius, kind, {});
 }
 
 py::tuple fill(const Tree& tree) {

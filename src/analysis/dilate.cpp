@@ -8,9 +8,9 @@
 
 namespace vola::analysis {
 
-Tree dilate(const Tree& tree, int radius, Element element) {
+Tree dilate(const Tree& tree, int radius, Element element, const MorphProgress& progress) {
   detail::check_radius(tree, radius);
-  return detail::with_frame_of(detail::morph(tree, detail::Operation::dilate, radius, element), tree);
+  return detail::with_frame_of(detail::morph(tree, detail::Operation::dilate, radius, element, progress), tree);
 }
 
 }  // namespace vola::analysis

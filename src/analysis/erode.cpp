@@ -7,9 +7,9 @@
 
 namespace vola::analysis {
 
-Tree erode(const Tree& tree, int radius, Element element) {
+Tree erode(const Tree& tree, int radius, Element element, const MorphProgress& progress) {
   detail::check_radius(tree, radius);
-  return detail::with_frame_of(detail::morph(tree, detail::Operation::erode, radius, element), tree);
+  return detail::with_frame_of(detail::morph(tree, detail::Operation::erode, radius, element, progress), tree);
 }
 
 }  // namespace vola::analysis

@@ -1,5 +1,7 @@
 #include "morphology_walk.hpp"
 
+#include <functional>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -223,8 +225,12 @@ int ceil_quarter(int v) { return (v + 3) / 4; }
 // One pass over the tree for an element whose radius fits the halo of every level.
 class Walk {
  public:
-  Walk(const Tree& tree, Operation operation, int radius, Element element)
-      : depth_(tree.depth()),
+  // `report(done, total)`, when given, hears every kReportEvery blocks how many of the
+  // input's blocks above the leaves were walked.
+  Walk(const Tree& tree, Operation operation, int radius, Element element,
+       std::function<void(std::uint64_t, std::uint64_t)> report = {})
+      : report_(std::move(report)),
+        depth_(tree.depth()),
         dilate_(operation == Operation::dilate),
         half_(halves(tree.depth(), radius)),
         leaf_(operation, element, radius, half_[static_cast<std::size_t>(depth_ - 1)], depth_ == 1 ? 1 : 4) {
@@ -284,6 +290,7 @@ class Walk {
     root.word[centre] = words_[0][0];
     root.child[centre] = 0;
     if (visit(0) == 0) out_[0].push_back(0);  // an empty result: the zero root word
+    if (report_) report_(walked_, words_[depth_ - 2].size());  // every input block: the whole
 
     // The levels one after the other, in the leaf level's vector (the largest).
     std::size_t total = 0;
@@ -324,6 +331,9 @@ class Walk {
     std::uint64_t word = 0;
     if (level == depth_ - 2) {
       word = leaves();
+      const Window& w = window_[level];
+      if (report_ && w.word[w.word.size() / 2] != 0 && ++walked_ % kReportEvery == 0)
+        report_(walked_, words_[level].size());
     } else {
       const Window& w = window_[level];
       std::uint64_t todo = w.word[w.word.size() / 2];  // erosion keeps only input voxels
@@ -412,6 +422,12 @@ class Walk {
     return word;
   }
 
+  // Blocks of level depth - 2 between two reports (each computes 64 bricks: a report is
+  // a small cost beside them).
+  static constexpr std::uint64_t kReportEvery = 64;
+
+  std::function<void(std::uint64_t, std::uint64_t)> report_;
+  std::uint64_t walked_ = 0;  // input blocks of level depth - 2 visited
   int depth_;
   bool dilate_;
   std::array<int, kMaxDepth> half_;
@@ -428,7 +444,7 @@ class Walk {
 
 }  // namespace
 
-Tree morph(const Tree& tree, Operation operation, int radius, Element element) {
+Tree morph(const Tree& tree, Operation operation, int radius, Element element, const MorphProgress& progress) {
   if (radius == 0) {  // the voxels themselves, without payload
     std::vector<std::uint64_t> words;
     for (int l = 0; l < tree.depth(); ++l) {
@@ -437,14 +453,26 @@ Tree morph(const Tree& tree, Operation operation, int radius, Element element) {
     }
     return Tree::from_levels(tree.depth(), false, std::move(words));
   }
-  if (element == Element::sphere) return Walk(tree, operation, radius, element).run();
+  // A cube goes in passes of radius 4 at most (below); each pass reports its share of a
+  // million.
+  const int passes = element == Element::sphere ? 1 : (radius + 3) / 4;
+  constexpr std::uint64_t kWhole = 1'000'000;
+  const auto pass_report = [&](int pass) -> std::function<void(std::uint64_t, std::uint64_t)> {
+    if (!progress) return {};
+    return [&progress, pass, passes](std::uint64_t done, std::uint64_t total) {
+      const std::uint64_t share = total ? kWhole * std::min(done, total) / total : kWhole;
+      progress((static_cast<std::uint64_t>(pass) * kWhole + share) / static_cast<std::uint64_t>(passes), kWhole);
+    };
+  };
+  if (element == Element::sphere) return Walk(tree, operation, radius, element, pass_report(0)).run();
   // A cube of radius a + b is a cube of radius a grown by one of radius b, and both
   // operations compose that way (the grid is a box: a voxel within a + b of a source
   // inside it is within b of a cell within a of the source that is inside it too), so
   // a cube goes in steps of at most 4, one brick of halo each.
-  Tree current = Walk(tree, operation, std::min(radius, 4), element).run();
-  for (int done = std::min(radius, 4); done < radius; done += 4)
-    current = Walk(current, operation, std::min(radius - done, 4), element).run();
+  Tree current = Walk(tree, operation, std::min(radius, 4), element, pass_report(0)).run();
+  int pass = 1;
+  for (int done = std::min(radius, 4); done < radius; done += 4, ++pass)
+    current = Walk(current, operation, std::min(radius - done, 4), element, pass_report(pass)).run();
   return current;
 }
 

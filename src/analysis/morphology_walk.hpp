@@ -19,8 +19,8 @@ enum class Operation { dilate, erode };
 
 // The voxels of `tree` dilated or eroded by the element of radius `radius` (see
 // morphology.hpp), as a tree of the same depth without payload, frame or attributes.
-// radius must lie in 0 .. side - 1.
-Tree morph(const Tree& tree, Operation operation, int radius, Element element);
+// radius must lie in 0 .. side - 1. `progress` (may be empty) hears of the blocks done.
+Tree morph(const Tree& tree, Operation operation, int radius, Element element, const MorphProgress& progress);
 
 // Throws InvalidArgument unless 0 <= radius < the grid side.
 void check_radius(const Tree& tree, int radius);

@@ -3,6 +3,8 @@
 
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "analysis_models.hpp"
 #include "vola/analysis/crop.hpp"
@@ -204,4 +206,32 @@ TEST(Downsample, MatchesTheModelAndLevelOfDetail) {
 }
 
 }  // namespace
+TEST(Morphology, ProgressRisesToTheWholeAndLeavesTheResultAlone) {
+  XyzSet lattice;  // 8000 voxels 32 apart: 8000 blocks above the leaves, reported every 64
+  for (std::uint32_t z = 0; z < 20; ++z)
+    for (std::uint32_t y = 0; y < 20; ++y)
+      for (std::uint32_t x = 0; x < 20; ++x) lattice.insert({32 * x + 5, 32 * y + 7, 32 * z + 9});
+  const vola::Tree t = tree_of(lattice, 5);
+  for (const Element e : {Element::sphere, Element::cube}) {
+    for (const bool grow : {true, false}) {
+      SCOPED_TRACE(std::string(grow ? "dilate " : "erode ") + (e == Element::sphere ? "sphere" : "cube"));
+      std::vector<std::pair<std::uint64_t, std::uint64_t>> heard;
+      const auto listen = [&](std::uint64_t done, std::uint64_t total) { heard.emplace_back(done, total); };
+      const int radius = e == Element::cube ? 6 : 1;  // the cube in two passes
+      const vola::Tree with = grow ? vola::analysis::dilate(t, radius, e, listen) : vola::analysis::erode(t, radius, e, listen);
+      const vola::Tree without = grow ? vola::analysis::dilate(t, radius, e) : vola::analysis::erode(t, radius, e);
+      EXPECT_EQ(vola_test::voxel_set(with), vola_test::voxel_set(without));
+      ASSERT_GE(heard.size(), e == Element::cube && grow ? 2u : 1u);
+      EXPECT_EQ(heard.back().first, heard.back().second);  // the whole, at the end
+      for (std::size_t i = 0; i < heard.size(); ++i) {
+        EXPECT_EQ(heard[i].second, heard[0].second);
+        EXPECT_LE(heard[i].first, heard[i].second);
+        if (i > 0) {
+          EXPECT_GE(heard[i].first, heard[i - 1].first);
+        }
+      }
+    }
+  }
+}
+
 }  // namespace vola_analysis_test

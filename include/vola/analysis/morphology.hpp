@@ -5,6 +5,9 @@
 // attribute columns are dropped (a grown voxel has no measured value).
 #pragma once
 
+#include <cstdint>
+#include <functional>
+
 #include "vola/tree.hpp"
 
 namespace vola::analysis {
@@ -14,13 +17,17 @@ enum class Element {
   cube,    // offsets with max(|dx|, |dy|, |dz|) <= r
 };
 
+// How far a long dilation or erosion is (a radius of tens of voxels over a survey takes
+// minutes): `done` of `total`, called from the calling thread every 64 blocks of 16^3 voxels.
+using MorphProgress = std::function<void(std::uint64_t done, std::uint64_t total)>;
+
 // The voxels within the element of radius r of an occupied voxel, clipped to the grid.
 // r = 0 copies. Throws InvalidArgument for r < 0 or r >= the grid side.
-Tree dilate(const Tree& tree, int radius, Element element);
+Tree dilate(const Tree& tree, int radius, Element element, const MorphProgress& progress = {});
 // The voxels whose whole element of radius r is occupied; cells outside the grid
 // count as empty (scipy.ndimage.binary_erosion's border_value = 0), so voxels within r
 // of the grid's edge are removed. Computed on the input's own bricks (AND over the
 // element's offsets), without complementing the grid.
-Tree erode(const Tree& tree, int radius, Element element);
+Tree erode(const Tree& tree, int radius, Element element, const MorphProgress& progress = {});
 
 }  // namespace vola::analysis
