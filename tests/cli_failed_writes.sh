@@ -114,6 +114,37 @@ status=$?
 [[ $message == *"cut.wav: byte "*"the file is cut"* ]] || fail "cut WAV: message '$message' names no file, offset and cause"
 [[ ! -e cut_out.wav ]] || fail "cut WAV: an output was written"
 
+# What an output path holds is not replaced unless it is a regular, writable file: a
+# rename onto /dev/null or a FIFO would replace the node itself, a read-only survey would
+# be lost; a link is written through. And no command writes over its own input.
+mkdir -p special
+mkfifo special/pipe.ply
+refused() {  # refused NAME PATTERN COMMAND...: exit 1 with a message matching PATTERN
+  local name=$1 pattern=$2
+  shift 2
+  local message status
+  message=$("$@" 2>&1)
+  status=$?
+  [[ $status -eq 1 ]] || fail "$name: exit status $status, expected 1 ($message)"
+  [[ $message == *$pattern* ]] || fail "$name: message '$message' does not say '$pattern'"
+}
+refused "export to a FIFO" "pipe.ply: is a FIFO" "$vola" export city.vol special/pipe.ply -q
+[[ -p special/pipe.ply ]] || fail "the FIFO was replaced"
+refused "export to /dev/null" "/dev/null: is a character device" "$vola" export city.vol /dev/null --format xyz -q
+[[ -c /dev/null ]] || fail "/dev/null is no longer a device"
+cp city.vol special/kept.vol
+chmod 444 special/kept.vol
+refused "convert over a read-only file" "kept.vol: is read-only" "$vola" convert room.xyz special/kept.vol --voxel-size 1 -q
+cmp -s city.vol special/kept.vol || fail "the read-only file was replaced"
+ln -s ../city.vol special/link.vol
+refused "export over its input" "is the input: vola export writes another file" \
+  "$vola" export special/link.vol city.vol --format xyz -q
+cp room.vol special/target.vol
+ln -s target.vol special/through.vol
+"$vola" lod city.vol --depth 2 special/through.vol > /dev/null || fail "writing through a link failed"
+[[ -L special/through.vol ]] || fail "the link was replaced by a file"
+cmp -s room.vol special/target.vol && fail "the link's target was not written"
+
 if [[ $failures -ne 0 ]]; then
   echo "$failures failure(s)" >&2
   exit 1

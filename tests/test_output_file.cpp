@@ -71,6 +71,49 @@ TEST(OutputFile, CommitReplacesTheOldFileWholeKeepingItsPermissions) {
   EXPECT_EQ(names_in(dir.path()), std::vector<std::string>{"out.txt"});
 }
 
+// The rename replaces whatever has the name: a link is followed, a device, FIFO or
+// directory is refused (the rename would replace /dev/null itself), and so is a read-only
+// file (root's rename would replace it all the same).
+TEST(OutputFile, OnlyRegularWritableFilesAreReplacedAndLinksAreFollowed) {
+  TempDir dir;
+  const fs::path target = dir / "target.txt", link = dir / "link.txt";
+  put_text(target, "old");
+  fs::create_symlink(target, link);
+  {
+    vola::OutputFile out(link.string());
+    out.write("through the link");
+    out.commit();
+  }
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(text_of(target), "through the link");
+
+  const fs::path fifo = dir / "pipe.xyz";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const auto refusal = [](const fs::path& p) {
+    try {
+      vola::OutputFile out(p.string());
+    } catch (const vola::IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal(fifo).find("pipe.xyz: is a FIFO: vola writes regular files"), std::string::npos) << refusal(fifo);
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_NE(refusal(dir.path()).find("is a directory"), std::string::npos);
+  EXPECT_NE(refusal("/dev/null").find("/dev/null: is a character device"), std::string::npos);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  const fs::path read_only = dir / "survey.las";
+  put_text(read_only, "keep");
+  ::chmod(read_only.c_str(), 0444);
+  EXPECT_NE(refusal(read_only).find("survey.las: is read-only: vola does not replace it"), std::string::npos);
+  EXPECT_EQ(text_of(read_only), "keep");
+  const fs::path dangling = dir / "dangling.txt";
+  fs::create_symlink(dir / "missing" / "x.txt", dangling);
+  EXPECT_NE(refusal(dangling).find("symbolic link to a file that cannot be reached"), std::string::npos);
+  EXPECT_EQ(names_in(dir.path()), (std::vector<std::string>{"dangling.txt", "link.txt", "pipe.xyz", "survey.las",
+                                                            "target.txt"}));
+}
+
 TEST(OutputFile, AnUncommittedFileLeavesNothing) {
   TempDir dir;
   const fs::path path = dir / "out.txt";

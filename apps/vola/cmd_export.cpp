@@ -18,6 +18,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/export_format.hpp"
 #include "vola/io/occupancy_maps.hpp"
+#include "vola/io/same_file.hpp"
 
 namespace vola::cli {
 
@@ -91,6 +92,8 @@ void export_map(const ExportArgs& a, const Tree& tree, const std::string& format
 }
 
 void run_export(const ExportArgs& a) {
+  io::refuse_output_over_input(a.input, a.output, "vola export writes another file; give it another name");
+  if (!a.free.empty()) io::refuse_output_over_input(a.free, a.output, "it is --free's file; give the output another name");
   const std::string format = resolve_format(a);
   Tree tree = open_voxels(a.input);
   if (a.depth > tree.depth())

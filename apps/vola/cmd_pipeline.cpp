@@ -58,6 +58,9 @@ void add_pipeline(CLI::App& app) {
   auto* cmd = app.add_subcommand("pipeline", "Run a PDAL-style JSON pipeline: a reader, point filters, writers");
   cmd->footer(
       "A JSON array (or {\"pipeline\": [...]}): the input file first, filters, then outputs.\n"
+      "A file name right after the input is the output only when it is the last stage: PDAL reads\n"
+      "[\"a.las\", \"b.las\", \"out.las\"] as two inputs, vola reads one and refuses it. No output may\n"
+      "be the input.\n"
       "Filters: filters.smrf (cell, slope, window, threshold, scalar; metres), filters.range (limits,\n"
       "e.g. \"Classification[2:2]\", \"Z[:500)\", \"Classification![7:7]\"), filters.expression (expression),\n"
       "filters.hag_nn, filters.outlier (mean_k, multiplier), filters.crop (bounds \"([x0, x1], [y0, y1])\" or\n"

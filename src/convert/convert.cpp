@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -18,6 +17,7 @@
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/same_file.hpp"
 
 namespace vola {
 
@@ -238,9 +238,7 @@ WriteOptions write_options_of(const ConvertOptions& options) {
 }
 
 void check_convert_output(const std::string& input, const std::string& output) {
-  std::error_code error;
-  if (std::filesystem::equivalent(input, output, error))
-    throw InvalidArgument(output + " is the input: convert writes a new .vol file; give it another name");
+  io::refuse_output_over_input(input, output, "convert writes a new .vol file; give it another name");
   const std::string extension = io::lower_extension(output);
   for (const auto& format : io::input_formats())
     for (const auto& e : format.extensions)

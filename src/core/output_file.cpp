@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cerrno>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 
 #include "vola/error.hpp"
@@ -76,6 +77,49 @@ void on_signal(int signal) {
   ::raise(signal);
 }
 
+// What an existing output path is, when it is not a regular file vola may replace.
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// The name the finished file is renamed onto. The rename replaces whatever has the name,
+// so: a symbolic link is followed (its target is written, the link stays); a device, a
+// FIFO or a directory is refused (renaming a file onto /dev/null would replace the
+// device itself, and a reader of a FIFO would never see the bytes); so is a file without
+// its owner's write permission, which root's rename would replace all the same.
+// Empty with `why` set when the path cannot be written.
+std::string final_path(const std::string& path, std::string& why) {
+  struct stat link {};
+  if (::lstat(path.c_str(), &link) != 0) return path;  // a new file
+  std::string target = path;
+  if (S_ISLNK(link.st_mode)) {
+    char* resolved = ::realpath(path.c_str(), nullptr);
+    if (!resolved) {
+      why = path + ": is a symbolic link to a file that cannot be reached (" + std::strerror(errno) + ")";
+      return {};
+    }
+    target = resolved;
+    std::free(resolved);
+  }
+  struct stat st {};
+  if (::stat(target.c_str(), &st) != 0) return target;  // gone meanwhile: a new file
+  if (!S_ISREG(st.st_mode)) {
+    why = path + ": is " + kind_of(st.st_mode) +
+          ": vola writes regular files (a finished file is renamed onto the name, which would replace it)";
+    return {};
+  }
+  if (!(st.st_mode & S_IWUSR)) {
+    why = path + ": is read-only: vola does not replace it (make it writable, or write another name)";
+    return {};
+  }
+  return target;
+}
+
 }  // namespace
 
 namespace detail {
@@ -96,7 +140,13 @@ void remove_temporaries_on_signal() noexcept {
   }
 }
 
-OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
+OutputFile::OutputFile(std::string path) {
+  std::string why;
+  path_ = final_path(path, why);
+  if (path_.empty()) {
+    path_ = std::move(path);
+    VOLA_THROW(IoError(why));
+  }
   // An unnamed file first (Linux's O_TMPFILE): until commit() it has no name, so not even
   // SIGKILL or a power cut can leave it behind. Filesystems without it get a named one.
   int fd = ::open(directory_of(path_).c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);

@@ -153,13 +153,31 @@ class StageReader {
   std::string type_, prefix_;
 };
 
+// A file named without a type: the input when first; PDAL reads every other name but the
+// last as one more input, merged with the first, where vola pipelines read one. A name
+// right after the input that is not the last stage is therefore refused (taken as a
+// writer, it would overwrite a second input); after a filter or a writer, and last, a
+// name is an output.
+void add_untyped_file(const std::string& file, std::size_t index, std::size_t stages, Pipeline& pipeline) {
+  if (index == 0) {
+    pipeline.input = file;
+    return;
+  }
+  const bool right_after_the_input = pipeline.stages.empty() && pipeline.writers.empty();
+  if (right_after_the_input && index + 1 != stages)
+    throw InvalidArgument("pipeline stage " + std::to_string(index) + ": " + file +
+                          ": a second file right after the input is another input to PDAL (merged with the first), "
+                          "and vola pipelines read one; merge the inputs first, or give an output its type "
+                          "({\"type\": \"writers.las\", \"filename\": \"" + file + "\"})");
+  pipeline.writers.push_back({file, {}});
+}
+
 // One object stage into `pipeline`: a reader, a writer or a filter.
-void read_stage(const json& element, std::size_t index, Pipeline& pipeline) {
+void read_stage(const json& element, std::size_t index, std::size_t stages, Pipeline& pipeline) {
   const StageReader stage(element, index);
   const std::string& type = stage.type();
   if (type.empty() && element.contains("filename")) {  // PDAL infers the kind from the position
-    if (index == 0) pipeline.input = stage.text("filename");
-    else pipeline.writers.push_back({stage.text("filename"), {}});
+    add_untyped_file(stage.text("filename"), index, stages, pipeline);
   } else if (type.rfind("readers.", 0) == 0) {
     if (index != 0) stage.fail("a reader must come first (vola pipelines read one input)");
     stage.only({"filename"});
@@ -270,14 +288,12 @@ Pipeline parse_pipeline(const std::string& text, const std::string& name) {
     const json& element = document[index];
     const std::string prefix = "pipeline stage " + std::to_string(index) + ": ";
     if (element.is_string()) {
-      const std::string file = element.get<std::string>();
-      if (pipeline.input.empty() && index == 0) pipeline.input = file;
-      else pipeline.writers.push_back({file, {}});
+      add_untyped_file(element.get<std::string>(), index, document.size(), pipeline);
       continue;
     }
     if (!element.is_object()) throw InvalidArgument(prefix + "a stage is a file name or an object with \"type\"");
     try {
-      read_stage(element, index, pipeline);
+      read_stage(element, index, document.size(), pipeline);
     } catch (const json::exception& e) {  // a member of an unexpected JSON type
       throw InvalidArgument(prefix + e.what());
     }

@@ -16,6 +16,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/same_file.hpp"
 #include "vola/io/translate.hpp"
 
 namespace vola::io {
@@ -265,6 +266,7 @@ void drop_points_las_cannot_hold(const std::string& input, PointCloud& cloud, st
 std::vector<std::string> translate_points(const std::string& input, const std::string& output,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                                           const PointEdit& edit) {
+  refuse_output_over_input(input, output, "vola translate writes a new point file; give it another name");
   const std::string out_ext = lower_extension(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";

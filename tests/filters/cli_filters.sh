@@ -96,6 +96,24 @@ grep -q "no filter 'ground'" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt"
 echo '["a.las", {"type": "filters.smrf", "cells": 2}, "b.las"]' > "$tmp/bad.json"
 if "$vola" pipeline "$tmp/bad.json" 2> "$tmp/err.txt"; then fail "a misspelt stage option was accepted"; fi
 grep -q 'pipeline stage 1 (filters.smrf): no option "cells"' "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+# PDAL reads ["a.las", "b.las", "out.las"] as two inputs: vola, reading one, refuses it
+# (it took b.las as an output and wrote a.las's points over it); no output may be the input.
+cp "$autzen" "$tmp/second.las"
+echo "[\"$autzen\", \"$tmp/second.las\", \"$tmp/out.las\"]" > "$tmp/two.json"
+if "$vola" pipeline "$tmp/two.json" 2> "$tmp/err.txt"; then fail "a second input was taken as an output"; fi
+grep -q "pipeline stage 1: .*second.las: a second file right after the input is another input to PDAL" "$tmp/err.txt" \
+  || fail "error: $(cat "$tmp/err.txt")"
+cmp -s "$autzen" "$tmp/second.las" || fail "the second input was changed"
+cp "$autzen" "$tmp/mine.las"
+echo "[\"$tmp/mine.las\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"}, \"$tmp/mine.las\"]" \
+  > "$tmp/self.json"
+if "$vola" pipeline "$tmp/self.json" 2> "$tmp/err.txt"; then fail "a pipeline wrote over its input"; fi
+grep -q "mine.las is the input" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+if "$vola" translate "$tmp/mine.las" "$tmp/mine.las" --where "Classification == 2" 2> "$tmp/err.txt"; then
+  fail "translate wrote over its input"
+fi
+grep -q "mine.las is the input: vola translate writes a new point file" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+cmp -s "$autzen" "$tmp/mine.las" || fail "the input was changed"
 # A PLY or XYZ output has no place for the CRS: a warning says so (-q too), a LAS keeps it.
 "$vola" translate "$autzen" "$tmp/crs.ply" -q 2> "$tmp/err.txt" || fail "translate to PLY failed"
 grep -q "PLY has no place for the CRS of .* (a WKT with no EPSG code): it is not kept" "$tmp/err.txt" ||
