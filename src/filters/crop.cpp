@@ -11,30 +11,35 @@
 namespace vola::filters {
 
 bool PolygonSet::contains(double x, double y) const {
-  bool inside = false;
-  for (const auto& ring : rings) {
-    const std::size_t n = ring.size();
-    for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
-      const auto& a = ring[i];
-      const auto& b = ring[j];
-      if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) inside = !inside;
+  for (const auto& polygon : polygons) {
+    bool inside = false;
+    for (const auto& ring : polygon) {
+      const std::size_t n = ring.size();
+      for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+        const auto& a = ring[i];
+        const auto& b = ring[j];
+        if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) inside = !inside;
+      }
     }
+    if (inside) return true;
   }
-  return inside;
+  return false;
 }
 
 namespace {
 
-using Ring = std::vector<std::array<double, 2>>;
+using Ring = PolygonSet::Ring;
 
+// A ring of the set's last polygon.
 void add_ring(PolygonSet& set, Ring ring, const std::string& name) {
   if (ring.size() < 3) throw InvalidArgument(name + ": a polygon ring needs 3 vertices or more");
-  set.rings.push_back(std::move(ring));
+  set.polygons.back().push_back(std::move(ring));
 }
 
-// GeoJSON coordinates of a Polygon ([[ [x, y], ... ], ...]).
+// GeoJSON coordinates of a Polygon ([[ [x, y], ... ], ...]): one polygon of the set.
 void polygon_from_json(PolygonSet& set, const nlohmann::json& rings, const std::string& name) {
   if (!rings.is_array()) throw InvalidArgument(name + ": Polygon coordinates must be an array of rings");
+  set.polygons.emplace_back();
   for (const auto& r : rings) {
     Ring ring;
     if (!r.is_array()) throw InvalidArgument(name + ": a ring must be an array of positions");
@@ -64,7 +69,8 @@ void geometry_from_json(PolygonSet& set, const nlohmann::json& j, const std::str
 }
 
 // WKT: POLYGON ((x y, ...), (...)) or MULTIPOLYGON (((...)), ((...))); every innermost
-// parenthesised list is a ring.
+// parenthesised list is a ring, of the polygon whose list opened at depth 1 (POLYGON) or
+// 2 (MULTIPOLYGON).
 void polygons_from_wkt(PolygonSet& set, const std::string& text, const std::string& name) {
   std::size_t i = 0;
   while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
@@ -73,15 +79,21 @@ void polygons_from_wkt(PolygonSet& set, const std::string& text, const std::stri
     keyword += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i++])));
   if (keyword != "POLYGON" && keyword != "MULTIPOLYGON")
     throw InvalidArgument(name + ": expected WKT POLYGON or MULTIPOLYGON (or GeoJSON), found '" + keyword + "'");
+  const int polygon_depth = keyword == "POLYGON" ? 1 : 2;
   int depth = 0;
   Ring ring;
   for (; i < text.size(); ++i) {
     const char c = text[i];
     if (c == '(') {
-      ++depth;
+      if (++depth == polygon_depth) set.polygons.emplace_back();
       ring.clear();
     } else if (c == ')') {
-      if (!ring.empty()) add_ring(set, std::move(ring), name);
+      if (!ring.empty()) {
+        if (depth <= polygon_depth - 1 || set.polygons.empty())
+          throw InvalidArgument(name + ": at character " + std::to_string(i + 1) + ": a ring outside a polygon's "
+                                "parentheses");
+        add_ring(set, std::move(ring), name);
+      }
       ring.clear();
       --depth;
     } else if (depth > 0 && (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.')) {
@@ -115,7 +127,8 @@ PolygonSet parse_polygons(const std::string& text, const std::string& name) {
   } else {
     polygons_from_wkt(set, text, name);
   }
-  if (set.rings.empty()) throw InvalidArgument(name + ": no polygon in it");
+  std::erase_if(set.polygons, [](const auto& polygon) { return polygon.empty(); });
+  if (set.polygons.empty()) throw InvalidArgument(name + ": no polygon in it");
   return set;
 }
 

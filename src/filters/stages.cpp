@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 #include "vola/error.hpp"
@@ -142,8 +143,55 @@ std::vector<bool> per_point_mask(const std::vector<Stage>& stages, const PointCl
   return keep;
 }
 
+namespace {
+
+// The x/y extent of the finite points (empty when there are none).
+struct XyBox {
+  double min_x = INFINITY, min_y = INFINITY, max_x = -INFINITY, max_y = -INFINITY;
+  bool empty() const { return min_x > max_x; }
+};
+
+XyBox xy_box_of(const PointCloud& cloud) {
+  XyBox box;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double x = cloud.xyz[3 * i], y = cloud.xyz[3 * i + 1];
+    if (!std::isfinite(x) || !std::isfinite(y)) continue;
+    box.min_x = std::min(box.min_x, x), box.max_x = std::max(box.max_x, x);
+    box.min_y = std::min(box.min_y, y), box.max_y = std::max(box.max_y, y);
+  }
+  return box;
+}
+
+// A polygon crop that kept nothing because its polygons lie nowhere near the points is a
+// polygon in another CRS (GeoJSON in longitude/latitude, as RFC 7946 has it), not an
+// empty result: refused, with both extents.
+void refuse_polygons_apart(const Stage& s, const XyBox& points) {
+  XyBox shapes;
+  for (const auto& polygon : s.polygons.polygons)
+    for (const auto& ring : polygon)
+      for (const auto& [x, y] : ring) {
+        shapes.min_x = std::min(shapes.min_x, x), shapes.max_x = std::max(shapes.max_x, x);
+        shapes.min_y = std::min(shapes.min_y, y), shapes.max_y = std::max(shapes.max_y, y);
+      }
+  if (points.empty() || shapes.empty()) return;
+  const bool apart = shapes.max_x < points.min_x || shapes.min_x > points.max_x || shapes.max_y < points.min_y ||
+                     shapes.min_y > points.max_y;
+  if (!apart) return;
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "%s: the polygons (x %.10g..%.10g, y %.10g..%.10g) do not meet the points (x %.10g..%.10g, y "
+                "%.10g..%.10g): they are read in the points' CRS, so a polygon in another CRS (GeoJSON in "
+                "longitude/latitude) keeps nothing; reproject the polygon first (ogr2ogr -t_srs)",
+                s.spec.c_str(), shapes.min_x, shapes.max_x, shapes.min_y, shapes.max_y, points.min_x, points.max_x,
+                points.min_y, points.max_y);
+  throw InvalidArgument(text);
+}
+
+}  // namespace
+
 FilterResult run_stages(const std::vector<Stage>& stages, PointCloud& cloud, const std::optional<std::uint32_t>& epsg,
                         const std::string& wkt, std::uint64_t first_index) {
+  const XyBox cloud_box = xy_box_of(cloud);  // before the stages: what a crop could meet
   FilterResult result;
   result.kept.resize(cloud.size());
   std::iota(result.kept.begin(), result.kept.end(), first_index);
@@ -176,6 +224,8 @@ FilterResult run_stages(const std::vector<Stage>& stages, PointCloud& cloud, con
       result.kept.resize(out);
     }
     report.points_out = cloud.size();
+    if (s.kind == Stage::Kind::polygon && report.points_in > 0 && report.points_out == 0)
+      refuse_polygons_apart(s, cloud_box);
     result.stages.push_back(report);
   }
   return result;

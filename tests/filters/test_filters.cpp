@@ -185,6 +185,34 @@ TEST(Crop, BoxAndPolygonsWithHolesAgainstDirectTests) {
   EXPECT_THROW(parse_polygons(R"({"type":"Point","coordinates":[1,2]})", "point"), vola::InvalidArgument);
 }
 
+// Overlapping polygons (two features, two members of a multipolygon) make a union: the
+// even-odd rule over every ring at once dropped the points inside both.
+TEST(Crop, OverlappingPolygonsAreAUnion) {
+  const auto xyz = random_points(3000, 8, 10.0);
+  const PolygonSet features = parse_polygons(
+      R"({"type":"FeatureCollection","features":[
+          {"type":"Feature","geometry":{"type":"Polygon","coordinates":[[[1,1],[6,1],[6,6],[1,6],[1,1]]]}},
+          {"type":"Feature","geometry":{"type":"Polygon","coordinates":[[[4,4],[9,4],[9,9],[4,9],[4,4]]]}}]})",
+      "features");
+  const PolygonSet multi =
+      parse_polygons("MULTIPOLYGON (((1 1, 6 1, 6 6, 1 6, 1 1)), ((4 4, 9 4, 9 9, 4 9, 4 4), (7 7, 8 7, 8 8, 7 8, 7 7)))",
+                     "multi");
+  ASSERT_EQ(multi.polygons.size(), 2u);
+  EXPECT_EQ(multi.polygons[1].size(), 2u);  // the second with its hole
+  const auto in_features = inside_polygons(xyz, features), in_multi = inside_polygons(xyz, multi);
+  std::size_t both = 0;
+  for (std::size_t i = 0; i < xyz.size() / 3; ++i) {
+    const double x = xyz[3 * i], y = xyz[3 * i + 1];
+    const bool a = x > 1 && x < 6 && y > 1 && y < 6, b = x > 4 && x < 9 && y > 4 && y < 9;
+    const bool hole = x > 7 && x < 8 && y > 7 && y < 8;
+    ASSERT_EQ(in_features[i], a || b) << x << " " << y;
+    ASSERT_EQ(in_multi[i], a || (b && !hole)) << x << " " << y;
+    both += a && b;
+  }
+  EXPECT_GT(both, 0u);
+  EXPECT_THROW(parse_polygons("MULTIPOLYGON (0 0, 1 0, 1 1)", "flat"), vola::InvalidArgument);
+}
+
 TEST(HeightAboveGround, EqualsZMinusTheNearestGroundPointByBruteForce) {
   vola::PointCloud cloud;
   cloud.xyz = random_points(1500, 7, 30.0);

@@ -19,10 +19,14 @@ struct CropBox {
   }
 };
 
-// Polygons as rings of (x, y) vertices (closed or not); inside = an odd number of ring
-// crossings (even-odd), so holes and multipolygons need no special case.
+// Polygons, each as rings of (x, y) vertices (closed or not): the outer ring and its
+// holes. A point is inside a polygon when it crosses an odd number of its rings' edges
+// (even-odd, so holes need no special case), and inside the set when it is inside any
+// polygon: overlapping polygons (two features, two members of a multipolygon) make a
+// union, as in PDAL and every GIS.
 struct PolygonSet {
-  std::vector<std::vector<std::array<double, 2>>> rings;
+  using Ring = std::vector<std::array<double, 2>>;
+  std::vector<std::vector<Ring>> polygons;
   bool contains(double x, double y) const;
 };
 
