@@ -4,6 +4,8 @@
 // VLRs and EVLRs are copied but those of the input's compression (laszip, COPC), and a
 // LAZ output gets its own laszip VLR and chunk table.
 #include <algorithm>
+#include <optional>
+#include <filesystem>
 #include <cstring>
 #include <fstream>
 #include <span>
@@ -188,7 +190,9 @@ void translate_las(const std::string& input, const std::string& output,
   std::uint32_t vlr_count = 0;
   for (const LasVlr& v : hd.vlrs) {
     if (v.extended || is_compression_record(v)) continue;
-    append_vlr(vlrs, v.user_id, v.record_id, v.description, v.data);
+    // As the file holds it, reserved field (LAS 1.0's 0xAABB) and all.
+    const auto bytes = read_bytes(in, input, v.offset - 54, 54 + v.length);
+    vlrs.insert(vlrs.end(), bytes.begin(), bytes.end());
     ++vlr_count;
   }
   // Bytes between the last VLR and the points (LAS 1.0's 0xDDCC signature, or user
@@ -222,17 +226,43 @@ void translate_las(const std::string& input, const std::string& output,
   if (reader.points_read() != hd.point_count)
     throw FormatError(input, hd.offset_to_points, "holds " + std::to_string(reader.points_read()) + " points, not the " +
                                                       std::to_string(hd.point_count) + " its header says");
+  // Internal waveforms (global encoding bit 1): the header's field at 227 says where the
+  // waveform data packets' record starts (the points' wave packets point into it). LAS
+  // 1.3 has it as the one record after the points, to the end of the file; LAS 1.4 as
+  // one of the EVLRs. It moves with the points.
+  const std::uint64_t points_end = points_at + point_bytes;
+  std::uint64_t waveform_at = 0;
+  if (hd.version_minor >= 3 && (hd.global_encoding & 2u)) std::memcpy(&waveform_at, head.data() + 227, 8);
+  std::optional<std::uint64_t> waveform_moved_to;
+  if (hd.version_minor == 3 && waveform_at != 0) {
+    const std::uint64_t file_size = std::filesystem::file_size(input);
+    if (waveform_at < hd.offset_to_points || waveform_at >= file_size)
+      throw FormatError(input, 227, "the waveform data record's start " + std::to_string(waveform_at) +
+                                        " lies outside the file's data (" + std::to_string(hd.offset_to_points) + ".." +
+                                        std::to_string(file_size) + ")");
+    const auto bytes = read_bytes(in, input, waveform_at, file_size - waveform_at);
+    out.write(bytes.data(), bytes.size());
+    waveform_moved_to = points_end;
+  }
   // EVLRs (LAS 1.4): copied raw, 60-byte header and data, after the points.
   std::uint32_t evlr_count = 0;
+  std::uint64_t evlr_at = points_end;
   for (const LasVlr& v : hd.vlrs) {
     if (!v.extended || is_compression_record(v)) continue;
     const auto bytes = read_bytes(in, input, v.offset - 60, 60 + v.length);
+    if (waveform_at != 0 && v.offset - 60 == waveform_at) waveform_moved_to = evlr_at;
     out.write(bytes.data(), bytes.size());
+    evlr_at += bytes.size();
     ++evlr_count;
+  }
+  if (waveform_moved_to) {
+    if (std::fseek(out.stream(), 227, SEEK_SET) != 0 || std::fwrite(&*waveform_moved_to, 8, 1, out.stream()) != 1 ||
+        std::fseek(out.stream(), 0, SEEK_END) != 0)
+      throw IoError(output + ": cannot write the header's waveform record start");
   }
   if (hd.version_minor >= 4) {
     std::vector<std::uint8_t> evlr_fields(12);
-    store(evlr_fields, 0, static_cast<std::uint64_t>(evlr_count ? points_at + point_bytes : 0));
+    store(evlr_fields, 0, static_cast<std::uint64_t>(evlr_count ? points_end : 0));
     store(evlr_fields, 8, evlr_count);
     if (std::fseek(out.stream(), 235, SEEK_SET) != 0 || std::fwrite(evlr_fields.data(), 12, 1, out.stream()) != 1 ||
         std::fseek(out.stream(), 0, SEEK_END) != 0)

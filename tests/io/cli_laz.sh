@@ -24,20 +24,6 @@ print(hashlib.sha256(d[offset:offset + count * length]).hexdigest())
 PY
 }
 
-# The bytes between the last VLR and the points (LAS 1.0's signature, a writer's own).
-user_bytes_sha() {
-  python3 - "$1" <<'PY'
-import hashlib, struct, sys
-d = open(sys.argv[1], "rb").read()
-header, points, vlrs = struct.unpack_from("<H", d, 94)[0], struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<I", d, 100)[0]
-at = header
-for _ in range(vlrs):
-    length = struct.unpack_from("<H", d, at + 20)[0]
-    at += 54 + length
-print(points - at, hashlib.sha256(d[at:points]).hexdigest())
-PY
-}
-
 checked=0
 for laz in "$data"/laz/*.laz; do
   name=$(basename "$laz")
@@ -61,8 +47,12 @@ for las in "$data"/las/*.las "$data"/las/permutations/*.las; do
   "$vola" translate "$las" "$tmp/round.laz" -q || fail "$(basename "$las"): to LAZ failed"
   "$vola" translate "$tmp/round.laz" "$tmp/round.las" -q || fail "$(basename "$las"): back from LAZ failed"
   [ "$(records_sha "$las")" == "$(records_sha "$tmp/round.las")" ] || fail "$(basename "$las"): LAZ round trip changed records"
-  [ "$(user_bytes_sha "$las")" == "$(user_bytes_sha "$tmp/round.las")" ] \
-    || fail "$(basename "$las"): LAZ round trip lost the bytes between the VLRs and the points"
+  # Byte for byte: the VLRs as stored (LAS 1.0's reserved 0xAABB), the bytes between them
+  # and the points (LAS 1.0's signature, a writer's own), the internal waveform record
+  # after the points (LAS 1.3; its start in the header moves with it) were all lost.
+  cmp -s "$las" "$tmp/round.las" || fail "$(basename "$las"): LAS -> LAZ -> LAS changed bytes: $(cmp "$las" "$tmp/round.las")"
+  "$vola" translate "$las" "$tmp/copy.las" -q
+  cmp -s "$las" "$tmp/copy.las" || fail "$(basename "$las"): LAS -> LAS changed bytes: $(cmp "$las" "$tmp/copy.las")"
 done
 
 # vola tile takes LAZ as it takes LAS: the same tiles and index, whatever the threads.
