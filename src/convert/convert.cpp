@@ -92,6 +92,18 @@ const char* unit_of(const io::Input& input) {
   return input.terrain ? "cells" : "points";
 }
 
+// A file of no points, or none the filters left: said as it is (the file had points).
+InvalidArgument no_points(const std::string& path, const io::Input& input, const ConvertOptions& options) {
+  if (!options.filters.empty()) {
+    std::string stages;
+    for (const std::string& f : options.filters) stages += (stages.empty() ? "" : ", ") + f;
+    return InvalidArgument(path + ": no point is left after the filters (" + stages + ")");
+  }
+  return InvalidArgument(path + ": no points" +
+                         (input.not_finite ? " with finite coordinates (" + std::to_string(input.not_finite) + " without)"
+                                           : std::string()));
+}
+
 Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions& options, const BuildOptions& build,
                 BuildReport& report) {
   if (maps_cell_for_cell(path, input, options)) return tree_from_grid_cells(*input.grid, options.depth, report);
@@ -103,15 +115,12 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   build.check();
   if (input.build) {  // a streaming reader
     Tree tree = input.build(build, &report);
-    if (report.points_in == 0) throw InvalidArgument(path + ": no points");
+    if (report.points_in == 0) throw no_points(path, input, options);
     return tree;
   }
   if (input.grid) input.cloud = grid_cell_centres(*input.grid);
   if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
-  if (input.cloud.size() == 0)
-    throw InvalidArgument(path + ": no points" +
-                          (input.not_finite ? " with finite coordinates (" + std::to_string(input.not_finite) + " without)"
-                                            : std::string()));
+  if (input.cloud.size() == 0) throw no_points(path, input, options);
   return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
 }
 

@@ -38,7 +38,8 @@ void add_height_above_ground(PointCloud& cloud) {
 }
 
 void OutlierOptions::check() const {
-  if (neighbours < 1) throw OptionError("neighbours", "must be 1 or more");
+  if (neighbours < 1 || neighbours > kMaxNeighbours)
+    throw OptionError("neighbours", "must be 1 to " + std::to_string(kMaxNeighbours));
   if (!(multiplier >= 0.0) || !std::isfinite(multiplier)) throw OptionError("multiplier", "must be 0 or more");
 }
 

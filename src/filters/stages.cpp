@@ -79,8 +79,12 @@ Stage parse_stage(const std::string& spec) {
       s.kind = Stage::Kind::outlier;
       parameters(spec, args, [&](const std::string& key, double v) {
         if (key == "k" || key == "mean_k") {
-          // A count: whole and small enough for an int (a k near the point count is already absurd).
-          if (!(v >= 1.0 && v <= 1e6) || v != std::floor(v)) refuse(spec, "k must be a whole number from 1 to 1000000");
+          // A count of neighbours: the time grows with it (k = 5000 over 110,000 points took 76 s,
+          // k beyond the point count did not end), and statistics over a thousand neighbours
+          // are no longer about outliers.
+          if (!(v >= 1.0 && v <= OutlierOptions::kMaxNeighbours) || v != std::floor(v))
+            refuse(spec, "k must be a whole number from 1 to " + std::to_string(OutlierOptions::kMaxNeighbours) +
+                             " (the neighbours of each point whose mean distance is compared; PDAL's default is 8)");
           s.outlier.neighbours = static_cast<int>(v);
         }
         else if (key == "multiplier") s.outlier.multiplier = v;

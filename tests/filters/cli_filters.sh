@@ -124,6 +124,11 @@ if "$vola" translate "$autzen" "$tmp/none.las" --crop-polygon "$tmp/lonlat.geojs
 fi
 grep -q "the polygons (x -123.0725..-123.07, y 44.05..44.0515) do not meet the points" "$tmp/err.txt" \
   || fail "error: $(cat "$tmp/err.txt")"
+# Filters that leave nothing: said so (it said the survey had "no points").
+if "$vola" convert "$autzen" "$tmp/nothing.vol" --voxel-size 3 --where "Z > 10000" 2> "$tmp/err.txt"; then
+  fail "a conversion of no point succeeded"
+fi
+grep -q "no point is left after the filters (where:Z > 10000)" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
 # PDAL reads ["a.las", "b.las", "out.las"] as two inputs: vola, reading one, refuses it
 # (it took b.las as an output and wrote a.las's points over it); no output may be the input.
 cp "$autzen" "$tmp/second.las"

@@ -477,6 +477,10 @@ TEST(Stages, ParseTheirStringsAndRefuseUnknownOnes) {
   // not as a flag of its own ("--cell" is no option of any command).
   EXPECT_EQ(message("smrf:cell=-1"), "filters: 'smrf:cell=-1': cell must be a positive number (metres), not -1");
   EXPECT_EQ(message("outlier:multiplier=-2"), "filters: 'outlier:multiplier=-2': multiplier must be 0 or more");
+  // k = 200000 over 110,000 points did not end in minutes.
+  EXPECT_EQ(parse_stage("outlier:k=1000").outlier.neighbours, 1000);
+  EXPECT_EQ(message("outlier:k=1001"), "filters: 'outlier:k=1001': k must be a whole number from 1 to 1000 (the "
+                                       "neighbours of each point whose mean distance is compared; PDAL's default is 8)");
 }
 
 TEST(Stages, RunInOrderAndReportTheInputIndexOfEveryPointLeft) {

@@ -20,7 +20,8 @@ std::vector<double> height_above_ground(const PointCloud& cloud);
 void add_height_above_ground(PointCloud& cloud);
 
 struct OutlierOptions {
-  int neighbours = 8;       // k (PDAL's mean_k)
+  static constexpr int kMaxNeighbours = 1000;  // time grows with k; beyond, no outlier statistics
+  int neighbours = 8;       // k (PDAL's mean_k), 1 .. kMaxNeighbours
   double multiplier = 2.0;  // outliers: mean distance > mean + multiplier x standard deviation
   void check() const;       // throws OptionError
 };
