@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <shared_mutex>
 
 #include "python_support.hpp"
 #include "vola/file.hpp"
@@ -43,10 +45,21 @@ py::array_t<T> per_point(const py::handle& points, F&& f) {
   return owning_array(std::move(out), {static_cast<py::ssize_t>(n)});
 }
 
+// The map and a lock: insert() runs without the GIL, so two Python threads may insert,
+// or read while another inserts (that crashed the interpreter); inserts are exclusive,
+// reads shared. (Shared, so that PyMap moves.)
 struct PyMap {
   OccupancyMap map;
   double max_range;
+  std::shared_ptr<std::shared_mutex> guard = std::make_shared<std::shared_mutex>();
 };
+
+// The locks are taken without the GIL: a thread holding the GIL while it waits would stop
+// the inserting thread from ever handing its result back.
+std::shared_lock<std::shared_mutex> reading(const PyMap& self) {
+  py::gil_scoped_release release;
+  return std::shared_lock(*self.guard);
+}
 
 VoxelState map_state(const OccupancyMap& m, const Point& p) {
   const auto v = m.voxel_of(p);
@@ -81,7 +94,11 @@ void bind_map(py::module_& m) {
           "again gives the bytes of inserting every scan at once.")
       .def_property_readonly("voxel_size", [](const PyMap& self) { return self.map.voxel_size(); })
       .def_property_readonly("max_range", [](const PyMap& self) { return self.max_range; })
-      .def("__len__", [](const PyMap& self) { return self.map.size(); })
+      .def("__len__",
+           [](const PyMap& self) {
+             const auto lock = reading(self);
+             return self.map.size();
+           })
       .def(
           "insert",
           [](PyMap& self, const py::handle& points, const std::array<double, 3>& origin) {
@@ -90,6 +107,7 @@ void bind_map(py::module_& m) {
             map::ScanReport report;
             {
               py::gil_scoped_release release;
+              const std::unique_lock lock(*self.guard);
               report = self.map.insert_scan(values, to_point(origin), self.max_range);
             }
             return report_dict(report);
@@ -99,6 +117,7 @@ void bind_map(py::module_& m) {
           "of `vola map`'s summary (points, not_finite, outside, cut, hit_voxels, free_voxels).")
       .def("state",
            [](const PyMap& self, const py::handle& points) {
+             const auto lock = reading(self);
              return per_point<std::int8_t>(points, [&](const Point& p) {
                return static_cast<std::int8_t>(map_state(self.map, p));
              });
@@ -106,6 +125,7 @@ void bind_map(py::module_& m) {
            py::arg("points"), "(N,) int8 per world point: vola.UNKNOWN 0, vola.FREE 1, vola.OCCUPIED 2.")
       .def("probability",
            [](const PyMap& self, const py::handle& points) {
+             const auto lock = reading(self);
              return per_point<double>(points, [&](const Point& p) {
                const auto v = self.map.voxel_of(p);
                const auto value = v ? self.map.log_odds(*v) : std::nullopt;
@@ -113,12 +133,17 @@ void bind_map(py::module_& m) {
              });
            },
            py::arg("points"), "(N,) float64 occupancy probability per world point, NaN where unknown.")
-      .def("tree", [](const PyMap& self) { return map::freeze(self.map); },
+      .def("tree",
+           [](const PyMap& self) {
+             const auto lock = reading(self);
+             return map::freeze(self.map);
+           },
            "The map as a state map tree (Tree.is_state_map), as save() writes it.")
       .def(
           "save",
           [](const PyMap& self, const std::filesystem::path& path) {
             py::gil_scoped_release release;
+            const std::shared_lock lock(*self.guard);
             write(map::freeze(self.map), path.string());
           },
           py::arg("path"), "Writes the state map: the bytes `vola map` writes for the same scans.");

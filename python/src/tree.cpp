@@ -12,9 +12,18 @@ namespace {
 
 // ---- reading a tree ----
 
+// `level` checked against the tree's (an index out of range read past the level counts);
+// -1, where the finest is the default, stands for it.
+int checked_level(const Tree& tree, int level, bool minus_one_is_finest) {
+  if (minus_one_is_finest && level == -1) return tree.depth() - 1;
+  if (level < 0 || level >= tree.depth())
+    throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1) +
+                                (minus_one_is_finest ? " (or -1: the voxels)" : ""));
+  return level;
+}
+
 py::array_t<std::uint32_t> voxels_of(const Tree& tree, int level) {
-  if (level < 0) level = tree.depth() - 1;
-  if (level >= tree.depth()) throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  level = checked_level(tree, level, true);
   const auto n = static_cast<py::ssize_t>(tree.node_count(level));
   py::array_t<std::uint32_t> out({n, py::ssize_t{3}});
   std::uint32_t* p = out.mutable_data();
@@ -126,8 +135,7 @@ py::tuple world_to_voxel(const Tree& tree, const py::handle& input) {
 }
 
 py::array_t<bool> to_dense(const Tree& tree, int level, std::uint64_t max_cells) {
-  if (level < 0) level = tree.depth() - 1;
-  if (level >= tree.depth()) throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  level = checked_level(tree, level, true);
   const std::uint64_t side = vola::side_of(level + 1);
   if (side > 4096 || side * side * side > max_cells)
     throw vola::InvalidArgument("to_dense: a " + std::to_string(side) + "^3 grid is more than max_cells=" + std::to_string(max_cells) +
@@ -145,8 +153,7 @@ py::array_t<bool> to_dense(const Tree& tree, int level, std::uint64_t max_cells)
 
 py::array level_words(const py::object& self, int level, bool payload) {
   const Tree& tree = py::cast<const Tree&>(self);
-  if (level < 0 || level >= tree.depth())
-    throw vola::InvalidArgument("level " + std::to_string(level) + " is outside 0.." + std::to_string(tree.depth() - 1));
+  level = checked_level(tree, level, false);
   const auto words = payload ? tree.payload(level) : tree.occupancy(level);
   return readonly_view(py::dtype::of<std::uint64_t>(), {static_cast<py::ssize_t>(words.size())}, words.data(), self);
 }
@@ -225,7 +232,8 @@ py::class_<Tree> bind_tree(py::module_& m) {
           "is_state_map", [](const Tree& t) { return t.payload_meaning() == vola::PayloadMeaning::occupancy_state; },
           "True for a state map (vola map, vola.Map.save): known voxels, payload bit set = occupied.")
       .def_property_readonly("memory_bytes", &Tree::memory_bytes, "Bytes held in memory (mapped words not counted).")
-      .def("node_count", &Tree::node_count, py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
+      .def("node_count", [](const Tree& tree, int level) { return tree.node_count(checked_level(tree, level, false)); },
+           py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
       .def_property_readonly("quantization", [](const Tree& t) { return t.frame().quantization == vola::Quantization::grid ? "grid" : "toolkit"; },
                              "'grid' (floor((p - origin) / voxel_size)) or 'toolkit' (the reference's rounding).")
       .def_property_readonly("origin", [](const Tree& t) { return t.frame().origin; }, "World position of voxel (0, 0, 0)'s corner.")

@@ -178,3 +178,17 @@ def test_trees_pickle_with_their_attributes_and_crs(tmp_path):
         assert np.array_equal(back.voxels(), tree.voxels())
         assert np.array_equal(back.attribute("v"), tree.attribute("v"))
         assert back.crs_wkt == wkt and back.voxel_size == tree.voxel_size
+
+
+def test_levels_out_of_range_are_refused():
+    """node_count read past the level counts (garbage, or a segfault for a large level)."""
+    tree = vola.build_from_voxels(np.array([[0, 281, 0], [63, 17, 10]]), depth=5)
+    assert [tree.node_count(level) for level in range(5)] == [2, 2, 2, 2, 2]  # cells, two apart at every level
+    for bad in (5, 1000000, -1, -7):
+        with pytest.raises(vola.InvalidArgument, match="outside 0..4"):
+            tree.node_count(bad)
+    assert tree.voxels(-1).tolist() == tree.voxels().tolist()  # -1: the voxels, as documented
+    with pytest.raises(vola.InvalidArgument, match="outside 0..4"):
+        tree.voxels(-2)
+    with pytest.raises(vola.InvalidArgument, match="outside 0..4"):
+        tree.occupancy(-1)

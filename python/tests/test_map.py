@@ -118,3 +118,44 @@ def test_a_saved_map_takes_more_scans_as_vola_map_from_does(tmp_path: pathlib.Pa
     subprocess.run([vola_cli, "map", str(tmp_path / "rest.txt"), "--from", str(tmp_path / "all.vol"), "-o",
                     str(tmp_path / "x.vol"), "--voxel-size", "0.5", "-q"], check=False)
     assert not (tmp_path / "x.vol").exists(), "a voxel size other than the saved map's was accepted"
+
+
+def test_threads_may_share_a_map():
+    """insert() runs without the GIL: two threads inserting into one map, and one reading
+    it meanwhile, crashed the interpreter. Inserts are exclusive; four scans of few points
+    never reach the clamping bounds, so any order of them gives the serial map."""
+    import threading
+    scans = [(np.random.default_rng(seed).uniform(-4, 4, size=(3000, 3)), np.array([0.1 * seed, 0.0, 0.2]))
+             for seed in range(4)]
+    shared = vola.Map(0.1)
+    errors = []
+
+    def insert(part):
+        try:
+            for index in part:
+                shared.insert(*scans[index])
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    def read():
+        try:
+            for _ in range(20):
+                shared.state(scans[0][0])
+                len(shared)
+                shared.tree()
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=insert, args=((0, 2),)), threading.Thread(target=insert, args=((1, 3),)),
+               threading.Thread(target=read)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    serial = vola.Map(0.1)
+    for points, origin in scans:
+        serial.insert(points, origin)
+    assert shared.tree().voxels().tolist() == serial.tree().voxels().tolist()
+    probe = np.concatenate([points for points, _ in scans])
+    assert np.allclose(shared.probability(probe), serial.probability(probe), atol=1e-4, equal_nan=True)
