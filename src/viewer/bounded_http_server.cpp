@@ -12,6 +12,13 @@ BoundedHttpServer::BoundedHttpServer(const ServerLimits& limits) : limits_(limit
   new_task_queue = [this] { return new ConnectionQueue(limits_.workers, limits_.max_waiting_connections); };
   // httplib refuses a declared Content-Length over this with 413 before reading it.
   set_payload_max_length(limits_.max_body_bytes);
+  // httplib's default sets SO_REUSEPORT, with which a second viewer binds a port already
+  // in use and the kernel splits the requests between the two. SO_REUSEADDR only: a
+  // restarted viewer still rebinds a port whose old connections linger in TIME_WAIT.
+  set_socket_options([](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
 }
 
 void BoundedHttpServer::serve(Transport& transport) noexcept {

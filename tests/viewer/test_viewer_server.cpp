@@ -81,6 +81,19 @@ TEST_F(ServedFile, BytesThatAreNotUtf8Get400AndTheServerLives) {
   expect_alive();
 }
 
+// A second viewer on the port of a running one is refused (httplib's SO_REUSEPORT let it
+// bind, and the kernel split the requests between the two).
+TEST_F(ServedFile, ASecondServerCannotTakeItsPort) {
+  std::vector<std::unique_ptr<vola::viewer::ViewedFile>> files;
+  files.push_back(std::make_unique<vola::viewer::ViewedFile>(path_));
+  vola::viewer::ServerOptions options;
+  options.limits = test_limits();
+  options.port = port_;
+  vola::viewer::Server second(std::move(files), options);
+  EXPECT_THROW(second.bind(), vola::IoError);
+  expect_alive();
+}
+
 TEST_F(ServedFile, OnlyItsOwnNamesInHostAreAnswered) {
   const std::string port = std::to_string(port_);
   const std::vector<std::string> foreign{
