@@ -145,6 +145,15 @@ ln -s target.vol special/through.vol
 [[ -L special/through.vol ]] || fail "the link was replaced by a file"
 cmp -s room.vol special/target.vol && fail "the link's target was not written"
 
+# A FIFO named as an input blocked the reader forever (convert, info, map): refused.
+mkfifo special/in.las special/in.xyz special/in.vol
+echo "in.xyz 0 0 0 0 0 0 1" > special/scans.txt
+refused "info of a FIFO" "not a regular file" timeout 20 "$vola" info special/in.las
+refused "convert of a FIFO" "not a regular file" timeout 20 "$vola" convert special/in.xyz special/x.vol --voxel-size 1 -q
+refused "translate of a FIFO" "not a regular file" timeout 20 "$vola" translate special/in.las special/x.ply -q
+refused "map of a FIFO scan" "not a regular file" timeout 20 "$vola" map special/scans.txt -o special/m.vol --voxel-size 1 -q
+refused "info of a FIFO .vol" "not a regular file" timeout 20 "$vola" info special/in.vol
+
 if [[ $failures -ne 0 ]]; then
   echo "$failures failure(s)" >&2
   exit 1

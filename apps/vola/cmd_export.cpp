@@ -18,7 +18,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/export_format.hpp"
 #include "vola/io/occupancy_maps.hpp"
-#include "vola/io/same_file.hpp"
+#include "vola/io/file_checks.hpp"
 
 namespace vola::cli {
 

@@ -12,6 +12,7 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/io/file_checks.hpp"
 #include "vola/io/input.hpp"
 #include "vola/map/state_map.hpp"
 
@@ -94,6 +95,7 @@ std::string json_crs(const NamedCrs& crs) {
 }
 
 void run_info(const InfoArgs& a) {
+  io::refuse_non_regular_input(a.file);  // before its first bytes are read
   if (is_point_file(a.file) || !is_vol_file(a.file)) {
     if (is_point_file(a.file)) print_point_file_info(a.file, a.summary, a.json);
     else print_point_cloud_info(a.file, a.summary, a.json);

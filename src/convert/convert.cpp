@@ -17,7 +17,7 @@
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
-#include "vola/io/same_file.hpp"
+#include "vola/io/file_checks.hpp"
 
 namespace vola {
 

@@ -96,7 +96,8 @@ int claim_slot(const void* data, std::size_t size, const MappedFile* owner) noex
 }
 
 int open_regular(const std::string& path, std::size_t& size) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO would wait for a writer; it is refused below instead.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) VOLA_THROW(IoError(path + ": cannot open: " + std::strerror(errno)));
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
@@ -106,7 +107,7 @@ int open_regular(const std::string& path, std::size_t& size) {
   }
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
-    VOLA_THROW(IoError(path + ": not a regular file"));
+    VOLA_THROW(IoError(path + ": not a regular file (a FIFO, device or directory): inputs are files"));
   }
   size = static_cast<std::size_t>(st.st_size);
   return fd;

@@ -8,6 +8,7 @@
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/dem.hpp"
+#include "vola/io/file_checks.hpp"
 #include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/mesh.hpp"
@@ -138,6 +139,7 @@ std::string lower_extension(const std::string& path) {
 }
 
 const InputFormat& find_input_format(const std::string& path, const std::string& name) {
+  refuse_non_regular_input(path);  // every reader finds its format here first
   const auto& formats = input_formats();
   std::string known;
   for (const auto& f : formats) known += (known.empty() ? "" : ", ") + f.name;

@@ -266,11 +266,6 @@ void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
 }  // namespace
 
 void LasReader::read_header() {
-  if (in_) {
-    in_->seekg(0, std::ios::end);
-    file_size_ = static_cast<std::uint64_t>(in_->tellg());
-    in_->seekg(0);
-  }
   const HeaderSource src{path_, file_size_,
                          [this](std::uint64_t offset, std::uint64_t size, std::uint8_t* out) { fetch(offset, size, out); }};
   LasHeader& hd = header_;
@@ -296,7 +291,6 @@ void LasReader::read_header() {
                                       std::to_string(point_bytes) + " bytes follow the point data offset (truncated file)");
   parse_crs_and_fields(src, hd);
   points_total_ = hd.point_count;
-  if (in_) in_->seekg(hd.offset_to_points);
 }
 
 }  // namespace vola::io

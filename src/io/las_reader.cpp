@@ -39,7 +39,9 @@ void LasChunk::clear() {
 }
 
 LasReader::LasReader(const std::string& path) : path_(path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a FIFO opens at once instead of waiting for a writer, and is refused
+  // below (its reader would block until someone writes: forever, most often).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) throw IoError(path + ": cannot open");
   struct stat st {};
   if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
@@ -53,9 +55,7 @@ LasReader::LasReader(const std::string& path) : path_(path) {
 #endif
   } else {
     ::close(fd);
-    auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
-    if (!*file) throw IoError(path + ": cannot open");
-    in_ = std::move(file);
+    throw IoError(path + ": not a regular file (a FIFO, device or directory): inputs are files");
   }
   read_header();
 }
@@ -81,14 +81,7 @@ void LasReader::fetch(std::uint64_t offset, std::uint64_t size, std::uint8_t* ou
     }
     return;
   }
-  if (!in_) {
-    if (size) std::memcpy(out, bytes_.data() + offset, size);
-    return;
-  }
-  in_->clear();
-  in_->seekg(static_cast<std::streamoff>(offset));
-  in_->read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(size));
-  if (static_cast<std::uint64_t>(in_->gcount()) != size) throw FormatError(path_, offset, "cannot read");
+  if (size) std::memcpy(out, bytes_.data() + offset, size);
 }
 
 
@@ -99,24 +92,16 @@ std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   if (hd.compressed()) return read_laz_records(n);
   const std::size_t length = hd.record_length;
   const std::uint64_t at = hd.offset_to_points + next_ * length;
-  if (!fd_ && !in_) {  // in memory; the header check guarantees the records lie inside
+  if (!fd_) {  // in memory; the header check guarantees the records lie inside
     next_ += n;
     return bytes_.subspan(static_cast<std::size_t>(at), n * length);
   }
   // resize() only grows the buffer after the first chunk: no zeroing per chunk.
   if (buffer_.size() < n * length) buffer_.resize(n * length);
-  if (fd_) {
-    try {
-      fetch(at, n * length, buffer_.data());
-    } catch (const FormatError&) {
-      throw FormatError(path_, at, "cannot read the point records (truncated file)");
-    }
-  } else {
-    in_->clear();
-    in_->seekg(static_cast<std::streamoff>(at));
-    in_->read(reinterpret_cast<char*>(buffer_.data()), static_cast<std::streamsize>(n * length));
-    if (static_cast<std::size_t>(in_->gcount()) != n * length)
-      throw FormatError(path_, at, "cannot read the point records (truncated file)");
+  try {
+    fetch(at, n * length, buffer_.data());
+  } catch (const FormatError&) {
+    throw FormatError(path_, at, "cannot read the point records (truncated file)");
   }
   next_ += n;
   return {buffer_.data(), n * length};
@@ -170,10 +155,6 @@ void LasReader::rewind() {
   current_.first = current_.count = 0;
   batch_chunk_ = 0;
   batch_point_ = 0;
-  if (in_) {
-    in_->clear();
-    in_->seekg(header_.offset_to_points);
-  }
 }
 
 

@@ -74,10 +74,10 @@ void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optiona
 }
 
 // Chunks chunk_order_[begin ...] (one per thread, one at least) decoded into `batch`, in
-// parallel when the file is read with pread (a stream is read serially). The buffers are
+// parallel (the file is read with pread, or lies in memory). The buffers are
 // reused from batch to batch: no fresh pages to fault in and zero for every chunk.
 void LasReader::decode_laz_batch(LazBatch& batch, std::size_t begin) const {
-  const std::size_t threads = in_ ? 1 : thread_count();
+  const std::size_t threads = thread_count();
   batch.first = begin;
   batch.count = std::min(chunk_order_.size() - begin, threads);
   if (batch.records.size() < batch.count) batch.records.resize(batch.count);
@@ -133,7 +133,7 @@ std::span<const std::uint8_t> LasReader::read_laz_records(std::size_t max_points
     batch_chunk_ = 0;
     batch_point_ = 0;
     const std::size_t after = current_.first + current_.count;
-    if (!in_ && after < chunk_order_.size())
+    if (after < chunk_order_.size())
       prefetch_ = std::async(std::launch::async, [this, after] { decode_laz_batch(ahead_, after); });
   }
 }

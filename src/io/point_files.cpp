@@ -16,7 +16,7 @@
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
-#include "vola/io/same_file.hpp"
+#include "vola/io/file_checks.hpp"
 #include "vola/io/translate.hpp"
 
 namespace vola::io {

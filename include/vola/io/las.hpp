@@ -147,7 +147,6 @@ class LasReader {
   void decode_laz_batch(LazBatch& batch, std::size_t begin) const;
   void settle_laz_prefetch() noexcept;
 
-  std::unique_ptr<std::istream> in_;         // only for a file that pread() cannot read (a pipe)
   std::shared_ptr<const int> fd_;            // a regular file, open for pread()
   std::vector<std::uint8_t> owned_;          // the in-memory constructor's copy
   std::span<const std::uint8_t> bytes_;      // owned_ (empty when read from a file)
