@@ -430,6 +430,12 @@ Fusion<Store>::Fusion(Store& store, const Intrinsics& intrinsics, std::uint32_t 
     throw InvalidArgument("the store's voxel size differs from the fusion parameters'");
   if (width < (1u << kPyramidLevels) || height < (1u << kPyramidLevels))
     throw InvalidArgument("images must be at least 8 x 8 pixels");
+  // The principal point lies on the image (a cx of 1e9 made the bricks' projection sweep a
+  // billion columns per frame: minutes for two 160 x 120 frames, without a word).
+  if (!(intrinsics.cx >= 0.0 && intrinsics.cx <= width && intrinsics.cy >= 0.0 && intrinsics.cy <= height))
+    throw InvalidArgument("the principal point (cx " + std::to_string(intrinsics.cx) + ", cy " +
+                          std::to_string(intrinsics.cy) + ") lies outside the " + std::to_string(width) + " x " +
+                          std::to_string(height) + " image: check intrinsics.txt ('fx fy cx cy' in pixels)");
 }
 
 namespace {

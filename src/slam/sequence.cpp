@@ -154,6 +154,11 @@ std::vector<StampedPose> read_trajectory(const std::string& file) {
       line_error(file, number, "expected 'timestamp tx ty tz qx qy qz qw', found " + std::to_string(fields.size()) + " fields");
     poses.push_back({parse_number(fields[0], file, number, "the timestamp"), pose_from_fields(fields, 1, file, number)});
   });
+  // In time order, as TUM's tools read them: a tracker's threads or a file put together
+  // from pieces may write the lines out of order, and the relative pose error pairs poses
+  // by their order.
+  std::stable_sort(poses.begin(), poses.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
   return poses;
 }
 

@@ -110,6 +110,14 @@ TEST(SlamSequence, ListErrorsNameFileAndLine) {
   EXPECT_NE(format_error([&] { read_trajectory((dir.path() / "gt.txt").string()); }).find("line 1"), std::string::npos);
   write_text(dir.path() / "gt.txt", "1 0 0 nan 0 0 0 1\n");
   EXPECT_NE(format_error([&] { read_trajectory((dir.path() / "gt.txt").string()); }).find("tz"), std::string::npos);
+  // Lines out of time order come back in time order (the RPE pairs poses by it).
+  write_text(dir.path() / "gt.txt", "3 3 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
+  const auto sorted = read_trajectory((dir.path() / "gt.txt").string());
+  ASSERT_EQ(sorted.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(sorted[i].timestamp, static_cast<double>(i + 1));
+    EXPECT_EQ(sorted[i].pose.translation().x(), static_cast<double>(i + 1));
+  }
   write_text(dir.path() / "k.txt", "525 525 319.5\n");
   EXPECT_NE(format_error([&] { read_intrinsics((dir.path() / "k.txt").string()); }).find("k.txt: line 1"), std::string::npos);
 }

@@ -44,6 +44,19 @@ TEST(SlamParallel, AWorkerErrorInEveryStageReachesTheCaller) {
   fuse_two_frames();  // without a fault it runs
 }
 
+// A principal point off the image is a wrong intrinsics file (cx = 1e9 ran for minutes).
+TEST(SlamParallel, APrincipalPointOffTheImageIsRefused) {
+  SparseTsdfStore store(centred_geometry(Eigen::Vector3d(0, 0, 1.5), 0.02, 256));
+  for (const auto& [cx, cy] : {std::pair{1e9, kIntrinsics.cy}, std::pair{-1.0, kIntrinsics.cy},
+                               std::pair{kIntrinsics.cx, kHeight + 1.0}}) {
+    Intrinsics k = kIntrinsics;
+    k.cx = cx;
+    k.cy = cy;
+    EXPECT_THROW(Fusion<SparseTsdfStore>(store, k, kWidth, kHeight, vola_slam_test::small_scene_params()),
+                 vola::InvalidArgument);
+  }
+}
+
 TEST(SlamParallel, PerPixelStagesDoNotDependOnTheThreadCount) {
   const DepthImage depth = wall();
   const DepthImage one = bilateral_filter(depth, 3, 4.5, 0.03, 1);

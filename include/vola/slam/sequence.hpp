@@ -56,8 +56,9 @@ struct TimedPath {
 // not a finite timestamp followed by a path, IoError when the file cannot be opened.
 std::vector<TimedPath> read_timed_list(const std::string& file);
 
-// "timestamp tx ty tz qx qy qz qw" lines; the quaternion must have a norm within 1e-3
-// of 1 after parsing (it is then normalised). Errors name the file and line.
+// "timestamp tx ty tz qx qy qz qw" lines, returned in time order whatever the lines'
+// order; the quaternion must have a norm within 1e-3 of 1 after parsing (it is then
+// normalised). Errors name the file and line.
 std::vector<StampedPose> read_trajectory(const std::string& file);
 // Poses without timestamps ("tx ty tz qx qy qz qw"), timestamped 1, 2, ...
 std::vector<StampedPose> read_numbered_poses(const std::string& file);
