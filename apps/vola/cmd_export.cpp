@@ -91,6 +91,19 @@ void export_map(const ExportArgs& a, const Tree& tree, const std::string& format
               voxels.frame.voxel_size, a.output.c_str());
 }
 
+// Only LAS/LAZ and GeoTIFF carry a CRS; PLY, XYZ, binvox, NPY, PNG with its world file,
+// OctoMap and OpenVDB files lose it. Said, as vola translate says it, even with -q.
+void warn_if_crs_is_lost(const ExportArgs& a, const Tree& tree, const std::string& format) {
+  if (format == "las" || format == "tif") return;  // they keep it
+  const std::optional<std::string> crs = geo::crs_definition(tree.georef());
+  if (!crs) return;
+  const std::string named = tree.georef().crs_wkt.empty() ? *crs : "a WKT";
+  std::fprintf(stderr,
+               "vola: warning: %s: this format has no place for the CRS of %s (%s): it is not kept; a .las/.laz or "
+               "GeoTIFF (--raster) export keeps it\n",
+               a.output.c_str(), a.input.c_str(), named.c_str());
+}
+
 void run_export(const ExportArgs& a) {
   io::refuse_output_over_input(a.input, a.output, "vola export writes another file; give it another name");
   if (!a.free.empty()) io::refuse_output_over_input(a.free, a.output, "it is --free's file; give the output another name");
@@ -167,6 +180,7 @@ void run_export(const ExportArgs& a) {
     say("PNG occupancy map of voxels at z >= " + std::to_string(a.above) + ", " + std::to_string(tree.side()) +
         "^2 pixels, world file " + world);
   }
+  warn_if_crs_is_lost(a, tree, format);
 }
 
 }  // namespace

@@ -132,6 +132,15 @@ expect_error "has no CRS" "$vola" coords "$nocrs" --wgs84
 grep -q "has no CRS" "$tmp/err" || fail "coords on a file without a CRS did not say so"
 "$vola" coords "$nocrs" --crs 29902 >/dev/null 2>&1 && fail "coords --crs without --wgs84 was accepted"
 
+# A format with no place for the CRS says it is not kept (export dropped it without a word,
+# where translate warned); LAS keeps it and says nothing.
+"$vola" export "$irish" "$tmp/crs.ply" -q 2>"$tmp/err" || fail "export to PLY"
+grep -q "crs.ply: this format has no place for the CRS of .*: it is not kept" "$tmp/err" || fail "no CRS warning: $(cat "$tmp/err")"
+"$vola" export "$irish" "$tmp/crs.las" -q 2>"$tmp/err" || fail "export to LAS"
+[[ ! -s $tmp/err ]] || fail "LAS export warned: $(cat "$tmp/err")"
+"$vola" export "$nocrs" "$tmp/nocrs.ply" -q 2>"$tmp/err" || fail "export of a file without CRS"
+[[ ! -s $tmp/err ]] || fail "a file without a CRS warned: $(cat "$tmp/err")"
+
 if [[ $failures -ne 0 ]]; then
   echo "$failures failure(s)" >&2
   exit 1
