@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "text_output.hpp"
 #include "number_checks.hpp"
 #include "progress.hpp"
 #include "vola/error.hpp"
@@ -79,6 +80,10 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   if (result.trajectory.empty()) throw InvalidArgument(a.sequence + ": no frame has a ground-truth pose");
   if (!a.trajectory.empty()) slam::write_trajectory(a.trajectory, result.trajectory);
   const auto surface = slam::surface_voxels(store);
+  if (surface.empty())  // a map of nothing is a mistake (depth in another unit, empty frames), not a result
+    throw InvalidArgument(a.sequence + ": the frames made no surface: no depth was measured within --min-depth.."
+                          "--max-depth at --depth-factor " + shortest_text(a.depth_factor) +
+                          " stored units per metre (the warnings above say which frames); nothing written");
   const Tree tree = slam::surface_tree(surface, store.geometry(), result.coloured);
   if (!a.output.empty()) write(tree, a.output);
   std::size_t triangles = 0;

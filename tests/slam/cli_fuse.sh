@@ -31,6 +31,11 @@ awk '$1 == "ate_rmse_m" { exit !($2 < 0.03) }' "$work/eval.txt"
 mkdir "$work/empty"
 if "$vola" fuse "$work/empty" -o "$work/x.vol" 2> "$work/err.txt"; then exit 1; fi
 grep -q "no depth.txt" "$work/err.txt"
+# Depth in another unit than --depth-factor says (every depth below --min-depth): no
+# surface, said as such (it was an error about a --depth option fuse does not have).
+if "$vola" fuse "$work/seq" -o "$work/x.vol" --depth-factor 1e9 --groundtruth-poses 2> "$work/err.txt"; then exit 1; fi
+grep -q "the frames made no surface: no depth was measured within --min-depth..--max-depth" "$work/err.txt"
+test ! -e "$work/x.vol"
 printf '1.0 depth/000000.png\nbad line here\n' > "$work/seq/depth.txt"
 if "$vola" fuse "$work/seq" -o "$work/x.vol" 2> "$work/err.txt"; then exit 1; fi
 grep -q "depth.txt: line 2" "$work/err.txt"
