@@ -82,8 +82,13 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
   const auto& attributes = tree.attributes();
   const AttributeColumn* height = attributes.find("height");
   const double z0 = frame.origin[2];
-  std::vector<double> value(cells, std::numeric_limits<double>::quiet_NaN());
-  std::vector<std::uint32_t> count(cells, 0);
+  // The values in the Float32 the GeoTIFF stores (min and max commute with rounding to
+  // float), NaN where no voxel is; counts only for the products that need them: 4 or 8
+  // bytes a cell, where doubles and counts for every product took 16 (4.15 GB for a
+  // raster of 2^28 cells).
+  std::vector<float> value(cells, std::numeric_limits<float>::quiet_NaN());
+  std::vector<std::uint32_t> count;
+  if (options.product != RasterProduct::dsm && options.product != RasterProduct::dtm) count.assign(cells, 0);
 
   switch (options.product) {
     case RasterProduct::dsm: {
@@ -91,8 +96,8 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
                            : "top face of the cell's highest voxel (origin z + (k + 1) * voxel size)";
       std::uint64_t rank = 0;
       tree.for_each_voxel([&](const Voxel& v) {
-        const double z = height ? height->get(rank) : z0 + (static_cast<double>(v.z) + 1.0) * voxel;
-        double& top = value[index(v)];
+        const auto z = static_cast<float>(height ? height->get(rank) : z0 + (static_cast<double>(v.z) + 1.0) * voxel);
+        float& top = value[index(v)];
         if (!(top >= z)) top = z;  // NaN (no value yet) too
         ++rank;
       });
@@ -111,8 +116,8 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
       std::uint64_t rank = 0;
       tree.for_each_voxel([&](const Voxel& v) {
         if (!ground || classes->get(rank) == kGroundClass) {
-          const double z = height ? height->get(rank) : z0 + static_cast<double>(v.z) * voxel;
-          double& bottom = value[index(v)];
+          const auto z = static_cast<float>(height ? height->get(rank) : z0 + static_cast<double>(v.z) * voxel);
+          float& bottom = value[index(v)];
           if (!(bottom <= z)) bottom = z;
         }
         ++rank;
@@ -135,11 +140,11 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
       for (const auto& [column, top] : tops) {
         const Voxel v{static_cast<std::uint32_t>(column & 0xffffffffu), static_cast<std::uint32_t>(column >> 32), 0};
         const std::uint64_t i = index(v);
-        value[i] = (count[i] ? value[i] : 0.0) + intensity->get(top.second);
+        value[i] = (count[i] ? value[i] : 0.0f) + static_cast<float>(intensity->get(top.second));
         ++count[i];
       }
       for (std::size_t i = 0; i < cells; ++i)
-        if (count[i]) value[i] /= count[i];
+        if (count[i]) value[i] /= static_cast<float>(count[i]);
       break;
     }
     case RasterProduct::density:
@@ -149,17 +154,17 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
                             : "occupied voxels in the cell";
       tree.for_each_voxel([&](const Voxel& v) { ++count[index(v)]; });
       for (std::size_t i = 0; i < cells; ++i)
-        if (count[i]) value[i] = density ? count[i] / (cell * cell) : count[i];
+        if (count[i]) value[i] = static_cast<float>(density ? count[i] / (cell * cell) : count[i]);
       break;
     }
   }
 
-  raster.values.resize(cells);
-  for (std::size_t i = 0; i < cells; ++i) {
-    const bool has = !std::isnan(value[i]);
-    raster.values[i] = has ? static_cast<float>(value[i]) : kRasterNodata;
+  for (float& v : value) {
+    const bool has = !std::isnan(v);
+    if (!has) v = kRasterNodata;
     raster.cells_with_data += has;
   }
+  raster.values = std::move(value);
   return raster;
 }
 
