@@ -185,6 +185,19 @@ void read_stage(const json& element, std::size_t index, std::size_t stages, Pipe
   } else if (type.rfind("writers.", 0) == 0) {
     PipelineWriter writer;
     writer.filename = stage.text("filename");
+    // The output's name decides what is written: a type that says otherwise is refused
+    // (writers.vola named o.las wrote LAS and dropped voxel_size without a word).
+    const std::string extension = lower_extension(writer.filename);
+    const std::string wants = extension == ".vol"                      ? "writers.vola"
+                              : extension == ".las" || extension == ".laz" ? "writers.las"
+                              : extension == ".ply"                      ? "writers.ply"
+                              : extension == ".xyz" || extension == ".txt" ? "writers.text"
+                                                                           : "";
+    if (wants.empty())
+      stage.fail(writer.filename + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz or .txt");
+    if (type != wants)
+      stage.fail(type + " cannot write " + writer.filename + ": vola writes by the name's extension, and " + extension +
+                 " is " + wants);
     if (type == "writers.vola" || writer.voxels()) {
       stage.only({"filename", "voxel_size", "depth", "compress", "compress_max", "dense", "attributes"});
       for (const auto& [key, value] : element.items())

@@ -129,6 +129,12 @@ if "$vola" convert "$autzen" "$tmp/nothing.vol" --voxel-size 3 --where "Z > 1000
   fail "a conversion of no point succeeded"
 fi
 grep -q "no point is left after the filters (where:Z > 10000)" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+# A writer's type that disagrees with its name's extension is refused (writers.vola named
+# o.las wrote LAS and dropped voxel_size).
+echo "[\"$autzen\", {\"type\": \"writers.vola\", \"filename\": \"$tmp/o.las\", \"voxel_size\": 3}]" > "$tmp/typed.json"
+if "$vola" pipeline "$tmp/typed.json" 2> "$tmp/err.txt"; then fail "writers.vola wrote a .las"; fi
+grep -q "writers.vola cannot write .*o.las: vola writes by the name's extension, and .las is writers.las" "$tmp/err.txt" \
+  || fail "error: $(cat "$tmp/err.txt")"
 # PDAL reads ["a.las", "b.las", "out.las"] as two inputs: vola, reading one, refuses it
 # (it took b.las as an output and wrote a.las's points over it); no output may be the input.
 cp "$autzen" "$tmp/second.las"
