@@ -37,6 +37,7 @@ struct TileArgs {
   double density = 10.0;
   std::uint64_t seed = 1;
   std::size_t chunk_points = 0;  // 0: tile::chunk_points_for the options
+  std::uint64_t max_tiles = tile::TileOptions{}.max_tiles;
 };
 
 // "2G", "512M", "1.5G", "300000000" -> bytes.
@@ -74,6 +75,7 @@ void run_tile(const TileArgs& a) {
     options.output_dir = a.output;
     options.spill_dir = a.spill_dir;
     options.overviews = !a.no_overviews;
+    options.max_tiles = a.max_tiles;
     tile::TileInputs inputs;
     inputs.inputs = a.inputs;
     inputs.generate_survey = a.generate;
@@ -177,6 +179,10 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");
   cmd->add_option("--threads", args->threads, "Threads per process (0 = all cores)")->capture_default_str();
   cmd->add_flag("--no-overviews", args->no_overviews, "Write no overview pyramid");
+  cmd->add_option("--max-tiles", args->max_tiles,
+                  "Refuse, before writing any, more tiles than this (a tile size far below the point spacing; "
+                  "0: no limit)")
+      ->capture_default_str();
   cmd->add_flag("--no-attributes", args->no_attributes,
                 "Occupancy only: drop the attribute columns (by default every tile keeps the columns vola convert "
                 "keeps from the inputs, e.g. colour, intensity, classification; overviews reduce them further)");

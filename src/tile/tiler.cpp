@@ -2,6 +2,7 @@
 
 
 #include <algorithm>
+#include <cstdio>
 #include <array>
 #include <bit>
 #include <atomic>
@@ -378,6 +379,17 @@ void Tiling::share_statistics(const StatMap& stats, std::uint64_t points_read, s
     }
   }
   for (const auto& [t, st] : all_stats) tiles.push_back(t);
+  if (options.max_tiles != 0 && tiles.size() > options.max_tiles) {
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "the %llu points fall into %zu tiles of %.10g (%.3g points a tile): more than the limit of %llu "
+                  "tiles; give a larger tile size (or raise the limit, 0 for none)",
+                  static_cast<unsigned long long>(summary.points_in - summary.points_outside), tiles.size(),
+                  options.grid.tile_size,
+                  static_cast<double>(summary.points_in - summary.points_outside) / static_cast<double>(tiles.size()),
+                  static_cast<unsigned long long>(options.max_tiles));
+    throw OptionError("max_tiles", text);
+  }
 }
 
 // 3. Each tile's keys go to its owner (one gather per tile, all ranks in step).

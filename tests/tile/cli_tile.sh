@@ -93,6 +93,13 @@ grep -q "^tile .*: $first_tile" "$tmp/get.txt" || fail "get: $(cat "$tmp/get.txt
 grep -q ": occupied$" "$tmp/get.txt" || fail "get: $(cat "$tmp/get.txt")"
 "$vola" get "$index" 0 0 0 | grep -q "not in the set" || fail "get far away"
 
+# A tile size far below the point spacing (one tile per point: 440,000 files and 2 GB from
+# this 3.7 MB survey) is refused before a tile is written.
+"$vola" tile "$las" --tile-size 0.01 --depth 5 -o "$tmp/tiny" --max-tiles 50000 2> "$tmp/err.txt" \
+  && fail "110,000 tiles of 0.01 ft were written"
+grep -q -- "--max-tiles: the 110000 points fall into 110000 tiles of 0.01" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+[ -z "$(find "$tmp/tiny" -name '*.vol' 2> /dev/null)" ] || fail "tiles were written before the refusal"
+
 # render: rays cross the tiles; the image has hits.
 "$vola" render "$index" --size 160x120 -o "$tmp/view.png" > "$tmp/render.txt"
 grep -Eq "^view.png|rays hit" "$tmp/render.txt" || fail "render: $(cat "$tmp/render.txt")"

@@ -41,6 +41,10 @@ struct TileOptions {
   // keeps them, with the same reductions): points are reduced into each tile's voxels in
   // input order, so the values do not depend on threads, memory or ranks either.
   bool attributes = true;
+  // More tiles than this (0: no limit) is refused once the points are bucketed, before
+  // any tile is written: a tile size far below the point spacing made one tile per point
+  // (a 3.7 MB survey became 440,000 files and 2 GB).
+  std::uint64_t max_tiles = 100'000;
   // The CRS written into every tile (header code and WKT); the caller resolves it.
   std::optional<std::uint32_t> epsg;
   std::string crs_wkt;
