@@ -184,6 +184,25 @@ std::vector<std::string> clamped_value_warnings(const std::string& path, const P
   return out;
 }
 
+// A WKT record PROJ cannot read (pdal_warsaw_small.las holds "''") states no CRS: kept,
+// it would travel into the .vol and make every export that hands it to GDAL fail. Left
+// out, with a warning saying so; nothing when the WKT reads.
+std::optional<std::string> drop_unreadable_wkt(const std::string& path, io::Input& input) {
+  if (input.wkt.find_first_not_of(std::string(" \t\r\n\0", 5)) == std::string::npos) {
+    input.wkt.clear();
+    return std::nullopt;
+  }
+  try {
+    geo::describe_crs(input.wkt, geo::EpsgLookup::own_id_only);
+    return std::nullopt;
+  } catch (const Error&) {
+    const std::string shown = input.wkt.size() > 40 ? input.wkt.substr(0, 40) + "..." : input.wkt;
+    input.wkt.clear();
+    return path + ": its WKT record (" + shown + ") is not a CRS PROJ can read: it is not kept" +
+           (input.epsg ? " (the EPSG code is)" : "; give `assign_crs` if you know the CRS");
+  }
+}
+
 // A grid the points cannot be put on (an extent beyond a double or beyond depth 10, a
 // file's grid too large) is said by the core without the file's name; an option's
 // error already names what to change.
@@ -211,6 +230,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   std::vector<std::string> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
   std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
+  if (const auto dropped = drop_unreadable_wkt(path, input)) value_warnings.push_back(*dropped);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));

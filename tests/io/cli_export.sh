@@ -141,6 +141,13 @@ grep -q "crs.ply: this format has no place for the CRS of .*: it is not kept" "$
 "$vola" export "$nocrs" "$tmp/nocrs.ply" -q 2>"$tmp/err" || fail "export of a file without CRS"
 [[ ! -s $tmp/err ]] || fail "a file without a CRS warned: $(cat "$tmp/err")"
 
+# A WKT record PROJ cannot read ("''" in pdal_warsaw_small.las) is not kept, with a
+# warning: kept, it made every GeoTIFF export fail ("GDAL cannot read the file's CRS WKT").
+warsaw=$shared/data/las/pdal_warsaw_small.las
+"$vola" convert "$warsaw" "$tmp/warsaw.vol" --voxel-size 2 -q 2>"$tmp/err" || fail "convert warsaw"
+grep -q "its WKT record ('') is not a CRS PROJ can read: it is not kept" "$tmp/err" || fail "no WKT warning: $(cat "$tmp/err")"
+"$vola" export "$tmp/warsaw.vol" "$tmp/warsaw.tif" --raster dsm -q || fail "a raster of warsaw"
+
 if [[ $failures -ne 0 ]]; then
   echo "$failures failure(s)" >&2
   exit 1
