@@ -21,6 +21,32 @@ namespace {
 
 // ---- building ----
 
+// The CRS recorded as vola convert records it: a WKT's EPSG code in the header when PROJ
+// names one (build left the header at 2000), a code and a WKT that name different CRSs
+// refused, and the WGS84 latitude and longitude of the bbox centre (left at 0, 0).
+void georeference_built(Tree& tree, std::uint32_t epsg, const std::string& crs_wkt) {
+  vola::Georef& georef = tree.georef();
+  georef.epsg = epsg;
+  georef.crs_wkt = crs_wkt;  // kept in the extension, as vola convert keeps a WKT
+  if (!crs_wkt.empty()) {
+    const std::optional<std::uint32_t> named = vola::geo::epsg_from_wkt(crs_wkt);  // throws for a WKT PROJ cannot read
+    if (epsg != vola::geo::kUnsetEpsg && !vola::geo::same_crs("EPSG:" + std::to_string(epsg), crs_wkt))
+      throw vola::InvalidArgument("epsg=" + std::to_string(epsg) + " and crs_wkt name different CRSs" +
+                                  (named ? " (the WKT is EPSG:" + std::to_string(*named) + ")" : std::string()) +
+                                  ": give one");
+    if (epsg == vola::geo::kUnsetEpsg && named) georef.epsg = *named;
+  }
+  if (const auto definition = vola::geo::crs_definition(georef)) {
+    try {
+      const auto [lat, lon] = vola::geo::centre_lat_lon(*definition, georef.bbox);
+      georef.lat = lat;
+      georef.lon = lon;
+    } catch (const vola::Error&) {
+      // A CRS PROJ cannot place (an engineering CRS): no centre, as in vola convert.
+    }
+  }
+}
+
 Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
                   std::optional<std::array<double, 3>> origin, const py::dict& attributes, const py::dict& reductions,
                   std::uint32_t epsg, const std::string& crs_wkt) {
@@ -43,8 +69,7 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
   with_python_names([&] { options.check(); });
   py::gil_scoped_release release;
   Tree tree = vola::build(cloud, options);
-  tree.georef().epsg = epsg;
-  tree.georef().crs_wkt = crs_wkt;  // kept in the extension, as vola convert keeps a WKT
+  georeference_built(tree, epsg, crs_wkt);
   return tree;
 }
 
@@ -181,7 +206,8 @@ void bind_building(py::module_& m) {
         "quantize='grid': voxel_size and/or depth; origin defaults to the bbox minimum snapped to the voxel size.\n"
         "quantize='toolkit': the reference's rounding, needs depth.\n"
         "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: 'mean'|'max'|'min'|'majority'|'last'}.\n"
-        "epsg: the header's CRS code; crs_wkt: the CRS as WKT (for a CRS with no code), kept in the file.");
+        "epsg: the header's CRS code; crs_wkt: the CRS as WKT, kept in the file (its EPSG code, when PROJ names\n"
+        "one, goes into the header; an epsg naming another CRS is refused); lat_lon is the bbox centre's.");
   m.def("build_from_voxels", &build_voxels, py::arg("voxels"), py::arg("depth"),
         "Builds a tree from an (N, 3) array of integer voxels, each below 4**depth (duplicates allowed).");
   m.def("from_dense", &from_dense, py::arg("grid"), py::arg("origin") = py::none(), py::arg("voxel_size") = py::none(),

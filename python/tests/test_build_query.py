@@ -192,3 +192,19 @@ def test_levels_out_of_range_are_refused():
         tree.voxels(-2)
     with pytest.raises(vola.InvalidArgument, match="outside 0..4"):
         tree.occupancy(-1)
+
+
+def test_build_records_the_crs_as_convert_does(las_file):
+    """vola.build left epsg at 2000 for a WKT of a known code, lat_lon at (0, 0), accepted a
+    code and a WKT of different CRSs; a union with a CRS on one side only lost it."""
+    converted = vola.convert(str(las_file), voxel_size=10)
+    centres = converted.centers()
+    built = vola.build(centres, voxel_size=10, crs_wkt=converted.crs_wkt)
+    assert built.epsg == converted.epsg == 26910
+    assert built.lat_lon == pytest.approx(converted.lat_lon, abs=1e-3) and built.lat_lon[0] > 40
+    with pytest.raises(vola.InvalidArgument, match="name different CRSs"):
+        vola.build(centres, voxel_size=10, epsg=32610, crs_wkt=converted.crs_wkt)
+    assert vola.build(centres, voxel_size=10, epsg=26910, crs_wkt=converted.crs_wkt).epsg == 26910
+    bare = vola.build(centres, voxel_size=10, origin=converted.origin)
+    placed = vola.build(centres, voxel_size=10, origin=converted.origin, crs_wkt=converted.crs_wkt)
+    assert (bare | placed).crs_wkt == placed.crs_wkt and (placed | bare).crs_wkt == placed.crs_wkt

@@ -37,6 +37,15 @@ Tree combine(const Tree& a, const Tree& b, FrameCheck check, const char* what, M
   merge(ka, kb, std::back_inserter(out));
   Tree result = detail::emit_levels(out, a.depth(), {}, false);
   result.georef() = a.georef();
+  // A CRS only one side states is the result's (it was lost when the first had none).
+  const Georef none{};
+  if (a.georef().epsg == none.epsg && a.georef().crs_wkt.empty() &&
+      (b.georef().epsg != none.epsg || !b.georef().crs_wkt.empty())) {
+    result.georef().epsg = b.georef().epsg;
+    result.georef().crs_wkt = b.georef().crs_wkt;
+    result.georef().lat = b.georef().lat;
+    result.georef().lon = b.georef().lon;
+  }
   if (a.stored_frame()) result.set_frame(*a.stored_frame());
   return result;
 }
