@@ -234,7 +234,9 @@ Sequence read_sequence(const std::string& directory, double max_difference) {
   const auto require_files = [](const fs::path& list_file, const fs::path& base, const std::vector<TimedPath>& list) {
     for (const auto& entry : list)
       if (!fs::is_regular_file(resolve(base, entry.path)))
-        line_error(list_file.string(), entry.line, "frame file '" + resolve(base, entry.path) + "' does not exist");
+        line_error(list_file.string(), entry.line,
+                   "frame file '" + resolve(base, entry.path) + "' " +
+                       (fs::exists(resolve(base, entry.path)) ? "is not a regular file" : "does not exist"));
   };
   require_files(dir / "depth.txt", dir, depth);
   Sequence sequence;
@@ -245,7 +247,16 @@ Sequence read_sequence(const std::string& directory, double max_difference) {
     std::vector<double> td, tr;
     for (const auto& d : depth) td.push_back(d.timestamp);
     for (const auto& r : rgb) tr.push_back(r.timestamp);
-    for (const auto& [i, j] : associate(td, tr, max_difference)) sequence.frames[i].rgb_path = resolve(dir, rgb[j].path);
+    const auto pairs = associate(td, tr, max_difference);
+    // Colour listed but never close enough in time to a depth frame: the map would lose
+    // its colours (and tracking its features) without a word.
+    if (pairs.empty() && !rgb.empty())
+      throw FormatError((dir / "rgb.txt").string(), std::nullopt,
+                        "none of its " + std::to_string(rgb.size()) + " colour frames lies within " +
+                            std::to_string(static_cast<int>(max_difference * 1000)) +
+                            " ms of a depth frame (the timestamps of rgb.txt and depth.txt do not match); fix them, "
+                            "or remove rgb.txt to fuse depth alone");
+    for (const auto& [i, j] : pairs) sequence.frames[i].rgb_path = resolve(dir, rgb[j].path);
   }
   if (fs::exists(dir / "groundtruth.txt")) sequence.groundtruth = read_trajectory((dir / "groundtruth.txt").string());
   sequence.intrinsics = intrinsics;

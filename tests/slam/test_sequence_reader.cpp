@@ -147,6 +147,16 @@ TEST(SlamSequence, TumLayoutAssociatesColourByNearestTimestamp) {
   EXPECT_EQ(s.groundtruth[0].pose.translation(), Eigen::Vector3d(1, 2, 3));
   ASSERT_TRUE(s.intrinsics);
   EXPECT_EQ(s.intrinsics->fy, -480.0);
+  // Colour none of whose timestamps meets a depth frame's is refused (colour, and the
+  // features tracking uses, were dropped without a word).
+  write_text(dir.path() / "rgb.txt", "5.0 rgb/1.png\n6.0 rgb/3.png\n");
+  const std::string unmatched = format_error([&] { read_sequence(dir.path().string()); });
+  EXPECT_NE(unmatched.find("none of its 2 colour frames lies within 20 ms of a depth frame"), std::string::npos)
+      << unmatched;
+  // A listed frame that is not a regular file is named as such, not as missing.
+  write_text(dir.path() / "rgb.txt", "1.005 rgb\n");
+  const std::string folder = format_error([&] { read_sequence(dir.path().string()); });
+  EXPECT_NE(folder.find("is not a regular file"), std::string::npos) << folder;
   write_text(dir.path() / "depth.txt", "1.00 depth/1.png\n0.90 depth/2.png\n");
   EXPECT_NE(format_error([&] { read_sequence(dir.path().string()); }).find("timestamps must increase"), std::string::npos);
 }
