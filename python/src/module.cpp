@@ -9,7 +9,16 @@ PYBIND11_MODULE(_vola, m) {
 
   // Most specific last: pybind11 tries the latest registered translator first.
   static py::exception<vola::Error> error(m, "Error", PyExc_RuntimeError);
-  static py::exception<vola::InvalidArgument> invalid(m, "InvalidArgument", error.ptr());
+  // A bad argument is a ValueError too, as Python code expects of one (`except
+  // ValueError` caught numpy's complaints but not a bad voxel size). Both bases share
+  // BaseException's layout; the type lives as long as the module (never freed).
+  static PyObject* const invalid = [&] {
+    const py::tuple bases = py::make_tuple(error, py::handle(PyExc_ValueError));
+    PyObject* type = PyErr_NewException("vola._vola.InvalidArgument", bases.ptr(), nullptr);
+    if (!type) throw py::error_already_set();
+    return type;
+  }();
+  m.add_object("InvalidArgument", py::handle(invalid));
   static py::exception<vola::IoError> io_error(m, "IoError", error.ptr());
   static py::exception<vola::FormatError> format_error(m, "FormatError", error.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
@@ -20,7 +29,7 @@ PYBIND11_MODULE(_vola, m) {
     } catch (const vola::IoError& e) {
       io_error(e.what());
     } catch (const vola::InvalidArgument& e) {
-      invalid(e.what());
+      PyErr_SetString(invalid, e.what());
     } catch (const vola::Error& e) {
       error(e.what());
     }

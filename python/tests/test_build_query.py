@@ -208,3 +208,10 @@ def test_build_records_the_crs_as_convert_does(las_file):
     bare = vola.build(centres, voxel_size=10, origin=converted.origin)
     placed = vola.build(centres, voxel_size=10, origin=converted.origin, crs_wkt=converted.crs_wkt)
     assert (bare | placed).crs_wkt == placed.crs_wkt and (placed | bare).crs_wkt == placed.crs_wkt
+
+
+def test_a_bad_argument_is_a_value_error():
+    """vola.InvalidArgument derives from ValueError too: `except ValueError` missed a bad voxel size."""
+    assert issubclass(vola.InvalidArgument, ValueError) and issubclass(vola.InvalidArgument, vola.Error)
+    with pytest.raises(ValueError, match="voxel_size"):
+        vola.build(np.zeros((3, 3)), voxel_size=-1)
