@@ -4,10 +4,10 @@
 // VLRs and EVLRs are copied but those of the input's compression (laszip, COPC), and a
 // LAZ output gets its own laszip VLR and chunk table.
 #include <algorithm>
-#include <optional>
-#include <filesystem>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <span>
 
 #include "las_format.hpp"
@@ -35,6 +35,18 @@ std::vector<std::uint8_t> read_bytes(std::ifstream& in, const std::string& path,
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(n));
   if (static_cast<std::uint64_t>(in.gcount()) != n) throw FormatError(path, offset, "cannot read " + std::to_string(n) + " bytes");
   return bytes;
+}
+
+// Bytes [offset, offset + n) of the input onto the output, in pieces of 8 MiB: waveform
+// records after the points run to gigabytes.
+void copy_bytes(std::ifstream& in, const std::string& path, std::uint64_t offset, std::uint64_t n, OutputFile& out) {
+  constexpr std::uint64_t kPiece = std::uint64_t{8} << 20;
+  for (std::uint64_t done = 0; done < n;) {
+    const std::uint64_t size = std::min(kPiece, n - done);
+    const auto piece = read_bytes(in, path, offset + done, size);
+    out.write(piece.data(), piece.size());
+    done += size;
+  }
 }
 
 // One VLR (54-byte header and data) as a LAS file holds it.
@@ -240,8 +252,7 @@ void translate_las(const std::string& input, const std::string& output,
       throw FormatError(input, 227, "the waveform data record's start " + std::to_string(waveform_at) +
                                         " lies outside the file's data (" + std::to_string(hd.offset_to_points) + ".." +
                                         std::to_string(file_size) + ")");
-    const auto bytes = read_bytes(in, input, waveform_at, file_size - waveform_at);
-    out.write(bytes.data(), bytes.size());
+    copy_bytes(in, input, waveform_at, file_size - waveform_at, out);
     waveform_moved_to = points_end;
   }
   // EVLRs (LAS 1.4): copied raw, 60-byte header and data, after the points.
@@ -249,10 +260,9 @@ void translate_las(const std::string& input, const std::string& output,
   std::uint64_t evlr_at = points_end;
   for (const LasVlr& v : hd.vlrs) {
     if (!v.extended || is_compression_record(v)) continue;
-    const auto bytes = read_bytes(in, input, v.offset - 60, 60 + v.length);
     if (waveform_at != 0 && v.offset - 60 == waveform_at) waveform_moved_to = evlr_at;
-    out.write(bytes.data(), bytes.size());
-    evlr_at += bytes.size();
+    copy_bytes(in, input, v.offset - 60, 60 + v.length, out);
+    evlr_at += 60 + v.length;
     ++evlr_count;
   }
   if (waveform_moved_to) {
