@@ -354,6 +354,15 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   bucketers.clear();
   summary.seconds_bucket = seconds_since(mark);
   share_statistics(stats, points_read.load(), outside);
+  // Inputs of points of which none is left (filters that keep none, a crop polygon in
+  // another CRS, no finite point) made an empty tile set, exit 0: refused, before the
+  // index replaces the previous one.
+  std::uint64_t offered = 0;
+  for (const PointSource* s : sources) offered += s->point_count();
+  if (tiles.empty() && offered > 0)
+    throw InvalidArgument("none of the inputs' " + std::to_string(offered) +
+                          " points is left to tile: the filters kept none (a crop polygon in another CRS than "
+                          "the points'?), or none has finite coordinates");
 }
 
 // 2. Every rank learns every tile's statistics (and so the list of tiles).

@@ -100,6 +100,14 @@ grep -q ": occupied$" "$tmp/get.txt" || fail "get: $(cat "$tmp/get.txt")"
 grep -q -- "--max-tiles: the 110000 points fall into 110000 tiles of 0.01" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
 [ -z "$(find "$tmp/tiny" -name '*.vol' 2> /dev/null)" ] || fail "tiles were written before the refusal"
 
+# Filters that keep no point (a crop polygon in longitude/latitude over a survey in feet)
+# wrote an empty tile set with exit 0.
+echo '{"type": "Polygon", "coordinates": [[[-123.0725, 44.05], [-123.07, 44.05], [-123.07, 44.0515], [-123.0725, 44.05]]]}' \
+  > "$tmp/lonlat.geojson"
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/none" --crop-polygon "$tmp/lonlat.geojson" 2> "$tmp/err.txt" \
+  && fail "an empty tile set was written"
+grep -q "none of the inputs' 110000 points is left to tile" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+
 # render: rays cross the tiles; the image has hits.
 "$vola" render "$index" --size 160x120 -o "$tmp/view.png" > "$tmp/render.txt"
 grep -Eq "^view.png|rays hit" "$tmp/render.txt" || fail "render: $(cat "$tmp/render.txt")"
