@@ -61,28 +61,14 @@ std::vector<double> world_points(const map::ScanEntry& scan, const std::string& 
   return std::move(input.cloud.xyz);
 }
 
-// A scan whose rays cross too many voxels is a mistake more often than a scan: points in
-// survey coordinates with a sensor pose near 0, or the voxel size in the wrong unit. Each
-// voxel crossed may become a known voxel of ~40 bytes (20,000 points 1 km from the sensor
-// at 5 cm: 4e8 voxel steps, 260 M free voxels, 9.8 GB and a minute), so such a scan is
-// refused before it is inserted, saying what the distances were.
+// Refuses a scan whose rays cross more than --max-ray-voxels (map::RayExtent says why:
+// 20,000 points 1 km from the sensor at 5 cm were 4e8 voxel steps, 260 M free voxels,
+// 9.8 GB and a minute), saying what the distances were.
 void check_ray_lengths(const MapArgs& a, const map::ScanEntry& scan, std::span<const double> xyz) {
   if (a.max_ray_voxels <= 0) return;
   const Point& o = scan.pose.translation;
-  double steps = 0.0, longest = 0.0, sum = 0.0;
-  std::uint64_t finite = 0;
-  for (std::size_t n = 0; n + 2 < xyz.size(); n += 3) {
-    const double dx = xyz[n] - o[0], dy = xyz[n + 1] - o[1], dz = xyz[n + 2] - o[2];
-    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    if (!std::isfinite(d)) continue;
-    ++finite;
-    sum += d;
-    longest = std::max(longest, d);
-    // A ray crosses at most |dx| + |dy| + |dz| voxel faces, fewer when --max-range cuts it.
-    const double scale = a.max_range > 0.0 && d > a.max_range ? a.max_range / d : 1.0;
-    steps += (std::abs(dx) + std::abs(dy) + std::abs(dz)) * scale / a.voxel_size;
-  }
-  if (steps <= a.max_ray_voxels) return;
+  const map::RayExtent e = map::ray_extent(xyz, o, a.voxel_size, a.max_range);
+  if (e.voxel_steps <= a.max_ray_voxels) return;
   char text[600];
   std::snprintf(text, sizeof text,
                 "%s: line %llu: %s: its rays cross up to %.3g voxels of %s, more than --max-ray-voxels %.3g (each may "
@@ -90,9 +76,8 @@ void check_ray_lengths(const MapArgs& a, const map::ScanEntry& scan, std::span<c
                 "(%.10g, %.10g, %.10g). Check that the pose's translation is the sensor's position in the points' "
                 "frame and the voxel size's unit; give --max-range, or a larger --max-ray-voxels for a scan that "
                 "is this large",
-                a.list.c_str(), static_cast<unsigned long long>(scan.line), scan.file.c_str(), steps,
-                shortest_text(a.voxel_size).c_str(), a.max_ray_voxels, finite ? sum / static_cast<double>(finite) : 0.0,
-                longest, o[0], o[1], o[2]);
+                a.list.c_str(), static_cast<unsigned long long>(scan.line), scan.file.c_str(), e.voxel_steps,
+                shortest_text(a.voxel_size).c_str(), a.max_ray_voxels, e.mean, e.longest, o[0], o[1], o[2]);
   throw InvalidArgument(text);
 }
 

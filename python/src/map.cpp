@@ -1,6 +1,7 @@
 // vola.Map (an occupancy map from range scans, as vola map builds it) and the state of
 // points in a loaded state map (vola.state, vola.probability).
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -61,6 +62,24 @@ std::shared_lock<std::shared_mutex> reading(const PyMap& self) {
   return std::shared_lock(*self.guard);
 }
 
+// map::RayExtent's guard, as `vola map --max-ray-voxels` applies it.
+void check_ray_extent(std::span<const double> xyz, const std::array<double, 3>& origin, const PyMap& self,
+                      double max_ray_voxels) {
+  if (!(max_ray_voxels >= 0.0)) throw InvalidArgument("max_ray_voxels must be >= 0 (0: no limit)");
+  if (max_ray_voxels == 0.0) return;
+  const map::RayExtent e = map::ray_extent(xyz, to_point(origin), self.map.voxel_size(), self.max_range);
+  if (e.voxel_steps <= max_ray_voxels) return;
+  char text[480];
+  std::snprintf(text, sizeof text,
+                "the scan's rays cross up to %.3g voxels of %.6g, more than max_ray_voxels %.3g (each may become a "
+                "known voxel of ~40 bytes): its points lie %.6g on average and up to %.6g from the origin (%.10g, "
+                "%.10g, %.10g). Check that origin is the sensor's position in the points' frame and the voxel "
+                "size's unit; give the Map a max_range, or a larger max_ray_voxels for a scan this large",
+                e.voxel_steps, self.map.voxel_size(), max_ray_voxels, e.mean, e.longest, origin[0], origin[1],
+                origin[2]);
+  throw InvalidArgument(text);
+}
+
 VoxelState map_state(const OccupancyMap& m, const Point& p) {
   const auto v = m.voxel_of(p);
   const auto value = v ? m.log_odds(*v) : std::nullopt;
@@ -101,20 +120,24 @@ void bind_map(py::module_& m) {
            })
       .def(
           "insert",
-          [](PyMap& self, const py::handle& points, const std::array<double, 3>& origin) {
+          [](PyMap& self, const py::handle& points, const std::array<double, 3>& origin, double max_ray_voxels) {
             const auto xyz = rows_of_three<double>(points, "points");
             const std::span<const double> values(xyz.data(), static_cast<std::size_t>(xyz.size()));
             map::ScanReport report;
             {
               py::gil_scoped_release release;
+              check_ray_extent(values, origin, self, max_ray_voxels);
               const std::unique_lock lock(*self.guard);
               report = self.map.insert_scan(values, to_point(origin), self.max_range);
             }
             return report_dict(report);
           },
-          py::arg("points"), py::arg("origin"),
+          py::arg("points"), py::arg("origin"), py::arg("max_ray_voxels") = 2e8,
           "One scan: points (N, 3) in world coordinates, each a ray from origin (the sensor). Returns the counts\n"
-          "of `vola map`'s summary (points, not_finite, outside, cut, hit_voxels, free_voxels).")
+          "of `vola map`'s summary (points, not_finite, outside, cut, hit_voxels, free_voxels).\n"
+          "A scan whose rays would cross more than max_ray_voxels voxels in all (each may become a known voxel\n"
+          "of ~40 bytes; 2e8 is about 8 GB) raises vola.InvalidArgument before any work, as `vola map\n"
+          "--max-ray-voxels` does: usually points and origin in different frames or units. 0: no limit.")
       .def("state",
            [](const PyMap& self, const py::handle& points) {
              const auto lock = reading(self);

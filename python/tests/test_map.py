@@ -39,6 +39,22 @@ def test_constants_and_states_of_a_hand_made_scan():
         m.insert(np.zeros((2, 2)), origin=(0, 0, 0))
 
 
+def test_a_scan_in_another_frame_is_refused_before_any_work():
+    # Points 1 km from an origin at 0 with 5 cm voxels: 20,000 rays of 20,000+ voxels each.
+    m = vola.Map(0.05)
+    far = np.column_stack([np.full(20000, 1000.0), np.linspace(0, 10, 20000), np.zeros(20000)])
+    with pytest.raises(vola.InvalidArgument, match="max_ray_voxels"):
+        m.insert(far, origin=(0, 0, 0))
+    assert len(m) == 0
+    # The same rays cut by the map's max_range, or a scan within the limit, are inserted.
+    assert vola.Map(0.05, max_range=5.0).insert(far, origin=(0, 0, 0))["cut"] == 20000
+    assert m.insert(far[::2000], origin=(0, 0, 0))["hit_voxels"] == 10
+    with pytest.raises(vola.InvalidArgument, match="max_ray_voxels"):
+        m.insert(far[::2000], origin=(0, 0, 0), max_ray_voxels=1000)
+    with pytest.raises(vola.InvalidArgument):
+        m.insert(far[::2000], origin=(0, 0, 0), max_ray_voxels=-1)
+
+
 def test_a_saved_map_answers_as_the_map(tmp_path: pathlib.Path):
     m = vola.Map(0.25, max_range=2.5)
     for points, origin in _scans(3):

@@ -269,6 +269,24 @@ std::size_t OccupancyMap::memory_bytes() const noexcept {
          pages_.size() * (sizeof(Block) << kPageBits);
 }
 
+RayExtent ray_extent(std::span<const double> xyz, const Point& origin, double voxel_size, double max_range) {
+  RayExtent e;
+  double sum = 0.0;
+  for (std::size_t n = 0; n + 2 < xyz.size(); n += 3) {
+    const double dx = xyz[n] - origin[0], dy = xyz[n + 1] - origin[1], dz = xyz[n + 2] - origin[2];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (!std::isfinite(d)) continue;
+    ++e.finite;
+    sum += d;
+    e.longest = std::max(e.longest, d);
+    // A ray crosses at most |dx| + |dy| + |dz| voxel faces, fewer when max_range cuts it.
+    const double scale = max_range > 0.0 && d > max_range ? max_range / d : 1.0;
+    e.voxel_steps += (std::abs(dx) + std::abs(dy) + std::abs(dz)) * scale / voxel_size;
+  }
+  e.mean = e.finite ? sum / static_cast<double>(e.finite) : 0.0;
+  return e;
+}
+
 ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& origin, double max_range,
                                      unsigned threads) {
   if (!voxel_of(origin))

@@ -92,6 +92,20 @@ struct ScanReport {
   std::uint64_t free_voxels = 0;   // voxels updated as free
 };
 
+// How far a scan's rays reach, before it is inserted: a scan whose rays cross far more
+// voxels than expected is a mistake more often than a scan (points in survey coordinates
+// with a sensor pose near 0, or the voxel size in the wrong unit), and each voxel crossed
+// may become a known voxel of ~40 bytes, so callers refuse it up front (`vola map
+// --max-ray-voxels`, Python `Map.insert(..., max_ray_voxels=)`).
+struct RayExtent {
+  double voxel_steps = 0.0;   // at most this many voxels crossed in all (|dx|+|dy|+|dz| / R per ray)
+  double longest = 0.0;       // the farthest point's distance from the sensor
+  double mean = 0.0;          // the points' mean distance from the sensor
+  std::uint64_t finite = 0;   // points with finite coordinates (the others are skipped)
+};
+// max_range > 0 cuts each ray at it, as insert_scan does.
+RayExtent ray_extent(std::span<const double> xyz, const Point& origin, double voxel_size, double max_range);
+
 class OccupancyMap {
  public:
   // Throws OptionError ("voxel_size") unless voxel_size is finite and > 0.
