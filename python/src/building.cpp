@@ -173,7 +173,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   options.compress_max = compress_max;
   py::gil_scoped_release release;
   return with_python_names([&] {
-    Tree tree = vola::convert(path.string(), options);
+    Tree tree = vola::convert(path.string(), options, interruptible());
     if (output) {
       vola::write(tree, output->string(), vola::write_options_of(options));
     }

@@ -25,7 +25,7 @@ template <Tree (*Op)(const Tree&, int, vola::analysis::Element, const vola::anal
 Tree morph(const Tree& tree, int radius, const std::string& element) {
   const auto kind = element_of(element);
   py::gil_scoped_release release;
-  return Op(tree, radius, kind, {});
+  return Op(tree, radius, kind, interruptible());
 }
 
 py::tuple fill(const Tree& tree) {

@@ -11,6 +11,10 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -162,6 +166,25 @@ auto with_python_names(Body&& body) {
   }
 }
 
+
+// Ctrl-C during a long call. Long calls run without the GIL, and Python acts on a signal
+// only between the main thread's bytecodes, so a KeyboardInterrupt used to wait for the
+// whole call (minutes for a large conversion or dilation). Those calls take interruptible()
+// as their progress callback: at most every 50 ms it takes the GIL and lets Python run
+// its pending signal handlers (PyErr_CheckSignals: on the main thread only, as Python
+// itself does); when a handler raises, it throws error_already_set, which unwinds the
+// library's work (output temporaries removed, as for any error) and reaches the caller as
+// the handler's exception, KeyboardInterrupt for Ctrl-C.
+inline std::function<void(std::uint64_t, std::uint64_t)> interruptible() {
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  return [last](std::uint64_t, std::uint64_t) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - *last < std::chrono::milliseconds(50)) return;
+    *last = now;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  };
+}
 
 // Each part of the module adds its functions and classes.
 void bind_building(py::module_& m);

@@ -28,6 +28,9 @@ py::dict make_tiles(const std::vector<std::filesystem::path>& paths, const std::
   if (spill_dir) options.spill_dir = spill_dir->string();
   options.memory_budget = memory_budget;
   options.threads = threads;
+  options.progress = [check = interruptible()](const std::string&, std::uint64_t done, std::uint64_t total) {
+    check(done, total);
+  };
   options.overviews = overviews;
   options.attributes = attributes;
   vola::tile::TileInputs inputs;
