@@ -84,19 +84,22 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
     throw InvalidArgument(a.sequence + ": the frames made no surface: no depth was measured within --min-depth.."
                           "--max-depth at --depth-factor " + shortest_text(a.depth_factor) +
                           " stored units per metre (the warnings above say which frames); nothing written");
-  const Tree tree = slam::surface_tree(surface, store.geometry(), result.coloured);
+  slam::VolumeGeometry world = store.geometry();
+  world.origin += result.origin;
+  const Tree tree = slam::surface_tree(surface, world, result.coloured);
   if (!a.output.empty()) write(tree, a.output);
   std::size_t triangles = 0;
   if (!a.mesh.empty()) {
     const slam::Mesh mesh = slam::marching_cubes(store);
-    slam::write_ply(a.mesh, mesh, result.coloured);
+    slam::write_ply(a.mesh, mesh, result.coloured, result.origin);
     triangles = mesh.triangles.size();
   }
   if (!a.render.empty()) {
     slam::Pose view = result.trajectory.at(std::min(a.render_frame, result.trajectory.size()) - 1).pose;
     if (!a.render_pose.empty()) view = pose_from(a.render_pose);
-    slam::write_rgb_png(a.render, slam::render_view(store, options.intrinsics, result.width, result.height, view,
-                                                    options.params, result.coloured));
+    slam::write_rgb_png(a.render, slam::render_view(store, options.intrinsics, result.width, result.height,
+                                                    slam::to_local(view, result.origin), options.params,
+                                                    result.coloured));
   }
   if (a.quiet) return;
   const auto frames = result.trajectory.size();
@@ -169,8 +172,8 @@ void run_fuse(const FuseArgs& a) {
   if ((a.groundtruth_poses || a.start_at_groundtruth) && sequence.groundtruth.empty())
     throw InvalidArgument(a.sequence + ": no ground truth (groundtruth.txt or pose.txt) for --groundtruth-poses / --start-at-groundtruth");
 
-  const slam::Pose start = slam::first_pose(sequence, options);
-  const slam::VolumeGeometry geometry = slam::centred_geometry(start.translation(), p.voxel_size, a.bricks);
+  // In the local frame of slam::fuse_origin (the first frame at its centre); the outputs go back to the world.
+  const slam::VolumeGeometry geometry = slam::centred_geometry(Eigen::Vector3d::Zero(), p.voxel_size, a.bricks);
   if (a.dense) {
     const double bytes = std::pow(static_cast<double>(a.bricks), 3) * slam::kBrickVoxels * sizeof(slam::TsdfVoxel);
     if (bytes > 64.0 * (1ull << 30)) throw InvalidArgument("--dense: a grid of --bricks " + std::to_string(a.bricks) + " needs more than 64 GiB");
@@ -204,7 +207,9 @@ void add_fuse(CLI::App& app) {
       "(a wrong --depth-factor) or when most of it lies outside --min-depth..--max-depth.\n"
       "Outputs: the trajectory \"timestamp tx ty tz qx qy qz qw\" (camera to world; the first frame at the\n"
       "origin unless --start-at-groundtruth), the surface voxels as .vol (red/green/blue columns when colour\n"
-      "frames exist), a marching-cubes mesh (PLY) and a rendered view (PNG).\n"
+      "frames exist), a marching-cubes mesh (PLY) and a rendered view (PNG). Ground truth in survey\n"
+      "coordinates (UTM's millions of metres) is fine: tracking works relative to the first frame, and\n"
+      "the mesh's vertices are then written as doubles.\n"
       "Examples:\n"
       "  vola rgbd-generate room --frames 300 && vola fuse room -o map.vol --trajectory est.txt --mesh map.ply --render view.png\n"
       "  vola fuse icl_frames --intrinsics 481.2 -480 319.5 239.5 --groundtruth-poses -o map.vol --render view.png");

@@ -26,6 +26,20 @@ Pose first_pose(const Sequence& sequence, const FuseOptions& options) {
   throw InvalidArgument("the sequence has no ground-truth pose for any frame");
 }
 
+Eigen::Vector3d fuse_origin(const Sequence& sequence, const FuseOptions& options) {
+  return first_pose(sequence, options).translation();
+}
+
+Pose to_local(Pose pose, const Eigen::Vector3d& origin) {
+  pose.translation() -= origin;
+  return pose;
+}
+
+Pose to_world(Pose pose, const Eigen::Vector3d& origin) {
+  pose.translation() += origin;
+  return pose;
+}
+
 VolumeGeometry centred_geometry(const Eigen::Vector3d& centre, double voxel_size, std::uint32_t bricks_per_side) {
   VolumeGeometry g;
   g.voxel_size = voxel_size;
@@ -65,17 +79,26 @@ std::optional<std::string> depth_unit_warning(const DepthImage& depth, const std
   return std::nullopt;
 }
 
+namespace {
+
+// fuse_sequence in the local frame of result.origin: every pose here, the trajectory's
+// included, is local.
 template <class Store>
-FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, Store& store,
-                         const std::function<void(std::size_t, std::size_t, const FrameResult&)>& progress) {
+FuseResult fuse_locally(const Sequence& sequence, const FuseOptions& options, Store& store,
+                        const std::function<void(std::size_t, std::size_t, const FrameResult&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t total =
       options.max_frames ? std::min(options.max_frames, sequence.frames.size()) : sequence.frames.size();
   if (total == 0) throw InvalidArgument("the sequence has no frames");
   std::vector<std::optional<Pose>> truth;
-  if (options.groundtruth_poses) truth = groundtruth_per_frame(sequence, options.max_difference);
-  const Pose initial = first_pose(sequence, options);
   FuseResult result;
+  result.origin = fuse_origin(sequence, options);
+  if (options.groundtruth_poses) {
+    truth = groundtruth_per_frame(sequence, options.max_difference);
+    for (auto& pose : truth)
+      if (pose) pose = to_local(*pose, result.origin);
+  }
+  const Pose initial = to_local(first_pose(sequence, options), result.origin);
   const auto read_colour = [&](const SequenceFrame& frame, const DepthImage& depth) -> std::optional<RgbImage> {
     if (!options.use_colour || frame.rgb_path.empty()) return std::nullopt;
     RgbImage rgb = read_rgb_png(frame.rgb_path);
@@ -194,6 +217,16 @@ FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, S
     }
     result.reintegration_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - again_start).count();
   }
+  return result;
+}
+
+}  // namespace
+
+template <class Store>
+FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, Store& store,
+                         const std::function<void(std::size_t, std::size_t, const FrameResult&)>& progress) {
+  FuseResult result = fuse_locally(sequence, options, store, progress);
+  for (StampedPose& p : result.trajectory) p.pose = to_world(p.pose, result.origin);
   return result;
 }
 

@@ -210,15 +210,23 @@ Mesh marching_cubes(const Store& store) {
   return mesh;
 }
 
-void write_ply(const std::string& path, const Mesh& mesh, bool with_colour) {
+void write_ply(const std::string& path, const Mesh& mesh, bool with_colour, const Eigen::Vector3d& origin) {
+  const bool shifted = origin != Eigen::Vector3d::Zero();
+  const char* type = shifted ? "double" : "float";
   OutputStream out(path);
   out << "ply\nformat binary_little_endian 1.0\ncomment vola fuse: marching cubes of the TSDF\nelement vertex "
-      << mesh.vertices.size() << "\nproperty float x\nproperty float y\nproperty float z\n";
+      << mesh.vertices.size() << "\nproperty " << type << " x\nproperty " << type << " y\nproperty " << type << " z\n";
   if (with_colour) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   out << "element face " << mesh.triangles.size() << "\nproperty list uchar uint vertex_indices\nend_header\n";
   static_assert(std::endian::native == std::endian::little, "PLY writer assumes a little-endian host");
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    out.write(reinterpret_cast<const char*>(mesh.vertices[i].data()), 12);
+    if (shifted) {
+      const std::array<double, 3> world{origin[0] + mesh.vertices[i][0], origin[1] + mesh.vertices[i][1],
+                                        origin[2] + mesh.vertices[i][2]};
+      out.write(reinterpret_cast<const char*>(world.data()), 24);
+    } else {
+      out.write(reinterpret_cast<const char*>(mesh.vertices[i].data()), 12);
+    }
     if (with_colour) out.write(reinterpret_cast<const char*>(mesh.colours[i].data()), 3);
   }
   for (const auto& t : mesh.triangles) {

@@ -25,14 +25,14 @@ TEST(SlamRealFrames, IclNuimFusesIntoARoomAtItsPoses) {
   o.params.max_depth = 6.0;
   o.params.threads = 2;
   o.groundtruth_poses = true;
-  SparseTsdfStore store(centred_geometry(s.groundtruth[0].pose.translation(), o.params.voxel_size, 1024));
+  SparseTsdfStore store(centred_geometry(Eigen::Vector3d::Zero(), o.params.voxel_size, 1024));
   const FuseResult r = fuse_sequence(s, o, store);
   ASSERT_EQ(r.trajectory.size(), 5u);
   EXPECT_TRUE(r.coloured);
   const auto surface = surface_voxels(store);
   EXPECT_GT(surface.size(), 20000u);
   // Seen from the first pose, the fused map covers most of the first frame's view.
-  const RgbImage view = render_view(store, o.intrinsics, r.width, r.height, r.trajectory[0].pose, o.params, true);
+  const RgbImage view = render_view(store, o.intrinsics, r.width, r.height, to_local(r.trajectory[0].pose, r.origin), o.params, true);
   std::size_t lit = 0;
   for (std::size_t i = 0; i < view.rgb.size(); i += 3) lit += view.rgb[i] | view.rgb[i + 1] | view.rgb[i + 2] ? 1 : 0;
   EXPECT_GT(lit, std::size_t{640} * 480 * 8 / 10);

@@ -23,7 +23,8 @@ struct FuseOptions {
 };
 
 struct FuseResult {
-  std::vector<StampedPose> trajectory;  // one pose per processed frame
+  std::vector<StampedPose> trajectory;  // one pose per processed frame, in world coordinates
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // fuse_origin(): where the store's frame lies in the world
   std::size_t lost = 0;                 // frames whose tracking failed (kept the previous pose)
   std::size_t wide_baseline = 0;        // frames tracked by ICP from a colour-feature pose (large motion)
   std::size_t relocalised = 0;          // frames placed after a loss (the next frame, or the lost one later)
@@ -71,9 +72,23 @@ std::vector<std::optional<Pose>> groundtruth_per_frame(const Sequence& sequence,
 // The pose of the first frame under `options` (identity unless it starts at ground truth).
 Pose first_pose(const Sequence& sequence, const FuseOptions& options);
 
+// The world point the fusion's frame is placed at: the first frame's ground-truth position
+// when ground truth places the frames (start_at_groundtruth, groundtruth_poses), else 0.
+// Tracking and fusion compute in single precision, which keeps about half a metre at
+// survey coordinates such as UTM's millions of metres (a sequence placed there tracked
+// 170 times worse), so they work relative to this point: the store's geometry is in that
+// local frame (centred_geometry(zero, ...) puts the first frame at its centre), and
+// FuseResult::trajectory comes back in world coordinates.
+Eigen::Vector3d fuse_origin(const Sequence& sequence, const FuseOptions& options);
+
+// A world pose in the frame whose origin is `origin` (to_local), and back (to_world).
+Pose to_local(Pose pose, const Eigen::Vector3d& origin);
+Pose to_world(Pose pose, const Eigen::Vector3d& origin);
+
 // A volume of bricks_per_side bricks whose centre is at `centre`.
 VolumeGeometry centred_geometry(const Eigen::Vector3d& centre, double voxel_size, std::uint32_t bricks_per_side);
 
+// The store's geometry is in the local frame of fuse_origin() (see there).
 // progress(frames done, frames total, last frame's result).
 template <class Store>
 FuseResult fuse_sequence(const Sequence& sequence, const FuseOptions& options, Store& store,

@@ -45,8 +45,11 @@ Mesh marching_cubes(const Store& store);
 const std::vector<std::vector<std::array<int, 3>>>& marching_cubes_table();
 extern const std::array<std::array<int, 2>, 12> kEdgeCorners;
 
-// Binary little-endian PLY; colours written when with_colour. Throws IoError.
-void write_ply(const std::string& path, const Mesh& mesh, bool with_colour);
+// Binary little-endian PLY; colours written when with_colour. The vertices are moved by
+// `origin` (the map's place in the world, FuseResult::origin) and written as doubles when
+// it is not 0: floats keep only about half a metre at survey coordinates. Throws IoError.
+void write_ply(const std::string& path, const Mesh& mesh, bool with_colour,
+               const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 
 struct MapMemory {
   std::size_t sparse_bytes = 0;     // the sparse store as it is
