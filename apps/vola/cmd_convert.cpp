@@ -116,7 +116,7 @@ void add_convert(CLI::App& app) {
       "           input and options the output is byte-identical to the reference's.\n"
       "Maps (OctoMap .bt/.ot through liboctomap, OpenVDB .vdb through OpenVDB):\n"
       "  the occupied cells (.bt/.ot: occupied leaves, pruned nodes expanded; .vdb: the active\n"
-      "  voxels of the first grid or --grid NAME) become voxels cell for cell at the file's own\n"
+      "  voxels of --grid NAME, else of the only grid) become voxels cell for cell at the file's own\n"
       "  voxel size (--voxel-size must equal it), the grid origin on the file's cells; .ot\n"
       "  log-odds and .vdb float/double/int32 values become a column (log_odds, or the grid's\n"
       "  name). Rotated, sheared or non-uniform .vdb transforms are refused.\n"
@@ -150,7 +150,7 @@ void add_convert(CLI::App& app) {
                   "--voxel-size, --origin and --bbox");
   cmd->add_option("--level", args->options.level,
                   "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
-  cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the file's first)");
+  cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the only grid, or vola's own occupied grid of a map it wrote; several others are refused, listed)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1 (default: found by name in a header line such as "

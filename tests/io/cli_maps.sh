@@ -71,6 +71,9 @@ grep -q "(.ot, log-odds from the log_odds columns) of .* nodes: 2 occupied and 7
 "$vola" voxels "$tmp/map_back.vol" --attributes --header | head -1 | grep -q "log_odds" || fail "map.ot lost the log-odds"
 "$vola" export "$tmp/map.vol" "$tmp/map.vdb" >"$tmp/out" || fail "export map.vdb"
 grep -q "^OpenVDB grids log_odds free_log_odds: 2 occupied and 7 free" "$tmp/out" || fail "map.vdb summary: $(cat "$tmp/out")"
+"$vola" convert "$tmp/map.vdb" "$tmp/vdb_back.vol" -q || fail "convert map.vdb"
+"$vola" coords "$tmp/vdb_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.vol" | sort) ||
+  fail "map.vdb round trip: not the occupied voxels (free_log_odds sorts before log_odds)"
 "$vola" convert "$tmp/map.vdb" "$tmp/free_back.vol" --grid free_log_odds -q || fail "convert map.vdb --grid free_log_odds"
 "$vola" coords "$tmp/free_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.free.vol" | sort) ||
   fail "map.vdb: the free voxels differ"

@@ -104,6 +104,10 @@ TEST(VdbExport, LogOddsAndFreeVoxelsGoToFloatGrids) {
   EXPECT_EQ(miss_cells.size(), map.free.size());
   for (const auto& [cell, value] : map.occupied) EXPECT_EQ(hit_cells.at(cell), value);
   for (const auto& [cell, value] : map.free) EXPECT_EQ(miss_cells.at(cell), value);
+  // Read back without naming a grid: the occupied one, though "free_log_odds" sorts first.
+  const vola::Tree back = vola::convert((dir / "s.vdb").string(), {});
+  EXPECT_EQ(back.voxel_count(), map.occupied.size());
+  ASSERT_TRUE(back.attributes().find("log_odds"));
 }
 
 // Voxels one per 128^3 block: each costs OpenVDB an internal node of 33 KiB, 4.7 GB in all.
@@ -167,6 +171,17 @@ TEST(VdbImport, AFileWrittenByOpenvdbReadsCellForCell) {
   openvdb::io::File((dir / "fields.vdb").string()).write({density, mask});
 
   vola::ConvertOptions options;
+  // Two grids of its own: which one is wanted is the user's to say (OpenVDB lists grids by
+  // name, so "the first" would be the first name, not the first written).
+  try {
+    vola::convert((dir / "fields.vdb").string(), options);
+    ADD_FAILURE() << "one of two grids was picked";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds 2 grids ('density', 'mask'): choose one with --grid NAME"),
+              std::string::npos)
+        << e.what();
+  }
+  options.grid = "density";
   const vola::Tree tree = vola::convert((dir / "fields.vdb").string(), options);
   ASSERT_EQ(tree.voxel_count(), expected.size());
   EXPECT_DOUBLE_EQ(tree.frame().voxel_size, size);

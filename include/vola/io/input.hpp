@@ -26,7 +26,7 @@ struct InputOptions {
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
   std::optional<int> copc_level;   // COPC: only the octree's levels 0..copc_level
-  std::string grid;                // OpenVDB: the grid to read (empty: the file's first)
+  std::string grid;                // OpenVDB: the grid to read (empty: the only one, or vola's own occupied grid)
 };
 
 // Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <type_traits>
 
 #include "../reader_plugin.hpp"
@@ -172,6 +174,18 @@ void collect_active(const GridT& grid, bool keep_values, const std::string& path
   if (numeric && keep_values) out.attributes.push_back(std::move(column));
 }
 
+// The grid read when none is named: the only one, or the occupied grid of a map vola
+// wrote ("log_odds", else "occupied"; its free grid sorts before it); none when the file
+// holds several others. OpenVDB lists grids by name, so "the first" would be the first
+// name, not the first written: refusing is clearer than guessing.
+std::optional<std::string> default_grid(const openvdb::GridPtrVec& grids) {
+  if (grids.size() == 1) return grids.front()->getName();
+  for (const char* own : {"log_odds", "occupied"})
+    for (const auto& g : grids)
+      if (g->getName() == own) return own;
+  return std::nullopt;
+}
+
 }  // namespace
 
 VoxelGrid read_vdb_with_openvdb(const std::string& path, const std::string& name, bool attributes) {
@@ -181,14 +195,17 @@ VoxelGrid read_vdb_with_openvdb(const std::string& path, const std::string& name
   try {
     openvdb::io::File file(path);
     file.open(false);  // no delayed loading: a damaged file fails here, not halfway through the voxels
-    const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();  // in file order
+    const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();  // by name, not in file order
     if (!grids || grids->empty()) throw FormatError(path, std::nullopt, "holds no grid");
-    std::string chosen = name.empty() ? grids->front()->getName() : name;
-    if (!file.hasGrid(chosen)) {
-      std::string names;
-      for (const auto& g : *grids) names += (names.empty() ? "'" : ", '") + g->getName() + "'";
+    std::string names;
+    for (const auto& g : *grids) names += (names.empty() ? "'" : ", '") + g->getName() + "'";
+    const std::optional<std::string> found = name.empty() ? default_grid(*grids) : name;
+    if (!found)
+      throw FormatError(path, std::nullopt,
+                        "holds " + std::to_string(grids->size()) + " grids (" + names + "): choose one with --grid NAME");
+    const std::string& chosen = *found;
+    if (!file.hasGrid(chosen))
       throw FormatError(path, std::nullopt, "has no grid named '" + chosen + "' (its grids: " + names + ")");
-    }
     // The count OpenVDB's writer records, checked before the grid's voxels are read.
     const openvdb::GridBase::Ptr meta = file.readGridMetadata(chosen);
     if (const auto recorded = meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
