@@ -16,7 +16,7 @@ import vola
 
 las_path, png_path = sys.argv[1], sys.argv[2]
 
-# 1. Convert: any input `vola convert` reads. 2 m voxels on a grid in the survey's CRS.
+# 1. Convert: any input `vola convert` reads. 2-unit voxels on a grid in the survey's CRS (Autzen's unit is the foot: 2 ft).
 tree = vola.convert(las_path, voxel_size=2.0)
 print(tree)
 crs = vola.describe_crs(tree.crs_wkt) if tree.crs_wkt else {"name": "unknown", "unit": "unit"}
