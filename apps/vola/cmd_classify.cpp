@@ -303,7 +303,7 @@ void add_classify(CLI::App& app) {
   evaluate->footer(std::string(kModelFooter) +
                    "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
                    "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
-                   "with the lines `mean per-class accuracy: 0.xxxx` and `accuracy: 0.xxxx`.\n"
+                   "with the lines `mean per-class accuracy: 0.xxxx (N classes)` and `accuracy: 0.xxxx`.\n"
                    "With --segment each scene's object is found first (see `vola classify --help`); scenes where none\n"
                    "is found count as wrong and are said.\n"
                    "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"

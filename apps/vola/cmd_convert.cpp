@@ -170,7 +170,7 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");
   add_filter_options(*cmd, args->options.filters);
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_convert(*args); });
 }
 

@@ -233,7 +233,7 @@ void add_export(CLI::App& app) {
       "grid of the first K levels (4^K voxels per axis), e.g. to fit a dense format.\n"
       "Examples:\n"
       "  vola export city.vol city.ply\n"
-      "  vola export city.vol city_mesh.ply --cubes --depth 6\n"
+      "  vola export city.vol city_mesh.ply --cubes --depth 4\n"
       "  vola export city.vol city.las\n"
       "  vola export city.vol grid.npy --depth 4\n"
       "  vola export city.vol slices --slices --depth 4\n"
@@ -267,7 +267,7 @@ void add_export(CLI::App& app) {
       ->each([args](const std::string&) { args->resolution_given = true; });
   cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb) from a plain tree: a .vol of the free voxels on the same grid (a state map from vola map holds its own)")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_export(*args); });
 }
 

@@ -31,7 +31,10 @@ void run_generate(const GenerateArgs& a) {
   Progress progress("generating " + a.output);
   std::uint64_t done = 0;
   TextOutput out(file.stream(), a.output);
-  out.text("# x y z intensity classification (ASPRS: 2 ground, 5 vegetation, 6 building); vola generate city\n");
+  // The names on a line of their own, so that readers take it for the header (a line with
+  // numbers in it is a comment).
+  out.text("# vola generate city; classification as ASPRS: 2 ground, 5 vegetation, 6 building\n");
+  out.text("# x y z intensity classification\n");
   synth::generate_city(o, [&](const synth::CityPoint& p) {
     // Millimetre precision, as a LIDAR survey delivers.
     out.number(std::round(p.x * 1000.0) / 1000.0).ch(' ').number(std::round(p.y * 1000.0) / 1000.0).ch(' ');
@@ -51,7 +54,9 @@ void add_generate(CLI::App& app) {
   auto* cmd = app.add_subcommand("generate", "Write a generated scene as XYZ text (the project's own demo data)");
   cmd->footer(
       "city: ground, box buildings and trees over SIZE x SIZE metres at UTM-like coordinates\n"
-      "(easting 500000, northing 5000000), columns x y z intensity classification.\n"
+      "(easting 500000, northing 5000000), columns x y z intensity classification, named in a\n"
+      "header line (vola convert keeps both per voxel, as doubles: intensity mean, classification majority;\n"
+      "--attribute gives them narrower types).\n"
       "Example: vola generate city city.xyz --points 2000000 && vola convert city.xyz city.vol --voxel-size 0.25 \\\n"
       "           --attribute intensity=4:u16:mean --attribute classification=5:u8:majority");
   cmd->add_option("scene", args->scene, "Scene: city")->required();

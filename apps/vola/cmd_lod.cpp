@@ -39,7 +39,7 @@ void add_lod(CLI::App& app) {
   cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("--depth", args->depth, "Depth of the copy, 1..depth of the input")->required()->check(CLI::Range(1, 10));
   cmd->add_option("output", args->output, "Output .vol")->required();
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_lod(*args); });
 }
 

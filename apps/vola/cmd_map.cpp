@@ -211,7 +211,7 @@ void add_map(CLI::App& app) {
       ->capture_default_str()
       ->check(non_negative_number());
   cmd->add_flag("--free", args->free, "Also write the free voxels to MAP.free.vol as a plain tree");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_map(*args); });
 }
 

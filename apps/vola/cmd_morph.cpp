@@ -36,7 +36,7 @@ CLI::App* add_io(CLI::App& app, const char* name, const char* help, const std::s
   auto* cmd = app.add_subcommand(name, help);
   cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol")->required();
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   return cmd;
 }
 

@@ -73,7 +73,7 @@ void add_pipeline(CLI::App& app) {
       "   \"ground.laz\", {\"type\": \"writers.vola\", \"filename\": \"ground.vol\", \"voxel_size\": 3}]\n"
       "  vola pipeline ground.json");
   cmd->add_option("file", args->file, "The pipeline's JSON file")->required()->check(CLI::ExistingFile);
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_pipeline_command(*args); });
 }
 

@@ -256,7 +256,7 @@ void add_plan(CLI::App& app) {
   cmd->add_option("--unknown", args->unknown,
                   "State maps: is unknown space occupied (the default there) or free (optimistic)?")
       ->check(CLI::IsMember({"occupied", "free"}));
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_plan(*args); });
 }
 

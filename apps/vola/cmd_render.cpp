@@ -151,7 +151,7 @@ void add_render(CLI::App& app) {
       "Examples:\n"
       "  vola render city.vol -o city.png                         (a default view from above a corner)\n"
       "  vola render city.vol --camera 100 -50 80 512 512 0 --size 1280x720 -o view.png\n"
-      "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o frames/orbit.png\n"
+      "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o orbit.png  (orbit_0000.png ...)\n"
       "  vola render tiles/index.geojson --size 1024x768 -o survey.png");
   cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--camera", args->camera, "Eye X Y Z then look-at X Y Z (default: a view of the whole scene)")
@@ -164,7 +164,7 @@ void add_render(CLI::App& app) {
   cmd->add_option("--orbit", args->orbit, "Write N frames turning the eye around the look-at point (OUT_0000.png ...)");
   cmd->add_option("--threads", args->threads, "Threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--grid", args->grid, "--camera is in voxel-grid coordinates, not world coordinates");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_render(*args); });
 }
 

@@ -49,7 +49,7 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   cmd->add_option("b", args->b, "Second .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol")->required();
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args, op, name] {
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);
@@ -77,7 +77,7 @@ void add_diff(CLI::App& app) {
   cmd->add_option("output", args->output, "Output .vol: A - B");
   cmd->add_option("--outputs", args->outputs_dir, "Write added.vol, removed.vol and unchanged.vol into this folder");
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] {
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);

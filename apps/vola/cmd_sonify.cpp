@@ -418,7 +418,7 @@ void add_sonify(CLI::App& app) {
   cmd->add_flag("--no-normalize", args->no_normalize,
                 "Keep the physical level (1 = the dry level at 1 m) instead of peaking at -1 dBFS");
   cmd->add_option("--threads", args->response.threads, "Threads (0 = all cores)")->capture_default_str();
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_sonify(*args); });
 }
 

@@ -194,7 +194,7 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--chunk-points", args->chunk_points,
                   "LAS points per work unit (default: 2^20, or fewer with attributes when --memory is small)")
       ->check(positive_number());
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_tile(*args); });
 }
 

@@ -95,7 +95,7 @@ void add_translate(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .las, .laz, .ply or .xyz")->required();
   add_filter_options(*cmd, args->filters);
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_translate(*args); });
 }
 

@@ -130,7 +130,8 @@ ResolvedCrs resolve_crs(std::span<const StatedCrs> inputs, const std::string& gi
     if (!same_meaning(*first, first_epsg, s, epsg))
       throw InvalidArgument("inputs disagree on the CRS: " + first->source + " says " + described(*first, first_epsg) +
                             ", " + s.source + " says " + described(s, epsg) +
-                            " (convert them separately, or name one CRS if they really are the same)");
+                            " (reproject them into one with --target-crs CRS, convert them separately, or name one CRS with "
+                            "--assign-crs if they really are the same)");
   }
   if (!first) return out;
   out.epsg = first_epsg;

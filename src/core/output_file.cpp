@@ -162,7 +162,13 @@ OutputFile::OutputFile(std::string path) {
       const int e = errno;
       release_slot(slot_);
       slot_ = -1;
-      VOLA_THROW(IoError(path_ + ": cannot create " + temporary_ + ": " + std::strerror(e)));
+      // The temporary's name is ours, not the user's: say what they can act on.
+      const std::string folder = directory_of(path_);
+      struct stat place {};
+      if (::stat(folder.c_str(), &place) != 0 || !S_ISDIR(place.st_mode))
+        VOLA_THROW(IoError(path_ + ": cannot create it: the folder " + folder + " does not exist"));
+      VOLA_THROW(IoError(path_ + ": cannot create it (nor a temporary beside it in " + folder +
+                         "): " + std::strerror(e)));
     }
   }
   // A replaced file keeps its permissions (the temporary has the umask's).

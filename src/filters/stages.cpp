@@ -15,7 +15,10 @@ namespace vola::filters {
 
 namespace {
 
+// A `where` stage came from --where (its expression is what the user typed); the others
+// from --filter.
 [[noreturn]] void refuse(const std::string& spec, const std::string& cause) {
+  if (spec.starts_with("where:")) throw OptionError("where", "'" + spec.substr(6) + "': " + cause);
   throw OptionError("filters", "'" + spec + "': " + cause);
 }
 

@@ -471,7 +471,8 @@ TEST(Stages, ParseTheirStringsAndRefuseUnknownOnes) {
   EXPECT_EQ(message("ground"), "filters: 'ground': no filter 'ground' (where:EXPR, smrf, hag, outlier, voxel:R, "
                                "poisson:R, crop:..., polygon:FILE)");
   EXPECT_EQ(message("smrf:cells=2"), "filters: 'smrf:cells=2': smrf has no parameter 'cells' (cell, slope, window, threshold, scalar)");
-  EXPECT_EQ(message("where:z >"), "filters: 'where:z >': where: at character 4: expected a dimension name or a number, found the end");
+  // A where stage came from --where: its error names that option and the expression alone.
+  EXPECT_EQ(message("where:z >"), "where: 'z >': where: at character 4: expected a dimension name or a number, found the end");
   EXPECT_EQ(message("crop:1,2,3"), "filters: 'crop:1,2,3': crop takes MINX,MINY,MAXX,MAXY or MINX,MINY,MINZ,MAXX,MAXY,MAXZ");
   // A parameter's own check names it inside the stage (the CLI shows "filters" as --filter),
   // not as a flag of its own ("--cell" is no option of any command).
