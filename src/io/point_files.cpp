@@ -187,11 +187,19 @@ void write_ply_points(const PointCloud& cloud, const std::string& path) {
   out.commit();
 }
 
+// `digits` decimals (the file's own precision), or the shortest text that reads back as v
+// when there are none or v is too large for fixed notation in 64 characters (a LAS offset
+// of 1e62 made one; the shortest text of a double always fits).
 void append_fixed(std::string& out, double v, int digits) {
   char s[64];
-  const auto r = digits >= 0 ? std::to_chars(s, s + sizeof s, v, std::chars_format::fixed, digits)
-                             : std::to_chars(s, s + sizeof s, v);
-  out.append(s, r.ptr);
+  if (digits >= 0) {
+    const auto r = std::to_chars(s, s + sizeof s, v, std::chars_format::fixed, digits);
+    if (r.ec == std::errc()) {
+      out.append(s, r.ptr);
+      return;
+    }
+  }
+  out.append(s, std::to_chars(s, s + sizeof s, v).ptr);
 }
 
 void write_xyz_points(const PointCloud& cloud, const std::string& path, int coordinate_digits) {

@@ -217,4 +217,20 @@ grep -q "97920 points with a coordinate that is not finite (an organized cloud's
 "$vola" translate "$data/ply/trimesh_bunny_ascii.ply" "$tmp/b.las" 2> "$tmp/err.txt" && fail "a mesh written as points"
 grep -Eq "takes? point files" "$tmp/err.txt" || fail "mesh message: $(cat "$tmp/err.txt")"
 
+# Coordinates too large for fixed notation (an x offset of 1e62) go to XYZ as the shortest
+# text of the number: the fixed-notation buffer was written out unfilled (stack bytes).
+python3 - "$data/las/pdal_autzen_trim.las" "$tmp/huge.las" <<'PY'
+import struct, sys
+d = bytearray(open(sys.argv[1], "rb").read())
+struct.pack_into("<d", d, 155, 1e62)  # the x offset
+open(sys.argv[2], "wb").write(d)
+PY
+"$vola" translate "$tmp/huge.las" "$tmp/huge.xyz" -q 2>/dev/null || fail "translate of a 1e62 offset failed"
+LC_ALL=C grep -q '[^[:print:][:space:]]' "$tmp/huge.xyz" && fail "XYZ of huge coordinates holds unprintable bytes"
+python3 - "$tmp/huge.xyz" <<'PY' || fail "XYZ of huge coordinates does not read back"
+import sys
+rows = [line.split() for line in open(sys.argv[1]) if not line.startswith("#")]
+assert len(rows) == 110000 and all(1e61 < float(r[0]) < 1e63 for r in rows), rows[:2]
+PY
+
 echo "LAZ: $checked files decoded as laz-perf does; LAS -> LAZ -> LAS round trips intact"
