@@ -256,7 +256,7 @@ Architecture read_architecture(torch::serialize::InputArchive& archive, const st
 // every record read through to the end (libzip compares its CRC there), no record
 // stating more bytes than the file holds. A damaged model is then a FormatError before
 // libtorch sees it; a deliberately crafted one (valid CRCs) still reaches libtorch.
-void check_model_archive(const std::string& path) {
+RecordSizes check_model_archive(const std::string& path) {
   std::error_code error;
   const std::uint64_t file_bytes = std::filesystem::file_size(path, error);
   if (error) throw IoError("cannot open model " + path + ": " + error.message());
@@ -272,6 +272,7 @@ void check_model_archive(const std::string& path) {
   }
   const zip_int64_t count = zip_get_num_entries(archive.get(), 0);
   std::vector<char> sink(64 * 1024);
+  RecordSizes tensor_records;
   for (zip_int64_t i = 0; i < count; ++i) {
     zip_stat_t stat;
     zip_stat_init(&stat);
@@ -285,16 +286,35 @@ void check_model_archive(const std::string& path) {
                                                              zip_fclose);
     if (!member) throw FormatError(path, std::nullopt, name + ": " + zip_strerror(archive.get()));
     zip_int64_t got = 0;
-    while ((got = zip_fread(member.get(), sink.data(), sink.size())) > 0) {
-    }
+    std::uint64_t bytes = 0;
+    while ((got = zip_fread(member.get(), sink.data(), sink.size())) > 0) bytes += static_cast<std::uint64_t>(got);
     if (got < 0) throw FormatError(path, std::nullopt, name + ": " + zip_file_strerror(member.get()));
+    // libtorch names a tensor's storage "<archive>/data/<key>".
+    const auto data = name.rfind("/data/");
+    if (data != std::string::npos && name.find('/', data + 6) == std::string::npos) tensor_records.insert(bytes);
+  }
+  return tensor_records;
+}
+
+void check_tensor_records(const std::vector<torch::Tensor>& tensors, RecordSizes records, const std::string& path) {
+  std::set<const void*> seen;  // tensors may share a storage, which then has one record
+  for (const torch::Tensor& t : tensors) {
+    if (!t.defined() || !seen.insert(t.storage().unsafeGetStorageImpl()).second) continue;
+    const std::uint64_t bytes = t.storage().nbytes();
+    if (bytes == 0) continue;
+    const auto record = records.find(bytes);
+    if (record == records.end())
+      throw FormatError(path, std::nullopt,
+                        "a tensor of " + std::to_string(bytes) + " bytes (" + c10::str(t.sizes(), " ", t.scalar_type()) +
+                            ") has no record of that size: a record was cut short or damaged");
+    records.erase(record);
   }
 }
 
-void load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
+RecordSizes load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) throw IoError("cannot open model " + path + ": no such file");
-  check_model_archive(path);
+  RecordSizes records = check_model_archive(path);
   try {
     archive.load_from(path);
   } catch (const std::bad_alloc&) {
@@ -304,6 +324,14 @@ void load_archive(torch::serialize::InputArchive& archive, const std::string& pa
     // std::runtime_error ("expected a valid token but found ''").
     throw FormatError(path, std::nullopt, "not a torch archive: " + first_line(failure.what()));
   }
+  return records;
+}
+
+std::vector<torch::Tensor> network_tensors(const Network& network) {
+  std::vector<torch::Tensor> out;
+  for (const auto& item : network.named_parameters()) out.push_back(item.value());
+  for (const auto& item : network.named_buffers()) out.push_back(item.value());
+  return out;
 }
 
 void read_weights(torch::serialize::InputArchive& archive, Network& network, const std::string& path) {
@@ -366,10 +394,11 @@ struct Classifier::Impl {
 
 Classifier::Classifier(const std::string& model_path) : impl_(std::make_unique<Impl>()) {
   torch::serialize::InputArchive archive;
-  load_archive(archive, model_path);
+  const RecordSizes records = load_archive(archive, model_path);
   impl_->architecture = read_architecture(archive, model_path);
   impl_->network = make_network(impl_->architecture);
   read_weights(archive, *impl_->network, model_path);
+  check_tensor_records(network_tensors(*impl_->network), records, model_path);
   impl_->network->eval();
   impl_->network->prepare_inference();
 }

@@ -5,6 +5,8 @@
 #include <torch/torch.h>
 
 #include <memory>
+#include <cstdint>
+#include <set>
 #include <string>
 
 #include "batch_producer.hpp"
@@ -28,8 +30,17 @@ std::shared_ptr<Network> make_network(Architecture architecture);
 void write_architecture(torch::serialize::OutputArchive& archive, Architecture architecture);
 Architecture read_architecture(torch::serialize::InputArchive& archive, const std::string& path);
 void save_model(const Network& network, Architecture architecture, const std::string& path);
-// Loads the archive at `path`, or throws FormatError naming it.
-void load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+// The byte sizes of an archive's tensor records ("data/N" members), as the zip holds them.
+using RecordSizes = std::multiset<std::uint64_t>;
+// Loads the archive at `path`, or throws FormatError naming it; returns its tensor records' sizes.
+RecordSizes load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+// Throws FormatError unless every tensor's storage has a record of its own of that many
+// bytes. libtorch sizes a storage by what the archive's pickle says and reads the record
+// into it without comparing: a record cut short (a full disk, a copy cut off) inside a
+// valid zip gave tensors reaching past their memory, and the first forward pass crashed.
+void check_tensor_records(const std::vector<torch::Tensor>& tensors, RecordSizes records, const std::string& path);
+// Every parameter and buffer of the network.
+std::vector<torch::Tensor> network_tensors(const Network& network);
 // Reads weights from the "model" member into `network`; FormatError when they do not fit.
 void read_weights(torch::serialize::InputArchive& archive, Network& network, const std::string& path);
 

@@ -58,7 +58,7 @@ void save_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectu
 // Loads a checkpoint into network and optimizer; returns the epochs it had done.
 int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architecture architecture, const std::string& path) {
   torch::serialize::InputArchive archive;
-  load_archive(archive, path);
+  const RecordSizes records = load_archive(archive, path);
   if (read_architecture(archive, path) != architecture)
     throw OptionError("architecture", path + ": checkpoint of another architecture than " +
                                           std::string(architecture_name(architecture)));
@@ -68,6 +68,12 @@ int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectur
     torch::Tensor epochs_done;
     if (!archive.try_read("optimizer", optimizer_state)) throw FormatError(path, std::nullopt, "not a checkpoint: no optimizer state");
     optimizer.load(optimizer_state);
+    std::vector<torch::Tensor> tensors = network_tensors(network);
+    for (const auto& [key, state] : optimizer.state()) {
+      const auto& adam = static_cast<const torch::optim::AdamParamState&>(*state);
+      for (const torch::Tensor& t : {adam.exp_avg(), adam.exp_avg_sq(), adam.max_exp_avg_sq()}) tensors.push_back(t);
+    }
+    check_tensor_records(tensors, records, path);
     archive.read("epochs_done", epochs_done);
     return static_cast<int>(epochs_done.item<std::int64_t>());
   } catch (const Error&) {

@@ -238,6 +238,34 @@ TEST(Classifier, RefusesDamagedModelFiles) {
   // The intact copy loads (the damage, not the copying, is what is refused).
   vola_test::write_bytes(dir / "intact.pt", good);
   EXPECT_NO_THROW(Classifier((dir / "intact.pt").string()));
+
+  // The largest tensor record cut to half its bytes inside a valid zip (fresh CRCs): libtorch
+  // sized the tensor by the pickle and the first forward pass read past its memory (a crash).
+  vola_test::write_bytes(dir / "short.pt", good);
+  int code = 0;
+  zip_t* archive = zip_open((dir / "short.pt").c_str(), 0, &code);
+  ASSERT_NE(archive, nullptr) << code;
+  zip_int64_t largest = -1;
+  zip_uint64_t largest_size = 0;
+  for (zip_int64_t i = 0; i < zip_get_num_entries(archive, 0); ++i) {
+    zip_stat_t stat;
+    ASSERT_EQ(zip_stat_index(archive, zip_uint64_t(i), 0, &stat), 0);
+    if (std::string(stat.name).find("/data/") != std::string::npos && stat.size > largest_size)
+      largest = i, largest_size = stat.size;
+  }
+  ASSERT_GT(largest_size, 1000000u);
+  static std::vector<char> half;  // libzip reads it at zip_close
+  half.assign(largest_size / 2, 0);
+  zip_source_t* source = zip_source_buffer(archive, half.data(), half.size(), 0);
+  ASSERT_EQ(zip_file_replace(archive, zip_uint64_t(largest), source, 0), 0) << zip_strerror(archive);
+  ASSERT_EQ(zip_close(archive), 0);
+  try {
+    Classifier classifier((dir / "short.pt").string());
+    ADD_FAILURE() << "a model with a record cut short was accepted";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no record of that size: a record was cut short"), std::string::npos)
+        << e.what();
+  }
 }
 
 
