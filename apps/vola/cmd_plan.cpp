@@ -63,7 +63,7 @@ raycast::Flight fly_to(const PlanArgs& a, const Tree& tree, const Point& from, c
   if (collider.sphere(from, options.radius))
     throw InvalidArgument("--from: the agent there touches an occupied voxel (or is closer than --radius to one)");
   const raycast::ObstacleAvoider avoider(collider, options);
-  return raycast::fly(avoider, from, to, a.max_steps, std::max(0.5, options.speed));
+  return raycast::fly(avoider, from, to, a.max_steps);
 }
 
 // A .vol file: a state map's occupied voxels, its known ones too unless --unknown free;

@@ -139,7 +139,13 @@ Flight fly(const ObstacleAvoider& avoider, const Point& start, const Point& goal
     position = s.position;
     flight.positions.push_back(position);
   }
-  flight.reached = norm(sub(goal, position)) <= tolerance;
+  // The last leg, onto the goal itself, is checked as every step is: within the tolerance
+  // is not at the goal, and the gap may hold a voxel.
+  if (norm(sub(goal, position)) <= tolerance && !(position == goal) && avoider.sweep_is_free(position, goal)) {
+    position = goal;
+    flight.positions.push_back(position);
+  }
+  flight.reached = position == goal;
   return flight;
 }
 

@@ -88,9 +88,31 @@ TEST(Avoidance, AroundAWallThroughItsHole) {
   EXPECT_TRUE(flight.reached) << "ended at " << flight.positions.back()[0] << " " << flight.positions.back()[1] << " "
                               << flight.positions.back()[2] << " after " << flight.positions.size() << " steps";
   EXPECT_GT(closest_approach(wall, flight.positions, options.radius + 1.0), options.radius);
-  // Every step is at most `speed` long.
+  // Every step is at most `speed` long, and the flight ends on the goal itself.
   for (std::size_t i = 1; i < flight.positions.size(); ++i)
     EXPECT_LE(distance(flight.positions[i - 1], flight.positions[i]), options.speed + 1e-12);
+  EXPECT_EQ(flight.positions.back(), goal);
+}
+
+// "Near the goal" is not "at the goal": a tolerance wider than the gap to the goal must not
+// skip the last leg or its collision check (vola plan --avoid --speed 20 once reported the
+// goal reached from 14 voxels away, across an occupied voxel).
+TEST(Avoidance, TheLastLegOntoTheGoalIsCheckedLikeEveryStep) {
+  const std::vector<vola::Voxel> voxels{{0, 0, 0}, {1, 1, 1}, {5, 5, 5}, {15, 15, 15}};
+  const vola::Tree tree = vola::build_from_voxels(voxels, 2);
+  const Collider collider(tree);
+  AvoidanceOptions options;
+  options.radius = 0.5;
+  options.speed = 20.0;
+  const ObstacleAvoider avoider(collider, options);
+  const Point start{2.5, 2.5, 2.5}, goal{10.5, 10.5, 10.5};
+  const auto blocked = vola::raycast::fly(avoider, start, goal, 100, 20.0);
+  EXPECT_FALSE(blocked.reached);  // within the tolerance from the start, but (5, 5, 5) lies between
+  EXPECT_EQ(blocked.positions.size(), 1u);
+  const auto flown = vola::raycast::fly(avoider, start, goal, 100);
+  EXPECT_TRUE(flown.reached);
+  EXPECT_EQ(flown.positions.back(), goal);
+  EXPECT_GT(closest_approach(voxels, flown.positions, options.radius + 1.0), options.radius);
 }
 
 TEST(Avoidance, HoldsWhenBoxedIn) {

@@ -64,12 +64,14 @@ class ObstacleAvoider {
 
 struct Flight {
   std::vector<Point> positions;  // the start, then the end of every step
-  bool reached = false;          // within `tolerance` of the goal
+  bool reached = false;          // the last position is the goal
   std::size_t held_steps = 0;    // steps on which no direction was safe
 };
 
 // Steps from start towards goal until within `tolerance` of it, `max_steps` steps, or a
-// step on which the agent has to hold from rest (nothing would change after it).
+// step on which the agent has to hold from rest (nothing would change after it); from
+// within `tolerance` a last leg onto the goal, when its sweep is free. Reached means the
+// agent stands on the goal with every leg checked.
 Flight fly(const ObstacleAvoider& avoider, const Point& start, const Point& goal, std::size_t max_steps,
            double tolerance = 0.5);
 
