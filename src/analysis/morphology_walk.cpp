@@ -471,8 +471,9 @@ Tree morph(const Tree& tree, Operation operation, int radius, Element element, c
   // a cube goes in steps of at most 4, one brick of halo each.
   Tree current = Walk(tree, operation, std::min(radius, 4), element, pass_report(0)).run();
   int pass = 1;
-  for (int done = std::min(radius, 4); done < radius; done += 4, ++pass)
+  for (int done = std::min(radius, 4); done < radius && !current.empty(); done += 4, ++pass)  // empty stays empty
     current = Walk(current, operation, std::min(radius - done, 4), element, pass_report(pass)).run();
+  if (pass < passes && progress) progress(kWhole, kWhole);  // emptied early: the passes left have nothing to do
   return current;
 }
 

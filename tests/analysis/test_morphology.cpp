@@ -135,6 +135,34 @@ TEST(Morphology, RadiusOutsideTheGridIsRefused) {
   EXPECT_THROW(vola::analysis::erode(t, -1, Element::sphere), vola::InvalidArgument);
 }
 
+// Cost follows the data, not the radius: an element that fits nowhere erodes to nothing at
+// once (three voxels across a depth-10 grid at radius 5000 took 2.9 GB and failed), and a
+// dilation no machine could hold is refused before the walk (a cube of radius 10^6 ran
+// for minutes).
+TEST(Morphology, HugeRadiiAreAnsweredOrRefusedAtOnce) {
+  const vola::Tree t = tree_of({{0, 0, 0}, {500000, 500000, 500000}, {1048575, 1048575, 1048575}}, 10);
+  for (const Element e : {Element::sphere, Element::cube}) {
+    const vola::Tree eroded = vola::analysis::erode(t, 5000, e);
+    EXPECT_TRUE(eroded.empty());
+    EXPECT_EQ(eroded.depth(), 10);
+    try {
+      vola::analysis::dilate(t, 1048575, e);
+      ADD_FAILURE() << "a dilation of 2^60 voxels was attempted";
+    } catch (const vola::InvalidArgument& error) {
+      EXPECT_NE(std::string(error.what()).find("the dilation would hold at least"), std::string::npos) << error.what();
+    }
+  }
+  // A 5^3 cube of voxels erodes by radius 2 to its centre, by 3 to nothing (the shortcut and
+  // the walk agree).
+  XyzSet cube;
+  for (std::uint32_t x = 10; x < 15; ++x)
+    for (std::uint32_t y = 10; y < 15; ++y)
+      for (std::uint32_t z = 10; z < 15; ++z) cube.insert({x, y, z});
+  const vola::Tree c = tree_of(cube, 3);
+  EXPECT_EQ(vola::analysis::erode(c, 2, Element::cube).voxel_count(), 1u);
+  EXPECT_TRUE(vola::analysis::erode(c, 3, Element::cube).empty());
+}
+
 TEST(Fill, MatchesTheModelOnRandomGridsAndShells) {
   for (const Grid& g : random_grids(4)) {
     if (g.depth > 4) continue;  // the dense model's box would be the whole grid
