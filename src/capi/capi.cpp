@@ -22,10 +22,7 @@ using vola::capi::fail;
 using vola::capi::guarded;
 using vola::capi::require;
 
-const vola::Tree& tree_of(const vola_tree* handle) {
-  require(handle != nullptr, "tree is NULL");
-  return handle->tree;
-}
+using vola::capi::tree_of;
 
 void require_depth(int depth) {
   if (depth < vola::kMinDepth || depth > vola::kMaxDepth)
@@ -56,6 +53,11 @@ void visit_from(const vola::Tree& tree, std::uint64_t first, F&& f) {
 }
 
 }  // namespace
+
+std::vector<const vola::Tree*>& vola::capi::trees_in_use() noexcept {
+  thread_local std::vector<const vola::Tree*> trees;
+  return trees;
+}
 
 std::string& vola::capi::last_error() noexcept {
   thread_local std::string message;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "vola/file.hpp"
 #include "vola/tree.hpp"
 #include "vola/vola.h"
 
@@ -37,10 +38,26 @@ inline vola_status fail(vola_status status, const std::string& message) noexcept
   return status;
 }
 
+// The trees this thread's current call reads (tree_of records them). A mapped file cut
+// by another process meanwhile leaves zero pages where the file was (file.hpp), so the
+// call's answers would mean nothing: guarded() fails it instead of returning VOLA_OK.
+std::vector<const vola::Tree*>& trees_in_use() noexcept;
+
+// The handle's tree, refused when NULL or when its mapped file was cut before the call.
+inline const vola::Tree& tree_of(const vola_tree* handle) {
+  if (handle == nullptr) throw vola::InvalidArgument("tree is NULL");
+  vola::check_mapped(handle->tree);
+  trees_in_use().push_back(&handle->tree);
+  return handle->tree;
+}
+
 template <class Body>
 vola_status guarded(Body&& body) noexcept {
   try {
+    trees_in_use().clear();
     body();
+    for (const vola::Tree* tree : trees_in_use()) vola::check_mapped(*tree);  // cut during the call
+    trees_in_use().clear();
     return VOLA_OK;
   } catch (const vola::FormatError& e) {
     return fail(VOLA_ERROR_FORMAT, e.what());

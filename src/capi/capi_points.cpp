@@ -15,7 +15,7 @@ vola_status vola_export_las(const vola_tree* tree, const char* path) {
   return vola::capi::guarded([&] {
     vola::capi::require(tree != nullptr && path != nullptr, "vola_export_las: tree and path must not be NULL");
 #ifdef VOLA_C_HAS_CONVERT
-    vola::io::write_las(tree->tree, path);
+    vola::io::write_las(vola::capi::tree_of(tree), path);
 #else
     throw vola::InvalidArgument("vola_export_las: this library was built without writers (VOLA_BUILD_MODULES=OFF)");
 #endif

@@ -2,10 +2,12 @@
  * files written and read back (in memory and mapped), and the error paths (status code
  * and message). Usage: test_capi SCRATCH_DIR. Prints one line per failed check; exit 1
  * on any failure. */
+#define _POSIX_C_SOURCE 200809L /* truncate() */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "vola/vola.h"
 
@@ -251,6 +253,33 @@ static void test_shared_file(const char *path) {
   vola_tree_free(mapped);
 }
 
+/* A mapped file cut by another process (cp over it, a truncation) leaves zero pages: calls
+ * on its tree must fail, not answer from the zeros with VOLA_OK. */
+static void test_cut_while_mapped(const char *scratch) {
+  enum { kCount = 20000 };
+  uint32_t *xyz = malloc(3 * sizeof(uint32_t) * kCount);
+  for (int i = 0; i < 3 * kCount; ++i) xyz[i] = next_random(1024);
+  vola_tree *built = NULL, *mapped = NULL;
+  CHECK_OK(vola_build_from_voxels(xyz, kCount, 5, &built));
+  char path[4096];
+  snprintf(path, sizeof path, "%s/cut_while_mapped.vol", scratch);
+  CHECK_OK(vola_write(built, path, 0));
+  CHECK_OK(vola_open(path, VOLA_OPEN_MAPPED, &mapped));
+  int hit = -1;
+  CHECK_OK(vola_contains(mapped, xyz[0], xyz[1], xyz[2], &hit));
+  CHECK(hit == 1);
+  CHECK(truncate(path, 0) == 0);
+  CHECK(vola_contains(mapped, xyz[0], xyz[1], xyz[2], &hit) == VOLA_ERROR_IO);
+  CHECK(strstr(vola_last_error(), "cut_while_mapped.vol") != NULL && strstr(vola_last_error(), "was cut") != NULL);
+  vola_info info;
+  CHECK(vola_get_info(mapped, &info) == VOLA_ERROR_IO);
+  snprintf(path, sizeof path, "%s/from_cut.vol", scratch);
+  CHECK(vola_write(mapped, path, 0) == VOLA_ERROR_IO);
+  vola_tree_free(mapped);
+  vola_tree_free(built);
+  free(xyz);
+}
+
 static void test_errors(const char *scratch) {
   vola_tree *tree = NULL;
   char path[4096];
@@ -407,6 +436,7 @@ int main(int argc, char **argv) {
   if (argc > 3) test_translate_warnings(argv[1], argv[3]);
   if (argc > 5) test_state_map(argv[4], strtoull(argv[5], NULL, 10));
   test_errors(argv[1]);
+  test_cut_while_mapped(argv[1]);
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;
