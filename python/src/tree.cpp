@@ -228,6 +228,10 @@ py::class_<Tree> bind_tree(py::module_& m) {
       .def("__len__", [](const Tree& t) { return t.voxel_count(); })
       .def("__repr__", &repr)
       .def_property_readonly("is_mapped", &Tree::is_mapped, "True when the level words live in a file mapping.")
+      .def("check_mapped", [](const Tree& t) { vola::check_mapped(t); },
+           "Raises vola.IoError when the file this tree maps was cut (truncated, or copied over in place) since it\n"
+           "was opened: the mapping then reads zeros. Every Tree method and vola function does this before and\n"
+           "after its work; numpy views of the levels (occupancy(), payload()) cannot, so call it after using them.")
       .def_property_readonly(
           "is_state_map", [](const Tree& t) { return t.payload_meaning() == vola::PayloadMeaning::occupancy_state; },
           "True for a state map (vola map, vola.Map.save): known voxels, payload bit set = occupied.")

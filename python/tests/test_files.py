@@ -1,5 +1,7 @@
 """Writing, reading, parsing and memory-mapping .vol files; errors from bad bytes."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -34,6 +36,25 @@ def test_write_read_mapped_parse_agree(tree, tmp_path, dense, compress):
     same(tree, vola.parse(path.read_bytes(), name="t.vol"))
     assert path.read_bytes() == tree.to_bytes(dense=dense, compress=compress)
     assert mapped.is_mapped == (not dense and not compress) and not read.is_mapped
+
+
+def test_a_file_cut_while_mapped_is_refused_not_read_as_zeros(tree, tmp_path):
+    path = tmp_path / "t.vol"
+    tree.write(path)
+    mapped = vola.open(path)
+    assert len(mapped.voxels()) == tree.voxel_count
+    other = vola.build(np.zeros((1, 3)), voxel_size=1.0)
+    os.truncate(path, 4096)  # another process cuts the file (or copies another over it)
+    with pytest.raises(vola.IoError, match="was cut"):
+        mapped.voxels()  # rows of [0 0 0] before
+    with pytest.raises(vola.IoError, match="was cut"):
+        mapped.write(tmp_path / "copy.vol")  # a file vola then refused
+    assert not (tmp_path / "copy.vol").exists()
+    with pytest.raises(vola.IoError, match="was cut"):
+        vola.union(other, mapped)
+    mapped.census  # an attribute lookup alone reads nothing
+    with pytest.raises(vola.IoError, match="was cut"):
+        mapped.check_mapped()
 
 
 def test_mapped_levels_are_views_of_the_file(tree, tmp_path):

@@ -54,6 +54,7 @@ tree's first K levels); a format that refuses a deep tree says so naming `depth`
 from __future__ import annotations
 
 import builtins
+import functools
 import json
 import os
 from typing import Any, Optional, Union
@@ -106,6 +107,36 @@ from ._vola import (
     _export_format,
     _run_pipeline,
 )
+
+
+
+def _refusing_cut_mappings(function):
+    """`function` with every mapped Tree among its arguments checked before and after the
+    call: a file cut by another process while mapped (truncated, or copied over in place)
+    reads as zeros, and what a call read from it would mean nothing (voxels() gave rows of
+    [0 0 0], write() wrote a file vola then refused)."""
+
+    @functools.wraps(function)
+    def call(*args, **kwargs):
+        mapped = [a for a in (*args, *kwargs.values()) if isinstance(a, Tree) and a.is_mapped]
+        for tree in mapped:
+            tree.check_mapped()
+        result = function(*args, **kwargs)
+        for tree in mapped:
+            tree.check_mapped()
+        return result
+
+    return call
+
+
+for _name, _member in list(vars(Tree).items()):
+    if type(_member).__name__ == "instancemethod" and _name not in ("__repr__", "__len__", "__setstate__", "check_mapped"):
+        setattr(Tree, _name, _refusing_cut_mappings(_member))
+for _name in ("difference", "export_binvox", "export_height_map", "export_las", "export_map", "export_npy",
+              "export_occupancy_above", "export_ply", "export_raster", "export_slices", "export_xyz", "free_tree",
+              "intersect", "occupied_tree", "probability", "state", "union", "_export_format"):
+    globals()[_name] = _refusing_cut_mappings(globals()[_name])
+del _name, _member
 
 __all__ = [
     "FREE",
@@ -165,7 +196,9 @@ def open(path: Union[str, os.PathLike], mapped: bool = True, states: bool = Fals
     as every vola command reads it, so that contains, collide, plan, render and the rest
     see obstacles only; states=True keeps every known voxel, free ones too, for
     vola.state, vola.probability and vola.free_tree. (vola.read and vola.open_mapped give
-    the file as it is.)"""
+    the file as it is.) When another process cuts a mapped file (truncates it, or copies
+    another file over it in place), every Tree method and vola function given the tree
+    raises vola.IoError instead of answering from the zeros the mapping then holds."""
     tree = open_mapped(path) if mapped else read(path)
     if tree.is_state_map and not states:
         return occupied_tree(tree)
