@@ -74,6 +74,15 @@ TEST(OutputFile, CommitReplacesTheOldFileWholeKeepingItsPermissions) {
 // The rename replaces whatever has the name: a link is followed, a device, FIFO or
 // directory is refused (the rename would replace /dev/null itself), and so is a read-only
 // file (root's rename would replace it all the same).
+TEST(OutputFile, AnEmptyNameIsRefusedSayingSo) {
+  try {
+    vola::OutputFile out("");
+    ADD_FAILURE() << "an empty name was accepted";
+  } catch (const vola::IoError& e) {
+    EXPECT_STREQ(e.what(), "the output file name is empty");  // it was "": `vola: ` and nothing more
+  }
+}
+
 TEST(OutputFile, OnlyRegularWritableFilesAreReplacedAndLinksAreFollowed) {
   TempDir dir;
   const fs::path target = dir / "target.txt", link = dir / "link.txt";

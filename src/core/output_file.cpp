@@ -94,6 +94,10 @@ const char* kind_of(mode_t mode) {
 // its owner's write permission, which root's rename would replace all the same.
 // Empty with `why` set when the path cannot be written.
 std::string final_path(const std::string& path, std::string& why) {
+  if (path.empty()) {
+    why = "the output file name is empty";
+    return {};
+  }
   struct stat link {};
   if (::lstat(path.c_str(), &link) != 0) return path;  // a new file
   std::string target = path;

@@ -40,10 +40,14 @@ std::optional<RayHit> Collider::segment(const Point& a, const Point& b) const {
 }
 
 bool Collider::sphere(const Point& centre, double radius) const {
+  // Bounded as ray origins are, so that the squared distances below cannot overflow (a
+  // centre and radius of 1e308 both squared to infinity and "hit").
   for (const double c : centre)
-    if (!std::isfinite(c)) throw InvalidArgument("sphere: the centre must be finite");
+    if (!std::isfinite(c) || std::abs(c) > kMaxOriginMagnitude)
+      throw InvalidArgument("sphere: the centre must be finite and within 1e12 voxels of the grid");
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("sphere: the radius must be >= 0");
   if (tree().empty()) return false;
+  if (radius > 4 * kMaxOriginMagnitude) return true;  // reaches every cell of any grid from any such centre
   const double r2 = radius * radius;
   return any_voxel(0, 0, Voxel{}, [&](const Point& lo, const Point& hi) {
     double d2 = 0.0;

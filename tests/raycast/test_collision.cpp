@@ -91,6 +91,11 @@ TEST(Collision, TouchingRules) {
   EXPECT_FALSE(c.segment({0.5, 2.5, 2.5}, {1.5, 2.5, 2.5}));
   EXPECT_THROW(c.segment({1, 1, 1}, {1, 1, 1}), vola::InvalidArgument);
   EXPECT_THROW(c.sphere({1, 1, 1}, -1), vola::InvalidArgument);
+  // Squares of 1e308 overflowed to infinity, and infinity <= infinity "hit".
+  EXPECT_THROW(c.sphere({1e308, 1e308, 1e308}, 1e308), vola::InvalidArgument);
+  EXPECT_FALSE(c.sphere({1e12, 1e12, 1e12}, 1e12));  // the voxel is 1.73e12 away
+  EXPECT_TRUE(c.sphere({1e12, 1e12, 1e12}, 1.8e12));
+  EXPECT_TRUE(c.sphere({-1e12, 0, 0}, 1e300));
   EXPECT_THROW(c.box({{2, 0, 0}, {1, 1, 1}}), vola::InvalidArgument);
 }
 
