@@ -215,7 +215,8 @@ VOLA_C_API vola_status vola_convert_file(const char *input, const char *output, 
 
 /* The tree's voxel centres as LAS 1.4 (point format 6, or 7 with colour; attribute
  * columns into LAS fields and extra bytes; the CRS as WKT); a path ending in .laz is
- * LASzip-compressed. As `vola export TREE OUT.las|.laz`. */
+ * LASzip-compressed; another extension is refused (VOLA_ERROR_INVALID_ARGUMENT). As
+ * `vola export TREE OUT.las|.laz`. */
 VOLA_C_API vola_status vola_export_las(const vola_tree *tree, const char *path);
 /* Point file to point file, point by point, no voxels, as `vola translate IN OUT`: LAS,
  * LAZ, COPC, PLY, PCD, XYZ, NPY or KITTI in; LAS, LAZ, PLY or XYZ out (by extension). */

@@ -120,7 +120,7 @@ vola_status vola_build_from_points(const double* xyz, size_t count, const vola_b
   return guarded([&] {
     require(options != nullptr && out != nullptr, "vola_build_from_points: options and out must not be NULL");
     require(xyz != nullptr || count == 0, "vola_build_from_points: xyz is NULL");
-    require(count <= SIZE_MAX / 3, "vola_build_from_points: count is too large");
+    require(count <= SIZE_MAX / (3 * sizeof(double)), "vola_build_from_points: count is too large");
     require(options->quantization == VOLA_QUANTIZE_TOOLKIT || options->quantization == VOLA_QUANTIZE_GRID,
             "vola_build_from_points: quantization is neither toolkit nor grid");
     vola::BuildOptions build;
@@ -144,6 +144,7 @@ vola_status vola_build_from_voxels(const uint32_t* xyz, size_t count, int depth,
   return guarded([&] {
     require(out != nullptr, "vola_build_from_voxels: out is NULL");
     require(xyz != nullptr || count == 0, "vola_build_from_voxels: xyz is NULL");
+    require(count <= SIZE_MAX / (3 * sizeof(uint32_t)), "vola_build_from_voxels: count is too large");
     require_depth(depth);
     std::vector<vola::Voxel> voxels(count);
     for (size_t i = 0; i < count; ++i) voxels[i] = vola::Voxel{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};

@@ -25,9 +25,13 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   if (c.has_bbox) o.bbox = vola::Box{{c.bbox[0], c.bbox[1], c.bbox[2]}, {c.bbox[3], c.bbox[4], c.bbox[5]}};
   o.nbits = c.nbits;
   if (c.epsg) o.epsg = c.epsg;
+  // NULL leaves a CRS option unset; "" is a mistake, not a way to say so.
+  vola::capi::require(!c.assign_crs || *c.assign_crs, "assign_crs is empty (NULL: none)");
+  vola::capi::require(!c.target_crs || *c.target_crs, "target_crs is empty (NULL: none)");
   if (c.assign_crs) o.assign_crs = c.assign_crs;
   if (c.target_crs) o.target_crs = c.target_crs;
   o.allow_geographic = c.allow_geographic != 0;
+  vola::capi::require(c.level >= -1, "level must be -1 (every level) or a COPC level >= 0");
   if (c.level >= 0) o.level = c.level;
   if (c.grid) o.grid = c.grid;
   o.attributes = c.attributes != 0;

@@ -333,6 +333,19 @@ static void test_errors(const char *scratch) {
   snprintf(path, sizeof path, "%s/no_such_dir/out.vol", scratch);
   CHECK(vola_write(tree, path, VOLA_WRITE_SPARSE) == VOLA_ERROR_IO);
   CHECK(strstr(vola_last_error(), "no_such_dir") != NULL);
+  CHECK(vola_write(tree, "", VOLA_WRITE_SPARSE) == VOLA_ERROR_IO);
+  CHECK(strstr(vola_last_error(), "name is empty") != NULL);  /* the message was "" */
+  snprintf(path, sizeof path, "%s/points.txt", scratch);
+  CHECK(vola_export_las(tree, path) == VOLA_ERROR_INVALID_ARGUMENT);  /* LAS bytes under a .txt name */
+  vola_tree *none = NULL;
+  CHECK(vola_build_from_voxels(one, SIZE_MAX / 3, 2, &none) == VOLA_ERROR_INVALID_ARGUMENT && none == NULL);
+  vola_convert_options options;
+  vola_convert_options_init(&options);
+  options.level = -5;
+  CHECK(vola_convert(path, &options, &none, NULL) == VOLA_ERROR_INVALID_ARGUMENT);
+  vola_convert_options_init(&options);
+  options.target_crs = "";
+  CHECK(vola_convert(path, &options, &none, NULL) == VOLA_ERROR_INVALID_ARGUMENT);
   vola_tree_free(tree);
   vola_tree_free(NULL);
   CHECK(strcmp(vola_status_string(VOLA_ERROR_FORMAT), "format error") == 0);
