@@ -213,9 +213,12 @@ void bind_building(py::module_& m) {
   m.def("from_dense", &from_dense, py::arg("grid"), py::arg("origin") = py::none(), py::arg("voxel_size") = py::none(),
         py::arg("depth") = 0, "Builds a tree from a dense 3-D array indexed [x, y, z] (non-zero = occupied).");
   m.def("read", [](const std::filesystem::path& p) { py::gil_scoped_release r; return vola::read(p.string()); }, py::arg("path"),
-        "Reads a .vol file into memory.");
+        "Reads a .vol file into memory, as it is: a state map's voxels are all its known voxels, free ones\n"
+        "too (tree.is_state_map), so census() and voxels() count them; vola.open reads its occupied voxels,\n"
+        "as every vola command does.");
   m.def("open_mapped", [](const std::filesystem::path& p) { py::gil_scoped_release r; return vola::open_mapped(p.string()); },
-        py::arg("path"), "Memory-maps a .vol file: a sparse uncompressed file's level words are used in place.");
+        py::arg("path"), "Memory-maps a .vol file, as it is (a state map's free voxels too; see read): a sparse\n"
+        "uncompressed file's level words are used in place.");
   m.def("parse", [](py::bytes data, const std::string& name) {
           const std::string bytes = data;
           return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), name);

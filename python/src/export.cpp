@@ -15,6 +15,7 @@
 #include "vola/io/export_format.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/occupancy_maps.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::python {
 
@@ -86,7 +87,18 @@ py::dict export_las(const Tree& tree, const std::filesystem::path& path, int dep
   return out;
 }
 
-py::dict export_map(const Tree& tree, const std::filesystem::path& path, const Tree* free, int depth) {
+py::dict export_map(const Tree& given, const std::filesystem::path& path, const Tree* given_free, int depth) {
+  // A state map (vola map, Map.save) holds its free voxels: split it as `vola export` does,
+  // so that the report counts occupied and free voxels (it counted every known voxel as
+  // occupied, though the file was right).
+  std::optional<Tree> occupied, own_free;
+  if (vola::map::is_state_map(given)) {
+    if (given_free) throw vola::InvalidArgument("the tree is a state map and holds its free voxels; free is for plain trees");
+    occupied = vola::map::occupied_tree(given);
+    own_free = vola::map::free_tree(given);
+  }
+  const Tree& tree = occupied ? *occupied : given;
+  const Tree* free = own_free ? &*own_free : given_free;
   const vola::io::MapExportReport r = write_released([&] {
     const std::optional<Tree> coarse_free =
         free && depth > 0 && depth < free->depth() ? std::optional<Tree>(free->level_of_detail(depth)) : std::nullopt;

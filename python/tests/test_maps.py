@@ -63,3 +63,17 @@ def test_free_voxels_and_the_cli_agree(tmp_path, vola_cli):
     subprocess.run([vola_cli, "export", str(tmp_path / "occupied.vol"), str(tmp_path / "cli.bt"), "--free",
                     str(tmp_path / "free.vol"), "-q"], check=True)
     assert (tmp_path / "py.bt").read_bytes() == (tmp_path / "cli.bt").read_bytes()
+
+
+def test_a_state_map_exports_its_occupied_and_free_voxels(tmp_path):
+    m = vola.Map(0.25)
+    rng = np.random.default_rng(4)
+    m.insert(rng.uniform(-3, 3, size=(300, 3)), origin=(0.05, 0.1, 0.15))
+    m.save(tmp_path / "map.vol")
+    state = vola.read(tmp_path / "map.vol")  # the file as it is: every known voxel
+    occupied, free = vola.occupied_tree(state), vola.free_tree(state)
+    assert occupied.voxel_count > 0 and free.voxel_count > 0
+    report = vola.export_map(state, tmp_path / "s.ot")
+    assert (report["occupied"], report["free"]) == (occupied.voxel_count, free.voxel_count)  # was (all known, 0)
+    with pytest.raises(vola.InvalidArgument, match="holds its free voxels"):
+        vola.export_map(state, tmp_path / "t.ot", free=free)
