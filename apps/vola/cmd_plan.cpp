@@ -116,7 +116,7 @@ bool use_hierarchical(const PlanArgs& a, const Point& from, const Point& to) {
   if (a.hierarchical || a.exact) return a.hierarchical;
   if (a.level >= 0) return false;
   const double apart = std::max({std::abs(to[0] - from[0]), std::abs(to[1] - from[1]), std::abs(to[2] - from[2])});
-  if (apart < kAutoHierarchicalVoxels) return false;
+  if (!(apart >= kAutoHierarchicalVoxels)) return false;  // NaN too: the search refuses it, naming the point
   if (!a.quiet)
     std::printf("searching hierarchically: the points are %.0f voxels apart (--exact for the optimal path, slower)\n",
                 apart);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
@@ -109,6 +110,14 @@ std::vector<std::uint8_t> read_member(zip_file_t* file, std::uint64_t size, cons
   return bytes;
 }
 
+// A label as the file holds it: integers without a fraction (they were printed as
+// "99.000000", and 2^40 as "1099511627776.000000").
+std::string label_text(double label) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", label);
+  return text;
+}
+
 }  // namespace
 
 io::NpyArray read_npz_array(const std::string& path, const std::string& name) {
@@ -164,7 +173,8 @@ LabelledGrids read_labelled_grids(const std::string& path, const std::string& sp
   for (std::uint64_t i = 0; i < y.shape[0]; ++i) {
     const double label = y.value(i);
     if (!(label >= 0 && label <= 9))
-      throw FormatError(y_where, std::nullopt, "label " + std::to_string(i) + " is " + std::to_string(label) + ", not 0..9");
+      throw FormatError(y_where, std::nullopt,
+                        "grid " + std::to_string(i) + "'s label is " + label_text(label) + ", not 0..9");
     grids.labels[i] = static_cast<int>(label);
   }
   grids.cells.resize(x.size());

@@ -81,7 +81,7 @@ TEST(Npz, RefusesBadShapesDtypesValuesAndLabels) {
   check("not_cubic", {{"X_train", vola_io_test::npy_bytes("|u1", {1, 8, 8, 4}, false, Bytes(256, 0))}, {"y_train", labels_npy({0})}},
         "expected (N, S, S, S)");
   check("count", {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 1})}}, "one label per grid (3)");
-  check("label", {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 12, 1})}}, "label 1 is 12");
+  check("label", {{"X_train", grids_npy(grids, 32)}, {"y_train", labels_npy({0, 12, 1})}}, "grid 1's label is 12, not 0..9");
   check("float_labels", {{"X_train", grids_npy(grids, 32)}, {"y_train", vola_io_test::npy_bytes("<f8", {3}, false, Bytes(24, 0))}},
         "expected integer labels");
   Bytes two(8 * 8 * 8, 0);
