@@ -109,6 +109,25 @@ TEST(BuildToolkit, PointsOutsideAFixedBboxAreClamped) {
 TEST(BuildToolkit, ZeroExtentPutsEveryPointInVoxelZero) {
   const vola::Tree tree = vola::build(cloud_of({{1, 2, 3}, {1, 2, 3}}), {.depth = 4});
   EXPECT_EQ(voxel_set(tree), (XyzSet{{0, 0, 0}}));
+  EXPECT_EQ(tree.quantizer().center({0, 0, 0}), (vola::Point{1, 2, 3}));  // the one point
+}
+
+// A tree built from voxels has no bbox to quantize by: its voxels are one unit apart, the
+// same in frame() (info, components) and quantizer() (coords, census, world queries),
+// which put every voxel at one point before.
+TEST(BuildFromVoxels, VoxelsLieOneUnitApartEverywhere) {
+  const std::vector<vola::Voxel> voxels{{0, 0, 0}, {5, 5, 5}, {15, 2, 9}};
+  const vola::Tree tree = vola::build_from_voxels(voxels, 2);
+  const vola::Frame frame = tree.frame();
+  for (const vola::Voxel& v : voxels) {
+    const vola::Point c = tree.quantizer().center(v);
+    EXPECT_EQ(c, (vola::Point{frame.origin[0] + (v.x + 0.5) * frame.voxel_size,
+                              frame.origin[1] + (v.y + 0.5) * frame.voxel_size,
+                              frame.origin[2] + (v.z + 0.5) * frame.voxel_size}));
+    vola::Voxel back{};
+    ASSERT_TRUE(tree.quantizer().to_voxel(c, back));
+    EXPECT_EQ(back, v);
+  }
 }
 
 TEST(BuildToolkit, AxisWhoseScaleRoundsToZeroLandsInVoxelZero) {

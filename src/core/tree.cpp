@@ -331,7 +331,18 @@ Frame Tree::frame() const noexcept {
 Quantizer Tree::quantizer() const {
   if (frame_ && frame_->quantization == Quantization::grid)
     return Quantizer::grid(frame_->origin, frame_->voxel_size, depth_);
-  return Quantizer::toolkit(georef_.bbox, depth_);
+  Quantizer toolkit = Quantizer::toolkit(georef_.bbox, depth_);
+  // A zero-extent bbox maps every point to voxel 0. A tree with other voxels was not
+  // quantized by it (vola.build_from_voxels, vola_build_from_voxels): its grid is the
+  // frame's, voxels one unit apart, as info and components already placed them (coords
+  // put every voxel at the bbox's one point).
+  const Frame fallback = toolkit.frame();
+  if (!frame_ && fallback.voxel_size == 1.0 && voxel_count() > 0 && (voxel_count() > 1 || !contains(0, 0, 0))) {
+    double extent = 0.0;
+    for (int a = 0; a < 3; ++a) extent = std::max(extent, georef_.bbox.max[a] - georef_.bbox.min[a]);
+    if (!(extent > 0.0)) return Quantizer::grid(fallback.origin, 1.0, depth_);
+  }
+  return toolkit;
 }
 
 VOLA_INLINE_NAMESPACE_END
