@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -54,10 +57,29 @@ const TileSet::Opened* TileSet::open(const TileIndex& tile) const {
     if (tree.depth() != index_.grid.depth || tree.frame().quantization != Quantization::grid)
       throw FormatError(path, 0, "tile does not match its index (depth " + std::to_string(tree.depth()) +
                                      ", the index says " + std::to_string(index_.grid.depth) + ")");
+    check_tile_place(tree, tile, path);
     slot = std::make_unique<Opened>();
     slot->tree = std::move(tree);
   }
   return slot.get();
+}
+
+// A tile file holds its own place (origin and voxel size): it must be the cell the index
+// puts it in. A hand-edited index that swapped two files, or gave the grid another tile
+// size, answered "empty" for occupied points without a word.
+void TileSet::check_tile_place(const Tree& tree, const TileIndex& tile, const std::string& path) const {
+  const Frame own = tree.frame(), cell = index_.grid.tile_frame(tile);
+  const double tolerance = 1e-6 * cell.voxel_size;
+  bool same = std::abs(own.voxel_size - cell.voxel_size) <= tolerance;
+  for (int a = 0; a < 3; ++a) same = same && std::abs(own.origin[a] - cell.origin[a]) <= tolerance;
+  if (same) return;
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the tile's grid (origin %.10g %.10g %.10g, voxel %.10g) is not that of the cell [%d, %d, %d] the "
+                "index puts it in (origin %.10g %.10g %.10g, voxel %.10g)",
+                own.origin[0], own.origin[1], own.origin[2], own.voxel_size, tile.i, tile.j, tile.k, cell.origin[0],
+                cell.origin[1], cell.origin[2], cell.voxel_size);
+  throw FormatError(path, std::nullopt, text);
 }
 
 const Tree* TileSet::tree(const TileIndex& tile) const {
@@ -107,6 +129,13 @@ std::optional<TileHit> TileSet::cast(const raycast::Ray& world_ray) const {
   }
   if (!(t0 <= t1)) return std::nullopt;
   const TileGrid& g = index_.grid;
+  // The DDA below visits every cell the ray crosses in the box of all tiles, listed or
+  // not. Where that is more than the listed tiles (a few tiles far apart: an index with
+  // one tile at [2^31 - 1, ...] spun for minutes), the listed tiles the ray meets are
+  // taken in the ray's order instead.
+  double crossed = 1.0;
+  for (int a = 0; a < 3; ++a) crossed += std::abs((t1 - t0) * d[a]) / g.tile_size + 1.0;
+  if (crossed > 2.0 * static_cast<double>(index_.tiles.size()) + 64.0) return cast_listed(world_ray, t0, t1);
   // A DDA over the tile grid from the entry point; each tile the set has casts the ray
   // itself, and tiles come in the ray's order, so the first hit is the nearest.
   std::array<std::int64_t, 3> cell{}, step{}, lo{}, hi{};
@@ -125,26 +154,57 @@ std::optional<TileHit> TileSet::cast(const raycast::Ray& world_ray) const {
       delta[a] = g.tile_size / std::abs(d[a]);
     }
   }
-  const double voxel = g.voxel_size();
   for (;;) {
     const TileIndex t{static_cast<std::int32_t>(cell[0]), static_cast<std::int32_t>(cell[1]),
                       static_cast<std::int32_t>(cell[2])};
-    if (const Opened* opened = open(t)) {
-      std::call_once(const_cast<Opened*>(opened)->caster_once, [opened] {
-        const_cast<Opened*>(opened)->caster = std::make_unique<raycast::RayCaster>(opened->tree);
-        const_cast<Opened*>(opened)->colours = std::make_unique<raycast::VoxelColours>(opened->tree);
-      });
-      raycast::Ray local = raycast::world_ray_to_grid(g.tile_frame(t), world_ray);
-      const auto hit = opened->caster->cast(local);
-      check_mapped(opened->tree);
-      if (hit) return TileHit{t, hit->voxel, hit->t * voxel, hit->normal};
-    }
+    if (auto hit = cast_in_tile(t, world_ray)) return hit;
     const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
     if (!(next[a] <= t1)) return std::nullopt;
     cell[a] += step[a];
     if (cell[a] < lo[a] || cell[a] > hi[a]) return std::nullopt;
     next[a] += delta[a];
   }
+}
+
+std::optional<TileHit> TileSet::cast_in_tile(const TileIndex& t, const raycast::Ray& world_ray) const {
+  const Opened* opened = open(t);
+  if (!opened) return std::nullopt;
+  std::call_once(const_cast<Opened*>(opened)->caster_once, [opened] {
+    const_cast<Opened*>(opened)->caster = std::make_unique<raycast::RayCaster>(opened->tree);
+    const_cast<Opened*>(opened)->colours = std::make_unique<raycast::VoxelColours>(opened->tree);
+  });
+  const raycast::Ray local = raycast::world_ray_to_grid(index_.grid.tile_frame(t), world_ray);
+  const auto hit = opened->caster->cast(local);
+  check_mapped(opened->tree);
+  if (!hit) return std::nullopt;
+  return TileHit{t, hit->voxel, hit->t * index_.grid.voxel_size(), hit->normal};
+}
+
+// The listed tiles whose boxes the ray meets within [t0, t1], by entry distance: tiles do
+// not overlap, so a hit in one comes before any in the tiles the ray enters later.
+std::optional<TileHit> TileSet::cast_listed(const raycast::Ray& world_ray, double t0, double t1) const {
+  const Point& o = world_ray.origin;
+  const Point& d = world_ray.direction;
+  std::vector<std::pair<double, std::size_t>> met;
+  for (std::size_t p = 0; p < index_.tiles.size(); ++p) {
+    const Box b = index_.grid.tile_box(index_.tiles[p].tile);
+    double enter = t0, leave = t1;
+    for (int a = 0; a < 3 && enter <= leave; ++a) {
+      if (d[a] == 0.0) {
+        if (o[a] < b.min[a] || o[a] > b.max[a]) enter = leave + 1.0;
+        continue;
+      }
+      double ta = (b.min[a] - o[a]) / d[a], tb = (b.max[a] - o[a]) / d[a];
+      if (ta > tb) std::swap(ta, tb);
+      enter = std::max(enter, ta);
+      leave = std::min(leave, tb);
+    }
+    if (enter <= leave) met.emplace_back(enter, p);
+  }
+  std::sort(met.begin(), met.end());
+  for (const auto& [enter, p] : met)
+    if (auto hit = cast_in_tile(index_.tiles[p].tile, world_ray)) return hit;
+  return std::nullopt;
 }
 
 Tree TileSet::mosaic(const Box& box) const {

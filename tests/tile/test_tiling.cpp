@@ -4,8 +4,11 @@
 // agree with one grid over the same voxels.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
@@ -300,6 +303,68 @@ TEST(TileSet, LocateMosaicAndRaysAgreeWithOneGrid) {
     EXPECT_EQ(a->normal, b->normal) << "ray " << r;
   }
   EXPECT_GT(hits, 8000);
+}
+
+// A copy of the set's index with its features changed by `edit`, written as `name`.
+std::string edited_index(const fs::path& folder, const std::string& name,
+                         const std::function<void(nlohmann::json& features)>& edit) {
+  nlohmann::json index = nlohmann::json::parse(std::ifstream(folder / "index.geojson"));
+  edit(index["features"]);
+  std::ofstream(folder / name) << index.dump();
+  return (folder / name).string();
+}
+
+// Listed tiles far apart: the DDA steps through every empty cell between them (an index
+// with one tile at [2^31 - 1, ...] spun for minutes), so such rays take the listed tiles
+// in their order instead, with the same hits. A tile file is checked against the cell the
+// index puts it in: a swapped index answered "empty" for occupied points.
+TEST(TileSet, FarApartTilesAndMisplacedFiles) {
+  vola_test::TempDir dir;
+  const PointsInMemory points(40000, 4, 4);
+  const tile::TileOptions o = small_grid(dir / "t");
+  auto comm = tile::single_process();
+  tile::make_tiles({&points}, o, *comm);
+  const tile::TileSet near((dir / "t" / "index.geojson").string());
+  ASSERT_GE(near.index().tiles.size(), 2u);
+  const tile::TileSet spread(edited_index(dir / "t", "far.geojson", [](nlohmann::json& features) {
+    nlohmann::json far = features[0];
+    far["properties"]["tile"] = {2147483000, 2147483000, 2147483000};
+    features.push_back(far);
+  }));
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-120.0, 140.0);
+  int hits = 0;
+  for (int r = 0; r < 2000; ++r) {
+    raycast::Ray ray;
+    ray.origin = {u(rng), u(rng), u(rng)};
+    const std::size_t p = static_cast<std::size_t>(r) * 7919 % 40000;
+    Point d{};
+    for (int a = 0; a < 3; ++a) d[a] = points.all()[3 * p + a] - ray.origin[a];
+    const double m = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(m > 1e-3)) continue;
+    for (double& c : d) c /= m;
+    ray.direction = d;
+    const auto a = near.cast(ray), b = spread.cast(ray);
+    ASSERT_EQ(a.has_value(), b.has_value()) << "ray " << r;
+    if (!a) continue;
+    ++hits;
+    EXPECT_EQ(a->tile, b->tile);
+    EXPECT_EQ(a->voxel, b->voxel);
+    EXPECT_EQ(a->t, b->t);
+  }
+  EXPECT_GT(hits, 1000);
+
+  const tile::TileSet swapped(edited_index(dir / "t", "swapped.geojson", [](nlohmann::json& features) {
+    std::swap(features[0]["properties"]["file"], features[1]["properties"]["file"]);
+  }));
+  const tile::TileIndex first = near.index().tiles[0].tile;
+  const Box box = near.grid().tile_box(first);
+  try {
+    swapped.locate({0.5 * (box.min[0] + box.max[0]), 0.5 * (box.min[1] + box.max[1]), 0.5 * (box.min[2] + box.max[2])});
+    ADD_FAILURE() << "a tile file in another tile's cell was read";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not that of the cell"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TileIndex, BadIndexFilesGetClearErrors) {

@@ -61,7 +61,11 @@ class TileSet {
 
  private:
   struct Opened;
+  // Maps the tile on first use; throws FormatError when its file's grid is not its cell's.
   const Opened* open(const TileIndex& tile) const;
+  void check_tile_place(const Tree& tree, const TileIndex& tile, const std::string& path) const;
+  std::optional<TileHit> cast_in_tile(const TileIndex& tile, const raycast::Ray& world_ray) const;
+  std::optional<TileHit> cast_listed(const raycast::Ray& world_ray, double t0, double t1) const;
 
   std::string folder_;
   TileIndexFile index_;
