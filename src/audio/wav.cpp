@@ -3,6 +3,7 @@
 #include <sndfile.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <memory>
@@ -91,7 +92,16 @@ Sound read_sound(const std::string& path) {
     const sf_count_t got = sf_readf_double(file.get(), chunk.data(), chunk_frames);
     if (got < 0) throw IoError(path + ": " + sf_strerror(file.get()));
     for (sf_count_t f = 0; f < got; ++f)
-      for (std::size_t c = 0; c < channels; ++c) s.channels[c].push_back(chunk[static_cast<std::size_t>(f) * channels + c]);
+      for (std::size_t c = 0; c < channels; ++c) {
+        const double sample = chunk[static_cast<std::size_t>(f) * channels + c];
+        // A float file may hold NaN or infinity: one such sample made every output sample
+        // NaN (or -32768 as PCM) through the convolution and the normalisation.
+        if (!std::isfinite(sample))
+          throw FormatError(path, std::nullopt,
+                            "sample " + std::to_string(s.channels[c].size()) + " of channel " + std::to_string(c) +
+                                " is not a finite number");
+        s.channels[c].push_back(sample);
+      }
     if (got < chunk_frames) break;
   }
   if (sf_error(file.get()) != SF_ERR_NO_ERROR) throw IoError(path + ": " + sf_strerror(file.get()));

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <vector>
 
 #include "audio_test_support.hpp"
 #include "vola/audio/wav.hpp"
@@ -134,6 +136,15 @@ TEST_F(SonifyCli, BadInputsFailWithOneClearLine) {
   r = run(path("room.vol") + " --listener 9 3 2 --out " + path("o.wav") + " --source 2 1.5 1.25 --in " + dry, dir_);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("the listener (9, 3, 2) is outside the scene's grid"), std::string::npos) << r.output;
+  // One NaN in a float recording made every output sample NaN (-32768 as PCM), exit 0.
+  vola::audio::Sound tone;
+  tone.sample_rate = 16000;
+  tone.channels.assign(1, std::vector<double>(2000, 0.25));
+  tone.channels[0][100] = std::numeric_limits<double>::quiet_NaN();
+  vola::audio::write_wav(path("nan.wav"), tone, vola::audio::SampleFormat::float32);
+  r = run(base + " --source 2 1.5 1.25 --in " + path("nan.wav"), dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("nan.wav: sample 100 of channel 0 is not a finite number"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(path("o.wav")));
 }
 
