@@ -213,6 +213,16 @@ class BinaryInput {
     if (count > (bytes_.size() - at_) / static_cast<std::uint64_t>(byte_size(t)))
       fail("a list of " + std::to_string(count) + " values runs past the end of the file");
   }
+  void end_record(const std::string&) {}  // records have no separators
+  // Bytes after the last element (a file of more vertices than its header declares gave
+  // the declared number); a line end or spaces some writers add are no data.
+  void end_data() {
+    for (std::size_t i = at_; i < bytes_.size(); ++i)
+      if (bytes_[i] != '\n' && bytes_[i] != '\r' && bytes_[i] != ' ') {
+        at_ = i;
+        fail(std::to_string(bytes_.size() - i) + " bytes after the last element the header declares");
+      }
+  }
   [[noreturn]] void fail(const std::string& cause) const { throw FormatError(name_, at_, cause); }
 
  private:
@@ -244,6 +254,29 @@ class AsciiInput {
     for (std::uint64_t i = 0; i < count; ++i) next();
   }
   void expect(PlyType, std::uint64_t) {}  // values are read one by one
+  // One element a line: values left on the line mean the header does not describe the
+  // data (a line "x y z 99" under three properties shifted every later coordinate).
+  void end_record(const std::string& element) {
+    while (at_ < text_.size() && (text_[at_] == ' ' || text_[at_] == '\t' || text_[at_] == '\r')) ++at_;
+    if (at_ < text_.size() && text_[at_] != '\n') {
+      token_start_ = at_;
+      token_line_ = line_;
+      fail("more values than the header's " + element + " properties");
+    }
+  }
+  // Nothing but white space may follow the last element (a file of more vertices than its
+  // header declares gave the declared number, the rest unread).
+  void end_data() {
+    while (at_ < text_.size() && is_header_space(text_[at_])) {
+      if (text_[at_] == '\n') ++line_;
+      ++at_;
+    }
+    if (at_ < text_.size()) {
+      token_start_ = at_;
+      token_line_ = line_;
+      fail("values after the last element the header declares");
+    }
+  }
   [[noreturn]] void fail(const std::string& cause) const {
     throw FormatError(name_, token_start_, "line " + std::to_string(token_line_) + ": " + cause);
   }
@@ -362,8 +395,10 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
         out.cloud.xyz.insert(out.cloud.xyz.end(), {v[0], v[1], v[2]});
         if (colours) colours->add(v[3], v[4], v[5]);
       }
+      in.end_record(e.name);
     }
   }
+  in.end_data();
 }
 
 }  // namespace

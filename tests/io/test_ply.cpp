@@ -337,6 +337,13 @@ TEST(Ply, CorruptedInputIsAFormatErrorNamingTheProblem) {
       {"ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty double x\nproperty double y\n"
        "property double z\nend_header\n",
        "truncated"},
+      // One element a line: "x y z 99" under three properties shifted every later coordinate.
+      {head + faces.substr(0, faces.find("0 0 0")) + "0 0 0 99\n1 1 1\n3 0 1 1\n", "more values than the header's vertex"},
+      // More elements than the header declares were left unread.
+      {head + faces + "3 0 1 1\n2 2 2\n", "values after the last element"},
+      {"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n0123456789ab",
+       "12 bytes after the last element"},
   };
   for (const auto& c : cases) {
     const auto error = error_of_text(c.text);
