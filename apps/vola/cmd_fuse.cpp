@@ -134,7 +134,20 @@ void fuse_into(const FuseArgs& a, const slam::Sequence& sequence, const slam::Fu
   std::printf("surface: %zu voxels in the .vol (depth %d)%s\n", surface.size(), tree.depth(),
               a.mesh.empty() ? "" : (", " + std::to_string(triangles) + " triangles in the mesh").c_str());
   if (!sequence.groundtruth.empty() && !a.groundtruth_poses && frames >= 3) {
-    const auto ate = slam::absolute_trajectory_error(sequence.groundtruth, result.trajectory);
+    // The outputs are written: ground truth that matches no frame in time is a warning
+    // about the figures, not a failure of the run (it exited 1, or 0 with -q).
+    slam::AbsoluteError ate;
+    try {
+      ate = slam::absolute_trajectory_error(sequence.groundtruth, result.trajectory);
+    } catch (const InvalidArgument& e) {  // fewer than 3 poses associate
+      std::fprintf(stderr,
+                   "vola fuse: warning: %s: no ATE or RPE: its timestamps (%.6f .. %.6f s) and the frames' (%.6f .. "
+                   "%.6f s) do not match (%s)\n",
+                   (a.sequence + "/groundtruth.txt").c_str(), sequence.groundtruth.front().timestamp,
+                   sequence.groundtruth.back().timestamp, result.trajectory.front().timestamp,
+                   result.trajectory.back().timestamp, e.what());
+      return;
+    }
     std::printf("ATE: RMSE %.4f m, mean %.4f m, median %.4f m, max %.4f m over %zu poses\n", ate.rmse, ate.mean,
                 ate.median, ate.max, ate.pairs);
     const auto rpe = slam::relative_pose_error(sequence.groundtruth, result.trajectory);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -194,12 +195,32 @@ std::vector<std::pair<std::size_t, std::size_t>> associate(const std::vector<dou
     double difference;
     std::size_t ia, ib;
   };
+  // Every pair within the window is a candidate, as TUM's associate.py has it: counted
+  // first, since repeated timestamps or a window far wider than the frames' spacing make
+  // it n x m (15,000 poses at one timestamp ran out of memory at 3 GB).
+  const auto window = [&](double t) {
+    const auto lo = std::lower_bound(b_order.begin(), b_order.end(), t - max_difference,
+                                     [&](std::size_t ib, double v) { return b[ib] < v; });
+    const auto hi = std::upper_bound(lo, b_order.end(), t + max_difference,
+                                     [&](double v, std::size_t ib) { return v < b[ib]; });
+    return std::pair(lo, hi);
+  };
+  constexpr std::uint64_t kMaxCandidates = 20'000'000;  // ~480 MB of candidates
+  std::uint64_t count = 0;
+  for (const double t : a) {
+    const auto [lo, hi] = window(t);
+    count += static_cast<std::uint64_t>(hi - lo);
+  }
+  if (count > kMaxCandidates)
+    throw InvalidArgument("associating timestamps: " + std::to_string(count) + " pairs lie within " +
+                          std::to_string(max_difference) + " s of each other (more than " +
+                          std::to_string(kMaxCandidates) + "): the timestamps repeat, or the allowed difference is "
+                          "far wider than the frames' spacing");
   std::vector<Candidate> candidates;
+  candidates.reserve(count);
   for (std::size_t ia = 0; ia < a.size(); ++ia) {
-    auto it = std::lower_bound(b_order.begin(), b_order.end(), a[ia] - max_difference,
-                               [&](std::size_t ib, double t) { return b[ib] < t; });
-    for (; it != b_order.end() && b[*it] <= a[ia] + max_difference; ++it)
-      candidates.push_back({std::abs(a[ia] - b[*it]), ia, *it});
+    const auto [lo, hi] = window(a[ia]);
+    for (auto it = lo; it != hi; ++it) candidates.push_back({std::abs(a[ia] - b[*it]), ia, *it});
   }
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& x, const Candidate& y) { return x.difference < y.difference; });

@@ -167,6 +167,15 @@ TEST(SlamSequence, AssociateIsGreedyByTimeDifference) {
   ASSERT_EQ(m.size(), 2u);
   EXPECT_EQ(m[0], std::make_pair(std::size_t{0}, std::size_t{0}));
   EXPECT_EQ(m[1], std::make_pair(std::size_t{1}, std::size_t{2}));
+  // Every pair within the window is a candidate (TUM's associate.py): 15,000 poses at one
+  // timestamp make 2.25e8 of them, which ran out of memory at 3 GB. Refused, counted first.
+  const std::vector<double> same(15000, 5.0);
+  try {
+    associate(same, same, 0.02);
+    ADD_FAILURE() << "2.25e8 candidate pairs were built";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("225000000 pairs lie within"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SlamSequence, MissingSequenceSaysWhatIsMissing) {
