@@ -183,6 +183,25 @@ TEST(DemGdal, FilesGdalCannotReadThrowFormatErrors) {
   bytes.resize(bytes.size() / 2);
   vola_test::write_bytes(dir / "half.tif", bytes);
   EXPECT_THROW(vola::io::read_dem((dir / "half.tif").string()), vola::FormatError);
+
+  // Placed by ground control points, no geotransform: it was read in pixel units, its CRS
+  // (on the points) dropped, without a word.
+  {
+    GDALDataset* d = GetGDALDriverManager()->GetDriverByName("GTiff")->Create((dir / "gcp.tif").c_str(), 8, 8, 1,
+                                                                                GDT_Float32, nullptr);
+    ASSERT_NE(d, nullptr);
+    OGRSpatialReference srs;
+    srs.importFromEPSG(32633);
+    GDAL_GCP gcp;
+    GDALInitGCPs(1, &gcp);
+    gcp.dfGCPPixel = 0, gcp.dfGCPLine = 0, gcp.dfGCPX = 500000, gcp.dfGCPY = 5000000;
+    ASSERT_EQ(d->SetGCPs(1, &gcp, &srs), CE_None);
+    GDALDeinitGCPs(1, &gcp);
+    GDALClose(d);
+  }
+  const auto gcp = vola_test::format_error_of([&] { vola::io::read_dem((dir / "gcp.tif").string()); });
+  ASSERT_TRUE(gcp.has_value());
+  EXPECT_NE(gcp->cause().find("ground control points, not a geotransform"), std::string::npos) << gcp->what();
 }
 
 }  // namespace

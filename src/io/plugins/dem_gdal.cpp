@@ -60,8 +60,13 @@ DemRaster read_dem_with_gdal(const std::string& path,
                           " cells is more than " + std::to_string(kMaxDemCells) + "; crop or resample it first");
   crs_of(*dataset, path, dem);
   double gt[6];
-  // Without a geotransform GDAL fills the identity: cell (i, j) is at (i, j).
-  (void)dataset->GetGeoTransform(gt);
+  // Without a geotransform GDAL fills the identity: cell (i, j) is at (i, j). A raster
+  // placed by ground control points instead has its CRS on them, not on the cells: read
+  // as the identity, it came out in pixel units with no CRS and no word.
+  if (dataset->GetGeoTransform(gt) != CE_None && dataset->GetGCPCount() > 0)
+    throw FormatError(path, std::nullopt,
+                      "the raster is placed by " + std::to_string(dataset->GetGCPCount()) +
+                          " ground control points, not a geotransform; warp it onto a grid first (gdalwarp)");
   if (gt[2] == 0.0 && gt[4] == 0.0 && std::isfinite(gt[0]) && std::isfinite(gt[3]))
     dem.lattice = std::array<double, 2>{gt[0], gt[3]};
 
