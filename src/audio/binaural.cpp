@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -18,11 +19,33 @@ struct Hrtf::Handle {
   }
 };
 
+namespace {
+
+// libmysofa's error as words: its own codes from 10000 on, and errno values (a missing
+// file gave "libmysofa error 2") below.
+std::string sofa_error_text(int error) {
+  switch (error) {
+    case MYSOFA_INTERNAL_ERROR: return "libmysofa's internal error";
+    case MYSOFA_INVALID_FORMAT: return "not a SOFA (HDF5) file, or a damaged one";
+    case MYSOFA_UNSUPPORTED_FORMAT: return "a SOFA convention libmysofa does not support";
+    case MYSOFA_NO_MEMORY: return "out of memory";
+    case MYSOFA_READ_ERROR: return "a read error";
+    case MYSOFA_INVALID_ATTRIBUTES: return "SOFA attributes missing or invalid";
+    case MYSOFA_INVALID_DIMENSIONS: case MYSOFA_INVALID_DIMENSION_LIST: return "SOFA dimensions invalid";
+    case MYSOFA_ONLY_THE_SAME_SAMPLING_RATE_SUPPORTED: return "measurements at more than one sampling rate";
+    default: break;
+  }
+  if (error > 0 && error < MYSOFA_INVALID_FORMAT) return std::strerror(error);
+  return "libmysofa error " + std::to_string(error);
+}
+
+}  // namespace
+
 Hrtf::Hrtf(const std::string& path, double sample_rate) : handle_(std::make_unique<Handle>()), sample_rate_(sample_rate) {
   int length = 0, error = 0;
   handle_->easy = mysofa_open(path.c_str(), static_cast<float>(sample_rate), &length, &error);
   if (!handle_->easy || error != MYSOFA_OK || length <= 0)
-    throw IoError(path + ": cannot load the HRTF (SOFA file; libmysofa error " + std::to_string(error) + ")");
+    throw IoError(path + ": cannot load the HRTF (SOFA file): " + sofa_error_text(error));
   length_ = static_cast<std::size_t>(length);
 }
 

@@ -27,6 +27,7 @@ void for_each_data_line(const std::string& file, F&& f) {
   std::size_t number = 0;
   while (std::getline(in, line)) {
     ++number;
+    if (number == 1 && line.starts_with("\xef\xbb\xbf")) line.erase(0, 3);  // a UTF-8 byte order mark
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
