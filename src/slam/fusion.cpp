@@ -436,6 +436,16 @@ Fusion<Store>::Fusion(Store& store, const Intrinsics& intrinsics, std::uint32_t 
     throw InvalidArgument("the principal point (cx " + std::to_string(intrinsics.cx) + ", cy " +
                           std::to_string(intrinsics.cy) + ") lies outside the " + std::to_string(width) + " x " +
                           std::to_string(height) + " image: check intrinsics.txt ('fx fy cx cy' in pixels)");
+  // Focal lengths that no camera has: a field of view under 0.06 or over 177 degrees
+  // (fx of 1e300 or 1e-300 ended in "no depth was measured", which blamed the depth).
+  const auto plausible = [](double focal, std::uint32_t side) {
+    return std::abs(focal) >= 0.01 * side && std::abs(focal) <= 1000.0 * side;
+  };
+  if (!plausible(intrinsics.fx, width) || !plausible(intrinsics.fy, height))
+    throw InvalidArgument("the focal lengths (fx " + std::to_string(intrinsics.fx) + ", fy " +
+                          std::to_string(intrinsics.fy) + " pixels) are implausible for a " + std::to_string(width) +
+                          " x " + std::to_string(height) + " image (0.01 to 1000 times its side): check "
+                          "intrinsics.txt ('fx fy cx cy' in pixels)");
 }
 
 namespace {

@@ -55,6 +55,14 @@ TEST(SlamParallel, APrincipalPointOffTheImageIsRefused) {
     EXPECT_THROW(Fusion<SparseTsdfStore>(store, k, kWidth, kHeight, vola_slam_test::small_scene_params()),
                  vola::InvalidArgument);
   }
+  // So are focal lengths no camera has (1e300 ended in "no depth was measured").
+  for (const double f : {1e300, 1e-300, -1e300}) {
+    Intrinsics k = kIntrinsics;
+    k.fx = f;
+    EXPECT_THROW(Fusion<SparseTsdfStore>(store, k, kWidth, kHeight, vola_slam_test::small_scene_params()),
+                 vola::InvalidArgument);
+  }
+  EXPECT_NO_THROW(Fusion<SparseTsdfStore>(store, kIntrinsics, kWidth, kHeight, vola_slam_test::small_scene_params()));
 }
 
 TEST(SlamParallel, PerPixelStagesDoNotDependOnTheThreadCount) {
