@@ -3,7 +3,6 @@
 // 0..r, each seen at the (dy, dz) offsets of the disc whose x extent is that half width:
 // about pi r^2 shifted words per brick instead of 4/3 pi r^3.
 #include <algorithm>
-#include <array>
 #include <cstdint>
 #include <string>
 
@@ -16,23 +15,16 @@ namespace vola::analysis {
 namespace {
 
 // A result that no machine here could hold is refused before the walk: it holds at least
-// the element around any one voxel (clipped to the grid), and a sphere at least half of
-// that cube. 2^36 voxels are 8 GiB of leaf words even packed densely. (Three voxels
-// dilated by a cube of radius 10^6 ran for minutes; by 10^5, "out of memory".)
+// the element around one voxel, clipped to the grid, which is smallest at a corner
+// (min(r + 1, side) cells per axis; a sphere at least half of that cube). 2^36 voxels are
+// 8 GiB of leaf words even packed densely. (Three voxels dilated by a cube of radius 10^6
+// ran for minutes; by 10^5, "out of memory".)
 constexpr double kMaxResultVoxels = 68719476736.0;  // 2^36
 
 void check_result_size(const Tree& tree, int radius, Element element) {
   if (tree.empty()) return;
-  double least = 0.0;
-  tree.for_each_voxel([&](const Voxel& v) {
-    if (least > 0.0) return;
-    double cells = element == Element::sphere ? 0.5 : 1.0;
-    for (const std::uint32_t c : {v.x, v.y, v.z}) {
-      const double lo = std::max(0.0, double(c) - radius), hi = std::min(double(tree.side()) - 1.0, double(c) + radius);
-      cells *= hi - lo + 1.0;
-    }
-    least = cells;
-  });
+  const double per_axis = std::min(double(radius) + 1.0, double(tree.side()));
+  const double least = (element == Element::sphere ? 0.5 : 1.0) * per_axis * per_axis * per_axis;
   if (least > kMaxResultVoxels)
     throw InvalidArgument("radius " + std::to_string(radius) + ": the dilation would hold at least " +
                           std::to_string(static_cast<std::uint64_t>(least)) + " voxels (more than 2^36, 8 GiB of " +
