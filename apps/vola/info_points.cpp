@@ -81,9 +81,11 @@ void print_compression(const io::LasHeader& hd) {
   const char* kinds[] = {"none", "point-wise", "point-wise chunked", "layered chunked"};
   std::printf("laz:         compressor %u (%s), LASzip %u.%u r%u, ", z.compressor, z.compressor <= 3 ? kinds[z.compressor] : "?",
               z.version_major, z.version_minor, z.revision);
-  if (z.chunk_size == io::laz::kVariableChunkSize) std::printf("variable chunks");
+  if (z.compressor == 1) std::printf("one stream, not chunked");  // its chunk size field means nothing
+  else if (z.chunk_size == io::laz::kVariableChunkSize) std::printf("variable chunks");
   else std::printf("chunks of %u points", z.chunk_size);
-  std::printf(", %zu chunk%s\nitems:      ", hd.laz_chunks.size(), hd.laz_chunks.size() == 1 ? "" : "s");
+  if (z.compressor != 1) std::printf(", %zu chunk%s", hd.laz_chunks.size(), hd.laz_chunks.size() == 1 ? "" : "s");
+  std::printf("\nitems:      ");
   for (const auto& item : z.items) std::printf(" %s", io::laz::describe_item(item).c_str());
   std::printf("\n");
 }

@@ -1,6 +1,6 @@
 // Seeds for fuzz_laz_read: the small LAZ files of the shared data folder (beside
 // golden/) and LAZ files written here with the codec's encoder (point formats 0-3 and
-// 6-8, the wave-packet formats 4, 5, 9 and 10, extra bytes, several chunks, variable chunks, compressor 1, item version 4).
+// 6-8, the wave-packet formats 4, 5, 9 and 10, extra bytes, several chunks, variable chunks, compressor 1, item versions 1 and 4).
 // Linked into fuzz_laz_replay in place of fuzz_seeds.cpp.
 #include <algorithm>
 #include <cstring>
@@ -87,6 +87,8 @@ std::vector<Seed> synthetic_seeds() {
     } else {
       info.compressor = 1;
       seeds.push_back({name + "_unchunked", laz_file(info, static_cast<std::uint8_t>(format), records(length, 20, static_cast<std::uint64_t>(format) + 9), 0)});
+      for (auto& item : info.items) item.version = 1;  // LASzip 1.x
+      seeds.push_back({name + "_v1_unchunked", laz_file(info, static_cast<std::uint8_t>(format), records(length, 20, static_cast<std::uint64_t>(format) + 17), 0)});
     }
   }
   return seeds;

@@ -129,11 +129,14 @@ Bytes las_file_bytes(std::uint8_t point_format, std::uint16_t record_length, std
 }
 
 Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points) {
+  return laz_from_las(las, chunk_points, vola::io::laz::laszip_info_for(las.point_format, las.record_length));
+}
+
+Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points, vola::io::laz::LaszipInfo info) {
   namespace laz = vola::io::laz;
-  laz::LaszipInfo info = laz::laszip_info_for(las.point_format, las.record_length);
   const Bytes records = las_records(las);
   const LasFile made = make_laz(info, records, chunk_points);  // the chunks and table
-  info.chunk_size = chunk_points;
+  if (info.compressor != 1) info.chunk_size = chunk_points;
   const Bytes payload = laz::laszip_vlr_payload(info);
   // The header and VLRs, without any padding before the point data.
   std::size_t vlrs_end = get<std::uint16_t>(las.bytes, 94);
@@ -156,6 +159,10 @@ Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points) {
   std::memcpy(out.data() + 96, &offset_to_points, 4);
   out[104] = static_cast<std::uint8_t>(las.point_format | 0x80);
   if (out[25] >= 4 && out.size() >= 247) std::memset(out.data() + 235, 0, 12);  // no EVLRs
+  if (info.compressor == 1) {  // one stream, no table
+    out.insert(out.end(), made.bytes.begin() + made.offset_to_points, made.bytes.end());
+    return out;
+  }
   // The chunks and table, with the offsets moved to this file's point data.
   const std::int64_t shift = static_cast<std::int64_t>(offset_to_points) - made.offset_to_points;
   std::uint64_t table_at;

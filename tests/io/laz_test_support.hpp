@@ -51,5 +51,7 @@ Bytes las_file_bytes(std::uint8_t point_format, std::uint16_t record_length, std
 // the uncompressed LAS file `las`: its header and VLRs, plus the laszip VLR, point
 // format | 0x80, chunks of `chunk_points` records and the chunk table; EVLRs dropped.
 Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points);
+// The same with the given items and compressor (1: one stream, no chunk table).
+Bytes laz_from_las(const LasFile& las, std::uint32_t chunk_points, vola::io::laz::LaszipInfo info);
 
 }  // namespace vola_laz_test

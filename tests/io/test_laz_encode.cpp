@@ -13,6 +13,7 @@
 #include "io_test_data.hpp"
 #include "laz_test_support.hpp"
 #include "vola/error.hpp"
+#include "vola/io/las.hpp"
 
 namespace {
 
@@ -205,6 +206,71 @@ TEST(LazEncode, GeneratedStreamsRoundTripInEveryFormat) {
       }
     }
   }
+}
+
+// Version 1 of the point-wise items (what LASzip 1.x wrote): `info` with every item
+// but the wave packet (whose only version is 1) in version 1.
+laz::LaszipInfo version_one(laz::LaszipInfo info) {
+  for (auto& item : info.items) item.version = 1;
+  return info;
+}
+
+// Version 1 items, alone and one at a time beside version 2 ones, in one unchunked
+// stream (as LASzip 1.x wrote them) and in chunks. Each stream must differ from the
+// version 2 stream of the same records: a reader that took version 1 for version 2
+// would round-trip too.
+TEST(LazEncode, VersionOneItemsRoundTrip) {
+  for (std::uint8_t format = 0; format <= 5; ++format) {
+    for (const std::uint16_t extra : {std::uint16_t{0}, std::uint16_t{3}}) {
+      for (double noise : {0.0, 0.05, 1.0}) {
+        SCOPED_TRACE("format " + std::to_string(format) + " extra " + std::to_string(extra) + " noise " +
+                     std::to_string(noise));
+        static constexpr std::uint16_t kBase[] = {20, 28, 26, 34, 57, 63};
+        const auto length = static_cast<std::uint16_t>(kBase[format] + extra);
+        const Bytes records = generated_records(format, length, 3000, 700u + format * 10u + extra, noise);
+        const laz::LaszipInfo v2 = laz::laszip_info_for(format, length);
+        laz::LaszipInfo v1 = version_one(v2);
+        expect_round_trip(v1, records, 1000);
+        EXPECT_NE(vola_laz_test::make_laz(v1, records, 1000).bytes, vola_laz_test::make_laz(v2, records, 1000).bytes);
+        v1.compressor = 1;
+        expect_round_trip(v1, records, 0);
+        for (std::size_t i = 0; i < v2.items.size(); ++i) {
+          if (v2.items[i].type == laz::kWavePacket13) continue;
+          laz::LaszipInfo mixed = v2;
+          mixed.items[i].version = 1;
+          SCOPED_TRACE(laz::describe_item(mixed.items[i]));
+          expect_round_trip(mixed, records, 1000);
+          EXPECT_NE(vola_laz_test::make_laz(mixed, records, 1000).bytes,
+                    vola_laz_test::make_laz(v2, records, 1000).bytes);
+        }
+      }
+    }
+  }
+}
+
+// Whole LASzip 1.x-style files (version 1 items, compressor 1) of every shared LAS
+// file of formats 0-5, read through the LAS reader (`translate_las` to LAS), give the
+// LAS file's records back.
+TEST(LazEncode, VersionOneFilesReadLikeTheirLas) {
+  VOLA_REQUIRE_DATA(data);
+  vola_test::TempDir tmp;
+  int tested = 0;
+  for (const fs::path& path : vola_io_test::files_ending(data / "las", ".las")) {
+    const LasFile las = vola_laz_test::read_las_file(path);
+    if (las.point_format > 5) continue;
+    SCOPED_TRACE(path.filename().string());
+    laz::LaszipInfo info = version_one(laz::laszip_info_for(las.point_format, las.record_length));
+    info.compressor = 1;
+    const fs::path laz_path = tmp / (path.stem().string() + ".laz"), back = tmp / (path.stem().string() + ".las");
+    Bytes file = vola_laz_test::laz_from_las(las, 0, info);
+    // A LAS 1.3+ header's start of waveform data pointed into the LAS file, not this one.
+    if (file[25] >= 3) std::memset(file.data() + 227, 0, 8);
+    vola_test::write_bytes(laz_path, file);
+    ASSERT_NO_THROW(vola::io::translate_las(laz_path.string(), back.string()));
+    EXPECT_TRUE(vola_laz_test::las_records(vola_laz_test::read_las_file(back)) == vola_laz_test::las_records(las));
+    ++tested;
+  }
+  EXPECT_GE(tested, 10);
 }
 
 // A chunk whose wave packets never change leaves their layer out; its points still

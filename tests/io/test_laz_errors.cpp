@@ -139,7 +139,9 @@ TEST(LazErrors, UnsupportedRecordsAreRefused) {
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(0, 7)));        // compressor
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(0, 0)));        // compressor "none"
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(2, 1)));        // coder
-  EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 4, 1)));   // POINT10 version 1 (LASzip 1.x)
+  EXPECT_NO_THROW(laz::parse_laszip_vlr(patched(34 + 4, 1)));       // POINT10 version 1 (LASzip 1.x)
+  EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 4, 0)));   // POINT10 version 0
+  EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 4, 3)));   // POINT10 version 3
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 10, 3)));  // GPSTIME11 version 3
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 8, 9)));   // GPSTIME11 size
   EXPECT_FORMAT_ERROR(laz::parse_laszip_vlr(patched(34 + 6, 9)));   // WAVEPACKET13 (size 8: also wrong)

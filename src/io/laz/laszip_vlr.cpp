@@ -42,13 +42,14 @@ class ItemCursor {
     if (at_ == info_.items.size() || info_.items[at_].type != type) return nullptr;
     const Item& item = info_.items[at_];
     if (size ? item.size != size : item.size == 0) fail(describe_item(item) + " has the wrong size");
-    // LASzip defines WAVEPACKET13 in version 1 only, beside version 2 of the other items.
+    // LASzip defines WAVEPACKET13 in version 1 only, the other point-wise items in
+    // versions 1 (LASzip 1.x) and 2.
     const bool supported = layered                    ? (item.version == 3 || item.version == 4)
                            : item.type == kWavePacket13 ? item.version == 1
-                                                        : item.version == 2;
+                                                        : (item.version == 1 || item.version == 2);
     if (!supported)
       fail(describe_item(item) +
-           " is not supported (point-wise items need version 2, wave packets 1; layered items 3 or 4)");
+           " is not supported (point-wise items need version 1 or 2, wave packets 1; layered items 3 or 4)");
     ++at_;
     return &item;
   }
@@ -91,14 +92,23 @@ RecordLayout record_layout(const LaszipInfo& info, const std::string& source, st
     cursor.fail("compressor " + std::to_string(info.compressor) + " is not one of 1, 2, 3");
   if (info.compressor != 1 && info.chunk_size == 0) cursor.fail("chunk size 0");
   if (!layout.layered) {
-    if (!cursor.take(kPoint10, 20, false)) cursor.fail("point-wise records must start with POINT10");
+    const Item* point = cursor.take(kPoint10, 20, false);
+    if (!point) cursor.fail("point-wise records must start with POINT10");
+    layout.point_v1 = point->version == 1;
     layout.length = 20;
-    if (cursor.take(kGpsTime11, 8, false)) layout.gps_at = std::exchange(layout.length, layout.length + 8);
-    if (cursor.take(kRgb12, 6, false)) layout.rgb_at = std::exchange(layout.length, layout.length + 6);
+    if (const Item* gps = cursor.take(kGpsTime11, 8, false)) {
+      layout.gps_at = std::exchange(layout.length, layout.length + 8);
+      layout.gps_v1 = gps->version == 1;
+    }
+    if (const Item* rgb = cursor.take(kRgb12, 6, false)) {
+      layout.rgb_at = std::exchange(layout.length, layout.length + 6);
+      layout.rgb_v1 = rgb->version == 1;
+    }
     if (cursor.take(kWavePacket13, 29, false)) layout.wave_at = std::exchange(layout.length, layout.length + 29);
     if (const Item* bytes = cursor.take(kByte, 0, false)) {
       layout.bytes_at = layout.length;
       layout.bytes = bytes->size;
+      layout.bytes_v1 = bytes->version == 1;
       layout.length += bytes->size;
     }
   } else {

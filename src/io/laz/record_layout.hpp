@@ -1,7 +1,7 @@
 // Internal to the LAZ codec: where each item sits in a point record, checked once per
 // call so that the per-point loops only test flags. A record is one of the sequences
-//   POINT10 [GPSTIME11] [RGB12] [WAVEPACKET13] [BYTE]    (compressors 1, 2; version 2,
-//                                                         wave packets version 1)
+//   POINT10 [GPSTIME11] [RGB12] [WAVEPACKET13] [BYTE]    (compressors 1, 2; version 1
+//                                                         or 2, wave packets version 1)
 //   POINT14 [RGB14 | RGBNIR14] [WAVEPACKET14] [BYTE14]   (compressor 3; version 3 or 4)
 // which are the layouts of LAS point formats 0-10 with extra bytes.
 #pragma once
@@ -21,6 +21,9 @@ struct RecordLayout {
   // Version 4 of the layered items fixes how they follow the scanner channel (see
   // layered_chunk.cpp); each item has its own version.
   bool point_v4 = false, rgb_v4 = false, wave_v4 = false, bytes_v4 = false;
+  // Version 1 of the point-wise items (LASzip 1.x); each item has its own version.
+  bool point_v1 = false, gps_v1 = false, rgb_v1 = false, bytes_v1 = false;
+  bool any_v1() const { return point_v1 || gps_v1 || rgb_v1 || bytes_v1; }
   std::size_t length = 0;
   std::size_t gps_at = 0;    // 0 = none (point-wise only; layered records always have it)
   std::size_t rgb_at = 0;    // 0 = none
