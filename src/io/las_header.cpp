@@ -9,6 +9,7 @@
 
 #include "column_names.hpp"
 #include "las_format.hpp"
+#include "reader_plugin.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/las.hpp"
@@ -174,19 +175,24 @@ void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::u
 struct UnitKeys {
   std::uint32_t linear = 0;    // ProjLinearUnitsGeoKey
   std::uint32_t vertical = 0;  // VerticalUnitsGeoKey, when no VerticalCSTypeGeoKey names a vertical CRS
+  // The CRS is defined by its parts, not by a code: a user-defined (32767) projected CRS
+  // (its geographic code, if any, is only its base), or a model type that says projected
+  // with no projected code, or a user-defined geographic CRS with no projected one.
+  bool user_defined = false;
 };
 
 // GeoKeyDirectoryTag: the projected CRS code, else the geographic one (none when
 // user-defined), and the unit keys.
 void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
   const std::size_t keys = load_le<std::uint16_t>(&vlr.data[6]);
-  std::optional<std::uint32_t> projected, geographic;
+  std::optional<std::uint32_t> projected, geographic, model;
   bool vertical_crs = false;
   for (std::size_t k = 0; k < keys && 8 + 8 * k + 8 <= vlr.data.size(); ++k) {
     const std::uint8_t* e = &vlr.data[8 + 8 * k];
     const std::uint16_t id = load_le<std::uint16_t>(e), location = load_le<std::uint16_t>(e + 2);
     const std::uint16_t value = load_le<std::uint16_t>(e + 6);
     if (location != 0) continue;
+    if (id == 1024) model = value;
     if (id == 3072) projected = value;
     if (id == 2048) geographic = value;
     if (id == 3076) units.linear = value;
@@ -196,8 +202,42 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
   // A named vertical CRS has a unit of its own; GDAL then reads no vertical part at all
   // by default, and neither does vola (heights in the unit of x and y).
   if (vertical_crs) units.vertical = 0;
-  if (projected && *projected != las::kUserDefined && *projected != 0) hd.epsg = *projected;
-  else if (geographic && *geographic != las::kUserDefined && *geographic != 0) hd.epsg = *geographic;
+  const auto coded = [](const std::optional<std::uint32_t>& v) { return v && *v != las::kUserDefined && *v != 0; };
+  units.user_defined = coded(projected) ? false
+                       : projected      ? *projected == las::kUserDefined
+                                        : (model == 1u || (!coded(geographic) && geographic == las::kUserDefined));
+  if (units.user_defined) return;
+  if (coded(projected)) hd.epsg = *projected;
+  else if (coded(geographic)) hd.epsg = *geographic;
+}
+
+// A key directory that defines its CRS by its parts, read as GDAL reads it (the gdal
+// plugin, src/io/plugins/geokeys_gdal.cpp). Like a unit-qualified code, it becomes the
+// header's WKT (unless a WKT record wins) and the code PROJ identifies it as, or none.
+// Without GDAL's reading (GDAL reads no CRS from the keys, or cannot be loaded) the file
+// states none: never the base geographic code of projected coordinates.
+void apply_user_defined_keys(LasHeader& hd, const UnitKeys& units) {
+  if (!units.user_defined || !hd.wkt.empty()) return;
+  plugin::GeoKeyRecords records;
+  for (const auto& vlr : hd.vlrs) {
+    if (vlr.user_id != "LASF_Projection") continue;
+    if (vlr.record_id == 34735 && records.directory.empty()) records.directory = vlr.data;
+    if (vlr.record_id == 34736 && records.doubles.empty()) records.doubles = vlr.data;
+    if (vlr.record_id == 34737 && records.ascii.empty()) records.ascii = vlr.data;
+  }
+  try {
+    const auto entry = reinterpret_cast<plugin::GeokeysWktEntry>(
+        vola::plugin::plugin_symbol("gdal", plugin::kGeokeysWktSymbol, "reading the user-defined GeoTIFF keys"));
+    std::string wkt;
+    PluginFailure failure;
+    entry(records, wkt, failure);
+    vola::plugin::throw_failure(failure);
+    if (wkt.empty()) return;
+    hd.epsg = geo::epsg_from_wkt(wkt);
+    hd.wkt = std::move(wkt);
+  } catch (const Error&) {
+    // GDAL or PROJ cannot be loaded: no CRS, as for keys GDAL cannot read.
+  }
 }
 
 // A projected CRS code whose unit keys say more than the code (geo::keyed_projected_crs:
@@ -261,6 +301,7 @@ void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
     else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
   }
   apply_unit_keys(hd, units);
+  apply_user_defined_keys(hd, units);
 }
 
 }  // namespace

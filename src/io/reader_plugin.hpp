@@ -1,5 +1,5 @@
 // The entry points of the plugins libvola_gdal.so (elevation rasters read, GeoTIFF
-// rasters and footprint layers written, through GDAL/OGR), libvola_assimp.so (meshes
+// rasters and footprint layers written, user-defined GeoTIFF keys read, through GDAL/OGR), libvola_assimp.so (meshes
 // through Assimp), libvola_octomap.so (OctoMap .bt/.ot through liboctomap) and
 // libvola_openvdb.so (.vdb through OpenVDB); see src/plugin/plugin.hpp for why they are plugins.
 #pragma once
@@ -35,6 +35,14 @@ using FootprintsGeojsonEntry = void (*)(const FootprintLayer& layer, const std::
                                         std::vector<std::uint8_t>& out, PluginFailure& failure);
 using FootprintsGeopackageEntry = void (*)(const FootprintLayer& layer, std::vector<std::uint8_t>& out,
                                            PluginFailure& failure);
+// The CRS (WKT2) of a GeoTIFF key directory as GDAL reads it; "" when GDAL reads none.
+// The three LASF_Projection records' bytes: 34735 (the directory), 34736 (doubles) and
+// 34737 (ASCII), the last two empty when the file has none.
+struct GeoKeyRecords {
+  std::vector<std::uint8_t> directory, doubles, ascii;
+};
+using GeokeysWktEntry = void (*)(const GeoKeyRecords& keys, std::string& out, PluginFailure& failure);
+inline constexpr const char* kGeokeysWktSymbol = "vola_plugin_geokeys_wkt";
 inline constexpr const char* kFootprintsGeojsonSymbol = "vola_plugin_footprints_geojson";
 inline constexpr const char* kFootprintsGeopackageSymbol = "vola_plugin_footprints_geopackage";
 inline constexpr const char* kReadDemSymbol = "vola_plugin_read_dem";

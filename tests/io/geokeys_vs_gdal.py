@@ -11,7 +11,9 @@ into the tags of a 1 x 1 GeoTIFF, has GDAL read its CRS, and requires `vola info
 to give the same CRS name and linear unit. Then made-up key directories in a one-point
 LAS file: a projected code with a linear unit key, and with a vertical unit key other than
 the horizontal one (no vertical CRS named), where GDAL (asked to report compound CRSs,
-GTIFF_REPORT_COMPD_CS) gives heights in the vertical key's unit and so must vola.
+GTIFF_REPORT_COMPD_CS) gives heights in the vertical key's unit and so must vola; and
+user-defined projections (keys 32767 with their parameters), where vola's CRS must place
+a point where pyproj places it with the PROJ definition the keys spell out.
 
 Usage: geokeys_vs_gdal.py VOLA SHARED_DIR
 Exit 77 (skip) without the shared data, unless CI is set (then 1).
@@ -82,25 +84,82 @@ def geotiff_with_keys(records, out):
     out.write_bytes(b"II*\0" + struct.pack("<I", 8) + ifd + struct.pack("<I", 0) + blobs + b"\0")
 
 
-def las_with_keys(keys, out):
-    """A LAS 1.2 file of one point (format 0) whose only VLR is a GeoKeyDirectory of
-    (key, value) pairs."""
+def las_with_keys(keys, out, doubles=()):
+    """A LAS 1.2 file of one point (format 0) whose VLRs are a GeoKeyDirectory of (key,
+    value) pairs and, with `doubles`, a GeoDoubleParams record: a key whose value is a
+    float is given as (key, ("double", index into doubles))."""
     directory = [1, 1, 0, len(keys)]
     for key, value in keys:
-        directory += [key, 0, 1, value]
-    vlr_data = struct.pack(f"<{len(directory)}H", *directory)
-    vlr = struct.pack("<H16sHH32s", 0, b"LASF_Projection", 34735, len(vlr_data), b"") + vlr_data
+        directory += [key, 34736, 1, value[1]] if isinstance(value, tuple) else [key, 0, 1, value]
+    records = [(34735, struct.pack(f"<{len(directory)}H", *directory))]
+    if doubles:
+        records.append((34736, struct.pack(f"<{len(doubles)}d", *doubles)))
+    vlrs = b"".join(struct.pack("<H16sHH32s", 0, b"LASF_Projection", record, len(data), b"") + data
+                    for record, data in records)
     header_size, record_length = 227, 20
-    offset = header_size + len(vlr)
+    offset = header_size + len(vlrs)
     header = bytearray(header_size)
     header[0:4] = b"LASF"
     header[24], header[25] = 1, 2
     struct.pack_into("<H", header, 94, header_size)
-    struct.pack_into("<IIBHI", header, 96, offset, 1, 0, record_length, 1)
+    struct.pack_into("<IIBHI", header, 96, offset, len(records), 0, record_length, 1)
     struct.pack_into("<3d", header, 131, 0.01, 0.01, 0.01)
     struct.pack_into("<6d", header, 179, 500001.0, 500000.0, 5000001.0, 5000000.0, 101.0, 100.0)
     point = struct.pack("<3iH", 50000000, 500000000, 10000, 0) + bytes(6)
-    out.write_bytes(bytes(header) + vlr + point)
+    out.write_bytes(bytes(header) + vlrs + point)
+
+
+# Key directories that define a projected CRS by its parts (user-defined, 32767), with
+# the PROJ definition the keys spell out (written here from the GeoTIFF specification's
+# key meanings: false eastings in the linear unit's, angles in degrees). The second's
+# geographic code NAD83 is only the base of its projection: reading it as the file's
+# CRS would put feet in degrees.
+US_FOOT = 1200 / 3937
+USER_DEFINED = [
+    ("transverse Mercator on the WGS 84 ellipsoid, metres",
+     [(1024, 1), (2048, 32767), (2050, 32767), (2056, 7030), (3072, 32767), (3074, 32767), (3075, 1),
+      (3076, 9001), (3080, ("double", 0)), (3081, ("double", 1)), (3092, ("double", 2)), (3082, ("double", 3)),
+      (3083, ("double", 4))],
+     (15.0, 0.0, 0.9999, 300000.0, 0.0),
+     "+proj=tmerc +lat_0=0 +lon_0=15 +k=0.9999 +x_0=300000 +y_0=0 +ellps=WGS84 +units=m +no_defs",
+     (16.0, 45.0)),
+    ("Lambert conformal conic (2 parallels) on NAD83, US survey feet",
+     [(1024, 1), (2048, 4269), (3072, 32767), (3074, 32767), (3075, 8), (3076, 9003),
+      (3078, ("double", 0)), (3079, ("double", 1)), (3085, ("double", 2)), (3084, ("double", 3)),
+      (3086, ("double", 4)), (3087, ("double", 5))],
+     (45.0, 47.0, 44.0, -120.0, 600000.0 / US_FOOT, 0.0),
+     "+proj=lcc +lat_1=45 +lat_2=47 +lat_0=44 +lon_0=-120 +x_0=600000 +y_0=0 +datum=NAD83 +units=us-ft +no_defs",
+     (-119.5, 45.5)),
+]
+
+
+def user_defined_keys(vola, tmp, failures):
+    """vola's CRS of each USER_DEFINED directory places a point where the PROJ definition
+    the keys spell out (pyproj) places it, and has GDAL's name and unit."""
+    from pyproj import CRS, Transformer
+    checked = 0
+    for what, keys, doubles, definition, lon_lat in USER_DEFINED:
+        las, tiff = Path(tmp) / "user_defined.las", Path(tmp) / "user_defined.tif"
+        las_with_keys(keys, las, doubles)
+        geotiff_with_keys(projection_records(las), tiff)
+        srs = gdal.Open(str(tiff)).GetSpatialRef()
+        crs = json.loads(subprocess.run([vola, "info", "--json", str(las)], check=True, capture_output=True,
+                                        text=True).stdout).get("crs") or {}
+        checked += 1
+        if not crs.get("wkt"):
+            failures.append(f"{what}: vola reads no CRS from the keys (GDAL: {srs.GetName() if srs else None})")
+            continue
+        want = Transformer.from_crs("EPSG:4326", CRS.from_proj4(definition), always_xy=True).transform(*lon_lat)
+        got = Transformer.from_crs("EPSG:4326", CRS.from_wkt(crs["wkt"]), always_xy=True).transform(*lon_lat)
+        off = max(abs(a - b) for a, b in zip(want, got))
+        print(f"{what}: vola {crs.get('name')!r} in {crs.get('unit')}, epsg {crs.get('epsg')}; "
+              f"({lon_lat}) -> {got}, the keys' definition {want}, {off:.2e} apart")
+        if off > 1e-3:
+            failures.append(f"{what}: vola's CRS puts {lon_lat} at {got}, the keys' definition at {want}")
+        if srs is None or (crs.get("name"), crs.get("unit")) != (srs.GetName(), srs.GetLinearUnitsName()):
+            failures.append(f"{what}: GDAL reads {(srs.GetName(), srs.GetLinearUnitsName()) if srs else None}, "
+                            f"vola {(crs.get('name'), crs.get('unit'))}")
+    return checked
 
 
 def made_up_keys(vola, tmp, failures):
@@ -158,7 +217,7 @@ def main():
             checked += 1
             if got != want:
                 failures.append(f"{path.name}: GDAL reads {want}, vola {got}")
-        made_up = made_up_keys(vola, tmp, failures)
+        made_up = made_up_keys(vola, tmp, failures) + user_defined_keys(vola, tmp, failures)
     if checked < 3:
         failures.append(f"only {checked} files with projected GeoKeys and no WKT were found (expected at least 3)")
     if failures:
