@@ -254,15 +254,13 @@ class AsciiInput {
     for (std::uint64_t i = 0; i < count; ++i) next();
   }
   void expect(PlyType, std::uint64_t) {}  // values are read one by one
-  // One element a line: values left on the line mean the header does not describe the
-  // data (a line "x y z 99" under three properties shifted every later coordinate).
-  void end_record(const std::string& element) {
-    while (at_ < text_.size() && (text_[at_] == ' ' || text_[at_] == '\t' || text_[at_] == '\r')) ++at_;
-    if (at_ < text_.size() && text_[at_] != '\n') {
-      token_start_ = at_;
-      token_line_ = line_;
-      fail("more values than the header's " + element + " properties");
-    }
+  // One element a line: values left on the line after the element's properties are not
+  // described by the header and are skipped, so that they cannot shift the next element
+  // ("x y z 99" under three properties). MeshLab (VCGlib) writes such lines: trimesh's
+  // fuze_ascii.ply has an undeclared list after each face's colour; MeshLab, Assimp and
+  // trimesh read them the same way.
+  void end_record(const std::string&) {
+    while (at_ < text_.size() && text_[at_] != '\n') ++at_;
   }
   // Nothing but white space may follow the last element (a file of more vertices than its
   // header declares gave the declared number, the rest unread).

@@ -337,8 +337,6 @@ TEST(Ply, CorruptedInputIsAFormatErrorNamingTheProblem) {
       {"ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty double x\nproperty double y\n"
        "property double z\nend_header\n",
        "truncated"},
-      // One element a line: "x y z 99" under three properties shifted every later coordinate.
-      {head + faces.substr(0, faces.find("0 0 0")) + "0 0 0 99\n1 1 1\n3 0 1 1\n", "more values than the header's vertex"},
       // More elements than the header declares were left unread.
       {head + faces + "3 0 1 1\n2 2 2\n", "values after the last element"},
       {"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
@@ -363,6 +361,21 @@ TEST(Ply, CorruptedInputIsAFormatErrorNamingTheProblem) {
   const auto line = error_of_text(head + faces + "3 0 1 5\n");
   ASSERT_TRUE(line);
   EXPECT_NE(line->cause().find("line 12"), std::string::npos) << line->what();
+}
+
+// One element a line: values after an element's properties on its line are skipped, not
+// taken for the next element's ("x y z 99" under three properties shifted every later
+// coordinate), as MeshLab writes faces with an undeclared list after their colour.
+TEST(Ply, ValuesAfterAnElementsPropertiesOnItsLineAreSkipped) {
+  const std::string text =
+      "ply\nformat ascii 1.0\ncomment VCGLIB generated\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty uchar red\nend_header\n"
+      "0 0 0 99\n1 2 3\n4 5 6 \n3 0 1 2 9 6 1 1 1 1 1 1\n";
+  const auto in = vola::io::parse_ply(Bytes(text.begin(), text.end()), "vcg.ply");
+  ASSERT_EQ(in.triangles.size(), 1u);
+  const std::array<double, 9> want = {0, 0, 0, 1, 2, 3, 4, 5, 6};
+  for (int v = 0; v < 3; ++v)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(in.triangles[0][v][k], want[3 * v + k]) << v << " " << k;
 }
 
 TEST(Ply, ElementsWithoutPropertiesTakeNoTimeWhateverTheirCount) {
