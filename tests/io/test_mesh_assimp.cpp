@@ -372,6 +372,25 @@ TEST(MeshAssimp, ScenesCannotReadOtherFiles) {
   EXPECT_EQ(vola::io::read_mesh_triangles((dir / "fifo_mtl.obj").string()).size(), 1u);
 }
 
+// Assimp 5.2's OBJ importer labels the primitive types of a mesh whose first face has two
+// corners wrongly, and its own validation refuses the scene ("mFaces[0] is a LINE but
+// mPrimitiveTypes does not report the LINE flag"). vola reads it again without that
+// validation: the line (a degenerate triangle) and the triangle, each where the file puts
+// it; a missing material library is not blamed for the failure.
+TEST(MeshAssimp, MislabelledPrimitiveTypesAreReadWithTheStructureChecked) {
+  vola_test::TempDir dir;
+  write_file(dir / "line_first.obj", "mtllib absent.mtl\no strip\nv -5 0 5\nv 5 0 5\nv 5 5 5\nusemtl Material\n"
+                                     "f 1// 2//\nf 1// 2// 3//\n");
+  const auto triangles = vola::io::read_mesh_triangles((dir / "line_first.obj").string());
+  ASSERT_EQ(triangles.size(), 2u);
+  const vola::Point a{-5, 0, 5}, b{5, 0, 5}, c{5, 5, 5};
+  std::vector<vola::io::Triangle> want = {{a, b, b}, {a, b, c}};
+  auto sorted = triangles;
+  std::sort(sorted.begin(), sorted.end());
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(sorted, want);
+}
+
 TEST(MeshAssimp, OnlyTheDocumentedMeshFormatsReachAssimp) {
   vola_test::TempDir dir;
   // An ASCII PLY (vola reads PLY itself) and a Wavefront OBJ named .md5mesh: Assimp would read both.

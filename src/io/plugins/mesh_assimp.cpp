@@ -51,14 +51,14 @@ Point transform(const Matrix& m, const aiVector3D& v) {
 // (some with references to further files, most never fuzzed here) are not opened.
 constexpr std::array<std::string_view, 7> kMeshExtensions = {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"};
 
-std::string lower_extension(const std::string& path) {
+std::string lowercase_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 
 void check_mesh_extension(const std::string& path) {
-  const std::string ext = lower_extension(path);
+  const std::string ext = lowercase_extension(path);
   if (std::find(kMeshExtensions.begin(), kMeshExtensions.end(), ext) == kMeshExtensions.end())
     throw FormatError(path, std::nullopt,
                       "meshes are read from .stl, .obj, .off, .gltf, .glb, .dae and .3ds files only, not '" + ext + "'");
@@ -69,7 +69,7 @@ void check_mesh_extension(const std::string& path) {
 // bytes of text, so counts the file cannot hold are refused first, read as Assimp reads
 // them (off_header.hpp).
 void check_off_counts(const std::string& path) {
-  if (lower_extension(path) != ".off") return;  // Assimp picks its OFF importer by extension
+  if (lowercase_extension(path) != ".off") return;  // Assimp picks its OFF importer by extension
   std::ifstream in(path, std::ios::binary);
   std::ostringstream whole;
   whole << in.rdbuf();
@@ -123,6 +123,31 @@ class ConfinedIOSystem : public Assimp::DefaultIOSystem {
   mutable std::string refused_;
 };
 
+// What Assimp's validation checks of the parts read below: every mesh, vertex array,
+// face array and index array that a count says is there, and the node tree's arrays.
+bool structurally_sound(const aiScene& scene) {
+  if (!scene.mRootNode || (scene.mNumMeshes && !scene.mMeshes)) return false;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (!mesh || (mesh->mNumVertices && !mesh->mVertices) || (mesh->mNumFaces && !mesh->mFaces)) return false;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f)
+      if (mesh->mFaces[f].mNumIndices && !mesh->mFaces[f].mIndices) return false;
+  }
+  std::vector<const aiNode*> pending{scene.mRootNode};
+  std::uint64_t nodes = 0;
+  while (!pending.empty()) {
+    const aiNode* node = pending.back();
+    pending.pop_back();
+    if (++nodes > (std::uint64_t{1} << 26) || (node->mNumMeshes && !node->mMeshes) || (node->mNumChildren && !node->mChildren))
+      return false;
+    for (unsigned i = 0; i < node->mNumChildren; ++i) {
+      if (!node->mChildren[i]) return false;
+      pending.push_back(node->mChildren[i]);
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
@@ -132,7 +157,18 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   auto* io = new ConfinedIOSystem(path);
   importer.SetIOHandler(io);  // the importer owns it
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
-  if (!scene && !io->refused().empty())
+  // Assimp 5.2's OBJ importer can label a mesh's primitive types wrongly (trimesh's
+  // cubevt.obj, a textured cube of triangles: "mFaces[0] is a POINT but mPrimitiveTypes
+  // does not report the POINT flag"), which its own validation then refuses. The flags
+  // are not used here, so such a scene is read again without the validation and held to
+  // the structural checks the validation would have made (structurally_sound below).
+  if (!scene && std::string(importer.GetErrorString()).find("mPrimitiveTypes does not report") != std::string::npos) {
+    const std::string refusal = importer.GetErrorString();
+    scene = importer.ReadFile(path, aiProcess_Triangulate);
+    if (scene && !structurally_sound(*scene)) throw FormatError(path, std::nullopt, "Assimp: " + refusal);
+  }
+  // A missing material library is only a warning to Assimp: it is not why a scene failed.
+  if (!scene && !io->refused().empty() && lowercase_extension(io->refused()) != ".mtl")
     throw FormatError(path, std::nullopt,
                       "the scene's data lies in another file, '" + io->refused() +
                           "', and vola reads only the file it is given (a glTF with its buffers embedded, "
