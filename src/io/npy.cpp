@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "file_bytes.hpp"
+#include "npy_fields.hpp"
 #include "vola/error.hpp"
 #include "vola/little_endian.hpp"
 
@@ -42,6 +43,7 @@ std::uint64_t NpyArray::size() const noexcept {
 }
 
 std::string NpyArray::dtype() const {
+  if (!fields.empty() || kind == 'V') return "records of " + std::to_string(item_size) + " bytes";
   return std::string(big_endian ? ">" : "<") + kind + std::to_string(item_size);
 }
 
@@ -86,6 +88,9 @@ double NpyArray::value(std::uint64_t index) const noexcept {
 
 namespace {
 
+void parse_plain_dtype(std::string_view descr, const std::string& name, std::uint64_t header_start, NpyArray& a);
+void parse_shape_and_order(std::string_view dict, const std::string& name, std::uint64_t header_start, NpyArray& a);
+
 // The header of `bytes` into `a` (everything but the data); returns the data's offset.
 std::uint64_t parse_npy_header(std::span<const std::uint8_t> bytes, const std::string& name, NpyArray& a) {
   static const std::uint8_t magic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
@@ -110,8 +115,29 @@ std::uint64_t parse_npy_header(std::span<const std::uint8_t> bytes, const std::s
   const std::string_view dict(reinterpret_cast<const char*>(bytes.data() + header_start), header_length);
 
   std::string_view descr = find_value(dict, "descr", name, header_start);
+  if (!descr.empty() && descr[0] == '[') {  // a structured dtype: records of named fields
+    std::uint64_t record_size = 0;
+    a.fields = parse_npy_fields(descr, name, header_start, record_size);
+    a.kind = 'V';
+    a.item_size = static_cast<int>(record_size);
+  } else {
+    parse_plain_dtype(descr, name, header_start, a);
+  }
+  parse_shape_and_order(dict, name, header_start, a);
+  const std::uint64_t count = a.size();
+  const std::uint64_t data_start = header_start + header_length;
+  const std::uint64_t available = bytes.size() - data_start;
+  if (count > available / static_cast<std::uint64_t>(a.item_size))
+    throw FormatError(name, bytes.size(),
+                      "npy shape promises " + std::to_string(count) + " values of " + std::to_string(a.item_size) +
+                          " bytes but only " + std::to_string(available) + " bytes follow the header (truncated)");
+  return data_start;
+}
+
+// A simple dtype string ('<f8', '|u1', ...) into `a`.
+void parse_plain_dtype(std::string_view descr, const std::string& name, std::uint64_t header_start, NpyArray& a) {
   if (descr.size() < 5 || (descr[0] != '\'' && descr[0] != '"'))
-    throw FormatError(name, header_start, "npy descr is not a simple dtype string");
+    throw FormatError(name, header_start, "npy descr is neither a dtype string nor a list of fields");
   const char order = descr[1];
   a.kind = descr[2];
   const std::size_t close = descr.find(descr[0], 1);
@@ -125,7 +151,10 @@ std::uint64_t parse_npy_header(std::span<const std::uint8_t> bytes, const std::s
                       "npy dtype " + std::string(descr.substr(0, close + 1)) +
                           " is not supported (float32/64, int8..64, uint8..64, bool)");
   a.big_endian = order == '>';
+}
 
+// The shape and the fortran_order flag into `a`; throws when the product overflows.
+void parse_shape_and_order(std::string_view dict, const std::string& name, std::uint64_t header_start, NpyArray& a) {
   const std::string_view fortran = find_value(dict, "fortran_order", name, header_start);
   a.fortran_order = fortran.substr(0, 4) == "True";
 
@@ -156,13 +185,6 @@ std::uint64_t parse_npy_header(std::span<const std::uint8_t> bytes, const std::s
       throw FormatError(name, header_start, std::string("npy shape has an unexpected '") + c + "'");
     }
   }
-  const std::uint64_t data_start = header_start + header_length;
-  const std::uint64_t available = bytes.size() - data_start;
-  if (count > available / static_cast<std::uint64_t>(a.item_size))
-    throw FormatError(name, bytes.size(),
-                      "npy shape promises " + std::to_string(count) + " values of " + std::to_string(a.item_size) +
-                          " bytes but only " + std::to_string(available) + " bytes follow the header (truncated)");
-  return data_start;
 }
 
 }  // namespace
@@ -303,7 +325,9 @@ VoxelGrid npy_grid(const NpyArray& array, const std::string& name) {
 Input npy_input(const NpyArray& array, const std::string& name, const InputOptions& options) {
   Input in;
   in.format = "npy";
-  if (array.shape.size() == 3) {
+  if (array.kind == 'V') {
+    in.cloud = npy_record_points(array, name);
+  } else if (array.shape.size() == 3) {
     in.grid = npy_grid(array, name);
   } else if (array.shape.size() == 2) {
     in.cloud = npy_points(array, name, options.payload);
