@@ -110,7 +110,9 @@ Bytes kitti() {
 }
 
 Bytes npy(const std::string& dtype, const std::string& shape, const Bytes& data, bool fortran = false) {
-  std::string header = "{'descr': '" + dtype + "', 'fortran_order': " + (fortran ? "True" : "False") +
+  // A structured dtype (a list of fields) goes in as it is, a plain one quoted.
+  const std::string descr = dtype.starts_with("[") ? dtype : "'" + dtype + "'";
+  std::string header = "{'descr': " + descr + ", 'fortran_order': " + (fortran ? "True" : "False") +
                        ", 'shape': " + shape + ", }";
   while ((11 + header.size()) % 64 != 0) header += ' ';
   header += '\n';
@@ -145,6 +147,15 @@ std::vector<Seed> synthetic_seeds() {
   Bytes points;
   for (int i = 0; i < 12; ++i) put<double>(points, 0.5 * i);
   seeds.push_back(seed("npy_points", kNpy, npy("<f8", "(3, 4)", points)));
+  Bytes records;
+  for (int i = 0; i < 4; ++i) {
+    for (int a = 0; a < 3; ++a) put<double>(records, 1.5 * i + a);
+    put<std::uint16_t>(records, static_cast<std::uint16_t>(100 * i));
+    records.insert(records.end(), {1, 2, 3, 0});
+  }
+  seeds.push_back(seed("npy_records", kNpy,
+                       npy("[('X', '<f8'), ('Y', '<f8'), ('Z', '<f8'), ('Intensity', '<u2'), ('rgb', '|u1', (3,)), ('', '|V1')]",
+                           "(4,)", records)));
   std::vector<vola::Voxel> voxels;
   for (std::uint32_t i = 0; i < 20; ++i) voxels.push_back({i % 7, (i * 3) % 11, i % 5});
   vola::Tree tree = vola::build_from_voxels(voxels, 2);
