@@ -198,6 +198,12 @@ def main():
     if not files:
         skip(f"no LAS files under {data}")
     checked, failures = 0, []
+    # Reading keys goes through PROJ and GDAL, which print errors to stderr by default
+    # (laspy_simple1_3.las names an EPSG CRS code as its linear unit); vola prints nothing.
+    for path in files:
+        run = subprocess.run([vola, "info", str(path)], capture_output=True, text=True)
+        if run.returncode != 0 or run.stderr:
+            failures.append(f"{path.name}: vola info exits {run.returncode}, stderr {run.stderr.strip()!r}")
     with tempfile.TemporaryDirectory() as tmp:
         tiff = Path(tmp) / "keys.tif"
         for path in files:

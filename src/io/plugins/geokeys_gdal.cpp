@@ -9,6 +9,7 @@
 #include <cpl_vsi.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
+#include <proj.h>
 
 #include <cstring>
 #include <string>
@@ -73,12 +74,28 @@ Bytes geotiff_with_keys(const plugin::GeoKeyRecords& keys) {
   return tiff;
 }
 
+// libgeotiff, asked by GDAL for a unit the keys name, creates PROJ contexts of its own,
+// copies of PROJ's default context, which print PROJ's errors to stderr (a unit code PROJ
+// does not know: laspy's simple1_3.las names 32632 as its linear unit). The library
+// never prints, so the default context logs nothing while GDAL reads the keys.
+class QuietProjDefaultContext {
+ public:
+  QuietProjDefaultContext() : previous_(proj_log_level(nullptr, PJ_LOG_TELL)) { proj_log_level(nullptr, PJ_LOG_NONE); }
+  ~QuietProjDefaultContext() { proj_log_level(nullptr, previous_); }
+  QuietProjDefaultContext(const QuietProjDefaultContext&) = delete;
+  QuietProjDefaultContext& operator=(const QuietProjDefaultContext&) = delete;
+
+ private:
+  PJ_LOG_LEVEL previous_;
+};
+
 std::string geokeys_wkt_with_gdal(const plugin::GeoKeyRecords& keys) {
   // A directory is 4 shorts of header and 4 per key; SHORT tags need an even size.
   if (keys.directory.size() < 8 || keys.directory.size() % 2) return {};
   register_gdal_drivers();
   const ConfinedGdalConfig confined;
   const QuietGdalErrors quiet;
+  const QuietProjDefaultContext quiet_proj;
   const MemoryFolder folder;
   const std::string path = folder.path() + "/keys.tif";
   Bytes tiff = geotiff_with_keys(keys);
