@@ -262,6 +262,11 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     for (std::size_t i = 0; i < rest.size();) {
       while (i < rest.size() && is_separator(rest[i], decimal_comma)) ++i;
       std::size_t end = i;
+      // A quoted name may hold separators ("M3C2 distance", as CloudCompare writes it).
+      if (end < rest.size() && (rest[end] == '"' || rest[end] == '\'')) {
+        const std::size_t close = rest.find(rest[end], end + 1);
+        if (close != std::string_view::npos) end = close + 1;
+      }
       while (end < rest.size() && !is_separator(rest[end], decimal_comma)) ++end;
       if (end > i) {
         const std::string_view word = unquoted(rest.substr(i, end - i));

@@ -55,6 +55,18 @@ TEST(TextHeader, PdalsQuotedCsvNamesEveryColumn) {
   EXPECT_EQ(column(cloud, "red").type, vola::ValueType::u16);
 }
 
+// A quoted name may hold spaces (CloudCompare's M3C2 output, re-written by PDAL): the
+// quotes, not the spaces, delimit it, so the names line up with the values.
+TEST(TextHeader, QuotedNamesMayHoldSpaces) {
+  TempDir dir;
+  const auto cloud = read_text(dir, "\"X\",\"Y\",\"Z\",\"M3C2 distance\",'significant change',\"Intensity\"\n"
+                                    "1.5,2.5,3.5,0.25,1,100\n4,5,6,-0.5,0,200\n");
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(names(cloud), (std::vector<std::string>{"m3c2 distance", "significant change", "intensity"}));
+  EXPECT_EQ(column(cloud, "m3c2 distance").values, (std::vector<double>{0.25, -0.5}));
+  EXPECT_EQ(column(cloud, "intensity").values, (std::vector<double>{100, 200}));
+}
+
 TEST(TextHeader, CommentHeadersOfCloudCompareAndVolaExport) {
   TempDir dir;
   const auto cc = read_text(dir, "//X,Y,Z,R,G,B\n1,2,3,255,0,7\n4,5,6,0,10,0\n");
