@@ -9,6 +9,11 @@ consolidated; this script checks that today's CLI, Python's vola.convert and the
 vola_convert still write exactly those bytes. The three DEM cases with a voxel size were
 recorded again on 2026-11-28, when a DEM's default grid origin began to follow the
 raster's own cells (before, it snapped to multiples of the voxel size and moved the cells).
+The two laspy_simple1_3.las cases were recorded again on 2026-11-28, when GeoTIFF keys that
+define a CRS by its parts began to be read through GDAL: the file's keys (a projected model
+type, no projection, a linear unit code GDAL does not know) now give GDAL's engineering CRS
+in metres, and the .vol holds its WKT. The same file with its key record renamed away
+still converts to the old bytes, so the voxels did not change.
 
   convert_equivalence.py --vola build/apps/vola/vola --c-tool build/tests/capi_convert_tool \
       --python-path build/python [--front-ends cli,python,c] [--write-manifest]
