@@ -202,10 +202,11 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
   // A named vertical CRS has a unit of its own; GDAL then reads no vertical part at all
   // by default, and neither does vola (heights in the unit of x and y).
   if (vertical_crs) units.vertical = 0;
+  // A code of 0 is no code (GDAL reads it so).
   const auto coded = [](const std::optional<std::uint32_t>& v) { return v && *v != las::kUserDefined && *v != 0; };
-  units.user_defined = coded(projected) ? false
-                       : projected      ? *projected == las::kUserDefined
-                                        : (model == 1u || (!coded(geographic) && geographic == las::kUserDefined));
+  units.user_defined =
+      !coded(projected) && (projected == las::kUserDefined || model == 1u ||
+                            (!coded(geographic) && geographic == las::kUserDefined));
   if (units.user_defined) return;
   if (coded(projected)) hd.epsg = *projected;
   else if (coded(geographic)) hd.epsg = *geographic;
@@ -294,9 +295,12 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
 // The CRS (GeoKeys, WKT) and the extra-bytes fields, from the (E)VLRs read.
 void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
   UnitKeys units;
+  bool keys_read = false;  // the first key directory counts, as for GDAL's reading of it
   for (const auto& vlr : hd.vlrs) {
-    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8)
+    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8 && !keys_read) {
       parse_geokeys(vlr, hd, units);
+      keys_read = true;
+    }
     else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
     else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
   }

@@ -4,6 +4,7 @@
 // in file order, exactly as from an uncompressed file: every reader of records (the
 // attribute columns, the streaming builder, export) works on LAZ unchanged.
 #include <algorithm>
+#include <limits>
 
 #include "vola/error.hpp"
 #include "vola/io/las.hpp"
@@ -19,7 +20,10 @@ namespace {
 // never makes the reader allocate gigabytes.
 void check_chunk_size(const std::string& path, const LasHeader& hd, std::size_t chunk) {
   const laz::ChunkEntry& c = hd.laz_chunks[chunk];
-  const std::uint64_t bytes = c.point_count * hd.record_length;
+  // A compressor 1 file is one chunk of the header's 64-bit point count, whose bytes
+  // may not even fit 64 bits.
+  const bool overflows = c.point_count > std::numeric_limits<std::uint64_t>::max() / hd.record_length;
+  const std::uint64_t bytes = overflows ? std::numeric_limits<std::uint64_t>::max() : c.point_count * hd.record_length;
   if (bytes > (std::uint64_t{1} << 30) && bytes / 4096 > c.byte_size)
     throw FormatError(path, c.byte_offset,
                       "LAZ chunk " + std::to_string(chunk) + " claims " + std::to_string(c.point_count) +

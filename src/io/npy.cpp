@@ -14,24 +14,33 @@ namespace vola::io {
 
 namespace {
 
+// The text after `key`'s colon in the header dict, looked up among the dict's own keys
+// only: a quoted 'shape' inside a structured dtype's field list is a field name.
 std::string_view find_value(std::string_view dict, std::string_view key, const std::string& name,
                             std::uint64_t offset) {
-  std::string quoted1(1, '\'');
-  quoted1.append(key).push_back('\'');
-  std::string quoted2(1, '"');
-  quoted2.append(key).push_back('"');
-  std::size_t at = dict.find(quoted1);
-  std::size_t len = quoted1.size();
-  if (at == std::string_view::npos) {
-    at = dict.find(quoted2);
-    len = quoted2.size();
+  int depth = 0;
+  for (std::size_t i = 0; i < dict.size(); ++i) {
+    const char c = dict[i];
+    if (c == '\'' || c == '"') {
+      const std::size_t close = dict.find(c, i + 1);
+      if (close == std::string_view::npos) break;
+      if (depth == 1 && dict.substr(i + 1, close - i - 1) == key) {
+        std::size_t at = close + 1;
+        while (at < dict.size() && dict[at] == ' ') ++at;
+        if (at < dict.size() && dict[at] == ':') {
+          std::string_view rest = dict.substr(at + 1);
+          while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
+          return rest;
+        }
+      }
+      i = close;
+    } else if (c == '{' || c == '[' || c == '(') {
+      ++depth;
+    } else if (c == '}' || c == ']' || c == ')') {
+      --depth;
+    }
   }
-  if (at == std::string_view::npos) throw FormatError(name, offset, "npy header has no '" + std::string(key) + "'");
-  std::size_t colon = dict.find(':', at + len);
-  if (colon == std::string_view::npos) throw FormatError(name, offset, "npy header: no ':' after " + std::string(key));
-  std::string_view rest = dict.substr(colon + 1);
-  while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
-  return rest;
+  throw FormatError(name, offset, "npy header has no '" + std::string(key) + "'");
 }
 
 }  // namespace

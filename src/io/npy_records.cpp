@@ -165,18 +165,18 @@ std::vector<NpyField> parse_npy_fields(std::string_view descr, const std::string
     }
     in.expect(')');
     if (in.next_is(',')) in.expect(',');
-    for (std::uint64_t e = 0; e < elements; ++e) {
-      NpyField f = type;
-      f.offset = at;
-      if (subarray && is_numeric(f)) f.name = field + "_" + std::to_string(e);
-      at += static_cast<std::uint64_t>(f.item_size);
-      if (at > (std::uint64_t{1} << 30)) in.fail("records of over 1 GiB");
-      if (is_numeric(f)) fields.push_back(std::move(f));
-      if (!is_numeric(type)) {  // bytes vola skips: the whole subarray at once
-        at += static_cast<std::uint64_t>(type.item_size) * (elements - 1);
-        break;
+    if (!is_numeric(type)) {  // bytes vola skips: the whole subarray at once
+      at += static_cast<std::uint64_t>(type.item_size) * elements;
+    } else {
+      for (std::uint64_t e = 0; e < elements; ++e) {
+        NpyField f = type;
+        f.offset = at;
+        if (subarray) f.name = field + "_" + std::to_string(e);
+        at += static_cast<std::uint64_t>(f.item_size);
+        fields.push_back(std::move(f));
       }
     }
+    if (at > (std::uint64_t{1} << 30)) in.fail("records of over 1 GiB");
     if (fields.size() > (1u << 16)) in.fail("more than 65536 fields");
   }
   in.expect(']');

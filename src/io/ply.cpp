@@ -213,7 +213,7 @@ class BinaryInput {
     if (count > (bytes_.size() - at_) / static_cast<std::uint64_t>(byte_size(t)))
       fail("a list of " + std::to_string(count) + " values runs past the end of the file");
   }
-  void end_record(const std::string&) {}  // records have no separators
+  void end_record(const Element&) {}  // records have no separators
   // Bytes after the last element (a file of more vertices than its header declares gave
   // the declared number); a line end or spaces some writers add are no data.
   void end_data() {
@@ -254,13 +254,30 @@ class AsciiInput {
     for (std::uint64_t i = 0; i < count; ++i) next();
   }
   void expect(PlyType, std::uint64_t) {}  // values are read one by one
-  // One element a line: values left on the line after the element's properties are not
+  // One element a line. Values left on the line after the element's properties are not
   // described by the header and are skipped, so that they cannot shift the next element
   // ("x y z 99" under three properties). MeshLab (VCGlib) writes such lines: trimesh's
   // fuze_ascii.ply has an undeclared list after each face's colour; MeshLab, Assimp and
-  // trimesh read them the same way.
-  void end_record(const std::string&) {
-    while (at_ < text_.size() && text_[at_] != '\n') ++at_;
+  // trimesh read them the same way. But as many values as a whole further element of
+  // fixed size may be one: several elements on a line are an error, not skipped.
+  void end_record(const Element& element) {
+    bool fixed_size = true;
+    for (const auto& p : element.properties) fixed_size = fixed_size && !p.list;
+    std::size_t extra = 0;
+    const std::size_t extra_at = at_;
+    while (at_ < text_.size() && text_[at_] != '\n') {
+      while (at_ < text_.size() && (text_[at_] == ' ' || text_[at_] == '\t' || text_[at_] == '\r')) ++at_;
+      if (at_ == text_.size() || text_[at_] == '\n') break;
+      ++extra;
+      while (at_ < text_.size() && !is_header_space(text_[at_])) ++at_;
+    }
+    if (fixed_size && extra >= element.properties.size()) {
+      token_start_ = extra_at;
+      token_line_ = line_;
+      fail(std::to_string(extra) + " values after the " + std::to_string(element.properties.size()) +
+           " properties of a " + element.name + ": several elements on one line?");
+    }
+    in_record_ = false;
   }
   // Nothing but white space may follow the last element (a file of more vertices than its
   // header declares gave the declared number, the rest unread).
@@ -282,13 +299,23 @@ class AsciiInput {
  private:
   std::string_view next() {
     while (at_ < text_.size() && is_header_space(text_[at_])) {
-      if (text_[at_] == '\n') ++line_;
+      if (text_[at_] == '\n') {
+        // One element a line: a value of this element on the next line would shift every
+        // element after it.
+        if (in_record_) {
+          token_start_ = at_;
+          token_line_ = line_;
+          fail("the line ends before the element's last property (fewer values than the header declares)");
+        }
+        ++line_;
+      }
       ++at_;
     }
     token_start_ = at_;
     token_line_ = line_;
     if (at_ == text_.size()) fail("the data ends before every element was read (truncated file)");
     while (at_ < text_.size() && !is_header_space(text_[at_])) ++at_;
+    in_record_ = true;
     return text_.substr(token_start_, at_ - token_start_);
   }
   std::string_view text_;
@@ -296,6 +323,7 @@ class AsciiInput {
   std::uint64_t line_;
   std::size_t token_start_ = 0;
   std::uint64_t token_line_ = 0;
+  bool in_record_ = false;  // a value of the current element was read from this line
   const std::string& name_;
 };
 
@@ -393,7 +421,7 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
         out.cloud.xyz.insert(out.cloud.xyz.end(), {v[0], v[1], v[2]});
         if (colours) colours->add(v[3], v[4], v[5]);
       }
-      in.end_record(e.name);
+      in.end_record(e);
     }
   }
   in.end_data();

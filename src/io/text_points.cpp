@@ -194,6 +194,19 @@ class LineParser {
   std::uint64_t first_line_ = 0;
 };
 
+// Where the field starting at `i` ends: at the next separator, or, for a quoted field
+// (a header name may hold separators: "M3C2 distance", as CloudCompare writes it), at
+// the next separator after its closing quote.
+std::size_t field_end(std::string_view line, std::size_t i, bool decimal_comma) {
+  std::size_t end = i;
+  if (end < line.size() && (line[end] == '"' || line[end] == '\'')) {
+    const std::size_t close = line.find(line[end], end + 1);
+    if (close != std::string_view::npos) end = close + 1;
+  }
+  while (end < line.size() && !is_separator(line[end], decimal_comma)) ++end;
+  return end;
+}
+
 std::string_view unquoted(std::string_view w) {
   if (w.size() >= 2 && (w.front() == '"' || w.front() == '\'') && w.back() == w.front()) return w.substr(1, w.size() - 2);
   return w;
@@ -261,13 +274,7 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     const bool decimal_comma = uses_decimal_comma(rest);
     for (std::size_t i = 0; i < rest.size();) {
       while (i < rest.size() && is_separator(rest[i], decimal_comma)) ++i;
-      std::size_t end = i;
-      // A quoted name may hold separators ("M3C2 distance", as CloudCompare writes it).
-      if (end < rest.size() && (rest[end] == '"' || rest[end] == '\'')) {
-        const std::size_t close = rest.find(rest[end], end + 1);
-        if (close != std::string_view::npos) end = close + 1;
-      }
-      while (end < rest.size() && !is_separator(rest[end], decimal_comma)) ++end;
+      const std::size_t end = field_end(rest, i, decimal_comma);
       if (end > i) {
         const std::string_view word = unquoted(rest.substr(i, end - i));
         all_names = all_names && !word.empty() && !is_number(word, decimal_comma);
@@ -323,7 +330,7 @@ int count_text_columns(const std::string& path, int skip_lines) {
     int columns = 0;
     while (i < line.size()) {
       ++columns;
-      while (i < line.size() && !is_separator(line[i], decimal_comma)) ++i;
+      i = field_end(line, i, decimal_comma);  // a header's quoted names count once
       while (i < line.size() && is_separator(line[i], decimal_comma)) ++i;
     }
     return columns;

@@ -51,7 +51,7 @@ def projection_records(path):
             break
         user = data[at + 2 : at + 18].rstrip(b"\0")
         record_id, length = struct.unpack_from("<HH", data, at + 18)
-        if user == b"LASF_Projection":
+        if user == b"LASF_Projection" and record_id not in records:  # the first of each counts
             records[record_id] = data[at + 54 : at + 54 + length]
         at += 54 + length
     return records
@@ -84,16 +84,30 @@ def geotiff_with_keys(records, out):
     out.write_bytes(b"II*\0" + struct.pack("<I", 8) + ifd + struct.pack("<I", 0) + blobs + b"\0")
 
 
-def las_with_keys(keys, out, doubles=()):
-    """A LAS 1.2 file of one point (format 0) whose VLRs are a GeoKeyDirectory of (key,
-    value) pairs and, with `doubles`, a GeoDoubleParams record: a key whose value is a
-    float is given as (key, ("double", index into doubles))."""
+def key_directory(keys):
+    """A GeoKeyDirectory record of (key, value) pairs: a float value is (key, ("double",
+    index into the doubles)), text (key, ("ascii", offset, length))."""
     directory = [1, 1, 0, len(keys)]
     for key, value in keys:
-        directory += [key, 34736, 1, value[1]] if isinstance(value, tuple) else [key, 0, 1, value]
-    records = [(34735, struct.pack(f"<{len(directory)}H", *directory))]
+        if isinstance(value, tuple) and value[0] == "ascii":
+            directory += [key, 34737, value[2], value[1]]
+        elif isinstance(value, tuple):
+            directory += [key, 34736, 1, value[1]]
+        else:
+            directory += [key, 0, 1, value]
+    return struct.pack(f"<{len(directory)}H", *directory)
+
+
+def las_with_keys(keys, out, doubles=(), ascii=b"", more_records=()):
+    """A LAS 1.2 file of one point (format 0) whose VLRs are a GeoKeyDirectory of `keys`
+    (key_directory), with `doubles` a GeoDoubleParams record, with `ascii` a GeoAsciiParams
+    record, then `more_records` ((record id, bytes) pairs)."""
+    records = [(34735, key_directory(keys))]
     if doubles:
         records.append((34736, struct.pack(f"<{len(doubles)}d", *doubles)))
+    if ascii:
+        records.append((34737, ascii))
+    records += list(more_records)
     vlrs = b"".join(struct.pack("<H16sHH32s", 0, b"LASF_Projection", record, len(data), b"") + data
                     for record, data in records)
     header_size, record_length = 227, 20
@@ -131,6 +145,41 @@ USER_DEFINED = [
      "+proj=lcc +lat_1=45 +lat_2=47 +lat_0=44 +lon_0=-120 +x_0=600000 +y_0=0 +datum=NAD83 +units=us-ft +no_defs",
      (-119.5, 45.5)),
 ]
+
+
+# Key directories where reading the codes alone, or writing the records into a GeoTIFF
+# carelessly, went wrong: vola must read what GDAL reads from the same records.
+TM_KEYS = [(1024, 1), (2048, 32767), (2050, 32767), (2056, 7030), (3072, 32767), (3074, 32767), (3075, 1),
+           (3076, 9001), (3080, ("double", 0)), (3081, ("double", 1)), (3092, ("double", 2)), (3082, ("double", 3)),
+           (3083, ("double", 4))]
+TM_DOUBLES = (15.0, 0.0, 0.9999, 300000.0, 0.0)
+AS_GDAL_READS = [
+    # A citation of 3 bytes: TIFF keeps values of 4 bytes or less inside the tag entry.
+    ("a 3-byte citation", TM_KEYS + [(3073, ("ascii", 0, 3))], TM_DOUBLES, b"ab|", ()),
+    # A projected model with projected code 0 over a geographic code: not that code.
+    ("projected code 0 over WGS 84", [(1024, 1), (2048, 4326), (3072, 0)], (), b"", ()),
+    # Two key directories: the first one counts.
+    ("two directories, user-defined first", TM_KEYS, TM_DOUBLES, b"",
+     ((34735, key_directory([(1024, 1), (3072, 32617)])),)),
+]
+
+
+def keys_as_gdal_reads(vola, tmp, failures):
+    checked = 0
+    for what, keys, doubles, ascii, more in AS_GDAL_READS:
+        las, tiff = Path(tmp) / "as_gdal.las", Path(tmp) / "as_gdal.tif"
+        las_with_keys(keys, las, doubles, ascii, more)
+        geotiff_with_keys(projection_records(las), tiff)
+        srs = gdal.Open(str(tiff)).GetSpatialRef()
+        crs = json.loads(subprocess.run([vola, "info", "--json", str(las)], check=True, capture_output=True,
+                                        text=True).stdout).get("crs") or {}
+        want = (srs.GetName(), srs.GetLinearUnitsName()) if srs else (None, None)
+        got = (crs.get("name"), crs.get("unit"))
+        print(f"{what}: GDAL {want}, vola {got}")
+        checked += 1
+        if got != want:
+            failures.append(f"{what}: GDAL reads {want}, vola {got}")
+    return checked
 
 
 def user_defined_keys(vola, tmp, failures):
@@ -223,7 +272,8 @@ def main():
             checked += 1
             if got != want:
                 failures.append(f"{path.name}: GDAL reads {want}, vola {got}")
-        made_up = made_up_keys(vola, tmp, failures) + user_defined_keys(vola, tmp, failures)
+        made_up = (made_up_keys(vola, tmp, failures) + user_defined_keys(vola, tmp, failures) +
+                   keys_as_gdal_reads(vola, tmp, failures))
     if checked < 3:
         failures.append(f"only {checked} files with projected GeoKeys and no WKT were found (expected at least 3)")
     if failures:

@@ -337,6 +337,10 @@ TEST(Ply, CorruptedInputIsAFormatErrorNamingTheProblem) {
       {"ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty double x\nproperty double y\n"
        "property double z\nend_header\n",
        "truncated"},
+      // One element a line: a whole element more on a line, and a line short of values
+      // (its element would take the next line's first value and shift the rest).
+      {head + faces.substr(0, faces.find("0 0 0")) + "0 0 0 1 1 1\n3 0 1 1\n", "several elements on one line"},
+      {head + faces.substr(0, faces.find("0 0 0")) + "0 0\n0 1 1 1\n3 0 1 1\n", "fewer values than the header"},
       // More elements than the header declares were left unread.
       {head + faces + "3 0 1 1\n2 2 2\n", "values after the last element"},
       {"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"

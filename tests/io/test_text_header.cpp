@@ -65,6 +65,8 @@ TEST(TextHeader, QuotedNamesMayHoldSpaces) {
   EXPECT_EQ(names(cloud), (std::vector<std::string>{"m3c2 distance", "significant change", "intensity"}));
   EXPECT_EQ(column(cloud, "m3c2 distance").values, (std::vector<double>{0.25, -0.5}));
   EXPECT_EQ(column(cloud, "intensity").values, (std::vector<double>{100, 200}));
+  // The column count (what --nbits 1 lays payload bytes out by) counts each name once.
+  EXPECT_EQ(vola::io::count_text_columns((dir / "points.txt").string(), 0), 6);
 }
 
 TEST(TextHeader, CommentHeadersOfCloudCompareAndVolaExport) {

@@ -50,10 +50,16 @@ Bytes geotiff_with_keys(const plugin::GeoKeyRecords& keys) {
   std::vector<std::uint32_t> blob_at(tags.size(), 0);
   for (std::size_t i = 0; i < tags.size(); ++i) {
     if (!tags[i].data) continue;
-    blob_at[i] = data_at + static_cast<std::uint32_t>(blobs.size());
     const std::size_t bytes = tags[i].type == 3 ? 2 * std::size_t{tags[i].count}
                               : tags[i].type == 12 ? 8 * std::size_t{tags[i].count}
                                                    : tags[i].count;
+    if (bytes <= 4) {  // TIFF holds a value of 4 bytes or less in the entry itself
+      std::uint32_t packed = 0;
+      std::memcpy(&packed, tags[i].data->data(), bytes);
+      blob_at[i] = packed;
+      continue;
+    }
+    blob_at[i] = data_at + static_cast<std::uint32_t>(blobs.size());
     blobs.insert(blobs.end(), tags[i].data->begin(), tags[i].data->begin() + static_cast<std::ptrdiff_t>(bytes));
     if (blobs.size() % 2) blobs.push_back(0);  // TIFF values start on word boundaries
   }
@@ -65,7 +71,8 @@ Bytes geotiff_with_keys(const plugin::GeoKeyRecords& keys) {
     put16(tiff, tags[i].id);
     put16(tiff, tags[i].type);
     put32(tiff, tags[i].count);
-    // Inline values: a SHORT sits in the low bytes of the field (little-endian).
+    // Inline values: a SHORT sits in the low bytes of the field (little-endian); a short
+    // record's bytes as they are (blob_at holds them).
     put32(tiff, tags[i].data ? blob_at[i] : (tags[i].id == 273 ? pixel_at : tags[i].value));
   }
   put32(tiff, 0);  // no next IFD
@@ -90,8 +97,9 @@ class QuietProjDefaultContext {
 };
 
 std::string geokeys_wkt_with_gdal(const plugin::GeoKeyRecords& keys) {
-  // A directory is 4 shorts of header and 4 per key; SHORT tags need an even size.
-  if (keys.directory.size() < 8 || keys.directory.size() % 2) return {};
+  // A directory is 4 shorts of header and 4 per key; an odd last byte is no short, and
+  // GDAL reads the whole shorts of such a record.
+  if (keys.directory.size() < 8) return {};
   register_gdal_drivers();
   const ConfinedGdalConfig confined;
   const QuietGdalErrors quiet;
