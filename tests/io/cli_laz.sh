@@ -233,4 +233,39 @@ rows = [line.split() for line in open(sys.argv[1]) if not line.startswith("#")]
 assert len(rows) == 110000 and all(1e61 < float(r[0]) < 1e63 for r in rows), rows[:2]
 PY
 
+# Compressor 1 (one stream, as LASzip 1.x wrote it) decodes the header's point count as one
+# chunk; in a LAS 1.4 header that count is 64 bits, and count x record length overflowed:
+# a 2^63 + 1 count made a 34-byte buffer the decoder wrote past (SIGSEGV). The file is
+# the single-chunk LAZ of pdal_1.2-with-color.las made compressor 1, in a LAS 1.4 header.
+"$vola" translate "$data/las/pdal_1.2-with-color.las" "$tmp/one_chunk.laz" -q || fail "to LAZ failed"
+python3 - "$tmp/one_chunk.laz" "$tmp/huge_count.laz" "$tmp/unchunked.laz" <<'PY'
+import struct, sys
+d = bytearray(open(sys.argv[1], "rb").read())
+points_at = struct.unpack_from("<I", d, 96)[0]
+header_size, vlrs = struct.unpack_from("<H", d, 94)[0], struct.unpack_from("<I", d, 100)[0]
+at = header_size
+for _ in range(vlrs):  # the laszip record: compressor 2 -> 1
+    record, length = struct.unpack_from("<HH", d, at + 18)
+    if record == 22204:
+        struct.pack_into("<H", d, at + 54, 1)
+    at += 54 + length
+table_at = struct.unpack_from("<Q", d, points_at)[0]
+one = d[:points_at] + d[points_at + 8:table_at]  # no table offset, no table
+open(sys.argv[3], "wb").write(one)
+big = one[:227] + bytearray(148) + one[227:]
+big[25] = 4
+struct.pack_into("<H", big, 94, 375)
+struct.pack_into("<I", big, 96, points_at + 148)
+struct.pack_into("<I", big, 107, 0)
+struct.pack_into("<Q", big, 247, 2**63 + 1)
+open(sys.argv[2], "wb").write(big)
+PY
+"$vola" translate "$tmp/unchunked.laz" "$tmp/unchunked.las" -q || fail "a compressor 1 file did not decode"
+[ "$(records_sha "$tmp/unchunked.las")" == "$(records_sha "$data/las/pdal_1.2-with-color.las")" ] ||
+  fail "a compressor 1 file decoded to other records"
+status=0
+"$vola" translate "$tmp/huge_count.laz" "$tmp/huge_count.las" -q 2> "$tmp/err.txt" || status=$?
+[ "$status" -eq 1 ] || fail "a 2^63-point compressor 1 file: exit $status, not a refusal"
+grep -q "more than the file can hold" "$tmp/err.txt" || fail "huge count message: $(cat "$tmp/err.txt")"
+
 echo "LAZ: $checked files decoded as laz-perf does; LAS -> LAZ -> LAS round trips intact"
