@@ -266,7 +266,7 @@ class AsciiInput {
     std::size_t extra = 0;
     const std::size_t extra_at = at_;
     while (at_ < text_.size() && text_[at_] != '\n') {
-      while (at_ < text_.size() && (text_[at_] == ' ' || text_[at_] == '\t' || text_[at_] == '\r')) ++at_;
+      while (at_ < text_.size() && text_[at_] != '\n' && is_header_space(text_[at_])) ++at_;
       if (at_ == text_.size() || text_[at_] == '\n') break;
       ++extra;
       while (at_ < text_.size() && !is_header_space(text_[at_])) ++at_;

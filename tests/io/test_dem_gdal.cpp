@@ -202,6 +202,19 @@ TEST(DemGdal, FilesGdalCannotReadThrowFormatErrors) {
   const auto gcp = vola_test::format_error_of([&] { vola::io::read_dem((dir / "gcp.tif").string()); });
   ASSERT_TRUE(gcp.has_value());
   EXPECT_NE(gcp->cause().find("ground control points, not a geotransform"), std::string::npos) << gcp->what();
+
+  // An RGB picture (PHOTOMETRIC=RGB: band 1 is red) was read as a relief of its red channel.
+  {
+    const char* options[] = {"PHOTOMETRIC=RGB", nullptr};
+    GDALDataset* d = GetGDALDriverManager()->GetDriverByName("GTiff")->Create((dir / "rgb.tif").c_str(), 4, 4, 3,
+                                                                                GDT_Byte, const_cast<char**>(options));
+    ASSERT_NE(d, nullptr);
+    ASSERT_EQ(d->GetRasterBand(1)->GetColorInterpretation(), GCI_RedBand);
+    GDALClose(d);
+  }
+  const auto rgb = vola_test::format_error_of([&] { vola::io::read_dem((dir / "rgb.tif").string()); });
+  ASSERT_TRUE(rgb.has_value());
+  EXPECT_NE(rgb->cause().find("Red band of a 3-band colour image"), std::string::npos) << rgb->what();
 }
 
 }  // namespace

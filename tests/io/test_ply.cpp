@@ -374,7 +374,7 @@ TEST(Ply, ValuesAfterAnElementsPropertiesOnItsLineAreSkipped) {
   const std::string text =
       "ply\nformat ascii 1.0\ncomment VCGLIB generated\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty uchar red\nend_header\n"
-      "0 0 0 99\n1 2 3\n4 5 6 \n3 0 1 2 9 6 1 1 1 1 1 1\n";
+      "0 0 0 99\n1 2 3\v\f\n4 5 6 \n3 0 1 2 9 6 1 1 1 1 1 1\n";  // vertical tab and form feed are spaces too
   const auto in = vola::io::parse_ply(Bytes(text.begin(), text.end()), "vcg.ply");
   ASSERT_EQ(in.triangles.size(), 1u);
   const std::array<double, 9> want = {0, 0, 0, 1, 2, 3, 4, 5, 6};

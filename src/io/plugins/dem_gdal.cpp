@@ -41,6 +41,21 @@ void crs_of(const GDALDataset& dataset, const std::string& path, DemRaster& dem)
   }
 }
 
+// A colour image is not an elevation raster: its band 1 holds red, a palette index or
+// a hue, which read as heights give a relief of the picture (PDAL's autzen-height.tif is
+// an RGB rendering of heights, not heights). Grey and undeclared bands are read.
+void refuse_colour_images(GDALDataset& dataset, const std::string& path) {
+  const GDALColorInterp interpretation = dataset.GetRasterBand(1)->GetColorInterpretation();
+  const bool colour = interpretation == GCI_RedBand || interpretation == GCI_PaletteIndex ||
+                      interpretation == GCI_HueBand || interpretation == GCI_CyanBand ||
+                      interpretation == GCI_YCbCr_YBand;
+  if (colour)
+    throw FormatError(path, std::nullopt,
+                      std::string("band 1 is the ") + GDALGetColorInterpretationName(interpretation) + " band of a " +
+                          std::to_string(dataset.GetRasterCount()) +
+                          "-band colour image, not heights (an elevation raster's band 1 holds heights)");
+}
+
 }  // namespace
 
 DemRaster read_dem_with_gdal(const std::string& path,
@@ -50,6 +65,7 @@ DemRaster read_dem_with_gdal(const std::string& path,
   const ConfinedGdalConfig confined;  // gdal_confined.hpp: one local file, nothing else
   const Dataset dataset = open_confined_raster(path);
   if (dataset->GetRasterCount() < 1) throw FormatError(path, std::nullopt, "the raster has no band");
+  refuse_colour_images(*dataset, path);
   check_raster_sizes(*dataset, path);
 
   DemRaster dem;
