@@ -22,8 +22,9 @@ std::string_view find_value(std::string_view dict, std::string_view key, const s
   for (std::size_t i = 0; i < dict.size(); ++i) {
     const char c = dict[i];
     if (c == '\'' || c == '"') {
-      const std::size_t close = dict.find(c, i + 1);
-      if (close == std::string_view::npos) break;
+      std::size_t close = i + 1;  // the closing quote; a backslash escapes the next character
+      while (close < dict.size() && dict[close] != c) close += dict[close] == '\\' ? 2 : 1;
+      if (close >= dict.size()) break;
       if (depth == 1 && dict.substr(i + 1, close - i - 1) == key) {
         std::size_t at = close + 1;
         while (at < dict.size() && dict[at] == ' ') ++at;

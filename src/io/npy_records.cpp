@@ -34,10 +34,13 @@ class DescrReader {
     skip_space();
     if (at_ >= text_.size() || (text_[at_] != '\'' && text_[at_] != '"')) fail("expected a quoted string");
     const char quote = text_[at_++];
-    const std::size_t close = text_.find(quote, at_);
-    if (close == std::string_view::npos) fail("a string is not terminated");
-    std::string s(text_.substr(at_, close - at_));
-    at_ = close + 1;
+    std::string s;  // Python's repr escapes quotes and backslashes in a name with a backslash
+    while (at_ < text_.size() && text_[at_] != quote) {
+      if (text_[at_] == '\\' && at_ + 1 < text_.size()) ++at_;
+      s.push_back(text_[at_++]);
+    }
+    if (at_ >= text_.size()) fail("a string is not terminated");
+    ++at_;
     return s;
   }
   std::uint64_t number() {

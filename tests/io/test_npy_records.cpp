@@ -81,6 +81,24 @@ TEST(NpyRecords, AnyShapeIsPointsOnePerRecord) {
   EXPECT_EQ(in.cloud.xyz[17], 52.0);
 }
 
+// numpy writes a name holding a quote or a backslash escaped ('it\\'s'), and a field may be
+// called 'shape': neither may hide the header's own keys.
+TEST(NpyRecords, EscapedNamesAndAFieldCalledShape) {
+  Bytes data;
+  for (int i = 0; i < 3; ++i)
+    for (int a = 0; a < 4; ++a) put<double>(data, 10.0 * i + a);
+  const auto array = vola::io::parse_npy(
+      record_npy("[('x', '<f8'), ('y', '<f8'), ('z', '<f8'), ('it\\'s \"q\" \\\\ shape', '<f8')]", "(3,)", data), "e.npy");
+  const auto in = vola::io::npy_input(array, "e.npy", {});
+  ASSERT_EQ(in.cloud.size(), 3u);
+  ASSERT_EQ(in.cloud.attributes.size(), 1u);
+  EXPECT_EQ(in.cloud.attributes[0].name, "it's \"q\" \\ shape");
+  EXPECT_EQ(in.cloud.attributes[0].values, (std::vector<double>{3, 13, 23}));
+  const auto shaped = vola::io::parse_npy(
+      record_npy("[('shape', '<f8'), ('x', '<f8'), ('y', '<f8'), ('z', '<f8')]", "(3,)", data), "s.npy");
+  EXPECT_EQ(shaped.shape, (std::vector<std::uint64_t>{3}));
+}
+
 TEST(NpyRecords, WhatCannotBeReadIsRefused) {
   struct Case {
     std::string descr, cause;
