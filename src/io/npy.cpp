@@ -244,14 +244,6 @@ void with_value_type(const NpyArray& a, F&& f) {
   }
 }
 
-template <class T>
-T load_value(const std::uint8_t* p, bool swap) noexcept {
-  if (!swap) return load_le<T>(p);
-  std::uint8_t reversed[sizeof(T)];
-  for (std::size_t b = 0; b < sizeof(T); ++b) reversed[b] = p[sizeof(T) - 1 - b];
-  return load_le<T>(reversed);
-}
-
 }  // namespace
 
 PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns) {
@@ -273,7 +265,7 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
     double* out = cloud.xyz.data();
     for (std::uint64_t i = 0; i < n; ++i)
       for (std::uint64_t c = 0; c < 3; ++c) {
-        const T v = load_value<T>(base + (i * row_step + c * column_step) * sizeof(T), array.big_endian);
+        const T v = load_npy_value<T>(base + (i * row_step + c * column_step) * sizeof(T), array.big_endian);
         *out++ = boolean ? static_cast<double>(v != 0) : static_cast<double>(v);
       }
   });

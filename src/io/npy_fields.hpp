@@ -1,4 +1,5 @@
-// Internal to the NPY reader: the fields of a structured dtype (src/io/npy_records.cpp).
+// Internal to the NPY reader: loading a stored value of either byte order, and the
+// fields of a structured dtype (src/io/npy_records.cpp).
 #pragma once
 
 #include <cstdint>
@@ -7,8 +8,18 @@
 #include <vector>
 
 #include "vola/io/npy.hpp"
+#include "vola/little_endian.hpp"
 
 namespace vola::io {
+
+// A value of type T stored little-endian, or big-endian when `swap`.
+template <class T>
+T load_npy_value(const std::uint8_t* p, bool swap) noexcept {
+  if (!swap) return load_le<T>(p);
+  std::uint8_t reversed[sizeof(T)];
+  for (std::size_t b = 0; b < sizeof(T); ++b) reversed[b] = p[sizeof(T) - 1 - b];
+  return load_le<T>(reversed);
+}
 
 // numpy's descr list ("[('x', '<f8'), ('rgb', '|u1', (3,)), ...]", from its '[' on): the
 // numeric fields with their offsets (subarrays as one field per element; padding, bytes

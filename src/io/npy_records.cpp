@@ -77,7 +77,8 @@ NpyField field_type(const std::string& dtype, DescrReader& in, const std::string
   f.kind = dtype[1];
   std::uint64_t size = 0;
   for (std::size_t i = 2; i < dtype.size(); ++i) {
-    if (dtype[i] < '0' || dtype[i] > '9' || size > (1u << 24)) in.fail("field '" + field + "' has dtype '" + dtype + "'");
+    if (dtype[i] < '0' || dtype[i] > '9' || size > (1u << 24))
+      in.fail("field '" + field + "' has dtype '" + dtype + "'");
     size = size * 10 + static_cast<std::uint64_t>(dtype[i] - '0');
   }
   const bool numeric = (f.kind == 'f' && (size == 4 || size == 8)) ||
@@ -92,32 +93,35 @@ NpyField field_type(const std::string& dtype, DescrReader& in, const std::string
   return f;
 }
 
-template <class T>
-T load_swapped(const std::uint8_t* p, bool swap) noexcept {
-  if (!swap) return load_le<T>(p);
-  std::uint8_t reversed[sizeof(T)];
-  for (std::size_t b = 0; b < sizeof(T); ++b) reversed[b] = p[sizeof(T) - 1 - b];
-  return load_le<T>(reversed);
-}
-
 double field_value(const NpyField& f, const std::uint8_t* record) noexcept {
   const std::uint8_t* p = record + f.offset;
   switch (f.kind) {
-    case 'f': return f.item_size == 4 ? static_cast<double>(load_swapped<float>(p, f.big_endian)) : load_swapped<double>(p, f.big_endian);
-    case 'b': return *p ? 1.0 : 0.0;
+    case 'f':
+      return f.item_size == 4 ? static_cast<double>(load_npy_value<float>(p, f.big_endian))
+                              : load_npy_value<double>(p, f.big_endian);
+    case 'b':
+      return *p ? 1.0 : 0.0;
     case 'u':
       switch (f.item_size) {
-        case 1: return *p;
-        case 2: return load_swapped<std::uint16_t>(p, f.big_endian);
-        case 4: return load_swapped<std::uint32_t>(p, f.big_endian);
-        default: return static_cast<double>(load_swapped<std::uint64_t>(p, f.big_endian));
+        case 1:
+          return *p;
+        case 2:
+          return load_npy_value<std::uint16_t>(p, f.big_endian);
+        case 4:
+          return load_npy_value<std::uint32_t>(p, f.big_endian);
+        default:
+          return static_cast<double>(load_npy_value<std::uint64_t>(p, f.big_endian));
       }
     default:
       switch (f.item_size) {
-        case 1: return static_cast<std::int8_t>(*p);
-        case 2: return load_swapped<std::int16_t>(p, f.big_endian);
-        case 4: return load_swapped<std::int32_t>(p, f.big_endian);
-        default: return static_cast<double>(load_swapped<std::int64_t>(p, f.big_endian));
+        case 1:
+          return static_cast<std::int8_t>(*p);
+        case 2:
+          return load_npy_value<std::int16_t>(p, f.big_endian);
+        case 4:
+          return load_npy_value<std::int32_t>(p, f.big_endian);
+        default:
+          return static_cast<double>(load_npy_value<std::int64_t>(p, f.big_endian));
       }
   }
 }
@@ -196,15 +200,17 @@ PointCloud npy_record_points(const NpyArray& array, const std::string& name) {
   if (!axis[0] || !axis[1] || !axis[2]) {
     std::string names;
     for (const NpyField& f : array.fields) names += (names.empty() ? "" : ", ") + f.name;
-    throw FormatError(name, {}, "a structured array needs numeric fields x, y and z (in any case); its fields are " +
-                                    (names.empty() ? std::string("none") : names));
+    throw FormatError(name, {},
+                      "a structured array needs numeric fields x, y and z (in any case); its fields are " +
+                          (names.empty() ? std::string("none") : names));
   }
   const std::uint64_t n = array.size();
   const auto record = static_cast<std::uint64_t>(array.item_size);
   PointCloud cloud;
   cloud.xyz.resize(3 * n);
   for (std::uint64_t i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) cloud.xyz[3 * i + static_cast<std::uint64_t>(a)] = field_value(*axis[a], array.data.data() + i * record);
+    for (int a = 0; a < 3; ++a)
+      cloud.xyz[3 * i + static_cast<std::uint64_t>(a)] = field_value(*axis[a], array.data.data() + i * record);
   std::unordered_set<std::string> taken = {"x", "y", "z"};
   for (const NpyField& f : array.fields) {
     if (&f == axis[0] || &f == axis[1] || &f == axis[2]) continue;

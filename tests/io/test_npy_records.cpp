@@ -74,7 +74,8 @@ TEST(NpyRecords, AnyShapeIsPointsOnePerRecord) {
   Bytes data;
   for (int i = 0; i < 6; ++i)
     for (int a = 0; a < 3; ++a) put<float>(data, static_cast<float>(10 * i + a));
-  const auto array = vola::io::parse_npy(record_npy("[('x', '<f4'), ('y', '<f4'), ('z', '<f4')]", "(2, 3)", data), "r.npy");
+  const auto array =
+      vola::io::parse_npy(record_npy("[('x', '<f4'), ('y', '<f4'), ('z', '<f4')]", "(2, 3)", data), "r.npy");
   const auto in = vola::io::npy_input(array, "r.npy", {});
   ASSERT_EQ(in.cloud.size(), 6u);
   EXPECT_EQ(in.cloud.xyz[15], 50.0);
@@ -88,7 +89,8 @@ TEST(NpyRecords, EscapedNamesAndAFieldCalledShape) {
   for (int i = 0; i < 3; ++i)
     for (int a = 0; a < 4; ++a) put<double>(data, 10.0 * i + a);
   const auto array = vola::io::parse_npy(
-      record_npy("[('x', '<f8'), ('y', '<f8'), ('z', '<f8'), ('it\\'s \"q\" \\\\ shape', '<f8')]", "(3,)", data), "e.npy");
+      record_npy("[('x', '<f8'), ('y', '<f8'), ('z', '<f8'), ('it\\'s \"q\" \\\\ shape', '<f8')]", "(3,)", data),
+      "e.npy");
   const auto in = vola::io::npy_input(array, "e.npy", {});
   ASSERT_EQ(in.cloud.size(), 3u);
   ASSERT_EQ(in.cloud.attributes.size(), 1u);
@@ -124,8 +126,9 @@ TEST(NpyRecords, WhatCannotBeReadIsRefused) {
     }
   }
   // More records than the data holds.
-  EXPECT_THROW(vola::io::parse_npy(record_npy("[('x', '<f8'), ('y', '<f8'), ('z', '<f8')]", "(3,)", Bytes(48, 0)), "t.npy"),
-               vola::FormatError);
+  EXPECT_THROW(
+      vola::io::parse_npy(record_npy("[('x', '<f8'), ('y', '<f8'), ('z', '<f8')]", "(3,)", Bytes(48, 0)), "t.npy"),
+      vola::FormatError);
 }
 
 }  // namespace

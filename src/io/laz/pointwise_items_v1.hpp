@@ -72,10 +72,10 @@ class Point10V1Coder {
     dy_.encode(e, median3(y_diffs_), dy, k < 19 ? k : 19);
     k = (k + dy_.k()) / 2;
     dz_.encode(e, load_le<std::int32_t>(last_ + 8), load_le<std::int32_t>(in + 8), k < 19 ? k : 19);
-    const std::uint32_t changed = (std::uint32_t{std::memcmp(last_ + 12, in + 12, 2) != 0} << 5) |
-                                  (std::uint32_t{last_[14] != in[14]} << 4) | (std::uint32_t{last_[15] != in[15]} << 3) |
-                                  (std::uint32_t{last_[16] != in[16]} << 2) | (std::uint32_t{last_[17] != in[17]} << 1) |
-                                  std::uint32_t{std::memcmp(last_ + 18, in + 18, 2) != 0};
+    const std::uint32_t changed =
+        (std::uint32_t{std::memcmp(last_ + 12, in + 12, 2) != 0} << 5) | (std::uint32_t{last_[14] != in[14]} << 4) |
+        (std::uint32_t{last_[15] != in[15]} << 3) | (std::uint32_t{last_[16] != in[16]} << 2) |
+        (std::uint32_t{last_[17] != in[17]} << 1) | std::uint32_t{std::memcmp(last_ + 18, in + 18, 2) != 0};
     e.encode_symbol(changed_, changed);
     if (changed & 32) intensity_.encode(e, load_le<std::uint16_t>(last_ + 12), load_le<std::uint16_t>(in + 12));
     if (changed & 16) e.encode_symbol(bit_byte_.at(last_[14]), in[14]);
@@ -182,7 +182,8 @@ class GpsTime11V1Coder {
     } else if (fits) {
       // The nearest multiple of the regular difference, within the multiplier's range.
       const double ratio = static_cast<double>(diff) / static_cast<double>(last_diff_) + 0.5;
-      const std::uint32_t multi = ratio < 1 ? 0 : (ratio >= kMultiMax - 3 ? kMultiMax - 3 : static_cast<std::uint32_t>(ratio));
+      const std::uint32_t multi =
+          ratio < 1 ? 0 : (ratio >= kMultiMax - 3 ? kMultiMax - 3 : static_cast<std::uint32_t>(ratio));
       e.encode_symbol(multi_, multi);
       step(multi, [&](std::int32_t prediction, std::uint32_t context) {
         ic_.encode(e, prediction, diff, context);

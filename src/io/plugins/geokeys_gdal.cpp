@@ -25,7 +25,9 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 
-void put16(Bytes& b, std::uint16_t v) { b.insert(b.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)}); }
+void put16(Bytes& b, std::uint16_t v) {
+  b.insert(b.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v >> 8)});
+}
 void put32(Bytes& b, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
 }
@@ -43,14 +45,15 @@ Bytes geotiff_with_keys(const plugin::GeoKeyRecords& keys) {
                            {259, 3, 1, nullptr, 1}, {262, 3, 1, nullptr, 1}, {273, 4, 1, nullptr, 0},
                            {277, 3, 1, nullptr, 1}, {278, 3, 1, nullptr, 1}, {279, 4, 1, nullptr, 1}};
   tags.push_back({34735, 3, static_cast<std::uint32_t>(keys.directory.size() / 2), &keys.directory, 0});
-  if (keys.doubles.size() >= 8) tags.push_back({34736, 12, static_cast<std::uint32_t>(keys.doubles.size() / 8), &keys.doubles, 0});
+  if (keys.doubles.size() >= 8)
+    tags.push_back({34736, 12, static_cast<std::uint32_t>(keys.doubles.size() / 8), &keys.doubles, 0});
   if (!keys.ascii.empty()) tags.push_back({34737, 2, static_cast<std::uint32_t>(keys.ascii.size()), &keys.ascii, 0});
   const std::uint32_t data_at = 8 + 2 + 12 * static_cast<std::uint32_t>(tags.size()) + 4;
   Bytes blobs;
   std::vector<std::uint32_t> blob_at(tags.size(), 0);
   for (std::size_t i = 0; i < tags.size(); ++i) {
     if (!tags[i].data) continue;
-    const std::size_t bytes = tags[i].type == 3 ? 2 * std::size_t{tags[i].count}
+    const std::size_t bytes = tags[i].type == 3    ? 2 * std::size_t{tags[i].count}
                               : tags[i].type == 12 ? 8 * std::size_t{tags[i].count}
                                                    : tags[i].count;
     if (bytes <= 4) {  // TIFF holds a value of 4 bytes or less in the entry itself
