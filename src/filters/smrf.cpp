@@ -271,6 +271,57 @@ std::vector<bool> raised_plateaus(const ElevationGrid& g) {
   return raised;
 }
 
+// Pits of the low-outlier opening that are ground seen through a canopy. Under dense
+// vegetation most cells' lowest point is a leaf or a branch, and the few cells that reach
+// the ground lie metres below all their neighbours: the opening takes each for a pit. Yet
+// they continue one another, cell to cell a few metres apart, across the whole forest,
+// while echoes below glass or water come in clusters a few metres wide. Pits join when
+// they lie within kLowOutlierWindow of each other and within kPitDepth + kPitSlope x
+// distance in height (the reach unsupported() allows); a network wider than
+// kPitNetworkExtent is ground.
+std::vector<bool> pits_in_wide_networks(const ElevationGrid& g, const std::vector<bool>& pit) {
+  const std::size_t cols = g.cols, rows = g.rows, cells = g.cells();
+  const auto r = static_cast<std::ptrdiff_t>(std::floor(kLowOutlierWindow / g.cell));
+  std::vector<std::uint32_t> parent(cells);
+  for (std::size_t k = 0; k < cells; ++k) parent[k] = static_cast<std::uint32_t>(k);
+  const auto root = [&](std::size_t k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (!pit[k]) continue;
+    const auto i = static_cast<std::ptrdiff_t>(k % cols), j = static_cast<std::ptrdiff_t>(k / cols);
+    // Each pair once: the rows after this one, and the cells after it in its own row.
+    for (std::ptrdiff_t jj = j; jj <= std::min(static_cast<std::ptrdiff_t>(rows) - 1, j + r); ++jj)
+      for (std::ptrdiff_t ii = std::max<std::ptrdiff_t>(0, i - r);
+           ii <= std::min(static_cast<std::ptrdiff_t>(cols) - 1, i + r); ++ii) {
+        if (jj == j && ii <= i) continue;
+        const auto q = static_cast<std::size_t>(jj) * cols + static_cast<std::size_t>(ii);
+        if (!pit[q]) continue;
+        const double d = std::hypot(static_cast<double>(ii - i), static_cast<double>(jj - j)) * g.cell;
+        if (d <= kLowOutlierWindow && std::abs(double{g.z[k]} - double{g.z[q]}) <= kPitDepth + kPitSlope * d)
+          parent[root(k)] = static_cast<std::uint32_t>(root(q));
+      }
+  }
+  struct Span {
+    std::size_t col0 = SIZE_MAX, row0 = SIZE_MAX, col1 = 0, row1 = 0;
+  };
+  std::vector<Span> span(cells);
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (!pit[k]) continue;
+    Span& s = span[root(k)];
+    s.col0 = std::min(s.col0, k % cols), s.col1 = std::max(s.col1, k % cols);
+    s.row0 = std::min(s.row0, k / cols), s.row1 = std::max(s.row1, k / cols);
+  }
+  std::vector<bool> wide(cells, false);
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (!pit[k]) continue;
+    const Span& s = span[root(k)];
+    wide[k] = static_cast<double>(std::max(s.col1 - s.col0, s.row1 - s.row0)) * g.cell > kPitNetworkExtent;
+  }
+  return wide;
+}
+
 }  // namespace
 
 std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<bool>& candidate,
@@ -311,7 +362,7 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
 
   // Low outliers: cells below their neighbours that no neighbour continues (repeated, as
   // removing one can leave another without support), then pits of the minimum surface
-  // found as peaks of its negation.
+  // found as peaks of its negation, but for those that are ground under a canopy.
   const int support_radius = std::max(1, static_cast<int>(std::lround(kSupportRadius / c)));
   for (int pass = 0; pass < kSupportPasses; ++pass) {
     const std::vector<bool> low = unsupported_lows(zmin, support_radius);
@@ -324,8 +375,9 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   detail::inpaint(negated);
   const int low_radius = std::max(1, static_cast<int>(std::ceil(kLowOutlierWindow / c)));
   const std::vector<bool> pit = progressive_objects(negated, low_radius, kLowOutlierSlope);
+  const std::vector<bool> under_canopy = pits_in_wide_networks(zmin, pit);
   for (std::size_t k = 0; k < zmin.cells(); ++k)
-    if (pit[k]) zmin.z[k] = NAN;
+    if (pit[k] && !under_canopy[k]) zmin.z[k] = NAN;
 
   ElevationGrid filled = zmin;
   detail::inpaint(filled);

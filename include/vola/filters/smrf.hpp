@@ -46,6 +46,10 @@ struct SmrfOptions {
 // radius within 5 m are not terrain (real ditches and banks are far gentler).
 inline constexpr double kLowOutlierWindow = 5.0;
 inline constexpr double kLowOutlierSlope = 5.0;
+// Pits that continue one another (within kLowOutlierWindow metres, heights within
+// kPitDepth + kPitSlope x distance) across more than kPitNetworkExtent metres are ground
+// seen through gaps in a canopy, not a cluster of echoes: they are kept.
+inline constexpr double kPitNetworkExtent = 4.0 * kLowOutlierWindow;
 // Before it, a cell is an unsupported low when some filled cell within kSupportRadius
 // metres lies more than kPitDepth + kPitSlope x distance above it and fewer than two lie
 // within that height of it; repeated up to kSupportPasses times.
