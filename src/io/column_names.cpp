@@ -73,8 +73,24 @@ std::string point_column_name(std::string_view raw) {
   return lower;
 }
 
-Reduction point_column_reduction(const std::string& column) {
-  if (column == "classification" || column == "class" || column == "label" || column == "scalar_classification")
+bool names_identifiers(std::string_view field) {
+  const auto lower = [](char c) { return std::islower(static_cast<unsigned char>(c)) != 0; };
+  const auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  const auto separator = [](char c) { return c == '_' || c == ' ' || c == '-' || c == '.'; };
+  if (field == "id" || field == "ID" || field == "Id") return true;
+  if (field.size() < 3) return false;
+  const std::string_view tail = field.substr(field.size() - 2);
+  const char before = field[field.size() - 3];
+  // treeID, OriginId, Segment3ID, tree_id, cluster-id; not geoid, centroid, GEOID (a
+  // geoid height is a measurement), nor any word that merely ends in "id".
+  if (tail == "ID" || tail == "Id") return lower(before) || digit(before) || separator(before);
+  if (tail == "id" || tail == "iD") return separator(before);
+  return false;
+}
+
+Reduction point_column_reduction(const std::string& column, std::string_view field) {
+  if (column == "classification" || column == "class" || column == "label" || column == "scalar_classification" ||
+      column == "cluster" || column == "segment" || column == "instance" || names_identifiers(field))
     return Reduction::majority;
   if (column == "number_of_returns") return Reduction::max;
   return Reduction::mean;

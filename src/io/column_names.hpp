@@ -21,8 +21,15 @@ std::string utf8_name(std::string_view name);
 // (and UTF-8, as utf8_name makes them).
 std::string point_column_name(std::string_view field);
 
-// Classes (classification, class, label) by majority, number_of_returns by maximum
-// (as the LAS reader keeps them), the rest by mean.
-Reduction point_column_reduction(const std::string& column);
+// Whether a field name, as the file spells it, names identifiers: "id", or a name ending
+// in "ID"/"Id" after a lower-case letter, a digit or a separator (treeID, OriginId), or in
+// "_id" (tree_id). Labels, not measurements: the mean of two ids is neither.
+bool names_identifiers(std::string_view field);
+
+// Classes (classification, class, label), clusters, segments, instances and identifiers
+// (names_identifiers of `field`, the name as the file spells it) by majority,
+// number_of_returns by maximum (as the LAS reader keeps them), the rest by mean.
+// `column` is the name point_column_name gives it.
+Reduction point_column_reduction(const std::string& column, std::string_view field);
 
 }  // namespace vola::io

@@ -216,7 +216,7 @@ PointCloud npy_record_points(const NpyArray& array, const std::string& name) {
     if (&f == axis[0] || &f == axis[1] || &f == axis[2]) continue;
     const std::string column = point_column_name(f.name);
     if (!taken.insert(column).second) continue;  // a second field of one name stays unread
-    PointAttribute attribute{column, value_type_of(f), point_column_reduction(column), {}};
+    PointAttribute attribute{column, value_type_of(f), point_column_reduction(column, f.name), {}};
     attribute.values.resize(n);
     for (std::uint64_t i = 0; i < n; ++i) attribute.values[i] = field_value(f, array.data.data() + i * record);
     cloud.attributes.push_back(std::move(attribute));

@@ -256,7 +256,7 @@ Layout find_layout(const Header& h, const std::string& name) {
     if (used || !scalar(f) || f.name.find_first_not_of('_') == std::string::npos) continue;
     std::string column = point_column_name(f.name);
     if (!taken.insert(column).second) continue;
-    const Reduction reduction = point_column_reduction(column);
+    const Reduction reduction = point_column_reduction(column, f.name);
     l.others.push_back({&f, std::move(column), field_value_type(f), reduction});
   }
   return l;

@@ -1,6 +1,7 @@
 #include "vola/io/ply.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -161,7 +162,8 @@ ValueType value_type_of(PlyType t) {
 
 // The vertex's other scalar properties (intensity, normals, scalar fields, labels...)
 // as attribute columns: role `attribute`, column[p] their place in cloud.attributes.
-// Class-like names take the majority of a voxel's points, the others the mean.
+// Class-like names and identifiers (point_column_reduction) take the majority of a
+// voxel's points, the others the mean.
 std::vector<std::size_t> attribute_columns(const std::vector<Property>& properties, std::vector<Role>& roles,
                                            PointCloud& cloud) {
   std::vector<std::size_t> column(properties.size(), 0);
@@ -171,7 +173,9 @@ std::vector<std::size_t> attribute_columns(const std::vector<Property>& properti
     if (properties[p].list || roles[p] != Role::skip) continue;
     const std::string name = utf8_name(properties[p].name);
     if (!taken.insert(name).second) continue;  // a second property of one name stays unread
-    const bool label = name == "classification" || name == "class" || name == "label" || name == "scalar_Classification";
+    std::string lower = name;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool label = point_column_reduction(lower, name) == Reduction::majority;
     roles[p] = Role::attribute;
     column[p] = cloud.attributes.size();
     cloud.attributes.push_back({name, value_type_of(properties[p].type), label ? Reduction::majority : Reduction::mean, {}});

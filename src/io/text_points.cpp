@@ -306,7 +306,7 @@ TextColumns text_columns_of(const TextHeader& header) {
     if (column == columns.x || column == columns.y || column == columns.z) continue;
     std::string name = point_column_name(header.names[c]);
     if (name.empty() || !taken.insert(name).second) continue;  // a second column of one name stays unread, as in PLY
-    const Reduction reduction = point_column_reduction(name);
+    const Reduction reduction = point_column_reduction(name, header.names[c]);
     columns.attributes.push_back({std::move(name), ValueType::f64, reduction, {}});
     columns.attribute_columns.push_back(column);
   }

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
 
 #include "io_test_data.hpp"
@@ -291,6 +292,62 @@ TEST(LasStream, ExtendedFormatWithExtraBytesBuildsAsTheWholeCloudDoes) {
     ASSERT_EQ(probe.header().extra_fields.size(), 3u);
     check_file([&] { return vola::io::LasReader(path.string()); }, 4001);
   }
+}
+
+// Extra-bytes identifiers (lidR writes its segmented trees' treeID as one) are reduced
+// by majority, measurements (GEOID: a geoid height, upper case) by mean; the streamed
+// build and the whole cloud agree, and every voxel's treeID is one its points hold most.
+TEST(LasStream, IdentifierExtraBytesTakeTheMajorityOfAVoxel) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> coordinate(0.0, 8.0), any(-50.0, 50.0);
+  std::uniform_int_distribution<int> tree(1, 5);
+  vola::PointCloud cloud;
+  for (const char* name : {"treeID", "GEOID", "temperature"})
+    cloud.attributes.push_back({name, vola::ValueType::f64, vola::Reduction::mean, {}});
+  for (int i = 0; i < 20000; ++i) {
+    for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
+    cloud.attributes[0].values.push_back(tree(rng));
+    cloud.attributes[1].values.push_back(any(rng));
+    cloud.attributes[2].values.push_back(any(rng));
+  }
+  const vola_test::TempDir dir;
+  const auto path = dir.path() / "trees.las";
+  vola::io::write_las(cloud, path.string());
+  vola::io::LasReader reader(path.string());
+  for (const auto& spec : vola::io::las_attributes(reader.header())) {
+    const vola::Reduction want = spec.name == "treeID" ? vola::Reduction::majority : vola::Reduction::mean;
+    if (spec.name == "treeID" || spec.name == "GEOID" || spec.name == "temperature") {
+      EXPECT_EQ(spec.reduction, want) << spec.name;
+    }
+  }
+  check_file([&] { return vola::io::LasReader(path.string()); }, 3001);
+
+  vola::BuildOptions options;
+  options.quantization = vola::Quantization::grid;
+  options.voxel_size = 1.0;
+  options.origin = vola::Point{0, 0, 0};
+  const vola::Tree built = vola::io::build_las(reader, options, true, false, nullptr);
+  const vola::Quantizer grid = vola::Quantizer::grid({0, 0, 0}, 1.0, built.depth());
+  const vola::AttributeColumn* ids = built.attributes().find("treeID");
+  ASSERT_NE(ids, nullptr);
+  ASSERT_EQ(ids->reduction(), vola::Reduction::majority);
+  std::map<std::uint64_t, std::map<double, int>> counts;  // voxel rank -> tree id -> points
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    vola::Voxel v;
+    ASSERT_TRUE(grid.to_voxel({cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]}, v));
+    ++counts[*built.rank(v)][cloud.attributes[0].values[i]];
+  }
+  ASSERT_EQ(counts.size(), built.voxel_count());
+  std::size_t ties = 0;
+  for (const auto& [rank, ids_of_voxel] : counts) {
+    int most = 0;
+    for (const auto& [id, n] : ids_of_voxel) most = std::max(most, n);
+    const double got = ids->get(rank);
+    ASSERT_TRUE(ids_of_voxel.count(got) && ids_of_voxel.at(got) == most) << "voxel " << rank << " holds " << got;
+    ties +=
+        std::count_if(ids_of_voxel.begin(), ids_of_voxel.end(), [&](const auto& e) { return e.second == most; }) > 1;
+  }
+  EXPECT_LT(ties, counts.size());  // most voxels have one most common id: the check has teeth
 }
 
 TEST(LasStream, NegativeScaleBoundsAsDecoded) {

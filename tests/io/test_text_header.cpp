@@ -55,6 +55,21 @@ TEST(TextHeader, PdalsQuotedCsvNamesEveryColumn) {
   EXPECT_EQ(column(cloud, "red").type, vola::ValueType::u16);
 }
 
+// Identifiers and labels are reduced by majority, as classes are: lidR's treeID, PDAL's
+// EPT OriginId, segmentation output; the mean of two tree ids is a third tree. A name
+// that merely ends in "id" (geoid, centroid) is a measurement and keeps the mean.
+TEST(TextHeader, IdentifierColumnsTakeTheMajorityOfAVoxel) {
+  TempDir dir;
+  const auto cloud = read_text(dir,
+                               "x y z treeID tree_id OriginId ID cluster-id segment3ID cluster instance "
+                               "geoid centroid paid temperature\n"
+                               "1 2 3 4 5 6 7 8 9 10 11 12 13 14 15\n");
+  for (const char* id : {"treeid", "tree_id", "originid", "id", "cluster-id", "segment3id", "cluster", "instance"})
+    EXPECT_EQ(column(cloud, id).reduction, vola::Reduction::majority) << id;
+  for (const char* value : {"geoid", "centroid", "paid", "temperature"})
+    EXPECT_EQ(column(cloud, value).reduction, vola::Reduction::mean) << value;
+}
+
 // A quoted name may hold spaces (CloudCompare's M3C2 output, re-written by PDAL): the
 // quotes, not the spaces, delimit it, so the names line up with the values.
 TEST(TextHeader, QuotedNamesMayHoldSpaces) {
