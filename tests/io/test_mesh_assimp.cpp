@@ -391,6 +391,24 @@ TEST(MeshAssimp, MislabelledPrimitiveTypesAreReadWithTheStructureChecked) {
   EXPECT_EQ(sorted, want);
 }
 
+// An ASCII STL whose second solid is empty (CAD exporters write one for an empty body;
+// Assimp's test model triangle_with_empty_solid.stl is one): Assimp's validation refuses
+// the empty mesh, yet the file's one triangle is all there is to read. An STL of empty
+// solids alone still holds nothing to voxelise.
+TEST(MeshAssimp, AnEmptySolidBesideARealOneIsPassedOver) {
+  vola_test::TempDir dir;
+  write_file(dir / "two_solids.stl",
+             "solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 1 1 0\n      vertex -1 1 0\n"
+             "      vertex 0 -1 0\n    endloop\n  endfacet\nendsolid part\nsolid empty\nendsolid empty\n");
+  const auto triangles = vola::io::read_mesh_triangles((dir / "two_solids.stl").string());
+  ASSERT_EQ(triangles.size(), 1u);
+  auto corners = triangles[0];
+  std::sort(corners.begin(), corners.end());
+  EXPECT_EQ(corners, (vola::io::Triangle{vola::Point{-1, 1, 0}, vola::Point{0, -1, 0}, vola::Point{1, 1, 0}}));
+  write_file(dir / "empty.stl", "solid empty\nendsolid empty\n");
+  EXPECT_TRUE(vola_test::format_error_of([&] { vola::io::read_mesh_triangles((dir / "empty.stl").string()); }));
+}
+
 TEST(MeshAssimp, OnlyTheDocumentedMeshFormatsReachAssimp) {
   vola_test::TempDir dir;
   // An ASCII PLY (vola reads PLY itself) and a Wavefront OBJ named .md5mesh: Assimp would read both.

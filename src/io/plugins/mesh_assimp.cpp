@@ -157,12 +157,19 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   auto* io = new ConfinedIOSystem(path);
   importer.SetIOHandler(io);  // the importer owns it
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
-  // Assimp 5.2's OBJ importer can label a mesh's primitive types wrongly (trimesh's
-  // cubevt.obj, a textured cube of triangles: "mFaces[0] is a POINT but mPrimitiveTypes
-  // does not report the POINT flag"), which its own validation then refuses. The flags
-  // are not used here, so such a scene is read again without the validation and held to
-  // the structural checks the validation would have made (structurally_sound below).
-  if (!scene && std::string(importer.GetErrorString()).find("mPrimitiveTypes does not report") != std::string::npos) {
+  // Assimp's validation refuses two things that do not matter here. Its OBJ importer
+  // (5.2) can label a mesh's primitive types wrongly (trimesh's cubevt.obj, a textured
+  // cube of triangles: "mFaces[0] is a POINT but mPrimitiveTypes does not report the POINT
+  // flag"), and a mesh may be empty (an ASCII STL with an empty "solid ... endsolid" beside
+  // the real one, as CAD exporters write for an empty body: "The mesh emptySolid contains
+  // no vertices"). Neither the flags nor an empty mesh are used, so such a scene is read
+  // again without the validation and held to the structural checks the validation would
+  // have made (structurally_sound below).
+  const auto harmless = [](const std::string& refusal) {
+    return refusal.find("mPrimitiveTypes does not report") != std::string::npos ||
+           refusal.find("contains no vertices") != std::string::npos;
+  };
+  if (!scene && harmless(importer.GetErrorString())) {
     const std::string refusal = importer.GetErrorString();
     scene = importer.ReadFile(path, aiProcess_Triangulate);
     if (scene && !structurally_sound(*scene)) throw FormatError(path, std::nullopt, "Assimp: " + refusal);
