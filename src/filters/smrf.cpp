@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <span>
+#include <string>
+
+#include <unistd.h>
 
 #include "elevation_grid.hpp"
 #include "vola/error.hpp"
@@ -40,6 +43,21 @@ void SmrfOptions::check() const {
 namespace {
 
 constexpr double kMaxCells = double(1u << 28);
+// Bytes the grids take per cell: the minimum surface, its fills and openings, the plateau
+// step's patches (measured: 5.0 GB for 8001 x 8001 cells of three points).
+constexpr double kBytesPerCell = 80.0;
+
+// The grid memory SMRF may take: half of this machine's.
+double grid_memory_budget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? 0.5 * static_cast<double>(pages) * static_cast<double>(page) : 8e9;
+}
+
+std::string gigabytes(double bytes) {
+  char out[32];
+  std::snprintf(out, sizeof out, "%.1f GB", bytes / 1e9);
+  return out;
+}
 
 // Cells an opening lowers by more than slope x radius x cell, for radius 1..max_radius
 // (each opening of the previous surface: openings by growing disks, the progressive filter).
@@ -280,16 +298,23 @@ std::vector<bool> raised_plateaus(const ElevationGrid& g) {
 // distance in height (the reach unsupported() allows); a network wider than
 // kPitNetworkExtent is ground.
 std::vector<bool> pits_in_wide_networks(const ElevationGrid& g, const std::vector<bool>& pit) {
-  const std::size_t cols = g.cols, rows = g.rows, cells = g.cells();
-  const auto r = static_cast<std::ptrdiff_t>(std::floor(kLowOutlierWindow / g.cell));
-  std::vector<std::uint32_t> parent(cells);
-  for (std::size_t k = 0; k < cells; ++k) parent[k] = static_cast<std::uint32_t>(k);
-  const auto root = [&](std::size_t k) {
-    while (parent[k] != k) k = parent[k] = parent[parent[k]];
-    return k;
+  const std::size_t cols = g.cols, rows = g.rows;
+  // Per pit, not per cell: a survey's grid can hold 10^8 cells and only a few pits.
+  std::vector<std::size_t> pits;  // cell indices, ascending
+  for (std::size_t k = 0; k < g.cells(); ++k)
+    if (pit[k]) pits.push_back(k);
+  const auto index_of = [&](std::size_t cell) {
+    return static_cast<std::size_t>(std::lower_bound(pits.begin(), pits.end(), cell) - pits.begin());
   };
-  for (std::size_t k = 0; k < cells; ++k) {
-    if (!pit[k]) continue;
+  std::vector<std::size_t> parent(pits.size());
+  for (std::size_t p = 0; p < pits.size(); ++p) parent[p] = p;
+  const auto root = [&](std::size_t p) {
+    while (parent[p] != p) p = parent[p] = parent[parent[p]];
+    return p;
+  };
+  const auto r = static_cast<std::ptrdiff_t>(std::floor(kLowOutlierWindow / g.cell));
+  for (std::size_t p = 0; p < pits.size(); ++p) {
+    const std::size_t k = pits[p];
     const auto i = static_cast<std::ptrdiff_t>(k % cols), j = static_cast<std::ptrdiff_t>(k / cols);
     // Each pair once: the rows after this one, and the cells after it in its own row.
     for (std::ptrdiff_t jj = j; jj <= std::min(static_cast<std::ptrdiff_t>(rows) - 1, j + r); ++jj)
@@ -300,24 +325,23 @@ std::vector<bool> pits_in_wide_networks(const ElevationGrid& g, const std::vecto
         if (!pit[q]) continue;
         const double d = std::hypot(static_cast<double>(ii - i), static_cast<double>(jj - j)) * g.cell;
         if (d <= kLowOutlierWindow && std::abs(double{g.z[k]} - double{g.z[q]}) <= kPitDepth + kPitSlope * d)
-          parent[root(k)] = static_cast<std::uint32_t>(root(q));
+          parent[root(p)] = root(index_of(q));
       }
   }
   struct Span {
     std::size_t col0 = SIZE_MAX, row0 = SIZE_MAX, col1 = 0, row1 = 0;
   };
-  std::vector<Span> span(cells);
-  for (std::size_t k = 0; k < cells; ++k) {
-    if (!pit[k]) continue;
-    Span& s = span[root(k)];
-    s.col0 = std::min(s.col0, k % cols), s.col1 = std::max(s.col1, k % cols);
-    s.row0 = std::min(s.row0, k / cols), s.row1 = std::max(s.row1, k / cols);
+  std::vector<Span> span(pits.size());
+  for (std::size_t p = 0; p < pits.size(); ++p) {
+    Span& s = span[root(p)];
+    const std::size_t col = pits[p] % cols, row = pits[p] / cols;
+    s.col0 = std::min(s.col0, col), s.col1 = std::max(s.col1, col);
+    s.row0 = std::min(s.row0, row), s.row1 = std::max(s.row1, row);
   }
-  std::vector<bool> wide(cells, false);
-  for (std::size_t k = 0; k < cells; ++k) {
-    if (!pit[k]) continue;
-    const Span& s = span[root(k)];
-    wide[k] = static_cast<double>(std::max(s.col1 - s.col0, s.row1 - s.row0)) * g.cell > kPitNetworkExtent;
+  std::vector<bool> wide(g.cells(), false);
+  for (std::size_t p = 0; p < pits.size(); ++p) {
+    const Span& s = span[root(p)];
+    wide[pits[p]] = static_cast<double>(std::max(s.col1 - s.col0, s.row1 - s.row0)) * g.cell > kPitNetworkExtent;
   }
   return wide;
 }
@@ -343,9 +367,21 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   if (candidates == 0) return ground;
   const double c = options.cell;
   const double cols_d = std::floor((maxx - minx) / c) + 1, rows_d = std::floor((maxy - miny) / c) + 1;
-  if (cols_d * rows_d > kMaxCells)
-    throw InvalidArgument("smrf: a grid of " + std::to_string(cols_d) + " x " + std::to_string(rows_d) + " cells of " +
-                          std::to_string(c) + " m is too large; give a larger cell or crop first");
+  // A stray point kilometres from the survey stretches the grid over empty ground: say so
+  // before allocating it, with the extent that makes it large.
+  const double cells = cols_d * rows_d, budget = grid_memory_budget();
+  if (cells > kMaxCells || cells * kBytesPerCell > budget) {
+    char what[320];
+    std::snprintf(what, sizeof what,
+                  "smrf: the points span %.0f x %.0f m, from (%.3f, %.3f) to (%.3f, %.3f) in metres: a grid of "
+                  "%.0f x %.0f cells of %g m would need about %s, more than SMRF may take here (%s)",
+                  maxx - minx, maxy - miny, minx, miny, maxx, maxy, cols_d, rows_d, c,
+                  gigabytes(cells * kBytesPerCell).c_str(),
+                  gigabytes(std::min(budget, kMaxCells * kBytesPerCell)).c_str());
+    throw InvalidArgument(std::string(what) +
+                          "; remove points far from the survey (--filter outlier, or --where on X and Y), crop it, "
+                          "or give a larger cell");
+  }
   ElevationGrid zmin(static_cast<std::size_t>(cols_d), static_cast<std::size_t>(rows_d), minx, miny, c);
   const auto cell_of = [&](std::size_t i) {
     const auto col = std::min(zmin.cols - 1, static_cast<std::size_t>((xyz[3 * i] * h - minx) / c));

@@ -463,6 +463,27 @@ TEST(Smrf, FlatGroundAroundAWideExcavationStaysGround) {
   EXPECT_GE(static_cast<double>(n.found), 0.99 * static_cast<double>(n.truth)) << n.found << " of " << n.truth;
 }
 
+// A stray point far from the survey stretches SMRF's grid over empty ground: the grid is
+// refused before it is allocated, and the error gives the extent that made it large and
+// what to do, instead of taking gigabytes (80 bytes a cell) or being killed for memory.
+TEST(Smrf, AGridStretchedByAStrayPointIsRefusedNamingItsExtent) {
+  const std::vector<double> xyz = {0, 0, 10, 1, 1, 10, 2, 0, 10, 900000, 900000, 11};
+  const std::vector<bool> all(4, true);
+  try {
+    smrf_ground(xyz, all, SmrfOptions{}, Units{});
+    FAIL() << "a 900 km grid of 1 m cells was not refused";
+  } catch (const vola::InvalidArgument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the points span 900000 x 900000 m, from (0.000, 0.000) to (900000.000, 900000.000)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("remove points far from the survey"), std::string::npos) << what;
+  }
+  SmrfOptions coarse;
+  coarse.cell = 1000.0;  // 901 x 901 cells: well within any machine
+  EXPECT_EQ(smrf_ground(xyz, all, coarse, Units{}).size(), 4u);
+}
+
 // The same scene in US survey feet gives the same answer as in metres.
 TEST(Smrf, ParametersAreMetresWhateverTheUnits) {
   std::mt19937_64 rng(9);
