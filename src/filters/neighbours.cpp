@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <unordered_map>
 
 #include "vola/error.hpp"
@@ -96,8 +97,11 @@ void check_cells(const char* option, std::span<const double> xyz, double size) {
   double reach = 0.0;
   for (const double v : xyz)
     if (std::isfinite(v)) reach = std::max(reach, std::abs(v));
-  if (reach / size > 4.5e15)
-    throw OptionError(option, std::to_string(size) + " is too small for coordinates reaching " + std::to_string(reach));
+  if (reach / size > 4.5e15) {
+    char what[96];
+    std::snprintf(what, sizeof what, "%g is too small for coordinates reaching %g", size, reach);
+    throw OptionError(option, what);
+  }
 }
 
 }  // namespace

@@ -55,7 +55,7 @@ double grid_memory_budget() {
 
 std::string gigabytes(double bytes) {
   char out[32];
-  std::snprintf(out, sizeof out, "%.1f GB", bytes / 1e9);
+  std::snprintf(out, sizeof out, bytes < 1e15 ? "%.1f GB" : "%.3g GB", bytes / 1e9);
   return out;
 }
 
@@ -371,12 +371,13 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   // before allocating it, with the extent that makes it large.
   const double cells = cols_d * rows_d, budget = grid_memory_budget();
   if (cells > kMaxCells || cells * kBytesPerCell > budget) {
-    char what[320];
+    const double bytes = cells * kBytesPerCell;
+    const std::string need = std::isfinite(bytes) ? "about " + gigabytes(bytes) : "more memory than any machine holds";
+    char what[512];
     std::snprintf(what, sizeof what,
-                  "smrf: the points span %.0f x %.0f m, from (%.3f, %.3f) to (%.3f, %.3f) in metres: a grid of "
-                  "%.0f x %.0f cells of %g m would need about %s, more than SMRF may take here (%s)",
-                  maxx - minx, maxy - miny, minx, miny, maxx, maxy, cols_d, rows_d, c,
-                  gigabytes(cells * kBytesPerCell).c_str(),
+                  "smrf: the points span %.10g x %.10g m, from (%.10g, %.10g) to (%.10g, %.10g) in metres: a grid of "
+                  "%.10g x %.10g cells of %g m would need %s, more than SMRF may take here (%s)",
+                  maxx - minx, maxy - miny, minx, miny, maxx, maxy, cols_d, rows_d, c, need.c_str(),
                   gigabytes(std::min(budget, kMaxCells * kBytesPerCell)).c_str());
     throw InvalidArgument(std::string(what) +
                           "; remove points far from the survey (--filter outlier, or --where on X and Y), crop it, "
