@@ -9,9 +9,10 @@
 
 #include "vola/builder.hpp"
 #include "vola/convert.hpp"
+#include "vola/file.hpp"
 #include "vola/filters/stages.hpp"
 #include "vola/geo/crs.hpp"
-#include "vola/file.hpp"
+#include "vola/io/column_reduction.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/translate.hpp"
 
@@ -52,6 +53,8 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
                   std::uint32_t epsg, const std::string& crs_wkt) {
   vola::PointCloud cloud = point_cloud_of(points, attributes);
   for (vola::PointAttribute& a : cloud.attributes) {
+    // As the readers reduce a column of that name: classes and ids by majority, ...
+    a.reduction = vola::io::default_reduction(a.name);
     if (!reductions.contains(a.name)) continue;
     const auto name = py::cast<std::string>(reductions[py::str(a.name)]);
     const auto r = vola::parse_reduction(name);
@@ -205,7 +208,10 @@ void bind_building(py::module_& m) {
         "Builds a tree from an (N, 3) array of world points.\n"
         "quantize='grid': voxel_size and/or depth; origin defaults to the bbox minimum snapped to the voxel size.\n"
         "quantize='toolkit': the reference's rounding, needs depth.\n"
-        "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: 'mean'|'max'|'min'|'majority'|'last'}.\n"
+        "attributes: {name: (N,) array}; the column type follows the dtype; reductions: {name: "
+        "'mean'|'max'|'min'|'majority'|'last'}\n"
+        "(default by name, as the file readers: classification/class/label, ids such as treeID and cluster/segment/\n"
+        "instance by majority, number_of_returns by max, the rest mean).\n"
         "epsg: the header's CRS code; crs_wkt: the CRS as WKT, kept in the file (its EPSG code, when PROJ names\n"
         "one, goes into the header; an epsg naming another CRS is refused); lat_lon is the bbox centre's.");
   m.def("build_from_voxels", &build_voxels, py::arg("voxels"), py::arg("depth"),

@@ -125,6 +125,26 @@ def test_level_of_detail_is_any_over_4x4x4():
         tree.level_of_detail(5)
 
 
+def test_reductions_default_by_name_as_the_readers_do():
+    # Three points in one voxel: classes and ids take the majority (the mean of classes 2,
+    # 6 and 6 would be class 5, of trees 3, 5 and 5 a tree 4.33), number_of_returns the
+    # maximum, a measurement the mean; a reduction given by name still wins.
+    points = np.array([[0.1, 0.1, 0.1], [0.2, 0.2, 0.2], [0.3, 0.3, 0.3]])
+    columns = {
+        "classification": np.array([2, 6, 6], np.uint8),
+        "treeID": np.array([3.0, 5.0, 5.0]),
+        "NumberOfReturns": np.array([1, 3, 2], np.uint8),
+        "geoid": np.array([1.0, 2.0, 6.0]),
+    }
+    tree = vola.build(points, voxel_size=1.0, attributes=columns)
+    assert tree.attribute("classification")[0] == 6
+    assert tree.attribute("treeID")[0] == 5.0
+    assert tree.attribute("NumberOfReturns")[0] == 3
+    assert tree.attribute("geoid")[0] == 3.0
+    averaged = vola.build(points, voxel_size=1.0, attributes=columns, reductions={"classification": "mean"})
+    assert averaged.attribute("classification")[0] == 5
+
+
 def test_attributes_reduce_per_voxel_like_numpy(cloud):
     n = len(cloud)
     rng = np.random.default_rng(11)

@@ -5,7 +5,7 @@
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
 #include "vola/filters/stages.hpp"
-#include "vola/io/las.hpp"
+#include "vola/io/column_reduction.hpp"
 #include "vola/io/translate.hpp"
 
 namespace vola::convert_detail {
@@ -50,7 +50,7 @@ PointCloud las_voxel_columns(PointCloud&& table) {
   for (auto& column : columns) {
     if (dropped_las_field(column.name)) continue;
     column.type = ValueType::f64;
-    column.reduction = io::las_extra_field_reduction(column.name);
+    column.reduction = io::default_reduction(column.name);
     cloud.attributes.push_back(std::move(column));
   }
   return cloud;

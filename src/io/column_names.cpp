@@ -1,5 +1,7 @@
 #include "column_names.hpp"
 
+#include "vola/io/column_reduction.hpp"
+
 #include <cstdint>
 
 #include <cctype>
@@ -95,5 +97,7 @@ Reduction point_column_reduction(const std::string& column, std::string_view fie
   if (column == "number_of_returns") return Reduction::max;
   return Reduction::mean;
 }
+
+Reduction default_reduction(std::string_view name) { return point_column_reduction(point_column_name(name), name); }
 
 }  // namespace vola::io

@@ -2,11 +2,10 @@
 // intensity, classification, height, returns, extra bytes), the reference's payload word,
 // and a whole file as a PointCloud.
 #include <algorithm>
-#include <cctype>
 
-#include "column_names.hpp"
 #include "las_format.hpp"
 
+#include "vola/io/column_reduction.hpp"
 #include "vola/io/las.hpp"
 
 namespace vola::io {
@@ -22,12 +21,6 @@ std::uint64_t payload_byte(double v, double lo, double hi) {
 
 }  // namespace
 
-Reduction las_extra_field_reduction(std::string_view name) {
-  std::string lower(name);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return point_column_reduction(lower, name) == Reduction::majority ? Reduction::majority : Reduction::mean;
-}
-
 std::vector<AttributeSpec> las_attributes(const LasHeader& hd) {
   std::vector<AttributeSpec> specs;
   if (hd.has_rgb()) {
@@ -40,7 +33,7 @@ std::vector<AttributeSpec> las_attributes(const LasHeader& hd) {
   specs.push_back({"height", ValueType::f32, Reduction::mean});
   specs.push_back({"number_of_returns", ValueType::u8, Reduction::max});
   for (const auto& f : hd.extra_fields)
-    if (f.name != "height") specs.push_back({f.name, ValueType::f64, las_extra_field_reduction(f.name)});
+    if (f.name != "height") specs.push_back({f.name, ValueType::f64, default_reduction(f.name)});
   return specs;
 }
 

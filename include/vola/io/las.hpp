@@ -193,15 +193,10 @@ constexpr std::size_t kLasRecordBatchBytes = std::size_t{256} << 10;
 
 // The whole file as a point cloud with the attribute columns vola keeps from LAS:
 // red/green/blue (mean), intensity (mean), classification (majority), height (mean z),
-// number_of_returns (max), extra-bytes fields (las_extra_field_reduction); and, with
-// `payload`, the
-// reference's 7-byte payload word per point (FORMAT.md section 8).
+// number_of_returns (max), extra-bytes fields by name (io::default_reduction); and, with
+// `payload`, the reference's 7-byte payload word per point (FORMAT.md section 8).
 PointCloud las_points(LasReader& reader, bool attributes, bool payload,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
-
-// How a voxel reduces an extra-bytes field: labels and identifiers (classes, clusters,
-// segments, instances; treeID, tree_id, OriginId) by majority, the rest by mean.
-Reduction las_extra_field_reduction(std::string_view name);
 
 // The attribute columns vola keeps from a LAS file, and their per-point values for a
 // chunk (one vector per column, in the same order).
