@@ -157,9 +157,12 @@ void add_convert(CLI::App& app) {
                   "'x,y,z,intensity', which also keeps the other columns as attributes; else 1 2 3)")->expected(3)->capture_default_str();
   cmd->add_option("--payload-columns", args->options.payload_columns,
                   "Text with --nbits 1: columns holding payload bytes 0..7 (default: every column after x y z)");
-  cmd->add_option("--attribute", args->options.text_attributes,
-                  "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "
-                  "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean)");
+  cmd->add_option(
+      "--attribute", args->options.text_attributes,
+      "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "
+      "TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default by NAME, as "
+      "for a header's columns: classification, class, label and ids such as treeID majority, "
+      "number_of_returns max, the rest mean)");
   cmd->add_option("--skip-lines", args->options.skip_lines, "Text: header lines to skip")->check(non_negative_number());
   cmd->add_flag("--no-attributes", args->no_attributes, "Keep occupancy only, no per-voxel attribute columns (LAS, PLY, PCD, .ot log-odds, .vdb values)");
   cmd->add_flag("--compress", args->options.compress, "compress the levels (context-coded occupancy) and attributes (predicted, zstd): a file only vola reads");

@@ -64,7 +64,8 @@ struct ConvertOptions {
   std::array<int, 3> columns{1, 2, 3};  // x y z
   std::vector<int> payload_columns;     // nbits 1: payload bytes 0..7 (default: every column after x y z)
   // Columns kept as attributes: NAME=COLUMN[:TYPE[:REDUCTION]], e.g. "intensity=4:u16:mean";
-  // TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default mean).
+  // TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default:
+  // io::default_reduction of NAME, as for a header's columns).
   std::vector<std::string> text_attributes;
   int skip_lines = 0;               // header lines before the points
   bool solid = false;               // meshes: fill the inside of closed surfaces too

@@ -10,6 +10,7 @@
 #include "vola/attributes.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/stages.hpp"
+#include "vola/io/column_reduction.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -36,6 +37,7 @@ TextAttributeSpec parse_text_attribute(const std::string& spec) {
   if (eq == std::string::npos || eq == 0) throw fail("expected NAME=COLUMN[:TYPE[:REDUCTION]]");
   TextAttributeSpec out;
   out.attribute.name = spec.substr(0, eq);
+  out.attribute.reduction = io::default_reduction(out.attribute.name);  // as a header's column of that name
   const std::vector<std::string> parts = split(spec.substr(eq + 1), ':');
   if (parts.size() > 3) throw fail("expected NAME=COLUMN[:TYPE[:REDUCTION]]");
   try {

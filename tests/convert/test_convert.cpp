@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <regex>
 #include <string>
@@ -57,6 +58,24 @@ TEST(ConvertOptions, ErrorsNameTheMemberThatIsWrong) {
   o.bbox.reset();
   o.dense = o.compress = true;
   EXPECT_EQ(refused_option([&] { o.check(); }), "compress");
+}
+
+// --attribute NAME=COL without a reduction reduces as a header's column of that name
+// would: a tree id by majority, a measurement by mean.
+TEST(ConvertOptions, TextAttributesWithoutAReductionGoByTheirName) {
+  const vola_test::TempDir dir;
+  const auto path = dir.path() / "trees.xyz";
+  std::ofstream(path) << "0.1 0.1 0.1 3 1\n0.2 0.2 0.2 5 2\n0.3 0.3 0.3 5 6\n";
+  vola::ConvertOptions o;
+  o.voxel_size = 1.0;
+  o.text_attributes = {"treeID=4", "temperature=5", "cls=4:u8:mean"};
+  const vola::Tree tree = vola::convert(path.string(), o);
+  ASSERT_NE(tree.attributes().find("treeID"), nullptr);
+  EXPECT_EQ(tree.attributes().find("treeID")->reduction(), vola::Reduction::majority);
+  EXPECT_EQ(tree.attributes().find("treeID")->get(0), 5.0);
+  EXPECT_EQ(tree.attributes().find("temperature")->reduction(), vola::Reduction::mean);
+  EXPECT_EQ(tree.attributes().find("temperature")->get(0), 3.0);
+  EXPECT_EQ(tree.attributes().find("cls")->reduction(), vola::Reduction::mean);  // given, so kept
 }
 
 TEST(BuildOptions, CheckOwnsTheQuantizationRules) {
