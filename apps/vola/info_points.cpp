@@ -83,6 +83,7 @@ void print_compression(const io::LasHeader& hd) {
               z.version_major, z.version_minor, z.revision);
   if (z.compressor == 1) std::printf("one stream, not chunked");  // its chunk size field means nothing
   else if (z.chunk_size == io::laz::kVariableChunkSize) std::printf("variable chunks");
+  else if (z.chunk_size == 0) std::printf("chunk size 0 (one chunk of every point)");
   else std::printf("chunks of %u points", z.chunk_size);
   if (z.compressor != 1) std::printf(", %zu chunk%s", hd.laz_chunks.size(), hd.laz_chunks.size() == 1 ? "" : "s");
   std::printf("\nitems:      ");

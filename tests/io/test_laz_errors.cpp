@@ -218,4 +218,31 @@ TEST(LazErrors, DamagedFilesFailCleanly) {
   std::printf("damaged files: %d refused, %d decoded (to whatever the damage says)\n", refused, decoded);
 }
 
+// A chunk size of 0 in the laszip record, as lasR's COPC writer leaves it
+// (inst/extdata/example.copc.laz): LASzip and laz-perf start a chunk at the first point
+// and never another, so a table of one chunk holds every point, and a table of more
+// cannot be read that way.
+TEST(LazErrors, ChunkSizeZeroIsOneChunkOfEveryPoint) {
+  for (const auto& [format, length] : {std::pair<std::uint8_t, std::uint16_t>{3, 34}, {7, 36}}) {
+    SCOPED_TRACE(int{format});
+    const auto zero_chunk_size = [](LasFile f) {
+      std::memset(f.laszip.data() + 12, 0, 4);  // the record's chunk size, in the file and the copy
+      std::memset(f.bytes.data() + f.laszip_offset + 12, 0, 4);
+      return f;
+    };
+    const LasFile one = generated(format, length, 3000, 3000);
+    const LasFile zero = zero_chunk_size(one);
+    ASSERT_EQ(laz::parse_laszip_vlr(zero.laszip).chunk_size, 0u);
+    EXPECT_EQ(vola_laz_test::decode_all(zero), vola_laz_test::decode_all(one));
+    const LasFile three = zero_chunk_size(generated(format, length, 3000, 1000));
+    try {
+      chunks_of(three);
+      ADD_FAILURE() << "three chunks under a chunk size of 0 were read";
+    } catch (const vola::FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("chunk size of 0 puts every point in the first"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 }  // namespace

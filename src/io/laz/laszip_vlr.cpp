@@ -90,7 +90,6 @@ RecordLayout record_layout(const LaszipInfo& info, const std::string& source, st
   layout.layered = info.compressor == 3;
   if (info.compressor < 1 || info.compressor > 3)
     cursor.fail("compressor " + std::to_string(info.compressor) + " is not one of 1, 2, 3");
-  if (info.compressor != 1 && info.chunk_size == 0) cursor.fail("chunk size 0");
   if (!layout.layered) {
     const Item* point = cursor.take(kPoint10, 20, false);
     if (!point) cursor.fail("point-wise records must start with POINT10");

@@ -84,6 +84,19 @@ std::vector<ChunkEntry> read_chunk_table(const LaszipInfo& info, const ReadAt& r
     if (point_count) fail(source, table_at + 4, "chunk table lists no chunks for " + std::to_string(point_count) + " points");
     return {};
   }
+  // A chunk size of 0 (lasR's COPC writer puts it in the laszip record) is one chunk that
+  // never ends, as LASzip and laz-perf read it: the first chunk holds every point, from
+  // the table's offset to the table, whatever the table's entries say (that writer's
+  // hold a count and a size, as variable chunks' do, which a table of fixed chunks does
+  // not). A table of more chunks cannot be read that way.
+  if (info.chunk_size == 0) {
+    if (chunks > 1)
+      fail(source, table_at + 4,
+           "chunk table lists " + std::to_string(chunks) +
+               " chunks, but the laszip record's chunk size of 0 puts "
+               "every point in the first");
+    return {{point_count, offset_to_points + 8, table_at - offset_to_points - 8}};
+  }
   // An entry takes at most ~14 coded bytes; read no more than the table can use.
   const std::uint64_t available = file_size - table_at - 8;
   std::vector<std::uint8_t> coded(static_cast<std::size_t>(std::min<std::uint64_t>(available, 16ull * chunks + 16)));
@@ -137,7 +150,7 @@ void decode_chunk(const LaszipInfo& info, std::span<const std::uint8_t> chunk, s
   if (record_length != layout.length)
     fail(source, chunk_offset, name + ": records of " + std::to_string(record_length) + " bytes, but the laszip items make " +
                                    std::to_string(layout.length));
-  if (info.compressor == 2 && info.chunk_size != kVariableChunkSize && count > info.chunk_size)
+  if (info.compressor == 2 && info.chunk_size != kVariableChunkSize && info.chunk_size != 0 && count > info.chunk_size)
     fail(source, chunk_offset, name + ": " + std::to_string(count) + " points in chunks of " + std::to_string(info.chunk_size));
   const std::uint64_t overrun =
       layout.layered ? decode_layered_chunk(layout, chunk, count, records, name, chunk_offset, source, xyz_only)
