@@ -171,13 +171,17 @@ std::vector<bool> unsupported_lows(const ElevationGrid& g, int radius) {
   return low;
 }
 
-// Gradient magnitude (rise over run) of a filled grid, central differences inside.
-std::vector<float> slope_of(const ElevationGrid& g) {
+// Gradient magnitude (rise over run) of a filled grid: central differences between the
+// cells `reach` cells to each side (fewer at the edges). The paper takes neighbouring
+// cells; over a surface of cell minima that measures the roughness of the ground cover as
+// much as the terrain's slope, and the tolerance it feeds then lets low vegetation on
+// slopes pass for ground (kSlopeBaseline, docs/FILTERS.md).
+std::vector<float> slope_of(const ElevationGrid& g, std::size_t reach) {
   std::vector<float> s(g.cells());
   for (std::size_t j = 0; j < g.rows; ++j)
     for (std::size_t i = 0; i < g.cols; ++i) {
-      const std::size_t il = i > 0 ? i - 1 : i, ir = i + 1 < g.cols ? i + 1 : i;
-      const std::size_t jl = j > 0 ? j - 1 : j, jr = j + 1 < g.rows ? j + 1 : j;
+      const std::size_t il = i >= reach ? i - reach : 0, ir = std::min(g.cols - 1, i + reach);
+      const std::size_t jl = j >= reach ? j - reach : 0, jr = std::min(g.rows - 1, j + reach);
       const double gx = ir > il ? (g.at(ir, j) - g.at(il, j)) / (static_cast<double>(ir - il) * g.cell) : 0.0;
       const double gy = jr > jl ? (g.at(i, jr) - g.at(i, jl)) / (static_cast<double>(jr - jl) * g.cell) : 0.0;
       s[j * g.cols + i] = static_cast<float>(std::sqrt(gx * gx + gy * gy));
@@ -428,7 +432,8 @@ std::vector<bool> smrf_ground(std::span<const double> xyz, const std::vector<boo
   for (std::size_t k = 0; k < surface.cells(); ++k)
     if (raised[k]) surface.z[k] = NAN;
   detail::inpaint(surface);
-  const std::vector<float> slope = slope_of(surface);
+  const auto slope_reach = static_cast<std::size_t>(std::max(1L, std::lround(kSlopeBaseline / c)));
+  const std::vector<float> slope = slope_of(surface, slope_reach);
 
   for (std::size_t i = 0; i < n; ++i) {
     if (!candidate[i] || !std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))

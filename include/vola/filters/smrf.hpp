@@ -70,6 +70,9 @@ inline constexpr double kLinkRadius = 20.0;
 inline constexpr double kLinkRise = 3.0;
 inline constexpr double kLinkSlope = 0.5;
 inline constexpr double kMinBaseArea = 16.0;
+// The slope in the ground tolerance (threshold + scalar x slope) is taken between cells
+// kSlopeBaseline metres to each side, not between neighbouring cells as the paper does.
+inline constexpr double kSlopeBaseline = 3.0;
 
 // Ground flags for points xyz (x y z triples); candidate[i] false leaves point i out of
 // the surface and not ground. Throws InvalidArgument when the grid would pass 2^28 cells
