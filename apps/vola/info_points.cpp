@@ -273,7 +273,7 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json) {
   if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json);
   if (json) {
     ordered_json doc = {{"file", path}, {"format", in.format}, {"points", in.cloud.size()},
-                        {"crs", crs_json(in.wkt, in.epsg)}};
+                        {"points_not_finite", in.not_finite}, {"crs", crs_json(in.wkt, in.epsg)}};
     ordered_json dimensions = ordered_json::array();
     for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
     doc["dimensions"] = std::move(dimensions);
@@ -282,7 +282,12 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json) {
     return;
   }
   std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
-  std::printf("points:      %zu\n", in.cloud.size());
+  std::printf("points:      %zu", in.cloud.size());
+  // An organized cloud (PCD) holds its missing points as NaN: say how many were left out.
+  if (in.not_finite > 0)
+    std::printf(" (and %llu with a coordinate that is not a number, left out)",
+                static_cast<unsigned long long>(in.not_finite));
+  std::printf("\n");
   std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());
   std::printf("columns:    ");
   for (const auto& a : in.cloud.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());

@@ -35,6 +35,8 @@ std::optional<PlyType> parse_type(std::string_view s) {
                                    {"float", "float32", PlyType::f32}, {"double", "float64", PlyType::f64}};
   for (const auto& n : names)
     if (s == n.classic || s == n.sized) return n.type;
+  // Not a PLY type, but pyntcloud writes numpy's one-byte bools so (read_ply's allow_bool).
+  if (s == "bool") return PlyType::u8;
   return std::nullopt;
 }
 

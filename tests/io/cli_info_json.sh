@@ -52,6 +52,17 @@ assert 'crs' in d and isinstance(d['dimensions'], list), d
 done
 "${VOLA_PYTHON:-python3}" -c "import json,sys; assert json.load(open(sys.argv[1]))['points'] == 115384" "$tmp/other.json" ||
   fail "KITTI 000000.bin: not 115384 points"
+# An organized PCD (640 x 480, its missing points NaN): the finite points, and the others
+# counted as left out, as EXPECTED.txt has them (points=307200 finite=209280).
+mug=$data/pcd/pcl_table_scene_mug_stereo_textured.pcd
+"$vola" info --json "$mug" > "$tmp/mug.json" || fail "info --json on an organized PCD failed"
+"${VOLA_PYTHON:-python3}" -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert (d['points'], d['points_not_finite']) == (209280, 97920), d
+" "$tmp/mug.json" || fail "organized PCD: not 209280 points and 97920 left out"
+"$vola" info "$mug" | grep -q "^points: *209280 (and 97920 with a coordinate that is not a number, left out)" ||
+  fail "info on an organized PCD does not say that 97920 NaN points were left out"
 
 # Inputs that are not point clouds, against the files' own headers read here: a binary
 # STL's triangle count (bytes 80-83), a binvox file's dims, cube side and run-length

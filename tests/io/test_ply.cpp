@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include <fstream>
 #include <map>
@@ -380,6 +381,32 @@ TEST(Ply, ValuesAfterAnElementsPropertiesOnItsLineAreSkipped) {
   const std::array<double, 9> want = {0, 0, 0, 1, 2, 3, 4, 5, 6};
   for (int v = 0; v < 3; ++v)
     for (int k = 0; k < 3; ++k) EXPECT_EQ(in.triangles[0][v][k], want[3 * v + k]) << v << " " << k;
+}
+
+// pyntcloud's write_ply (with allow_bool) stores numpy bools as "property bool", one byte
+// each; the bytes here are what it writes for two points with an is_green flag.
+TEST(Ply, PyntcloudsOneByteBoolsAreRead) {
+  std::string text =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nproperty bool is_green\nend_header\n";
+  Bytes bytes(text.begin(), text.end());
+  const auto put_point = [&](float x, float y, float z, std::uint8_t flag) {
+    for (float v : {x, y, z}) {
+      std::uint8_t raw[4];
+      std::memcpy(raw, &v, 4);
+      bytes.insert(bytes.end(), raw, raw + 4);
+    }
+    bytes.push_back(flag);
+  };
+  put_point(0.5f, 0.0f, 0.5f, 1);
+  put_point(0.0f, 0.5f, 0.5f, 0);
+  const auto in = vola::io::parse_ply(bytes, "diamond_with_bool.ply");
+  ASSERT_EQ(in.cloud.size(), 2u);
+  EXPECT_EQ(in.cloud.xyz[3], 0.0);
+  EXPECT_EQ(in.cloud.xyz[4], 0.5);
+  ASSERT_EQ(in.cloud.attributes.size(), 1u);
+  EXPECT_EQ(in.cloud.attributes[0].name, "is_green");
+  EXPECT_EQ(in.cloud.attributes[0].values, (std::vector<double>{1.0, 0.0}));
 }
 
 TEST(Ply, ElementsWithoutPropertiesTakeNoTimeWhateverTheirCount) {
