@@ -150,7 +150,10 @@ void add_convert(CLI::App& app) {
                   "--voxel-size, --origin and --bbox");
   cmd->add_option("--level", args->options.level,
                   "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
-  cmd->add_option("--grid", args->options.grid, "OpenVDB: the grid to read (default: the only grid, or vola's own occupied grid of a map it wrote; several others are refused, listed)");
+  cmd->add_option("--grid", args->options.grid,
+                  "OpenVDB: the grid to read (default: the only grid, or vola's own occupied grid of a map it wrote; "
+                  "several others are refused, listed). NumPy .npz: the array to read (default: the only one, or the "
+                  "one named points, xyz, positions, pos, point_cloud, pc or cloud)");
   cmd->add_option("--bbox", args->bbox, "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1 (default: found by name in a header line such as "

@@ -56,8 +56,9 @@ struct ConvertOptions {
   // coarser sample of the cloud from a small part of the file. With a grid bbox, nodes
   // outside the grid are skipped whatever the level.
   std::optional<int> level;
-  // OpenVDB input: the grid to read (empty: the file's first). Maps (OctoMap, OpenVDB) keep
-  // their own cells: a voxel_size other than the file's is refused.
+  // OpenVDB input: the grid to read (empty: the file's first); NumPy .npz input: the array
+  // to read (empty: the only one, or the one named points, xyz, ...: io::npz_points_member).
+  // Maps (OctoMap, OpenVDB) keep their own cells: a voxel_size other than the file's is refused.
   std::string grid;
   bool attributes = true;  // keep the per-point attributes the format carries (LAS, PLY, PCD, ...)
   // Text input (XYZ/TXT/CSV); column numbers count from 1, as a user reads the file.

@@ -189,7 +189,7 @@ typedef struct vola_convert_options {
   void *progress_user;
   const char *assign_crs;              /* NULL, or the input's CRS as any definition (not with epsg) */
   int allow_geographic;                /* voxelise in a geographic CRS's degrees anyway (default 0: refused) */
-  const char *grid;                    /* OpenVDB: the grid to read; NULL = the file's first */
+  const char *grid;                    /* OpenVDB: the grid to read; .npz: the array; NULL = the default */
   const char *const *filters;          /* point filter stages, run in order ("where:Classification == 2", */
   size_t filter_count;                 /* "smrf", "hag", "crop:X0,Y0,X1,Y1", ...: docs/FILTERS.md) */
 } vola_convert_options;

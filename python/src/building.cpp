@@ -229,20 +229,20 @@ void bind_building(py::module_& m) {
           const std::string bytes = data;
           return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), name);
         }, py::arg("data"), py::arg("name") = "<bytes>", "Parses the bytes of a .vol file.");
-  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0,
-        py::arg("voxel_size") = 0.0, py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(),
-        py::arg("solid") = false, py::arg("attributes") = true, py::arg("dem_base") = py::none(),
-        py::arg("dem_surface_only") = false, py::arg("origin") = py::none(), py::arg("bbox") = py::none(),
-        py::arg("nbits") = 0, py::arg("columns") = std::array<int, 3>{1, 2, 3},
-        py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
-        py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false,
-        py::arg("output") = py::none(), py::arg("target_crs") = "", py::arg("level") = py::none(),
-        py::arg("assign_crs") = "", py::arg("allow_geographic") = false, py::arg("grid") = "",
-        py::arg("filters") = std::vector<std::string>{}, py::arg("compress_max") = false,
+  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0,
+        py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(), py::arg("solid") = false,
+        py::arg("attributes") = true, py::arg("dem_base") = py::none(), py::arg("dem_surface_only") = false,
+        py::arg("origin") = py::none(), py::arg("bbox") = py::none(), py::arg("nbits") = 0,
+        py::arg("columns") = std::array<int, 3>{1, 2, 3}, py::arg("payload_columns") = std::vector<int>{},
+        py::arg("text_attributes") = std::vector<std::string>{}, py::arg("skip_lines") = 0, py::arg("dense") = false,
+        py::arg("compress") = false, py::arg("output") = py::none(), py::arg("target_crs") = "",
+        py::arg("level") = py::none(), py::arg("assign_crs") = "", py::arg("allow_geographic") = false,
+        py::arg("grid") = "", py::arg("filters") = std::vector<std::string>{}, py::arg("compress_max") = false,
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
         "OpenVDB .vdb) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
-        "it (dense=, compress=, compress_max=: smallest, slower to open). Every `vola convert` option is a keyword: quantize ('grid', default with\n"
+        "it (dense=, compress=, compress_max=: smallest, slower to open). Every `vola convert` option is a keyword: "
+        "quantize ('grid', default with\n"
         "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
         "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
         "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
@@ -250,7 +250,8 @@ void bind_building(py::module_& m) {
         "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
         "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
         "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
-        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid.\n"
+        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid or "
+        "an .npz array.\n"
         "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
         "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).");
   m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output,

@@ -20,7 +20,7 @@ VOLA_BUILD_PACKAGES+=(python3-venv python3-pip python3-setuptools python3-wheel 
 VOLA_BUILD_PACKAGES+=(libcpp-httplib-dev pkg-config chromium)
 command -v npm > /dev/null || VOLA_BUILD_PACKAGES+=(nodejs npm)
 
-# 3D CNN classification (vola_learn): libtorch (CPU) and libzip for .npz, found through pkg-config.
+# 3D CNN classification (vola_learn): libtorch (CPU); libzip for .npz (vola_io), found through pkg-config.
 VOLA_BUILD_PACKAGES+=(libtorch-dev libzip-dev pkg-config)
 
 # Occupancy maps in and out: OctoMap .bt/.ot through liboctomap (the octomap plugin; the

@@ -47,8 +47,8 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (options.level && format.name != "las")
     throw OptionError("level", "applies to COPC input only (" + path + " is " + format.name + ")");
   input.copc_level = options.level;
-  if (!options.grid.empty() && format.name != "vdb")
-    throw OptionError("grid", "applies to OpenVDB input only (" + path + " is " + format.name + ")");
+  if (!options.grid.empty() && format.name != "vdb" && format.name != "npy")
+    throw OptionError("grid", "applies to OpenVDB and .npz input only (" + path + " is " + format.name + ")");
   input.grid = options.grid;
   input.progress = progress;
   io::Input loaded = options.filters.empty() ? format.read(path, input) : read_filtered(path, format, options, input, filter_report);

@@ -238,7 +238,7 @@ const char* other_format(std::span<const std::uint8_t> bytes) {
       {"ply"sv, "a PLY file: `vola convert` makes voxels of it, `vola translate` converts its points"},
       {"# .PCD"sv, "a PCD point file: `vola convert` makes voxels of it"},
       {"\x93NUMPY"sv, "a NumPy array: `vola convert` makes voxels of its points"},
-      {"PK\x03\x04"sv, "a zip archive (an .npz?): unzip it first"},
+      {"PK\x03\x04"sv, "a zip archive (a NumPy .npz? `vola convert` makes voxels of its points)"},
       {"# Octomap"sv, "an OctoMap file: `vola convert` reads it"},
       {"II*\0"sv, "a TIFF (a DEM?): `vola convert` makes voxels of it"},
       {"MM\0*"sv, "a TIFF (a DEM?): `vola convert` makes voxels of it"},

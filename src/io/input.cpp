@@ -13,6 +13,7 @@
 #include "vola/io/las.hpp"
 #include "vola/io/mesh.hpp"
 #include "vola/io/npy.hpp"
+#include "vola/io/npz.hpp"
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
@@ -47,7 +48,14 @@ Input read_text_input(const std::string& path, const InputOptions& options) {
 }
 
 Input read_npy_input(const std::string& path, const InputOptions& options) {
-  return npy_input(read_npy(path), path, options);
+  if (lower_extension(path) != ".npz") {
+    if (!options.grid.empty())
+      throw OptionError(
+          "grid", "names an array of an .npz archive or a grid of an OpenVDB file; " + path + " is one .npy array");
+    return npy_input(read_npy(path), path, options);
+  }
+  const std::string member = npz_points_member(path, options.grid);
+  return npy_input(read_npz_array(path, member), path + ":" + member, options);
 }
 
 Input read_pcd_input(const std::string& path, const InputOptions& options) {
@@ -108,18 +116,30 @@ Input read_vdb_input(const std::string& path, const InputOptions& options) {
 
 std::vector<InputFormat> make_formats() {
   return {
-      {"las", {".las", ".laz"}, "ASPRS LAS 1.0-1.4, point formats 0-10, and LAZ (compressed LAS, COPC)", read_las_input},
+      {"las",
+       {".las", ".laz"},
+       "ASPRS LAS 1.0-1.4, point formats 0-10, and LAZ (compressed LAS, COPC)",
+       read_las_input},
       {"text", {".xyz", ".txt", ".csv", ".pts", ".asc"}, "points as text columns (x y z ...)", read_text_input},
-      {"npy", {".npy"}, "NumPy (N,3+) point arrays or (X,Y,Z) occupancy grids", read_npy_input},
+      {"npy",
+       {".npy", ".npz"},
+       "NumPy (N,3+) point arrays, record arrays or (X,Y,Z) occupancy grids; .npz archives of them",
+       read_npy_input},
       {"ply", {".ply"}, "PLY ascii/binary points, vertex colours, faces as a mesh", read_ply},
       {"pcd", {".pcd"}, "PCD .5-0.7 ascii/binary/binary_compressed points", read_pcd_input},
       {"kitti", {".bin"}, "KITTI velodyne float32 x y z reflectance", read_kitti_input},
       {"binvox", {".binvox"}, "binvox occupancy grids", read_binvox_input},
-      {"mesh", {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"},
-       "meshes through Assimp: STL, OBJ, OFF, glTF, COLLADA, 3DS", read_mesh_input},
-      {"dem", {".tif", ".tiff", ".dem", ".img"}, "elevation rasters through GDAL (GeoTIFF, ...): cells as columns",
+      {"mesh",
+       {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"},
+       "meshes through Assimp: STL, OBJ, OFF, glTF, COLLADA, 3DS",
+       read_mesh_input},
+      {"dem",
+       {".tif", ".tiff", ".dem", ".img"},
+       "elevation rasters through GDAL (GeoTIFF, ...): cells as columns",
        read_dem_input},
-      {"octomap", {".bt", ".ot"}, "OctoMap occupancy maps through liboctomap: occupied cells (.ot: with log-odds)",
+      {"octomap",
+       {".bt", ".ot"},
+       "OctoMap occupancy maps through liboctomap: occupied cells (.ot: with log-odds)",
        read_octomap_input},
       {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
   };

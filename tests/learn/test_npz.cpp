@@ -1,12 +1,14 @@
 // .npz reading: the labelled grid layout, dtype conversions and every refusal.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
 
 #include "learn_test_data.hpp"
 #include "memory_cap.hpp"
 #include "test_support.hpp"
 #include "vola/error.hpp"
+#include "vola/io/input.hpp"
 #include "vola/learn/npz.hpp"
 
 namespace {
@@ -37,7 +39,7 @@ TEST(Npz, ReadsGridsAndLabelsInNpyOrder) {
     name += ".npz";
     const std::string path = (dir / name).string();
     write_npz(path, {{"X_train", grids_npy(grids, 32, dtype)}, {"y_train", labels_npy({0, 3, 9})}});
-    EXPECT_EQ(vola::learn::npz_array_names(path), (std::vector<std::string>{"X_train", "y_train"}));
+    EXPECT_EQ(vola::io::npz_array_names(path), (std::vector<std::string>{"X_train", "y_train"}));
     const auto read = read_labelled_grids(path);
     EXPECT_EQ(read.split, "train");
     EXPECT_EQ(read.side, 32);
@@ -175,6 +177,90 @@ TEST(Npz, ReadsTheModelNetTrainingSplit) {
   std::size_t filled = 0;
   for (auto c : grids.cells) filled += c;
   EXPECT_NEAR(double(filled) / double(grids.cells.size()), 0.0954, 0.0005);
+}
+
+// ---- .npz archives as point files (vola convert X.npz, io::read_input) ----
+
+// (N, 3) little-endian doubles, one row per point.
+Bytes points_npy(const std::vector<std::array<double, 3>>& points) {
+  Bytes data;
+  for (const auto& p : points)
+    for (double v : p) vola_io_test::put(data, v);
+  return vola_io_test::npy_bytes("<f8", {points.size(), 3}, false, data);
+}
+
+// The FormatError message of reading `path` as a point file, or "" when it reads.
+std::string points_error(const std::string& path, const std::string& member = {}) {
+  vola::io::InputOptions options;
+  options.grid = member;
+  try {
+    vola::io::read_input(path, "auto", options);
+  } catch (const vola::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// What pyntcloud's to_file("x.npz") writes: a "points" record array beside a "mesh".
+TEST(NpzPoints, PyntcloudsPointsBesideItsMeshAreRead) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "diamond.npz").string();
+  Bytes records;
+  for (float x : {0.5f, 0.0f, 1.0f}) {
+    vola_io_test::put(records, x);
+    vola_io_test::put(records, 1.0f - x);
+    vola_io_test::put(records, 0.25f);
+    records.push_back(static_cast<std::uint8_t>(x * 200));
+  }
+  std::string dict =
+      "{'descr': [('x', '<f4'), ('y', '<f4'), ('z', '<f4'), ('red', '|u1')], 'fortran_order': False, "
+      "'shape': (3,), }";
+  while ((10 + dict.size() + 1) % 64) dict.push_back(' ');
+  dict.push_back('\n');
+  Bytes npy = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0};
+  vola_io_test::put<std::uint16_t>(npy, static_cast<std::uint16_t>(dict.size()));
+  npy.insert(npy.end(), dict.begin(), dict.end());
+  npy.insert(npy.end(), records.begin(), records.end());
+  write_npz(path, {{"points", npy}, {"mesh", labels_npy({0, 1, 2})}});
+  const vola::io::Input in = vola::io::read_input(path, "auto", {});
+  EXPECT_EQ(in.format, "npy");
+  ASSERT_EQ(in.cloud.size(), 3u);
+  EXPECT_EQ(in.cloud.xyz, (std::vector<double>{0.5, 0.5, 0.25, 0.0, 1.0, 0.25, 1.0, 0.0, 0.25}));
+  ASSERT_EQ(in.cloud.attributes.size(), 1u);
+  EXPECT_EQ(in.cloud.attributes[0].name, "red");
+  EXPECT_EQ(in.cloud.attributes[0].values, (std::vector<double>{100, 0, 200}));
+}
+
+// numpy.savez("x.npz", points) names its only array arr_0.
+TEST(NpzPoints, TheOnlyArrayIsReadWhateverItsName) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "x.npz").string();
+  write_npz(path, {{"arr_0", points_npy({{1, 2, 3}, {4, 5, 6}})}});
+  const vola::io::Input in = vola::io::read_input(path, "auto", {});
+  EXPECT_EQ(in.cloud.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+}
+
+TEST(NpzPoints, SeveralArraysNeedANameAndTheErrorListsThem) {
+  vola_test::TempDir dir;
+  const std::string path = (dir / "two.npz").string();
+  write_npz(path, {{"before", points_npy({{1, 2, 3}})}, {"after", points_npy({{7, 8, 9}, {1, 1, 1}})}});
+  const std::string error = points_error(path);
+  EXPECT_NE(error.find("which array holds the points? The archive holds before, after"), std::string::npos) << error;
+  EXPECT_NE(error.find("--grid NAME"), std::string::npos) << error;
+  EXPECT_NE(points_error(path, "later").find("no array 'later' in the archive (it holds before, after)"),
+            std::string::npos);
+  vola::io::InputOptions options;
+  options.grid = "after";
+  const vola::io::Input in = vola::io::read_input(path, "auto", options);
+  EXPECT_EQ(in.cloud.size(), 2u);
+  // Two arrays named as points are as ambiguous as none.
+  const std::string both = (dir / "both.npz").string();
+  write_npz(both, {{"xyz", points_npy({{1, 2, 3}})}, {"points", points_npy({{7, 8, 9}})}});
+  EXPECT_NE(points_error(both).find("several named as points are"), std::string::npos) << points_error(both);
+  // The chosen array's own errors name the archive and the member.
+  const std::string flat = (dir / "flat.npz").string();
+  write_npz(flat, {{"points", labels_npy({0, 1, 2})}, {"rgb", labels_npy({0})}});
+  EXPECT_NE(points_error(flat).find(flat + ":points: an array of shape (3)"), std::string::npos) << points_error(flat);
 }
 
 }  // namespace

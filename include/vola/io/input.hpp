@@ -26,7 +26,8 @@ struct InputOptions {
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
   std::optional<int> copc_level;   // COPC: only the octree's levels 0..copc_level
-  std::string grid;                // OpenVDB: the grid to read (empty: the only one, or vola's own occupied grid)
+  std::string grid;                // OpenVDB: the grid to read (empty: the only one, or vola's own occupied grid);
+                                   // .npz: the array to read (empty: npz_points_member's choice)
 };
 
 // Occupied cells of an input that is already a voxel grid (binvox, NPY occupancy).

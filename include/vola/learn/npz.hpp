@@ -1,6 +1,6 @@
-// NumPy .npz archives (a zip of .npy members, stored or deflated) through libzip, and
-// the labelled occupancy-grid sets the classifier is trained on: an X_<split> array of
-// (N, S, S, S) 0/1 grids beside a y_<split> array of N labels.
+// The labelled occupancy-grid sets the classifier is trained on: an .npz archive
+// (vola/io/npz.hpp) with an X_<split> array of (N, S, S, S) 0/1 grids beside a
+// y_<split> array of N labels.
 #pragma once
 
 #include <cstddef>
@@ -9,18 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "vola/io/npy.hpp"
+#include "vola/io/npz.hpp"
 
 namespace vola::learn {
-
-// Member names of the archive, without the ".npy" suffix, in archive order.
-// Throws IoError when the file cannot be opened, FormatError when it is not a zip.
-std::vector<std::string> npz_array_names(const std::string& path);
-
-// One member (name without ".npy") parsed as .npy. The member is inflated into a
-// buffer no larger than what its stated size says and deflate can yield from its
-// compressed bytes; a member that inflates past its stated size is an error.
-io::NpyArray read_npz_array(const std::string& path, const std::string& name);
 
 // N grids of side^3 cells, each 0 or 1, cell (x, y, z) at (x * side + y) * side + z
 // (the npy C order of array[n][x][y][z]), with a label 0..9 per grid.
