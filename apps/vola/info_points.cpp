@@ -11,12 +11,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "vola/error.hpp"
-#include "vola/geo/crs.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/crs_rules.hpp"
+#include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/text_points.hpp"
 
 namespace vola::cli {
 
@@ -292,6 +293,15 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json) {
   std::printf("columns:    ");
   for (const auto& a : in.cloud.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
   std::printf("%s\n", in.cloud.attributes.empty() ? " none" : "");
+  // Text columns without names are not read: say so rather than let them vanish.
+  if (in.format == "text" && in.cloud.attributes.empty()) {
+    const int values = io::count_text_columns(path, 0);
+    if (values > 3)
+      std::printf(
+          "             (each line holds %d values: the %d after x y z have no names and are not read; a first "
+          "line '# x y z NAME ...', one name a column, names them)\n",
+          values, values - 3);
+  }
   if (summary) print_summary(in.cloud);
 }
 

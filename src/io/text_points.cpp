@@ -11,7 +11,9 @@
 #include <unordered_set>
 
 #include "column_names.hpp"
+#include "point_colours.hpp"
 #include "vola/error.hpp"
+#include "vola/io/input.hpp"
 
 namespace vola::io {
 
@@ -243,9 +245,18 @@ void type_colours(PointCloud& cloud) {
   }
 }
 
-}  // namespace
+// Open3D's text formats name their columns by the extension alone.
+std::optional<std::vector<std::string>> names_of_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".xyzn") return std::vector<std::string>{"x", "y", "z", "nx", "ny", "nz"};
+  if (ext == ".xyzrgb") return std::vector<std::string>{"x", "y", "z", "red", "green", "blue"};
+  return std::nullopt;
+}
 
-std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
+// The names of the header line, if there is one.
+std::optional<TextHeader> read_header_line(const std::string& path, int skip_lines) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
   const char line_end = line_end_of(in);
@@ -290,6 +301,14 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
     if (named) return TextHeader{names, header.line, header.offset, false};
     return std::nullopt;
   }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
+  if (auto header = read_header_line(path, skip_lines)) return header;
+  if (auto names = names_of_extension(path)) return TextHeader{std::move(*names), 0, 0, true};
   return std::nullopt;
 }
 
@@ -389,6 +408,10 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     buffer.erase(0, kept);
     if (progress) progress(consumed, total);
   }
+  if (named && !header->line && lower_extension(path) == ".xyzrgb")  // Open3D writes colours in 0..1
+    for (PointAttribute& a : cloud.attributes)
+      if (a.name == "red" || a.name == "green" || a.name == "blue")
+        for (double& v : a.values) v = colour_attribute(v, ColourScale::unit);
   if (named) type_colours(cloud);
   return cloud;
 }

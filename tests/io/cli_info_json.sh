@@ -124,4 +124,12 @@ grep -q "reproject the raster first (gdalwarp" "$tmp/err.txt" || fail "DEM in de
 printf 'not a point file\n' > "$tmp/notes.md"
 "$vola" info "$tmp/notes.md" 2> "$tmp/err.txt" && fail "info on a .md succeeded"
 grep -q "notes.md: cannot tell the format" "$tmp/err.txt" || fail ".md: $(cat "$tmp/err.txt")"
+# Text columns without names are not read, and info says so (pyntcloud's diamond.xyz has
+# normals after x y z and no header line); named ones are listed.
+printf '0.5 0 0.5 0 -1 0\n0 0.5 0.5 -1 0 0\n' > "$tmp/diamond.xyz"
+"$vola" info "$tmp/diamond.xyz" | grep -q "each line holds 6 values: the 3 after x y z have no names and are not read" ||
+  fail "info on a headerless 6-column .xyz does not say that 3 columns are not read"
+printf '# x y z nx ny nz\n0.5 0 0.5 0 -1 0\n' > "$tmp/named.xyz"
+"$vola" info "$tmp/named.xyz" | grep -q "^columns: *nx (f64) ny (f64) nz (f64)$" || fail "named .xyz columns: $("$vola" info "$tmp/named.xyz")"
+"$vola" info "$tmp/named.xyz" | grep -q "have no names" && fail "info says named columns have no names"
 echo "cli_info_json: OK ($checked LAS/LAZ files)"

@@ -91,7 +91,7 @@ grep -q ": 2 occupied and 7 free voxels of 0.25" "$tmp/out" || fail "plain.ot su
 expect_error "is a state map and holds its free voxels" "$vola" export "$tmp/map.vol" "$tmp/x.ot" --free "$tmp/map.free.vol"
 expect_error "is a map of 2 cells" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --voxel-size 3
 expect_error "its grids: 'occupied'" "$vola" convert "$tmp/a.vdb" "$tmp/x.vol" --grid density
-expect_error "applies to OpenVDB input only" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --grid occupied
+expect_error "applies to OpenVDB and .npz input only" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --grid occupied
 expect_error "--free applies to .bt, .ot and .vdb maps" "$vola" export "$tmp/a.vol" "$tmp/x.ply" --free "$tmp/map.free.vol"
 head -c 300 "$tmp/a.bt" >"$tmp/cut.bt"
 expect_error "$tmp/cut.bt.*the node stream ends inside a node" "$vola" convert "$tmp/cut.bt" "$tmp/x.vol"

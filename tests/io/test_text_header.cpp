@@ -131,6 +131,32 @@ TEST(TextHeader, FilesWithoutOneReadAsBefore) {
   EXPECT_THROW(read_text(dir, "1 2 3\nx y z\n"), vola::FormatError);
 }
 
+// Open3D's write_point_cloud: .xyzn holds x y z nx ny nz, .xyzrgb x y z r g b with
+// colours in 0..1, neither with a header line.
+TEST(TextHeader, Open3DsExtensionsNameTheirColumns) {
+  TempDir dir;
+  const auto normals_path = dir / "cloud.xyzn";
+  std::ofstream(normals_path, std::ios::binary) << "1 2 3 0 0 1\n4 5 6 0.6 0.8 0\n";
+  const auto normals = vola::io::read_text_points(normals_path.string(), {});
+  EXPECT_EQ(normals.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(names(normals), (std::vector<std::string>{"nx", "ny", "nz"}));
+  EXPECT_EQ(column(normals, "nx").values, (std::vector<double>{0, 0.6}));
+
+  const auto colour_path = dir / "cloud.XYZRGB";
+  std::ofstream(colour_path, std::ios::binary) << "1 2 3 1.0000000000 0.5000000000 0.0000000000\n4 5 6 0.2 0 1\n";
+  const auto coloured = vola::io::read_text_points(colour_path.string(), {});
+  EXPECT_EQ(coloured.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(column(coloured, "red").values, (std::vector<double>{255, 51}));
+  EXPECT_EQ(column(coloured, "green").values, (std::vector<double>{128, 0}));
+  EXPECT_EQ(column(coloured, "blue").values, (std::vector<double>{0, 255}));
+  EXPECT_EQ(column(coloured, "red").type, vola::ValueType::u8);
+
+  // A header line still wins over the extension.
+  std::ofstream(colour_path, std::ios::binary) << "x y z intensity nx ny\n1 2 3 7 8 9\n";
+  EXPECT_EQ(names(vola::io::read_text_points(colour_path.string(), {})),
+            (std::vector<std::string>{"intensity", "nx", "ny"}));
+}
+
 }  // namespace
 
 // Spreadsheets in most of Europe write decimal commas and separate fields by semicolons

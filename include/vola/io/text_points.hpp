@@ -42,7 +42,9 @@ struct TextColumns {
 
 // The column names of a header line (see above), or none when the first line after
 // `skip_lines` holds values or does not name x, y and z. `line` is its number (1-based);
-// `comment` whether it began with '#' or '//'.
+// `comment` whether it began with '#' or '//'. A file without one whose extension names
+// its columns (Open3D's .xyzn: x y z nx ny nz; .xyzrgb: x y z red green blue, colours in
+// 0..1) gets those names, as a comment at line 0.
 struct TextHeader {
   std::vector<std::string> names;  // as written, quotes removed
   std::uint64_t line = 0;
