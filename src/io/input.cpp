@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <string_view>
 
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
@@ -114,6 +116,20 @@ Input read_vdb_input(const std::string& path, const InputOptions& options) {
   return in;
 }
 
+// Whether the file's first word is ncols or nrows (any case), as ESRI ASCII grids begin.
+bool is_esri_ascii_grid(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[64] = {};
+  in.read(head, sizeof head);
+  std::string_view text(head, static_cast<std::size_t>(in.gcount()));
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
+  std::string word;
+  for (char c : text.substr(0, 6)) word += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return word.size() == 6 && (word.starts_with("ncols") || word.starts_with("nrows")) &&
+         std::isspace(static_cast<unsigned char>(word[5]));
+}
+
 std::vector<InputFormat> make_formats() {
   return {
       {"las",
@@ -173,7 +189,14 @@ const InputFormat& find_input_format(const std::string& path, const std::string&
   }
   const std::string ext = lower_extension(path);
   for (const auto& f : formats)
-    if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) return f;
+    if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) {
+      // .asc (and .txt) is also ESRI's ASCII grid, which begins with ncols/nrows: an
+      // elevation raster for GDAL, not points.
+      if (f.name == "text" && is_esri_ascii_grid(path))
+        for (const auto& dem : formats)
+          if (dem.name == "dem") return dem;
+      return f;
+    }
   throw OptionError("format", path + ": cannot tell the format from the extension '" + ext + "'; say which (" + known + ")");
 }
 

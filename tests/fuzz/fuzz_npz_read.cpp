@@ -13,7 +13,6 @@
 #include "fuzz_seeds.hpp"
 #include "scratch_file.hpp"
 #include "vola/error.hpp"
-#include "vola/io/input.hpp"
 #include "vola/learn/npz.hpp"
 
 namespace {
@@ -37,7 +36,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     // As a point file (vola convert X.npz): the member the reader picks, read as points.
     try {
-      const vola::io::Input in = io::read_input(path, "npy", {});
+      const std::string member = io::npz_points_member(path, "");
+      const vola::io::Input in = io::npy_input(io::read_npz_array(path, member), path, {});
       check(in.cloud.xyz.size() % 3 == 0);
       for (const auto& a : in.cloud.attributes) check(a.values.size() == in.cloud.size());
     } catch (const vola::Error&) {

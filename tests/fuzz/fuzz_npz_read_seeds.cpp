@@ -29,12 +29,14 @@ struct Member {
   Bytes npy;
 };
 
-// A version 1.0 .npy: the header dict padded with spaces to a multiple of 64 bytes.
+// A version 1.0 .npy: the header dict padded with spaces to a multiple of 64 bytes. A
+// structured dtype's descr is a list ("[('x', '<f4'), ...]"), written unquoted.
 Bytes npy(const std::string& descr, const std::vector<std::uint64_t>& shape, const Bytes& values) {
   std::string dims;
   for (auto s : shape) dims += std::to_string(s) + ",";
   if (shape.size() > 1) dims.pop_back();
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': (" + dims + "), }";
+  const std::string quoted = descr.starts_with("[") ? descr : "'" + descr + "'";
+  std::string header = "{'descr': " + quoted + ", 'fortran_order': False, 'shape': (" + dims + "), }";
   while ((10 + header.size() + 1) % 64) header += ' ';
   header += '\n';
   Bytes b{0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, static_cast<std::uint8_t>(header.size() & 0xff),
@@ -78,15 +80,29 @@ std::vector<Seed> synthetic_seeds() {
   std::vector<float> float_grid(4 * 4 * 4);
   for (std::size_t i = 0; i < float_grid.size(); ++i) float_grid[i] = i % 3 == 0 ? 1.0f : 0.0f;
   const Bytes labels2 = raw(std::vector<std::int32_t>{3, 9});
+  // Point files: pyntcloud's records beside a mesh, numpy.savez's lone arr_0.
+  Bytes records;
+  for (int i = 0; i < 3; ++i) {
+    const Bytes xyz = raw(std::vector<float>{0.5f * static_cast<float>(i), 1.0f, -2.0f});
+    records.insert(records.end(), xyz.begin(), xyz.end());
+    records.push_back(static_cast<std::uint8_t>(80 * i));
+  }
+  const std::string point_descr = "[('x', '<f4'), ('y', '<f4'), ('z', '<f4'), ('red', '|u1')]";
   return {
-      {"bool_int32.npz", archive({{"X_train", npy("|b1", {2, 4, 4, 4}, bool_grid)}, {"y_train", npy("<i4", {2}, labels2)}}, true)},
-      {"float_stored.npz",
-       archive({{"X_test", npy("<f4", {1, 4, 4, 4}, raw(float_grid))}, {"y_test", npy("<i8", {1}, raw(std::vector<std::int64_t>{0}))}}, false)},
+      {"pyntcloud_points.npz",
+       archive({{"points", npy(point_descr, {3}, records)}, {"mesh", npy("<i4", {2}, labels2)}}, true)},
+      {"savez_arr_0.npz", archive({{"arr_0", npy("<f8", {2, 3}, raw(std::vector<double>{1, 2, 3, 4, 5, 6}))}}, false)},
+      {"bool_int32.npz",
+       archive({{"X_train", npy("|b1", {2, 4, 4, 4}, bool_grid)}, {"y_train", npy("<i4", {2}, labels2)}}, true)},
+      {"float_stored.npz", archive({{"X_test", npy("<f4", {1, 4, 4, 4}, raw(float_grid))},
+                                    {"y_test", npy("<i8", {1}, raw(std::vector<std::int64_t>{0}))}},
+                                   false)},
       {"no_labels.npz", archive({{"X_train", npy("|u1", {2, 4, 4, 4}, bool_grid)}}, true)},
-      {"two_splits.npz",
-       archive({{"X_train", npy("|u1", {2, 4, 4, 4}, bool_grid)}, {"y_train", npy("<i4", {2}, labels2)},
-                {"X_test", npy("|u1", {2, 4, 4, 4}, bool_grid)}, {"y_test", npy(">i2", {2}, Bytes{0, 1, 0, 2})}},
-               false)},
+      {"two_splits.npz", archive({{"X_train", npy("|u1", {2, 4, 4, 4}, bool_grid)},
+                                  {"y_train", npy("<i4", {2}, labels2)},
+                                  {"X_test", npy("|u1", {2, 4, 4, 4}, bool_grid)},
+                                  {"y_test", npy(">i2", {2}, Bytes{0, 1, 0, 2})}},
+                                 false)},
   };
 }
 

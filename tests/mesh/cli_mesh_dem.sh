@@ -111,6 +111,14 @@ if "$vola" convert "$pdal" "$tmp/x.vol" --voxel-size 60 --solid -q 2>/dev/null; 
 if "$vola" convert "$cube" "$tmp/x.vol" --voxel-size 1 --dem-base 0 -q 2>/dev/null; then fail "--dem-base on a mesh was accepted"; fi
 if "$vola" convert "$cube" "$tmp/x.vol" --voxel-size 1 --nbits 1 -q 2>/dev/null; then fail "--nbits on a mesh was accepted"; fi
 
+# An ESRI ASCII grid (.asc, which is also a text-points extension) is told by its first
+# word and read as a DEM: 3 x 2 cells of 10, one without data.
+printf 'NCOLS 3\nNROWS 2\nxllcorner 100\nyllcorner 200\ncellsize 10\nNODATA_value -9999\n1 2 3\n4 -9999 6\n' > "$tmp/grid.asc"
+"$vola" info "$tmp/grid.asc" > "$tmp/asc_info.txt" || fail "info on an ESRI ASCII grid failed"
+grep -q "^cells: *5 with a height" "$tmp/asc_info.txt" || fail "ESRI ASCII grid: $(cat "$tmp/asc_info.txt")"
+"$vola" convert "$tmp/grid.asc" "$tmp/asc.vol" --voxel-size 10 --dem-surface-only -q || fail "convert of an ESRI ASCII grid failed"
+[[ $(info_field "$tmp/asc.vol" voxels) == 5 ]] || fail "ESRI ASCII grid: not 5 surface voxels"
+
 if [[ $failures -gt 0 ]]; then
   echo "$failures failure(s)" >&2
   exit 1
