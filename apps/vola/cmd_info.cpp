@@ -24,6 +24,7 @@ struct InfoArgs {
   std::string file;
   bool json = false;
   bool summary = false;
+  std::string grid;
 };
 
 // A JSON string: control characters escaped, bytes that are not UTF-8 (a name from a
@@ -97,10 +98,15 @@ std::string json_crs(const NamedCrs& crs) {
 void run_info(const InfoArgs& a) {
   io::refuse_non_regular_input(a.file);  // before its first bytes are read
   if (is_point_file(a.file) || !is_vol_file(a.file)) {
+    if (!a.grid.empty() && is_point_file(a.file))
+      throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + a.file + " is a LAS/LAZ file");
     if (is_point_file(a.file)) print_point_file_info(a.file, a.summary, a.json);
-    else print_point_cloud_info(a.file, a.summary, a.json);
+    else
+      print_point_cloud_info(a.file, a.summary, a.json, a.grid);
     return;
   }
+  if (!a.grid.empty())
+    throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + a.file + " is a .vol file");
   if (a.summary) throw InvalidArgument("--summary reads the points of a point file; " + a.file + " is a .vol file");
   FileLayout layout;
   const Tree tree = open_mapped(a.file, &layout);
@@ -208,6 +214,8 @@ void add_info(CLI::App& app) {
   cmd->add_flag("--summary", args->summary,
                 "Point files and DEMs: read every point (cell) for their own bounds, column ranges and points per class "
                 "(like pdal info --summary)");
+  cmd->add_option("--grid", args->grid,
+                  "OpenVDB: the grid to show (a file of several names them when none is given); NumPy .npz: the array");
   cmd->callback([args] { run_info(*args); });
 }
 

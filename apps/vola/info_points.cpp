@@ -199,7 +199,8 @@ int utm_for_dem_in_degrees(const io::Input& in, bool bounded, const Point& lo, c
 // triangles, a voxel grid's or map's cells (binvox, NPY occupancy, OctoMap, OpenVDB), a
 // height field's cells (DEM: one point per cell with a height). `summary` adds the height
 // field's column ranges; a mesh or grid has nothing more to read.
-void print_other_input_info(const std::string& path, const io::Input& in, bool summary, bool json) {
+void print_other_input_info(const std::string& path, const io::Input& in, bool summary, bool json,
+                            const std::string& part) {
   const char* kind = in.is_mesh() ? "mesh" : in.grid ? "voxel grid" : "height field";
   Point lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   const auto extend = [&](const Point& p) {
@@ -258,8 +259,9 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
                 hi[0], hi[1], hi[2], in.terrain ? " (cell centres)" : "");
   // A grid's cells are its voxels; the others need a voxel size.
   const int utm = utm_for_dem_in_degrees(in, bounded, lo, hi);
-  std::printf("to voxels:   vola convert %s OUT.vol%s%s\n", path.c_str(), in.grid ? "" : " --voxel-size S",
-              utm ? " --allow-geographic (voxels of degrees)" : "");
+  const std::string grid_option = part.empty() ? "" : " --grid " + part;
+  std::printf("to voxels:   vola convert %s OUT.vol%s%s%s\n", path.c_str(), grid_option.c_str(),
+              in.grid ? "" : " --voxel-size S", utm ? " --allow-geographic (voxels of degrees)" : "");
   if (utm)
     std::printf("or in metres: gdalwarp -t_srs EPSG:%d %s OUT.tif, then vola convert OUT.tif\n", utm, path.c_str());
   if (in.terrain && summary) print_summary(in.cloud);
@@ -267,11 +269,17 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
 
 }  // namespace
 
-void print_point_cloud_info(const std::string& path, bool summary, bool json) {
+void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part) {
   io::InputOptions options;
   options.attributes = true;
+  options.grid = part;
+  if (!part.empty()) {
+    const std::string format = io::find_input_format(path, "auto").name;
+    if (format != "vdb" && format != "npy")
+      throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + path + " is " + format);
+  }
   const io::Input in = io::read_input(path, "auto", options);
-  if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json);
+  if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json, part);
   if (json) {
     ordered_json doc = {{"file", path}, {"format", in.format}, {"points", in.cloud.size()},
                         {"points_not_finite", in.not_finite}, {"crs", crs_json(in.wkt, in.epsg)}};

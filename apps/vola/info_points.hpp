@@ -14,7 +14,8 @@ void print_point_file_info(const std::string& path, bool summary, bool json);
 // columns; with `summary`, bounds, column ranges and points per class. A mesh (triangles),
 // a voxel grid or map (binvox, NPY occupancy, OctoMap, OpenVDB: dims, cell size, occupied
 // cells) or a DEM (cells with a height): what vola convert reads, with its CRS and bounds.
-// `json`: the same as one JSON object on stdout (pdal info --summary's content).
-void print_point_cloud_info(const std::string& path, bool summary, bool json);
+// `json`: the same as one JSON object on stdout (pdal info --summary's content). `part`:
+// the grid of an OpenVDB file or the array of an .npz archive to show (empty: the default).
+void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part = {});
 
 }  // namespace vola::cli

@@ -77,6 +77,13 @@ grep -q "^OpenVDB grids log_odds free_log_odds: 2 occupied and 7 free" "$tmp/out
 "$vola" convert "$tmp/map.vdb" "$tmp/free_back.vol" --grid free_log_odds -q || fail "convert map.vdb --grid free_log_odds"
 "$vola" coords "$tmp/free_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.free.vol" | sort) ||
   fail "map.vdb: the free voxels differ"
+# vola info shows the default grid, or the one --grid names (a file of several others
+# names them and points to --grid, which info takes as convert does).
+"$vola" info "$tmp/map.vdb" | grep -q "^occupied: *2 cells" || fail "info map.vdb: $("$vola" info "$tmp/map.vdb")"
+"$vola" info "$tmp/map.vdb" --grid free_log_odds | grep -q "^occupied: *7 cells" ||
+  fail "info map.vdb --grid free_log_odds: $("$vola" info "$tmp/map.vdb" --grid free_log_odds)"
+expect_error "has no grid named 'density'" "$vola" info "$tmp/map.vdb" --grid density
+expect_error "applies to OpenVDB (.vdb) and NumPy .npz files" "$vola" info "$tmp/map.vol" --grid occupied
 
 # Plain trees take their free voxels from --free (here the state map's two halves; the
 # union keeps no log-odds, so the occupied leaves get OctoMap's clamping maximum).
