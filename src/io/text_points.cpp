@@ -304,6 +304,20 @@ std::optional<TextHeader> read_header_line(const std::string& path, int skip_lin
   return std::nullopt;
 }
 
+// Open3D writes .xyzrgb colours in 0..1; other writers of the extension may give 0..255,
+// which are kept as they are rather than clamped to white.
+void unit_colours_to_bytes(PointCloud& cloud) {
+  const auto is_colour = [](const PointAttribute& a) {
+    return a.name == "red" || a.name == "green" || a.name == "blue";
+  };
+  for (const PointAttribute& a : cloud.attributes)
+    if (is_colour(a) && std::any_of(a.values.begin(), a.values.end(), [](double v) { return !(v >= 0 && v <= 1); }))
+      return;
+  for (PointAttribute& a : cloud.attributes)
+    if (is_colour(a))
+      for (double& v : a.values) v = colour_attribute(v, ColourScale::unit);
+}
+
 }  // namespace
 
 std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
@@ -408,10 +422,7 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     buffer.erase(0, kept);
     if (progress) progress(consumed, total);
   }
-  if (named && !header->line && lower_extension(path) == ".xyzrgb")  // Open3D writes colours in 0..1
-    for (PointAttribute& a : cloud.attributes)
-      if (a.name == "red" || a.name == "green" || a.name == "blue")
-        for (double& v : a.values) v = colour_attribute(v, ColourScale::unit);
+  if (named && !header->line && lower_extension(path) == ".xyzrgb") unit_colours_to_bytes(cloud);
   if (named) type_colours(cloud);
   return cloud;
 }

@@ -150,6 +150,10 @@ TEST(TextHeader, Open3DsExtensionsNameTheirColumns) {
   EXPECT_EQ(column(coloured, "green").values, (std::vector<double>{128, 0}));
   EXPECT_EQ(column(coloured, "blue").values, (std::vector<double>{0, 255}));
   EXPECT_EQ(column(coloured, "red").type, vola::ValueType::u8);
+  // Colours past 1 are bytes already: kept, not clamped to 255.
+  std::ofstream(colour_path, std::ios::binary) << "1 2 3 200 0.5 1\n";
+  EXPECT_EQ(column(vola::io::read_text_points(colour_path.string(), {}), "red").values, (std::vector<double>{200}));
+  EXPECT_EQ(column(vola::io::read_text_points(colour_path.string(), {}), "green").values, (std::vector<double>{0.5}));
 
   // A header line still wins over the extension.
   std::ofstream(colour_path, std::ios::binary) << "x y z intensity nx ny\n1 2 3 7 8 9\n";
