@@ -110,7 +110,11 @@ void render_frames(const RenderArgs& a, raycast::PinholeCamera camera, std::uint
 
 void run_render(const RenderArgs& a) {
   const auto [width, height] = parse_size(a.size);
-  raycast::PinholeCamera camera;
+  raycast::PinholeCamera camera;  // the default view frames the scene with the image's settings
+  camera.up = {a.up[0], a.up[1], a.up[2]};
+  camera.vertical_fov_degrees = a.fov;
+  camera.width = width;
+  camera.height = height;
   if (!a.camera.empty()) {
     camera.eye = {a.camera[0], a.camera[1], a.camera[2]};
     camera.look_at = {a.camera[3], a.camera[4], a.camera[5]};
@@ -118,7 +122,7 @@ void run_render(const RenderArgs& a) {
   if (tile::is_tile_index_path(a.input)) {  // world coordinates; a tile opens when a ray first reaches it
     if (a.grid) throw InvalidArgument("--grid: a tile set has no single voxel grid; give world coordinates");
     const tile::TileSet tiles(a.input);
-    if (a.camera.empty()) camera = tile::overview_camera(tiles);
+    if (a.camera.empty()) camera = tile::overview_camera(tiles, camera);
     render_frames(
         a, camera, width, height, [&](const raycast::PinholeCamera& cam) { return tile::render(tiles, cam, a.threads); },
         [&] {
@@ -128,7 +132,8 @@ void run_render(const RenderArgs& a) {
     return;
   }
   const Tree tree = open_voxels(a.input);
-  if (a.camera.empty()) camera = raycast::overview_camera(tree);
+  if (a.camera.empty())
+    camera = raycast::overview_camera(tree, camera);
   else if (!a.grid) camera = raycast::world_camera_to_grid(tree.frame(), camera);
   const raycast::RayCaster caster(tree);
   render_frames(a, camera, width, height,
@@ -149,7 +154,7 @@ void add_render(CLI::App& app) {
       "INPUT may be a tile index (index.geojson from vola tile): rays then cross the tiles in order,\n"
       "each tile mapped when a ray first reaches it; depths are in world units.\n"
       "Examples:\n"
-      "  vola render city.vol -o city.png                         (a default view from above a corner)\n"
+      "  vola render city.vol -o city.png                         (the whole scene, from above a corner)\n"
       "  vola render city.vol --camera 100 -50 80 512 512 0 --size 1280x720 -o view.png\n"
       "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o orbit.png  (orbit_0000.png ...)\n"
       "  vola render tiles/index.geojson --size 1024x768 -o survey.png");

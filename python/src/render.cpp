@@ -14,8 +14,9 @@ namespace vola::python {
 
 namespace {
 
-// The camera the keywords describe, as `vola render` makes it from its flags: `eye` and
-// `look_at` (else `overview()`), then up, field of view, size and orbit frame.
+// The camera the keywords describe, as `vola render` makes it from its flags: up, field of
+// view and size, then `eye` and `look_at` (else `overview(settings)`, which frames the scene
+// with them), then the orbit frame.
 template <class Overview>
 vola::raycast::PinholeCamera camera_of(std::optional<std::array<double, 3>> eye, std::optional<std::array<double, 3>> look_at,
                                        std::array<double, 3> up, double fov, std::array<std::int64_t, 2> size,
@@ -27,16 +28,16 @@ vola::raycast::PinholeCamera camera_of(std::optional<std::array<double, 3>> eye,
       throw vola::InvalidArgument("render: size must be (width, height) with each 1..16384, got (" +
                                   std::to_string(size[0]) + ", " + std::to_string(size[1]) + ")");
   vola::raycast::PinholeCamera camera;
-  if (eye) {
-    camera.eye = to_point(*eye);
-    camera.look_at = to_point(*look_at);
-  } else {
-    camera = overview();
-  }
   camera.up = to_point(up);
   camera.vertical_fov_degrees = fov;
   camera.width = static_cast<std::uint32_t>(size[0]);
   camera.height = static_cast<std::uint32_t>(size[1]);
+  if (eye) {
+    camera.eye = to_point(*eye);
+    camera.look_at = to_point(*look_at);
+  } else {
+    camera = overview(camera);  // framed with the image's field of view and aspect
+  }
   camera.check();
   if (orbit) {
     if ((*orbit)[1] == 0 || (*orbit)[0] >= (*orbit)[1])
@@ -68,7 +69,9 @@ py::dict render_tree(const Tree& tree, std::optional<std::array<double, 3>> eye,
     eye = given.eye;
     look_at = given.look_at;
   }
-  const auto camera = camera_of(eye, look_at, up, fov, size, orbit, [&] { return vola::raycast::overview_camera(tree); });
+  const auto camera = camera_of(eye, look_at, up, fov, size, orbit, [&](const vola::raycast::PinholeCamera& s) {
+    return vola::raycast::overview_camera(tree, s);
+  });
   vola::raycast::Rendering image;
   {
     py::gil_scoped_release release;
@@ -83,7 +86,9 @@ py::dict render_tree(const Tree& tree, std::optional<std::array<double, 3>> eye,
 py::dict render_tiles(const vola::tile::TileSet& tiles, std::optional<std::array<double, 3>> eye,
                       std::optional<std::array<double, 3>> look_at, std::array<double, 3> up, double fov,
                       std::array<std::int64_t, 2> size, std::optional<std::array<std::uint32_t, 2>> orbit, unsigned threads) {
-  const auto camera = camera_of(eye, look_at, up, fov, size, orbit, [&] { return vola::tile::overview_camera(tiles); });
+  const auto camera = camera_of(eye, look_at, up, fov, size, orbit, [&](const vola::raycast::PinholeCamera& s) {
+    return vola::tile::overview_camera(tiles, s);
+  });
   vola::raycast::Rendering image;
   {
     py::gil_scoped_release release;
@@ -105,7 +110,7 @@ void bind_render(py::class_<Tree>& tree, py::module_& m) {
            "'depth': (H, W) float64 distance to the entry point (world units, voxels with world=False), inf\n"
            "for a miss; 'hits': rays that hit}. Row 0 is the top of the image.\n"
            "eye, look_at: the camera (world coordinates unless world=False); neither: the CLI's default view\n"
-           "from above a corner of the occupied box. fov: vertical, degrees; size=(width, height);\n"
+           "of the whole occupied box from above a corner. fov: vertical, degrees; size=(width, height);\n"
            "orbit=(i, n): frame i of `vola render --orbit n` (the eye turned 360*i/n degrees about +z).");
   tiles.def("render", &render_tiles, py::arg("eye") = py::none(), py::arg("look_at") = py::none(),
             py::arg("up") = std::array<double, 3>{0, 0, 1}, py::arg("fov") = 60.0,

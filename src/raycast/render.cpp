@@ -70,25 +70,17 @@ Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned 
   return out;
 }
 
-PinholeCamera overview_camera(const Tree& tree) {
-  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  const int level = std::min(tree.depth() - 1, 3);
+PinholeCamera overview_camera(const Tree& tree, const PinholeCamera& settings) {
+  // The corners of the occupied cells of level min(depth - 1, 2): at most 16^3 cells.
+  const int level = std::min(tree.depth() - 1, 2);
   const double cell = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
+  std::vector<Point> corners;
   tree.for_each_node(level, [&](const Voxel& c) {
-    const double p[3] = {c.x * cell, c.y * cell, c.z * cell};
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[a]);
-      hi[a] = std::max(hi[a], p[a] + cell);
-    }
+    for (int k = 0; k < 8; ++k)
+      corners.push_back({(c.x + (k & 1)) * cell, (c.y + (k >> 1 & 1)) * cell, (c.z + (k >> 2 & 1)) * cell});
   });
-  PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (lo[a] + hi[a]);
-    extent = std::max(extent, hi[a] - lo[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
+  if (corners.empty()) corners.push_back({0, 0, 0});  // an empty tree: any view shows nothing
+  return framing(corners, settings);
 }
 
 }  // namespace vola::raycast

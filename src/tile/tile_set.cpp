@@ -275,21 +275,13 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& ca
   return out;
 }
 
-raycast::PinholeCamera overview_camera(const TileSet& tiles) {
-  Box box = tiles.index().tiles.front().bbox;
+raycast::PinholeCamera overview_camera(const TileSet& tiles, const raycast::PinholeCamera& settings) {
+  std::vector<Point> corners;  // every tile's box: a survey's empty tiles do not push the camera back
   for (const auto& t : tiles.index().tiles)
-    for (int a = 0; a < 3; ++a) {
-      box.min[a] = std::min(box.min[a], t.bbox.min[a]);
-      box.max[a] = std::max(box.max[a], t.bbox.max[a]);
-    }
-  raycast::PinholeCamera cam;
-  double extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    cam.look_at[a] = 0.5 * (box.min[a] + box.max[a]);
-    extent = std::max(extent, box.max[a] - box.min[a]);
-  }
-  cam.eye = {cam.look_at[0] - 0.55 * extent, cam.look_at[1] - 0.45 * extent, cam.look_at[2] + 0.4 * extent};
-  return cam;
+    for (int k = 0; k < 8; ++k)
+      corners.push_back({k & 1 ? t.bbox.max[0] : t.bbox.min[0], k & 2 ? t.bbox.max[1] : t.bbox.min[1],
+                         k & 4 ? t.bbox.max[2] : t.bbox.min[2]});
+  return raycast::framing(corners, settings);
 }
 
 }  // namespace vola::tile

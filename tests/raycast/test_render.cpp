@@ -2,7 +2,11 @@
 // single casts, and cameras refuse impossible settings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <utility>
+
 #include "raycast_test_scenes.hpp"
+#include "vola/builder.hpp"
 #include "vola/error.hpp"
 #include "vola/raycast/render.hpp"
 #include "vola/raycast/world.hpp"
@@ -68,6 +72,45 @@ TEST(Render, WorldCameraMapsThroughTheFrame) {
   EXPECT_EQ(vola::raycast::grid_to_world(frame, grid.eye), world.eye);
   const auto ray = vola::raycast::world_ray_to_grid(frame, {{100, 200, 300}, {1, 0, 0}, 3.0});
   EXPECT_EQ(ray.t_max, 6.0);
+}
+
+// The voxels' x (or z) range the default view's rays reach: every pixel cast.
+std::pair<std::uint32_t, std::uint32_t> seen_range(const vola::Tree& tree, const PinholeCamera& camera, int axis) {
+  const vola::raycast::RayCaster caster(tree);
+  std::uint32_t lo = UINT32_MAX, hi = 0;
+  for (std::uint32_t row = 0; row < camera.height; ++row)
+    for (std::uint32_t col = 0; col < camera.width; ++col)
+      if (const auto hit = caster.cast(camera.ray(col, row))) {
+        const std::uint32_t v = axis == 0 ? hit->voxel.x : hit->voxel.z;
+        lo = std::min(lo, v), hi = std::max(hi, v);
+      }
+  return {lo, hi};
+}
+
+// A long strip (a road, a power line corridor, las-rs's 800 x 28 m clip) and a tall
+// tower: the default view sees both ends, whatever the image's aspect. The view placed
+// at 0.8 x the longest extent, as before, cut the strip's ends off.
+TEST(Render, TheDefaultViewFramesLongAndTallScenesWhole) {
+  std::vector<vola::Voxel> strip, tower;
+  for (std::uint32_t x = 0; x < 250; ++x)
+    for (std::uint32_t y = 100; y < 116; ++y) strip.push_back({x, y, 10});
+  for (std::uint32_t z = 0; z < 250; ++z)
+    for (std::uint32_t x = 100; x < 116; ++x)
+      for (std::uint32_t y = 100; y < 116; ++y) tower.push_back({x, y, z});
+  const vola::Tree strip_tree = vola::build_from_voxels(strip, 4);
+  const vola::Tree tower_tree = vola::build_from_voxels(tower, 4);
+  for (const auto& [width, height] : {std::pair{160u, 120u}, std::pair{64u, 160u}, std::pair{200u, 50u}}) {
+    PinholeCamera settings;
+    settings.width = width, settings.height = height;
+    const PinholeCamera s = vola::raycast::overview_camera(strip_tree, settings);
+    EXPECT_EQ(s.width, width);
+    const auto [x0, x1] = seen_range(strip_tree, s, 0);
+    EXPECT_LE(x0, 8u) << width << "x" << height;
+    EXPECT_GE(x1, 241u) << width << "x" << height;
+    const auto [z0, z1] = seen_range(tower_tree, vola::raycast::overview_camera(tower_tree, settings), 2);
+    EXPECT_LE(z0, 8u) << width << "x" << height;
+    EXPECT_GE(z1, 241u) << width << "x" << height;
+  }
 }
 
 TEST(Render, CameraRefusesImpossibleSettings) {

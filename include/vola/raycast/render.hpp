@@ -43,9 +43,9 @@ void shade_pixel(const std::array<double, 3>& colour, const std::array<int, 3>& 
 
 Rendering render(const RayCaster& caster, const PinholeCamera& camera, unsigned threads = 0);
 
-// The default view of a tree (grid coordinates, the rest of the camera as constructed):
-// from above one corner of its occupied bounding box (at level min(depth - 1, 3)),
-// looking at the box's centre.
-PinholeCamera overview_camera(const Tree& tree);
+// The default view of a tree (grid coordinates; up, field of view and image size from
+// `settings`): its occupied cells of level min(depth - 1, 2) framed whole from above one
+// corner of their box (framing()).
+PinholeCamera overview_camera(const Tree& tree, const PinholeCamera& settings = {});
 
 }  // namespace vola::raycast

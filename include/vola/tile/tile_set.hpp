@@ -82,6 +82,6 @@ raycast::Rendering render(const TileSet& tiles, const raycast::PinholeCamera& wo
 // The default view of a tile set (world coordinates), placed as raycast::overview_camera
 // places a tree's, over the points' bounding box of every tile (from the index: no tile
 // is opened).
-raycast::PinholeCamera overview_camera(const TileSet& tiles);
+raycast::PinholeCamera overview_camera(const TileSet& tiles, const raycast::PinholeCamera& settings = {});
 
 }  // namespace vola::tile
