@@ -57,7 +57,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 1: check_cloud(vola::io::parse_pcd(file, "fuzz.pcd", options)); break;
-      case 2: check_cloud(vola::io::parse_kitti(file, "fuzz.bin", options)); break;
+      case 2:
+        check_cloud(vola::io::parse_kitti(file, "fuzz.bin", options));
+        check_cloud(vola::io::parse_nuscenes(file, "fuzz.pcd.bin", options));
+        break;
       case 3: {
         const vola::io::Input in = vola::io::npy_input(vola::io::parse_npy(file, "fuzz.npy"), "fuzz.npy", options);
         check_cloud(in.cloud);

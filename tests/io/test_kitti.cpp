@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "io_test_data.hpp"
+#include "test_support.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/kitti.hpp"
 
@@ -80,6 +81,42 @@ TEST(Kitti, SizesThatAreNotWholeRecordsAreFormatErrors) {
     EXPECT_NE(error->cause().find("16-byte records"), std::string::npos);
   }
   EXPECT_EQ(vola::io::parse_kitti({}, "empty.bin").size(), 0u);
+}
+
+// nuScenes' devkit reads a sweep as np.fromfile(f, np.float32).reshape(-1, 5): x y z
+// intensity ring. Four such records are 80 bytes, five whole KITTI records too: only the
+// name (.pcd.bin) tells them apart, and as KITTI they would read as five wrong points.
+TEST(Kitti, NuscenesSweepsAreFiveFloatsAPoint) {
+  Bytes bytes;
+  for (float v : {1.0f, 2.0f, 3.0f, 17.0f, 0.0f,  -1.0f, -2.0f, -3.0f, 300.0f, 31.0f,
+                  4.5f, 5.5f, 6.5f, 0.0f,  12.0f, 7.0f,  8.0f,  9.0f,  255.0f, 1e9f})
+    put<float>(bytes, v);
+  vola_test::TempDir dir;
+  const auto path = dir / "n008-2018-08-01-15-16-36-0400__LIDAR_TOP__1533151603547590.pcd.bin";
+  vola_test::write_bytes(path, bytes);
+  EXPECT_TRUE(vola::io::is_nuscenes_sweep(path.string()));
+  EXPECT_FALSE(vola::io::is_nuscenes_sweep((dir / "000000.bin").string()));
+  vola::io::InputOptions options;
+  options.payload = true;
+  const vola::io::Input in = vola::io::read_input(path.string(), "auto", options);
+  EXPECT_EQ(in.format, "kitti");
+  EXPECT_EQ(in.cloud.xyz, (std::vector<double>{1, 2, 3, -1, -2, -3, 4.5, 5.5, 6.5, 7, 8, 9}));
+  ASSERT_EQ(in.cloud.attributes.size(), 2u);
+  EXPECT_EQ(in.cloud.attributes[0].name, "intensity");
+  EXPECT_EQ(in.cloud.attributes[0].values, (std::vector<double>{17, 300, 0, 255}));
+  EXPECT_EQ(in.cloud.attributes[1].name, "ring");
+  EXPECT_EQ(in.cloud.attributes[1].values, (std::vector<double>{0, 31, 12, 255}));  // 1e9 is no ring: 255
+  EXPECT_EQ(in.cloud.payload, (std::vector<std::uint64_t>{17 * 0x010101u, 255 * 0x010101u, 0, 255 * 0x010101u}));
+  // The same bytes as KITTI: five records, as the size allows.
+  EXPECT_EQ(vola::io::parse_kitti(bytes, "000000.bin").size(), 4u * 20 / 16);
+  for (std::size_t n = 1; n < bytes.size(); ++n) {
+    if (n % 20 == 0) continue;
+    const Bytes cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+    const auto error = vola_test::format_error_of([&] { vola::io::parse_nuscenes(cut, "cut.pcd.bin"); });
+    ASSERT_TRUE(error) << n;
+    EXPECT_EQ(error->offset(), n / 20 * 20);
+    EXPECT_NE(error->cause().find("20-byte records"), std::string::npos);
+  }
 }
 
 }  // namespace
