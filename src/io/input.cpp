@@ -10,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/dem.hpp"
+#include "vola/io/ept.hpp"
 #include "vola/io/file_checks.hpp"
 #include "vola/io/kitti.hpp"
 #include "vola/io/las.hpp"
@@ -164,6 +165,7 @@ std::vector<InputFormat> make_formats() {
        "OctoMap occupancy maps through liboctomap: occupied cells (.ot: with log-odds)",
        read_octomap_input},
       {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
+      {"ept", {".json"}, "Entwine Point Tiles: the ept.json of a local EPT folder (laszip or binary data)", read_ept},
   };
 }
 
