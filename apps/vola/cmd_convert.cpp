@@ -148,8 +148,9 @@ void add_convert(CLI::App& app) {
   cmd->add_flag("--dense", args->options.dense, "Write the reference's dense layout (depth <= 5)");
   add_crs_options(*cmd, args->options.assign_crs, args->options.target_crs, args->options.allow_geographic,
                   "--voxel-size, --origin and --bbox");
-  cmd->add_option("--level", args->options.level,
-                  "COPC: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the file)");
+  cmd->add_option(
+      "--level", args->options.level,
+      "COPC and EPT: read only the octree's levels 0..LEVEL (a coarser sample from a small part of the data)");
   cmd->add_option("--grid", args->options.grid,
                   "OpenVDB: the grid to read (default: the only grid, or vola's own occupied grid of a map it wrote; "
                   "several others are refused, listed). NumPy .npz: the array to read (default: the only one, or the "

@@ -101,6 +101,8 @@ void run_info(const InfoArgs& a) {
     if (!a.grid.empty() && is_point_file(a.file))
       throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + a.file + " is a LAS/LAZ file");
     if (is_point_file(a.file)) print_point_file_info(a.file, a.summary, a.json);
+    else if (a.grid.empty() && io::find_input_format(a.file, "auto").name == "ept")
+      print_ept_info(a.file, a.summary, a.json);
     else
       print_point_cloud_info(a.file, a.summary, a.json, a.grid);
     return;

@@ -5,16 +5,19 @@
 #include "info_points.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "vola/analysis/census.hpp"
 #include "vola/crs_rules.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/io/ept.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/text_points.hpp"
@@ -311,6 +314,59 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
           values, values - 3);
   }
   if (summary) print_summary(in.cloud);
+}
+
+void print_ept_info(const std::string& path, bool summary, bool json) {
+  const io::EptDataset d = io::ept_dataset(path);
+  const std::vector<io::EptNode> nodes = io::ept_nodes(path);
+  std::map<int, std::pair<std::uint64_t, std::uint64_t>> depths;  // depth -> nodes, points
+  std::uint64_t stated = 0;
+  for (const io::EptNode& n : nodes) {
+    ++depths[n.depth].first;
+    depths[n.depth].second += n.points;
+    stated += n.points;
+  }
+  const std::array<double, 6>& box = d.conforming ? *d.conforming : d.bounds;
+  std::optional<io::Input> read;
+  if (summary) read = io::read_input(path, "ept", {});
+  if (json) {
+    ordered_json hierarchy = ordered_json::array();
+    for (const auto& [depth, counts] : depths)
+      hierarchy.push_back({{"depth", depth}, {"nodes", counts.first}, {"points", counts.second}});
+    ordered_json dimensions = ordered_json::array();
+    for (const auto& name : d.dimensions) dimensions.push_back(name);
+    ordered_json doc = {{"file", path},
+                        {"format", "EPT"},
+                        {"version", d.version},
+                        {"data_type", d.data_type},
+                        {"points", d.points},
+                        {"crs", crs_json(d.wkt, d.epsg)},
+                        {"bounds",
+                         {{"min", xyz(box.data())},
+                          {"max", xyz(box.data() + 3)},
+                          {"source", d.conforming ? "boundsConforming" : "bounds"}}},
+                        {"dimensions", std::move(dimensions)},
+                        {"nodes", nodes.size()},
+                        {"hierarchy", std::move(hierarchy)}};
+    if (read) doc["summary"] = summary_json(read->cloud);
+    print_json(doc);
+    return;
+  }
+  std::printf("file:        %s (EPT %s, %s)\n", path.c_str(), d.version.empty() ? "?" : d.version.c_str(),
+              d.data_type.c_str());
+  std::printf("points:      %llu in %zu nodes", static_cast<unsigned long long>(d.points), nodes.size());
+  if (stated != d.points) std::printf(" (the hierarchy states %llu)", static_cast<unsigned long long>(stated));
+  std::printf("\ncrs:         %s\n", crs_text(crs_definition(d.wkt, d.epsg)).c_str());
+  std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (ept.json's %s)\n", box[0],
+              box[1], box[2], box[3], box[4], box[5], d.conforming ? "boundsConforming" : "bounds");
+  std::printf("dimensions: ");
+  for (const auto& name : d.dimensions) std::printf(" %s", name.c_str());
+  std::printf("\n");
+  for (const auto& [depth, counts] : depths)
+    std::printf("depth %-5d  %llu nodes, %llu points\n", depth, static_cast<unsigned long long>(counts.first),
+                static_cast<unsigned long long>(counts.second));
+  std::printf("to voxels:   vola convert %s OUT.vol --voxel-size S [--level L: depths 0..L only]\n", path.c_str());
+  if (read) print_summary(read->cloud);
 }
 
 bool is_point_file(const std::string& path) {

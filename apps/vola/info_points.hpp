@@ -5,6 +5,10 @@
 
 namespace vola::cli {
 
+// An Entwine Point Tiles dataset (its ept.json): version, data type, points, CRS, bounds,
+// schema and the hierarchy's nodes and points per depth, from the JSON alone; with
+// `summary`, every node read too.
+void print_ept_info(const std::string& path, bool summary, bool json);
 // Whether the file starts with a LAS signature ("LASF"): LAS, LAZ and COPC files.
 bool is_point_file(const std::string& path);
 // The header, (E)VLRs, CRS, compression and COPC octree of a LAS/LAZ/COPC file; with

@@ -44,8 +44,8 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
-  if (options.level && format.name != "las")
-    throw OptionError("level", "applies to COPC input only (" + path + " is " + format.name + ")");
+  if (options.level && format.name != "las" && format.name != "ept")
+    throw OptionError("level", "applies to COPC and EPT input only (" + path + " is " + format.name + ")");
   input.copc_level = options.level;
   if (!options.grid.empty() && format.name != "vdb" && format.name != "npy")
     throw OptionError("grid", "applies to OpenVDB and .npz input only (" + path + " is " + format.name + ")");

@@ -226,7 +226,7 @@ std::vector<EptNode> ept_nodes(const std::string& ept_json) {
         throw FormatError(
             file.string(), std::nullopt,
             "the nodes hold more points than ept.json's " + std::to_string(total) + " (at node " + key + ")");
-      nodes.push_back({k, {key, static_cast<std::uint64_t>(c)}});
+      nodes.push_back({k, {key, static_cast<int>(k[0]), static_cast<std::uint64_t>(c)}});
     }
     if (seen.size() > (std::uint64_t{1} << 24))
       throw FormatError(file.string(), std::nullopt, "more than 2^24 nodes: not read");
@@ -237,12 +237,48 @@ std::vector<EptNode> ept_nodes(const std::string& ept_json) {
   return out;
 }
 
-Input read_ept(const std::string& ept_json, const InputOptions& options) {
-  const fs::path root = fs::path(ept_json).parent_path();
+EptDataset ept_dataset(const std::string& ept_json) {
   const json ept = parse_json_file(ept_json);
   if (!ept.is_object() || !ept.contains("dataType") || !ept["dataType"].is_string())
     throw FormatError(ept_json, std::nullopt, "not an EPT ept.json: no \"dataType\"");
-  const std::string type = ept["dataType"].get<std::string>();
+  EptDataset d;
+  d.data_type = ept["dataType"].get<std::string>();
+  if (ept.contains("version") && ept["version"].is_string()) d.version = ept["version"].get<std::string>();
+  if (ept.contains("points") && ept["points"].is_number_unsigned()) d.points = ept["points"].get<std::uint64_t>();
+  const auto box = [&](const char* key) -> std::optional<std::array<double, 6>> {
+    if (!ept.contains(key) || !ept[key].is_array() || ept[key].size() != 6) return std::nullopt;
+    std::array<double, 6> b{};
+    for (std::size_t i = 0; i < 6; ++i) {
+      if (!ept[key][i].is_number()) return std::nullopt;
+      b[i] = ept[key][i].get<double>();
+    }
+    return b;
+  };
+  if (const auto b = box("bounds")) d.bounds = *b;
+  d.conforming = box("boundsConforming");
+  if (ept.contains("schema") && ept["schema"].is_array())
+    for (const json& dim : ept["schema"])
+      if (dim.is_object() && dim.contains("name") && dim["name"].is_string())
+        d.dimensions.push_back(dim["name"].get<std::string>());
+  if (ept.contains("srs") && ept["srs"].is_object()) {
+    const json& srs = ept["srs"];
+    if (srs.contains("wkt") && srs["wkt"].is_string()) d.wkt = srs["wkt"].get<std::string>();
+    if (srs.contains("authority") && srs["authority"] == "EPSG" && srs.contains("horizontal")) {
+      const std::string code =
+          srs["horizontal"].is_string() ? srs["horizontal"].get<std::string>() : srs["horizontal"].dump();
+      std::uint32_t epsg = 0;
+      const auto [end, error] = std::from_chars(code.data(), code.data() + code.size(), epsg);
+      if (error == std::errc{} && end == code.data() + code.size() && epsg > 0) d.epsg = epsg;
+    }
+  }
+  return d;
+}
+
+Input read_ept(const std::string& ept_json, const InputOptions& options) {
+  const fs::path root = fs::path(ept_json).parent_path();
+  const json ept = parse_json_file(ept_json);
+  const EptDataset dataset = ept_dataset(ept_json);
+  const std::string& type = dataset.data_type;
   if (type == "zstandard")
     throw FormatError(
         ept_json, std::nullopt,
@@ -253,18 +289,10 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
   const std::vector<Dimension> dims = type == "binary" ? schema_of(ept, ept_json) : std::vector<Dimension>{};
   Input in;
   in.format = "ept";
-  if (ept.contains("srs") && ept["srs"].is_object()) {
-    const json& srs = ept["srs"];
-    if (srs.contains("wkt") && srs["wkt"].is_string()) in.wkt = srs["wkt"].get<std::string>();
-    if (srs.contains("authority") && srs["authority"] == "EPSG" && srs.contains("horizontal")) {
-      const std::string code =
-          srs["horizontal"].is_string() ? srs["horizontal"].get<std::string>() : srs["horizontal"].dump();
-      std::uint32_t epsg = 0;
-      const auto [end, error] = std::from_chars(code.data(), code.data() + code.size(), epsg);
-      if (error == std::errc{} && end == code.data() + code.size() && epsg > 0) in.epsg = epsg;
-    }
-  }
-  const std::vector<EptNode> nodes = ept_nodes(ept_json);
+  in.wkt = dataset.wkt;
+  in.epsg = dataset.epsg;
+  std::vector<EptNode> nodes = ept_nodes(ept_json);
+  if (options.copc_level) std::erase_if(nodes, [&](const EptNode& n) { return n.depth > *options.copc_level; });
   std::uint64_t done = 0, total = 0;
   for (const EptNode& n : nodes) total += n.points;
   bool first = true;
@@ -275,6 +303,7 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
       InputOptions one = options;
       one.stream = false;
       one.progress = nullptr;
+      one.copc_level.reset();  // the dataset's levels, not the node's (a node is no COPC file)
       Input las = read_input(file, "las", one);
       cloud = std::move(las.cloud);
       if (in.wkt.empty() && !in.epsg) in.wkt = las.wkt, in.epsg = las.epsg;

@@ -132,4 +132,28 @@ printf '0.5 0 0.5 0 -1 0\n0 0.5 0.5 -1 0 0\n' > "$tmp/diamond.xyz"
 printf '# x y z nx ny nz\n0.5 0 0.5 0 -1 0\n' > "$tmp/named.xyz"
 "$vola" info "$tmp/named.xyz" | grep -q "^columns: *nx (f64) ny (f64) nz (f64)$" || fail "named .xyz columns: $("$vola" info "$tmp/named.xyz")"
 "$vola" info "$tmp/named.xyz" | grep -q "have no names" && fail "info says named columns have no names"
+# An Entwine Point Tiles folder made here from a shared LAZ file (a root node and a child
+# behind a subtree file): info from the JSON alone, and --level 0 reads the root only.
+ept=$tmp/ept
+mkdir -p "$ept/ept-hierarchy" "$ept/ept-data"
+cp "$data/laz/laspy_simple.laz" "$ept/ept-data/0-0-0-0.laz"
+cp "$data/laz/laspy_simple.laz" "$ept/ept-data/1-0-1-1.laz"
+printf '{"bounds": [0, 0, 0, 1, 1, 1], "dataType": "laszip", "hierarchyType": "json", "points": 2130, "schema": [], "srs": {"authority": "EPSG", "horizontal": "32610"}, "version": "1.0.0"}' > "$ept/ept.json"
+printf '{"0-0-0-0": 1065, "1-0-1-1": -1}' > "$ept/ept-hierarchy/0-0-0-0.json"
+printf '{"1-0-1-1": 1065}' > "$ept/ept-hierarchy/1-0-1-1.json"
+"$vola" info "$ept/ept.json" > "$tmp/ept_info.txt" || fail "info on an EPT dataset failed"
+grep -q "^points: *2130 in 2 nodes$" "$tmp/ept_info.txt" || fail "EPT info: $(cat "$tmp/ept_info.txt")"
+grep -q "^depth 1 .* 1 nodes, 1065 points$" "$tmp/ept_info.txt" || fail "EPT info depths: $(cat "$tmp/ept_info.txt")"
+"$vola" info --json --summary "$ept/ept.json" > "$tmp/ept.json" || fail "info --json --summary on an EPT dataset failed"
+"${VOLA_PYTHON:-python3}" -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['format'] == 'EPT' and d['points'] == 2130 and d['nodes'] == 2, d
+assert d['hierarchy'] == [{'depth': 0, 'nodes': 1, 'points': 1065}, {'depth': 1, 'nodes': 1, 'points': 1065}], d
+assert d['summary']['points_read'] == 2130 and d['crs']['epsg'] == 32610, d
+" "$tmp/ept.json" || fail "EPT info --json: $(cat "$tmp/ept.json")"
+"$vola" convert "$ept/ept.json" "$tmp/ept_root.vol" --voxel-size 1 --level 0 -q || fail "convert EPT --level 0"
+"$vola" convert "$data/laz/laspy_simple.laz" "$tmp/simple.vol" --voxel-size 1 -q || fail "convert laspy_simple.laz"
+"$vola" coords "$tmp/ept_root.vol" 2>/dev/null | cmp -s - <("$vola" coords "$tmp/simple.vol" 2>/dev/null) ||
+  fail "EPT --level 0: not the root node's voxels"
 echo "cli_info_json: OK ($checked LAS/LAZ files)"
