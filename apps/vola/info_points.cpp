@@ -245,7 +245,17 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
   }
   if (in.format == kind) std::printf("file:        %s (%s)\n", path.c_str(), kind);
   else std::printf("file:        %s (%s, a %s)\n", path.c_str(), in.format.c_str(), kind);
-  if (in.is_mesh()) std::printf("triangles:   %zu\n", in.triangles.size());
+  if (in.is_mesh()) {
+    // Mesh readers keep lone vertices (an OBJ of "v" lines alone) as triangles of one point.
+    const auto points = static_cast<std::size_t>(std::count_if(
+        in.triangles.begin(), in.triangles.end(), [](const io::Triangle& t) { return t[0] == t[1] && t[1] == t[2]; }));
+    if (points == in.triangles.size())
+      std::printf("points:      %zu (vertices without faces)\n", points);
+    else if (points > 0)
+      std::printf("triangles:   %zu (%zu of them single points)\n", in.triangles.size(), points);
+    else
+      std::printf("triangles:   %zu\n", in.triangles.size());
+  }
   if (in.grid) {
     const io::VoxelGrid& g = *in.grid;
     std::printf("grid:        %u x %u x %u cells of %.9g, origin (%.9g, %.9g, %.9g)%s\n", g.dims[0], g.dims[1], g.dims[2],

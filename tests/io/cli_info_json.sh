@@ -132,6 +132,10 @@ printf '0.5 0 0.5 0 -1 0\n0 0.5 0.5 -1 0 0\n' > "$tmp/diamond.xyz"
 printf '# x y z nx ny nz\n0.5 0 0.5 0 -1 0\n' > "$tmp/named.xyz"
 "$vola" info "$tmp/named.xyz" | grep -q "^columns: *nx (f64) ny (f64) nz (f64)$" || fail "named .xyz columns: $("$vola" info "$tmp/named.xyz")"
 "$vola" info "$tmp/named.xyz" | grep -q "have no names" && fail "info says named columns have no names"
+# An OBJ of vertices alone (a point cloud exported from MeshLab or Blender) is points, not triangles.
+printf 'v 1 2 3\nv 4 5 6\nv 7 8 9.5\n' > "$tmp/cloud.obj"
+"$vola" info "$tmp/cloud.obj" | grep -q "^points: *3 (vertices without faces)$" || fail "vertex-only OBJ: $("$vola" info "$tmp/cloud.obj")"
+
 # An Entwine Point Tiles folder made here from a shared LAZ file (a root node and a child
 # behind a subtree file): info from the JSON alone, and --level 0 reads the root only.
 ept=$tmp/ept
