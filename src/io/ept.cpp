@@ -25,7 +25,17 @@ using nlohmann::json;
 // The octree's depth is bounded by the coordinates' 64 bits; EPT writers stay far below.
 constexpr int kMaxDepth = 62;
 
+// ept.json and hierarchy files are small (Entwine splits large hierarchies into subtree
+// files); a parsed JSON document takes several times its bytes, so larger ones are refused.
+constexpr std::uint64_t kMaxJsonBytes = std::uint64_t{64} << 20;
+
 json parse_json_file(const fs::path& path) {
+  std::error_code error;
+  const std::uint64_t size = fs::file_size(path, error);
+  if (!error && size > kMaxJsonBytes)
+    throw FormatError(path.string(), std::nullopt,
+                      std::to_string(size) + " bytes of JSON, more than the " + std::to_string(kMaxJsonBytes >> 20) +
+                          " MiB an EPT metadata file may take here");
   const std::vector<std::uint8_t> bytes = read_file_bytes(path.string());
   try {
     return json::parse(bytes.begin(), bytes.end());

@@ -135,6 +135,10 @@ TEST(Ept, LyingHierarchiesAreRefusedNamingTheFile) {
   expect("{\"0-0-0-0\": -1}", "a loop of hierarchy files");  // the root names itself as its subtree
   expect("[1, 2]", "a hierarchy file must be one JSON object");
   expect("{\"0-0-0-0\": ", "not valid JSON");
+  // A hierarchy file too large to be one (sparse: no disk is spent) is refused unread.
+  write_text(root, "{}");
+  fs::resize_file(root, (std::uintmax_t{64} << 20) + 1);
+  EXPECT_NE(read_error(ept).find("bytes of JSON, more than the 64 MiB"), std::string::npos) << read_error(ept);
   // A subtree file that is not there.
   write_text(root, "{\"0-0-0-0\": 1, \"1-0-0-0\": -1}");
   EXPECT_NE(read_error(ept).find("1-0-0-0.json"), std::string::npos) << read_error(ept);
