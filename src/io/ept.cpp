@@ -53,7 +53,7 @@ std::array<std::uint64_t, 4> parse_key(const std::string& key, const fs::path& f
     const auto [next, error] = std::from_chars(at, end, k[static_cast<std::size_t>(i)]);
     if (error != std::errc{} || next == at || (i < 3 && (next == end || *next != '-')) || (i == 3 && next != end))
       throw FormatError(file.string(), std::nullopt, "'" + key + "' is not a node key D-X-Y-Z");
-    at = next + 1;
+    at = i < 3 ? next + 1 : next;
   }
   if (k[0] > kMaxDepth || k[1] >> k[0] || k[2] >> k[0] || k[3] >> k[0])
     throw FormatError(file.string(), std::nullopt, "node key '" + key + "' lies outside an octree of its depth");
