@@ -195,11 +195,9 @@ PointCloud binary_node(const std::string& file, const std::vector<Dimension>& di
   return cloud;
 }
 
-}  // namespace
-
-std::vector<EptNode> ept_nodes(const std::string& ept_json) {
+// The nodes with points of the dataset whose ept.json (at `ept_json`) is `ept`.
+std::vector<EptNode> nodes_of(const json& ept, const std::string& ept_json) {
   const fs::path root = fs::path(ept_json).parent_path();
-  const json ept = parse_json_file(ept_json);
   if (!ept.is_object() || !ept.contains("points") || !ept["points"].is_number_unsigned())
     throw FormatError(ept_json, std::nullopt, "ept.json states no point count (\"points\")");
   const std::uint64_t total = ept["points"].get<std::uint64_t>();
@@ -247,8 +245,8 @@ std::vector<EptNode> ept_nodes(const std::string& ept_json) {
   return out;
 }
 
-EptDataset ept_dataset(const std::string& ept_json) {
-  const json ept = parse_json_file(ept_json);
+// What the parsed ept.json `ept` (at `ept_json`) says of its dataset.
+EptDataset dataset_of(const json& ept, const std::string& ept_json) {
   if (!ept.is_object() || !ept.contains("dataType") || !ept["dataType"].is_string())
     throw FormatError(ept_json, std::nullopt, "not an EPT ept.json: no \"dataType\"");
   EptDataset d;
@@ -284,10 +282,16 @@ EptDataset ept_dataset(const std::string& ept_json) {
   return d;
 }
 
+}  // namespace
+
+std::vector<EptNode> ept_nodes(const std::string& ept_json) { return nodes_of(parse_json_file(ept_json), ept_json); }
+
+EptDataset ept_dataset(const std::string& ept_json) { return dataset_of(parse_json_file(ept_json), ept_json); }
+
 Input read_ept(const std::string& ept_json, const InputOptions& options) {
   const fs::path root = fs::path(ept_json).parent_path();
-  const json ept = parse_json_file(ept_json);
-  const EptDataset dataset = ept_dataset(ept_json);
+  const json ept = parse_json_file(ept_json);  // once: the dataset, the nodes and the schema all come from it
+  const EptDataset dataset = dataset_of(ept, ept_json);
   const std::string& type = dataset.data_type;
   if (type == "zstandard")
     throw FormatError(
@@ -301,7 +305,7 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
   in.format = "ept";
   in.wkt = dataset.wkt;
   in.epsg = dataset.epsg;
-  std::vector<EptNode> nodes = ept_nodes(ept_json);
+  std::vector<EptNode> nodes = nodes_of(ept, ept_json);
   if (options.copc_level) std::erase_if(nodes, [&](const EptNode& n) { return n.depth > *options.copc_level; });
   std::uint64_t done = 0, total = 0;
   for (const EptNode& n : nodes) total += n.points;
