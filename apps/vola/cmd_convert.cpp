@@ -40,7 +40,8 @@ ConvertOptions options_of(ConvertArgs& a) {
 }
 
 void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& report, double seconds) {
-  const auto in_bytes = std::filesystem::file_size(a.input);
+  // An EPT dataset is its node files, not its ept.json.
+  const std::uint64_t in_bytes = report.bytes_total.value_or(std::filesystem::file_size(a.input));
   const auto out_bytes = std::filesystem::file_size(a.output);
   const Frame frame = tree.frame();
   if (report.crs_wkt_only)
@@ -66,8 +67,9 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
               static_cast<unsigned long long>(out_bytes), a.output.c_str(), static_cast<unsigned long long>(in_bytes),
               ratio, smaller ? "smaller" : "larger");
   if (report.bytes_read && *report.bytes_read < in_bytes)
-    std::printf("input read:     %llu of its %llu bytes (COPC nodes outside the level or grid skipped)\n",
-                static_cast<unsigned long long>(*report.bytes_read), static_cast<unsigned long long>(in_bytes));
+    std::printf("input read:     %llu of its %llu bytes (%s nodes outside the level or grid skipped)\n",
+                static_cast<unsigned long long>(*report.bytes_read), static_cast<unsigned long long>(in_bytes),
+                report.format == "ept" ? "EPT" : "COPC");
   if (build.voxels)
     std::printf("bits per voxel: %.2f (occupied voxels)\n",
                 8.0 * static_cast<double>(out_bytes) / static_cast<double>(build.voxels));

@@ -94,6 +94,13 @@ void radix_sort(std::vector<Key>& keys, std::vector<std::uint32_t>* index, int k
 // voxel size the options leave open are derived from the box. Checks the options first.
 Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options);
 
+// Where a build can keep points when the options fix the grid before any point is read
+// (grid quantization with a bbox): the grid's cube, a voxel wider on every side for
+// rounding at its faces. Readers of spatially indexed files (COPC, EPT) skip the nodes
+// that miss it. Nothing when the grid comes from the points, or under toolkit
+// quantization, which clamps outside points onto the border voxels.
+std::optional<Box> grid_region(const BuildOptions& options);
+
 // The largest anchor + k x step (k whole) at or below `value`: a grid line of a lattice
 // through `anchor`. floor(value / step) x step alone can round above the value
 // (470692.44 at 0.01), which drops the points at the minimum.

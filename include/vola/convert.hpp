@@ -52,9 +52,10 @@ struct ConvertOptions {
   // Grid voxels in a geographic CRS (degrees of longitude and latitude by metres of
   // height, not cubes) are refused unless forced here or target_crs reprojects them.
   bool allow_geographic = false;
-  // COPC input: read only the octree's levels 0..level (0 = the root's points), a
+  // COPC and EPT input: read only the octree's levels 0..level (0 = the root's points), a
   // coarser sample of the cloud from a small part of the file. With a grid bbox, nodes
-  // outside the grid are skipped whatever the level.
+  // outside the grid are skipped whatever the level (EPT: unless filters or target_crs
+  // are given, since filters look around the window and reprojection moves the points).
   std::optional<int> level;
   // OpenVDB input: the grid to read (empty: the file's first); NumPy .npz input: the array
   // to read (empty: the only one, or the one named points, xyz, ...: io::npz_points_member).
@@ -101,9 +102,11 @@ struct ConvertReport {
   // crs_wkt_only when the input gave a WKT with no code for it.
   std::optional<std::uint32_t> epsg;
   bool crs_wkt_only = false;
-  // Bytes of the input read, when the reader counts them (LAS, LAZ, COPC): with a COPC
-  // file's --level or a grid bbox, less than the file.
+  // Bytes of the input read, when the reader counts them (LAS, LAZ, COPC, EPT): with
+  // --level or a grid bbox, less than the input's bytes_total (an EPT dataset's node
+  // files; otherwise the file's size, left empty).
   std::optional<std::uint64_t> bytes_read;
+  std::optional<std::uint64_t> bytes_total;
   // What a careful user should know about the result (a CRS relabelled, voxels in
   // degrees allowed or quantized by the toolkit): one sentence each, for the front end.
   std::vector<std::string> warnings;

@@ -47,6 +47,10 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (options.level && format.name != "las" && format.name != "ept")
     throw OptionError("level", "applies to COPC and EPT input only (" + path + " is " + format.name + ")");
   input.copc_level = options.level;
+  // A grid fixed by the bbox lets EPT skip the nodes it misses; filters (SMRF, outliers)
+  // see the points around the window, and reprojection moves them, so neither skips.
+  if (format.name == "ept" && options.filters.empty() && options.target_crs.empty())
+    input.region = grid_region(build_options(options, 2000));
   if (!options.grid.empty() && format.name != "vdb" && format.name != "npy")
     throw OptionError("grid", "applies to OpenVDB and .npz input only (" + path + " is " + format.name + ")");
   input.grid = options.grid;
@@ -250,6 +254,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.epsg = crs.epsg;
     report.crs_wkt_only = !crs.epsg && !input.wkt.empty();
     if (input.bytes_read) report.bytes_read = input.bytes_read();
+    if (input.bytes_total) report.bytes_total = input.bytes_total;
     report.warnings = crs_warnings(path, options, input, crs);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
     report.filters = std::move(filter_report);

@@ -141,7 +141,7 @@ void ConvertOptions::check() const {
   if (!filters.empty()) {
     filters::parse_stages(filters);  // throws OptionError("filters", ...) naming the stage
     if (nbits > 0) throw OptionError("filters", "cannot be combined with payload words (nbits); keep attributes instead");
-    if (level) throw OptionError("filters", "cannot be combined with a COPC level yet");
+    if (level) throw OptionError("filters", "cannot be combined with a COPC or EPT level yet");
   }
 }
 

@@ -340,6 +340,19 @@ Quantizer resolve_quantizer(const Box& bbox, const BuildOptions& options) {
   return quantizer;
 }
 
+std::optional<Box> grid_region(const BuildOptions& options) {
+  if (!options.bbox || options.quantization != Quantization::grid) return std::nullopt;
+  const Quantizer quantizer = resolve_quantizer(*options.bbox, options);
+  const Frame frame = quantizer.frame();
+  const double extent = frame.voxel_size * side_of(quantizer.depth());
+  Box region;
+  for (int a = 0; a < 3; ++a) {
+    region.min[a] = frame.origin[a] - frame.voxel_size;
+    region.max[a] = frame.origin[a] + extent + frame.voxel_size;
+  }
+  return region;
+}
+
 Tree build(const PointCloud& cloud, const BuildOptions& options, BuildReport* report) {
   const std::size_t n = cloud.size();
   if (cloud.xyz.size() != 3 * n) VOLA_THROW(InvalidArgument("point cloud: xyz size is not a multiple of 3"));

@@ -234,7 +234,7 @@ std::vector<EptNode> nodes_of(const json& ept, const std::string& ept_json) {
         throw FormatError(
             file.string(), std::nullopt,
             "the nodes hold more points than ept.json's " + std::to_string(total) + " (at node " + key + ")");
-      nodes.push_back({k, {key, static_cast<int>(k[0]), static_cast<std::uint64_t>(c)}});
+      nodes.push_back({k, {key, static_cast<int>(k[0]), {k[1], k[2], k[3]}, static_cast<std::uint64_t>(c)}});
     }
     if (seen.size() > (std::uint64_t{1} << 24))
       throw FormatError(file.string(), std::nullopt, "more than 2^24 nodes: not read");
@@ -288,6 +288,36 @@ std::vector<EptNode> ept_nodes(const std::string& ept_json) { return nodes_of(pa
 
 EptDataset ept_dataset(const std::string& ept_json) { return dataset_of(parse_json_file(ept_json), ept_json); }
 
+std::array<double, 6> ept_node_bounds(const EptDataset& dataset, const EptNode& node) {
+  std::array<double, 6> cube{};
+  const double parts = std::ldexp(1.0, node.depth);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double lo = dataset.bounds[a], hi = dataset.bounds[a + 3];
+    const double step = (hi - lo) / parts;
+    cube[a] = lo + static_cast<double>(node.place[a]) * step;
+    // The last cube along an axis ends at the dataset's own bound, not at a rounded sum.
+    cube[a + 3] =
+        node.place[a] + 1 == std::uint64_t{1} << node.depth ? hi : lo + static_cast<double>(node.place[a] + 1) * step;
+  }
+  return cube;
+}
+
+namespace {
+
+bool meets(const std::array<double, 6>& cube, const Box& box) {
+  for (std::size_t a = 0; a < 3; ++a)
+    if (cube[a] > box.max[a] || cube[a + 3] < box.min[a]) return false;
+  return true;
+}
+
+std::uint64_t size_or_zero(const fs::path& file) {
+  std::error_code error;
+  const std::uint64_t size = fs::file_size(file, error);
+  return error ? 0 : size;
+}
+
+}  // namespace
+
 Input read_ept(const std::string& ept_json, const InputOptions& options) {
   const fs::path root = fs::path(ept_json).parent_path();
   const json ept = parse_json_file(ept_json);  // once: the dataset, the nodes and the schema all come from it
@@ -306,12 +336,21 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
   in.wkt = dataset.wkt;
   in.epsg = dataset.epsg;
   std::vector<EptNode> nodes = nodes_of(ept, ept_json);
+  const auto file_of = [&](const EptNode& node) {
+    return (root / "ept-data" / (node.key + (type == "laszip" ? ".laz" : ".bin"))).string();
+  };
+  for (const EptNode& node : nodes) in.bytes_total += size_or_zero(file_of(node));
   if (options.copc_level) std::erase_if(nodes, [&](const EptNode& n) { return n.depth > *options.copc_level; });
-  std::uint64_t done = 0, total = 0;
+  const bool has_cube = dataset.bounds[0] < dataset.bounds[3] && dataset.bounds[1] < dataset.bounds[4] &&
+                        dataset.bounds[2] < dataset.bounds[5];
+  if (options.region && has_cube)  // without a cube of its own, no node can be placed: all are read
+    std::erase_if(nodes, [&](const EptNode& n) { return !meets(ept_node_bounds(dataset, n), *options.region); });
+  std::uint64_t done = 0, total = 0, bytes_read = 0;
   for (const EptNode& n : nodes) total += n.points;
   bool first = true;
   for (const EptNode& node : nodes) {
-    const std::string file = (root / "ept-data" / (node.key + (type == "laszip" ? ".laz" : ".bin"))).string();
+    const std::string file = file_of(node);
+    bytes_read += size_or_zero(file);
     PointCloud cloud;
     if (type == "laszip") {
       InputOptions one = options;
@@ -333,6 +372,7 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
     done += node.points;
     if (options.progress) options.progress(done, total);
   }
+  in.bytes_read = [bytes_read] { return bytes_read; };
   return in;
 }
 

@@ -373,19 +373,10 @@ std::optional<Tree> occupancy_in_one_pass(LasReader& reader, const BuildOptions&
 namespace {
 
 // COPC in grid mode with a given bbox: the grid is known before any point is read, and a
-// node whose cube misses it holds only points the grid drops, so it is never read. (The
-// toolkit's rule clamps outside points onto the border voxels: nothing can be skipped.)
+// node whose cube misses it holds only points the grid drops, so it is never read.
 void skip_copc_nodes_outside_the_grid(LasReader& reader, const BuildOptions& requested) {
-  if (!reader.header().copc || !requested.bbox || requested.quantization != Quantization::grid) return;
-  const Quantizer quantizer = resolve_quantizer(*requested.bbox, requested);
-  const Frame frame = quantizer.frame();
-  const double extent = frame.voxel_size * side_of(quantizer.depth());
-  Box grid;
-  for (int a = 0; a < 3; ++a) {
-    grid.min[a] = frame.origin[a] - frame.voxel_size;  // a voxel of margin for rounding at the faces
-    grid.max[a] = frame.origin[a] + extent + frame.voxel_size;
-  }
-  reader.select_copc_nodes(grid, reader.copc_level());
+  if (!reader.header().copc) return;
+  if (const std::optional<Box> region = grid_region(requested)) reader.select_copc_nodes(region, reader.copc_level());
 }
 
 }  // namespace

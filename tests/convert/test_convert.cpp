@@ -576,4 +576,47 @@ TEST(Convert, ValuesAnIntegerAttributeCannotHoldAreSaid) {
   }
 }
 
+// An EPT dataset converted on a grid its bbox fixes: the nodes whose cube misses the grid
+// are not read (the report's bytes say so), and the voxels are those of the whole read.
+TEST(Convert, AGridBboxSkipsTheEptNodesOutsideIt) {
+  const vola_test::TempDir dir;
+  const auto text = [&](const std::filesystem::path& path, const std::string& content) {
+    std::filesystem::create_directories(path.parent_path());
+    std::ofstream(path, std::ios::binary) << content;
+  };
+  text(dir / "ept.json",
+       "{\"bounds\": [0, 0, 0, 8, 8, 8], \"dataType\": \"binary\", \"hierarchyType\": \"json\", \"points\": 3, "
+       "\"schema\": [{\"name\": \"X\", \"size\": 8, \"type\": \"float\"}, {\"name\": \"Y\", \"size\": 8, \"type\": "
+       "\"float\"}, {\"name\": \"Z\", \"size\": 8, \"type\": \"float\"}], \"span\": 128, \"version\": \"1.0.0\"}");
+  text(dir / "ept-hierarchy" / "0-0-0-0.json", "{\"0-0-0-0\": 1, \"1-0-0-0\": 1, \"1-1-1-1\": 1}");
+  for (const auto& [key, at] : {std::pair{"0-0-0-0", 1.0}, std::pair{"1-0-0-0", 2.0}, std::pair{"1-1-1-1", 6.0}}) {
+    std::string record;
+    for (int a = 0; a < 3; ++a) record.append(reinterpret_cast<const char*>(&at), sizeof at);
+    text(dir / "ept-data" / (std::string(key) + ".bin"), record);
+  }
+  const std::string ept = (dir / "ept.json").string();
+  vola::ConvertOptions options;
+  options.voxel_size = 0.5;
+  options.bbox = vola::Box{{5, 5, 5}, {7, 7, 7}};
+  vola::ConvertReport window;
+  const vola::Tree tree = vola::convert(ept, options, {}, &window);
+  ASSERT_TRUE(window.bytes_read && window.bytes_total);
+  EXPECT_EQ(*window.bytes_read, 48u);  // the root and 1-1-1-1
+  EXPECT_EQ(*window.bytes_total, 72u);
+  EXPECT_EQ(window.build.points_in, 2u);
+  // The same grid with a filter reads every node (filters see the points around the window).
+  options.filters = {"where:Z >= 0"};
+  vola::ConvertReport whole;
+  const vola::Tree same = vola::convert(ept, options, {}, &whole);
+  EXPECT_EQ(whole.build.points_in, 3u);
+  const auto voxels = [](const vola::Tree& t) {
+    std::vector<vola::Voxel> out;
+    t.for_each_voxel([&](const vola::Voxel& v) { out.push_back(v); });
+    return out;
+  };
+  EXPECT_EQ(tree.voxel_count(), 1u);
+  EXPECT_EQ(voxels(tree), voxels(same));
+  EXPECT_EQ(tree.frame(), same.frame());
+}
+
 }  // namespace

@@ -115,6 +115,53 @@ TEST(Ept, BinaryNodesFollowTheSchema) {
       << read_error(dir / "ept.json");
 }
 
+// Three binary nodes of one point each: the root (its cube the dataset's, 0..8), 1-0-0-0
+// (0..4 along each axis) and 1-1-1-1 (4..8). A region inside the upper octant reads the
+// root and 1-1-1-1 only; the bytes read say so.
+TEST(Ept, ARegionReadsOnlyTheNodesWhoseCubeMeetsIt) {
+  vola_test::TempDir dir;
+  const std::string schema =
+      "[{\"name\": \"X\", \"size\": 8, \"type\": \"float\"}, {\"name\": \"Y\", \"size\": 8, \"type\": \"float\"},"
+      " {\"name\": \"Z\", \"size\": 8, \"type\": \"float\"}]";
+  write_text(dir / "ept.json", ept_json("binary", 3, schema));
+  write_text(dir / "ept-hierarchy" / "0-0-0-0.json", "{\"0-0-0-0\": 1, \"1-0-0-0\": 1, \"1-1-1-1\": 1}");
+  const auto node = [&](const std::string& key, double at) {
+    Bytes record;
+    for (int a = 0; a < 3; ++a) put<double>(record, at);
+    fs::create_directories(dir / "ept-data");
+    vola_test::write_bytes(dir / "ept-data" / (key + ".bin"), record);
+  };
+  node("0-0-0-0", 1.0);
+  node("1-0-0-0", 2.0);
+  node("1-1-1-1", 6.0);
+  const std::string ept = (dir / "ept.json").string();
+  const vola::io::EptDataset dataset = vola::io::ept_dataset(ept);
+  const auto nodes = vola::io::ept_nodes(ept);
+  ASSERT_EQ(nodes.size(), 3u);
+  EXPECT_EQ(vola::io::ept_node_bounds(dataset, nodes[0]), (std::array<double, 6>{0, 0, 0, 8, 8, 8}));
+  EXPECT_EQ(vola::io::ept_node_bounds(dataset, nodes[1]), (std::array<double, 6>{0, 0, 0, 4, 4, 4}));
+  EXPECT_EQ(vola::io::ept_node_bounds(dataset, nodes[2]), (std::array<double, 6>{4, 4, 4, 8, 8, 8}));
+
+  const vola::io::Input all = vola::io::read_input(ept, "auto", {});
+  EXPECT_EQ(all.cloud.xyz, (std::vector<double>{1, 1, 1, 2, 2, 2, 6, 6, 6}));
+  EXPECT_EQ(all.bytes_total, 72u);
+  ASSERT_TRUE(all.bytes_read);
+  EXPECT_EQ(all.bytes_read(), 72u);
+
+  vola::io::InputOptions options;
+  options.region = vola::Box{{4.5, 4.5, 4.5}, {7, 7, 7}};
+  const vola::io::Input window = vola::io::read_input(ept, "auto", options);
+  EXPECT_EQ(window.cloud.xyz, (std::vector<double>{1, 1, 1, 6, 6, 6}));  // the root's point is not in it: the root is
+  EXPECT_EQ(window.bytes_total, 72u);
+  EXPECT_EQ(window.bytes_read(), 48u);
+  // A region touching the face between the octants reads both (Entwine's cubes are closed).
+  options.region = vola::Box{{4, 4, 4}, {4, 4, 4}};
+  EXPECT_EQ(vola::io::read_input(ept, "auto", options).cloud.size(), 3u);
+  // With the level too, the root alone.
+  options.copc_level = 0;
+  EXPECT_EQ(vola::io::read_input(ept, "auto", options).cloud.xyz, (std::vector<double>{1, 1, 1}));
+}
+
 TEST(Ept, LyingHierarchiesAreRefusedNamingTheFile) {
   vola_test::TempDir dir;
   const fs::path ept = dir / "ept.json";

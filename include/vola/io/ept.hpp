@@ -15,11 +15,12 @@
 
 namespace vola::io {
 
-// One node of the octree with points: its key "D-X-Y-Z", its depth D and the count the
-// hierarchy states.
+// One node of the octree with points: its key "D-X-Y-Z", its depth D, its place X, Y, Z
+// among the 2^D cubes along each axis and the count the hierarchy states.
 struct EptNode {
   std::string key;
   int depth = 0;
+  std::array<std::uint64_t, 3> place{0, 0, 0};
   std::uint64_t points = 0;
 };
 
@@ -43,9 +44,15 @@ EptDataset ept_dataset(const std::string& ept_json);
 // total past ept.json's "points".
 std::vector<EptNode> ept_nodes(const std::string& ept_json);
 
+// The cube of `node` inside the dataset's (bounds cut in 2^depth along each axis): min
+// x y z, max x y z. Entwine keeps every point of a node inside its cube.
+std::array<double, 6> ept_node_bounds(const EptDataset& dataset, const EptNode& node);
+
 // Every node's points in one cloud (attributes as the LAS reader names them; binary
 // nodes' dimensions named as text columns are), the CRS from "srs"; with
-// options.copc_level, only the nodes of depth 0..level (a coarser sample, as for COPC).
+// options.copc_level, only the nodes of depth 0..level (a coarser sample, as for COPC);
+// with options.region, only the nodes whose cube meets it. Input::bytes_read counts the
+// node files' bytes read, Input::bytes_total those of every node file.
 // A node whose file holds another number of points than the hierarchy states is an error
 // naming the file.
 Input read_ept(const std::string& ept_json, const InputOptions& options);

@@ -25,7 +25,11 @@ struct InputOptions {
   std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
-  std::optional<int> copc_level;   // COPC: only the octree's levels 0..copc_level
+  std::optional<int> copc_level;   // COPC and EPT: only the octree's levels 0..copc_level
+  // EPT: nodes whose cube misses this box are not read (vola convert passes the grid's
+  // region, vola::grid_region, when a bbox fixes the grid); points outside it may still
+  // come back from the nodes that are read.
+  std::optional<Box> region;
   std::string grid;                // OpenVDB: the grid to read (empty: the only one, or vola's own occupied grid);
                                    // .npz: the array to read (empty: npz_points_member's choice)
 };
@@ -58,8 +62,11 @@ struct Input {
   // Points the reader left out for a coordinate that is not finite (a PCD organized
   // cloud's missing points), so that counts of the file's points stay true.
   std::uint64_t not_finite = 0;
-  // Readers that can skip parts of a file (COPC) say how many bytes they read so far.
+  // Readers that can skip parts of a file (COPC, EPT) say how many bytes they read so far,
+  // and, when the input is more than the file named (EPT: its node files), the bytes of
+  // the whole input (0: the named file's size).
   std::function<std::uint64_t()> bytes_read;
+  std::uint64_t bytes_total = 0;
   // Height fields (DEM): `cloud` holds one point per cell centre at the cell's height,
   // each to become a column of voxels down (or up) to terrain_base, or only the voxel
   // of its height when terrain_surface_only.
