@@ -17,6 +17,7 @@
 #include "vola/crs_rules.hpp"
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
+#include "vola/io/e57.hpp"
 #include "vola/io/ept.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
@@ -83,12 +84,16 @@ ordered_json xyz_at(const double* v, const double* scale) {
 void print_compression(const io::LasHeader& hd) {
   const auto& z = *hd.laszip;
   const char* kinds[] = {"none", "point-wise", "point-wise chunked", "layered chunked"};
-  std::printf("laz:         compressor %u (%s), LASzip %u.%u r%u, ", z.compressor, z.compressor <= 3 ? kinds[z.compressor] : "?",
-              z.version_major, z.version_minor, z.revision);
-  if (z.compressor == 1) std::printf("one stream, not chunked");  // its chunk size field means nothing
-  else if (z.chunk_size == io::laz::kVariableChunkSize) std::printf("variable chunks");
-  else if (z.chunk_size == 0) std::printf("chunk size 0 (one chunk of every point)");
-  else std::printf("chunks of %u points", z.chunk_size);
+  std::printf("laz:         compressor %u (%s), LASzip %u.%u r%u, ", z.compressor,
+              z.compressor <= 3 ? kinds[z.compressor] : "?", z.version_major, z.version_minor, z.revision);
+  if (z.compressor == 1)
+    std::printf("one stream, not chunked");  // its chunk size field means nothing
+  else if (z.chunk_size == io::laz::kVariableChunkSize)
+    std::printf("variable chunks");
+  else if (z.chunk_size == 0)
+    std::printf("chunk size 0 (one chunk of every point)");
+  else
+    std::printf("chunks of %u points", z.chunk_size);
   if (z.compressor != 1) std::printf(", %zu chunk%s", hd.laz_chunks.size(), hd.laz_chunks.size() == 1 ? "" : "s");
   std::printf("\nitems:      ");
   for (const auto& item : z.items) std::printf(" %s", io::laz::describe_item(item).c_str());
@@ -105,10 +110,10 @@ void print_copc(const io::CopcHierarchy& copc) {
     ++nodes_per_level[static_cast<std::size_t>(n.level)];
   }
   const auto& i = copc.info;
-  std::printf("copc:        octree of %d levels, %zu nodes with points (%llu points), %zu hierarchy pages\n", copc.levels,
-              copc.nodes.size(), static_cast<unsigned long long>(points), copc.pages);
-  std::printf("             cube centre (%.9g, %.9g, %.9g), half size %.9g, root spacing %.9g\n", i.center[0], i.center[1],
-              i.center[2], i.halfsize, i.spacing);
+  std::printf("copc:        octree of %d levels, %zu nodes with points (%llu points), %zu hierarchy pages\n",
+              copc.levels, copc.nodes.size(), static_cast<unsigned long long>(points), copc.pages);
+  std::printf("             cube centre (%.9g, %.9g, %.9g), half size %.9g, root spacing %.9g\n", i.center[0],
+              i.center[1], i.center[2], i.halfsize, i.spacing);
   for (std::size_t l = 0; l < per_level.size(); ++l)
     std::printf("             level %zu: %zu nodes, %llu points, spacing %.6g\n", l, nodes_per_level[l],
                 static_cast<unsigned long long>(per_level[l]), i.spacing / static_cast<double>(std::uint64_t{1} << l));
@@ -123,11 +128,16 @@ ordered_json copc_json(const io::CopcHierarchy& copc) {
     ++nodes_per_level[static_cast<std::size_t>(n.level)];
   }
   for (std::size_t l = 0; l < per_level.size(); ++l)
-    levels.push_back({{"level", l}, {"nodes", nodes_per_level[l]}, {"points", per_level[l]},
+    levels.push_back({{"level", l},
+                      {"nodes", nodes_per_level[l]},
+                      {"points", per_level[l]},
                       {"spacing", copc.info.spacing / static_cast<double>(std::uint64_t{1} << l)}});
-  return {{"levels", copc.levels},       {"nodes", copc.nodes.size()},
-          {"pages", copc.pages},         {"center", xyz(copc.info.center.data())},
-          {"halfsize", copc.info.halfsize}, {"spacing", copc.info.spacing},
+  return {{"levels", copc.levels},
+          {"nodes", copc.nodes.size()},
+          {"pages", copc.pages},
+          {"center", xyz(copc.info.center.data())},
+          {"halfsize", copc.info.halfsize},
+          {"spacing", copc.info.spacing},
           {"per_level", std::move(levels)}};
 }
 
@@ -185,7 +195,9 @@ ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr
   return out;
 }
 
-void print_json(const ordered_json& doc) { std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str()); }
+void print_json(const ordered_json& doc) {
+  std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+}
 
 // For a DEM in degrees, WGS 84's UTM zone (its EPSG code) at the centre of its cells;
 // otherwise 0. vola convert refuses voxels of degrees and reprojects only points, so such
@@ -243,8 +255,10 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
     print_json(doc);
     return;
   }
-  if (in.format == kind) std::printf("file:        %s (%s)\n", path.c_str(), kind);
-  else std::printf("file:        %s (%s, a %s)\n", path.c_str(), in.format.c_str(), kind);
+  if (in.format == kind)
+    std::printf("file:        %s (%s)\n", path.c_str(), kind);
+  else
+    std::printf("file:        %s (%s, a %s)\n", path.c_str(), in.format.c_str(), kind);
   if (in.is_mesh()) {
     // Mesh readers keep lone vertices (an OBJ of "v" lines alone) as triangles of one point.
     const auto points = static_cast<std::size_t>(std::count_if(
@@ -258,8 +272,9 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
   }
   if (in.grid) {
     const io::VoxelGrid& g = *in.grid;
-    std::printf("grid:        %u x %u x %u cells of %.9g, origin (%.9g, %.9g, %.9g)%s\n", g.dims[0], g.dims[1], g.dims[2],
-                g.voxel_size, g.origin[0], g.origin[1], g.origin[2], g.fixed_voxel_size ? ", the map's own cells" : "");
+    std::printf("grid:        %u x %u x %u cells of %.9g, origin (%.9g, %.9g, %.9g)%s\n", g.dims[0], g.dims[1],
+                g.dims[2], g.voxel_size, g.origin[0], g.origin[1], g.origin[2],
+                g.fixed_voxel_size ? ", the map's own cells" : "");
     std::printf("occupied:    %zu cells\n", g.voxels.size());
     std::printf("columns:    ");
     for (const auto& a : g.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
@@ -282,6 +297,37 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
 
 }  // namespace
 
+// An E57 file's scans as its XML states them: name, records, pose, fields.
+ordered_json e57_json(const io::E57Summary& e) {
+  ordered_json scans = ordered_json::array();
+  for (const io::E57Scan& s : e.scans) {
+    ordered_json pose = nullptr;
+    if (s.has_pose)
+      pose = {{"rotation_wxyz", {s.rotation[0], s.rotation[1], s.rotation[2], s.rotation[3]}},
+              {"translation", {s.translation[0], s.translation[1], s.translation[2]}}};
+    scans.push_back({{"name", s.name}, {"records", s.records}, {"pose", pose}, {"fields", s.fields}});
+  }
+  return {{"version", std::to_string(e.version_major) + "." + std::to_string(e.version_minor)},
+          {"library", e.library},
+          {"scans", std::move(scans)},
+          {"images", e.images}};
+}
+
+void print_e57_scans(const io::E57Summary& e) {
+  std::printf("e57:         version %u.%u%s%s, %zu scan%s, %llu image%s (not read)\n", e.version_major, e.version_minor,
+              e.library.empty() ? "" : ", written by ", e.library.c_str(), e.scans.size(),
+              e.scans.size() == 1 ? "" : "s", static_cast<unsigned long long>(e.images), e.images == 1 ? "" : "s");
+  for (const io::E57Scan& s : e.scans) {
+    std::printf("scan:        '%s': %llu records", s.name.c_str(), static_cast<unsigned long long>(s.records));
+    if (s.has_pose)
+      std::printf(", pose: rotation (w x y z) %.9g %.9g %.9g %.9g, translation %.9g %.9g %.9g", s.rotation[0],
+                  s.rotation[1], s.rotation[2], s.rotation[3], s.translation[0], s.translation[1], s.translation[2]);
+    std::printf("\n             fields:");
+    for (const auto& f : s.fields) std::printf(" %s", f.c_str());
+    std::printf("\n");
+  }
+}
+
 void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part) {
   io::InputOptions options;
   options.attributes = true;
@@ -293,26 +339,35 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
   }
   const io::Input in = io::read_input(path, "auto", options);
   if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json, part);
+  const bool e57 = in.format == "e57";
   if (json) {
-    ordered_json doc = {{"file", path}, {"format", in.format}, {"points", in.cloud.size()},
-                        {"points_not_finite", in.not_finite}, {"crs", crs_json(in.wkt, in.epsg)}};
+    ordered_json doc = {{"file", path},
+                        {"format", in.format},
+                        {"points", in.cloud.size()},
+                        {"points_not_finite", in.not_finite},
+                        {"crs", crs_json(in.wkt, in.epsg)}};
     ordered_json dimensions = ordered_json::array();
     for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
     doc["dimensions"] = std::move(dimensions);
+    if (e57) doc["e57"] = e57_json(io::e57_summary(path));
     if (summary) doc["summary"] = summary_json(in.cloud);
     print_json(doc);
     return;
   }
   std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
   std::printf("points:      %zu", in.cloud.size());
-  // An organized cloud (PCD) holds its missing points as NaN: say how many were left out.
+  // An organized cloud (PCD) holds its missing points as NaN, an E57 scan marks them
+  // invalid: say how many were left out.
   if (in.not_finite > 0)
-    std::printf(" (and %llu with a coordinate that is not a number, left out)",
+    std::printf(e57 ? " (and %llu the scanner marked invalid, left out)"
+                    : " (and %llu with a coordinate that is not a number, left out)",
                 static_cast<unsigned long long>(in.not_finite));
   std::printf("\n");
+  if (e57) print_e57_scans(io::e57_summary(path));
   std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());
   std::printf("columns:    ");
-  for (const auto& a : in.cloud.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
+  for (const auto& a : in.cloud.attributes)
+    std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
   std::printf("%s\n", in.cloud.attributes.empty() ? " none" : "");
   // Text columns without names are not read: say so rather than let them vanish.
   if (in.format == "text" && in.cloud.attributes.empty()) {
@@ -393,7 +448,9 @@ namespace {
 void print_las_json(io::LasReader& reader, const std::string& path, bool summary) {
   const io::LasHeader& hd = reader.header();
   ordered_json doc = {{"file", path},
-                      {"format", hd.copc ? "COPC" : hd.compressed() ? "LAZ" : "LAS"},
+                      {"format", hd.copc           ? "COPC"
+                                 : hd.compressed() ? "LAZ"
+                                                   : "LAS"},
                       {"version", hd.version()},
                       {"software", hd.generating_software},
                       {"system", hd.system_identifier},
@@ -408,20 +465,24 @@ void print_las_json(io::LasReader& reader, const std::string& path, bool summary
                         {"max", xyz_at(hd.max.data(), hd.scale.data())},
                         {"source", "header"}}}};
   ordered_json dimensions = ordered_json::array();
-  for (const auto& spec : io::las_attributes(hd)) dimensions.push_back({{"name", spec.name}, {"type", name_of(spec.type)}});
+  for (const auto& spec : io::las_attributes(hd))
+    dimensions.push_back({{"name", spec.name}, {"type", name_of(spec.type)}});
   doc["dimensions"] = std::move(dimensions);
   ordered_json vlrs = ordered_json::array();
   for (const auto& v : hd.vlrs)
-    vlrs.push_back({{"user_id", v.user_id}, {"record_id", v.record_id}, {"bytes", v.length},
-                    {"extended", v.extended}, {"description", v.description}});
+    vlrs.push_back({{"user_id", v.user_id},
+                    {"record_id", v.record_id},
+                    {"bytes", v.length},
+                    {"extended", v.extended},
+                    {"description", v.description}});
   doc["vlrs"] = std::move(vlrs);
   if (hd.compressed()) {
     const auto& z = *hd.laszip;
     ordered_json items = ordered_json::array();
     for (const auto& item : z.items) items.push_back(io::laz::describe_item(item));
     doc["laz"] = {{"compressor", z.compressor},
-                  {"chunk_size", z.chunk_size == io::laz::kVariableChunkSize ? ordered_json("variable")
-                                                                             : ordered_json(z.chunk_size)},
+                  {"chunk_size",
+                   z.chunk_size == io::laz::kVariableChunkSize ? ordered_json("variable") : ordered_json(z.chunk_size)},
                   {"chunks", hd.laz_chunks.size()},
                   {"items", std::move(items)}};
   }
@@ -436,15 +497,18 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
   io::LasReader reader(path);
   if (json) return print_las_json(reader, path, summary);
   const io::LasHeader& hd = reader.header();
-  std::printf("file:        %s (%s %s)\n", path.c_str(), hd.copc ? "COPC" : hd.compressed() ? "LAZ" : "LAS",
+  std::printf("file:        %s (%s %s)\n", path.c_str(),
+              hd.copc           ? "COPC"
+              : hd.compressed() ? "LAZ"
+                                : "LAS",
               hd.version().c_str());
   std::printf("software:    %s%s%s\n", hd.generating_software.c_str(), hd.system_identifier.empty() ? "" : ", system ",
               hd.system_identifier.c_str());
-  std::printf("points:      %llu, point format %u, %u bytes a record\n", static_cast<unsigned long long>(hd.point_count),
-              hd.point_format, hd.record_length);
+  std::printf("points:      %llu, point format %u, %u bytes a record\n",
+              static_cast<unsigned long long>(hd.point_count), hd.point_format, hd.record_length);
   std::printf("crs:         %s\n", crs_text(crs_definition(hd.wkt, hd.epsg)).c_str());
-  std::printf("scale:       %.9g %.9g %.9g, offset %.9g %.9g %.9g\n", hd.scale[0], hd.scale[1], hd.scale[2], hd.offset[0],
-              hd.offset[1], hd.offset[2]);
+  std::printf("scale:       %.9g %.9g %.9g, offset %.9g %.9g %.9g\n", hd.scale[0], hd.scale[1], hd.scale[2],
+              hd.offset[0], hd.offset[1], hd.offset[2]);
   std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the header's)\n", hd.min[0],
               hd.min[1], hd.min[2], hd.max[0], hd.max[1], hd.max[2]);
   for (const auto& f : hd.extra_fields) std::printf("extra bytes: %s (type %u)\n", f.name.c_str(), f.data_type);

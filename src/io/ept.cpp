@@ -13,6 +13,7 @@
 #include "column_names.hpp"
 #include "file_bytes.hpp"
 #include "vola/error.hpp"
+#include "vola/io/las.hpp"
 #include "vola/little_endian.hpp"
 
 namespace vola::io {
@@ -353,13 +354,9 @@ Input read_ept(const std::string& ept_json, const InputOptions& options) {
     bytes_read += size_or_zero(file);
     PointCloud cloud;
     if (type == "laszip") {
-      InputOptions one = options;
-      one.stream = false;
-      one.progress = nullptr;
-      one.copc_level.reset();  // the dataset's levels, not the node's (a node is no COPC file)
-      Input las = read_input(file, "las", one);
-      cloud = std::move(las.cloud);
-      if (in.wkt.empty() && !in.epsg) in.wkt = las.wkt, in.epsg = las.epsg;
+      LasReader las(file);  // every node whole: the dataset's levels, not a node's (a node is no COPC file)
+      cloud = las_points(las, options.attributes, options.payload, nullptr);
+      if (in.wkt.empty() && !in.epsg) in.wkt = las.header().wkt, in.epsg = las.header().epsg;
     } else {
       cloud = binary_node(file, dims, node.points, options);
     }

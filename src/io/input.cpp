@@ -10,6 +10,7 @@
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/dem.hpp"
+#include "vola/io/e57.hpp"
 #include "vola/io/ept.hpp"
 #include "vola/io/file_checks.hpp"
 #include "vola/io/kitti.hpp"
@@ -166,6 +167,10 @@ std::vector<InputFormat> make_formats() {
        read_octomap_input},
       {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
       {"ept", {".json"}, "Entwine Point Tiles: the ept.json of a local EPT folder (laszip or binary data)", read_ept},
+      {"e57",
+       {".e57"},
+       "ASTM E57 scans (terrestrial scanners): cartesian or spherical points, each scan's pose, colour, intensity",
+       read_e57},
   };
 }
 

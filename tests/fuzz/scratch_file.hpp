@@ -23,7 +23,7 @@ class ScratchFiles {
   ~ScratchFiles() {
     for (const auto& path : paths_) {
       std::error_code ignored;
-      std::filesystem::remove(path, ignored);
+      std::filesystem::remove_all(path, ignored);  // a file, or a scratch folder (fuzz_ept_read)
     }
   }
   void add(const std::string& path) { paths_.insert(path); }

@@ -4,9 +4,11 @@
 # header bounds at the file's precision and the points per class (--summary reads them);
 # for PLY/PCD/KITTI files, the count; for a mesh, a voxel grid and a DEM, their size and
 # bounds. A file of the wrong kind gets a clear message.
-# Usage: cli_info_json.sh VOLA SHARED_DATA_DIR   ($VOLA_SHARED/data, when set, wins)
+# E57 files come from E57_WRITER (fuzz_e57_read_replay --write-corpus: files written by
+# tests/io/e57_test_file.hpp), when given.
+# Usage: cli_info_json.sh VOLA SHARED_DATA_DIR [E57_WRITER]   ($VOLA_SHARED/data, when set, wins)
 set -euo pipefail
-vola=$1 data=${VOLA_SHARED:+$VOLA_SHARED/data}
+vola=$1 e57_writer=${3:-} data=${VOLA_SHARED:+$VOLA_SHARED/data}
 data=${data:-$2}
 source "$(dirname "$0")/../lib/cli_test.sh"
 [ -f "$data/EXPECTED.txt" ] || skip "no $data/EXPECTED.txt (set VOLA_SHARED)"
@@ -160,4 +162,25 @@ assert d['summary']['points_read'] == 2130 and d['crs']['epsg'] == 32610, d
 "$vola" convert "$data/laz/laspy_simple.laz" "$tmp/simple.vol" --voxel-size 1 -q || fail "convert laspy_simple.laz"
 "$vola" coords "$tmp/ept_root.vol" 2>/dev/null | cmp -s - <("$vola" coords "$tmp/simple.vol" 2>/dev/null) ||
   fail "EPT --level 0: not the root node's voxels"
+
+# E57: the scans as the XML states them, invalid points said, and a conversion of the points.
+if [ -n "$e57_writer" ]; then
+  "$e57_writer" --write-corpus "$tmp/e57" > /dev/null || fail "could not write the E57 files"
+  "$vola" info "$tmp/e57/spherical_pose.e57" > "$tmp/e57_info.txt" || fail "info on an E57 file failed"
+  grep -q "^points: *2 (and 2 the scanner marked invalid, left out)$" "$tmp/e57_info.txt" ||
+    fail "E57 info: $(cat "$tmp/e57_info.txt")"
+  grep -q "^scan: *'spherical': 4 records, pose: rotation (w x y z) 0.70710678" "$tmp/e57_info.txt" ||
+    fail "E57 info scans: $(cat "$tmp/e57_info.txt")"
+  "$vola" info --json --summary "$tmp/e57/two_scans.e57" > "$tmp/e57.json" || fail "info --json on an E57 file failed"
+  "${VOLA_PYTHON:-python3}" -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['format'] == 'e57' and d['points'] == 41, d
+assert [s['records'] for s in d['e57']['scans']] == [40, 1], d
+assert [c['name'] for c in d['dimensions']] == ['intensity'], d  # the only field both scans have
+assert d['summary']['points_read'] == 41, d
+" "$tmp/e57.json" || fail "E57 info --json: $(cat "$tmp/e57.json")"
+  "$vola" convert "$tmp/e57/typed.e57" "$tmp/typed.vol" --voxel-size 0.5 -q || fail "convert an E57 file"
+  "$vola" info "$tmp/typed.vol" | grep -q "red" || fail "E57 colours not kept: $("$vola" info "$tmp/typed.vol")"
+fi
 echo "cli_info_json: OK ($checked LAS/LAZ files)"
