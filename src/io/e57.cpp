@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <span>
 
 #include "column_names.hpp"
 #include "e57_pages.hpp"
@@ -187,10 +188,69 @@ E57Parsed parse_e57(E57Pages& pages) {
   return p;
 }
 
-// Each field's bytestream of one scan, gathered from its data packets: the fields asked
-// for (`wanted`), each up to the bytes its records take.
-std::vector<std::vector<std::uint8_t>> read_bytestreams(E57Pages& pages, const E57ScanData& s,
-                                                        const std::vector<bool>& wanted) {
+// One field's bytestream, fed packet by packet and read a batch of records at a time:
+// little-endian floats, or integers packed `bits` to a record from the least significant
+// bit of each byte, stored less the minimum. A record's bits may start in one packet and
+// end in the next.
+class FieldStream {
+ public:
+  explicit FieldStream(const E57Field& field) : f_(field) {}
+
+  void append(std::span<const std::uint8_t> bytes) {
+    const std::size_t consumed = static_cast<std::size_t>(bit_ >> 3);  // whole bytes read: dropped
+    bytes_.erase(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(consumed));
+    bit_ &= 7;
+    bytes_.insert(bytes_.end(), bytes.begin(), bytes.end());
+  }
+
+  // Records whose bits are all here (a constant field: any number).
+  std::uint64_t available() const {
+    if (f_.bits == 0) return std::numeric_limits<std::uint64_t>::max();
+    return (8 * static_cast<std::uint64_t>(bytes_.size()) - bit_) / static_cast<std::uint64_t>(f_.bits);
+  }
+
+  // The next `n` values (n <= available()).
+  void take(std::uint64_t n, std::vector<double>& out) {
+    out.resize(static_cast<std::size_t>(n));
+    const std::uint64_t mask = f_.bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << f_.bits) - 1;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (f_.kind == E57Field::Kind::floating) {
+        const std::uint8_t* at = bytes_.data() + (bit_ >> 3);
+        out[i] = f_.float_bytes == 4 ? static_cast<double>(load_le<float>(at)) : load_le<double>(at);
+      } else {
+        const auto value = static_cast<std::int64_t>(raw(mask) + static_cast<std::uint64_t>(f_.minimum));  // wraps
+        out[i] = f_.kind == E57Field::Kind::scaled ? static_cast<double>(value) * f_.scale + f_.offset
+                                                   : static_cast<double>(value);
+      }
+      bit_ += static_cast<std::uint64_t>(f_.bits);
+    }
+  }
+
+ private:
+  // The record at bit_: up to 64 bits from the (at most 9) bytes holding them.
+  std::uint64_t raw(std::uint64_t mask) const {
+    if (f_.bits == 0) return 0;
+    const std::size_t byte = static_cast<std::size_t>(bit_ >> 3);
+    const int shift = static_cast<int>(bit_ & 7);
+    std::uint8_t word[16] = {};
+    std::memcpy(word, bytes_.data() + byte, std::min<std::size_t>(16, bytes_.size() - byte));
+    std::uint64_t v = load_le<std::uint64_t>(word) >> shift;
+    if (shift + f_.bits > 64) v |= static_cast<std::uint64_t>(word[8]) << (64 - shift);
+    return v & mask;
+  }
+
+  const E57Field& f_;
+  std::vector<std::uint8_t> bytes_;
+  std::uint64_t bit_ = 0;  // the next record's first bit in bytes_
+};
+
+// Calls `on_packet(streams, physical)` with each data packet's bytestreams (one per
+// prototype field, in order), in file order, until it returns false; index and empty
+// packets are passed over. Checks the section header and that the section can hold the
+// scan's records (every record's bits, or one record a byte when every field is
+// constant), so that no count allocates more than the file justifies.
+template <class OnPacket>
+void for_each_data_packet(E57Pages& pages, const E57ScanData& s, OnPacket&& on_packet) {
   const std::string& file = pages.path();
   const std::uint64_t start = pages.logical_of(s.file_offset, "a scan's binary section");
   const std::vector<std::uint8_t> h = pages.read(start, kCvSectionHeaderBytes);
@@ -202,8 +262,6 @@ std::vector<std::vector<std::uint8_t>> read_bytestreams(E57Pages& pages, const E
   const std::uint64_t data_physical = load_le<std::uint64_t>(h.data() + 16);
   pages.check_range(start, length);
   const std::uint64_t end = start + length;
-  // The section must hold every record's bits (a record of constant fields takes none:
-  // then at most one record a byte), so that no count allocates more than the file justifies.
   std::uint64_t record_bits = 0;
   for (const E57Field& f : s.fields) record_bits += static_cast<std::uint64_t>(f.bits);
   const bool too_many = record_bits == 0 ? s.info.records > length : s.info.records > length * 8 / record_bits;
@@ -211,22 +269,14 @@ std::vector<std::vector<std::uint8_t>> read_bytestreams(E57Pages& pages, const E
     throw FormatError(file, s.file_offset,
                       "scan '" + s.info.name + "' claims " + std::to_string(s.info.records) +
                           " records; its section of " + std::to_string(length) + " bytes cannot hold them");
-  std::vector<std::uint64_t> need(s.fields.size(), 0);
-  for (std::size_t i = 0; i < s.fields.size(); ++i)
-    if (wanted[i]) need[i] = (s.info.records * static_cast<std::uint64_t>(s.fields[i].bits) + 7) / 8;
-  std::vector<std::vector<std::uint8_t>> streams(s.fields.size());
-  if (s.info.records == 0) return streams;
-  const auto complete = [&] {
-    for (std::size_t i = 0; i < streams.size(); ++i)
-      if (streams[i].size() < need[i]) return false;
-    return true;
-  };
+  if (s.info.records == 0) return;
   std::uint64_t at = pages.logical_of(data_physical, "a scan's first data packet");
   if (at < start + kCvSectionHeaderBytes || at >= end)
     throw FormatError(file, data_physical,
                       "scan '" + s.info.name + "': its first data packet lies outside its section");
   std::vector<std::uint8_t> packet;
-  while (at < end && !complete()) {
+  std::vector<std::span<const std::uint8_t>> streams(s.fields.size());
+  while (at < end) {
     const std::uint64_t physical = at / 1020 * 1024 + at % 1020;
     if (end - at < 4) throw FormatError(file, physical, "a packet header runs past its section");
     std::uint8_t head[4];
@@ -249,54 +299,15 @@ std::vector<std::vector<std::uint8_t>> read_bytestreams(E57Pages& pages, const E
         const std::size_t n = load_le<std::uint16_t>(packet.data() + 6 + 2 * i);
         if (n > packet.size() - offset)
           throw FormatError(file, physical, "bytestream " + std::to_string(i) + " runs past its data packet");
-        if (streams[i].size() < need[i]) {
-          const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(n, need[i] - streams[i].size()));
-          streams[i].insert(streams[i].end(), packet.begin() + static_cast<std::ptrdiff_t>(offset),
-                            packet.begin() + static_cast<std::ptrdiff_t>(offset + take));
-        }
+        streams[i] = std::span<const std::uint8_t>(packet.data() + offset, n);
         offset += n;
       }
+      if (!on_packet(streams, physical)) return;
     } else if (head[0] != 0 && head[0] != 2) {  // index and empty packets are passed over
       throw FormatError(file, physical, "a packet of unknown type " + std::to_string(head[0]));
     }
     at += size;
   }
-  for (std::size_t i = 0; i < streams.size(); ++i)
-    if (streams[i].size() < need[i])
-      throw FormatError(file, s.file_offset,
-                        "scan '" + s.info.name + "': field " + s.fields[i].name + " holds " +
-                            std::to_string(streams[i].size()) + " bytes where its " + std::to_string(s.info.records) +
-                            " records take " + std::to_string(need[i]) + " (the section ends early)");
-  return streams;
-}
-
-// The values of a field from its bytestream: little-endian floats, or integers packed
-// `bits` to a record from the least significant bit of each byte, stored less the minimum.
-std::vector<double> decode_field(const E57Field& f, std::vector<std::uint8_t> bytes, std::uint64_t records) {
-  std::vector<double> out(static_cast<std::size_t>(records));
-  if (f.kind == E57Field::Kind::floating) {
-    for (std::size_t i = 0; i < out.size(); ++i)
-      out[i] = f.float_bytes == 4 ? static_cast<double>(load_le<float>(bytes.data() + 4 * i))
-                                  : load_le<double>(bytes.data() + 8 * i);
-    return out;
-  }
-  bytes.resize(bytes.size() + 16, 0);  // whole words past the last record
-  const std::uint64_t mask = f.bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << f.bits) - 1;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    std::uint64_t raw = 0;
-    if (f.bits > 0) {
-      const std::uint64_t bit = static_cast<std::uint64_t>(i) * static_cast<std::uint64_t>(f.bits);
-      const std::size_t byte = static_cast<std::size_t>(bit >> 3);
-      const int shift = static_cast<int>(bit & 7);
-      raw = load_le<std::uint64_t>(bytes.data() + byte) >> shift;
-      if (shift + f.bits > 64) raw |= static_cast<std::uint64_t>(bytes[byte + 8]) << (64 - shift);
-      raw &= mask;
-    }
-    const auto value = static_cast<std::int64_t>(raw + static_cast<std::uint64_t>(f.minimum));  // wraps as stored
-    out[i] =
-        f.kind == E57Field::Kind::scaled ? static_cast<double>(value) * f.scale + f.offset : static_cast<double>(value);
-  }
-  return out;
 }
 
 std::optional<std::size_t> field_index(const E57ScanData& s, std::string_view name) {
@@ -428,45 +439,70 @@ Input read_e57(const std::string& path, const InputOptions& options) {
                                                   field_index(s, "colorBlue")};
     if (colour)
       for (auto i : rgb) wanted[*i] = true;
-    std::vector<std::vector<std::uint8_t>> streams = read_bytestreams(pages, s, wanted);
-    std::vector<std::vector<double>> values(s.fields.size());
-    for (std::size_t i = 0; i < s.fields.size(); ++i)
-      if (wanted[i]) values[i] = decode_field(s.fields[i], std::move(streams[i]), s.info.records);
     // 8-bit channels in a file whose colours are 16-bit (another scan's) are widened.
     const double widen = colour && scale == ColourScale::bits16 && s.fields[*rgb[0]].maximum <= 255 ? 257.0 : 1.0;
-    const auto& a = values[*(cartesian ? cx : range)];
-    const auto& b = values[*(cartesian ? cy : azimuth)];
-    const auto& c = values[*(cartesian ? cz : elevation)];
-    const std::vector<double>* state = invalid ? &values[*invalid] : nullptr;
-    for (std::size_t k = 0; k < a.size(); ++k) {
-      if (state && (*state)[k] != 0) {
-        ++in.not_finite;
-        continue;
+    std::vector<std::optional<FieldStream>> streams(s.fields.size());
+    for (std::size_t i = 0; i < s.fields.size(); ++i)
+      if (wanted[i]) streams[i].emplace(s.fields[i]);
+    std::vector<std::vector<double>> values(s.fields.size());
+    std::uint64_t decoded = 0;
+    // The points of one batch of records (those whose every wanted field is here).
+    const auto emit = [&](std::size_t n) {
+      const auto& a = values[*(cartesian ? cx : range)];
+      const auto& b = values[*(cartesian ? cy : azimuth)];
+      const auto& c = values[*(cartesian ? cz : elevation)];
+      const std::vector<double>* state = invalid ? &values[*invalid] : nullptr;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (state && (*state)[k] != 0) {
+          ++in.not_finite;
+          continue;
+        }
+        double local[3] = {a[k], b[k], c[k]};
+        if (!cartesian) {
+          const double r = a[k], az = b[k], el = c[k];
+          local[0] = r * std::cos(el) * std::cos(az);
+          local[1] = r * std::cos(el) * std::sin(az);
+          local[2] = r * std::sin(el);
+        }
+        double world[3];
+        for (std::size_t r = 0; r < 3; ++r)
+          world[r] = s.rotation[r][0] * local[0] + s.rotation[r][1] * local[1] + s.rotation[r][2] * local[2] +
+                     s.info.translation[r];
+        if (!std::isfinite(world[0]) || !std::isfinite(world[1]) || !std::isfinite(world[2])) {
+          ++in.not_finite;
+          continue;
+        }
+        cloud.xyz.insert(cloud.xyz.end(), world, world + 3);
+        for (std::size_t col = 0; col < columns.size(); ++col)
+          cloud.attributes[col].values.push_back(values[column_field[col]][k]);
+        if (colour) colour->add(values[*rgb[0]][k] * widen, values[*rgb[1]][k] * widen, values[*rgb[2]][k] * widen);
       }
-      double local[3] = {a[k], b[k], c[k]};
-      if (!cartesian) {
-        const double r = a[k], az = b[k], el = c[k];
-        local[0] = r * std::cos(el) * std::cos(az);
-        local[1] = r * std::cos(el) * std::sin(az);
-        local[2] = r * std::sin(el);
-      }
-      double world[3];
-      for (std::size_t r = 0; r < 3; ++r)
-        world[r] = s.rotation[r][0] * local[0] + s.rotation[r][1] * local[1] + s.rotation[r][2] * local[2] +
-                   s.info.translation[r];
-      if (!std::isfinite(world[0]) || !std::isfinite(world[1]) || !std::isfinite(world[2])) {
-        ++in.not_finite;
-        continue;
-      }
-      cloud.xyz.insert(cloud.xyz.end(), world, world + 3);
-      for (std::size_t col = 0; col < columns.size(); ++col) {
-        const double v = values[column_field[col]][k];
-        cloud.attributes[col].values.push_back(v);
-      }
-      if (colour) colour->add(values[*rgb[0]][k] * widen, values[*rgb[1]][k] * widen, values[*rgb[2]][k] * widen);
+    };
+    for_each_data_packet(pages, s, [&](const std::vector<std::span<const std::uint8_t>>& packet, std::uint64_t) {
+      std::uint64_t n = s.info.records - decoded;
+      for (std::size_t i = 0; i < streams.size(); ++i)
+        if (streams[i]) {
+          streams[i]->append(packet[i]);
+          n = std::min(n, streams[i]->available());
+        }
+      for (std::size_t i = 0; i < streams.size(); ++i)
+        if (streams[i]) streams[i]->take(n, values[i]);
+      emit(static_cast<std::size_t>(n));
+      decoded += n;
+      if (options.progress) options.progress(done + decoded, total);
+      return decoded < s.info.records;
+    });
+    if (decoded < s.info.records) {
+      std::size_t shortest = 0;  // the field that ran out first
+      std::uint64_t fewest = std::numeric_limits<std::uint64_t>::max();
+      for (std::size_t i = 0; i < streams.size(); ++i)
+        if (streams[i] && streams[i]->available() < fewest) fewest = streams[i]->available(), shortest = i;
+      throw FormatError(path, s.file_offset,
+                        "scan '" + s.info.name + "': field " + s.fields[shortest].name + " ends after " +
+                            std::to_string(decoded) + " of its " + std::to_string(s.info.records) +
+                            " records (the section ends early)");
     }
     done += s.info.records;
-    if (options.progress) options.progress(done, total);
   }
   return in;
 }
