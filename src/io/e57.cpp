@@ -123,6 +123,7 @@ std::array<std::array<double, 3>, 3> quaternion_matrix(std::array<double, 4> q, 
 struct E57Parsed {
   E57Header header;
   std::string library;
+  std::string crs;  // coordinateMetadata: the standard leaves its form open (WKT, EPSG:code)
   std::vector<E57ScanData> scans;
   std::uint64_t images = 0;
 };
@@ -143,6 +144,10 @@ E57Parsed parse_e57(E57Pages& pages) {
   E57Parsed p;
   p.header = h;
   if (const XmlElement* lib = root.child("e57LibraryVersion")) p.library = lib->text;
+  if (const XmlElement* crs = root.child("coordinateMetadata")) {
+    const auto first = crs->text.find_first_not_of(" \t\r\n");
+    if (first != std::string::npos) p.crs = crs->text.substr(first, crs->text.find_last_not_of(" \t\r\n") + 1 - first);
+  }
   if (const XmlElement* images = root.child("images2D")) p.images = images->children.size();
   const XmlElement* data3d = root.child("data3D");
   if (!data3d) return p;  // a file of images only
@@ -364,6 +369,7 @@ E57Summary e57_summary(const std::string& path) {
   s.version_major = p.header.major;
   s.version_minor = p.header.minor;
   s.library = p.library;
+  s.crs = p.crs;
   s.images = p.images;
   for (const E57ScanData& scan : p.scans) s.scans.push_back(scan.info);
   return s;
@@ -374,6 +380,15 @@ Input read_e57(const std::string& path, const InputOptions& options) {
   const E57Parsed p = parse_e57(pages);
   Input in;
   in.format = "e57";
+  // "EPSG:32633" gives the code; any other text is taken as a CRS definition (WKT), which
+  // vola convert keeps only when PROJ reads it (and says so when it does not).
+  std::uint32_t code = 0;
+  const std::string_view crs = p.crs;
+  if (crs.starts_with("EPSG:") &&
+      std::from_chars(crs.data() + 5, crs.data() + crs.size(), code).ptr == crs.data() + crs.size() && code > 0)
+    in.epsg = code;
+  else
+    in.wkt = p.crs;
   // Columns: the numeric fields every scan has (by column name), colours as red/green/blue.
   std::vector<std::string> columns;
   std::vector<ValueType> types;

@@ -104,7 +104,8 @@ inline std::string e57_test_number(double v) {
 }
 
 // The whole file.
-inline std::vector<std::uint8_t> e57_test_file(const std::vector<E57TestScan>& scans) {
+inline std::vector<std::uint8_t> e57_test_file(const std::vector<E57TestScan>& scans,
+                                               const std::string& coordinate_metadata = "") {
   std::vector<std::uint8_t> logical(48, 0);  // the header, filled in last
   std::string data3d;
   for (const E57TestScan& s : scans) {
@@ -170,7 +171,10 @@ inline std::vector<std::uint8_t> e57_test_file(const std::vector<E57TestScan>& s
   const std::string xml =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<e57Root type=\"Structure\" "
       "xmlns=\"http://www.astm.org/COMMIT/E57/2010-e57-v1.0\"><formatName type=\"String\"><![CDATA[ASTM E57 3D "
-      "Imaging Data File]]></formatName><versionMajor type=\"Integer\">1</versionMajor><e57LibraryVersion "
+      "Imaging Data File]]></formatName><versionMajor type=\"Integer\">1</versionMajor><coordinateMetadata "
+      "type=\"String\"><![CDATA[" +
+      coordinate_metadata +
+      "]]></coordinateMetadata><e57LibraryVersion "
       "type=\"String\"><![CDATA[vola tests]]></e57LibraryVersion><data3D type=\"Vector\" "
       "allowHeterogeneousChildren=\"1\">" +
       data3d + "</data3D><images2D type=\"Vector\" allowHeterogeneousChildren=\"1\"></images2D></e57Root>\n";

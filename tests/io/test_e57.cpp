@@ -162,6 +162,26 @@ TEST(E57, ScansWithOtherFieldsKeepTheColumnsTheyShare) {
   EXPECT_EQ(in.cloud.attributes[0].values, (std::vector<double>{10, 20, 0.25}));
 }
 
+// coordinateMetadata: "EPSG:N" is a code, other text a definition for PROJ to read.
+TEST(E57, CoordinateMetadataIsTheCrs) {
+  E57TestScan scan;
+  scan.fields = {floats("cartesianX", {1}), floats("cartesianY", {2}), floats("cartesianZ", {3})};
+  vola_test::TempDir dir;
+  const fs::path path = dir / "crs.e57";
+  vola_test::write_bytes(path, vola_io_test::e57_test_file({scan}, "EPSG:32633"));
+  vola::io::Input in = vola::io::read_input(path.string(), "auto", {});
+  EXPECT_EQ(in.epsg, 32633u);
+  EXPECT_TRUE(in.wkt.empty());
+  const std::string wkt = "GEOGCRS[\"WGS 84\",DATUM[\"World Geodetic System 1984\"]]";
+  vola_test::write_bytes(path, vola_io_test::e57_test_file({scan}, "  " + wkt + "\n"));
+  in = vola::io::read_input(path.string(), "auto", {});
+  EXPECT_FALSE(in.epsg);
+  EXPECT_EQ(in.wkt, wkt);
+  EXPECT_EQ(vola::io::e57_summary(path.string()).crs, wkt);
+  vola_test::write_bytes(path, vola_io_test::e57_test_file({scan}));
+  EXPECT_TRUE(vola::io::read_input(path.string(), "auto", {}).wkt.empty());
+}
+
 TEST(E57, DamagedAndLyingFilesAreRefusedNamingTheFile) {
   E57TestScan scan;
   scan.fields = {floats("cartesianX", {1, 2, 3}), floats("cartesianY", {4, 5, 6}), floats("cartesianZ", {7, 8, 9})};

@@ -28,6 +28,7 @@ struct E57Scan {
 struct E57Summary {
   std::uint32_t version_major = 0, version_minor = 0;
   std::string library;  // e57LibraryVersion, when stated
+  std::string crs;      // coordinateMetadata (WKT, EPSG:code, ...), when stated
   std::vector<E57Scan> scans;
   std::uint64_t images = 0;  // images2D entries (not read)
 };
@@ -43,7 +44,8 @@ E57Summary e57_summary(const std::string& path);
 // field: intensity, red/green/blue (colorRed/Green/Blue), return_index (returnIndex as
 // stored: the standard counts from 0, some converters write LAS's 1-based numbers),
 // number_of_returns (returnCount) and any other numeric field by its name as text columns
-// are named (an extension's prefix dropped: las:pointSourceId -> point_source_id).
+// are named (an extension's prefix dropped: las:pointSourceId -> point_source_id). The CRS
+// from coordinateMetadata: "EPSG:N" as a code, other text as a definition (WKT).
 Input read_e57(const std::string& path, const InputOptions& options);
 
 }  // namespace vola::io
