@@ -356,11 +356,11 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
   }
   std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
   std::printf("points:      %zu", in.cloud.size());
-  // An organized cloud (PCD) holds its missing points as NaN, an E57 scan marks them
-  // invalid: say how many were left out.
+  // An organized cloud (PCD) holds its missing points as NaN, an E57 or PTX scan marks
+  // them invalid or as 0 0 0: say how many were left out.
   if (in.not_finite > 0)
-    std::printf(e57 ? " (and %llu the scanner marked invalid, left out)"
-                    : " (and %llu with a coordinate that is not a number, left out)",
+    std::printf(e57 || in.format == "ptx" ? " (and %llu the scanner marked as no return or invalid, left out)"
+                                          : " (and %llu with a coordinate that is not a number, left out)",
                 static_cast<unsigned long long>(in.not_finite));
   std::printf("\n");
   if (e57) print_e57_scans(io::e57_summary(path));

@@ -228,7 +228,16 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
              ConvertReport* report_out) {
   options.check();
   // A CRS PROJ does not know fails before gigabytes are read.
-  if (const std::string given = given_crs(options); !given.empty()) resolve_crs({}, given);
+  if (const std::string given = given_crs(options); !given.empty()) {
+    try {
+      resolve_crs({}, given);
+    } catch (const OptionError&) {
+      throw;
+    } catch (const Error& e) {  // the option's fault, not the library's: named as such (and C's INVALID_ARGUMENT)
+      throw OptionError(options.epsg ? "epsg" : "assign_crs",
+                        "'" + given.substr(0, 60) + "' is not a CRS PROJ knows: " + e.what());
+    }
+  }
   if (!options.target_crs.empty()) check_target_crs(options.target_crs);
   const io::InputFormat& format = io::find_input_format(path, options.format);
   std::vector<std::string> filter_report;

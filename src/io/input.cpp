@@ -21,6 +21,7 @@
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
+#include "vola/io/ptx.hpp"
 
 namespace vola::io {
 
@@ -167,6 +168,10 @@ std::vector<InputFormat> make_formats() {
        read_octomap_input},
       {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
       {"ept", {".json"}, "Entwine Point Tiles: the ept.json of a local EPT folder (laszip or binary data)", read_ept},
+      {"ptx",
+       {".ptx"},
+       "Leica PTX scans (text): x y z intensity [r g b] per point, each scan moved by its 4 x 4 matrix",
+       read_ptx},
       {"e57",
        {".e57"},
        "ASTM E57 scans (terrestrial scanners): cartesian or spherical points, each scan's pose, colour, intensity",

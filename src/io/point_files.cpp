@@ -295,8 +295,10 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
   std::vector<std::string> warnings;
   if (table.not_finite > 0)
     warnings.push_back(input + ": " + std::to_string(table.not_finite) +
-                       " points with a coordinate that is not finite (an organized cloud's missing points) are not "
-                       "read, so not written");
+                       (table.format == "e57" || table.format == "ptx"
+                            ? " points the scanner marked as no return or invalid"
+                            : " points with a coordinate that is not finite") +
+                       " (an organized cloud's missing points) are not read, so not written");
   if (las_out) drop_points_las_cannot_hold(input, table.cloud, warnings);
   if (!las_out && (table.epsg || !table.wkt.empty()))
     warnings.push_back(output + ": " + (out_ext == ".ply" ? "PLY" : "XYZ") + " has no place for the CRS of " + input +

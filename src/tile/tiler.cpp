@@ -359,10 +359,14 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   // index replaces the previous one.
   std::uint64_t offered = 0;
   for (const PointSource* s : sources) offered += s->point_count();
-  if (tiles.empty() && offered > 0)
+  if (tiles.empty() && offered > 0) {
+    char size[32];
+    std::snprintf(size, sizeof size, "%.6g", options.grid.tile_size);
     throw InvalidArgument("none of the inputs' " + std::to_string(offered) +
                           " points is left to tile: the filters kept none (a crop polygon in another CRS than "
-                          "the points'?), or none has finite coordinates");
+                          "the points'?), none has finite coordinates, or every one lies beyond the 2^31 tiles of " +
+                          size + " the grid can index from its origin (a tile size too small for the coordinates)");
+  }
 }
 
 // 2. Every rank learns every tile's statistics (and so the list of tiles).

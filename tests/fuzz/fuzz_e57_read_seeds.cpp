@@ -1,7 +1,8 @@
 // Seeds for fuzz_e57_read: E57 files written here (tests/io/e57_test_file.hpp; no E57 file
 // is in the shared data folder): cartesian scans of every field type with bit widths that
 // cross bytes and packets, a spherical scan with invalid points and a pose, two scans of
-// different fields. Linked into fuzz_e57_read_replay in place of fuzz_seeds.cpp.
+// different fields; and two Leica PTX files (colours, points of no return, two scans).
+// Linked into fuzz_e57_read_replay in place of fuzz_seeds.cpp.
 #include <cmath>
 
 #include "../io/e57_test_file.hpp"
@@ -55,7 +56,14 @@ std::vector<Seed> synthetic_seeds() {
   other.name = "other";
   other.fields = {field("cartesianX", "Float", 0, 0, {3}), field("cartesianY", "Float", 0, 0, {0}),
                   field("cartesianZ", "Float", 0, 0, {0}), field("intensity", "Float", 0, 0, {0.25})};
-  return {seed("typed.e57", {typed}), seed("spherical_pose.e57", {spherical}), seed("two_scans.e57", {typed, other})};
+  const auto text = [](const std::string& name, const std::string& t) {
+    return Seed{name, std::vector<std::uint8_t>(t.begin(), t.end())};
+  };
+  const std::string ptx_header = "2\n2\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 1 0 0\n-1 0 0 0\n0 0 1 0\n10 20 30 1\n";
+  return {seed("typed.e57", {typed}), seed("spherical_pose.e57", {spherical}), seed("two_scans.e57", {typed, other}),
+          text("colour.ptx", ptx_header + "1 0 0 0.5 255 0 0\n0 0 0 0.5 0 0 0\n0 2 0.5 0.25 0 255 0\n0 0 0 0\n"),
+          text("two_scans.ptx", ptx_header + "1 2 3 0.5\n0 0 0 0\n4 5 6 0.25\n7 8 9 1\n\n" +
+                                    "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n3 2 1 0\n")};
 }
 
 std::vector<Seed> golden_seeds(const std::filesystem::path&) { return {}; }

@@ -167,7 +167,7 @@ assert d['summary']['points_read'] == 2130 and d['crs']['epsg'] == 32610, d
 if [ -n "$e57_writer" ]; then
   "$e57_writer" --write-corpus "$tmp/e57" > /dev/null || fail "could not write the E57 files"
   "$vola" info "$tmp/e57/spherical_pose.e57" > "$tmp/e57_info.txt" || fail "info on an E57 file failed"
-  grep -q "^points: *2 (and 2 the scanner marked invalid, left out)$" "$tmp/e57_info.txt" ||
+  grep -q "^points: *2 (and 2 the scanner marked as no return or invalid, left out)$" "$tmp/e57_info.txt" ||
     fail "E57 info: $(cat "$tmp/e57_info.txt")"
   grep -q "^scan: *'spherical': 4 records, pose: rotation (w x y z) 0.70710678" "$tmp/e57_info.txt" ||
     fail "E57 info scans: $(cat "$tmp/e57_info.txt")"
