@@ -109,7 +109,8 @@ E57Field prototype_field(const XmlElement& e, const std::string& file, std::uint
 }
 
 // The rotation matrix of the quaternion w x y z (normalised here).
-std::array<std::array<double, 3>, 3> quaternion_matrix(std::array<double, 4> q, const std::string& file,
+// Normalises the quaternion w x y z in place and returns its rotation matrix.
+std::array<std::array<double, 3>, 3> quaternion_matrix(std::array<double, 4>& q, const std::string& file,
                                                        std::uint64_t offset) {
   const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!(n > 0) || !std::isfinite(n)) throw FormatError(file, offset, "a pose's rotation quaternion has no length");
@@ -176,9 +177,6 @@ E57Parsed parse_e57(E57Pages& pages) {
         for (std::size_t i = 0; i < 4; ++i)
           if (const XmlElement* c = r->child(names[i])) s.info.rotation[i] = element_number(*c, file, at);
         s.rotation = quaternion_matrix(s.info.rotation, file, at);
-        const double n = std::sqrt(s.info.rotation[0] * s.info.rotation[0] + s.info.rotation[1] * s.info.rotation[1] +
-                                   s.info.rotation[2] * s.info.rotation[2] + s.info.rotation[3] * s.info.rotation[3]);
-        for (double& c : s.info.rotation) c /= n;
       }
       if (const XmlElement* t = pose->child("translation")) {
         const char* names[] = {"x", "y", "z"};
