@@ -8,7 +8,7 @@ export VOLA_SHARED=${VOLA_SHARED:-$(cd "$VOLA_ROOT/.." && pwd)/shared}
 
 # Packages every build needs (the core needs none; the CLI, tests and geo do).
 VOLA_BUILD_PACKAGES=(cmake make g++ libcli11-dev libzstd-dev libproj-dev proj-data libgtest-dev libgmock-dev
-  nlohmann-json3-dev python3 python3-numpy python3-scipy gzip libassimp-dev libgdal-dev libpng-dev liblzf-dev libeigen3-dev libsndfile1-dev libfftw3-dev libmysofa-dev pkg-config
+  nlohmann-json3-dev python3 python3-numpy python3-scipy gzip libassimp-dev libdraco-dev libgdal-dev libpng-dev liblzf-dev libeigen3-dev libsndfile1-dev libfftw3-dev libmysofa-dev pkg-config
   libexpat1-dev)
 
 # The Python module (pybind11, numpy) and its tests (pytest, matplotlib for the example).

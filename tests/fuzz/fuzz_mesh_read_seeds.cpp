@@ -1,12 +1,16 @@
 // Seeds for fuzz_mesh_read: the small mesh files of the shared data folder (beside
 // golden/) and a tetrahedron in each kind the entry point picks (STL ascii and binary,
-// OBJ, OFF, glTF with an embedded buffer), each prefixed with its selector byte.
+// OBJ, OFF, glTF with an embedded buffer, a .glb whose primitive is Draco-compressed), each
+// prefixed with its selector byte.
 // Linked into fuzz_mesh_read_replay in place of fuzz_seeds.cpp.
 #include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
+
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
 
 #include "fuzz_seeds.hpp"
 
@@ -88,6 +92,50 @@ std::string gltf() {
          R"({"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}]})";
 }
 
+// The tetrahedron as a .glb whose one primitive is KHR_draco_mesh_compression (32-bit
+// indices, which vola decodes before Assimp sees the scene).
+Bytes draco_glb() {
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(4);
+  const int position = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  for (std::uint32_t f = 0; f < 4; ++f)
+    builder.SetAttributeValuesForFace(position, draco::FaceIndex(f), kVertex[kFace[f][0]], kVertex[kFace[f][1]],
+                                      kVertex[kFace[f][2]]);
+  const auto mesh = builder.Finalize();
+  draco::Encoder encoder;
+  draco::EncoderBuffer encoded;
+  if (!encoder.EncodeMeshToBuffer(*mesh, &encoded).ok()) return {};
+  Bytes bin(encoded.data(), encoded.data() + encoded.size());
+  const std::size_t draco_bytes = bin.size();
+  bin.resize((bin.size() + 3) / 4 * 4, 0);
+  std::string json =
+      R"({"asset":{"version":"2.0"},"extensionsRequired":["KHR_draco_mesh_compression"],)"
+      R"("extensionsUsed":["KHR_draco_mesh_compression"],"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"extensions":)"
+      R"({"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":)" +
+      std::to_string(mesh->attribute(position)->unique_id()) +
+      R"(}}}}]}],)"
+      R"("accessors":[{"componentType":5126,"count":)" +
+      std::to_string(mesh->num_points()) +
+      R"(,"type":"VEC3"},{"componentType":5125,"count":12,"type":"SCALAR"}],)"
+      R"("bufferViews":[{"buffer":0,"byteLength":)" +
+      std::to_string(draco_bytes) +
+      R"(}],)"
+      R"("buffers":[{"byteLength":)" +
+      std::to_string(bin.size()) + "}]}";
+  json.append((4 - json.size() % 4) % 4, ' ');
+  Bytes glb = text("glTF");
+  put(glb, std::uint32_t{2});
+  put(glb, static_cast<std::uint32_t>(28 + json.size() + bin.size()));
+  put(glb, static_cast<std::uint32_t>(json.size()));
+  glb.insert(glb.end(), {'J', 'S', 'O', 'N'});
+  glb.insert(glb.end(), json.begin(), json.end());
+  put(glb, static_cast<std::uint32_t>(bin.size()));
+  glb.insert(glb.end(), {'B', 'I', 'N', 0});
+  glb.insert(glb.end(), bin.begin(), bin.end());
+  return glb;
+}
+
 Bytes read_all(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -107,9 +155,12 @@ std::vector<Seed> synthetic_seeds() {
     const std::string face = "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
     off += face;
   }
-  return {seed("tetra_ascii.stl", "stl", text(ascii_stl())), seed("tetra_binary.stl", "stl", binary_stl()),
-          seed("tetra.obj", "obj", text(obj)),                seed("tetra.off", "off", text(off)),
-          seed("tetra.gltf", "gltf", text(gltf()))};
+  return {seed("tetra_ascii.stl", "stl", text(ascii_stl())),
+          seed("tetra_binary.stl", "stl", binary_stl()),
+          seed("tetra.obj", "obj", text(obj)),
+          seed("tetra.off", "off", text(off)),
+          seed("tetra.gltf", "gltf", text(gltf())),
+          seed("tetra_draco.glb", "gltf", draco_glb())};
 }
 
 // The shared data folder's mesh files of at most 64 KiB (larger ones make each

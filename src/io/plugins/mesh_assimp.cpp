@@ -12,10 +12,11 @@
 #include <utility>
 #include <vector>
 
-#include "vola/error.hpp"
 #include "../reader_plugin.hpp"
+#include "gltf_draco.hpp"
 #include "off_header.hpp"
 #include "readers.hpp"
+#include "vola/error.hpp"
 #include "vola/io/mesh.hpp"
 
 namespace vola::io {
@@ -148,15 +149,31 @@ bool structurally_sound(const aiScene& scene) {
   return true;
 }
 
+std::optional<std::string> decoded_draco_scene(const std::string& path) {
+  const std::string ext = lowercase_extension(path);
+  if (ext != ".gltf" && ext != ".glb") return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  if (!in) throw IoError("cannot read " + path);
+  return gltf_with_draco_decoded(path, std::move(whole).str());
+}
+
 }  // namespace
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   check_mesh_extension(path);
   check_off_counts(path);
+  // A glTF with Draco-compressed primitives goes to Assimp with them decoded (gltf_draco.hpp).
+  const std::optional<std::string> draco_decoded = decoded_draco_scene(path);
   Assimp::Importer importer;
   auto* io = new ConfinedIOSystem(path);
   importer.SetIOHandler(io);  // the importer owns it
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+  const auto import = [&](unsigned flags) {
+    return draco_decoded ? importer.ReadFileFromMemory(draco_decoded->data(), draco_decoded->size(), flags, "glb")
+                         : importer.ReadFile(path, flags);
+  };
+  const aiScene* scene = import(aiProcess_Triangulate | aiProcess_ValidateDataStructure);
   // Assimp's validation refuses two things that do not matter here. Its OBJ importer
   // (5.2) can label a mesh's primitive types wrongly (trimesh's cubevt.obj, a textured
   // cube of triangles: "mFaces[0] is a POINT but mPrimitiveTypes does not report the POINT
@@ -171,7 +188,7 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   };
   if (!scene && harmless(importer.GetErrorString())) {
     const std::string refusal = importer.GetErrorString();
-    scene = importer.ReadFile(path, aiProcess_Triangulate);
+    scene = import(aiProcess_Triangulate);
     if (scene && !structurally_sound(*scene)) throw FormatError(path, std::nullopt, "Assimp: " + refusal);
   }
   // A missing material library is only a warning to Assimp: it is not why a scene failed.
@@ -187,7 +204,7 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   const bool points_only = !scene && std::string(importer.GetErrorString()).find("contains no faces") != std::string::npos;
   if (points_only) {
     const std::string refusal = importer.GetErrorString();
-    scene = importer.ReadFile(path, 0);
+    scene = import(0);
     const auto vertices_alone = [](const aiScene* s) {
       for (unsigned m = 0; m < s->mNumMeshes; ++m)
         if (!s->mMeshes[m] || s->mMeshes[m]->mNumFaces != 0 || (s->mMeshes[m]->mNumVertices && !s->mMeshes[m]->mVertices))
