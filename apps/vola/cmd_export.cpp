@@ -9,16 +9,17 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "open_voxels.hpp"
-#include "vola/map/state_map.hpp"
 #include "vola/error.hpp"
-#include "vola/io/input.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/export_format.hpp"
-#include "vola/io/occupancy_maps.hpp"
 #include "vola/io/file_checks.hpp"
+#include "vola/io/input.hpp"
+#include "vola/io/occupancy_maps.hpp"
+#include "vola/io/ros_map.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::cli {
 
@@ -35,6 +36,7 @@ struct ExportArgs {
   double resolution = 0.0;  // 0: the voxel size
   bool resolution_given = false;
   std::string free;  // maps: a .vol of the free voxels (`vola map --free`)
+  std::string band;  // ROS maps: ZMIN:ZMAX
 };
 
 // The format, after checking that the options given apply to it (the rule Python's
@@ -52,6 +54,7 @@ std::string resolve_format(const ExportArgs& a) {
   request.cubes = a.cubes;
   request.bits = a.bits != 16;
   request.free = !a.free.empty();
+  request.band = !a.band.empty();
   return io::resolve_export_format(request);
 }
 
@@ -89,6 +92,37 @@ void export_map(const ExportArgs& a, const Tree& tree, const std::string& format
   std::printf("%s: %llu occupied and %llu free voxels of %.17g -> %s\n", what.c_str(),
               static_cast<unsigned long long>(r.occupied), static_cast<unsigned long long>(r.free),
               voxels.frame.voxel_size, a.output.c_str());
+}
+
+// --band ZMIN:ZMAX as two numbers.
+io::RosMapOptions band_heights(const std::string& band) {
+  const std::size_t colon = band.find(':', 1);  // past a leading minus sign
+  io::RosMapOptions options;
+  std::size_t used_min = 0, used_max = 0;
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    options.z_min = std::stod(band.substr(0, colon), &used_min);
+    options.z_max = std::stod(band.substr(colon + 1), &used_max);
+  } catch (const std::exception&) {
+    used_min = 0;
+  }
+  if (colon == std::string::npos || used_min != colon || used_max != band.size() - colon - 1)
+    throw OptionError("band", "is ZMIN:ZMAX, two heights in the file's units (e.g. 0.2:1.8), not '" + band + "'");
+  return options;
+}
+
+void export_ros_map(const ExportArgs& a, const Tree& tree) {
+  const std::optional<Tree> free = free_voxels(a);
+  const io::MapVoxels voxels = io::map_voxels(tree, free ? &*free : nullptr);
+  const io::RosMapReport r = io::write_ros_map(voxels, a.output, band_heights(a.band));
+  if (a.quiet) return;
+  std::printf(
+      "ROS map (map_server YAML + PGM, trinary): %u x %u cells of %.17g, origin (%.17g, %.17g): %llu occupied, "
+      "%llu free (%s), %llu unknown -> %s, %s\n",
+      r.width, r.height, r.resolution, r.origin[0], r.origin[1], static_cast<unsigned long long>(r.occupied),
+      static_cast<unsigned long long>(r.free),
+      r.free_from_ground ? "columns with voxels below the band and none in it" : "free voxels in the band",
+      static_cast<unsigned long long>(r.unknown), a.output.c_str(), r.image.c_str());
 }
 
 // Only LAS/LAZ and GeoTIFF carry a CRS; PLY, XYZ, binvox, NPY, PNG with its world file,
@@ -164,6 +198,8 @@ void run_export(const ExportArgs& a) {
         (r.has_crs ? "the file's" : "none (the file has no CRS)"));
   } else if (format == "octomap" || format == "vdb") {
     export_map(a, tree, format);
+  } else if (format == "rosmap") {
+    export_ros_map(a, tree);
   } else if (a.slices) {
     const std::uint32_t images = io::write_png_slices(tree, a.output, true);
     say(std::to_string(images) + " PNG slices of " + std::to_string(tree.side()) +
@@ -187,8 +223,9 @@ void run_export(const ExportArgs& a) {
 
 void add_export(CLI::App& app) {
   auto args = std::make_shared<ExportArgs>();
-  auto* cmd = app.add_subcommand(
-      "export", "Write a .vol file as PLY, XYZ, LAS, binvox, a dense NPY grid, PNG images or GeoTIFF rasters");
+  auto* cmd = app.add_subcommand("export",
+                                 "Write a .vol file as PLY, XYZ, LAS, binvox, a dense NPY grid, PNG images, GeoTIFF "
+                                 "rasters, OctoMap/OpenVDB or ROS maps");
   cmd->footer(
       "Formats (from OUT's extension unless --format says):\n"
       "  .ply     voxel centres with every attribute as a vertex property (binary; --ascii),\n"
@@ -229,6 +266,12 @@ void add_export(CLI::App& app) {
       "  .vdb     OpenVDB: grid \"occupied\" (BoolGrid) or \"log_odds\" (FloatGrid) with a\n"
       "           log_odds column, and \"free\"/\"free_log_odds\" with --free; transform = voxel\n"
       "           size and the grid origin (index centres on the voxel centres)\n"
+      "  .yaml    --band ZMIN:ZMAX: a ROS map (map_server / nav2: OUT.yaml + OUT.pgm, trinary,\n"
+      "           as map_saver writes), one cell per voxel column, cropped to the columns\n"
+      "           with voxels: occupied where a voxel centre lies in the band (what a robot\n"
+      "           of that height meets), free where a free voxel does (a state map from vola\n"
+      "           map, or --free), or, with no free voxels, where the column has voxels below\n"
+      "           the band and none in it (ground seen, nothing in the way); else unknown\n"
       "Positions are voxel centres in the file's coordinates. --depth K exports the coarser\n"
       "grid of the first K levels (4^K voxels per axis), e.g. to fit a dense format.\n"
       "Examples:\n"
@@ -243,11 +286,14 @@ void add_export(CLI::App& app) {
       "  vola export city.vol obstacles.png --occupancy-above 3\n"
       "  vola map scans.txt -o map.vol --voxel-size 0.2 && vola export map.vol map.ot   # occupied, free, log-odds\n"
       "  vola export occupied.vol map.bt --free free.vol    # plain trees: free voxels from another file\n"
-      "  vola export map.vol map.vdb");
+      "  vola export map.vol map.vdb\n"
+      "  vola export map.vol floor.yaml --band 0.1:1.5        # 2D map for nav2 of a robot 1.5 high\n"
+      "  vola export autzen.vol nav.yaml --band 400:420 --depth 5");
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
-  cmd->add_option("--format", args->format, "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif, octomap, vdb")
-      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif", "octomap", "vdb"}))
+  cmd->add_option("--format", args->format,
+                  "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif, octomap, vdb, rosmap")
+      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif", "octomap", "vdb", "rosmap"}))
       ->capture_default_str();
   cmd->add_flag("--ascii", args->ascii, "PLY: ascii instead of binary little-endian");
   cmd->add_flag("--cubes", args->cubes, "PLY: the voxels' outer surface as a quad mesh instead of centre points");
@@ -265,8 +311,12 @@ void add_export(CLI::App& app) {
   cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
       ->check(positive_number())
       ->each([args](const std::string&) { args->resolution_given = true; });
-  cmd->add_option("--free", args->free, "Maps (.bt, .ot, .vdb) from a plain tree: a .vol of the free voxels on the same grid (a state map from vola map holds its own)")
+  cmd->add_option("--free", args->free,
+                  "Maps (.bt, .ot, .vdb, .yaml) from a plain tree: a .vol of the free voxels on the same grid (a state "
+                  "map from vola map holds its own)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--band", args->band,
+                  "ROS map (.yaml): ZMIN:ZMAX, the heights (file units) whose voxels are obstacles to a robot");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_export(*args); });
 }

@@ -15,6 +15,7 @@
 #include "vola/io/export_format.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/occupancy_maps.hpp"
+#include "vola/io/ros_map.hpp"
 #include "vola/map/state_map.hpp"
 
 namespace vola::python {
@@ -87,10 +88,11 @@ py::dict export_las(const Tree& tree, const std::filesystem::path& path, int dep
   return out;
 }
 
-py::dict export_map(const Tree& given, const std::filesystem::path& path, const Tree* given_free, int depth) {
-  // A state map (vola map, Map.save) holds its free voxels: split it as `vola export` does,
-  // so that the report counts occupied and free voxels (it counted every known voxel as
-  // occupied, though the file was right).
+// A map's occupied and free voxels on one grid, at `depth`. A state map (vola map,
+// Map.save) holds its free voxels: split it as `vola export` does, so that reports count
+// occupied and free voxels (they counted every known voxel as occupied, though the file
+// was right).
+vola::io::MapVoxels gathered_map(const Tree& given, const Tree* given_free, int depth) {
   std::optional<Tree> occupied, own_free;
   if (vola::map::is_state_map(given)) {
     if (given_free) throw vola::InvalidArgument("the tree is a state map and holds its free voxels; free is for plain trees");
@@ -99,12 +101,15 @@ py::dict export_map(const Tree& given, const std::filesystem::path& path, const 
   }
   const Tree& tree = occupied ? *occupied : given;
   const Tree* free = own_free ? &*own_free : given_free;
+  const std::optional<Tree> coarse_free =
+      free && depth > 0 && depth < free->depth() ? std::optional<Tree>(free->level_of_detail(depth)) : std::nullopt;
+  return at_depth(tree, depth,
+                  [&](const Tree& t) { return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free); });
+}
+
+py::dict export_map(const Tree& given, const std::filesystem::path& path, const Tree* given_free, int depth) {
   const vola::io::MapExportReport r = write_released([&] {
-    const std::optional<Tree> coarse_free =
-        free && depth > 0 && depth < free->depth() ? std::optional<Tree>(free->level_of_detail(depth)) : std::nullopt;
-    const vola::io::MapVoxels voxels = at_depth(tree, depth, [&](const Tree& t) {
-      return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free);
-    });
+    const vola::io::MapVoxels voxels = gathered_map(given, given_free, depth);
     return vola::io::lower_extension(path.string()) == ".vdb" ? vola::io::write_vdb(voxels, path.string()) : vola::io::write_octomap(voxels, path.string());
   });
   py::dict report;
@@ -118,6 +123,24 @@ py::dict export_map(const Tree& given, const std::filesystem::path& path, const 
   return report;
 }
 
+py::dict export_ros_map(const Tree& given, const std::filesystem::path& path, std::pair<double, double> band,
+                        const Tree* given_free, int depth) {
+  const vola::io::RosMapReport r = write_released([&] {
+    return vola::io::write_ros_map(gathered_map(given, given_free, depth), path.string(), {band.first, band.second});
+  });
+  py::dict report;
+  report["image"] = r.image;
+  report["width"] = r.width;
+  report["height"] = r.height;
+  report["resolution"] = r.resolution;
+  report["origin"] = py::make_tuple(r.origin[0], r.origin[1]);
+  report["occupied"] = r.occupied;
+  report["free"] = r.free;
+  report["unknown"] = r.unknown;
+  report["free_from_ground"] = r.free_from_ground;
+  return report;
+}
+
 }  // namespace
 
 void bind_export(py::module_& m, py::class_<Tree>& tree) {
@@ -125,7 +148,7 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
   m.def(
       "_export_format",
       [](const std::filesystem::path& path, bool slices, bool map, bool occupancy_above, bool raster, bool resolution,
-         bool ascii, bool cubes, bool bits, bool free) {
+         bool ascii, bool cubes, bool bits, bool free, bool band) {
         vola::io::ExportRequest request;
         request.output = path.string();
         request.slices = slices;
@@ -137,11 +160,13 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
         request.cubes = cubes;
         request.bits = bits;
         request.free = free;
+        request.band = band;
         return with_python_names([&] { return vola::io::resolve_export_format(request); });
       },
       py::arg("path"), py::arg("slices"), py::arg("map"), py::arg("occupancy_above"), py::arg("raster"),
       py::arg("resolution"), py::arg("ascii"), py::arg("cubes"), py::arg("bits"), py::arg("free"),
-      "vola.export's format ('ply', 'xyz', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb') from the\n"
+      py::arg("band") = false,
+      "vola.export's format ('ply', 'xyz', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap') from the\n"
       "path's extension and which options were given (True: given), by the rule `vola export` uses;\n"
       "InvalidArgument when an option does not apply to the format.");
   tree.def("raster", &raster, py::arg("product") = "dsm", py::arg("resolution") = 0.0, py::arg("depth") = 0,
@@ -220,6 +245,14 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
         "through OpenVDB; free= is a tree of free voxels on the same grid (vola map --free). Returns a dict:\n"
         "occupied, free, log_odds, shift (added to coordinates when OctoMap's cells needed it), nodes, grids,\n"
         "warnings.");
+  m.def("export_ros_map", &export_ros_map, py::arg("tree"), py::arg("path"), py::arg("band"),
+        py::arg("free") = py::none(), py::arg("depth") = 0,
+        "A 2D map for ROS navigation (`vola export TREE OUT.yaml --band ZMIN:ZMAX [--free FREE]`): OUT.yaml and\n"
+        "OUT.pgm as map_saver writes them (trinary), one cell per voxel column, cropped to the columns with\n"
+        "voxels: occupied where a voxel centre lies in band=(zmin, zmax) (file units), free where a free voxel\n"
+        "does (a state map's own, or free=), or with no free voxels where the column has voxels below the band\n"
+        "and none in it; else unknown. Returns {image, width, height, resolution, origin, occupied, free,\n"
+        "unknown, free_from_ground}.");
 }
 
 }  // namespace vola::python

@@ -163,7 +163,7 @@ def test_export_refuses_what_the_cli_refuses(autzen, tmp_path):
         ("a.png", {}, "PNG export needs slices"),
         ("a.ply", {"raster": "dsm"}, r"raster: writes a GeoTIFF: name the output \.tif, not .*a\.ply"),
         ("a.xyz", {"ascii": True}, "ascii and cubes apply to PLY export"),
-        ("a.las", {"free": autzen}, r"free applies to \.bt, \.ot and \.vdb maps"),
+        ("a.las", {"free": autzen}, r"free applies to \.bt, \.ot, \.vdb and ROS \(\.yaml\) maps"),
         ("a.png", {"map": True, "occupancy_above": 3}, "different images: give one"),
         ("a.png", {"bits": 8, "occupancy_above": 3}, "bits applies to map"),
     )

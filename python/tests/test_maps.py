@@ -77,3 +77,22 @@ def test_a_state_map_exports_its_occupied_and_free_voxels(tmp_path):
     assert (report["occupied"], report["free"]) == (occupied.voxel_count, free.voxel_count)  # was (all known, 0)
     with pytest.raises(vola.InvalidArgument, match="holds its free voxels"):
         vola.export_map(state, tmp_path / "t.ot", free=free)
+
+
+def test_a_ros_map_from_python_is_the_cli_s(tmp_path, vola_cli):
+    m = vola.Map(0.25)
+    rng = np.random.default_rng(5)
+    m.insert(rng.uniform(-3, 3, size=(400, 3)), origin=(0.05, 0.1, 0.15))
+    m.save(tmp_path / "map.vol")
+    state = vola.read(tmp_path / "map.vol")
+    report = vola.export(state, tmp_path / "py.yaml", band=(-0.5, 0.5))
+    assert report["free_from_ground"] is False and report["occupied"] > 0 and report["free"] > 0
+    assert report["occupied"] + report["free"] + report["unknown"] == report["width"] * report["height"]
+    subprocess.run([vola_cli, "export", str(tmp_path / "map.vol"), str(tmp_path / "cli.yaml"), "--band", "-0.5:0.5", "-q"],
+                   check=True)
+    assert (tmp_path / "py.pgm").read_bytes() == (tmp_path / "cli.pgm").read_bytes()
+    assert (tmp_path / "py.yaml").read_text() == (tmp_path / "cli.yaml").read_text().replace("cli.pgm", "py.pgm")
+    with pytest.raises(vola.InvalidArgument, match="band: a ROS map needs the height band"):
+        vola.export(state, tmp_path / "x.yaml")
+    with pytest.raises(vola.InvalidArgument, match="band: band applies to a ROS map"):
+        vola.export(state, tmp_path / "x.ply", band=(0, 1))

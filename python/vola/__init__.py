@@ -57,7 +57,7 @@ import builtins
 import functools
 import json
 import os
-from typing import Any, Optional, Union
+from typing import Any, Optional, Tuple, Union
 
 from ._vola import (
     FREE,
@@ -87,6 +87,7 @@ from ._vola import (
     export_occupancy_above,
     export_ply,
     export_raster,
+    export_ros_map,
     export_slices,
     export_xyz,
     filter_points,
@@ -133,7 +134,7 @@ for _name, _member in list(vars(Tree).items()):
     if type(_member).__name__ == "instancemethod" and _name not in ("__repr__", "__len__", "__setstate__", "check_mapped"):
         setattr(Tree, _name, _refusing_cut_mappings(_member))
 for _name in ("difference", "export_binvox", "export_height_map", "export_las", "export_map", "export_npy",
-              "export_occupancy_above", "export_ply", "export_raster", "export_slices", "export_xyz", "free_tree",
+              "export_occupancy_above", "export_ply", "export_raster", "export_ros_map", "export_slices", "export_xyz", "free_tree",
               "intersect", "occupied_tree", "probability", "state", "union", "_export_format"):
     globals()[_name] = _refusing_cut_mappings(globals()[_name])
 del _name, _member
@@ -167,6 +168,7 @@ __all__ = [
     "export_occupancy_above",
     "export_ply",
     "export_raster",
+    "export_ros_map",
     "export_slices",
     "export_xyz",
     "filter_points",
@@ -231,16 +233,17 @@ def pipeline(spec: Union[PathLike, list, dict]) -> list:
 def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resolution: float = 0.0,
            map: bool = False, bits: int = 16, occupancy_above: Optional[int] = None,  # noqa: A002 (--map)
            slices: bool = False, ascii: bool = False, cubes: bool = False,  # noqa: A002 (--ascii)
-           free: Optional[Tree] = None, depth: int = 0) -> Any:
+           free: Optional[Tree] = None, band: Optional[Tuple[float, float]] = None, depth: int = 0) -> Any:
     """`vola export TREE OUT` in one call: the format from path's extension (.ply, .xyz, .las,
-    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb), options as the CLI's flags:
+    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb, .yaml), options as the CLI's flags:
     raster='dsm'|'dtm'|'intensity'|'density'|'count' (+ resolution) for a GeoTIFF; map=True
     (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
-    for PLY; free= for maps. Options that do not apply to the format are refused, as the CLI
+    for PLY; free= for maps; band=(zmin, zmax) for a ROS map (.yaml, the robot's height band).
+    Options that do not apply to the format are refused, as the CLI
     refuses them. Returns what the export_* function for the format returns."""
     fmt = _export_format(os.fspath(path), slices=slices, map=map, occupancy_above=occupancy_above is not None,
                          raster=raster is not None, resolution=bool(resolution), ascii=ascii, cubes=cubes,
-                         bits=bits != 16, free=free is not None)
+                         bits=bits != 16, free=free is not None, band=band is not None)
     if fmt == "tif":
         return export_raster(tree, path, raster, resolution, depth)
     if fmt == "png":
@@ -253,4 +256,6 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
         return export_ply(tree, path, ascii, cubes, depth)
     if fmt in ("octomap", "vdb"):
         return export_map(tree, path, free, depth)
+    if fmt == "rosmap":
+        return export_ros_map(tree, path, tuple(band), free, depth)
     return {"xyz": export_xyz, "las": export_las, "binvox": export_binvox, "npy": export_npy}[fmt](tree, path, depth)

@@ -22,8 +22,9 @@ std::string format_from_extension(const std::string& path) {
   if (ext == ".tif" || ext == ".tiff") return "tif";
   if (ext == ".bt" || ext == ".ot") return "octomap";
   if (ext == ".vdb") return "vdb";
+  if (ext == ".yaml" || ext == ".yml") return "rosmap";
   throw OptionError("format", path + ": cannot tell the format from the extension '" + ext +
-                                  "'; say `format` (ply, xyz, las, binvox, npy, png, tif, octomap, vdb)");
+                                  "'; say `format` (ply, xyz, las, binvox, npy, png, tif, octomap, vdb, rosmap)");
 }
 
 }  // namespace
@@ -58,8 +59,13 @@ std::string resolve_export_format(const ExportRequest& r) {
   if (r.resolution && !r.raster) throw OptionError("resolution", "`resolution` applies to `raster`");
   if ((r.ascii || r.cubes) && format != "ply") throw OptionError("ascii", "`ascii` and `cubes` apply to PLY export");
   if (r.bits && !r.map) throw OptionError("bits", "`bits` applies to `map`");
-  if (r.free && format != "octomap" && format != "vdb")
-    throw OptionError("free", "`free` applies to .bt, .ot and .vdb maps");
+  if (r.free && format != "octomap" && format != "vdb" && format != "rosmap")
+    throw OptionError("free", "`free` applies to .bt, .ot, .vdb and ROS (.yaml) maps");
+  if (r.band && format != "rosmap") throw OptionError("band", "`band` applies to a ROS map (.yaml)");
+  if (format == "rosmap" && !r.band)
+    throw OptionError("band",
+                      "a ROS map needs the height band a robot sweeps, ZMIN:ZMAX in the file's units (voxels "
+                      "whose centres lie in it are obstacles), e.g. `band` 0.2:1.8 above a floor at z = 0");
   return format;
 }
 

@@ -6,8 +6,9 @@
 # A real survey (pdal_autzen-utm.las, UTM metres) at 2 m goes vol -> .bt/.ot/.vdb -> vol
 # and must give the same voxels (.bt/.ot: moved to OctoMap's 0 with a warning, since UTM
 # coordinates lie beyond OctoMap's keys; .vdb: the same world centres); a `vola map` with
-# a state map exports occupied and free voxels with their log-odds (plain trees: --free); wrong voxel sizes, damaged
-# files and misplaced options fail with a message.
+# a state map exports occupied and free voxels with their log-odds (plain trees: --free), and a
+# ROS map of a scanned room; wrong voxel sizes, damaged files and misplaced options fail
+# with a message.
 # Exit status: 0 all good, 1 failures, 77 shared folder missing (outside CI).
 set -uo pipefail
 
@@ -99,7 +100,7 @@ expect_error "is a state map and holds its free voxels" "$vola" export "$tmp/map
 expect_error "is a map of 2 cells" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --voxel-size 3
 expect_error "its grids: 'occupied'" "$vola" convert "$tmp/a.vdb" "$tmp/x.vol" --grid density
 expect_error "applies to OpenVDB and .npz input only" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --grid occupied
-expect_error "--free applies to .bt, .ot and .vdb maps" "$vola" export "$tmp/a.vol" "$tmp/x.ply" --free "$tmp/map.free.vol"
+expect_error "--free applies to .bt, .ot, .vdb and ROS (.yaml) maps" "$vola" export "$tmp/a.vol" "$tmp/x.ply" --free "$tmp/map.free.vol"
 head -c 300 "$tmp/a.bt" >"$tmp/cut.bt"
 expect_error "$tmp/cut.bt.*the node stream ends inside a node" "$vola" convert "$tmp/cut.bt" "$tmp/x.vol"
 head -c 2000 "$tmp/a.vdb" >"$tmp/cut.vdb"
@@ -115,6 +116,71 @@ expect_error "utm.vol is in NAD83 / UTM zone 10N (EPSG:26910)" "$vola" union "$t
 expect_error "feet.vol in NAD83(HARN) / Oregon GIC Lambert (ft) (EPSG:2994)" "$vola" intersect "$tmp/utm.vol" "$tmp/feet.vol" "$tmp/u.vol"
 expect_error "the same voxel indices are different places" "$vola" diff "$tmp/feet.vol" "$tmp/utm.vol"
 "$vola" union "$tmp/utm.vol" "$tmp/feet.vol" "$tmp/u.vol" --ignore-frame -q || fail "--ignore-frame did not combine two CRSs"
+
+# A robot's 2D map for ROS navigation (map_server YAML + PGM) from a scan of a room: a
+# sensor 0.5 m above the floor of a 4 x 4 m room with a box 1 m high at (1, 0). For a
+# robot 0.1-0.45 m high (the floor voxels are centred at 0.05), the walls and the box are
+# obstacles, the space the rays crossed is free, and the box's shadow is unknown.
+/usr/bin/python3 - "$tmp/room.xyz" <<'PYTHON' || fail "writing the room scan"
+import sys
+points = []
+steps = [i / 10 - 1.95 for i in range(40)]          # -1.95 .. 1.95
+for a in steps:
+    for h in [i / 10 + 0.05 for i in range(15)]:     # walls 0 .. 1.5 m high
+        for x, y in ((2.0, a), (-2.0, a), (a, 2.0), (a, -2.0)):
+            points.append((x, y, h))
+    for b in steps:
+        if not (0.8 <= a <= 1.2 and -0.2 <= b <= 0.2):
+            points.append((a, b, 0.0))               # floor
+for a in [0.8 + i / 20 for i in range(9)]:
+    for b in [-0.2 + i / 20 for i in range(9)]:
+        points.append((a, b, 1.0))                   # the box's top
+    for h in [i / 20 for i in range(21)]:
+        points.append((0.8, a - 1.0, h))             # its side facing the sensor
+def hidden(x, y, z):  # the segment from the sensor stops inside the box first (a slab test)
+    start, end = (0.0, 0.0, 0.5), (x, y, z)
+    low, high = 0.0, 0.999
+    for s, e, lo, hi in zip(start, end, (0.8, -0.2, 0.0), (1.2, 0.2, 1.0)):
+        if s == e:
+            if not lo <= s <= hi:
+                return False
+            continue
+        t0, t1 = sorted(((lo - s) / (e - s), (hi - s) / (e - s)))
+        low, high = max(low, t0), min(high, t1)
+    return low <= high
+with open(sys.argv[1], "w") as out:
+    for x, y, z in points:
+        if not hidden(x, y, z):
+            out.write(f"{x} {y} {z - 0.5}\n")        # in the sensor's frame
+PYTHON
+printf 'room.xyz 0 0 0.5 0 0 0 1\n' >"$tmp/room_list.txt"
+"$vola" map "$tmp/room_list.txt" -o "$tmp/room.vol" --voxel-size 0.1 -q || fail "vola map of the room"
+"$vola" export "$tmp/room.vol" "$tmp/room.yaml" --band 0.1:0.45 >"$tmp/out" 2>"$tmp/err" || fail "ROS map export: $(cat "$tmp/err")"
+grep -q "ROS map (map_server YAML + PGM, trinary)" "$tmp/out" || fail "ROS map export said: $(cat "$tmp/out")"
+grep -q "free voxels in the band" "$tmp/out" || fail "a state map's free voxels were not used: $(cat "$tmp/out")"
+/usr/bin/python3 - "$tmp/room.yaml" <<'PYTHON' || fail "the room's ROS map"
+import math, os, sys
+fields = dict(line.split(": ", 1) for line in open(sys.argv[1]).read().splitlines())
+assert fields["mode"] == "trinary" and fields["negate"] == "0", fields
+resolution = float(fields["resolution"])
+ox, oy, _ = (float(v) for v in fields["origin"].strip("[]").split(","))
+data = open(os.path.join(os.path.dirname(sys.argv[1]), fields["image"]), "rb").read()
+magic, width, height, maxval, pixels = data.split(maxsplit=4)
+width, height = int(width), int(height)
+assert magic == b"P5" and maxval == b"255" and len(pixels) == width * height, (magic, width, height, len(pixels))
+def at(x, y):
+    col, row = math.floor((x - ox) / resolution), height - 1 - math.floor((y - oy) / resolution)
+    return pixels[row * width + col]
+expected = {(2.0, 0.55): 0, (-2.0, -1.05): 0, (0.35, 2.0): 0, (0.85, 0.05): 0,  # walls, the box's near side
+            (0.55, 0.55): 254, (-1.05, -1.05): 254, (-1.55, 0.35): 254,          # space the rays crossed
+            (1.05, 0.05): 205, (1.55, 0.05): 205}                                # inside the box, its shadow
+for (x, y), value in expected.items():
+    assert at(x, y) == value, f"cell at ({x}, {y}) is {at(x, y)}, expected {value}"
+PYTHON
+expect_error "a ROS map needs the height band" "$vola" export "$tmp/room.vol" "$tmp/r2.yaml"
+expect_error "holds no voxel centre of the map" "$vola" export "$tmp/room.vol" "$tmp/r2.yaml" --band 50:60
+expect_error "band applies to a ROS map" "$vola" export "$tmp/room.vol" "$tmp/r2.ply" --band 0:1
+[[ ! -e $tmp/r2.yaml && ! -e $tmp/r2.pgm ]] || fail "a refused ROS map export wrote a file"
 
 if [[ $failures -ne 0 ]]; then
   echo "cli_maps: $failures failure(s)" >&2

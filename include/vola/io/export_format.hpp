@@ -18,10 +18,12 @@ struct ExportRequest {
   bool ascii = false, cubes = false;  // PLY options
   bool bits = false;              // a height-map bit depth other than 16
   bool free = false;              // a tree of free voxels (maps)
+  bool band = false;              // a height band (ROS maps)
 };
 
 // "ply", "xyz", "las" (.las and .laz), "binvox", "npy", "png" (slices, map or
-// occupancy_above), "tif", "octomap" (.bt, .ot) or "vdb", after checking that every option
+// occupancy_above), "tif", "octomap" (.bt, .ot), "vdb" or "rosmap" (.yaml, .yml: a ROS
+// map_server map, which needs `band`), after checking that every option
 // given applies to it. OptionError (its cause naming options as `member`) otherwise.
 std::string resolve_export_format(const ExportRequest& request);
 

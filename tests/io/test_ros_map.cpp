@@ -1,0 +1,152 @@
+// ROS maps (map_server YAML + PGM) against a cell-by-cell reading of the rule, done the
+// slow way: every column's voxels looked at one by one, centres compared with the band.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "test_support.hpp"
+#include "vola/error.hpp"
+#include "vola/io/ros_map.hpp"
+
+namespace {
+
+using vola::Voxel;
+using vola::io::MapVoxels;
+
+struct Pgm {
+  std::uint32_t width = 0, height = 0;
+  std::vector<std::uint8_t> pixels;  // row 0 the top
+};
+
+Pgm read_pgm(const std::filesystem::path& path) {
+  const std::vector<std::uint8_t> bytes = vola_test::read_bytes(path);
+  std::istringstream header(std::string(bytes.begin(), bytes.begin() + std::min<std::size_t>(bytes.size(), 64)));
+  std::string magic;
+  unsigned maxval = 0;
+  Pgm pgm;
+  header >> magic >> pgm.width >> pgm.height >> maxval;
+  EXPECT_EQ(magic, "P5");
+  EXPECT_EQ(maxval, 255u);
+  const std::size_t start = static_cast<std::size_t>(header.tellg()) + 1;  // one whitespace after maxval
+  pgm.pixels.assign(bytes.begin() + static_cast<std::ptrdiff_t>(start), bytes.end());
+  EXPECT_EQ(pgm.pixels.size(), std::size_t{pgm.width} * pgm.height);
+  return pgm;
+}
+
+std::map<std::string, std::string> read_yaml(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::map<std::string, std::string> fields;
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto colon = line.find(": ");
+    if (colon != std::string::npos) fields[line.substr(0, colon)] = line.substr(colon + 2);
+  }
+  return fields;
+}
+
+// What a cell shows, by the rule read literally.
+std::uint8_t expected_pixel(const MapVoxels& map, std::uint32_t x, std::uint32_t y, double z_min, double z_max) {
+  const auto centre = [&](const Voxel& v) { return map.frame.origin[2] + (v.z + 0.5) * map.frame.voxel_size; };
+  bool occupied_in_band = false, free_in_band = false, occupied_below = false;
+  for (const Voxel& v : map.occupied)
+    if (v.x == x && v.y == y) {
+      occupied_in_band |= centre(v) >= z_min && centre(v) <= z_max;
+      occupied_below |= centre(v) < z_min;
+    }
+  for (const Voxel& v : map.free)
+    if (v.x == x && v.y == y) free_in_band |= centre(v) >= z_min && centre(v) <= z_max;
+  if (occupied_in_band) return 0;
+  if (map.free.empty() ? occupied_below : free_in_band) return 254;
+  return 205;
+}
+
+MapVoxels random_map(std::uint64_t seed, bool with_free) {
+  std::mt19937_64 random(seed);
+  std::uniform_int_distribution<std::uint32_t> xy(3, 20), z(5, 12);
+  MapVoxels map;
+  map.frame.origin = {-3.5, 100.25, 7.0};
+  map.frame.voxel_size = 0.25;
+  std::map<std::array<std::uint32_t, 3>, bool> cells;  // true: occupied
+  for (int i = 0; i < 300; ++i) cells[{xy(random), xy(random), z(random)}] = !with_free || random() % 3 != 0;
+  for (const auto& [cell, occupied] : cells)
+    (occupied ? map.occupied : map.free).push_back({cell[0], cell[1], cell[2]});
+  return map;
+}
+
+TEST(RosMap, EveryCellFollowsTheRule) {
+  vola_test::TempDir dir;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const bool with_free = seed % 2 == 0;
+    const MapVoxels map = random_map(seed, with_free);
+    // Bands whose ends fall on a voxel centre (8.625 = layer 6's), between centres, and
+    // past the map's top.
+    for (const auto& [z_min, z_max] : {std::pair{8.625, 9.5}, std::pair{8.7, 9.0}, std::pair{9.3, 100.0}}) {
+      const auto yaml = dir / ("map" + std::to_string(seed) + ".yaml");
+      const auto report = vola::io::write_ros_map(map, yaml.string(), {z_min, z_max});
+      const Pgm pgm = read_pgm(dir / ("map" + std::to_string(seed) + ".pgm"));
+      std::uint32_t x0 = ~0u, y0 = ~0u, x1 = 0, y1 = 0;
+      for (const auto* list : {&map.occupied, &map.free})
+        for (const Voxel& v : *list)
+          x0 = std::min(x0, v.x), y0 = std::min(y0, v.y), x1 = std::max(x1, v.x), y1 = std::max(y1, v.y);
+      ASSERT_EQ(pgm.width, x1 - x0 + 1);
+      ASSERT_EQ(pgm.height, y1 - y0 + 1);
+      std::uint64_t counts[3] = {0, 0, 0};
+      for (std::uint32_t row = 0; row < pgm.height; ++row)
+        for (std::uint32_t col = 0; col < pgm.width; ++col) {
+          const std::uint8_t want = expected_pixel(map, x0 + col, y1 - row, z_min, z_max);
+          ASSERT_EQ(pgm.pixels[std::size_t{row} * pgm.width + col], want)
+              << "seed " << seed << " cell " << col << "," << row;
+          ++counts[want == 0 ? 0 : want == 254 ? 1 : 2];
+        }
+      EXPECT_EQ(report.occupied, counts[0]);
+      EXPECT_EQ(report.free, counts[1]);
+      EXPECT_EQ(report.unknown, counts[2]);
+      EXPECT_GT(counts[0] + counts[1], 0u);
+      EXPECT_EQ(report.free_from_ground, !with_free);
+
+      const auto fields = read_yaml(yaml);
+      EXPECT_EQ(fields.at("image"), "map" + std::to_string(seed) + ".pgm");
+      EXPECT_EQ(fields.at("mode"), "trinary");
+      EXPECT_EQ(fields.at("resolution"), "0.25");
+      // The image's lower-left corner: the lowest column's corner in world coordinates.
+      std::ostringstream origin;
+      origin << "[" << -3.5 + 0.25 * x0 << ", " << 100.25 + 0.25 * y0 << ", 0.0]";
+      EXPECT_EQ(fields.at("origin"), origin.str());
+      EXPECT_EQ(fields.at("negate"), "0");
+      EXPECT_EQ(fields.at("occupied_thresh"), "0.65");
+      EXPECT_EQ(fields.at("free_thresh"), "0.196");
+    }
+  }
+}
+
+TEST(RosMap, BandsThatCannotBeAreRefusedNamingTheOption) {
+  vola_test::TempDir dir;
+  const MapVoxels map = random_map(1, false);
+  const auto refusal = [&](double z_min, double z_max) {
+    try {
+      vola::io::write_ros_map(map, (dir / "m.yaml").string(), {z_min, z_max});
+    } catch (const vola::OptionError& e) {
+      EXPECT_EQ(e.option(), "band");
+      return std::string(e.what());
+    }
+    return std::string("written");
+  };
+  EXPECT_NE(refusal(2.0, 1.0).find("upside down"), std::string::npos);
+  EXPECT_NE(refusal(NAN, 1.0).find("finite"), std::string::npos);
+  // Between two layers' centres (8.375 and 8.625), and below the map in another unit.
+  EXPECT_NE(refusal(8.4, 8.6).find(
+                "holds no voxel centre of the map: its layers are 0.25 apart, centred from z = 8.375 to 10.125"),
+            std::string::npos)
+      << refusal(8.4, 8.6);
+  EXPECT_NE(refusal(0.1, 1.5).find("holds no voxel centre"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.yaml"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.pgm"));
+}
+
+}  // namespace
