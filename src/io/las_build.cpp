@@ -821,6 +821,9 @@ Tree build_las(LasReader& reader, const BuildOptions& requested, bool attributes
   std::int32_t lo[3], hi[3];
   if (payload || !attributes)
     return build_streamed(reader, requested, attributes, payload, report, progress, chunk_points, used, lo, hi);
+  // A LAZ file is read twice or three times (bounds, occupancy, attributes): its records
+  // are decoded once and kept in a temporary file for the other passes.
+  reader.keep_decoded_records();
   // The attribute pass is one more over the points: progress counts it after the others.
   const std::uint64_t total = reader.points_total();
   std::uint64_t before = 0;

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <string>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -89,7 +91,13 @@ std::span<const std::uint8_t> LasReader::read_records(std::size_t max_points) {
   const LasHeader& hd = header_;
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max_points, points_total_ - next_));
   if (n == 0) return {};
-  if (hd.compressed()) return read_laz_records(n);
+  if (hd.compressed()) {
+    if (kept_complete_) return read_kept_records(n);
+    const std::uint64_t first = next_;
+    const std::span<const std::uint8_t> records = read_laz_records(n);
+    if (kept_fd_) keep(records, first);
+    return records;
+  }
   const std::size_t length = hd.record_length;
   const std::uint64_t at = hd.offset_to_points + next_ * length;
   if (!fd_) {  // in memory; the header check guarantees the records lie inside
@@ -143,10 +151,70 @@ std::size_t LasReader::read(LasChunk& chunk, std::size_t max_points, bool xyz_on
 LasReader::~LasReader() { settle_laz_prefetch(); }
 
 void LasReader::set_coordinates_only(bool on) {
+  on = on && !(kept_fd_ && !kept_complete_);  // records being kept are decoded whole
   if (on == coordinates_only_) return;
   settle_laz_prefetch();  // a batch decoded ahead was decoded the other way
   coordinates_only_ = on;
   rewind();
+}
+
+bool LasReader::keep_decoded_records() {
+  rewind();
+  if (!header_.compressed()) return false;
+  if (!kept_fd_) {
+    const char* dir = std::getenv("TMPDIR");
+    const std::string folder = dir && *dir ? dir : "/tmp";
+    int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd < 0) {  // a file system without O_TMPFILE: a named file, unlinked at once
+      std::string name = folder + "/vola-records-XXXXXX";
+      fd = ::mkostemp(name.data(), O_CLOEXEC);
+      if (fd >= 0) ::unlink(name.c_str());
+    }
+    if (fd < 0) return false;
+    kept_fd_ = std::shared_ptr<const int>(new int(fd), [](const int* f) {
+      ::close(*f);
+      delete f;
+    });
+  }
+  kept_points_ = 0;
+  kept_complete_ = false;
+  set_coordinates_only(false);
+  return true;
+}
+
+// Records [first, first + n) as decoded, appended when they are the next ones to keep.
+void LasReader::keep(std::span<const std::uint8_t> records, std::uint64_t first) {
+  const std::size_t length = header_.record_length;
+  if (first != kept_points_ || records.empty()) return;
+  std::uint64_t done = 0;
+  while (done < records.size()) {
+    const ::ssize_t put =
+        ::pwrite(*kept_fd_, records.data() + done, records.size() - done, static_cast<off_t>(first * length + done));
+    if (put < 0 && errno == EINTR) continue;
+    if (put <= 0) {  // no room: decode on every pass, as without a file
+      kept_fd_.reset();
+      kept_points_ = 0;
+      return;
+    }
+    done += static_cast<std::uint64_t>(put);
+  }
+  kept_points_ += records.size() / length;
+  kept_complete_ = kept_points_ == points_total_;
+}
+
+std::span<const std::uint8_t> LasReader::read_kept_records(std::size_t n) {
+  const std::size_t length = header_.record_length;
+  if (buffer_.size() < n * length) buffer_.resize(n * length);
+  std::uint64_t done = 0;
+  const std::uint64_t at = next_ * length;
+  while (done < n * length) {
+    const ::ssize_t got = ::pread(*kept_fd_, buffer_.data() + done, n * length - done, static_cast<off_t>(at + done));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) throw IoError(path_ + ": cannot read back the decoded records kept in a temporary file");
+    done += static_cast<std::uint64_t>(got);
+  }
+  next_ += n;
+  return {buffer_.data(), n * length};
 }
 
 void LasReader::rewind() {

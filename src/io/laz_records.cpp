@@ -56,6 +56,8 @@ void LasReader::select_copc_nodes(const std::optional<Box>& region, std::optiona
   chunk_order_.clear();
   points_total_ = 0;
   copc_level_ = max_level;
+  kept_points_ = 0;  // records kept were another selection's
+  kept_complete_ = false;
   std::vector<std::uint64_t> wanted;  // byte offsets of the selected nodes' chunks
   if (hd.copc)
     for (const CopcNode& node : hd.copc->nodes) {

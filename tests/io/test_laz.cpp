@@ -4,13 +4,16 @@
 // encode -> decode round trip; malformed input must be refused with FormatError.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
+#include <string>
 
 #include "io_test_data.hpp"
 #include "laz_test_support.hpp"
 #include "sha256.hpp"
 #include "vola/error.hpp"
+#include "vola/io/las.hpp"
 
 namespace {
 
@@ -98,3 +101,57 @@ TEST(LazDecode, LasTwinsGiveTheSameRecords) {
 }
 
 }  // namespace
+
+namespace {
+
+// Every record of `reader` from its start, by read_records().
+Bytes read_every_record(vola::io::LasReader& reader) {
+  reader.rewind();
+  Bytes out;
+  for (;;) {
+    const auto records = reader.read_records(997);  // batches that end inside chunks
+    if (records.empty()) return out;
+    out.insert(out.end(), records.begin(), records.end());
+  }
+}
+
+}  // namespace
+
+// A conversion with attributes reads a LAZ file two or three times; its records are
+// decoded once and kept in a temporary file. The kept records read back are the decoded
+// ones, a pass with coordinates alone keeps whole records, a new COPC selection starts
+// over, and a folder where no file can be made leaves the reader decoding as before.
+TEST(LazDecode, KeptRecordsReadBackAsDecoded) {
+  VOLA_REQUIRE_DATA(data);
+  for (const fs::path& path : vola_io_test::files_ending(data / "laz", ".laz")) {
+    SCOPED_TRACE(path.filename().string());
+    const Bytes decoded = vola_laz_test::decode_all(vola_laz_test::read_las_file(path));
+    vola::io::LasReader reader(path.string());
+    ASSERT_TRUE(reader.keep_decoded_records());
+    reader.set_coordinates_only(true);  // ignored while records are being kept
+    EXPECT_FALSE(reader.reads_kept_records());
+    EXPECT_TRUE(read_every_record(reader) == decoded);
+    EXPECT_TRUE(reader.reads_kept_records());
+    EXPECT_TRUE(read_every_record(reader) == decoded);
+    if (reader.header().copc) {
+      reader.select_copc_nodes(std::nullopt, 0);  // the root node alone
+      EXPECT_FALSE(reader.reads_kept_records());
+      const Bytes root = read_every_record(reader);
+      EXPECT_EQ(root.size(), reader.points_total() * reader.header().record_length);
+      EXPECT_TRUE(reader.reads_kept_records());
+      EXPECT_TRUE(read_every_record(reader) == root);
+    }
+  }
+  const char* before = std::getenv("TMPDIR");
+  const std::string saved = before ? before : "";
+  ::setenv("TMPDIR", "/nonexistent/folder", 1);
+  vola::io::LasReader reader((data / "laz" / "pdal_autzen_trim.laz").string());
+  EXPECT_FALSE(reader.keep_decoded_records());
+  const Bytes twice[2] = {read_every_record(reader), read_every_record(reader)};
+  EXPECT_FALSE(reader.reads_kept_records());
+  EXPECT_TRUE(twice[0] == twice[1]);
+  if (before)
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
+}

@@ -127,6 +127,18 @@ class LasReader {
   // only the coordinates. Off by default; changing it rewinds.
   void set_coordinates_only(bool on);
 
+  // LAZ: the next pass that reads every record keeps them, as decoded, in an unlinked
+  // temporary file ($TMPDIR, else /tmp: as many bytes as the LAS file would take); after
+  // it, read_records() reads them back from there (pread, as from a LAS file) instead of
+  // decoding the chunks again. For conversions that read the records more than once.
+  // Until that pass is complete, set_coordinates_only() is ignored (kept records are
+  // whole). A file that cannot be made or written (a full disk) is given up on quietly:
+  // the passes decode, as without it. Selecting COPC nodes starts the kept records over.
+  // Returns whether a file was made. Rewinds.
+  bool keep_decoded_records();
+  // Whether read_records() now reads kept records (the pass that kept them is complete).
+  bool reads_kept_records() const noexcept { return kept_complete_; }
+
   // LAZ: chunk `chunk` of header().laz_chunks decoded into `records` (resized to its
   // point count x record_length). Safe to call from many threads at once on a file
   // opened by path; throws FormatError naming the chunk and its byte offset.
@@ -144,6 +156,8 @@ class LasReader {
     std::size_t first = 0, count = 0;
   };
   std::span<const std::uint8_t> read_laz_records(std::size_t max_points);
+  void keep(std::span<const std::uint8_t> records, std::uint64_t first);
+  std::span<const std::uint8_t> read_kept_records(std::size_t max_points);
   void decode_laz_batch(LazBatch& batch, std::size_t begin) const;
   void settle_laz_prefetch() noexcept;
 
@@ -165,6 +179,11 @@ class LasReader {
   std::optional<int> copc_level_;
   bool coordinates_only_ = false;
   mutable std::atomic<std::uint64_t> bytes_read_{0};
+  // keep_decoded_records(): the temporary file, the records kept in it (the first
+  // kept_points_), and whether they are all there.
+  std::shared_ptr<const int> kept_fd_;
+  std::uint64_t kept_points_ = 0;
+  bool kept_complete_ = false;
 };
 
 // Point records from a LAS or LAZ file into a LAS (.las) or LAZ (.laz, LASzip compressor 2
