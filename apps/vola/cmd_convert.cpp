@@ -178,6 +178,10 @@ void add_convert(CLI::App& app) {
   cmd->add_flag("--solid", args->options.solid, "Mesh: also fill the inside of closed surfaces (flood fill of the outside)");
   cmd->add_option("--dem-base", args->options.dem_base, "DEM: height the voxel columns start from (default: the lowest cell)");
   cmd->add_flag("--dem-surface-only", args->options.dem_surface_only, "DEM: one voxel per cell at its height, no columns");
+  cmd->add_option(
+         "--map-height", args->options.map_height,
+         "ROS map (.yaml): each occupied cell a column this high from z = 0, in the map's units (default: one voxel)")
+      ->check(CLI::NonNegativeNumber);
   add_filter_options(*cmd, args->options.filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_convert(*args); });

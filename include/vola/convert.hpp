@@ -73,6 +73,7 @@ struct ConvertOptions {
   bool solid = false;               // meshes: fill the inside of closed surfaces too
   std::optional<double> dem_base;   // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;    // DEM: one voxel per cell at its height
+  double map_height = 0.0;          // ROS maps (.yaml): occupied cells as columns this high (0: one voxel)
 
   // ---- point filters, run in order on the points before they become voxels ----
   // One string per stage, as include/vola/filters/stages.hpp writes them: "where:EXPR",

@@ -139,15 +139,14 @@ Tree from_dense(const py::handle& input, std::optional<std::array<double, 3>> or
   return tree;
 }
 
-
-Tree convert(const std::filesystem::path& path, int depth,
-             double voxel_size, const std::string& quantize, const std::string& format, std::optional<std::uint32_t> epsg,
-             bool solid, bool attributes, std::optional<double> dem_base, bool dem_surface_only,
-             std::optional<std::array<double, 3>> origin, std::optional<std::array<double, 6>> bbox, int nbits,
-             std::array<int, 3> columns, std::vector<int> payload_columns, std::vector<std::string> text_attributes,
-             int skip_lines, bool dense, bool compress, const std::optional<std::filesystem::path>& output,
-             const std::string& target_crs, std::optional<int> level, const std::string& assign_crs,
-             bool allow_geographic, const std::string& grid, std::vector<std::string> filters, bool compress_max) {
+Tree convert(const std::filesystem::path& path, int depth, double voxel_size, const std::string& quantize,
+             const std::string& format, std::optional<std::uint32_t> epsg, bool solid, bool attributes,
+             std::optional<double> dem_base, bool dem_surface_only, std::optional<std::array<double, 3>> origin,
+             std::optional<std::array<double, 6>> bbox, int nbits, std::array<int, 3> columns,
+             std::vector<int> payload_columns, std::vector<std::string> text_attributes, int skip_lines, bool dense,
+             bool compress, const std::optional<std::filesystem::path>& output, const std::string& target_crs,
+             std::optional<int> level, const std::string& assign_crs, bool allow_geographic, const std::string& grid,
+             std::vector<std::string> filters, bool compress_max, double map_height) {
   vola::ConvertOptions options;
   options.filters = std::move(filters);
   options.format = format;
@@ -171,6 +170,7 @@ Tree convert(const std::filesystem::path& path, int depth,
   options.solid = solid;
   options.dem_base = dem_base;
   options.dem_surface_only = dem_surface_only;
+  options.map_height = map_height;
   options.dense = dense;
   options.compress = compress;
   options.compress_max = compress_max;
@@ -183,7 +183,6 @@ Tree convert(const std::filesystem::path& path, int depth,
     return tree;
   });
 }
-
 
 }  // namespace
 
@@ -238,6 +237,7 @@ void bind_building(py::module_& m) {
         py::arg("compress") = false, py::arg("output") = py::none(), py::arg("target_crs") = "",
         py::arg("level") = py::none(), py::arg("assign_crs") = "", py::arg("allow_geographic") = false,
         py::arg("grid") = "", py::arg("filters") = std::vector<std::string>{}, py::arg("compress_max") = false,
+        py::arg("map_height") = 0.0,
         "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
         "OpenVDB .vdb) and builds its\n"
         "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
@@ -250,7 +250,9 @@ void bind_building(py::module_& m) {
         "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
         "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
         "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
-        "maps (.bt, .ot, .vdb) keep their own cells (another voxel_size is refused); grid='NAME' picks a .vdb grid or "
+        "maps (.bt, .ot, .vdb, ROS .yaml) keep their own cells (another voxel_size is refused); map_height=H makes a "
+        "ROS\n"
+        "map's occupied cells columns H high; grid='NAME' picks a .vdb grid or "
         "an .npz array.\n"
         "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
         "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).");

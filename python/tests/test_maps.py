@@ -96,3 +96,18 @@ def test_a_ros_map_from_python_is_the_cli_s(tmp_path, vola_cli):
         vola.export(state, tmp_path / "x.yaml")
     with pytest.raises(vola.InvalidArgument, match="band: band applies to a ROS map"):
         vola.export(state, tmp_path / "x.ply", band=(0, 1))
+
+
+def test_a_ros_map_reads_back_as_columns(tmp_path):
+    m = vola.Map(0.25)
+    rng = np.random.default_rng(6)
+    m.insert(rng.uniform(-3, 3, size=(400, 3)), origin=(0.05, 0.1, 0.15))
+    m.save(tmp_path / "map.vol")
+    report = vola.export(vola.read(tmp_path / "map.vol"), tmp_path / "m.yaml", band=(-0.5, 0.5))
+    one = vola.convert(tmp_path / "m.yaml")
+    three = vola.convert(tmp_path / "m.yaml", map_height=0.6)  # 0.6 / 0.25: three voxels a column
+    assert one.voxel_count == report["occupied"]
+    assert three.voxel_count == 3 * report["occupied"]
+    (tmp_path / "p.xyz").write_text("0 0 0\n1 1 1\n")
+    with pytest.raises(vola.InvalidArgument, match="map_height: applies to ROS map input only"):
+        vola.convert(tmp_path / "p.xyz", voxel_size=1.0, map_height=1.0)

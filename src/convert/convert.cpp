@@ -44,6 +44,9 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
+  if (options.map_height != 0.0 && format.name != "rosmap")
+    throw OptionError("map_height", "applies to ROS map input only (" + path + " is " + format.name + ")");
+  input.map_height = options.map_height;
   if (options.level && format.name != "las" && format.name != "ept")
     throw OptionError("level", "applies to COPC and EPT input only (" + path + " is " + format.name + ")");
   input.copc_level = options.level;

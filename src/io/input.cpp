@@ -22,6 +22,7 @@
 #include "vola/io/pcd.hpp"
 #include "vola/io/ply.hpp"
 #include "vola/io/ptx.hpp"
+#include "vola/io/ros_map.hpp"
 
 namespace vola::io {
 
@@ -112,6 +113,13 @@ Input read_octomap_input(const std::string& path, const InputOptions& options) {
   return in;
 }
 
+Input read_ros_map_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "rosmap";
+  in.grid = read_ros_map(path, options.map_height);
+  return in;
+}
+
 Input read_vdb_input(const std::string& path, const InputOptions& options) {
   Input in;
   in.format = "vdb";
@@ -167,6 +175,10 @@ std::vector<InputFormat> make_formats() {
        "OctoMap occupancy maps through liboctomap: occupied cells (.ot: with log-odds)",
        read_octomap_input},
       {"vdb", {".vdb"}, "OpenVDB grids through OpenVDB: the active voxels of one grid", read_vdb_input},
+      {"rosmap",
+       {".yaml", ".yml"},
+       "ROS 2D maps (map_server YAML + PGM): occupied cells as voxel columns (map_height)",
+       read_ros_map_input},
       {"ept", {".json"}, "Entwine Point Tiles: the ept.json of a local EPT folder (laszip or binary data)", read_ept},
       {"ptx",
        {".ptx"},

@@ -8,7 +8,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <span>
 #include <string>
 #include <string_view>
@@ -24,20 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 using vola_fuzz::check;
 
-// The scratch dataset folder of this process, emptied for each input and removed when
-// the process exits.
-fs::path dataset_folder() {
-  static const fs::path folder = [] {
-    const fs::path f = fs::temp_directory_path() / ("vola_fuzz_ept_" + std::to_string(::getpid()));
-    vola_fuzz::scratch_files().add(f.string());
-    return f;
-  }();
+// The scratch dataset folder of this process, emptied for each input.
+const fs::path& dataset_folder() {
+  static const fs::path folder = vola_fuzz::scratch_folder("ept");
   return folder;
-}
-
-void write(const fs::path& path, std::string_view bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 // The number of points read, checking that every column has one value per point.
@@ -60,11 +49,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                             root / "ept-hierarchy" / "1-0-0-0.json"};
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (i < 3) {
-      write(files[i], parts[i]);
+      vola_fuzz::write_scratch(files[i], parts[i]);
     } else if (i < 5) {
       const std::string key = i == 3 ? "0-0-0-0" : "1-0-0-0";
-      write(root / "ept-data" / (key + ".bin"), parts[i]);
-      write(root / "ept-data" / (key + ".laz"), parts[i]);
+      vola_fuzz::write_scratch(root / "ept-data" / (key + ".bin"), parts[i]);
+      vola_fuzz::write_scratch(root / "ept-data" / (key + ".laz"), parts[i]);
     }
   }
   const std::string ept = (root / "ept.json").string();

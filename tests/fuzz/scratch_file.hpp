@@ -10,6 +10,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <string_view>
 
 namespace vola_fuzz {
 
@@ -48,6 +49,20 @@ inline std::string scratch_file(const std::string& stem, const std::string& exte
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   return path;
+}
+
+// "<tmp>/vola_fuzz_<stem>_<pid>", a folder for inputs that are several files (an EPT
+// dataset, a ROS map's YAML and image), removed when the process exits; not created here.
+inline std::filesystem::path scratch_folder(const std::string& stem) {
+  const auto folder = std::filesystem::temp_directory_path() / ("vola_fuzz_" + stem + "_" + std::to_string(::getpid()));
+  scratch_files().add(folder.string());
+  return folder;
+}
+
+// Writes `bytes` to `path`, replacing what was there.
+inline void write_scratch(const std::filesystem::path& path, std::string_view bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 }  // namespace vola_fuzz

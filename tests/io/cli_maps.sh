@@ -177,6 +177,12 @@ expected = {(2.0, 0.55): 0, (-2.0, -1.05): 0, (0.35, 2.0): 0, (0.85, 0.05): 0,  
 for (x, y), value in expected.items():
     assert at(x, y) == value, f"cell at ({x}, {y}) is {at(x, y)}, expected {value}"
 PYTHON
+# And back: the occupied cells as voxel columns 0.5 m high (five voxels of 0.1 m).
+occupied=$(grep -o "[0-9]* occupied" "$tmp/out" | grep -o "[0-9]*")
+"$vola" convert "$tmp/room.yaml" "$tmp/room_back.vol" --map-height 0.5 -q || fail "convert of the ROS map"
+"$vola" info "$tmp/room_back.vol" | grep -q "voxels: *$((occupied * 5)) occupied" ||
+  fail "the ROS map did not read back as $occupied columns of 5 voxels: $("$vola" info "$tmp/room_back.vol" | grep voxels)"
+expect_error "map-height: applies to ROS map input only" "$vola" convert "$las" "$tmp/x.vol" --voxel-size 2 --map-height 1
 expect_error "a ROS map needs the height band" "$vola" export "$tmp/room.vol" "$tmp/r2.yaml"
 expect_error "holds no voxel centre of the map" "$vola" export "$tmp/room.vol" "$tmp/r2.yaml" --band 50:60
 expect_error "band applies to a ROS map" "$vola" export "$tmp/room.vol" "$tmp/r2.ply" --band 0:1

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -150,3 +151,117 @@ TEST(RosMap, BandsThatCannotBeAreRefusedNamingTheOption) {
 }
 
 }  // namespace
+
+namespace {
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::set<std::array<std::uint32_t, 3>> voxel_set(const std::vector<Voxel>& voxels) {
+  std::set<std::array<std::uint32_t, 3>> out;
+  for (const Voxel& v : voxels) out.insert({v.x, v.y, v.z});
+  return out;
+}
+
+}  // namespace
+
+// What vola writes reads back: the occupied cells, on the map's grid, as one layer or as
+// columns of map_height.
+TEST(RosMap, WrittenMapsReadBackCellForCell) {
+  vola_test::TempDir dir;
+  const MapVoxels map = random_map(3, true);
+  const auto yaml = (dir / "m.yaml").string();
+  vola::io::write_ros_map(map, yaml, {8.625, 9.5});
+  const Pgm pgm = read_pgm(dir / "m.pgm");
+  std::uint32_t x0 = ~0u, y0 = ~0u;
+  for (const auto* list : {&map.occupied, &map.free})
+    for (const Voxel& v : *list) x0 = std::min(x0, v.x), y0 = std::min(y0, v.y);
+  std::set<std::array<std::uint32_t, 3>> expected;
+  for (std::uint32_t row = 0; row < pgm.height; ++row)
+    for (std::uint32_t col = 0; col < pgm.width; ++col)
+      if (pgm.pixels[std::size_t{row} * pgm.width + col] == 0) expected.insert({col, pgm.height - 1 - row, 0});
+  ASSERT_FALSE(expected.empty());
+  const vola::io::VoxelGrid one = vola::io::read_ros_map(yaml, 0.0);
+  EXPECT_EQ(voxel_set(one.voxels), expected);
+  EXPECT_EQ(one.voxel_size, 0.25);
+  EXPECT_EQ(one.origin, (vola::Point{-3.5 + 0.25 * x0, 100.25 + 0.25 * y0, 0.0}));
+  EXPECT_TRUE(one.fixed_voxel_size);
+  const vola::io::VoxelGrid tall = vola::io::read_ros_map(yaml, 0.6);  // 0.6 / 0.25: three layers
+  std::set<std::array<std::uint32_t, 3>> columns;
+  for (const auto& c : expected)
+    for (std::uint32_t k = 0; k < 3; ++k) columns.insert({c[0], c[1], k});
+  EXPECT_EQ(voxel_set(tall.voxels), columns);
+}
+
+// Maps as map_server reads them: text (P2) and 16-bit PGMs, negate, thresholds, raw mode,
+// lists as "- item" lines, quotes and comments.
+TEST(RosMap, MapServerVariantsRead) {
+  vola_test::TempDir dir;
+  // 3 x 2 pixels, row 0 the top: 0 (black) is occupied, 254 free, 205 unknown, 100 grey.
+  write_text(dir / "text.pgm", "P2\n# a comment\n3 2\n255\n0 254 205\n100 0 254\n");
+  write_text(dir / "a.yaml",
+             "image: \"text.pgm\"  # the picture\nresolution: 0.5\norigin:\n  - 1.0\n  - -2.0\n  - 0.0\n");
+  EXPECT_EQ(
+      voxel_set(vola::io::read_ros_map((dir / "a.yaml").string(), 0).voxels),
+      (std::set<std::array<std::uint32_t, 3>>{{0, 1, 0}, {1, 0, 0}}));  // the zeros; 100 is p = 0.61, not above 0.65
+  write_text(dir / "b.yaml", "image: text.pgm\nresolution: 0.5\norigin: [1.0, -2.0, 0.0]\noccupied_thresh: 0.5\n");
+  EXPECT_EQ(vola::io::read_ros_map((dir / "b.yaml").string(), 0).voxels.size(), 3u);  // 100 is p = 0.61 > 0.5
+  write_text(dir / "c.yaml", "image: text.pgm\nresolution: 0.5\norigin: [1.0, -2.0, 0.0]\nnegate: 1\n");
+  EXPECT_EQ(voxel_set(vola::io::read_ros_map((dir / "c.yaml").string(), 0).voxels),
+            (std::set<std::array<std::uint32_t, 3>>{{1, 1, 0}, {2, 1, 0}, {2, 0, 0}}));  // 254 and 205 are p > 0.65
+  std::string wide = "P5\n2 1\n65535\n";
+  wide += std::string("\x00\x00\xff\xff", 4);  // black, white
+  write_text(dir / "wide.pgm", wide);
+  write_text(dir / "d.yaml", "image: wide.pgm\nresolution: 1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(voxel_set(vola::io::read_ros_map((dir / "d.yaml").string(), 0).voxels),
+            (std::set<std::array<std::uint32_t, 3>>{{0, 0, 0}}));
+  std::string raw = "P5\n3 1\n255\n";
+  raw += std::string("\x64\x00\xff", 3);  // 100 %, 0 %, unknown
+  write_text(dir / "raw.pgm", raw);
+  write_text(dir / "e.yaml", "image: raw.pgm\nmode: raw\nresolution: 1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(voxel_set(vola::io::read_ros_map((dir / "e.yaml").string(), 0).voxels),
+            (std::set<std::array<std::uint32_t, 3>>{{0, 0, 0}}));
+}
+
+TEST(RosMap, BadMapsAreFormatErrorsNamingTheFile) {
+  vola_test::TempDir dir;
+  write_text(dir / "ok.pgm", "P5\n2 2\n255\n" + std::string(4, '\0'));
+  const auto error_of = [&](const std::string& name, const std::string& yaml) {
+    write_text(dir / name, yaml);
+    const std::string path = (dir / name).string();
+    try {
+      vola::io::read_ros_map(path, 0);
+    } catch (const vola::FormatError& e) {
+      return std::string(e.what());
+    }
+    return std::string("read");
+  };
+  const std::string base = "image: ok.pgm\nresolution: 0.1\n";
+  EXPECT_NE(error_of("nested.yaml", base + "origin: [[[[[0]]]], 0, 0]\n").find("nested list"), std::string::npos);
+  EXPECT_NE(error_of("map.yaml", base + "origin: {x: 0}\n").find("a mapping under 'origin'"), std::string::npos);
+  EXPECT_NE(error_of("indent.yaml", base + "origin: [0, 0, 0]\n  extra: 1\n").find("an indented line"),
+            std::string::npos);
+  EXPECT_NE(error_of("yaw.yaml", base + "origin: [0, 0, 1.57]\n").find("turned by yaw 1.57"), std::string::npos);
+  EXPECT_NE(error_of("noimage.yaml", "resolution: 0.1\norigin: [0, 0, 0]\n").find("no 'image'"), std::string::npos);
+  EXPECT_NE(error_of("noorigin.yaml", base).find("no 'origin'"), std::string::npos);
+  EXPECT_NE(error_of("twice.yaml", base + base + "origin: [0, 0, 0]\n").find("given twice"), std::string::npos);
+  EXPECT_NE(error_of("short.yaml", base + "origin: [0]\n").find("'origin' needs 2 values"), std::string::npos);
+  EXPECT_NE(error_of("nan.yaml", "image: ok.pgm\nresolution: nan\norigin: [0, 0, 0]\n").find("not a finite number"),
+            std::string::npos);
+  EXPECT_NE(error_of("mode.yaml", base + "origin: [0, 0, 0]\nmode: fancy\n").find("mode 'fancy'"), std::string::npos);
+  // A PGM whose header claims more than the file holds is refused before anything that
+  // size is allocated (2^31 cells here); one that is cut short names its byte.
+  write_text(dir / "lying.pgm", "P5\n65536 32768\n255\n" + std::string(16, '\0'));
+  EXPECT_NE(error_of("lying.yaml", "image: lying.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("cells is more than"),
+            std::string::npos);
+  write_text(dir / "cut.pgm", "P5\n100 100\n255\n" + std::string(16, '\0'));
+  EXPECT_NE(error_of("cut.yaml", "image: cut.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("byte 15: PGM: truncated"),
+            std::string::npos)
+      << error_of("cut.yaml", "image: cut.pgm\nresolution: 1\norigin: [0, 0, 0]\n");
+  EXPECT_NE(error_of("png.yaml", "image: noimage.yaml\nresolution: 1\norigin: [0, 0, 0]\n").find("not a PGM image"),
+            std::string::npos);
+  write_text(dir / "white.pgm", "P5\n2 2\n255\n" + std::string(4, '\xfe'));
+  EXPECT_NE(error_of("empty.yaml", "image: white.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("no occupied cell"),
+            std::string::npos);
+}

@@ -25,6 +25,7 @@ struct InputOptions {
   std::function<void(std::uint64_t, std::uint64_t)> progress;  // (done, total), any unit
   std::optional<double> dem_base;  // DEM: height the columns start from (default: the lowest cell)
   bool dem_surface_only = false;   // DEM: one voxel per cell, no column below it
+  double map_height = 0.0;         // ROS maps: occupied cells' column height (0: one voxel)
   std::optional<int> copc_level;   // COPC and EPT: only the octree's levels 0..copc_level
   // EPT: nodes whose cube misses this box are not read (vola convert passes the grid's
   // region, vola::grid_region, when a bbox fixes the grid); points outside it may still

@@ -1,12 +1,13 @@
-// A 2D occupancy grid for ROS navigation (map_server / nav2_map_server: a YAML file and
-// its PGM image, as map_saver writes them) from a 3D map: the voxels whose centres lie in a
-// height band (the space a robot sweeps) project onto the floor plan.
+// ROS 2D occupancy grids (map_server / nav2_map_server: a YAML file and its PGM image, as
+// map_saver writes them): written from a 3D map, the voxels whose centres lie in a height
+// band (the space a robot sweeps) projected onto the floor plan; read as voxel columns.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <string>
 
+#include "vola/io/input.hpp"
 #include "vola/io/occupancy_maps.hpp"
 
 namespace vola::io {
@@ -38,5 +39,15 @@ struct RosMapReport {
 // down or holds no voxel layer of the map; InvalidArgument for an empty map or more than
 // 2^30 cells.
 RosMapReport write_ros_map(const MapVoxels& voxels, const std::string& yaml_path, const RosMapOptions& options);
+
+// A map_server map (its YAML, naming a PGM image beside it or by an absolute path) as voxel
+// columns: every occupied cell (map_server's rule: p = (255 - v) / 255, v / 255 when
+// negated, occupied when p > occupied_thresh; raw mode: v percent) becomes a column of
+// ceil(height / resolution) voxels (one when height is 0) from z = 0, on the map's grid
+// (voxel size = resolution, origin = the YAML's origin x, y and 0). Free and unknown cells
+// are left out. FormatError (file, byte) for a YAML that is not flat keys, a missing key,
+// a yaw other than 0, a truncated or lying PGM; OptionError ("map_height") for a height
+// that is negative or makes more than 2^28 voxels.
+VoxelGrid read_ros_map(const std::string& yaml_path, double height);
 
 }  // namespace vola::io
