@@ -18,6 +18,7 @@
 
 #include "vola/error.hpp"
 #include "vola/io/input.hpp"
+#include "vola/io/png_decode.hpp"
 
 namespace vola::io {
 
@@ -137,14 +138,46 @@ double ros_yaml_number(const RosYaml& yaml, const std::string& path, const std::
   return value;
 }
 
-// The map image: binary (P5, 8 or 16 bits) or text (P2) PGM, as map_saver writes it.
+// The map image: binary (P5, 8 or 16 bits) or text (P2) PGM, as map_saver writes it, or a PNG.
 struct RosMapImage {
   std::uint32_t width = 0, height = 0;
   unsigned maxval = 255;
   std::vector<std::uint16_t> pixels;  // row 0 the top
 };
 
-RosMapImage read_ros_pgm(const std::string& path) {
+// A PNG map (map_saver --fmt png), as map_server reads one: colour channels averaged,
+// alpha left out. Its size is checked from the header chunk before libpng decodes it.
+RosMapImage read_ros_png(const std::string& path, const std::string& head) {
+  const auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(head[at + i]);
+    return v;
+  };
+  if (head.compare(12, 4, "IHDR") != 0) throw FormatError(path, 12, "PNG: the first chunk is not IHDR");
+  const std::uint64_t cells = std::uint64_t{be32(16)} * be32(20);
+  if (cells > kMaxRosMapCells)
+    throw FormatError(path, 16,
+                      "a map of " + std::to_string(be32(16)) + " x " + std::to_string(be32(20)) +
+                          " cells is more than " + std::to_string(kMaxRosMapCells));
+  const DecodedPng png = decode_png(path);
+  RosMapImage image;
+  image.width = png.width;
+  image.height = png.height;
+  image.maxval = png.bit_depth == 16 ? 65535 : 255;
+  const std::size_t sample_bytes = png.bit_depth == 16 ? 2 : 1;
+  const auto channels = static_cast<std::size_t>(png.channels);
+  const std::size_t averaged = channels >= 3 ? 3 : 1;  // grey (+ alpha): the grey; colour (+ alpha): R, G, B
+  image.pixels.resize(std::size_t{png.width} * png.height);
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    const std::uint8_t* p = png.bytes.data() + i * channels * sample_bytes;
+    unsigned sum = 0;
+    for (std::size_t c = 0; c < averaged; ++c) sum += sample_bytes == 2 ? unsigned{p[2 * c]} << 8 | p[2 * c + 1] : p[c];
+    image.pixels[i] = static_cast<std::uint16_t>(sum / averaged);
+  }
+  return image;
+}
+
+RosMapImage read_ros_image(const std::string& path) {
   std::error_code error;
   const std::uint64_t size =
       std::filesystem::is_regular_file(path, error) ? std::filesystem::file_size(path, error) : 0;
@@ -183,8 +216,9 @@ RosMapImage read_ros_pgm(const std::string& path) {
       throw FormatError(path, begin, std::string("PGM: expected the ") + what);
     return value;
   };
+  if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return read_ros_png(path, bytes);
   if (bytes.size() < 2 || bytes[0] != 'P' || (bytes[1] != '5' && bytes[1] != '2'))
-    throw FormatError(path, 0, "not a PGM image (P5 or P2): vola reads map_server maps saved as PGM");
+    throw FormatError(path, 0, "not a PGM (P5 or P2) or PNG image: vola reads map_server maps saved as PGM or PNG");
   const bool binary = bytes[1] == '5';
   at = 2;
   RosMapImage image;
@@ -265,7 +299,7 @@ VoxelGrid read_ros_map(const std::string& yaml_path, double height) {
 
   std::filesystem::path image_path = image_key->second[0];
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
-  const RosMapImage image = read_ros_pgm(image_path.string());
+  const RosMapImage image = read_ros_image(image_path.string());
 
   // map_server's rule: occupancy p = (255 - v) / 255 (v / 255 when negated), occupied when
   // p > occupied_thresh; raw mode takes v as the occupancy in percent (0-100; above 100,

@@ -1,10 +1,16 @@
 // Seeds for fuzz_rosmap_read: map_server maps in the entry point's layout (YAML, a zero
-// byte, the PGM): map_saver's trinary maps in binary and text PGM, a 16-bit image, a
+// byte, the image): map_saver's trinary maps in binary and text PGM and in PNG, a 16-bit image, a
 // negated map with "- item" lists, quotes and comments, raw and scale modes. Linked into
 // fuzz_rosmap_read_replay in place of fuzz_seeds.cpp.
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
+#include <unistd.h>
+
 #include "fuzz_seeds.hpp"
+#include "vola/io/png_image.hpp"
 
 namespace vola_fuzz {
 namespace {
@@ -25,6 +31,22 @@ std::string room_pgm() {
   return pgm;
 }
 
+// The room as an RGB PNG (map_saver --fmt png).
+std::string room_png() {
+  const std::string pgm = room_pgm();
+  const std::string grey = pgm.substr(pgm.size() - 24);
+  std::string rgb;
+  for (const char v : grey) rgb.append(3, v);
+  const auto path =
+      std::filesystem::temp_directory_path() / ("vola_seed_rosmap_" + std::to_string(::getpid()) + ".png");
+  vola::io::write_png(path.string(), 6, 4, reinterpret_cast<const std::uint8_t*>(rgb.data()), 8,
+                      vola::io::PngColour::rgb);
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::filesystem::remove(path);
+  return bytes;
+}
+
 }  // namespace
 
 std::vector<Seed> synthetic_seeds() {
@@ -41,6 +63,7 @@ std::vector<Seed> synthetic_seeds() {
       map_seed("raw", "image: map.pgm\nmode: raw\nresolution: 0.1\norigin: [0, 0, 0]\n", "P5\n3 1\n255\n\x64\x00\xff"),
       map_seed("scale", "---\nimage: \"map.pgm\"\nmode: scale\nresolution: 2.0\norigin: [5, 5, 0.0]\n...\n",
                room_pgm()),
+      map_seed("png", yaml, room_png()),
   };
 }
 

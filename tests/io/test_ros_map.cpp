@@ -13,6 +13,7 @@
 
 #include "test_support.hpp"
 #include "vola/error.hpp"
+#include "vola/io/png_image.hpp"
 #include "vola/io/ros_map.hpp"
 
 namespace {
@@ -224,6 +225,26 @@ TEST(RosMap, MapServerVariantsRead) {
             (std::set<std::array<std::uint32_t, 3>>{{0, 0, 0}}));
 }
 
+// A map saved as PNG (map_saver --fmt png) reads as its PGM: grey as it is, colour
+// channels averaged (alpha is not written here: PngImage writes grey or RGB).
+TEST(RosMap, PngMapsReadAsTheirPgm) {
+  vola_test::TempDir dir;
+  const std::uint8_t grey[6] = {0, 254, 205, 100, 0, 254};
+  write_text(dir / "grey.pgm", "P5\n3 2\n255\n" + std::string(reinterpret_cast<const char*>(grey), 6));
+  vola::io::write_png((dir / "grey.png").string(), 3, 2, grey, 8, vola::io::PngColour::grey);
+  // Colour pixels whose channel means are the grey values above (the last: 252.7, free too).
+  const std::uint8_t rgb[18] = {0, 0, 0, 254, 254, 254, 200, 210, 205, 90, 100, 110, 0, 0, 0, 250, 254, 254};
+  vola::io::write_png((dir / "rgb.png").string(), 3, 2, rgb, 8, vola::io::PngColour::rgb);
+  const auto cells = [&](const std::string& image) {
+    write_text(dir / "m.yaml", "image: " + image + "\nresolution: 1\norigin: [0, 0, 0]\noccupied_thresh: 0.5\n");
+    return voxel_set(vola::io::read_ros_map((dir / "m.yaml").string(), 0).voxels);
+  };
+  const auto expected = cells("grey.pgm");
+  EXPECT_EQ(expected.size(), 3u);
+  EXPECT_EQ(cells("grey.png"), expected);
+  EXPECT_EQ(cells("rgb.png"), expected);
+}
+
 TEST(RosMap, BadMapsAreFormatErrorsNamingTheFile) {
   vola_test::TempDir dir;
   write_text(dir / "ok.pgm", "P5\n2 2\n255\n" + std::string(4, '\0'));
@@ -259,7 +280,8 @@ TEST(RosMap, BadMapsAreFormatErrorsNamingTheFile) {
   EXPECT_NE(error_of("cut.yaml", "image: cut.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("byte 15: PGM: truncated"),
             std::string::npos)
       << error_of("cut.yaml", "image: cut.pgm\nresolution: 1\norigin: [0, 0, 0]\n");
-  EXPECT_NE(error_of("png.yaml", "image: noimage.yaml\nresolution: 1\norigin: [0, 0, 0]\n").find("not a PGM image"),
+  EXPECT_NE(error_of("png.yaml", "image: noimage.yaml\nresolution: 1\norigin: [0, 0, 0]\n")
+                .find("not a PGM (P5 or P2) or PNG image"),
             std::string::npos);
   write_text(dir / "white.pgm", "P5\n2 2\n255\n" + std::string(4, '\xfe'));
   EXPECT_NE(error_of("empty.yaml", "image: white.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("no occupied cell"),

@@ -40,7 +40,7 @@ struct RosMapReport {
 // 2^30 cells.
 RosMapReport write_ros_map(const MapVoxels& voxels, const std::string& yaml_path, const RosMapOptions& options);
 
-// A map_server map (its YAML, naming a PGM image beside it or by an absolute path) as voxel
+// A map_server map (its YAML, naming a PGM or PNG image beside it or by an absolute path) as voxel
 // columns: every occupied cell (map_server's rule: p = (255 - v) / 255, v / 255 when
 // negated, occupied when p > occupied_thresh; raw mode: v percent) becomes a column of
 // ceil(height / resolution) voxels (one when height is 0) from z = 0, on the map's grid
