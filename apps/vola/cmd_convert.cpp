@@ -122,6 +122,8 @@ void add_convert(CLI::App& app) {
       "  voxel size (--voxel-size must equal it), the grid origin on the file's cells; .ot\n"
       "  log-odds and .vdb float/double/int32 values become a column (log_odds, or the grid's\n"
       "  name). Rotated, sheared or non-uniform .vdb transforms are refused.\n"
+      "  ROS maps (map_server's MAP.yaml and its PGM or PNG): occupied cells as columns from\n"
+      "  z = 0, one voxel or --map-height H high, on the map's own grid (yaw 0 only).\n"
       "Examples:\n"
       "  vola convert city.xyz city.vol --voxel-size 0.5 --assign-crs 32633\n"
       "  vola convert input.txt out.vol --quantize toolkit --depth 3 --nbits 1\n"
@@ -132,6 +134,7 @@ void add_convert(CLI::App& app) {
       "  vola convert dem.tif dem.vol --voxel-size 30 --dem-base 0\n"
       "  vola convert map.bt map.vol\n"
       "  vola convert fields.vdb density.vol --grid density\n"
+      "  vola convert office.yaml office.vol --map-height 2    # a ROS map as walls 2 m high\n"
       "  vola convert autzen.laz ground.vol --voxel-size 3 --where \"Classification == 2\"\n"
       "  vola convert autzen.laz trees.vol --voxel-size 3 --filter smrf --filter hag --where \"HeightAboveGround > 6\"\n" +
       std::string(kFilterHelp));
