@@ -19,7 +19,7 @@ namespace {
 constexpr std::uint8_t kOccupiedPixel = 0, kFreePixel = 254, kUnknownPixel = 205;
 // A cell's evidence, as bits.
 constexpr std::uint8_t kOccupiedInBand = 1, kFreeInBand = 2, kOccupiedBelow = 4;
-constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 30;  // a byte each while the image is made
+constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 28;  // 16384 x 16384, as the reader takes
 
 std::string ros_map_number(double value) {
   char digits[32];

@@ -37,7 +37,7 @@ struct RosMapReport {
 // Pixel values and thresholds are map_saver's (trinary mode, negate 0, occupied_thresh
 // 0.65, free_thresh 0.196). OptionError ("band") for a band that is not finite, upside
 // down or holds no voxel layer of the map; InvalidArgument for an empty map or more than
-// 2^30 cells.
+// 2^28 cells (what read_ros_map takes).
 RosMapReport write_ros_map(const MapVoxels& voxels, const std::string& yaml_path, const RosMapOptions& options);
 
 // A map_server map (its YAML, naming a PGM or PNG image beside it or by an absolute path) as voxel
