@@ -16,14 +16,38 @@
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/geo/crs.hpp"
-#include "vola/io/input.hpp"
 #include "vola/io/file_checks.hpp"
+#include "vola/io/input.hpp"
+#include "vola/point_selection.hpp"
 
 namespace vola {
 
 namespace {
 
 using namespace convert_detail;
+
+// Toolkit quantization puts what lies outside its box on the border voxels, as the
+// reference does with the points' own bounds (nothing lies outside those). A box the user
+// gives crops the points instead, as a grid drops what lies outside it: the points are
+// read whole (LAS too) and cut to the box before the build (crop_to_bbox).
+bool crops_to_bbox(const ConvertOptions& options) {
+  return options.bbox && build_options(options, 2000).quantization == Quantization::toolkit;
+}
+
+// Drops the points outside the closed box; returns how many.
+std::uint64_t crop_to_bbox(PointCloud& cloud, const Box& box) {
+  std::vector<bool> keep(cloud.size());
+  std::uint64_t dropped = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double* p = cloud.xyz.data() + 3 * i;
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && p[a] >= box.min[a] && p[a] <= box.max[a];
+    keep[i] = inside;
+    dropped += inside ? 0 : 1;
+  }
+  if (dropped) keep_points(cloud, keep);
+  return dropped;
+}
 
 io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
                const ConvertProgress& progress, std::vector<std::string>& filter_report) {
@@ -40,7 +64,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   io::InputOptions input;
   input.attributes = options.attributes;
   input.payload = options.nbits > 0;
-  input.stream = options.target_crs.empty();  // reprojection moves the points read whole
+  input.stream = options.target_crs.empty() && !crops_to_bbox(options);  // reprojection moves the points read whole
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
@@ -128,7 +152,15 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   if (input.grid) input.cloud = grid_cell_centres(*input.grid);
   if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
   if (input.cloud.size() == 0) throw no_points(path, input, options);
-  return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
+  if (input.terrain) return tree_from_terrain(input, build, report);
+  const std::uint64_t cropped = crops_to_bbox(options) ? crop_to_bbox(input.cloud, *options.bbox) : 0;
+  if (input.cloud.size() == 0)
+    throw InvalidArgument(path + ": none of its " + std::to_string(cropped) + " " + unit_of(input) +
+                          " lies inside the bbox given");
+  Tree tree = vola::build(input.cloud, build, &report);
+  report.points_in += cropped;  // the points outside the box count as dropped, as a grid's do
+  report.points_outside += cropped;
+  return tree;
 }
 
 template <class T>

@@ -286,6 +286,55 @@ TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {
   }
 }
 
+// A bbox given with toolkit quantization crops: the points outside it are dropped and
+// counted, not piled onto the border voxels (the toolkit's clamping, which the points'
+// own bounds never trigger). Held against building the points inside the box by hand.
+TEST(Convert, AToolkitBboxDropsThePointsOutsideIt) {
+  VOLA_REQUIRE_DATA(data);
+  const std::string las = (data / "las" / "pdal_autzen_trim.las").string();
+  const vola::Box box{{636500, 849000, 400}, {637000, 849400, 520}};
+  vola::ConvertOptions o;
+  o.depth = 5;
+  o.bbox = box;
+  vola::ConvertReport report;
+  const vola::Tree converted = vola::convert(las, o, {}, &report);
+  EXPECT_EQ(converted.frame().quantization, vola::Quantization::toolkit);
+
+  vola::io::LasReader reader(las);
+  vola::PointCloud inside = vola::io::las_points(reader, true, false);
+  std::vector<double> kept;
+  for (std::size_t i = 0; i < inside.size(); ++i) {
+    const double* p = inside.xyz.data() + 3 * i;
+    bool in = true;
+    for (int a = 0; a < 3; ++a) in = in && p[a] >= box.min[a] && p[a] <= box.max[a];
+    if (in) kept.insert(kept.end(), p, p + 3);
+  }
+  const std::uint64_t outside = inside.size() - kept.size() / 3;
+  ASSERT_GT(outside, 1000u);  // the box cuts the survey
+  ASSERT_GT(kept.size(), 3000u);
+  vola::PointCloud cloud;
+  cloud.xyz = kept;
+  vola::BuildOptions b;
+  b.quantization = vola::Quantization::toolkit;
+  b.depth = 5;
+  b.bbox = box;
+  const vola::Tree built = vola::build(cloud, b);
+  EXPECT_EQ(report.build.points_in, inside.size());
+  EXPECT_EQ(report.build.points_outside, outside);
+  ASSERT_EQ(converted.voxel_count(), built.voxel_count());
+  EXPECT_TRUE(
+      std::equal(converted.words().begin(), converted.words().end(), built.words().begin(), built.words().end()));
+
+  o.bbox = vola::Box{{0, 0, 0}, {1, 1, 1}};  // nothing inside: said, not an empty tree
+  try {
+    (void)vola::convert(las, o);
+    ADD_FAILURE() << "a bbox holding no point was accepted";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("none of its 110000 points lies inside the bbox"), std::string::npos)
+        << e.what();
+  }
+}
+
 // Reprojected into metres, the height column is in metres too: each voxel's mean height
 // lies inside the voxel's own vertical extent (Autzen in feet kept heights in feet).
 TEST(Convert, ReprojectedHeightsAreInTheTargetsUnits) {
