@@ -51,6 +51,11 @@ void refuse_geographic_grid(const std::string& path, const ConvertOptions& optio
   if (options.allow_geographic || quantization != Quantization::grid || !voxelises_points(input)) return;
   const std::string result = result_definition(crs);
   if (result.empty() || !is_geographic_crs(result)) return;
+  if (!options.target_crs.empty())  // the target's fault, not the file's
+    throw OptionError("target_crs", "'" + options.target_crs.substr(0, 60) + "' is " + geographic_name(result) +
+                                        ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
+                                        "units of height, not cubes; give a projected CRS (such as UTM), or " +
+                                        "`allow_geographic` to voxelise in degrees anyway");
   throw OptionError("", path + " is in " + geographic_name(result) +
                                       ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
                                       "units of height, not cubes; " + cubes_advice(input) +

@@ -33,7 +33,9 @@ Input read_las_input(const std::string& path, const InputOptions& options) {
   if (options.copc_level) reader->select_copc_nodes(std::nullopt, options.copc_level);
   Input in;
   in.format = "las";
-  in.bytes_read = [reader] { return reader->bytes_read(); };
+  // What part of the file was read: said only for COPC, whose nodes outside the level or
+  // grid are skipped (a plain file is read whole, but for bytes no record needs).
+  if (reader->header().copc) in.bytes_read = [reader] { return reader->bytes_read(); };
   in.epsg = reader->header().epsg;
   in.wkt = reader->header().wkt;
   if (options.stream) {

@@ -504,6 +504,18 @@ TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
   relabelled.voxel_size = 10.0;
   relabelled.assign_crs = "4326";
   EXPECT_THROW(vola::convert((data / "las" / "pdal_autzen_trim.las").string(), relabelled), vola::OptionError);
+  // A geographic target is the target's fault, not the file's (which is in feet).
+  vola::ConvertOptions to_degrees;
+  to_degrees.voxel_size = 3.0;
+  to_degrees.target_crs = "EPSG:4326";
+  try {
+    vola::convert((data / "las" / "pdal_autzen_trim.las").string(), to_degrees);
+    ADD_FAILURE() << "a geographic target was not refused";
+  } catch (const vola::OptionError& e) {
+    EXPECT_EQ(e.option(), "target_crs");
+    EXPECT_NE(e.cause().find("'EPSG:4326' is WGS 84, a geographic CRS"), std::string::npos) << e.cause();
+    EXPECT_EQ(e.cause().find("pdal_autzen_trim"), std::string::npos) << e.cause();
+  }
   EXPECT_TRUE(vola::is_geographic_crs("EPSG:4979"));
   EXPECT_FALSE(vola::is_geographic_crs("EPSG:32610"));
 }
