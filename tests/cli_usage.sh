@@ -18,6 +18,22 @@ if "$vola" xyzzy 2> "$tmp/err.txt"; then fail "'xyzzy' ran"; fi
 grep -q "'xyzzy' is not a vola subcommand (vola --help" "$tmp/err.txt" || fail "xyzzy: $(cat "$tmp/err.txt")"
 "$vola" info --help > /dev/null || fail "vola info --help failed"
 
+# A mistyped option gets the nearest of its subcommand's options, after CLI11's own words.
+printf '0 0 0\n1000 0 0\n' > "$tmp/pair.xyz"
+expect_option_suggestion() {  # SUBCOMMAND WRONG RIGHT ARGS...
+  local command=$1 wrong=$2 right=$3
+  shift 3
+  if "$vola" "$command" "$@" 2> "$tmp/err.txt"; then fail "'$wrong' ran"; fi
+  grep -qF -- "'$wrong' is not an option of vola $command; did you mean '$right'?" "$tmp/err.txt" ||
+    fail "'$wrong': $(cat "$tmp/err.txt")"
+}
+expect_option_suggestion convert --voxelsize --voxel-size "$tmp/pair.xyz" "$tmp/o.vol" --voxelsize 3
+expect_option_suggestion convert --voxel_size --voxel-size "$tmp/pair.xyz" "$tmp/o.vol" --voxel_size=3
+expect_option_suggestion info --jsn --json "$tmp/pair.xyz" --jsn
+if "$vola" convert "$tmp/pair.xyz" "$tmp/o.vol" --xyzzy 3 2> "$tmp/err.txt"; then fail "--xyzzy ran"; fi
+grep -qF -- "'--xyzzy' is not an option of vola convert (vola convert --help lists them)" "$tmp/err.txt" ||
+  fail "--xyzzy: $(cat "$tmp/err.txt")"
+
 # A number out of range is named with what the option wants, not with the bounds of a
 # double printed in full (CLI11's PositiveNumber); the voxel size in %g, not "0.000000".
 printf '0 0 0\n1000 0 0\n' > "$tmp/two.xyz"

@@ -22,7 +22,10 @@ int run_app(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int status = app.exit(e);
+    if (status != 0)
+      if (const auto unknown = unknown_option(app, argc, argv)) std::fprintf(stderr, "vola: %s\n", unknown->c_str());
+    return status;
   } catch (const vola::OptionError& e) {
     std::fprintf(stderr, "vola: %s\n", in_flags(e).c_str());
     return 1;

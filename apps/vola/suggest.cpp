@@ -45,4 +45,34 @@ std::optional<std::string> unknown_subcommand(const CLI::App& app, int argc, cha
   return message + " (vola --help lists them)";
 }
 
+std::optional<std::string> unknown_option(const CLI::App& app, int argc, char** argv) {
+  if (argc < 3 || argv[1][0] == '-') return std::nullopt;
+  const CLI::App* command = nullptr;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (sub->get_name() == argv[1]) command = sub;
+  if (!command) return std::nullopt;
+  for (int i = 2; i < argc; ++i) {
+    const std::string word = argv[i];
+    // Long options only: a lone dash and negative numbers are values.
+    if (word.size() < 3 || word.rfind("--", 0) != 0) continue;
+    const std::string name =
+        word.substr(2, word.find('=') == std::string::npos ? std::string::npos : word.find('=') - 2);
+    if (command->get_option_no_throw("--" + name) || app.get_option_no_throw("--" + name)) continue;
+    std::string best;
+    std::size_t best_distance = 3;  // more than 2 edits away is no suggestion
+    for (const CLI::Option* option : command->get_options())
+      for (const std::string& known : option->get_lnames()) {
+        const std::size_t d = known.rfind(name, 0) == 0 ? 1 : edit_distance(name, known);
+        if (d < best_distance) {
+          best_distance = d;
+          best = known;
+        }
+      }
+    std::string message = "'--" + name + "' is not an option of vola " + command->get_name();
+    if (!best.empty()) message += "; did you mean '--" + best + "'?";
+    return message + " (vola " + command->get_name() + " --help lists them)";
+  }
+  return std::nullopt;
+}
+
 }  // namespace vola::cli
