@@ -22,6 +22,7 @@
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
 #include "vola/io/text_points.hpp"
+#include "vola/io/translate.hpp"
 
 namespace vola::cli {
 
@@ -141,54 +142,89 @@ ordered_json copc_json(const io::CopcHierarchy& copc) {
           {"per_level", std::move(levels)}};
 }
 
-// The column named `name`, or nullptr.
-const PointAttribute* column_named(const PointCloud& cloud, const std::string& name) {
-  for (const auto& a : cloud.attributes)
-    if (a.name == name) return &a;
-  return nullptr;
+// Every point read: the count, the points' own bounds, each column's range and, for a
+// classification column, the count per class (as pdal info --summary reports them),
+// gathered a chunk of points at a time.
+class Summary {
+ public:
+  void add(const PointCloud& chunk) {
+    if (names_.empty())
+      for (const auto& a : chunk.attributes) {
+        names_.push_back(a.name);
+        ranges_.emplace_back(INFINITY, -INFINITY);
+      }
+    points_ += chunk.size();
+    for (std::size_t i = 0; i < chunk.size(); ++i) {
+      const double* p = chunk.xyz.data() + 3 * i;
+      if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) continue;
+      bounded_ = true;
+      for (int a = 0; a < 3; ++a) box_.min[a] = std::min(box_.min[a], p[a]), box_.max[a] = std::max(box_.max[a], p[a]);
+    }
+    for (std::size_t c = 0; c < chunk.attributes.size() && c < ranges_.size(); ++c) {
+      auto& [lo, hi] = ranges_[c];
+      for (const double v : chunk.attributes[c].values) lo = std::min(lo, v), hi = std::max(hi, v);  // NaN left out
+      if (names_[c] == "classification")
+        for (const double v : chunk.attributes[c].values) ++classes_[static_cast<int>(v)];
+    }
+  }
+  std::uint64_t points() const { return points_; }
+  Box box() const { return bounded_ ? box_ : Box{}; }
+  // Each column with a value: its name and range.
+  std::vector<std::pair<std::string, std::pair<double, double>>> columns() const {
+    std::vector<std::pair<std::string, std::pair<double, double>>> out;
+    for (std::size_t c = 0; c < names_.size(); ++c)
+      if (ranges_[c].first <= ranges_[c].second) out.emplace_back(names_[c], ranges_[c]);
+    return out;
+  }
+  const std::map<int, std::uint64_t>& classes() const { return classes_; }
+
+ private:
+  std::uint64_t points_ = 0;
+  bool bounded_ = false;
+  Box box_{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  std::vector<std::string> names_;
+  std::vector<std::pair<double, double>> ranges_;
+  std::map<int, std::uint64_t> classes_;
+};
+
+Summary summarise(const PointCloud& cloud) {
+  Summary s;
+  s.add(cloud);
+  return s;
 }
 
-// Every point read: the count, the points' own bounds, each column's range and, for a
-// classification column, the count per class with ASPRS's names (as pdal info
-// --summary reports them).
-void print_summary(const PointCloud& cloud) {
-  const Box box = cloud.bounds();
-  std::printf("summary:     %zu points read\n", cloud.size());
+// A LAS/LAZ/COPC file's every record, every dimension, a chunk at a time.
+Summary summarise_las(io::LasReader& reader) {
+  Summary s;
+  io::for_each_las_chunk(reader, [&](const PointCloud& chunk) { s.add(chunk); });
+  return s;
+}
+
+void print_summary(const Summary& summary) {
+  const Box box = summary.box();
+  std::printf("summary:     %llu points read\n", static_cast<unsigned long long>(summary.points()));
   std::printf("             min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the points')\n", box.min[0],
               box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
-  for (const auto& a : cloud.attributes) {
-    if (a.values.empty()) continue;
-    const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
-    std::printf("column:      %s: %.9g .. %.9g\n", a.name.c_str(), *lo, *hi);
-  }
-  if (const PointAttribute* classes = column_named(cloud, "classification")) {
-    std::map<int, std::uint64_t> counts;
-    for (const double c : classes->values) ++counts[static_cast<int>(c)];
-    for (const auto& [code, n] : counts)
-      std::printf("class:       %3d %-38s %llu\n", code, std::string(analysis::asprs_class_name(code)).c_str(),
-                  static_cast<unsigned long long>(n));
-  }
+  for (const auto& [name, range] : summary.columns())
+    std::printf("column:      %s: %.9g .. %.9g\n", name.c_str(), range.first, range.second);
+  for (const auto& [code, n] : summary.classes())
+    std::printf("class:       %3d %-38s %llu\n", code, std::string(analysis::asprs_class_name(code)).c_str(),
+                static_cast<unsigned long long>(n));
 }
 
 // print_summary's figures as JSON (pdal info --summary's content, vola's names).
 // `scale`: a LAS file's, for coordinates at its precision (null: as read).
-ordered_json summary_json(const PointCloud& cloud, const double* scale = nullptr) {
-  const Box box = cloud.bounds();
+ordered_json summary_json(const Summary& summary, const double* scale = nullptr) {
+  const Box box = summary.box();
   const auto coordinates = [scale](const Point& p) { return scale ? xyz_at(p.data(), scale) : xyz(p.data()); };
-  ordered_json out = {{"points_read", cloud.size()},
+  ordered_json out = {{"points_read", summary.points()},
                       {"bounds", {{"min", coordinates(box.min)}, {"max", coordinates(box.max)}}}};
   ordered_json columns = ordered_json::object();
-  for (const auto& a : cloud.attributes) {
-    if (a.values.empty()) continue;
-    const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
-    columns[a.name] = {{"min", *lo}, {"max", *hi}};
-  }
+  for (const auto& [name, range] : summary.columns()) columns[name] = {{"min", range.first}, {"max", range.second}};
   out["columns"] = std::move(columns);
-  if (const PointAttribute* classes = column_named(cloud, "classification")) {
-    std::map<int, std::uint64_t> counts;
-    for (const double c : classes->values) ++counts[static_cast<int>(c)];
+  if (!summary.classes().empty()) {
     ordered_json list = ordered_json::array();
-    for (const auto& [code, n] : counts)
+    for (const auto& [code, n] : summary.classes())
       list.push_back({{"code", code}, {"name", std::string(analysis::asprs_class_name(code))}, {"points", n}});
     out["classes"] = std::move(list);
   }
@@ -251,7 +287,7 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
     if (in.grid) doc["grid"] = std::move(grid);
     if (in.terrain) doc["cells"] = in.cloud.size();
     doc["bounds"] = bounded ? ordered_json({{"min", xyz(lo.data())}, {"max", xyz(hi.data())}}) : ordered_json(nullptr);
-    if (in.terrain && summary) doc["summary"] = summary_json(in.cloud);
+    if (in.terrain && summary) doc["summary"] = summary_json(summarise(in.cloud));
     print_json(doc);
     return;
   }
@@ -292,7 +328,7 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
               in.grid ? "" : " --voxel-size S", utm ? " --allow-geographic (voxels of degrees)" : "");
   if (utm)
     std::printf("or in metres: gdalwarp -t_srs EPSG:%d %s OUT.tif, then vola convert OUT.tif\n", utm, path.c_str());
-  if (in.terrain && summary) print_summary(in.cloud);
+  if (in.terrain && summary) print_summary(summarise(in.cloud));
 }
 
 }  // namespace
@@ -350,7 +386,7 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
     for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
     doc["dimensions"] = std::move(dimensions);
     if (e57) doc["e57"] = e57_json(io::e57_summary(path));
-    if (summary) doc["summary"] = summary_json(in.cloud);
+    if (summary) doc["summary"] = summary_json(summarise(in.cloud));
     print_json(doc);
     return;
   }
@@ -378,7 +414,7 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
           "line '# x y z NAME ...', one name a column, names them)\n",
           values, values - 3);
   }
-  if (summary) print_summary(in.cloud);
+  if (summary) print_summary(summarise(in.cloud));
 }
 
 void print_ept_info(const std::string& path, bool summary, bool json) {
@@ -413,7 +449,7 @@ void print_ept_info(const std::string& path, bool summary, bool json) {
                         {"dimensions", std::move(dimensions)},
                         {"nodes", nodes.size()},
                         {"hierarchy", std::move(hierarchy)}};
-    if (read) doc["summary"] = summary_json(read->cloud);
+    if (read) doc["summary"] = summary_json(summarise(read->cloud));
     print_json(doc);
     return;
   }
@@ -431,7 +467,7 @@ void print_ept_info(const std::string& path, bool summary, bool json) {
     std::printf("depth %-5d  %llu nodes, %llu points\n", depth, static_cast<unsigned long long>(counts.first),
                 static_cast<unsigned long long>(counts.second));
   std::printf("to voxels:   vola convert %s OUT.vol --voxel-size S [--level L: depths 0..L only]\n", path.c_str());
-  if (read) print_summary(read->cloud);
+  if (read) print_summary(summarise(read->cloud));
 }
 
 bool is_point_file(const std::string& path) {
@@ -444,6 +480,15 @@ bool is_point_file(const std::string& path) {
 }
 
 namespace {
+
+// Every dimension of the records (x y z as stored: scaled integers), as PDAL lists them.
+ordered_json las_dimensions_json(const io::LasHeader& hd) {
+  ordered_json dimensions = ordered_json::array();
+  for (const char* axis : {"x", "y", "z"}) dimensions.push_back({{"name", axis}, {"type", "f64"}});
+  for (const auto& a : io::las_columns(hd).attributes)
+    dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
+  return dimensions;
+}
 
 void print_las_json(io::LasReader& reader, const std::string& path, bool summary) {
   const io::LasHeader& hd = reader.header();
@@ -464,10 +509,7 @@ void print_las_json(io::LasReader& reader, const std::string& path, bool summary
                        {{"min", xyz_at(hd.min.data(), hd.scale.data())},
                         {"max", xyz_at(hd.max.data(), hd.scale.data())},
                         {"source", "header"}}}};
-  ordered_json dimensions = ordered_json::array();
-  for (const auto& spec : io::las_attributes(hd))
-    dimensions.push_back({{"name", spec.name}, {"type", name_of(spec.type)}});
-  doc["dimensions"] = std::move(dimensions);
+  doc["dimensions"] = las_dimensions_json(hd);
   ordered_json vlrs = ordered_json::array();
   for (const auto& v : hd.vlrs)
     vlrs.push_back({{"user_id", v.user_id},
@@ -487,7 +529,7 @@ void print_las_json(io::LasReader& reader, const std::string& path, bool summary
                   {"items", std::move(items)}};
   }
   if (hd.copc) doc["copc"] = copc_json(*hd.copc);
-  if (summary) doc["summary"] = summary_json(io::las_points(reader, true, false), hd.scale.data());
+  if (summary) doc["summary"] = summary_json(summarise_las(reader), hd.scale.data());
   print_json(doc);
 }
 
@@ -511,6 +553,9 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
               hd.offset[0], hd.offset[1], hd.offset[2]);
   std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the header's)\n", hd.min[0],
               hd.min[1], hd.min[2], hd.max[0], hd.max[1], hd.max[2]);
+  std::printf("dimensions:  x y z");
+  for (const auto& a : io::las_columns(hd).attributes) std::printf(" %s", a.name.c_str());
+  std::printf("\n");
   for (const auto& f : hd.extra_fields) std::printf("extra bytes: %s (type %u)\n", f.name.c_str(), f.data_type);
   for (const auto& v : hd.vlrs)
     std::printf("%s %s:%u, %llu bytes%s%s\n", v.extended ? "evlr:       " : "vlr:        ", v.user_id.c_str(),
@@ -518,7 +563,7 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
                 v.description.c_str());
   if (hd.compressed()) print_compression(hd);
   if (hd.copc) print_copc(*hd.copc);
-  if (summary) print_summary(io::las_points(reader, true, false));
+  if (summary) print_summary(summarise_las(reader));
 }
 
 }  // namespace vola::cli

@@ -90,18 +90,11 @@ class RecordFieldColumns {
   std::size_t wave_at_ = 0;
 };
 
-// The columns of a LAS file's records, in record order.
-PointTable las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
-  LasReader reader(path);
-  const LasHeader& hd = reader.header();
-  PointTable table;
-  table.format = "las";
-  table.epsg = hd.epsg;
-  table.wkt = hd.wkt;
-  // Coordinates at the file's own precision: as many decimals as the finest scale needs.
-  const double finest = std::min({hd.scale[0], hd.scale[1], hd.scale[2]});
-  table.coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
-  PointCloud& cloud = table.cloud;
+}  // namespace
+
+// The columns of a LAS file's records, in record order (a chunk of them at a time).
+PointCloud las_columns(const LasHeader& hd) {
+  PointCloud cloud;
   const auto add = [&](const char* name, ValueType type) { cloud.attributes.push_back({name, type, Reduction::last, {}}); };
   add("intensity", ValueType::u16);
   add("return_number", ValueType::u8);
@@ -116,16 +109,25 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
     add("blue", ValueType::u16);
   }
   const RecordFieldColumns fields(hd);
-  const std::size_t fields_at = cloud.attributes.size();
   for (std::size_t k = 0; k < fields.names().size(); ++k) add(fields.names()[k], fields.types()[k]);
   for (const auto& f : hd.extra_fields) cloud.attributes.push_back({f.name, ValueType::f64, Reduction::last, {}});
+  return cloud;
+}
+
+void for_each_las_chunk(LasReader& reader, const std::function<void(const PointCloud&)>& each,
+                        const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  const LasHeader& hd = reader.header();
+  PointCloud cloud = las_columns(hd);
+  const RecordFieldColumns fields(hd);
+  const std::size_t fields_at = cloud.attributes.size() - fields.names().size() - hd.extra_fields.size();
   LasChunk chunk;
   for (;;) {
     const std::span<const std::uint8_t> records = reader.read_records(std::size_t{1} << 16);
     if (records.empty()) break;
     chunk.clear();
     decode_las_records(hd, records, chunk);
-    cloud.xyz.insert(cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
+    cloud.xyz.assign(chunk.xyz.begin(), chunk.xyz.end());
+    for (auto& a : cloud.attributes) a.values.clear();
     std::size_t c = 0;
     const auto append = [&](const auto& values) {
       auto& column = cloud.attributes[c++].values;
@@ -146,8 +148,34 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
     fields.append(records, std::span(cloud.attributes).subspan(fields_at, fields.names().size()));
     c += fields.names().size();
     for (const auto& e : chunk.extra) append(e);
+    each(cloud);
     if (progress) progress(reader.points_read(), reader.points_total());
   }
+}
+
+namespace {
+
+PointTable las_point_table(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  LasReader reader(path);
+  const LasHeader& hd = reader.header();
+  PointTable table;
+  table.format = "las";
+  table.epsg = hd.epsg;
+  table.wkt = hd.wkt;
+  // Coordinates at the file's own precision: as many decimals as the finest scale needs.
+  const double finest = std::min({hd.scale[0], hd.scale[1], hd.scale[2]});
+  table.coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
+  table.cloud = las_columns(hd);
+  for_each_las_chunk(
+      reader,
+      [&](const PointCloud& chunk) {
+        table.cloud.xyz.insert(table.cloud.xyz.end(), chunk.xyz.begin(), chunk.xyz.end());
+        for (std::size_t c = 0; c < chunk.attributes.size(); ++c) {
+          auto& column = table.cloud.attributes[c].values;
+          column.insert(column.end(), chunk.attributes[c].values.begin(), chunk.attributes[c].values.end());
+        }
+      },
+      progress);
   return table;
 }
 

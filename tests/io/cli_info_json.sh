@@ -37,6 +37,16 @@ if classes:
     got = {c["code"]: c["points"] for c in info["summary"].get("classes", [])}
     assert got == want, (got, want)
 assert info["summary"]["points_read"] == info["points"]
+# Every dimension of the records, as pdal info lists them (not the columns vola convert keeps).
+names = [d["name"] for d in info["dimensions"]]
+pf = info["point_format"]
+want = ["x", "y", "z", "intensity", "return_number", "number_of_returns", "classification", "user_data",
+        "point_source_id"] + (["gps_time"] if pf not in (0, 2) else []) + \
+       (["red", "green", "blue"] if pf in (2, 3, 5, 7, 8, 10) else []) + ["scan_angle_rank"]
+assert names[:len(want)] == want, names
+assert "height" not in names, names
+for name in want[3:]:
+    assert name in info["summary"]["columns"] or info["points"] == 0, (name, info["summary"]["columns"])
 PY
   checked=$((checked + 1))
 done

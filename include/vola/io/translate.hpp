@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vola/builder.hpp"
+#include "vola/io/las.hpp"
 
 namespace vola::io {
 
@@ -28,6 +29,14 @@ struct PointTable {
 PointTable read_point_table(const std::string& input, const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
                             const std::string& format = "auto");
 
+// The dimensions of a LAS/LAZ/COPC file's point records beyond x y z: the columns
+// read_point_table gives for it, empty.
+PointCloud las_columns(const LasHeader& header);
+// The records `reader` has not read yet, 65,536 at a time, as x y z and las_columns'
+// columns: each chunk is handed to `each` and then reused, so that memory stays a chunk's
+// whatever the file's size (vola info --summary).
+void for_each_las_chunk(LasReader& reader, const std::function<void(const PointCloud&)>& each,
+                        const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 // What happens to the points between reading and writing (point filters): may change
 // columns, add some and drop points; returns, for each point left, its index in the input.
 using PointEdit = std::function<std::vector<std::uint64_t>(PointTable&)>;
