@@ -48,6 +48,39 @@ void georeference_built(Tree& tree, std::uint32_t epsg, const std::string& crs_w
   }
 }
 
+// A CRS PROJ does not know is refused before anything is built, as vola convert refuses
+// --assign-crs (it was written to the file, and only `vola info` said so later).
+void check_crs(std::uint32_t epsg, const std::string& crs_wkt) {
+  const auto refuse = [](const std::string& argument, const std::string& shown, const vola::Error& e) {
+    throw vola::InvalidArgument(argument + "=" + shown + " is not a CRS PROJ knows: " + e.what());
+  };
+  if (epsg != vola::geo::kUnsetEpsg) try {
+      (void)vola::geo::crs_wkt("EPSG:" + std::to_string(epsg));
+    } catch (const vola::Error& e) {
+      refuse("epsg", std::to_string(epsg), e);
+    }
+  if (!crs_wkt.empty()) try {
+      (void)vola::geo::crs_wkt(crs_wkt);
+    } catch (const vola::Error& e) {
+      refuse("crs_wkt", "'" + crs_wkt.substr(0, 40) + (crs_wkt.size() > 40 ? "...'" : "'"), e);
+    }
+}
+
+// Points with a coordinate that is not finite (NaN, inf, None in an object array) are
+// left out by the build, as the readers leave them out: said with a warning and a count
+// (vola convert and Map.insert count them too), never silently.
+void warn_not_finite(const vola::PointCloud& cloud) {
+  std::size_t not_finite = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double* p = cloud.xyz.data() + 3 * i;
+    not_finite += std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) ? 0 : 1;
+  }
+  if (not_finite == 0) return;
+  const std::string message = "vola.build: " + std::to_string(not_finite) + " of the " + std::to_string(cloud.size()) +
+                              " points have a coordinate that is not finite (NaN or inf) and are left out";
+  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 Tree build_points(const py::handle& points, int depth, double voxel_size, const std::string& quantize,
                   std::optional<std::array<double, 3>> origin, const py::dict& attributes, const py::dict& reductions,
                   std::uint32_t epsg, const std::string& crs_wkt) {
@@ -70,6 +103,8 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
   if (origin) options.origin = to_point(*origin);
   options.epsg = epsg;
   with_python_names([&] { options.check(); });
+  check_crs(epsg, crs_wkt);
+  warn_not_finite(cloud);
   py::gil_scoped_release release;
   Tree tree = vola::build(cloud, options);
   georeference_built(tree, epsg, crs_wkt);

@@ -106,6 +106,10 @@ void bind_map(py::module_& m) {
           "from_tree",
           [](const Tree& state_map, double max_range) {
             if (!(max_range >= 0.0)) throw InvalidArgument("max_range must be >= 0 (0: no limit)");
+            if (!map::is_state_map(state_map))
+              throw InvalidArgument(
+                  "not a state map: give a tree read with its states, vola.read('map.vol') or "
+                  "vola.open('map.vol', states=True) (vola.open alone gives a state map's occupied voxels only)");
             return PyMap{map::thaw(state_map), max_range};
           },
           py::arg("tree"), py::arg("max_range") = 0.0,

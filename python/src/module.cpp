@@ -19,7 +19,15 @@ PYBIND11_MODULE(_vola, m) {
     return type;
   }();
   m.add_object("InvalidArgument", py::handle(invalid));
-  static py::exception<vola::IoError> io_error(m, "IoError", error.ptr());
+  // A file that cannot be read or written is an OSError too (`except OSError` around
+  // file handling caught Python's own errors but not vola's).
+  static PyObject* const io_error = [&] {
+    const py::tuple bases = py::make_tuple(error, py::handle(PyExc_OSError));
+    PyObject* type = PyErr_NewException("vola._vola.IoError", bases.ptr(), nullptr);
+    if (!type) throw py::error_already_set();
+    return type;
+  }();
+  m.add_object("IoError", py::handle(io_error));
   static py::exception<vola::FormatError> format_error(m, "FormatError", error.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -27,7 +35,7 @@ PYBIND11_MODULE(_vola, m) {
     } catch (const vola::FormatError& e) {
       format_error(e.what());
     } catch (const vola::IoError& e) {
-      io_error(e.what());
+      PyErr_SetString(io_error, e.what());
     } catch (const vola::InvalidArgument& e) {
       PyErr_SetString(invalid, e.what());
     } catch (const vola::Error& e) {

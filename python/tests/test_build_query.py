@@ -1,5 +1,7 @@
 """Building from points and voxels, queries and arrays, against numpy references."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -235,3 +237,35 @@ def test_a_bad_argument_is_a_value_error():
     assert issubclass(vola.InvalidArgument, ValueError) and issubclass(vola.InvalidArgument, vola.Error)
     with pytest.raises(ValueError, match="voxel_size"):
         vola.build(np.zeros((3, 3)), voxel_size=-1)
+
+
+def test_a_crs_proj_does_not_know_is_refused_before_building():
+    """vola.build wrote epsg=999999 and crs_wkt='garbage' into the tree; vola convert refuses both."""
+    points = np.zeros((3, 3))
+    with pytest.raises(vola.InvalidArgument, match="epsg=999999 is not a CRS PROJ knows"):
+        vola.build(points, voxel_size=1, epsg=999999)
+    with pytest.raises(vola.InvalidArgument, match="crs_wkt='garbage' is not a CRS PROJ knows"):
+        vola.build(points, voxel_size=1, crs_wkt="garbage")
+    assert vola.build(points, voxel_size=1, epsg=32610).epsg == 32610
+
+
+def test_points_that_are_not_finite_are_left_out_with_a_warning():
+    """A NaN point was dropped without a word (93 voxels for 94 points' worth, no count)."""
+    points = np.arange(30, dtype=float).reshape(10, 3)
+    points[3] = np.nan
+    points[5, 2] = np.inf
+    with pytest.warns(UserWarning, match="2 of the 10 points have a coordinate that is not finite"):
+        tree = vola.build(points, voxel_size=1)
+    assert tree.voxel_count == 8
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # finite points: no warning at all
+        vola.build(points[[0, 1, 2]], voxel_size=1)
+
+
+def test_a_file_that_cannot_be_opened_is_an_os_error(tmp_path):
+    """vola.IoError is an OSError too, with the system's reason, whatever reads the file."""
+    assert issubclass(vola.IoError, OSError) and issubclass(vola.IoError, vola.Error)
+    missing = str(tmp_path / "missing.las")
+    for call in (lambda: vola.open(missing), lambda: vola.convert(missing, voxel_size=1)):
+        with pytest.raises(OSError, match="missing.las: cannot open: No such file or directory"):
+            call()

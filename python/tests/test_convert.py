@@ -62,8 +62,12 @@ def test_voxel_grid_and_mesh_inputs_match_the_cli(shared_data, vola_cli, tmp_pat
 
 
 def test_convert_errors_name_the_problem(tmp_path, las_file):
+    unknown = tmp_path / "points.unknown_ext"
+    unknown.write_text("1 2 3\n")
     with pytest.raises(vola.InvalidArgument, match="unknown_ext"):
-        vola.convert(tmp_path / "points.unknown_ext", voxel_size=1.0)
+        vola.convert(unknown, voxel_size=1.0)
+    with pytest.raises(vola.IoError, match="missing.las: cannot open: No such file"):  # before any format
+        vola.convert(tmp_path / "missing.las", voxel_size=1.0)
     with pytest.raises(vola.InvalidArgument, match="toolkit quantization needs a depth"):
         vola.convert(las_file, quantize="toolkit")
     bad = tmp_path / "bad.las"

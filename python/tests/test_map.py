@@ -131,6 +131,10 @@ def test_a_saved_map_takes_more_scans_as_vola_map_from_does(tmp_path: pathlib.Pa
     assert (tmp_path / "again.vol").read_bytes() == (tmp_path / "all.vol").read_bytes()
     with pytest.raises(vola.InvalidArgument):
         vola.Map.from_tree(vola.build_from_voxels(np.array([[1, 2, 3]]), 2))
+    # A state map opened for its occupied voxels only: the message says how to read its states.
+    with pytest.raises(vola.InvalidArgument, match=r"vola.open\('map.vol', states=True\)"):
+        vola.Map.from_tree(vola.open(str(tmp_path / "all.vol")))
+    assert len(vola.Map.from_tree(vola.open(str(tmp_path / "all.vol"), states=True))) == len(m)
     subprocess.run([vola_cli, "map", str(tmp_path / "rest.txt"), "--from", str(tmp_path / "all.vol"), "-o",
                     str(tmp_path / "x.vol"), "--voxel-size", "0.5", "-q"], check=False)
     assert not (tmp_path / "x.vol").exists(), "a voxel size other than the saved map's was accepted"

@@ -1,5 +1,10 @@
 #include "vola/io/file_checks.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 
@@ -20,6 +25,16 @@ void refuse_non_regular_input(const std::string& path) {
   if (error || !fs::exists(status) || fs::is_regular_file(status)) return;
   const char* kind = fs::is_directory(status) ? "a directory" : fs::is_fifo(status) ? "a FIFO" : "a device or socket";
   throw InvalidArgument(path + ": not a regular file (" + kind + "): inputs are files");
+}
+
+void refuse_unopenable_input(const std::string& path) {
+  // O_NONBLOCK: a FIFO (refused above) does not wait for a writer here either.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    const int error = errno;
+    throw IoError(path + ": cannot open: " + std::strerror(error));
+  }
+  ::close(fd);
 }
 
 }  // namespace vola::io

@@ -206,8 +206,24 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+namespace {
+
+// "las" for a file beginning "LASF" (LAS, LAZ, COPC), "e57" for "ASTM-E57"; else null.
+const char* format_by_magic(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, sizeof magic);
+  const std::string_view head(magic, static_cast<std::size_t>(in.gcount()));
+  if (head.starts_with("LASF")) return "las";
+  if (head.starts_with("ASTM-E57")) return "e57";
+  return nullptr;
+}
+
+}  // namespace
+
 const InputFormat& find_input_format(const std::string& path, const std::string& name) {
   refuse_non_regular_input(path);  // every reader finds its format here first
+  refuse_unopenable_input(path);
   const auto& formats = input_formats();
   std::string known;
   for (const auto& f : formats) known += (known.empty() ? "" : ", ") + f.name;
@@ -216,6 +232,12 @@ const InputFormat& find_input_format(const std::string& path, const std::string&
       if (f.name == name) return f;
     throw OptionError("format", "'" + name + "' is not known (" + known + ")");
   }
+  // Formats that say what they are in their first bytes are read as what they are,
+  // whatever their name (a LAS file saved as .xyz was read as text: "column 1 'LASF...'
+  // is not a number", while vola info read it as LAS).
+  if (const char* by_magic = format_by_magic(path))
+    for (const auto& f : formats)
+      if (f.name == by_magic) return f;
   const std::string ext = lower_extension(path);
   for (const auto& f : formats)
     if (std::find(f.extensions.begin(), f.extensions.end(), ext) != f.extensions.end()) {

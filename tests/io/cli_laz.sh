@@ -268,4 +268,11 @@ status=0
 [ "$status" -eq 1 ] || fail "a 2^63-point compressor 1 file: exit $status, not a refusal"
 grep -q "more than the file can hold" "$tmp/err.txt" || fail "huge count message: $(cat "$tmp/err.txt")"
 
+# A LAS or LAZ file under another name is read as what its first bytes say, as vola info
+# reads it (a .las saved as .xyz was parsed as text: "column 1 'LASF...' is not a number").
+cp "$data/laz/pdal_autzen_trim.laz" "$tmp/autzen.xyz"
+"$vola" convert "$tmp/autzen.xyz" "$tmp/named.vol" --voxel-size 5 -q || fail "a LAZ named .xyz was refused"
+"$vola" convert "$data/laz/pdal_autzen_trim.laz" "$tmp/as_laz.vol" --voxel-size 5 -q
+cmp -s "$tmp/named.vol" "$tmp/as_laz.vol" || fail "a LAZ named .xyz converts otherwise than as .laz"
+
 echo "LAZ: $checked files decoded as laz-perf does; LAS -> LAZ -> LAS round trips intact"

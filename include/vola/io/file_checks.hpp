@@ -18,4 +18,8 @@ void refuse_output_over_input(const std::string& input, const std::string& outpu
 // missing file is the reader's to report).
 void refuse_non_regular_input(const std::string& path);
 
+// An input that cannot be opened for reading (missing, no permission) is an IoError with
+// the system's reason ("cannot open: No such file or directory"), before any reader.
+void refuse_unopenable_input(const std::string& path);
+
 }  // namespace vola::io
