@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
+#include "vola/map/state_map.hpp"
 #include "vola/raycast/collision.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -15,10 +17,14 @@ namespace {
 
 // Runs query(collider, i) for every row, the collider built and the rows answered without
 // the GIL; an InvalidArgument names the row when there are several.
+// A state map (vola.read, vola.open(..., states=True)) collides with its occupied voxels,
+// as `vola collide` does with the file: its free voxels are not obstacles.
 template <class Query>
 void each_query(const Tree& tree, py::ssize_t n, const char* what, Query&& query) {
   py::gil_scoped_release release;
-  const vola::raycast::Collider collider(tree);
+  std::optional<Tree> occupied;
+  if (vola::map::is_state_map(tree)) occupied = vola::map::occupied_tree(tree);
+  const vola::raycast::Collider collider(occupied ? *occupied : tree);
   for (py::ssize_t i = 0; i < n; ++i) {
     try {
       query(collider, i);

@@ -4,9 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <string>
 
 #include "vola/analysis/census.hpp"
 #include "vola/analysis/components.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/raycast/path_planner.hpp"
 #include "vola/raycast/ray_caster.hpp"
 #include "vola/raycast/world.hpp"
@@ -151,8 +154,22 @@ py::dict raycast(const Tree& tree, const py::handle& origins_in, const py::handl
   return out;
 }
 
-py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 3> goal, double radius, bool world, bool smooth,
-              int level, bool hierarchical, std::uint64_t max_expansions, bool solid_ground) {
+py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 3> goal, double radius, bool world,
+              bool smooth, int level, bool hierarchical, std::uint64_t max_expansions, bool solid_ground,
+              const std::string& unknown) {
+  if (!unknown.empty() && unknown != "occupied" && unknown != "free")
+    throw vola::InvalidArgument("unknown must be 'occupied' or 'free', not '" + unknown + "'");
+  // A state map (vola.read, vola.open(..., states=True)) is planned in as `vola plan`
+  // plans in the file: its occupied voxels are obstacles and, unless unknown='free',
+  // unknown space is one too. A tree of points has no unknown space.
+  const bool state_map = vola::map::is_state_map(tree);
+  if (!state_map && unknown == "occupied")
+    throw vola::InvalidArgument(
+        "unknown='occupied': this tree is not a state map (vola.read('map.vol') or vola.open('map.vol', "
+        "states=True) gives one): its empty space is free, it has no unknown space");
+  std::optional<Tree> occupied;
+  if (state_map) occupied = vola::map::occupied_tree(tree);
+  const Tree& obstacles = occupied ? *occupied : tree;
   const vola::Frame frame = tree.frame();
   vola::Point a = to_point(start), b = to_point(goal);
   if (world) {
@@ -167,11 +184,12 @@ py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 
   options.hierarchical = hierarchical;
   options.max_expansions = max_expansions;
   options.solid_ground = solid_ground;
+  if (state_map && unknown != "free") options.known = &tree;
   if (world) options.world = &frame;
   vola::raycast::PlannedPath path;
   {
     py::gil_scoped_release release;
-    path = vola::raycast::plan_path(tree, a, b, options);
+    path = vola::raycast::plan_path(obstacles, a, b, options);
   }
   const auto k = static_cast<py::ssize_t>(path.points.size());
   py::array_t<double> points({k, py::ssize_t{3}});
@@ -189,7 +207,6 @@ py::dict plan(const Tree& tree, std::array<double, 3> start, std::array<double, 
   return out;
 }
 
-
 }  // namespace
 
 void bind_tree_analysis(py::class_<Tree>& tree) {
@@ -198,18 +215,26 @@ void bind_tree_analysis(py::class_<Tree>& tree) {
            "'sizes', 'min', 'max', 'centroid', 'first_rank'}, components largest first.")
       .def("census", &census, py::arg("bins") = 16,
            "Per-level blocks and cells, height and attribute histograms, ASPRS class counts, volume and footprint.")
-      .def("raycast", &raycast, py::arg("origins"), py::arg("directions"), py::arg("t_max") = std::numeric_limits<double>::infinity(),
-           py::arg("world") = false, py::arg("threads") = 0u,
+      .def("raycast", &raycast, py::arg("origins"), py::arg("directions"),
+           py::arg("t_max") = std::numeric_limits<double>::infinity(), py::arg("world") = false,
+           py::arg("threads") = 0u,
            "First occupied voxel along each ray (hierarchical DDA). origins: (R, 3) or one (3,); directions: (R, 3).\n"
-           "Grid coordinates (voxel (i,j,k) = [i,i+1]^3) unless world=True. Returns {'hit', 'voxel', 't', 'normal', 'point'}.")
-      .def("plan", &plan, py::arg("start"), py::arg("goal"), py::arg("radius") = 0.0, py::arg("world") = false,
-           py::arg("smooth") = true, py::arg("level") = -1, py::arg("hierarchical") = false,
-           py::arg("max_expansions") = std::uint64_t{20'000'000}, py::arg("solid_ground") = false,
-           "A* path over free voxels for a robot of `radius` (no corner cutting: every leg keeps the sphere clear).\n"
-           "hierarchical=True: a coarse route first, then the voxels near it (scales; cost not guaranteed optimal).\n"
-           "solid_ground=True: the space under each column's lowest voxel is an obstacle (`vola plan --solid-ground`).\n"
-           "Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
-           "Grid coordinates unless world=True. Raises InvalidArgument when start/goal are blocked or unreachable.");
+           "Grid coordinates (voxel (i,j,k) = [i,i+1]^3) unless world=True. Returns {'hit', 'voxel', 't', 'normal', "
+           "'point'}.")
+      .def(
+          "plan", &plan, py::arg("start"), py::arg("goal"), py::arg("radius") = 0.0, py::arg("world") = false,
+          py::arg("smooth") = true, py::arg("level") = -1, py::arg("hierarchical") = false,
+          py::arg("max_expansions") = std::uint64_t{20'000'000}, py::arg("solid_ground") = false,
+          py::arg("unknown") = "",
+          "A* path over free voxels for a robot of `radius` (no corner cutting: every leg keeps the sphere clear).\n"
+          "hierarchical=True: a coarse route first, then the voxels near it (scales; cost not guaranteed optimal).\n"
+          "solid_ground=True: the space under each column's lowest voxel is an obstacle (`vola plan --solid-ground`).\n"
+          "A state map (vola.read('map.vol'), vola.open('map.vol', states=True)) plans as `vola plan` does: its\n"
+          "occupied voxels are obstacles, and unknown space too unless unknown='free' (vola.open('map.vol')\n"
+          "alone gives the occupied voxels only, so everything else counts as free).\n"
+          "Start and goal are snapped to their voxels' centres, the path's first and last points.\n"
+          "Returns {'points': (K, 3), 'cost', 'length', 'expanded'}.\n"
+          "Grid coordinates unless world=True. Raises InvalidArgument when start/goal are blocked or unreachable.");
 }
 
 }  // namespace vola::python

@@ -179,3 +179,31 @@ def test_threads_may_share_a_map():
     assert shared.tree().voxels().tolist() == serial.tree().voxels().tolist()
     probe = np.concatenate([points for points, _ in scans])
     assert np.allclose(shared.probability(probe), serial.probability(probe), atol=1e-4, equal_nan=True)
+
+
+def test_a_state_map_plans_and_collides_as_vola_plan_and_collide_do(tmp_path: pathlib.Path):
+    """A state map read with its states made free voxels obstacles (collide_sphere said True in
+    free space, plan found no start) and had no `unknown` option; vola.open alone planned
+    through unknown space. Now obstacles are the occupied voxels and unknown space counts
+    as one unless unknown='free', as in `vola plan`."""
+    m = vola.Map(0.5)
+    # A wall of hits at x = 5 seen from x = 0: free voxels along the rays, unknown beyond.
+    ys, zs = np.meshgrid(np.arange(-2, 2.5, 0.5), np.arange(-2, 2.5, 0.5))
+    wall = np.stack([np.full(ys.size, 5.2), ys.ravel() + 0.2, zs.ravel() + 0.2], axis=1)
+    m.insert(wall, origin=(0.2, 0.2, 0.2))
+    m.save(tmp_path / "map.vol")
+    states = vola.open(str(tmp_path / "map.vol"), states=True)
+    assert m.state(np.array([[1.2, 0.2, 0.2]])).tolist() == [vola.FREE]
+    assert not states.collide_sphere([1.2, 0.2, 0.2], 0.1)  # free space is no obstacle
+    assert states.collide_sphere([5.2, 0.2, 0.2], 0.1)     # the wall is
+    # Known free from one end of the rays to the other: a path.
+    path = states.plan([0.2, 0.2, 0.2], [4.2, 0.2, 0.2], world=True)
+    assert len(path["points"]) >= 2
+    # Into unknown space (behind the wall): refused unless unknown space is taken as free.
+    with pytest.raises(vola.InvalidArgument):
+        states.plan([0.2, 0.2, 0.2], [6.7, 0.2, 0.2], world=True)
+    assert len(states.plan([0.2, 0.2, 0.2], [6.7, 0.2, 0.2], world=True, unknown="free")["points"]) >= 2
+    with pytest.raises(vola.InvalidArgument, match="not a state map"):
+        vola.open(str(tmp_path / "map.vol")).plan([0, 0, 0], [1, 1, 1], unknown="occupied")
+    with pytest.raises(vola.InvalidArgument, match="'occupied' or 'free'"):
+        states.plan([0, 0, 0], [1, 1, 1], unknown="maybe")

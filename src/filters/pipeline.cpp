@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "vola/error.hpp"
@@ -261,12 +262,16 @@ std::string range_expression(const std::string& limits) {
     const bool open_high = limits[close] == ')';
     std::string range;
     const auto bound = [&](const std::string& text, const char* closed_op, const char* open_op, bool open) {
-      if (text.find_first_not_of(' ') == std::string::npos) return;
+      if (text.find_first_not_of(' ') == std::string::npos) return std::optional<double>();
       const double v = numeric(json(text), "a limit");
       range += std::string(range.empty() ? "" : " && ") + name + " " + (open ? open_op : closed_op) + " " + number_text(v);
+      return std::optional<double>(v);
     };
-    bound(low, ">=", ">", open_low);
-    bound(high, "<=", "<", open_high);
+    const std::optional<double> from = bound(low, ">=", ">", open_low), to = bound(high, "<=", "<", open_high);
+    // An empty range is a mistake, not a request for no points (the CLI's --crop refuses one too).
+    if (from && to && (*from > *to || (*from == *to && (open_low || open_high))))
+      fail(name + "'s range " + limits.substr(i - 1, close - i + 2) + " holds no value (a minimum of " +
+           number_text(*from) + ", a maximum of " + number_text(*to) + ")");
     if (range.empty()) range = name + " == " + name;  // [:] : any value (NaN aside)
     range = "(" + range + ")";
     if (negate) range = "!" + range;

@@ -143,6 +143,13 @@ if "$vola" pipeline "$tmp/two.json" 2> "$tmp/err.txt"; then fail "a second input
 grep -q "pipeline stage 1: .*second.las: a second file right after the input is another input to PDAL" "$tmp/err.txt" \
   || fail "error: $(cat "$tmp/err.txt")"
 cmp -s "$autzen" "$tmp/second.las" || fail "the second input was changed"
+# A range that holds no value is refused naming it, as --crop refuses an upside-down box
+# (it wrote an empty LAS and exited 0).
+echo "[\"$autzen\", {\"type\": \"filters.range\", \"limits\": \"Z[420:410]\"}, \"$tmp/none.las\"]" > "$tmp/empty.json"
+if "$vola" pipeline "$tmp/empty.json" 2> "$tmp/err.txt"; then fail "an empty range ran"; fi
+grep -qF "Z's range [420:410] holds no value (a minimum of 420, a maximum of 410)" "$tmp/err.txt" ||
+  fail "empty range: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/none.las" ] || fail "an empty range wrote a file"
 cp "$autzen" "$tmp/mine.las"
 echo "[\"$tmp/mine.las\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"}, \"$tmp/mine.las\"]" \
   > "$tmp/self.json"
