@@ -1,8 +1,11 @@
 // unite / intersect / subtract against std::set_union / set_intersection /
 // set_difference on voxel sets.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <iterator>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -98,6 +101,49 @@ TEST(SetOpsArguments, DifferentGridsAreRefusedUnlessIgnored) {
   EXPECT_EQ(u.georef(), a.georef());
   // Equal grids combine without FrameCheck::ignore.
   EXPECT_EQ(voxel_set(vola::intersect(a, a)), voxel_set(a));
+}
+
+// Grids of one voxel size whose origins differ by whole voxels are one lattice (maps of
+// separate `vola map` runs: each origin follows its data): combined in world space, on
+// the lower origin and a depth that holds both. Held to sets of voxel corners in world
+// coordinates, computed here from each tree's own frame.
+TEST(SetOpsArguments, GridsOnOneLatticeCombineInWorldSpace) {
+  using Corner = std::array<long long, 3>;  // a voxel's lower corner in whole metres
+  const auto corners = [](const vola::Tree& t) {
+    std::set<Corner> out;
+    const vola::Frame f = *t.stored_frame();
+    t.for_each_voxel([&](const vola::Voxel& v) {
+      out.insert({std::llround(f.origin[0] + v.x * f.voxel_size), std::llround(f.origin[1] + v.y * f.voxel_size),
+                  std::llround(f.origin[2] + v.z * f.voxel_size)});
+    });
+    return out;
+  };
+  vola::PointCloud first, second;
+  first.xyz = {0.5, 0.5, 0.5, 2.5, 2.5, 2.5, 7.5, 1.5, 0.5};
+  second.xyz = {2.5, 2.5, 2.5, -3.5, 4.5, 1.5, 20.5, 0.5, 9.5};
+  const vola::Tree a = vola::build(
+      first, {.quantization = vola::Quantization::grid, .depth = 2, .voxel_size = 1.0, .origin = vola::Point{0, 0, 0}});
+  const vola::Tree b = vola::build(
+      second,
+      {.quantization = vola::Quantization::grid, .depth = 3, .voxel_size = 1.0, .origin = vola::Point{-4, 0, -1}});
+  const std::set<Corner> ca = corners(a), cb = corners(b);
+  std::set<Corner> both, either, only_a;
+  std::set_union(ca.begin(), ca.end(), cb.begin(), cb.end(), std::inserter(either, either.end()));
+  std::set_intersection(ca.begin(), ca.end(), cb.begin(), cb.end(), std::inserter(both, both.end()));
+  std::set_difference(ca.begin(), ca.end(), cb.begin(), cb.end(), std::inserter(only_a, only_a.end()));
+  ASSERT_EQ(both.size(), 1u);  // (2, 2, 2) lies in both
+  const vola::Tree u = vola::unite(a, b), i = vola::intersect(a, b), d = vola::subtract(a, b);
+  EXPECT_EQ(corners(u), either);
+  EXPECT_EQ(corners(i), both);
+  EXPECT_EQ(corners(d), only_a);
+  EXPECT_EQ(u.stored_frame()->origin, (vola::Point{-4, 0, -1}));  // the lower origin on each axis
+  EXPECT_EQ(u.depth(), 3);                                        // what holds x from -4 to 20
+  EXPECT_EQ(corners(vola::unite(b, a)), either);
+  // Half a voxel apart is not one lattice: refused as before.
+  const vola::Tree half = vola::build(
+      second,
+      {.quantization = vola::Quantization::grid, .depth = 3, .voxel_size = 1.0, .origin = vola::Point{-4.5, 0, -1}});
+  EXPECT_THROW(vola::unite(a, half), vola::InvalidArgument);
 }
 
 }  // namespace

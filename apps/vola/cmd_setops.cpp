@@ -43,8 +43,10 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   auto args = std::make_shared<SetArgs>();
   auto* cmd = app.add_subcommand(name, help);
   cmd->footer(
-      "Both files must have the same depth, grid (origin and voxel size) and CRS (PROJ decides\n"
-      "whether two spellings name one CRS); payloads and attributes are not carried into the result.");
+      "Both files must be on one grid and in one CRS (PROJ decides whether two spellings name one\n"
+      "CRS): the same voxel size, origins a whole number of voxels apart (maps of separate vola map\n"
+      "runs are: their origins follow their data; the result takes the lower origin and the depth\n"
+      "that holds both). Payloads and attributes are not carried into the result.");
   cmd->add_option("a", args->a, "First .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("b", args->b, "Second .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol")->required();
@@ -70,7 +72,8 @@ void add_diff(CLI::App& app) {
       "With A the earlier survey and B the later one: added = B - A, removed = A - B,\n"
       "unchanged = both. OUTPUT (optional) receives A - B, the 'removed' set (swap A and B\n"
       "to get what was added). --outputs DIR writes added.vol, removed.vol, unchanged.vol.\n"
-      "Both files must have the same depth, grid and CRS; payloads and attributes are not carried.\n"
+      "Both files must be on one grid (one voxel size, origins whole voxels apart) and in one CRS;\n"
+      "payloads and attributes are not carried.\n"
       "Example: vola diff before.vol after.vol --outputs change/");
   cmd->add_option("a", args->a, "First .vol (before)")->required()->check(CLI::ExistingFile);
   cmd->add_option("b", args->b, "Second .vol (after)")->required()->check(CLI::ExistingFile);
@@ -96,7 +99,16 @@ void add_diff(CLI::App& app) {
     if (!args->output.empty())
       std::printf("diff: %llu and %llu voxels -> %llu voxels\n", static_cast<unsigned long long>(a.voxel_count()),
                   static_cast<unsigned long long>(b.voxel_count()), static_cast<unsigned long long>(removed.voxel_count()));
-    const analysis::ChangeCounts c = analysis::count_changes(a, b);
+    // On one grid, one merge of the key lists counts; on one lattice with other origins or
+    // depths, the set operations (which move the voxels into one frame) do.
+    analysis::ChangeCounts c;
+    if (args->ignore_frame || (a.depth() == b.depth() && a.frame() == b.frame())) {
+      c = analysis::count_changes(a, b);
+    } else {
+      c.added = subtract(b, a, check).voxel_count();
+      c.removed = removed.voxel_count();
+      c.unchanged = intersect(a, b, check).voxel_count();
+    }
     std::printf("added %llu, removed %llu, unchanged %llu voxels\n", static_cast<unsigned long long>(c.added),
                 static_cast<unsigned long long>(c.removed), static_cast<unsigned long long>(c.unchanged));
   });

@@ -65,3 +65,19 @@ def test_crs_must_agree_as_the_cli_says(las_file):
         utm & feet
     assert len(vola.union(utm, feet, ignore_frame=True)) == len(utm)
     assert len(utm | utm) == len(utm)
+
+
+def test_grids_whole_voxels_apart_combine_in_world_space():
+    """Maps of separate runs have origins that follow their data: the same voxel size with
+    origins whole voxels apart is one lattice, combined where the voxels are in the world."""
+    p = np.array([[0.5, 0.5, 0.5], [2.5, 2.5, 2.5], [7.5, 1.5, 0.5]])
+    q = np.array([[2.5, 2.5, 2.5], [-3.5, 4.5, 1.5], [9.5, 0.5, 0.5]])
+    a = vola.build(p, voxel_size=1.0, origin=(0.0, 0.0, 0.0))
+    b = vola.build(q, voxel_size=1.0, origin=(-4.0, 0.0, 0.0))
+    world = lambda t: {tuple(c) for c in np.floor(t.centers()).astype(int).tolist()}
+    assert world(a | b) == world(a) | world(b)
+    assert world(a & b) == world(a) & world(b) == {(2, 2, 2)}
+    assert world(a - b) == world(a) - world(b)
+    assert list((a | b).origin) == [-4.0, 0.0, 0.0]
+    with pytest.raises(vola.InvalidArgument, match="grids differ"):
+        a | vola.build(q, voxel_size=1.0, origin=(-4.5, 0.0, 0.0))
