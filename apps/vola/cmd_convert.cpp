@@ -55,7 +55,7 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
   std::printf("%-16s%llu (%s)\n", (report.unit + " in:").c_str(), static_cast<unsigned long long>(build.points_in),
               a.input.c_str());
   if (build.points_outside)
-    std::printf("%s dropped: %llu (outside the grid or the bbox, or not finite)\n", unit,
+    std::printf("%s dropped: %llu (outside the grid or not finite)\n", unit,
                 static_cast<unsigned long long>(build.points_outside));
   std::printf("voxels out:     %llu at depth %d (%u^3 grid, %s quantization, voxel %.6g)\n",
               static_cast<unsigned long long>(build.voxels), tree.depth(), tree.side(),
@@ -162,7 +162,8 @@ void add_convert(CLI::App& app) {
                   "one named points, xyz, positions, pos, point_cloud, pc or cloud)");
   cmd->add_option("--bbox", args->bbox,
                   "MINX MINY MINZ MAXX MAXY MAXZ: quantize against this box instead of the points' bounds (toolkit: "
-                  "the points outside it are dropped; grid: those outside the grid it makes, which covers the box)")
+                  "points outside it go to the border voxels, as the reference toolkit clips them, with a warning; "
+                  "grid: points outside the grid it makes, which covers the box, are dropped)")
       ->expected(6);
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1 (default: found by name in a header line such as "
                   "'x,y,z,intensity', which also keeps the other columns as attributes; else 1 2 3)")->expected(3)->capture_default_str();

@@ -51,7 +51,14 @@ bool is_geographic_crs(const std::string& definition);
 // reprojected to UTM keeps its heights in feet under a CRS in metres. When reprojecting
 // `source` to `target` (definitions as crs_definition_of reads them) does that (neither
 // has a vertical axis, their units differ, the source is not in degrees), the sentence to
-// tell the user; else "". "" too for what PROJ cannot read.
+// tell the user; else "". "" too for what PROJ cannot read. So too for a compound source
+// (its vertical part in another unit than the target's) reprojected to a target with no
+// vertical part: PROJ moves x and y and leaves z in the source's vertical unit.
 std::string unconverted_heights(const std::string& source, const std::string& target);
+
+// A compound CRS whose heights are in another unit than x and y (NAD83 / Oregon Lambert in
+// metres + NAVD88 in US survey feet): voxels of one size in it are not cubes. The sentence
+// to tell the user; else "" (one unit, degrees, or what PROJ cannot read).
+std::string mixed_units(const std::string& definition);
 
 }  // namespace vola

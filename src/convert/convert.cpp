@@ -18,7 +18,6 @@
 #include "vola/geo/crs.hpp"
 #include "vola/io/file_checks.hpp"
 #include "vola/io/input.hpp"
-#include "vola/point_selection.hpp"
 
 namespace vola {
 
@@ -27,26 +26,22 @@ namespace {
 using namespace convert_detail;
 
 // Toolkit quantization puts what lies outside its box on the border voxels, as the
-// reference does with the points' own bounds (nothing lies outside those). A box the user
-// gives crops the points instead, as a grid drops what lies outside it: the points are
-// read whole (LAS too) and cut to the box before the build (crop_to_bbox).
-bool crops_to_bbox(const ConvertOptions& options) {
+// reference toolkit does (npy2vola clips them; ../shared/golden/fixed_bbox_clip): with a
+// box the user gives, the points outside it are counted for a warning, so the walls they
+// make on the border are not a surprise. The points are read whole for it (LAS too).
+bool clamps_to_bbox(const ConvertOptions& options) {
   return options.bbox && build_options(options, 2000).quantization == Quantization::toolkit;
 }
 
-// Drops the points outside the closed box; returns how many.
-std::uint64_t crop_to_bbox(PointCloud& cloud, const Box& box) {
-  std::vector<bool> keep(cloud.size());
-  std::uint64_t dropped = 0;
+std::uint64_t points_outside(const PointCloud& cloud, const Box& box) {
+  std::uint64_t outside = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const double* p = cloud.xyz.data() + 3 * i;
     bool inside = true;
     for (int a = 0; a < 3; ++a) inside = inside && p[a] >= box.min[a] && p[a] <= box.max[a];
-    keep[i] = inside;
-    dropped += inside ? 0 : 1;
+    outside += inside ? 0 : 1;
   }
-  if (dropped) keep_points(cloud, keep);
-  return dropped;
+  return outside;
 }
 
 io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
@@ -64,7 +59,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   io::InputOptions input;
   input.attributes = options.attributes;
   input.payload = options.nbits > 0;
-  input.stream = options.target_crs.empty() && !crops_to_bbox(options);  // reprojection moves the points read whole
+  input.stream = options.target_crs.empty() && !clamps_to_bbox(options);  // reprojection moves the points read whole
   if (format.name == "text") input.text = text_columns(path, options);
   input.dem_base = options.dem_base;
   input.dem_surface_only = options.dem_surface_only;
@@ -152,15 +147,7 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
   if (input.grid) input.cloud = grid_cell_centres(*input.grid);
   if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
   if (input.cloud.size() == 0) throw no_points(path, input, options);
-  if (input.terrain) return tree_from_terrain(input, build, report);
-  const std::uint64_t cropped = crops_to_bbox(options) ? crop_to_bbox(input.cloud, *options.bbox) : 0;
-  if (input.cloud.size() == 0)
-    throw InvalidArgument(path + ": none of its " + std::to_string(cropped) + " " + unit_of(input) +
-                          " lies inside the bbox given");
-  Tree tree = vola::build(input.cloud, build, &report);
-  report.points_in += cropped;  // the points outside the box count as dropped, as a grid's do
-  report.points_outside += cropped;
-  return tree;
+  return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);
 }
 
 template <class T>
@@ -274,10 +261,17 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     }
   }
   if (!options.target_crs.empty()) check_target_crs(options.target_crs);
+  io::refuse_unopenable_input(path);  // the system's reason before anything else
   const io::InputFormat& format = io::find_input_format(path, options.format);
   std::vector<std::string> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
   std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
+  if (clamps_to_bbox(options) && !input.is_mesh() && !input.terrain)
+    if (const std::uint64_t outside = points_outside(input.cloud, *options.bbox))
+      value_warnings.push_back(path + ": " + std::to_string(outside) + " of its " + std::to_string(input.cloud.size()) +
+                               " points lie outside the bbox given: toolkit quantization puts them on the border "
+                               "voxels, as the reference toolkit clips them; grid quantization (a voxel size) "
+                               "drops what lies outside its grid, and `--crop` cuts the points first");
   if (const auto dropped = drop_unreadable_wkt(path, input)) value_warnings.push_back(*dropped);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);

@@ -153,12 +153,35 @@ std::string unconverted_heights(const std::string& source, const std::string& ta
   try {
     const geo::CrsDescription from = geo::describe_crs(crs_definition_of(source), geo::EpsgLookup::own_id_only);
     const geo::CrsDescription to = geo::describe_crs(crs_definition_of(target), geo::EpsgLookup::own_id_only);
+    // A compound source reprojected to a target without a vertical part: PROJ moves x and
+    // y and leaves z in the source's vertical unit (Autzen's EPSG:2991+6360 to EPSG:32610
+    // kept its heights in US survey feet under a metre CRS).
+    if (!from.vertical_name.empty() && to.vertical_name.empty() && !from.vertical_unit.empty() &&
+        to.horizontal_unit != "degree" && from.vertical_unit != to.horizontal_unit)
+      return "heights (z) stay in " + from.vertical_unit + " (" + from.vertical_name + ") while x and y go to " +
+             to.horizontal_unit +
+             ": the target has no vertical part to convert them to; give it one (a compound "
+             "CRS such as EPSG:32610+5703) to convert them";
     if (!from.vertical_name.empty() || !to.vertical_name.empty() || from.horizontal_unit == "degree" ||
         from.horizontal_unit == to.horizontal_unit)
       return "";
     return "heights (z) stay in " + from.horizontal_unit + " while x and y go to " + to.horizontal_unit +
            ": neither CRS has a vertical axis to convert them by (PROJ and PDAL do the same); give both a "
            "vertical part (a compound CRS such as EPSG:32610+5703) to convert them";
+  } catch (const Error&) {
+    return "";
+  }
+}
+
+std::string mixed_units(const std::string& definition) {
+  try {
+    const geo::CrsDescription d = geo::describe_crs(crs_definition_of(definition), geo::EpsgLookup::own_id_only);
+    if (d.vertical_name.empty() || d.vertical_unit.empty() || d.horizontal_unit.empty() ||
+        d.vertical_unit == d.horizontal_unit || d.horizontal_unit == "degree")
+      return "";
+    return "the CRS's heights are in " + d.vertical_unit + " (" + d.vertical_name + ") and x and y in " +
+           d.horizontal_unit + ": a voxel is as many " + d.horizontal_unit + " across as " + d.vertical_unit +
+           " high, not a cube; reproject to a CRS in one unit (a compound CRS such as EPSG:32610+5703) for cubes";
   } catch (const Error&) {
     return "";
   }

@@ -78,6 +78,8 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
           !heights.empty())
         out.push_back(path + ": " + heights);
     const std::string result = result_definition(crs);
+    if (!result.empty() && voxelises_points(input))
+      if (const std::string mixed = mixed_units(result); !mixed.empty()) out.push_back(mixed);
     if (!result.empty() && voxelises_points(input) && is_geographic_crs(result))
       out.push_back("the CRS (" + geographic_name(result) + ") is geographic: voxels are degrees of longitude and " +
                     "latitude by units of height, not cubes; " + cubes_advice(input) + " for cubes");

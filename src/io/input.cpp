@@ -223,7 +223,6 @@ const char* format_by_magic(const std::string& path) {
 
 const InputFormat& find_input_format(const std::string& path, const std::string& name) {
   refuse_non_regular_input(path);  // every reader finds its format here first
-  refuse_unopenable_input(path);
   const auto& formats = input_formats();
   std::string known;
   for (const auto& f : formats) known += (known.empty() ? "" : ", ") + f.name;
@@ -252,6 +251,7 @@ const InputFormat& find_input_format(const std::string& path, const std::string&
 }
 
 Input read_input(const std::string& path, const std::string& format, const InputOptions& options) {
+  refuse_unopenable_input(path);
   return find_input_format(path, format).read(path, options);
 }
 

@@ -258,6 +258,7 @@ void write_xyz_points(const PointCloud& cloud, const std::string& path, int coor
 
 PointTable read_point_table(const std::string& input, const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                             const std::string& format) {
+  refuse_unopenable_input(input);
   if (find_input_format(input, format).name == "las") return las_point_table(input, progress);
   InputOptions options;
   options.attributes = true;
@@ -303,6 +304,7 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
                                           const PointEdit& edit) {
   refuse_output_over_input(input, output, "vola translate writes a new point file; give it another name");
+  refuse_unopenable_input(input);
   const std::string out_ext = lower_extension(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";

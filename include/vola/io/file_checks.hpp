@@ -19,7 +19,9 @@ void refuse_output_over_input(const std::string& input, const std::string& outpu
 void refuse_non_regular_input(const std::string& path);
 
 // An input that cannot be opened for reading (missing, no permission) is an IoError with
-// the system's reason ("cannot open: No such file or directory"), before any reader.
+// the system's reason ("cannot open: No such file or directory"): called where reading
+// begins (convert, read_input, read_point_table, translate_points), not by
+// find_input_format, which names a format for any path.
 void refuse_unopenable_input(const std::string& path);
 
 }  // namespace vola::io
