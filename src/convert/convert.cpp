@@ -294,6 +294,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     if (input.bytes_read) report.bytes_read = input.bytes_read();
     if (input.bytes_total) report.bytes_total = input.bytes_total;
     report.warnings = crs_warnings(path, options, input, crs);
+    if (const std::string label = implausible_degrees(path, crs, tree.georef().bbox); !label.empty())
+      report.warnings.push_back(label);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
     report.filters = std::move(filter_report);
     *report_out = std::move(report);

@@ -519,6 +519,16 @@ TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
   relabelled.voxel_size = 10.0;
   relabelled.assign_crs = "4326";
   EXPECT_THROW(vola::convert((data / "las" / "pdal_autzen_trim.las").string(), relabelled), vola::OptionError);
+  // A RiSCAN export labelled WGS 84 that holds UTM-sized metres (x 515393): the label is
+  // said to be likely wrong when it is allowed through, on top of the degrees warning.
+  vola::ConvertOptions mislabelled;
+  mislabelled.voxel_size = 10.0;
+  mislabelled.allow_geographic = true;
+  vola::ConvertReport mislabelled_report;
+  vola::convert((data / "laz" / "pdal_lone-star-split-1.laz").string(), mislabelled, {}, &mislabelled_report);
+  ASSERT_EQ(mislabelled_report.warnings.size(), 2u);
+  EXPECT_NE(mislabelled_report.warnings[1].find("beyond any longitude and latitude, under WGS 84"), std::string::npos)
+      << mislabelled_report.warnings[1];
   // A geographic target is the target's fault, not the file's (which is in feet).
   vola::ConvertOptions to_degrees;
   to_degrees.voxel_size = 3.0;
