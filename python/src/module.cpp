@@ -3,31 +3,30 @@
 // collide.cpp, export.cpp, filters.cpp, tiling.cpp, tiles.cpp, map.cpp).
 #include "python_support.hpp"
 
+#include <string>
+
 PYBIND11_MODULE(_vola, m) {
   m.doc() = "VOLA volumetric trees (compiled core of the vola package).";
   m.attr("__version__") = VOLA_PYTHON_VERSION;
 
   // Most specific last: pybind11 tries the latest registered translator first.
   static py::exception<vola::Error> error(m, "Error", PyExc_RuntimeError);
-  // A bad argument is a ValueError too, as Python code expects of one (`except
-  // ValueError` caught numpy's complaints but not a bad voxel size). Both bases share
-  // BaseException's layout; the type lives as long as the module (never freed).
-  static PyObject* const invalid = [&] {
-    const py::tuple bases = py::make_tuple(error, py::handle(PyExc_ValueError));
-    PyObject* type = PyErr_NewException("vola._vola.InvalidArgument", bases.ptr(), nullptr);
+  // vola.NAME, a subclass of vola.Error and of a Python exception `also`, added to the
+  // module. Both bases share BaseException's layout (OSError extends it); the type lives
+  // as long as the module (never freed).
+  const auto error_that_is_also = [&](const char* name, PyObject* also) {
+    const py::tuple bases = py::make_tuple(error, py::handle(also));
+    PyObject* type = PyErr_NewException((std::string("vola._vola.") + name).c_str(), bases.ptr(), nullptr);
     if (!type) throw py::error_already_set();
+    m.add_object(name, py::handle(type));
     return type;
-  }();
-  m.add_object("InvalidArgument", py::handle(invalid));
+  };
+  // A bad argument is a ValueError too, as Python code expects of one (`except
+  // ValueError` caught numpy's complaints but not a bad voxel size).
+  static PyObject* const invalid = error_that_is_also("InvalidArgument", PyExc_ValueError);
   // A file that cannot be read or written is an OSError too (`except OSError` around
   // file handling caught Python's own errors but not vola's).
-  static PyObject* const io_error = [&] {
-    const py::tuple bases = py::make_tuple(error, py::handle(PyExc_OSError));
-    PyObject* type = PyErr_NewException("vola._vola.IoError", bases.ptr(), nullptr);
-    if (!type) throw py::error_already_set();
-    return type;
-  }();
-  m.add_object("IoError", py::handle(io_error));
+  static PyObject* const io_error = error_that_is_also("IoError", PyExc_OSError);
   static py::exception<vola::FormatError> format_error(m, "FormatError", error.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
     try {
