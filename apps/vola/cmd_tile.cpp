@@ -63,7 +63,9 @@ std::uint64_t parse_bytes(const std::string& text) {
 void run_tile(const TileArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<tile::Communicator> comm = tile::world();
-  const bool talk = comm->rank() == 0 && !a.quiet;
+  // Warnings are printed under --quiet too (rank 0 only); the rest only without it.
+  const bool warn = comm->rank() == 0;
+  const bool talk = warn && !a.quiet;
   try {
     tile::TileOptions options;
     options.memory_budget = parse_bytes(a.memory);
@@ -87,7 +89,7 @@ void run_tile(const TileArgs& a) {
     inputs.chunk_points = a.chunk_points;
     inputs.filters = a.filters;
     const tile::OpenedInputs opened = tile::open_inputs(inputs, options);
-    if (talk)
+    if (warn)
       for (const std::string& w : opened.warnings) std::fprintf(stderr, "vola: warning: %s\n", with_flags(w).c_str());
     std::unique_ptr<Progress> progress;
     std::string stage;
@@ -102,8 +104,9 @@ void run_tile(const TileArgs& a) {
       };
     const tile::TileSummary summary = tile::make_tiles(opened.views(), options, *comm);
     if (progress) progress->finish();
+    if (warn)
+      for (const std::string& w : summary.warnings) std::fprintf(stderr, "vola: warning: %s\n", with_flags(w).c_str());
     if (!talk) return;
-    for (const std::string& w : summary.warnings) std::fprintf(stderr, "vola: warning: %s\n", w.c_str());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("inputs:         %zu (%llu points)\n", opened.sources.size(), static_cast<unsigned long long>(opened.points));
     std::printf("crs:            %s\n", options.epsg ? ("EPSG:" + std::to_string(*options.epsg)).c_str()

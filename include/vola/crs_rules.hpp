@@ -61,4 +61,10 @@ std::string unconverted_heights(const std::string& source, const std::string& ta
 // to tell the user; else "" (one unit, degrees, or what PROJ cannot read).
 std::string mixed_units(const std::string& definition);
 
+// Coordinates no longitude or latitude can be (|x| > 180 or |y| > 90) under a geographic
+// CRS `definition`: a label that is likely wrong (a RiSCAN export labelled WGS 84 holding
+// UTM metres). The sentence to tell the user, from the points' or tiles' box (min x, min y,
+// max x, max y); else "" (in range, not geographic, or what PROJ cannot read).
+std::string implausible_degrees(const std::string& definition, double min_x, double min_y, double max_x, double max_y);
+
 }  // namespace vola

@@ -239,6 +239,9 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
     raster='dsm'|'dtm'|'intensity'|'density'|'count' (+ resolution) for a GeoTIFF; map=True
     (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
     for PLY; free= for maps; band=(zmin, zmax) for a ROS map (.yaml, the robot's height band).
+    A state map (`vola map`, Map.save) keeps its free space in .bt, .ot, .vdb and .yaml only
+    when opened with it: vola.open(path, states=True) or vola.read(path); vola.open(path)
+    alone gives its occupied voxels, and the map written then has no free cells.
     Options that do not apply to the format are refused, as the CLI
     refuses them. Returns what the export_* function for the format returns."""
     fmt = _export_format(os.fspath(path), slices=slices, map=map, occupancy_above=occupancy_above is not None,

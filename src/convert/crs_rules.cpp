@@ -1,6 +1,9 @@
 #include "vola/crs_rules.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <string_view>
 
 #include "vola/error.hpp"
@@ -185,6 +188,22 @@ std::string mixed_units(const std::string& definition) {
   } catch (const Error&) {
     return "";
   }
+}
+
+std::string implausible_degrees(const std::string& definition, double min_x, double min_y, double max_x, double max_y) {
+  if (definition.empty() || !is_geographic_crs(definition)) return "";
+  if (!(std::max(std::abs(min_x), std::abs(max_x)) > 180.0 || std::max(std::abs(min_y), std::abs(max_y)) > 90.0))
+    return "";
+  std::string name = definition.substr(0, 60);
+  try {
+    name = geo::describe_crs(definition, geo::EpsgLookup::own_id_only).name;
+  } catch (const Error&) {
+    // The definition's first characters name it well enough.
+  }
+  char reach[96];
+  std::snprintf(reach, sizeof reach, "x reaches %.10g and y %.10g", max_x, max_y);
+  return std::string(reach) + ", beyond any longitude and latitude, under " + name +
+         ": the CRS label is likely wrong (metres of a projected CRS?); give the right one with `assign_crs`";
 }
 
 }  // namespace vola

@@ -1,9 +1,5 @@
 #include "georeference.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 
@@ -94,16 +90,9 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
 }
 
 std::string implausible_degrees(const std::string& path, const ResolvedCrs& crs, const Box& bounds) {
-  const std::string result = result_definition(crs);
-  if (result.empty() || !is_geographic_crs(result)) return "";
-  const double x = std::max(std::abs(bounds.min[0]), std::abs(bounds.max[0]));
-  const double y = std::max(std::abs(bounds.min[1]), std::abs(bounds.max[1]));
-  if (!(x > 180.0 || y > 90.0)) return "";
-  char reach[96];
-  std::snprintf(reach, sizeof reach, "x reaches %.10g and y %.10g", bounds.max[0], bounds.max[1]);
-  return path + ": " + reach + ", beyond any longitude and latitude, under " + geographic_name(result) +
-         ": the file's CRS label is likely wrong (metres of a projected CRS?); give the right one with "
-         "`assign_crs`";
+  const std::string label =
+      vola::implausible_degrees(result_definition(crs), bounds.min[0], bounds.min[1], bounds.max[0], bounds.max[1]);
+  return label.empty() ? label : path + ": " + label;
 }
 
 void reproject_heights(const geo::Reprojection& reprojection, PointCloud& cloud) {

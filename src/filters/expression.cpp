@@ -236,8 +236,12 @@ Expression::Bound Expression::bind(const PointCloud& cloud) const {
   const auto resolve = [&](const Operand& o) {
     if (!o.is_dimension) return;
     const auto d = find_dimension(cloud, o.name);
+    // The expression is quoted: it may not be what the user typed (a pipeline's
+    // filters.range limits become one), and the position must point into something.
     if (!d)
-      fail(o.position, "no dimension '" + o.name + "' in these points (they have " + dimension_list(cloud) + ")");
+      throw InvalidArgument("where: at character " + std::to_string(o.position) + " of '" + text_ +
+                            "': no dimension '" + o.name + "' in these points (they have " + dimension_list(cloud) +
+                            ")");
     bound.slots_[o.slot] = *d;
   };
   for (const auto& n : nodes_)

@@ -20,6 +20,7 @@
 #include "spill.hpp"
 #include "tile_georef.hpp"
 #include "vola/builder.hpp"
+#include "vola/crs_rules.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 #include "vola/parallel.hpp"
@@ -593,7 +594,25 @@ std::vector<AttributeSpec> common_attributes(const std::vector<const PointSource
   return common;
 }
 
-// A folder that is removed with everything in it when this goes out of scope.
+// What to tell the user when the tiles' points lie beyond any longitude and latitude under
+// a geographic CRS (a label that is likely wrong): the index can place none of them.
+std::string implausible_label(const TileIndexFile& index) {
+  if (index.tiles.empty()) return "";
+  const std::string crs = !index.crs_wkt.empty() ? index.crs_wkt
+                          : index.epsg           ? "EPSG:" + std::to_string(*index.epsg)
+                                                 : "";
+  Box extent = index.tiles.front().bbox;
+  for (const TileEntry& t : index.tiles)
+    for (int a = 0; a < 2; ++a) {
+      extent.min[a] = std::min(extent.min[a], t.bbox.min[a]);
+      extent.max[a] = std::max(extent.max[a], t.bbox.max[a]);
+    }
+  const std::string label = implausible_degrees(crs, extent.min[0], extent.min[1], extent.max[0], extent.max[1]);
+  return label.empty() ? label
+                       : "the points' " + label + "; " + kIndexFileName +
+                             " gives tiles beyond them no footprint (a null geometry)";
+}
+
 // This run's spill folder, removed with its files; its parent too when it is vola's own
 // (OUTDIR/.spill, or a --tmp folder this run made) and left empty (other ranks' folders
 // keep it).
@@ -672,6 +691,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   for (TileEntry& t : index.tiles) t.file = generation.name + "/" + t.file;
   for (OverviewEntry& o : index.overviews) o.file = generation.name + "/" + o.file;
   if (run.rank == 0) {
+    if (const std::string label = implausible_label(index); !label.empty()) summary.warnings.push_back(label);
     summary.index_path = (fs::path(options.output_dir) / kIndexFileName).string();
     write_tile_index(index, summary.index_path);  // the switch: whole, by rename
   }

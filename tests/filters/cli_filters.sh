@@ -150,6 +150,13 @@ if "$vola" pipeline "$tmp/empty.json" 2> "$tmp/err.txt"; then fail "an empty ran
 grep -qF "Z's range [420:410] holds no value (a minimum of 420, a maximum of 410)" "$tmp/err.txt" ||
   fail "empty range: $(cat "$tmp/err.txt")"
 [ ! -e "$tmp/none.las" ] || fail "an empty range wrote a file"
+# A range on a dimension the points lack names it; the position points into the quoted
+# expression the limits became (not into text the user never saw).
+echo "[\"$autzen\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2],Nope[1:5]\"}, \"$tmp/nope.las\"]" \
+  > "$tmp/nope.json"
+if "$vola" pipeline "$tmp/nope.json" 2> "$tmp/err.txt"; then fail "a range on a missing dimension ran"; fi
+grep -qF "at character 50 of '(Classification >= 2 && Classification <= 2) && (Nope >= 1 && Nope <= 5)': no dimension 'Nope'" \
+  "$tmp/err.txt" || fail "missing dimension: $(cat "$tmp/err.txt")"
 cp "$autzen" "$tmp/mine.las"
 echo "[\"$tmp/mine.las\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"}, \"$tmp/mine.las\"]" \
   > "$tmp/self.json"

@@ -97,10 +97,12 @@ TEST(Expression, ErrorsNameThePositionAndWhatWasExpected) {
 
 TEST(Expression, UnknownDimensionsAreNamedWithTheOnesThePointsHave) {
   EXPECT_EQ(error_of("z > 1 && Colour == 3"),
-            "where: at character 10: no dimension 'Colour' in these points (they have x, y, z, classification, "
+            "where: at character 10 of 'z > 1 && Colour == 3': no dimension 'Colour' in these points (they have x, y, "
+            "z, classification, "
             "intensity, return_number)");
   EXPECT_EQ(error_of("HeightAboveGround > 2"),
-            "where: at character 1: no dimension 'HeightAboveGround' in these points (they have x, y, z, "
+            "where: at character 1 of 'HeightAboveGround > 2': no dimension 'HeightAboveGround' in these points (they "
+            "have x, y, z, "
             "classification, intensity, return_number)");
 }
 

@@ -170,6 +170,23 @@ geo=$data/las/pdal_epsg_4326.las
 grep -q "geographic CRS.*--allow-geographic" "$tmp/err.txt" || fail "degrees message: $(cat "$tmp/err.txt")"
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" --allow-geographic -q || fail "--allow-geographic refused"
 "$vola" tile "$geo" --tile-size 200 --depth 4 -o "$tmp/degrees_utm" --target-crs 32615 -q || fail "degrees to UTM refused"
+# A WGS 84 label on UTM metres (a RiSCAN export: x = 515393) forced through: a warning
+# says the label is likely wrong, and the index gives those tiles a null geometry rather
+# than an empty polygon (what OGR's antimeridian cut made of them).
+mislabelled=$data/laz/pdal_lone-star-split-1.laz
+if [ -f "$mislabelled" ]; then
+  "$vola" tile "$mislabelled" --tile-size 100 --depth 4 -o "$tmp/mislabelled" --allow-geographic -q 2> "$tmp/err.txt" ||
+    fail "--allow-geographic on the mislabelled file refused: $(cat "$tmp/err.txt")"
+  grep -q "beyond any longitude and latitude, under WGS 84.*null geometry" "$tmp/err.txt" ||
+    fail "no warning about the likely wrong label: $(cat "$tmp/err.txt")"
+  python3 - "$tmp/mislabelled/index.geojson" <<'PY' || fail "mislabelled tiles' geometries are not null"
+import json, sys
+features = json.load(open(sys.argv[1]))["features"]
+sys.exit(0 if features and all(f["geometry"] is None for f in features) else 1)
+PY
+  "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees2" --allow-geographic -q 2> "$tmp/err.txt"
+  grep -q "likely wrong" "$tmp/err.txt" && fail "a true WGS 84 file was said to be mislabelled: $(cat "$tmp/err.txt")"
+fi
 # --assign-crs relabels (a warning says the file stated another CRS); --crs is its old name.
 "$vola" tile "$las" --assign-crs 2994 --tile-size 256 --depth 4 -o "$tmp/assigned" > /dev/null 2> "$tmp/err.txt" ||
   fail "--assign-crs of the same CRS refused: $(cat "$tmp/err.txt")"

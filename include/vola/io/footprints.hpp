@@ -37,7 +37,9 @@ struct FootprintLayer {
 // the polygon follows the projected rectangle's curved edges) and reprojected to WGS84
 // longitude/latitude (7 decimals, about 1 cm); the members of `collection_members_json`
 // (a JSON object) written at the FeatureCollection's top level. Without a CRS, or one
-// GDAL cannot read or take to WGS84, the geometries are null (nowhere true to put them).
+// GDAL cannot read or take to WGS84, the geometries are null (nowhere true to put them);
+// so is each footprint whose corners land on no longitude and latitude (a geographic
+// label on projected coordinates).
 std::vector<std::uint8_t> footprints_geojson(const FootprintLayer& layer, const std::string& collection_members_json);
 
 // GeoPackage bytes: the footprints in the layer's own CRS (without one, a local

@@ -8,6 +8,7 @@
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -60,13 +61,27 @@ std::unique_ptr<OGRSpatialReference> spatial_reference(const std::string& wkt) {
   return srs;
 }
 
-// Whether OGR can take the CRS to WGS84 (an engineering or unknown datum cannot).
-bool reaches_wgs84(const OGRSpatialReference& srs) {
+// The transformation that takes the CRS to WGS84, or none when OGR has none (an
+// engineering or unknown datum).
+std::unique_ptr<OGRCoordinateTransformation> to_wgs84(const OGRSpatialReference& srs) {
   OGRSpatialReference wgs84;
   wgs84.SetWellKnownGeogCS("WGS84");
   wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  const std::unique_ptr<OGRCoordinateTransformation> transform(OGRCreateCoordinateTransformation(&srs, &wgs84));
-  return transform != nullptr;
+  return std::unique_ptr<OGRCoordinateTransformation>(OGRCreateCoordinateTransformation(&srs, &wgs84));
+}
+
+// Whether every corner of the footprint lands on a longitude and latitude. Under a
+// geographic label on projected metres (x = 515393 "degrees") it does not, and OGR's
+// RFC 7946 writer would cut the rectangle at the antimeridian into an empty polygon: such
+// a feature is written with a null geometry instead, which RFC 7946 allows.
+bool lands_in_wgs84(OGRCoordinateTransformation& transform, const Footprint& f) {
+  double x[4] = {f.min_x, f.max_x, f.max_x, f.min_x};
+  double y[4] = {f.min_y, f.min_y, f.max_y, f.max_y};
+  int ok[4] = {0, 0, 0, 0};
+  if (!transform.Transform(4, x, y, nullptr, ok)) return false;
+  for (int i = 0; i < 4; ++i)
+    if (!ok[i] || !(std::abs(x[i]) <= 180.0) || !(std::abs(y[i]) <= 90.0)) return false;
+  return true;
 }
 
 OGRFieldType ogr_type(Type type) {
@@ -109,8 +124,10 @@ std::unique_ptr<OGRPolygon> rectangle(const Footprint& f) {
 }
 
 // Fills `layer` (fields made by `create_fields`); lists as lists, or as JSON text when
-// the driver has no list types.
-void fill(OGRLayer& out, const FootprintLayer& layer, bool lists_as_text, bool geometry) {
+// the driver has no list types. Geometries when `geometry`, but where `placed_by` (when
+// given) cannot take a footprint to WGS84.
+void fill(OGRLayer& out, const FootprintLayer& layer, bool lists_as_text, bool geometry,
+          OGRCoordinateTransformation* placed_by = nullptr) {
   for (const FootprintField& field : layer.fields) {
     const bool list = field.type == Type::integer_list || field.type == Type::real_list;
     OGRFieldDefn definition(field.name.c_str(), list && lists_as_text ? OFTString : ogr_type(field.type));
@@ -137,7 +154,7 @@ void fill(OGRLayer& out, const FootprintLayer& layer, bool lists_as_text, bool g
           },
           f.values[i]);
     }
-    if (geometry) feature.SetGeometryDirectly(rectangle(f).release());
+    if (geometry && (!placed_by || lands_in_wgs84(*placed_by, f))) feature.SetGeometryDirectly(rectangle(f).release());
     if (out.CreateFeature(&feature) != OGRERR_NONE)
       throw IoError(gdal_message("footprints: OGR cannot write a feature"));
   }
@@ -164,7 +181,8 @@ std::vector<std::uint8_t> footprints_geojson_with_ogr(const FootprintLayer& laye
   GDALDriver& geojson = driver("GeoJSON");
   QuietGdalErrors quiet;
   const std::unique_ptr<OGRSpatialReference> srs = spatial_reference(layer.crs_wkt);
-  const bool placed = srs && reaches_wgs84(*srs);
+  const std::unique_ptr<OGRCoordinateTransformation> transform = srs ? to_wgs84(*srs) : nullptr;
+  const bool placed = transform != nullptr;
   const MemoryFolder folder;
   const std::string name = folder.path() + "/footprints.geojson";
   {
@@ -177,7 +195,7 @@ std::vector<std::uint8_t> footprints_geojson_with_ogr(const FootprintLayer& laye
     OGRLayer* out = dataset->CreateLayer(layer.name.c_str(), placed ? srs.get() : nullptr,
                                          placed ? wkbPolygon : wkbNone, options.get());
     if (!out) throw IoError(gdal_message("footprints: GDAL cannot create the GeoJSON layer"));
-    fill(*out, layer, false, placed);
+    fill(*out, layer, false, placed, transform.get());
   }
   if (CPLGetLastErrorType() >= CE_Failure) throw IoError(gdal_message("footprints: GDAL's GeoJSON driver failed"));
   return bytes_of(name);
