@@ -34,6 +34,8 @@ struct ClassifyArgs {
   std::string orientations = "best";
   learn::SegmentOptions segment_options;
   CLI::Option* votes_option = nullptr;
+  CLI::Option* plane_fill_option = nullptr;
+  CLI::Option* orientations_option = nullptr;
   // With --segment: the votes given, or the four quarter turns of the object's footprint.
   int segment_votes() const { return votes_option && votes_option->count() ? votes : 4; }
   std::string vote_key() const {
@@ -43,7 +45,11 @@ struct ClassifyArgs {
 };
 
 void check_segment_args(const ClassifyArgs& a) {
-  if (!a.segment) return;
+  if (!a.segment) {
+    for (const CLI::Option* o : {a.plane_fill_option, a.orientations_option})
+      if (o && o->count()) throw InvalidArgument(o->get_name() + " applies only with --segment");
+    return;
+  }
   if (a.orientations != "best" && a.orientations != "mean")
     throw InvalidArgument("--orientations must be best or mean, got '" + a.orientations + "'");
 }
@@ -64,11 +70,15 @@ void print_segmentation(const learn::Segmentation& s, double vote_degrees) {
                 s.footprint_angle * 180 / 3.14159265358979323846, vote_degrees);
 }
 
-learn::Classifier load_classifier(const ClassifyArgs& a) {
+// The model file --model names, else the committed one for the task.
+std::string model_path(const ClassifyArgs& a) {
+  if (!a.model.empty()) return a.model;
+  return learn::default_model_path(a.segment ? learn::kSegmentedRoomModelFile : learn::kDefaultModelFile);
+}
+
+learn::Classifier load_classifier(const ClassifyArgs& a, const std::string& path) {
   learn::set_threads(a.threads);
-  if (!a.model.empty()) return learn::Classifier(a.model);
-  return learn::Classifier(learn::default_model_path(a.segment ? learn::kSegmentedRoomModelFile
-                                                                : learn::kDefaultModelFile));
+  return learn::Classifier(path);
 }
 
 std::size_t best_class(const std::array<float, kClassCount>& p) {
@@ -77,13 +87,14 @@ std::size_t best_class(const std::array<float, kClassCount>& p) {
 
 void run_classify(const ClassifyArgs& a) {
   check_segment_args(a);
-  const learn::Classifier classifier = load_classifier(a);
+  const learn::Classifier classifier = load_classifier(a, model_path(a));
   const int side = learn::input_side(classifier.architecture());
   for (const auto& input : a.inputs) {
     const Tree tree = read(input);
     if (tree.side() < std::uint32_t(side))
       throw InvalidArgument(input + ": a " + std::to_string(tree.side()) + "^3 grid; the model reads " +
                             std::to_string(side) + "^3 or finer");
+    if (tree.voxel_count() == 0) throw InvalidArgument(input + ": holds no voxels: nothing to classify");
     const Tree* trees[] = {&tree};
     std::array<float, kClassCount> p;
     learn::SegmentedClassification found;
@@ -135,7 +146,8 @@ void write_confusion_png(const std::string& path, const std::vector<std::vector<
 
 void run_evaluate(const ClassifyArgs& a) {
   check_segment_args(a);
-  const learn::Classifier classifier = load_classifier(a);
+  const std::string path = model_path(a);
+  const learn::Classifier classifier = load_classifier(a, path);
   learn::SegmentOptions segment_options = a.segment_options;
   segment_options.average_orientations = a.orientations == "mean";
   std::size_t not_found = 0;
@@ -176,6 +188,7 @@ void run_evaluate(const ClassifyArgs& a) {
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("model: %s\n", path.c_str());
   if (a.segment)
     std::printf("%zu samples, %s model, %.2f ms per sample (batch %d, segmented, %d votes, %s, "
                 "segmentation + fill + network)\nno object found in %zu (counted as wrong, not in the matrix)\n\n",
@@ -260,22 +273,26 @@ void add_model_options(CLI::App* cmd, ClassifyArgs& args) {
                 "standing in its footprint, turn it to the axes of its horizontal layers, scale its longest extent to "
                 "64 voxels, centre it, and classify that with a model of clean objects (the default model), turned by "
                 "the --votes (4: the quarter turns); --orientations says how the votes are combined");
-  cmd->add_option("--plane-fill", args.segment_options.plane_fill,
-                  "With --segment: the share of the scene's cross-section a bounding layer must fill to be a plane")
-      ->capture_default_str()
-      ->check(CLI::Range(0.01, 1.0));
-  cmd->add_option("--orientations", args.orientations,
-                  "With --segment: 'best' keeps the most confident vote (models trained on aligned objects, as the "
-                  "default), 'mean' averages them (models trained with --max-rotation 180)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"best", "mean"}));
+  args.plane_fill_option =
+      cmd->add_option("--plane-fill", args.segment_options.plane_fill,
+                      "With --segment: the share of the scene's cross-section a bounding layer must fill to be a plane")
+          ->capture_default_str()
+          ->check(CLI::Range(0.01, 1.0));
+  args.orientations_option =
+      cmd->add_option("--orientations", args.orientations,
+                      "With --segment: 'best' keeps the most confident vote (models trained on aligned objects, as the "
+                      "default), 'mean' averages them (models trained with --max-rotation 180)")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"best", "mean"}));
 }
 
 constexpr const char* kModelFooter =
     "Without --model the committed small model models/modelnet10-small.pt is used (with --segment\n"
     "models/modelnet10-small-room-segmented.pt, trained on the objects --segment finds in rooms), looked for in\n"
-    "$VOLA_MODEL, <vola's folder>/../share/vola/models/ (installed), <vola's folder>/../models/ and\n"
-    "../../models/ (a build folder in the source tree), then the source tree vola was built from.\n";
+    "$VOLA_MODEL (the model file, or a folder holding it; a name that is neither is an error),\n"
+    "<vola's folder>/../share/vola/models/ (installed), <vola's folder>/../models/, ../../models/ and\n"
+    "../../../models/ (a build folder in the source tree), then the source tree vola was built from.\n"
+    "`vola evaluate` prints the model file it used.\n";
 
 }  // namespace
 

@@ -24,6 +24,7 @@ struct DatasetArgs {
   std::string input, output, split, class_name;
   bool background = false;
   bool segment = false;  // write the object `vola classify --segment` finds in each scene
+  bool overwrite = false;  // remove the .vol files of the folders this run writes first
   double validation_fraction = 0.1;
   std::size_t validation_per_class = 0;  // > 0: a class-balanced split instead of the fraction
   std::uint64_t seed = 1;
@@ -57,6 +58,32 @@ std::string sample_name(int label, std::size_t index) {
   return std::string(learn::kClassNames[std::size_t(label)]) + number;
 }
 
+// The .vol files under `folder` (any depth).
+std::vector<fs::path> samples_in(const fs::path& folder) {
+  std::vector<fs::path> found;
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return found;
+  for (const auto& item : fs::recursive_directory_iterator(folder))
+    if (item.is_regular_file() && item.path().extension() == ".vol") found.push_back(item.path());
+  return found;
+}
+
+// A run writes only the samples of its own split and seed: files an earlier run left in
+// the same folders (another seed, another validation size) would mix into them, and the
+// same object could then be in train/ and val/ at once. So a folder with samples in it is
+// refused, or emptied of them with --overwrite (other files stay).
+void clear_or_refuse(const std::vector<fs::path>& folders, bool overwrite) {
+  for (const fs::path& folder : folders) {
+    const std::vector<fs::path> old = samples_in(folder);
+    if (old.empty()) continue;
+    if (!overwrite)
+      throw InvalidArgument(folder.string() + " already holds " + std::to_string(old.size()) +
+                            " samples (.vol) of an earlier run, which would mix with this one's (an object in " +
+                            "train/ and val/ at once); give an empty folder, or --overwrite to remove them first");
+    for (const fs::path& f : old) fs::remove(f);
+  }
+}
+
 void run_npz(const DatasetArgs& a) {
   const learn::LabelledGrids grids = learn::read_labelled_grids(a.input, a.split);
   if (learn::kSceneSide % grids.side != 0)
@@ -71,6 +98,9 @@ void run_npz(const DatasetArgs& a) {
     for (std::size_t i : split.validation) held_out[i] = 1;
   }
   const fs::path root(a.output);
+  std::vector<fs::path> written{root / grids.split};
+  if (carve) written.push_back(root / "val");
+  clear_or_refuse(written, a.overwrite);
   std::vector<std::size_t> per_split[2];
   std::size_t not_found = 0;
   Progress progress("dataset");
@@ -112,6 +142,9 @@ void run_meshes(const DatasetArgs& a) {
     fixed = learn::class_index(a.class_name);
     if (!fixed) throw InvalidArgument("--class " + a.class_name + " is not a ModelNet10 class");
   }
+  std::vector<fs::path> written;
+  for (const std::string_view name : learn::kClassNames) written.push_back(fs::path(a.output) / name);
+  clear_or_refuse(written, a.overwrite);
   for (std::size_t i = 0; i < files.size(); ++i) {
     const auto label = fixed ? fixed : learn::class_from_file_name(files[i].filename().string());
     if (!label)
@@ -150,7 +183,9 @@ void add_dataset(CLI::App& app) {
       "Layout: OUTDIR/<split>/<class>/<class>_<row>.vol for an npz; the train split gives up a\n"
       "stratified, seeded validation split in OUTDIR/val/ (10% of each class, or N of each with\n"
       "--validation-per-class N). Meshes: OUTDIR/<class>/<file name>.vol, the\n"
-      "class from --class or from a class name in the file name.\n"
+      "class from --class or from a class name in the file name. A folder this run writes (train/ and\n"
+      "val/, test/, or the class folders) that already holds samples is refused: they would mix with\n"
+      "this run's (--overwrite removes them first; the other splits' folders are left alone).\n"
       "Examples:\n"
       "  vola dataset modelnet10_32_train.npz data/clean                  # data/clean/train, data/clean/val\n"
       "  vola dataset modelnet10_32_train.npz data/room --background\n"
@@ -174,6 +209,8 @@ void add_dataset(CLI::App& app) {
       ->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", args->seed, "Seed of the validation split and the rooms")->capture_default_str();
   cmd->add_option("--class", args->class_name, "Meshes: the class of every file");
+  cmd->add_flag("--overwrite", args->overwrite,
+                "Remove the samples an earlier run left in the folders this run writes, instead of refusing");
   cmd->callback([args] { run_dataset(*args); });
 }
 

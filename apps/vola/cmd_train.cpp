@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "commands.hpp"
@@ -34,6 +35,28 @@ nlohmann::json epoch_json(const learn::EpochReport& r) {
           {"seconds", r.seconds}};
 }
 
+// `vola dataset` names each object by its class and row, so a file name in both folders is
+// one object in both: its validation figure would be a training figure.
+void refuse_shared_samples(const std::vector<learn::DatasetEntry>& train, const std::string& train_dir,
+                           const std::vector<learn::DatasetEntry>& validation, const std::string& validation_dir) {
+  if (validation.empty()) return;
+  const auto name = [](const learn::DatasetEntry& e) {
+    const fs::path p(e.path);
+    return (p.parent_path().filename() / p.filename()).string();
+  };
+  std::set<std::string> trained;
+  for (const auto& e : train) trained.insert(name(e));
+  std::size_t shared = 0;
+  std::string example;
+  for (const auto& e : validation)
+    if (trained.count(name(e)) && shared++ == 0) example = name(e);
+  if (shared)
+    throw InvalidArgument(std::to_string(shared) + " of the " + std::to_string(validation.size()) + " samples of " +
+                          validation_dir + " are also in " + train_dir + " (" + example +
+                          ", ...): a model cannot be validated on what it trains on; make the two with one `vola "
+                          "dataset` run (into an empty folder, or with --overwrite)");
+}
+
 void run_train(TrainArgs& a) {
   const auto architecture = learn::parse_architecture(a.architecture);
   if (!architecture) throw InvalidArgument("--arch must be small, wide or paper, not " + a.architecture);
@@ -49,9 +72,13 @@ void run_train(TrainArgs& a) {
     validation_dir = (fs::path(train_dir) / "val").string();
     train_dir = (fs::path(train_dir) / "train").string();
   }
-  const auto train_set = learn::load_samples(learn::list_dataset(train_dir));
+  const auto train_entries = learn::list_dataset(train_dir);
+  const auto validation_entries =
+      validation_dir.empty() ? std::vector<learn::DatasetEntry>{} : learn::list_dataset(validation_dir);
+  refuse_shared_samples(train_entries, train_dir, validation_entries, validation_dir);
+  const auto train_set = learn::load_samples(train_entries);
   const auto validation_set =
-      validation_dir.empty() ? std::vector<learn::Sample>{} : learn::load_samples(learn::list_dataset(validation_dir));
+      validation_dir.empty() ? std::vector<learn::Sample>{} : learn::load_samples(validation_entries);
   std::printf("training %s (%d^3 input) on %zu samples of %s, validating on %zu%s\n", a.architecture.c_str(),
               learn::input_side(*architecture), train_set.size(), train_dir.c_str(), validation_set.size(),
               validation_dir.empty() ? "" : (" of " + validation_dir).c_str());

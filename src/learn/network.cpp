@@ -3,6 +3,7 @@
 #include <unistd.h>
 #include <zip.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <new>
@@ -426,36 +427,47 @@ std::vector<std::array<float, kClassCount>> Classifier::classify_votes(std::span
   if (trees.empty()) return result;
   const int side = input_side(impl_->architecture);
   const std::size_t cells = std::size_t(side) * side * side;
-  const std::size_t n = trees.size() * std::size_t(votes);
+  // The inputs are filled a group of trees at a time, about kInputBytes of them (at least
+  // one tree's votes): a batch of 4096 objects with 360 votes would otherwise take 190 GB
+  // at once. Each input's result does not depend on its neighbours, so groups change nothing.
+  constexpr std::size_t kInputBytes = std::size_t{64} << 20;
+  const std::size_t per_group = std::max<std::size_t>(1, kInputBytes / (cells * sizeof(float) * std::size_t(votes)));
+  result.reserve(trees.size() * std::size_t(votes));
   Batch batch;
-  batch.inputs.resize(n * cells);
-  batch.labels.assign(n, 0);
-  for (std::size_t i = 0; i < trees.size(); ++i)
-    for (int k = 0; k < votes; ++k) {
-      const double angle = 2 * std::numbers::pi * k / votes;
-      fill_occupancy(*trees[i], side, angle,
-                     std::span<float>(batch.inputs.data() + (i * std::size_t(votes) + std::size_t(k)) * cells, cells));
+  for (std::size_t first = 0; first < trees.size(); first += per_group) {
+    const std::size_t count = std::min(per_group, trees.size() - first);
+    const std::size_t n = count * std::size_t(votes);
+    batch.inputs.assign(n * cells, 0.0f);
+    batch.labels.assign(n, 0);
+    for (std::size_t i = 0; i < count; ++i)
+      for (int k = 0; k < votes; ++k) {
+        const double angle = 2 * std::numbers::pi * k / votes;
+        fill_occupancy(
+            *trees[first + i], side, angle,
+            std::span<float>(batch.inputs.data() + (i * std::size_t(votes) + std::size_t(k)) * cells, cells));
+      }
+    torch::Tensor logits;
+    if (detail::reference_inference) {
+      torch::NoGradGuard no_grad;
+      logits = impl_->network->forward(input_tensor(batch, side));
+    } else {
+      c10::InferenceMode inference;  // no autograd records, no version counters
+      // In slices of at most kInferenceSlice inputs: a slice's layers stay in the caches
+      // (6 inputs' first layer output is 2 MB, 384's 135 MB), so large batches are no slower
+      // per input than small ones.
+      const torch::Tensor all = input_tensor(batch, side);
+      std::vector<torch::Tensor> parts;
+      for (std::int64_t at = 0; at < all.size(0); at += kInferenceSlice)
+        parts.push_back(impl_->network->infer(all.slice(0, at, std::min(all.size(0), at + kInferenceSlice))));
+      logits = parts.size() == 1 ? parts.front() : torch::cat(parts, 0);
     }
-  torch::Tensor logits;
-  if (detail::reference_inference) {
-    torch::NoGradGuard no_grad;
-    logits = impl_->network->forward(input_tensor(batch, side));
-  } else {
-    c10::InferenceMode inference;  // no autograd records, no version counters
-    // In slices of at most kInferenceSlice inputs: a slice's layers stay in the caches
-    // (6 inputs' first layer output is 2 MB, 384's 135 MB), so large batches are no slower
-    // per input than small ones. Each input's result does not depend on its neighbours.
-    const torch::Tensor all = input_tensor(batch, side);
-    std::vector<torch::Tensor> parts;
-    for (std::int64_t first = 0; first < all.size(0); first += kInferenceSlice)
-      parts.push_back(impl_->network->infer(all.slice(0, first, std::min(all.size(0), first + kInferenceSlice))));
-    logits = parts.size() == 1 ? parts.front() : torch::cat(parts, 0);
+    const torch::Tensor probabilities = torch::softmax(logits, 1).contiguous();
+    const float* p = probabilities.data_ptr<float>();
+    for (std::size_t j = 0; j < n; ++j) {
+      std::array<float, kClassCount>& row = result.emplace_back();
+      for (std::size_t c = 0; c < std::size_t(kClassCount); ++c) row[c] = p[j * kClassCount + c];
+    }
   }
-  const torch::Tensor probabilities = torch::softmax(logits, 1).contiguous();
-  const float* p = probabilities.data_ptr<float>();
-  result.resize(n);
-  for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t c = 0; c < std::size_t(kClassCount); ++c) result[j][c] = p[j * kClassCount + c];
   return result;
 }
 
@@ -476,14 +488,24 @@ std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const
 std::string default_model_path(std::string_view file) {
   namespace fs = std::filesystem;
   std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("VOLA_MODEL"); env && *env) candidates.emplace_back(env);
   std::error_code error;
+  // $VOLA_MODEL names the model itself, or a folder holding the committed ones; a name
+  // that is neither is an error, not a reason to fall back on another model unseen.
+  if (const char* env = std::getenv("VOLA_MODEL"); env && *env) {
+    if (fs::is_directory(env, error))
+      candidates.push_back(fs::path(env) / file);
+    else if (fs::is_regular_file(env, error))
+      return fs::path(env).lexically_normal().string();
+    else
+      throw IoError(std::string("VOLA_MODEL=") + env + ": no such model file or folder");
+  }
   const fs::path exe = fs::read_symlink("/proc/self/exe", error);
   if (!error) {
     const fs::path dir = exe.parent_path();
     candidates.push_back(dir / ".." / "share" / "vola" / "models" / file);
     candidates.push_back(dir / ".." / "models" / file);
     candidates.push_back(dir / ".." / ".." / "models" / file);
+    candidates.push_back(dir / ".." / ".." / ".." / "models" / file);  // build/apps/vola/vola
   }
   if (*VOLA_LEARN_SOURCE_MODELS) candidates.push_back(fs::path(VOLA_LEARN_SOURCE_MODELS) / file);
   std::string looked;

@@ -23,6 +23,15 @@ PY
 [[ $(find "$work/clean/test" -name '*.vol' | wc -l) == 20 ]] || fail "expected 20 files"
 [[ -f $work/clean/test/night_stand/night_stand_00012.vol ]] || fail "layout: $(ls "$work/clean/test")"
 "$vola" info "$work/clean/test/chair/chair_00004.vol" | grep -q "depth" || fail "not a VOLA file"
+# A second run into the same folders would mix its samples with the first's (another
+# seed's validation split put objects in train/ and val/ at once): refused unless
+# --overwrite, which leaves exactly the new run's files.
+if "$vola" dataset "$work/small.npz" "$work/clean" 2> "$work/err.txt" > /dev/null; then fail "a used folder was taken"; fi
+grep -q "test already holds 20 samples .*--overwrite" "$work/err.txt" || fail "used folder: $(cat "$work/err.txt")"
+touch "$work/clean/test/notes.txt"
+"$vola" dataset "$work/small.npz" "$work/clean" --overwrite > /dev/null
+[[ $(find "$work/clean/test" -name '*.vol' | wc -l) == 20 && -f $work/clean/test/notes.txt ]] ||
+  fail "--overwrite: $(find "$work/clean/test" | wc -l) entries"
 
 # Objects in rooms: more voxels than the clean ones.
 "$vola" dataset "$work/small.npz" "$work/room" --background > /dev/null
@@ -55,6 +64,18 @@ grep -q "4 votes" "$work/eval4.txt" || fail "votes not stated: $(head -n 1 "$wor
 "$vola" classify --votes 12 "$work/clean/test/monitor/monitor_00010.vol" > "$work/one12.txt"
 [[ $(head -n 1 "$work/one12.txt" | cut -d' ' -f1) == monitor ]] || fail "classify --votes 12: $(cat "$work/one12.txt")"
 if "$vola" classify --votes 0 "$work/clean/test/monitor/monitor_00010.vol" 2> /dev/null; then fail "--votes 0 accepted"; fi
+# The model used is named; $VOLA_MODEL may name a folder of models, but one that does not
+# exist is an error, not a silent fall-back on the committed model.
+grep -q "^model: .*modelnet10-small.pt$" "$work/eval.txt" || fail "evaluate names no model: $(head -n 3 "$work/eval.txt")"
+monitor=$work/clean/test/monitor/monitor_00010.vol
+if VOLA_MODEL=$work/no-such.pt "$vola" classify "$monitor" > /dev/null 2> "$work/err.txt"; then
+  fail "a missing VOLA_MODEL fell back on another model"
+fi
+grep -q "VOLA_MODEL=.*no-such.pt: no such model file or folder" "$work/err.txt" || fail "VOLA_MODEL: $(cat "$work/err.txt")"
+model_dir=$(dirname "$(sed -n 's/^model: //p' "$work/eval.txt")")
+VOLA_MODEL=$model_dir "$vola" classify "$monitor" | head -n 1 | grep -q "^monitor " || fail "VOLA_MODEL as a folder"
+if "$vola" classify --orientations mean "$monitor" 2> "$work/err.txt" > /dev/null; then fail "--orientations without --segment"; fi
+grep -q -- "--orientations applies only with --segment" "$work/err.txt" || fail "orientations: $(cat "$work/err.txt")"
 
 # --segment: the object found in a room (floor and walls removed, components), classified
 # with the clean model; the first line still names the class, the last says what was found.

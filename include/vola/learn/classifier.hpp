@@ -125,10 +125,11 @@ extern bool reference_inference;
 void set_threads(int threads);
 
 // Where a committed model (by default the small clean one) is looked for, in order:
-// $VOLA_MODEL; next to the executable's prefix, <exe dir>/../share/vola/models/ (install)
-// and <exe dir>/../models/ and <exe dir>/../../models/ (a build folder inside the source
-// tree); the source tree the library was built from. Returns the first that exists, or
-// throws IoError listing where it looked.
+// $VOLA_MODEL (the model file itself, or a folder holding `file`; a name that is neither
+// throws IoError); next to the executable's prefix, <exe dir>/../share/vola/models/
+// (install) and <exe dir>/../models/, ../../models/ and ../../../models/ (a build folder
+// inside the source tree: build/apps/vola/vola); the source tree the library was built
+// from. Returns the first that exists, or throws IoError listing where it looked.
 inline constexpr std::string_view kDefaultModelFile = "modelnet10-small.pt";
 // The model for objects found in rooms (`classify --segment`): trained on what
 // segment_object and normalise_object give.
