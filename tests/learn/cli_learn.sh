@@ -76,6 +76,12 @@ model_dir=$(dirname "$(sed -n 's/^model: //p' "$work/eval.txt")")
 VOLA_MODEL=$model_dir "$vola" classify "$monitor" | head -n 1 | grep -q "^monitor " || fail "VOLA_MODEL as a folder"
 if "$vola" classify --orientations mean "$monitor" 2> "$work/err.txt" > /dev/null; then fail "--orientations without --segment"; fi
 grep -q -- "--orientations applies only with --segment" "$work/err.txt" || fail "orientations: $(cat "$work/err.txt")"
+"$vola" diff "$monitor" "$monitor" "$work/empty.vol" > /dev/null
+if "$vola" classify "$work/empty.vol" 2> "$work/err.txt" > /dev/null; then fail "an empty tree was classified"; fi
+grep -q "empty.vol: holds no voxels" "$work/err.txt" || fail "empty tree: $(cat "$work/err.txt")"
+if "$vola" train "$work/clean/test" --validation "$work/clean/test" -o "$work/same.pt" --epochs 1 2> "$work/err.txt" > /dev/null
+then fail "training validated on its own samples"; fi
+grep -q "20 of the 20 samples of .* are also in" "$work/err.txt" || fail "shared samples: $(cat "$work/err.txt")"
 
 # --segment: the object found in a room (floor and walls removed, components), classified
 # with the clean model; the first line still names the class, the last says what was found.
