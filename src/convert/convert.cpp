@@ -271,7 +271,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
       value_warnings.push_back(path + ": " + std::to_string(outside) + " of its " + std::to_string(input.cloud.size()) +
                                " points lie outside the bbox given: toolkit quantization puts them on the border "
                                "voxels, as the reference toolkit clips them; grid quantization (a voxel size) "
-                               "drops what lies outside its grid, and `--crop` cuts the points first");
+                               "drops what lies outside its grid, and `crop` cuts the points first");
   if (const auto dropped = drop_unreadable_wkt(path, input)) value_warnings.push_back(*dropped);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);

@@ -165,6 +165,15 @@ std::string unconverted_heights(const std::string& source, const std::string& ta
              to.horizontal_unit +
              ": the target has no vertical part to convert them to; give it one (a compound "
              "CRS such as EPSG:32610+5703) to convert them";
+    // A source without a vertical part reprojected to a compound target: PROJ leaves z as
+    // it is, now labelled with the target's vertical unit (Autzen's feet to
+    // EPSG:32610+5703 came out as NAVD88 metres holding feet).
+    if (from.vertical_name.empty() && !to.vertical_name.empty() && !to.vertical_unit.empty() &&
+        from.horizontal_unit != "degree" && !from.horizontal_unit.empty() && from.horizontal_unit != to.vertical_unit)
+      return "heights (z) stay in " + from.horizontal_unit + " though the target says " + to.vertical_unit + " (" +
+             to.vertical_name + "): the source has no vertical part for PROJ to convert them from; give it one " +
+             "(`assign_crs` with a compound CRS, such as EPSG:2994+6360 for Oregon Lambert feet and NAVD88 feet) " +
+             "to convert them";
     if (!from.vertical_name.empty() || !to.vertical_name.empty() || from.horizontal_unit == "degree" ||
         from.horizontal_unit == to.horizontal_unit)
       return "";

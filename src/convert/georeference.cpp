@@ -1,5 +1,7 @@
 #include "georeference.hpp"
 
+#include <algorithm>
+
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
 
@@ -35,6 +37,25 @@ std::string stated_or_given(const std::string& stated, const std::string& given)
   return !stated.empty() ? stated : given.empty() ? std::string() : crs_definition_of(given);
 }
 
+// The sentence of vola::implausible_degrees for the points read whole, else for the box
+// the file's header states (a LAS file streams later).
+std::string label_doubt(const std::string& definition, const io::Input& input) {
+  const PointCloud& cloud = input.cloud;
+  if (cloud.xyz.size() < 3) {
+    if (!input.stated_bounds) return "";
+    const Box& b = *input.stated_bounds;
+    return vola::implausible_degrees(definition, b.min[0], b.min[1], b.max[0], b.max[1]);
+  }
+  double min_x = cloud.xyz[0], max_x = min_x, min_y = cloud.xyz[1], max_y = min_y;
+  for (std::size_t i = 0; i + 2 < cloud.xyz.size(); i += 3) {
+    min_x = std::min(min_x, cloud.xyz[i]);
+    max_x = std::max(max_x, cloud.xyz[i]);
+    min_y = std::min(min_y, cloud.xyz[i + 1]);
+    max_y = std::max(max_y, cloud.xyz[i + 1]);
+  }
+  return vola::implausible_degrees(definition, min_x, min_y, max_x, max_y);
+}
+
 }  // namespace
 
 std::string given_crs(const ConvertOptions& options) {
@@ -56,6 +77,9 @@ void refuse_geographic_grid(const std::string& path, const ConvertOptions& optio
                                         ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
                                         "units of height, not cubes; give a projected CRS (such as UTM), or " +
                                         "`allow_geographic` to voxelise in degrees anyway");
+  // Coordinates no degree can be: the label, not the CRS, is what to fix.
+  if (const std::string doubt = label_doubt(result, input); !doubt.empty())
+    throw OptionError("", path + ": " + doubt + " (then `target_crs` reprojects from it, if needed)");
   throw OptionError("", path + " is in " + geographic_name(result) +
                                       ", a geographic CRS: voxels would be degrees of longitude and latitude by " +
                                       "units of height, not cubes; " + cubes_advice(input) +
@@ -117,6 +141,9 @@ ResolvedCrs reproject(const std::string& path, const ConvertOptions& options, io
     throw OptionError("target_crs", path + " states no CRS to reproject from; name it with `assign_crs`");
   const std::string from = source.wkt.empty() ? "EPSG:" + std::to_string(*source.epsg) : source.wkt;
   const std::string to = crs_definition_of(options.target_crs);
+  // PROJ would fail on the first point, naming nothing the user can act on.
+  if (const std::string doubt = label_doubt(from, input); !doubt.empty())
+    throw OptionError("", path + ": " + doubt + " to reproject from");
   geo::Reprojection reprojection(from, to);
   reproject_heights(reprojection, input.cloud);
   reprojection.transform(input.cloud.xyz);

@@ -1,9 +1,12 @@
 #include "shapes.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "vola/error.hpp"
+#include "vola/io/dem.hpp"
 #include "vola/mesh/terrain.hpp"
 #include "vola/mesh/voxelize.hpp"
 
@@ -87,11 +90,48 @@ BuildOptions on_the_cells(const io::Input& input, const Box& bbox, BuildOptions 
   return options;
 }
 
+// A cell wider than a voxel covers every voxel column whose centre lies on it, not only
+// the one under its own centre (a 60 m raster at 30 m voxels left three columns in four
+// empty): its point becomes a point per such column, each at the cell's height (the
+// raster's value, as GDAL's nearest resampling gives it, not interpolated). Empty when
+// each cell already is at most a voxel. Grid mode only (toolkit files follow the reference).
+PointCloud cells_on_voxels(const io::Input& input, const BuildOptions& options, double voxel) {
+  if (!input.terrain_cell || options.quantization != Quantization::grid || !(voxel > 0.0)) return {};
+  const auto [width, height] = *input.terrain_cell;
+  // Points no farther apart than a voxel reach every column the cell touches.
+  const auto split = [voxel](double side) { return std::max(1.0, std::ceil(side / voxel - 1e-9)); };
+  const double nx = split(width), ny = split(height);
+  if (nx * ny <= 1.0) return {};
+  const double cells = static_cast<double>(input.cloud.size());
+  if (cells * nx * ny > static_cast<double>(io::kMaxDemCells)) {
+    char what[192];
+    std::snprintf(what, sizeof what,
+                  "the DEM's %.0f cells of %g x %g at voxels of %g make %.0f voxel columns, more than %llu", cells,
+                  width, height, voxel, cells * nx * ny, static_cast<unsigned long long>(io::kMaxDemCells));
+    throw InvalidArgument(std::string(what) + "; give a larger voxel size, or crop the raster first");
+  }
+  PointCloud out;
+  out.xyz.reserve(static_cast<std::size_t>(cells * nx * ny) * 3);
+  const std::size_t ix = static_cast<std::size_t>(nx), iy = static_cast<std::size_t>(ny);
+  for (std::size_t c = 0; c < input.cloud.size(); ++c) {
+    const double* p = &input.cloud.xyz[3 * c];
+    for (std::size_t j = 0; j < iy; ++j)
+      for (std::size_t i = 0; i < ix; ++i) {
+        out.xyz.push_back(p[0] - width / 2 + (static_cast<double>(i) + 0.5) * width / nx);
+        out.xyz.push_back(p[1] - height / 2 + (static_cast<double>(j) + 0.5) * height / ny);
+        out.xyz.push_back(p[2]);
+      }
+  }
+  return out;
+}
+
 }  // namespace
 
 Tree tree_from_terrain(const io::Input& input, const BuildOptions& options, BuildReport& report) {
   if (options.payload) throw OptionError("nbits", "DEM input carries no payload");
-  Box bbox = input.cloud.bounds();
+  const PointCloud spread = cells_on_voxels(input, options, options.voxel_size);
+  const PointCloud& cells = spread.xyz.empty() ? input.cloud : spread;
+  Box bbox = cells.bounds();
   if (!input.terrain_surface_only) {
     bbox.min[2] = std::min(bbox.min[2], input.terrain_base);
     bbox.max[2] = std::max(bbox.max[2], input.terrain_base);
@@ -101,7 +141,7 @@ Tree tree_from_terrain(const io::Input& input, const BuildOptions& options, Buil
   mesh::TerrainOptions columns;
   columns.base = input.terrain_base;
   columns.surface_only = input.terrain_surface_only;
-  Tree tree = mesh::terrain_columns(input.cloud, quantizer, columns, &report);
+  Tree tree = mesh::terrain_columns(cells, quantizer, columns, &report);
   tree.georef().bbox = bbox;
   return tree;
 }

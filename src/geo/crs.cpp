@@ -185,8 +185,6 @@ void Reprojection::transform(std::span<double> xyz) const {
         plugin::PluginFailure failure;
         state.entries->reprojection_transform(state.worker(chunk.worker), xyz.data() + 3 * chunk.begin,
                                               chunk.end - chunk.begin, failure);
-        if (failure.kind != plugin::PluginFailure::Kind::none)  // the plugin counts within the batch
-          failure.message += " (the batch of points from " + std::to_string(chunk.begin) + ")";
         vola::plugin::throw_failure(failure);
       },
       options);

@@ -38,6 +38,8 @@ Input read_las_input(const std::string& path, const InputOptions& options) {
   if (reader->header().copc) in.bytes_read = [reader] { return reader->bytes_read(); };
   in.epsg = reader->header().epsg;
   in.wkt = reader->header().wkt;
+  const LasHeader& header = reader->header();
+  in.stated_bounds = Box{{header.min[0], header.min[1], header.min[2]}, {header.max[0], header.max[1], header.max[2]}};
   if (options.stream) {
     in.build = [reader, options](const BuildOptions& build_options, BuildReport* report) {
       return build_las(*reader, build_options, options.attributes, options.payload, report, options.progress);
@@ -105,6 +107,7 @@ Input read_dem_input(const std::string& path, const InputOptions& options) {
   in.terrain_base = options.dem_base.value_or(dem.minimum);
   in.terrain_surface_only = options.dem_surface_only;
   in.terrain_lattice = dem.lattice;
+  in.terrain_cell = dem.cell_size;
   return in;
 }
 

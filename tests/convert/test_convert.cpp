@@ -342,6 +342,15 @@ TEST(Convert, ReprojectedHeightsAreInTheTargetsUnits) {
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("heights (z) stay in foot while x and y go to metre"), std::string::npos)
       << report.warnings[0];
+  // To a compound target the source (no vertical part) gives PROJ nothing to convert z
+  // from: the heights stayed in feet labelled NAVD88 metres, and nothing was said.
+  options.target_crs = "EPSG:32610+5703";
+  vola::ConvertReport compound_target;
+  vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &compound_target);
+  ASSERT_EQ(compound_target.warnings.size(), 1u);
+  EXPECT_NE(compound_target.warnings[0].find("heights (z) stay in foot though the target says metre (NAVD88 height)"),
+            std::string::npos)
+      << compound_target.warnings[0];
   options.target_crs = "EPSG:2994";  // the file's own unit: nothing to say
   vola::ConvertReport same_unit;
   vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &same_unit);
@@ -529,6 +538,22 @@ TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
   ASSERT_EQ(mislabelled_report.warnings.size(), 2u);
   EXPECT_NE(mislabelled_report.warnings[1].find("beyond any longitude and latitude, under WGS 84"), std::string::npos)
       << mislabelled_report.warnings[1];
+  // Refused (not allowed), the label is what the error blames; so it is when reprojecting
+  // from it, where PROJ failed on the first point with a message naming nothing to fix.
+  for (const char* target : {"", "EPSG:32610"}) {
+    vola::ConvertOptions refused;
+    refused.voxel_size = 10.0;
+    refused.target_crs = target;
+    try {
+      vola::convert((data / "laz" / "pdal_lone-star-split-1.laz").string(), refused);
+      ADD_FAILURE() << "the mislabelled file was converted, target '" << target << "'";
+    } catch (const vola::OptionError& e) {
+      EXPECT_NE(e.cause().find("x reaches 515400.0017 and y 4918365, beyond any longitude and latitude, under WGS 84: "
+                               "the CRS label is likely wrong"),
+                std::string::npos)
+          << e.cause();
+    }
+  }
   // A geographic target is the target's fault, not the file's (which is in feet).
   vola::ConvertOptions to_degrees;
   to_degrees.voxel_size = 3.0;

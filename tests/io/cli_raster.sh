@@ -345,6 +345,24 @@ ok = b != out.GetRasterBand(1).GetNoDataValue()
 assert ok.all(), ok.sum()
 assert ((b - a >= 0) & (b - a <= 60)).all(), np.abs(b - a).max()
 PY
+  # At voxels half the cell, each cell covers its 2 x 2 voxel columns (only the one under
+  # its centre had a column: three in four were nodata), each at the cell's height.
+  "$vola" convert "$dem" "$tmp/dem30.vol" --voxel-size 30 --dem-surface-only -q || fail "convert the DEM at 30"
+  "$vola" export "$tmp/dem30.vol" "$tmp/dem30.tif" --raster dsm -q || fail "export the DEM's DSM at 30"
+  "$python" - "$dem" "$tmp/dem30.tif" <<'PY' || fail "the DEM's cells do not cover their voxels at half their size"
+import sys
+import numpy as np
+from osgeo import gdal
+src, out = gdal.Open(sys.argv[1]), gdal.Open(sys.argv[2])
+g, h = src.GetGeoTransform(), out.GetGeoTransform()
+assert (h[0], h[3], h[1], h[5]) == (g[0], g[3], g[1] / 2, g[5] / 2), (g, h)
+a = src.GetRasterBand(1).ReadAsArray().astype(float)
+b = out.GetRasterBand(1).ReadAsArray().astype(float)
+assert b.shape == (2 * a.shape[0], 2 * a.shape[1]), (a.shape, b.shape)
+assert (b != out.GetRasterBand(1).GetNoDataValue()).all(), "nodata cells"
+up = np.repeat(np.repeat(a, 2, 0), 2, 1)
+assert ((b - up >= 0) & (b - up <= 30)).all(), np.abs(b - up).max()
+PY
 else
   fail "$dem is missing"
 fi

@@ -25,6 +25,8 @@ struct DemRaster {
   // A corner of the cells of a north-up raster (the geotransform's origin), so that a grid
   // of voxels can line up with them; nullopt for a rotated raster.
   std::optional<std::array<double, 2>> lattice;
+  // The cells' width and height (positive) of a north-up raster; nullopt when rotated.
+  std::optional<std::array<double, 2>> cell_size;
 };
 
 // Cell centres through the geotransform (rotation terms included), heights through the

@@ -60,6 +60,9 @@ struct Input {
   std::function<Tree(const BuildOptions&, BuildReport*)> build;
   std::optional<std::uint32_t> epsg;   // what the input says its CRS is
   std::string wkt;
+  // The points' box as the file's header states it (LAS), for what is said before a
+  // streamed read (a CRS label its coordinates cannot fit); not trusted for building.
+  std::optional<Box> stated_bounds;
   // Points the reader left out for a coordinate that is not finite (a PCD organized
   // cloud's missing points), so that counts of the file's points stay true.
   std::uint64_t not_finite = 0;
@@ -77,6 +80,9 @@ struct Input {
   // A corner of the raster's cells (north-up rasters): the default grid origin lines up
   // with the cells rather than with multiples of the voxel size.
   std::optional<std::array<double, 2>> terrain_lattice;
+  // The cells' width and height (north-up rasters): a cell covers every voxel column whose
+  // centre lies on it, not only the one under its centre.
+  std::optional<std::array<double, 2>> terrain_cell;
   bool is_mesh() const noexcept { return !triangles.empty(); }
 };
 

@@ -297,12 +297,20 @@ class Wgs84Transformation {
   std::string source_;
 };
 
+// A CRS's name as PROJ gives it ("WGS 84 / UTM zone 10N"), else the definition's start:
+// for messages, where a WKT's first 60 characters say little.
+std::string crs_name(PJ_CONTEXT* ctx, const std::string& definition) {
+  const Pj crs(proj_create(ctx, definition.c_str()));
+  const char* name = crs ? proj_get_name(crs.get()) : nullptr;
+  return name && *name ? name : definition.substr(0, 60);
+}
+
 // Points from one CRS to another, in place, one batch at a time (proj_trans_generic over
 // strided x y z). Own context: one object per thread.
 class Reprojection {
  public:
   Reprojection(const std::string& from, const std::string& to)
-      : ctx_(make_context()), names_(from.substr(0, 60) + " to " + to.substr(0, 60)) {
+      : ctx_(make_context()), names_(crs_name(ctx_.get(), from) + " to " + crs_name(ctx_.get(), to)) {
     Pj transform(proj_create_crs_to_crs(ctx_.get(), from.c_str(), to.c_str(), nullptr));
     if (!transform) throw Error("PROJ has no transformation from " + names_ + ": " + last_error(ctx_.get()));
     transform_.reset(proj_normalize_for_visualization(ctx_.get(), transform.get()));
@@ -312,18 +320,24 @@ class Reprojection {
   void transform(double* xyz, std::size_t points) {
     constexpr std::size_t stride = 3 * sizeof(double);
     proj_errno_reset(transform_.get());
+    // The batch as it came, to name a point PROJ fails on (it is overwritten in place).
+    before_.assign(xyz, xyz + 3 * points);
     proj_trans_generic(transform_.get(), PJ_FWD, xyz, stride, points, xyz + 1, stride, points, xyz + 2, stride, points,
                        nullptr, 0, 0);
     for (std::size_t i = 0; i < points; ++i)
-      if (!std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
-        throw Error("PROJ cannot transform point " + std::to_string(i) + " of a batch from " + names_ +
-                    " (outside the CRSs' domain?)");
+      if (!std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2])) {
+        char at[128];
+        std::snprintf(at, sizeof at, "(%.10g, %.10g, %.10g)", before_[3 * i], before_[3 * i + 1], before_[3 * i + 2]);
+        throw Error("PROJ cannot transform the point " + std::string(at) + " from " + names_ +
+                    " (outside the source CRS's area, or a CRS label that does not fit the coordinates?)");
+      }
   }
 
  private:
   Context ctx_;
   Pj transform_;
   std::string names_;
+  std::vector<double> before_;
 };
 
 // A CRS definition (code, WKT of any version, PROJ string) as WKT: WKT2 2019 as

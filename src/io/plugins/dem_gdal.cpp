@@ -83,8 +83,11 @@ DemRaster read_dem_with_gdal(const std::string& path,
     throw FormatError(path, std::nullopt,
                       "the raster is placed by " + std::to_string(dataset->GetGCPCount()) +
                           " ground control points, not a geotransform; warp it onto a grid first (gdalwarp)");
-  if (gt[2] == 0.0 && gt[4] == 0.0 && std::isfinite(gt[0]) && std::isfinite(gt[3]))
+  if (gt[2] == 0.0 && gt[4] == 0.0 && std::isfinite(gt[0]) && std::isfinite(gt[3])) {
     dem.lattice = std::array<double, 2>{gt[0], gt[3]};
+    if (std::isfinite(gt[1]) && std::isfinite(gt[5]) && gt[1] != 0.0 && gt[5] != 0.0)
+      dem.cell_size = std::array<double, 2>{std::abs(gt[1]), std::abs(gt[5])};
+  }
 
   GDALRasterBand* band = dataset->GetRasterBand(1);
   int has_scale = 0, has_offset = 0;
