@@ -146,7 +146,14 @@ void run_export(const ExportArgs& a) {
   if (a.depth > tree.depth())
     throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
                           std::to_string(tree.depth()));
-  if (a.depth > 0 && a.depth < tree.depth()) tree = tree.level_of_detail(a.depth);
+  if (a.depth > 0 && a.depth < tree.depth()) {
+    // A coarser grid carries no attribute columns: say so rather than "no intensity column".
+    if (a.raster == "intensity" && tree.attributes().find("intensity"))
+      throw InvalidArgument("--raster intensity needs the intensity column, which --depth " + std::to_string(a.depth) +
+                            " drops (a coarser grid carries no attribute columns); for coarser cells give "
+                            "--resolution R at the file's depth instead");
+    tree = tree.level_of_detail(a.depth);
+  }
   const unsigned long long voxels = tree.voxel_count();
   auto say = [&](const std::string& what) {
     if (!a.quiet) std::printf("%s -> %s\n", what.c_str(), a.output.c_str());
@@ -288,7 +295,8 @@ void add_export(CLI::App& app) {
       "  vola export occupied.vol map.bt --free free.vol    # plain trees: free voxels from another file\n"
       "  vola export map.vol map.vdb\n"
       "  vola export map.vol floor.yaml --band 0.1:1.5        # 2D map for nav2 of a robot 1.5 high\n"
-      "  vola export autzen.vol nav.yaml --band 400:420 --depth 5");
+      "  vola export autzen.vol nav.yaml --band 430:450     # a survey in feet: obstacles 430-450 ft, free above\n"
+      "                                                     # ground that lies below the band (Autzen's is 400-430)");
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
   cmd->add_option("--format", args->format,

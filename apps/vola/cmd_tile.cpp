@@ -176,7 +176,7 @@ void add_tile(CLI::App& app) {
       ->check(CLI::Range(1, 10));
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
   add_crs_options(*cmd, args->assign_crs, args->target_crs, args->allow_geographic, "--tile-size and --origin");
-  add_filter_options(*cmd, args->filters);
+  add_filter_options(*cmd, args->filters, false);
   cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
       ->capture_default_str();
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");

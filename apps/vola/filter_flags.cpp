@@ -21,7 +21,7 @@ const char* const kFilterHelp =
     "  --crop MINX MINY MAXX MAXY  (or MINX MINY MINZ MAXX MAXY MAXZ) keep a box\n"
     "  --crop-polygon FILE   keep the points inside a GeoJSON or WKT polygon (holes, multipolygons)\n";
 
-void add_filter_options(CLI::App& cmd, std::vector<std::string>& stages) {
+void add_filter_options(CLI::App& cmd, std::vector<std::string>& stages, bool neighbour_stages) {
   cmd.add_option_function<std::string>(
          "--where", [&stages](const std::string& expr) { stages.push_back("where:" + expr); },
          "Keep the points EXPR holds for, e.g. \"Classification == 2 && z < 500\" (see below)")
@@ -29,7 +29,11 @@ void add_filter_options(CLI::App& cmd, std::vector<std::string>& stages) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   cmd.add_option_function<std::string>(
          "--filter", [&stages](const std::string& stage) { stages.push_back(stage); },
-         "A filter stage: smrf[:PARAMS], hag, outlier[:k=K,multiplier=M], voxel:R, poisson:R (repeatable, in order)")
+         neighbour_stages
+             ? "A filter stage: smrf[:PARAMS], hag, outlier[:k=K,multiplier=M], voxel:R, poisson:R (repeatable, in "
+               "order)"
+             : "A filter stage needing no neighbours (crop:..., polygon:FILE, where:EXPR); smrf, hag, outlier, "
+               "voxel:R and poisson:R are refused here: run them with vola translate first")
       ->trigger_on_parse()
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   cmd.add_option_function<std::vector<double>>(

@@ -11,7 +11,9 @@
 
 namespace vola::cli {
 
-void add_filter_options(CLI::App& cmd, std::vector<std::string>& stages);
+// `neighbour_stages`: whether the command runs the stages that need each point's neighbours
+// (smrf, hag, outlier, voxel, poisson); vola tile, which reads chunk by chunk, does not.
+void add_filter_options(CLI::App& cmd, std::vector<std::string>& stages, bool neighbour_stages = true);
 
 // The help footer's paragraph about the filters.
 extern const char* const kFilterHelp;

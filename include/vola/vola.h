@@ -192,6 +192,7 @@ typedef struct vola_convert_options {
   const char *grid;                    /* OpenVDB: the grid to read; .npz: the array; NULL = the default */
   const char *const *filters;          /* point filter stages, run in order ("where:Classification == 2", */
   size_t filter_count;                 /* "smrf", "hag", "crop:X0,Y0,X1,Y1", ...: docs/FILTERS.md) */
+  double map_height;                   /* ROS maps (MAP.yaml): occupied cells as columns this high; 0 = one voxel */
 } vola_convert_options;
 
 typedef struct vola_convert_report {

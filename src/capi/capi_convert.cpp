@@ -50,6 +50,7 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   o.solid = c.solid != 0;
   if (c.has_dem_base) o.dem_base = c.dem_base;
   o.dem_surface_only = c.dem_surface_only != 0;
+  o.map_height = c.map_height;
   vola::capi::require((c.write_flags & ~(VOLA_WRITE_DENSE | VOLA_WRITE_COMPRESS | VOLA_WRITE_COMPRESS_MAX)) == 0,
                       "write_flags: unknown flags");
   o.dense = (c.write_flags & VOLA_WRITE_DENSE) != 0;

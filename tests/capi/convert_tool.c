@@ -98,6 +98,8 @@ int main(int argc, char **argv) {
       options.dem_base = strtod(value, NULL);
     } else if (strcmp(key, "dem_surface_only") == 0) {
       options.dem_surface_only = atoi(value);
+    } else if (strcmp(key, "map_height") == 0) {
+      options.map_height = strtod(value, NULL);
     } else if (strcmp(key, "dense") == 0) {
       if (atoi(value)) options.write_flags |= VOLA_WRITE_DENSE;
     } else if (strcmp(key, "compress") == 0) {

@@ -150,6 +150,13 @@ if "$vola" pipeline "$tmp/empty.json" 2> "$tmp/err.txt"; then fail "an empty ran
 grep -qF "Z's range [420:410] holds no value (a minimum of 420, a maximum of 410)" "$tmp/err.txt" ||
   fail "empty range: $(cat "$tmp/err.txt")"
 [ ! -e "$tmp/none.las" ] || fail "an empty range wrote a file"
+# SMRF on points in degrees says what to do in the CLI's words (it named target_crs, which
+# vola translate does not have and which runs after the filters anyway).
+if "$vola" translate "$data/las/pdal_epsg_4326.las" "$tmp/deg.xyz" --filter smrf 2> "$tmp/err.txt"; then
+  fail "smrf ran on degrees"
+fi
+grep -q "smrf: the points' CRS (WGS 84) has coordinates in degree.*filters.reprojection.*--assign-crs" "$tmp/err.txt" ||
+  fail "smrf on degrees: $(cat "$tmp/err.txt")"
 # A range on a dimension the points lack names it; the position points into the quoted
 # expression the limits became (not into text the user never saw).
 echo "[\"$autzen\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2],Nope[1:5]\"}, \"$tmp/nope.las\"]" \
