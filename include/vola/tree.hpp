@@ -88,9 +88,10 @@ class Tree {
   static Tree from_levels(int depth, bool has_payload, std::vector<std::uint64_t> words,
                           const std::string& source = {}, std::uint64_t file_offset = 0);
   // The same over bytes kept alive by `keeper` (a memory map): nothing is copied.
+  // `in_mapping`: whether the bytes are a file's mapping (is_mapped), not a copy of it.
   static Tree view_levels(int depth, bool has_payload, std::span<const std::uint64_t> words,
                           std::shared_ptr<const void> keeper, const std::string& source = {},
-                          std::uint64_t file_offset = 0);
+                          std::uint64_t file_offset = 0, bool in_mapping = true);
 
   int depth() const noexcept { return depth_; }
   std::uint32_t side() const noexcept { return side_of(depth_); }

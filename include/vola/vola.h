@@ -91,8 +91,12 @@ typedef struct vola_build_options {
   uint32_t epsg;      /* recorded in the header; 0 = the reference's default (2000) */
 } vola_build_options;
 
-/* Points x0 y0 z0 x1 y1 z1 ... (count points). Non-finite points, and in grid mode points
- * outside the grid, are dropped; *dropped (may be NULL) receives how many. */
+/* Points x0 y0 z0 x1 y1 z1 ... (count points). Non-finite points are dropped; *dropped (may
+ * be NULL) receives how many. In grid mode the grid starts at the points' minimum, so no
+ * point lies outside it: a depth too small for their extent at voxel_size is refused
+ * (VOLA_ERROR_INVALID_ARGUMENT naming the depth that holds them), as is an extent no depth
+ * up to 10 holds (one stray point far away does that: crop first, or vola_convert with a
+ * bbox, whose grid drops what lies outside). */
 VOLA_C_API vola_status vola_build_from_points(const double *xyz, size_t count, const vola_build_options *options,
                                               vola_tree **out, uint64_t *dropped);
 /* Integer voxel coordinates x0 y0 z0 ..., each below 4^depth; duplicates allowed. */
@@ -188,7 +192,8 @@ typedef struct vola_convert_options {
   vola_progress_callback progress;     /* may be NULL; called now and then during long reads */
   void *progress_user;
   const char *assign_crs;              /* NULL, or the input's CRS as any definition (not with epsg) */
-  int allow_geographic;                /* voxelise in a geographic CRS's degrees anyway (default 0: refused) */
+  int allow_geographic;                /* grid mode: voxelise in a geographic CRS's degrees anyway (default 0: refused;
+                                          toolkit quantization, which has no voxel size, only warns) */
   const char *grid;                    /* OpenVDB: the grid to read; .npz: the array; NULL = the default */
   const char *const *filters;          /* point filter stages, run in order ("where:Classification == 2", */
   size_t filter_count;                 /* "smrf", "hag", "crop:X0,Y0,X1,Y1", ...: docs/FILTERS.md) */

@@ -57,6 +57,19 @@ def test_a_file_cut_while_mapped_is_refused_not_read_as_zeros(tree, tmp_path):
         mapped.check_mapped()
 
 
+@pytest.mark.parametrize("call", ["level_of_detail", "downsample"])
+def test_a_file_cut_before_its_first_read_is_an_io_error(tmp_path, call):
+    # Cut before any page was read, the call itself meets the zeros: it failed with a
+    # FormatError naming "<memory>"; the cut, naming the file, is what is raised.
+    path = tmp_path / "t.vol"
+    points = np.random.default_rng(3).uniform(0, 250, size=(20000, 3))
+    vola.build(points, voxel_size=1.0).write(path)  # levels over many pages
+    mapped = vola.open(path)
+    os.truncate(path, 4096)
+    with pytest.raises(vola.IoError, match="t.vol: the file was cut"):
+        getattr(mapped, call)(max(1, mapped.depth - 1))
+
+
 def test_mapped_levels_are_views_of_the_file(tree, tmp_path):
     path = tmp_path / "t.vol"
     tree.write(path)

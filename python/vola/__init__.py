@@ -122,7 +122,17 @@ def _refusing_cut_mappings(function):
         mapped = [a for a in (*args, *kwargs.values()) if isinstance(a, Tree) and a.is_mapped]
         for tree in mapped:
             tree.check_mapped()
-        result = function(*args, **kwargs)
+        try:
+            result = function(*args, **kwargs)
+        except Error:
+            # Cut during the call: the zeros it read made it fail ("<memory>: level 2 block 0
+            # is empty ..."); the cut, naming the file, is what to report.
+            for tree in mapped:
+                try:
+                    tree.check_mapped()
+                except IoError as cut:
+                    raise cut from None
+            raise
         for tree in mapped:
             tree.check_mapped()
         return result

@@ -18,6 +18,7 @@
 
 namespace {
 
+using vola::capi::check_trees_in_use;
 using vola::capi::fail;
 using vola::capi::guarded;
 using vola::capi::require;
@@ -159,7 +160,9 @@ vola_status vola_level_of_detail(const vola_tree* tree, int depth, vola_tree** o
     if (depth < 1 || depth > t.depth())
       throw vola::InvalidArgument("vola_level_of_detail: depth " + std::to_string(depth) + " is outside 1.." +
                                   std::to_string(t.depth()));
-    *out = new vola_tree{t.level_of_detail(depth)};
+    vola::Tree coarse = t.level_of_detail(depth);
+    check_trees_in_use();
+    *out = new vola_tree{std::move(coarse)};
   });
 }
 
@@ -196,6 +199,7 @@ vola_status vola_get_info(const vola_tree* tree, vola_info* out) {
     info.voxel_size = frame.voxel_size;
     info.epsg = t.georef().epsg;
     info.attribute_count = t.attributes().size();
+    check_trees_in_use();
     *out = info;
   });
 }
@@ -204,7 +208,9 @@ vola_status vola_contains(const vola_tree* tree, uint32_t x, uint32_t y, uint32_
   return guarded([&] {
     const vola::Tree& t = tree_of(tree);
     require(out != nullptr, "vola_contains: out is NULL");
-    *out = t.contains(x, y, z) ? 1 : 0;
+    const int inside = t.contains(x, y, z) ? 1 : 0;
+    check_trees_in_use();
+    *out = inside;
   });
 }
 
@@ -224,6 +230,7 @@ vola_status vola_rank(const vola_tree* tree, uint32_t x, uint32_t y, uint32_t z,
     if (!rank)
       throw vola::InvalidArgument("vola_rank: voxel (" + std::to_string(x) + ", " + std::to_string(y) + ", " +
                                   std::to_string(z) + ") is not occupied");
+    check_trees_in_use();
     *out = *rank;
   });
 }
@@ -237,6 +244,7 @@ vola_status vola_for_each_voxel(const vola_tree* tree, vola_voxel_callback callb
       ++count;
       return callback(v.x, v.y, v.z, user) == 0;
     });
+    check_trees_in_use();
     if (visited) *visited = count;
   });
 }
@@ -255,6 +263,7 @@ vola_status vola_copy_voxels(const vola_tree* tree, uint64_t first, uint32_t* xy
         return ++n < capacity;
       });
     }
+    check_trees_in_use();
     *written = n;
   });
 }
@@ -279,7 +288,9 @@ vola_status vola_attribute_value(const vola_tree* tree, const char* name, uint64
     if (rank >= column->size())
       throw vola::InvalidArgument("vola_attribute_value: rank " + std::to_string(rank) + " but the column has " +
                                   std::to_string(column->size()) + " values");
-    *out = column->get(static_cast<std::size_t>(rank));
+    const double value = column->get(static_cast<std::size_t>(rank));
+    check_trees_in_use();
+    *out = value;
   });
 }
 

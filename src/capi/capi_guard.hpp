@@ -51,12 +51,25 @@ inline const vola::Tree& tree_of(const vola_tree* handle) {
   return handle->tree;
 }
 
+// Called by an entry point before it writes its out-parameters: a tree the call read that
+// was cut meanwhile fails the call first, so that the out-parameters stay untouched.
+inline void check_trees_in_use() {
+  for (const vola::Tree* tree : trees_in_use()) vola::check_mapped(*tree);
+}
+
 template <class Body>
 vola_status guarded(Body&& body) noexcept {
   try {
     trees_in_use().clear();
-    body();
-    for (const vola::Tree* tree : trees_in_use()) vola::check_mapped(*tree);  // cut during the call
+    try {
+      body();
+    } catch (...) {
+      // A tree cut during the call fails it as an I/O error naming the file, whatever its
+      // zero pages made the call fail with ("<memory>: level 2 block 0 is empty ...").
+      check_trees_in_use();
+      throw;
+    }
+    check_trees_in_use();  // cut during the call
     trees_in_use().clear();
     return VOLA_OK;
   } catch (const vola::FormatError& e) {

@@ -126,7 +126,7 @@ void apply_extension(Tree& tree, const Header& h, detail::ExtensionContents& ext
 }
 
 Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::shared_ptr<const void> keeper,
-            FileLayout* layout) {
+            FileLayout* layout, bool in_mapping = false) {
   const Header h = decode_header(bytes, name);
   FileLayout info;
   info.header = h;
@@ -155,7 +155,7 @@ Tree decode(std::span<const std::uint8_t> bytes, const std::string& name, std::s
     const std::uint8_t* first = bytes.data() + kHeaderSize;
     if (keeper && reinterpret_cast<std::uintptr_t>(first) % alignof(std::uint64_t) == 0) {
       tree = Tree::view_levels(h.depth, payload, {reinterpret_cast<const std::uint64_t*>(first), words},
-                               std::move(keeper), name, kHeaderSize);
+                               std::move(keeper), name, kHeaderSize, in_mapping);
     } else {
       std::vector<std::uint64_t> copy(words);
       if (words) std::memcpy(copy.data(), first, 8 * words);
@@ -328,7 +328,7 @@ Tree open_mapped(const std::string& path, FileLayout* layout) {
 #if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
   // Cut while being checked: the zeros read since make a misleading FormatError; say what happened.
   try {
-    Tree tree = decode(bytes, path, file, layout);
+    Tree tree = decode(bytes, path, file, layout, file->is_mapping());
     check_mapped(tree);
     return tree;
   } catch (const FormatError&) {
@@ -336,7 +336,7 @@ Tree open_mapped(const std::string& path, FileLayout* layout) {
   }
   VOLA_THROW(IoError(path + ": the file was cut (truncated or rewritten in place) while it was being opened"));
 #else
-  return decode(bytes, path, file, layout);
+  return decode(bytes, path, file, layout, file->is_mapping());
 #endif
 }
 

@@ -42,6 +42,8 @@ class MappedFile {
 
   std::span<const std::uint8_t> bytes() const noexcept { return {data_, size_}; }
   const std::string& path() const noexcept { return path_; }
+  // False when the bytes are a copy: load(), or open() past the table of live mappings.
+  bool is_mapping() const noexcept { return slot_ >= 0; }
 
  private:
   MappedFile() = default;

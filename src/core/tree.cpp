@@ -112,8 +112,8 @@ Tree Tree::from_levels(int depth, bool has_payload, std::vector<std::uint64_t> w
 }
 
 Tree Tree::view_levels(int depth, bool has_payload, std::span<const std::uint64_t> words,
-                       std::shared_ptr<const void> keeper, const std::string& source,
-                       std::uint64_t file_offset) {
+                       std::shared_ptr<const void> keeper, const std::string& source, std::uint64_t file_offset,
+                       bool in_mapping) {
   if (depth < kMinDepth || depth > kMaxDepth)
     VOLA_THROW(InvalidArgument("depth " + std::to_string(depth) + " is outside 1..10"));
   Tree tree;
@@ -122,7 +122,7 @@ Tree Tree::view_levels(int depth, bool has_payload, std::span<const std::uint64_
   tree.nbits_ = has_payload ? 1 : 0;
   tree.keeper_ = std::move(keeper);
   tree.all_words_ = words;
-  tree.mapped_ = true;
+  tree.mapped_ = in_mapping;
   tree.index(source, file_offset);
   return tree;
 }

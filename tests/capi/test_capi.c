@@ -253,6 +253,15 @@ static void test_shared_file(const char *path) {
   vola_tree_free(mapped);
 }
 
+/* The callback of the cut-midway test: truncates the file at the tenth voxel. */
+static const char *cut_path = NULL;
+static int cut_calls = 0;
+static int cut_at_tenth(uint32_t x, uint32_t y, uint32_t z, void *user) {
+  (void)x, (void)y, (void)z, (void)user;
+  if (++cut_calls == 10) CHECK(truncate(cut_path, 0) == 0);
+  return 0;
+}
+
 /* A mapped file cut by another process (cp over it, a truncation) leaves zero pages: calls
  * on its tree must fail, not answer from the zeros with VOLA_OK. */
 static void test_cut_while_mapped(const char *scratch) {
@@ -275,6 +284,21 @@ static void test_cut_while_mapped(const char *scratch) {
   CHECK(vola_get_info(mapped, &info) == VOLA_ERROR_IO);
   snprintf(path, sizeof path, "%s/from_cut.vol", scratch);
   CHECK(vola_write(mapped, path, 0) == VOLA_ERROR_IO);
+  vola_tree_free(mapped);
+
+  /* Cut during a call: an I/O error (not the format error its zero pages would make), and
+   * the out-parameters untouched (visited was set to the voxels seen before the cut). */
+  snprintf(path, sizeof path, "%s/cut_midway.vol", scratch);
+  CHECK_OK(vola_write(built, path, 0));
+  CHECK_OK(vola_open(path, VOLA_OPEN_MAPPED, &mapped));
+  cut_path = path;
+  cut_calls = 0;
+  uint64_t visited = 12345;
+  CHECK(vola_for_each_voxel(mapped, cut_at_tenth, NULL, &visited) == VOLA_ERROR_IO);
+  CHECK(visited == 12345 && cut_calls == 10);
+  vola_tree *coarse = NULL;
+  CHECK(vola_level_of_detail(mapped, 3, &coarse) == VOLA_ERROR_IO && coarse == NULL);
+  CHECK(strstr(vola_last_error(), "cut_midway.vol") != NULL && strstr(vola_last_error(), "was cut") != NULL);
   vola_tree_free(mapped);
   vola_tree_free(built);
   free(xyz);
