@@ -20,6 +20,7 @@
 
 #include "vola/builder.hpp"
 #include "vola/file.hpp"
+#include "vola/filters/stages.hpp"
 #include "vola/tree.hpp"
 
 namespace vola {
@@ -111,8 +112,10 @@ struct ConvertReport {
   // What a careful user should know about the result (a CRS relabelled, voxels in
   // degrees allowed or quantized by the toolkit): one sentence each, for the front end.
   std::vector<std::string> warnings;
-  // Points each filter stage took in and left ("smrf: 110000 -> 110000, 26411 ground").
+  // Points each filter stage took in and left ("smrf: 110000 -> 110000, 26411 ground"),
+  // as lines and as counts.
   std::vector<std::string> filters;
+  std::vector<filters::StageReport> filter_stages;
 };
 
 // (done, total) in any unit, now and then during long reads.

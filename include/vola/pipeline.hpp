@@ -18,7 +18,7 @@ struct PipelineOutputReport {
   bool voxels = false;             // a .vol written by the conversion pipeline
   std::uint64_t voxel_count = 0;   // .vol outputs
   std::vector<std::string> filter_lines;          // .vol outputs: ConvertReport::filters
-  std::vector<filters::StageReport> stages;       // point outputs: each stage's counts
+  std::vector<filters::StageReport> stages;       // each stage's counts
   std::vector<std::string> warnings;              // for the user: CRS relabelled, CRS not kept, ...
 };
 

@@ -187,7 +187,9 @@ class Tree {
   // nullopt when the file had no extension (a reference file): its grid is then the
   // toolkit's, from the header bbox.
   const std::optional<Frame>& stored_frame() const noexcept { return frame_; }
-  void set_frame(const Frame& frame) { frame_ = frame; }
+  // Throws InvalidArgument for a frame whose origin or voxel size is not finite (a file
+  // written with it is one the reader refuses).
+  void set_frame(const Frame& frame);
   // The grid in world coordinates, whichever way it is known.
   Frame frame() const noexcept;
   Quantizer quantizer() const;

@@ -107,6 +107,12 @@ def test_build_from_voxels_and_dense_round_trip():
     voxels_back, inside = framed.world_to_voxel(np.array([[19.5, 37.0, 35.9], [9.0, 20.0, 30.0]]))
     np.testing.assert_array_equal(voxels_back, [[4, 8, 2], [-1, -1, -1]])
     np.testing.assert_array_equal(inside, [True, False])
+    # A frame vola's reader refuses is refused when it is made (the file was written, then
+    # refused by vola.open: "frame origin is not finite").
+    with pytest.raises(vola.InvalidArgument, match="origin: must be finite"):
+        vola.from_dense(small, origin=(float("nan"), 0.0, 0.0))
+    with pytest.raises(vola.InvalidArgument, match="voxel_size"):
+        vola.from_dense(small, voxel_size=float("inf"))
     with pytest.raises(vola.InvalidArgument, match="max_cells"):
         vola.build_from_voxels([[0, 0, 0]], depth=8).to_dense()
 

@@ -61,6 +61,8 @@ def test_pipeline_from_a_file_text_or_lists_writes_what_the_cli_writes(shared_da
         assert smrf["points_in"] == smrf["points_out"] == 110000 and 0 < smrf["ground"] < 110000
         assert where["points_out"] == smrf["ground"]
         assert voxels["voxel_count"] == len(vola.read(tmp_path / f"{prefix}ground.vol"))
+        # The .vol writer's report has the same stage counts (its "stages" were empty).
+        assert voxels["stages"] == points["stages"]
     with pytest.raises(vola.InvalidArgument, match="pipeline stage 1"):
         vola.pipeline([str(autzen), {"type": "filters.nothing"}, str(tmp_path / "x.las")])
     with pytest.raises(vola.IoError, match="no_such.json: cannot open"):

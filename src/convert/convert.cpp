@@ -45,7 +45,7 @@ std::uint64_t points_outside(const PointCloud& cloud, const Box& box) {
 }
 
 io::Input read(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
-               const ConvertProgress& progress, std::vector<std::string>& filter_report) {
+               const ConvertProgress& progress, std::vector<filters::StageReport>& filter_report) {
   if (format.name != "text") {
     const std::string why = "apply to text input only (" + path + " is " + format.name + ")";
     if (!options.text_attributes.empty()) throw OptionError("text_attributes", why);
@@ -263,7 +263,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   if (!options.target_crs.empty()) check_target_crs(options.target_crs);
   io::refuse_unopenable_input(path);  // the system's reason before anything else
   const io::InputFormat& format = io::find_input_format(path, options.format);
-  std::vector<std::string> filter_report;
+  std::vector<filters::StageReport> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
   std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
   if (clamps_to_bbox(options) && !input.is_mesh() && !input.terrain)
@@ -297,7 +297,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     if (const std::string label = implausible_degrees(path, crs, tree.georef().bbox); !label.empty())
       report.warnings.push_back(label);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
-    report.filters = std::move(filter_report);
+    for (const auto& stage : filter_report) report.filters.push_back(describe(stage));
+    report.filter_stages = std::move(filter_report);
     *report_out = std::move(report);
   }
   return tree;

@@ -65,14 +65,14 @@ std::string describe(const filters::StageReport& stage) {
 }
 
 io::Input read_filtered(const std::string& path, const io::InputFormat& format, const ConvertOptions& options,
-                        const io::InputOptions& input_options, std::vector<std::string>& report) {
+                        const io::InputOptions& input_options, std::vector<filters::StageReport>& report) {
   const std::vector<filters::Stage> stages = filters::parse_stages(options.filters);
   if (format.name == "text") {
     io::InputOptions whole = input_options;
     whole.stream = false;
     io::Input text = format.read(path, whole);
     const filters::FilterResult result = filters::run_stages(stages, text.cloud, text.epsg, text.wkt);
-    for (const auto& stage : result.stages) report.push_back(describe(stage));
+    report = result.stages;
     return text;
   }
   const ConvertProgress& progress = input_options.progress;
@@ -83,7 +83,7 @@ io::Input read_filtered(const std::string& path, const io::InputFormat& format, 
     throw OptionError("filters", std::string("apply to point input only: ") + e.what());
   }
   const filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
-  for (const auto& stage : result.stages) report.push_back(describe(stage));
+  report = result.stages;
   io::Input input;
   input.format = table.format;
   input.epsg = table.epsg;

@@ -3,6 +3,7 @@
 #include "vola/convert.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/pipeline.hpp"
+#include "vola/io/file_checks.hpp"
 #include "vola/io/translate.hpp"
 #include "vola/pipeline.hpp"
 
@@ -41,6 +42,10 @@ ConvertOptions convert_options(const filters::PipelineWriter& writer, const std:
 std::vector<PipelineOutputReport> run_pipeline(const std::string& json, const std::string& name) {
   const filters::Pipeline pipeline = filters::parse_pipeline(json, name);
   const std::vector<filters::Stage> stages = filters::parse_stages(pipeline.stages);
+  // Before any writer runs: a later writer over the input would read it half written.
+  for (const auto& writer : pipeline.writers)
+    io::refuse_output_over_input(pipeline.input, writer.filename,
+                                 "a pipeline's writers write new files (" + name + "); give this one another name");
   std::vector<PipelineOutputReport> reports;
   for (const auto& writer : pipeline.writers) {
     PipelineOutputReport out;
@@ -52,6 +57,7 @@ std::vector<PipelineOutputReport> run_pipeline(const std::string& json, const st
       convert_file(pipeline.input, writer.filename, convert_options(writer, pipeline.stages), {}, &report);
       out.voxel_count = report.build.voxels;
       out.filter_lines = std::move(report.filters);
+      out.stages = std::move(report.filter_stages);
       out.warnings = std::move(report.warnings);
     } else {
       out.warnings = io::translate_points(pipeline.input, writer.filename, {}, [&](io::PointTable& table) {

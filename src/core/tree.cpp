@@ -1,5 +1,6 @@
 #include "vola/tree.hpp"
 
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -101,6 +102,14 @@ Tree::Tree() {
   all_words_ = *root;
   keeper_ = std::move(root);
   index({}, 0);
+}
+
+void Tree::set_frame(const Frame& frame) {
+  if (!std::isfinite(frame.voxel_size))
+    VOLA_THROW(OptionError("voxel_size", "must be finite, got " + std::to_string(frame.voxel_size)));
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(frame.origin[a])) VOLA_THROW(OptionError("origin", "must be finite"));
+  frame_ = frame;
 }
 
 Tree Tree::from_levels(int depth, bool has_payload, std::vector<std::uint64_t> words,

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "ray_voxels.hpp"
@@ -289,9 +291,17 @@ RayExtent ray_extent(std::span<const double> xyz, const Point& origin, double vo
 
 ScanReport OccupancyMap::insert_scan(std::span<const double> xyz, const Point& origin, double max_range,
                                      unsigned threads) {
-  if (!voxel_of(origin))
-    throw InvalidArgument("sensor origin (" + std::to_string(origin[0]) + ", " + std::to_string(origin[1]) + ", " +
-                          std::to_string(origin[2]) + ") is not finite or outside the map's index range");
+  if (!voxel_of(origin)) {
+    char what[640];
+    const double reach = static_cast<double>(kIndexLimit) * voxel_size_;
+    std::snprintf(what, sizeof what,
+                  "sensor origin (%.10g, %.10g, %.10g) is not finite or outside the map's index range: the map "
+                  "holds %lld voxels each way from 0, i.e. within %.10g of 0 on each axis at voxels of %.10g; give "
+                  "scan poses in a local frame (subtract a fixed offset from every pose and point, e.g. a UTM "
+                  "corner) or a larger voxel size",
+                  origin[0], origin[1], origin[2], static_cast<long long>(kIndexLimit), reach, voxel_size_);
+    throw InvalidArgument(what);
+  }
   if (!(max_range >= 0.0)) throw InvalidArgument("max_range must be >= 0 (0: no limit)");
   if (xyz.size() % 3 != 0) throw InvalidArgument("xyz must hold 3 coordinates per point");
   const std::size_t count = xyz.size() / 3;

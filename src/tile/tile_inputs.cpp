@@ -43,10 +43,19 @@ void resolve_tile_crs(const std::string& assign, bool allow_geographic,
   std::vector<StatedCrs> stated;
   for (const auto& s : sources) stated.push_back({s->name(), s->epsg, s->wkt});
   const ResolvedCrs crs = resolve_crs(stated, assign);
-  if (!allow_geographic && !crs.wkt.empty() && is_geographic_crs(crs.wkt))
-    throw OptionError("target_crs", "the inputs are in a geographic CRS: tiles and voxels would be degrees of "
-                                    "longitude and latitude by units of height, not cubes; give `target_crs` (a "
-                                    "projected CRS such as UTM), or `allow_geographic` to tile in degrees anyway");
+  if (!allow_geographic && !crs.wkt.empty() && is_geographic_crs(crs.wkt)) {
+    std::string name = "a geographic CRS";
+    try {
+      name = geo::describe_crs(crs.wkt, geo::EpsgLookup::own_id_only).name + ", a geographic CRS";
+    } catch (const Error&) {
+      // The words above say enough.
+    }
+    throw OptionError("", sources.front()->name() + (sources.size() > 1 ? " and the other inputs are" : " is") +
+                              " in " + name +
+                              ": tiles and voxels would be degrees of longitude and latitude by "
+                              "units of height, not cubes; give `target_crs` (a projected CRS such as UTM), or "
+                              "`allow_geographic` to tile in degrees anyway");
+  }
   // The index's footprints go through GDAL, whose PROJ contexts would open the file.
   if (const std::string named = geo::crs_file_reference(crs.wkt); !named.empty())
     throw InvalidArgument("the inputs' CRS embeds a PROJ string that names a file ('" + named.substr(0, 80) +

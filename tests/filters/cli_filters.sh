@@ -168,7 +168,7 @@ cp "$autzen" "$tmp/mine.las"
 echo "[\"$tmp/mine.las\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"}, \"$tmp/mine.las\"]" \
   > "$tmp/self.json"
 if "$vola" pipeline "$tmp/self.json" 2> "$tmp/err.txt"; then fail "a pipeline wrote over its input"; fi
-grep -q "mine.las is the input" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
+grep -q "mine.las is the input: a pipeline.s writers write new files" "$tmp/err.txt" || fail "error: $(cat "$tmp/err.txt")"
 if "$vola" translate "$tmp/mine.las" "$tmp/mine.las" --where "Classification == 2" 2> "$tmp/err.txt"; then
   fail "translate wrote over its input"
 fi

@@ -167,7 +167,8 @@ grep -q "needs each point's neighbours.*vola translate" "$tmp/err.txt" || fail "
 # Degrees: tiles in a geographic CRS are refused unless reprojected or forced.
 geo=$data/las/pdal_epsg_4326.las
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" 2> "$tmp/err.txt" && fail "tiles in degrees accepted"
-grep -q "geographic CRS.*--allow-geographic" "$tmp/err.txt" || fail "degrees message: $(cat "$tmp/err.txt")"
+grep -q "^vola: .*pdal_epsg_4326.las is in WGS 84, a geographic CRS.*--allow-geographic" "$tmp/err.txt" ||
+  fail "degrees message: $(cat "$tmp/err.txt")"
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" --allow-geographic -q || fail "--allow-geographic refused"
 "$vola" tile "$geo" --tile-size 200 --depth 4 -o "$tmp/degrees_utm" --target-crs 32615 -q || fail "degrees to UTM refused"
 # A WGS 84 label on UTM metres (a RiSCAN export: x = 515393) forced through: a warning
