@@ -142,9 +142,6 @@ void run_meshes(const DatasetArgs& a) {
     fixed = learn::class_index(a.class_name);
     if (!fixed) throw InvalidArgument("--class " + a.class_name + " is not a ModelNet10 class");
   }
-  std::vector<fs::path> written;
-  for (const std::string_view name : learn::kClassNames) written.push_back(fs::path(a.output) / name);
-  clear_or_refuse(written, a.overwrite);
   for (std::size_t i = 0; i < files.size(); ++i) {
     const auto label = fixed ? fixed : learn::class_from_file_name(files[i].filename().string());
     if (!label)
@@ -183,9 +180,10 @@ void add_dataset(CLI::App& app) {
       "Layout: OUTDIR/<split>/<class>/<class>_<row>.vol for an npz; the train split gives up a\n"
       "stratified, seeded validation split in OUTDIR/val/ (10% of each class, or N of each with\n"
       "--validation-per-class N). Meshes: OUTDIR/<class>/<file name>.vol, the\n"
-      "class from --class or from a class name in the file name. A folder this run writes (train/ and\n"
-      "val/, test/, or the class folders) that already holds samples is refused: they would mix with\n"
-      "this run's (--overwrite removes them first; the other splits' folders are left alone).\n"
+      "class from --class or from a class name in the file name (files of earlier runs stay: a folder\n"
+      "of meshes can be added to). For an npz, a split folder this run writes (train/ and val/, or\n"
+      "test/) that already holds samples is refused: they would mix with this run's (--overwrite\n"
+      "removes them first; the other splits' folders are left alone).\n"
       "Examples:\n"
       "  vola dataset modelnet10_32_train.npz data/clean                  # data/clean/train, data/clean/val\n"
       "  vola dataset modelnet10_32_train.npz data/room --background\n"
@@ -210,7 +208,8 @@ void add_dataset(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "Seed of the validation split and the rooms")->capture_default_str();
   cmd->add_option("--class", args->class_name, "Meshes: the class of every file");
   cmd->add_flag("--overwrite", args->overwrite,
-                "Remove the samples an earlier run left in the folders this run writes, instead of refusing");
+                "npz: remove the samples an earlier run left in the split folders this run writes, instead of "
+                "refusing");
   cmd->callback([args] { run_dataset(*args); });
 }
 

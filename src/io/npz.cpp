@@ -151,7 +151,7 @@ std::string npz_points_member(const std::string& path, const std::string& wanted
   throw FormatError(path, std::nullopt,
                     "which array holds the points? The archive holds " + listed +
                         (named.empty() ? ", none named points or xyz" : ", several named as points are") +
-                        ": give one with --grid NAME (Python: grid=NAME)");
+                        ": give one with --grid NAME (Python: grid=NAME; C: vola_convert_options.grid)");
 }
 
 }  // namespace vola::io

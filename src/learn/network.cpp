@@ -314,6 +314,8 @@ void check_tensor_records(const std::vector<torch::Tensor>& tensors, RecordSizes
 
 RecordSizes load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
   std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw IoError("cannot open model " + path + ": a folder, not a model file (vola train writes one, e.g. model.pt)");
   if (!std::filesystem::is_regular_file(path, error)) throw IoError("cannot open model " + path + ": no such file");
   RecordSizes records = check_model_archive(path);
   try {

@@ -42,6 +42,11 @@ room_size=$(stat -c %s "$work/room/test/sofa/sofa_00014.vol")
 # Meshes: the class from the file name.
 "$vola" dataset "$data/modelnet/off/bathtub_0001.off" "$work/meshes" > /dev/null
 [[ -f $work/meshes/bathtub/bathtub_0001.vol ]] || fail "mesh not written"
+# A folder of meshes can be added to: a second run keeps the first's files.
+"$vola" dataset "$data/modelnet/off/gomesh_normalized_chair_0001.off" "$work/meshes" > /dev/null ||
+  fail "a second mesh run into the same folder was refused"
+[[ -f $work/meshes/bathtub/bathtub_0001.vol && -f $work/meshes/chair/gomesh_normalized_chair_0001.vol ]] ||
+  fail "mesh runs do not add up"
 
 # Evaluate with the committed model: 14 of these are training samples and 6 are in the
 # balanced validation split (--validation-per-class 100), so nearly all are right.
@@ -74,6 +79,8 @@ fi
 grep -q "VOLA_MODEL=.*no-such.pt: no such model file or folder" "$work/err.txt" || fail "VOLA_MODEL: $(cat "$work/err.txt")"
 model_dir=$(dirname "$(sed -n 's/^model: //p' "$work/eval.txt")")
 VOLA_MODEL=$model_dir "$vola" classify "$monitor" | head -n 1 | grep -q "^monitor " || fail "VOLA_MODEL as a folder"
+if "$vola" classify --model "$model_dir" "$monitor" > /dev/null 2> "$work/err.txt"; then fail "a folder as --model"; fi
+grep -q "a folder, not a model file" "$work/err.txt" || fail "--model folder: $(cat "$work/err.txt")"
 if "$vola" classify --orientations mean "$monitor" 2> "$work/err.txt" > /dev/null; then fail "--orientations without --segment"; fi
 grep -q -- "--orientations applies only with --segment" "$work/err.txt" || fail "orientations: $(cat "$work/err.txt")"
 "$vola" diff "$monitor" "$monitor" "$work/empty.vol" > /dev/null
