@@ -255,7 +255,9 @@ std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumn
   for (const auto& v : vlrs) offset_to_points += v.size();
   std::vector<std::uint8_t> h(kHeaderSize);
   std::memcpy(h.data(), "LASF", 4);
-  put<std::uint16_t>(h, 6, report.has_crs ? kWktBit : 0);
+  // Set with or without a CRS: point formats 6-10 take theirs as WKT only (LAS 1.4 R15),
+  // and PDAL complains of a format-6 file without the bit.
+  put<std::uint16_t>(h, 6, kWktBit);
   h[24] = 1;
   h[25] = 4;
   put_text(h, 26, 32, "vola");
@@ -279,9 +281,10 @@ std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumn
     put<double>(h, 187 + 16 * a, coords.integer(points.min, a) * coords.scale + coords.offset[a]);
   }
   put<std::uint64_t>(h, 247, points.count);
-  std::uint64_t first_returns = 0;  // points by return number: those that are return 1
-  for (std::size_t r = 0; r < points.count; ++r) first_returns += returns_of(columns, r).first == 1;
-  put<std::uint64_t>(h, 255, first_returns);
+  std::uint64_t by_return[15] = {};  // points by return number 1..15
+  for (std::size_t r = 0; r < points.count; ++r)
+    if (const std::uint32_t number = returns_of(columns, r).first; number >= 1 && number <= 15) ++by_return[number - 1];
+  for (int k = 0; k < 15; ++k) put<std::uint64_t>(h, 255 + 8 * static_cast<std::size_t>(k), by_return[k]);
   return h;
 }
 
