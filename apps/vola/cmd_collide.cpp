@@ -64,7 +64,6 @@ int run_collide(const CollideArgs& a) {
   if (!a.segment.empty()) {
     const auto& s = a.segment;
     const Point from{s[0], s[1], s[2]}, to{s[3], s[4], s[5]};
-    if (from == to) throw InvalidArgument("--segment: the two ends are the same point");
     const auto hit = collider.segment(to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5]));
     if (!hit) return report(false, "no occupied voxel on the segment");
     if (!a.quiet) print_segment_hit(a, from, to, *hit);

@@ -30,12 +30,16 @@ auto write_released(Write&& write) {
 }
 
 // write(tree) on the tree's first `depth` levels (0: the tree itself), as `vola export
-// --depth` does.
+// --depth` does. A state map's occupied voxels, as `vola export` reads one: its free
+// voxels are known empty space, not points, cells or returns.
 template <class Write>
-auto at_depth(const Tree& tree, int depth, Write&& write) {
-  if (depth < 0 || depth > tree.depth())
+auto at_depth(const Tree& given, int depth, Write&& write) {
+  if (depth < 0 || depth > given.depth())
     throw vola::OptionError("depth", "`depth` " + std::to_string(depth) + " is not one of the tree's depths 1.." +
-                                         std::to_string(tree.depth()) + " (0: the tree's own)");
+                                         std::to_string(given.depth()) + " (0: the tree's own)");
+  std::optional<Tree> occupied;
+  if (vola::map::is_state_map(given)) occupied = vola::map::occupied_tree(given);
+  const Tree& tree = occupied ? *occupied : given;
   if (depth == 0 || depth == tree.depth()) return write(tree);
   return write(tree.level_of_detail(depth));
 }

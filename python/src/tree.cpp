@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "vola/file.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola::python {
 
@@ -78,13 +79,22 @@ py::object contains(const Tree& tree, const py::handle& input) {
   py::array_t<bool> out(n);
   bool* hit = out.mutable_data();
   const std::int64_t* p = xyz.data();
+  const bool state_map = vola::map::is_state_map(tree);
   {
     py::gil_scoped_release release;
     constexpr std::int64_t limit = std::numeric_limits<std::uint32_t>::max();
     for (py::ssize_t i = 0; i < n; ++i, p += 3) {
       const bool representable = p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] <= limit && p[1] <= limit && p[2] <= limit;
-      hit[i] = representable && tree.contains(static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
-                                              static_cast<std::uint32_t>(p[2]));
+      if (!representable) {
+        hit[i] = false;
+      } else if (state_map) {  // occupied, not merely known (a state map holds its free voxels too)
+        const vola::Voxel v{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
+                            static_cast<std::uint32_t>(p[2])};
+        hit[i] = vola::map::state_at(tree, v) == vola::map::VoxelState::occupied;
+      } else {
+        hit[i] = tree.contains(static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
+                               static_cast<std::uint32_t>(p[2]));
+      }
     }
   }
   if (single_row(input)) return py::bool_(hit[0]);
@@ -228,27 +238,40 @@ py::class_<Tree> bind_tree(py::module_& m) {
       .def("__len__", [](const Tree& t) { return t.voxel_count(); })
       .def("__repr__", &repr)
       .def_property_readonly("is_mapped", &Tree::is_mapped, "True when the level words live in a file mapping.")
-      .def("check_mapped", [](const Tree& t) { vola::check_mapped(t); },
-           "Raises vola.IoError when the file this tree maps was cut (truncated, or copied over in place) since it\n"
-           "was opened: the mapping then reads zeros. Every Tree method and vola function does this before and\n"
-           "after its work; numpy views of the levels (occupancy(), payload()) cannot, so call it after using them.")
+      .def(
+          "check_mapped", [](const Tree& t) { vola::check_mapped(t); },
+          "Raises vola.IoError when the file this tree maps was cut (truncated, or copied over in place) since it\n"
+          "was opened: the mapping then reads zeros. Every Tree method and vola function does this before and\n"
+          "after its work; numpy views of the levels (occupancy(), payload()) cannot, so call it after using them.")
       .def_property_readonly(
           "is_state_map", [](const Tree& t) { return t.payload_meaning() == vola::PayloadMeaning::occupancy_state; },
           "True for a state map (vola map, vola.Map.save): known voxels, payload bit set = occupied.")
       .def_property_readonly("memory_bytes", &Tree::memory_bytes, "Bytes held in memory (mapped words not counted).")
-      .def("node_count", [](const Tree& tree, int level) { return tree.node_count(checked_level(tree, level, false)); },
-           py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
-      .def_property_readonly("quantization", [](const Tree& t) { return t.frame().quantization == vola::Quantization::grid ? "grid" : "toolkit"; },
-                             "'grid' (floor((p - origin) / voxel_size)) or 'toolkit' (the reference's rounding).")
-      .def_property_readonly("origin", [](const Tree& t) { return t.frame().origin; }, "World position of voxel (0, 0, 0)'s corner.")
-      .def_property_readonly("voxel_size", [](const Tree& t) { return t.frame().voxel_size; }, "World edge of one voxel.")
-      .def_property_readonly("epsg", [](const Tree& t) { return t.georef().epsg; }, "EPSG code in the header (2000 = the reference's default).")
-      .def_property_readonly("crs_wkt", [](const Tree& t) { return t.georef().crs_wkt; }, "The CRS as WKT ('' when unknown).")
-      .def_property_readonly("bbox", [](const Tree& t) { return py::make_tuple(t.georef().bbox.min, t.georef().bbox.max); },
-                             "(min, max) of the input points in world coordinates, as the header records it.")
-      .def_property_readonly("lat_lon", [](const Tree& t) { return py::make_tuple(t.georef().lat, t.georef().lon); },
-                             "WGS84 latitude and longitude of the bbox centre (0, 0 when unknown).")
-      .def_property_readonly("attribute_names", [](const Tree& t) {
+      .def(
+          "node_count", [](const Tree& tree, int level) { return tree.node_count(checked_level(tree, level, false)); },
+          py::arg("level"), "Occupied cells of `level` (depth - 1 = voxels).")
+      .def_property_readonly(
+          "quantization",
+          [](const Tree& t) { return t.frame().quantization == vola::Quantization::grid ? "grid" : "toolkit"; },
+          "'grid' (floor((p - origin) / voxel_size)) or 'toolkit' (the reference's rounding).")
+      .def_property_readonly(
+          "origin", [](const Tree& t) { return t.frame().origin; }, "World position of voxel (0, 0, 0)'s corner.")
+      .def_property_readonly(
+          "voxel_size", [](const Tree& t) { return t.frame().voxel_size; }, "World edge of one voxel.")
+      .def_property_readonly(
+          "epsg", [](const Tree& t) { return t.georef().epsg; },
+          "EPSG code in the header (2000 = the reference's default).")
+      .def_property_readonly(
+          "crs_wkt", [](const Tree& t) { return t.georef().crs_wkt; }, "The CRS as WKT ('' when unknown).")
+      .def_property_readonly(
+          "bbox", [](const Tree& t) { return py::make_tuple(t.georef().bbox.min, t.georef().bbox.max); },
+          "(min, max) of the input points in world coordinates, as the header records it.")
+      .def_property_readonly(
+          "lat_lon", [](const Tree& t) { return py::make_tuple(t.georef().lat, t.georef().lon); },
+          "WGS84 latitude and longitude of the bbox centre (0, 0 when unknown).")
+      .def_property_readonly(
+          "attribute_names",
+          [](const Tree& t) {
             // Bytes that are not UTF-8 (a name in a hostile file) become U+FFFD rather than
             // a UnicodeDecodeError; the readers write UTF-8 names.
             py::list names;
@@ -259,9 +282,11 @@ py::class_<Tree> bind_tree(py::module_& m) {
               names.append(py::reinterpret_steal<py::str>(text));
             }
             return names;
-          }, "Names of the per-voxel attribute columns.")
+          },
+          "Names of the per-voxel attribute columns.")
       .def("contains", &contains, py::arg("voxels"),
-           "Occupancy of integer voxels: an (M, 3) array gives an (M,) bool array, one (3,) row gives a bool.\n"
+           "Occupancy of integer voxels: an (M, 3) array gives an (M,) bool array, one (3,) row gives a bool\n"
+           "(of a state map, whether the voxel is occupied: its free voxels are False).\n"
            "Voxels off the grid (negative, >= side) are False; floats that are not whole numbers raise\n"
            "ValueError (world coordinates go through world_to_voxel first). Runs in C++ without the GIL.")
       .def("rank", &rank_of, py::arg("voxels"),
@@ -274,10 +299,13 @@ py::class_<Tree> bind_tree(py::module_& m) {
            "World points (M, 3) -> (voxels (M, 3) int64, inside (M,) bool); voxels off the grid are -1.")
       .def("to_dense", &to_dense, py::arg("level") = -1, py::arg("max_cells") = std::uint64_t{1} << 30,
            "A dense bool grid indexed [x, y, z] of `level` (default: the voxels). Refuses grids above max_cells.")
-      .def("occupancy", [](const py::object& self, int level) { return level_words(self, level, false); }, py::arg("level"),
-           "The occupancy words of `level` as a read-only uint64 view (of the file mapping for a mapped tree).")
-      .def("payload", [](const py::object& self, int level) { return level_words(self, level, true); }, py::arg("level"),
-           "The payload words of `level` (empty without payload) as a read-only uint64 view.")
+      .def(
+          "occupancy", [](const py::object& self, int level) { return level_words(self, level, false); },
+          py::arg("level"),
+          "The occupancy words of `level` as a read-only uint64 view (of the file mapping for a mapped tree).")
+      .def(
+          "payload", [](const py::object& self, int level) { return level_words(self, level, true); }, py::arg("level"),
+          "The payload words of `level` (empty without payload) as a read-only uint64 view.")
       .def("attribute", &attribute_view, py::arg("name"),
            "Attribute column `name` as a read-only view, one value per voxel in rank order. KeyError if missing.")
       .def("attributes", &attributes_of, "Every attribute column: {name: read-only array in rank order}.")

@@ -120,7 +120,11 @@ py::dict raycast(const Tree& tree, const py::handle& origins_in, const py::handl
   std::vector<std::optional<vola::raycast::RayHit>> hits(rays.size());
   {
     py::gil_scoped_release release;
-    vola::raycast::RayCaster(tree).cast(rays, hits, threads);
+    // A state map's rays stop at its occupied voxels, as collide_segment's do, not at the
+    // free ones it also holds.
+    std::optional<Tree> occupied;
+    if (vola::map::is_state_map(tree)) occupied = vola::map::occupied_tree(tree);
+    vola::raycast::RayCaster(occupied ? *occupied : tree).cast(rays, hits, threads);
   }
   py::array_t<bool> hit(n);
   py::array_t<std::int64_t> voxel({n, py::ssize_t{3}});
@@ -218,7 +222,8 @@ void bind_tree_analysis(py::class_<Tree>& tree) {
       .def("raycast", &raycast, py::arg("origins"), py::arg("directions"),
            py::arg("t_max") = std::numeric_limits<double>::infinity(), py::arg("world") = false,
            py::arg("threads") = 0u,
-           "First occupied voxel along each ray (hierarchical DDA). origins: (R, 3) or one (3,); directions: (R, 3).\n"
+           "First occupied voxel along each ray (hierarchical DDA; of a state map, its occupied voxels, not its\n"
+           "free ones). origins: (R, 3) or one (3,); directions: (R, 3).\n"
            "Grid coordinates (voxel (i,j,k) = [i,i+1]^3) unless world=True. Returns {'hit', 'voxel', 't', 'normal', "
            "'point'}.")
       .def(

@@ -61,8 +61,11 @@ def test_segments_match_brute_force():
     inside = (result["point"][hit] >= result["voxel"][hit] - 1e-9) & (result["point"][hit] <= result["voxel"][hit] + 1 + 1e-9)
     assert inside.all()
     assert np.all(result["voxel"][~hit] == -1) and np.all(np.isinf(result["t"][~hit]))
-    with pytest.raises(vola.InvalidArgument, match="same point"):
-        tree.collide_segment([1.0, 2.0, 3.0], [1.0, 2.0, 3.0])
+    # A segment of no length (a robot standing still) is its point: the voxel holding it.
+    occupied = tree.voxels()[0] + 0.5
+    still = tree.collide_segment([occupied, occupied + 0.25], [occupied, [-5.0, -5.0, -5.0]], world=False)
+    assert still["hit"][0] and still["t"][0] == 0 and (still["voxel"][0] == occupied - 0.5).all()
+    assert not tree.collide_segment([-3.0, -3.0, -3.0], [-3.0, -3.0, -3.0], world=False)["hit"][0]
 
 
 def test_same_answers_as_the_cli(autzen_trim, vola_cli, tmp_path):

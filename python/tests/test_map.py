@@ -207,3 +207,25 @@ def test_a_state_map_plans_and_collides_as_vola_plan_and_collide_do(tmp_path: pa
         vola.open(str(tmp_path / "map.vol")).plan([0, 0, 0], [1, 1, 1], unknown="occupied")
     with pytest.raises(vola.InvalidArgument, match="'occupied' or 'free'"):
         states.plan([0, 0, 0], [1, 1, 1], unknown="maybe")
+
+
+def test_a_state_map_raycasts_exports_and_answers_contains_by_its_occupied_voxels(tmp_path: pathlib.Path):
+    """Map.tree() (and vola.read of a saved map) holds the free voxels too; raycast hit them at
+    t = 0, contains said True for them and exports wrote them as points or cells, where
+    collide_segment, plan and `vola export` already took only the occupied voxels."""
+    m = vola.Map(0.5)
+    ys, zs = np.meshgrid(np.arange(-2, 2.5, 0.5), np.arange(-2, 2.5, 0.5))
+    wall = np.stack([np.full(ys.size, 5.2), ys.ravel() + 0.2, zs.ravel() + 0.2], axis=1)
+    m.insert(wall, origin=(0.2, 0.2, 0.2))
+    tree = m.tree()
+    assert tree.is_state_map
+    occupied = vola.occupied_tree(tree)
+    hit = tree.raycast([[0.2, 0.2, 0.2]], [[1.0, 0.0, 0.0]], world=True)
+    assert hit["hit"][0] and hit["point"][0][0] == pytest.approx(5.0)  # the wall, not the free voxel at the start
+    start, inside = tree.world_to_voxel(np.array([[0.2, 0.2, 0.2]]))
+    assert inside[0] and m.state(np.array([[0.2, 0.2, 0.2]])).tolist() == [vola.FREE]
+    assert not tree.contains(start[0])
+    assert tree.contains(occupied.voxels()).all()
+    vola.export(tree, tmp_path / "map.ply")
+    vola.export(occupied, tmp_path / "occupied.ply")
+    assert (tmp_path / "map.ply").read_bytes() == (tmp_path / "occupied.ply").read_bytes()

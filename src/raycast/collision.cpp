@@ -35,7 +35,18 @@ bool Collider::any_voxel(int level, std::size_t block, const Voxel& origin, cons
 
 std::optional<RayHit> Collider::segment(const Point& a, const Point& b) const {
   const Point d{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  if (d == Point{0, 0, 0}) throw InvalidArgument("segment: the two ends are the same point");
+  if (d == Point{0, 0, 0}) {
+    // A segment of no length (a robot standing still between two waypoints) is its point:
+    // a hit at t = 0 when the point lies in an occupied voxel (the one whose cube holds it,
+    // as a ray starting there would enter it).
+    check_ray(Ray{a, Point{1, 0, 0}, 0.0});  // the point's bounds, as a ray origin's
+    if (!(a[0] >= 0 && a[1] >= 0 && a[2] >= 0)) return std::nullopt;
+    const double side = static_cast<double>(tree().side());
+    if (!(a[0] < side && a[1] < side && a[2] < side)) return std::nullopt;
+    const Voxel v{static_cast<std::uint32_t>(a[0]), static_cast<std::uint32_t>(a[1]), static_cast<std::uint32_t>(a[2])};
+    if (!tree().contains(v.x, v.y, v.z)) return std::nullopt;
+    return RayHit{v, 0.0, {0, 0, 0}};
+  }
   return caster_.cast(Ray{a, d, 1.0});
 }
 

@@ -41,6 +41,10 @@ expect 0 '^free: no occupied voxel on the segment$' "$tmp/wall.vol" --grid --seg
 expect 0 '^free' "$tmp/wall.vol" --segment 101 231 41 115.9 221 31
 expect 3 '^hit: the segment starts inside voxel 2 2 2$' "$tmp/wall.vol" --grid --segment 2.5 2.5 2.5 2.5 2.5 5.5
 expect 3 '^hit: the segment starts inside voxel 2 2 2$' "$tmp/wall.vol" --segment 105 205 15 101 201 11
+# A segment of no length (a robot standing still) is its point.
+expect 3 '^hit: the segment starts inside voxel 2 2 2$' "$tmp/wall.vol" --grid --segment 2.5 2.5 2.5 2.5 2.5 2.5
+expect 0 '^free: no occupied voxel on the segment$' "$tmp/wall.vol" --grid --segment 3.5 2.5 2.5 3.5 2.5 2.5
+expect 0 '^free' "$tmp/wall.vol" --segment 1 2 3 1 2 3
 # Segments outside the grid, or crossing into it.
 expect 0 '^free' "$tmp/wall.vol" --grid --segment -5 -5 -5 -1 20 20
 expect 3 '^hit: voxel 8 5 5, entered at 8 5.5 5.5' "$tmp/wall.vol" --grid --segment -20 5.5 5.5 30 5.5 5.5
@@ -67,7 +71,6 @@ status=0
 # Errors: exit 1 with a message that says what is wrong; usage errors are CLI11's.
 expect 1 'exactly one of --segment, --sphere or --box' "$tmp/wall.vol"
 expect 1 'exactly one of --segment, --sphere or --box' "$tmp/wall.vol" --sphere 1 1 1 1 --box 0 0 0 1 1 1
-expect 1 'the two ends are the same point' "$tmp/wall.vol" --segment 1 2 3 1 2 3
 expect 1 'min <= max' "$tmp/wall.vol" --box 5 0 0 4 1 1
 expect 1 'radius must be >= 0' "$tmp/wall.vol" --sphere 1 1 1 -1
 expect usage 'At least 6 required' "$tmp/wall.vol" --segment 1 2 3 4 5

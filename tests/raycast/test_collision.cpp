@@ -89,7 +89,11 @@ TEST(Collision, TouchingRules) {
   EXPECT_TRUE(c.box({{0, 0, 0}, {2.01, 2.01, 2.01}}));
   EXPECT_TRUE(c.segment({0.5, 2.5, 2.5}, {2.5, 2.5, 2.5}));
   EXPECT_FALSE(c.segment({0.5, 2.5, 2.5}, {1.5, 2.5, 2.5}));
-  EXPECT_THROW(c.segment({1, 1, 1}, {1, 1, 1}), vola::InvalidArgument);
+  // A segment of no length is its point: the voxel holding it, at t = 0, or nothing.
+  EXPECT_FALSE(c.segment({1, 1, 1}, {1, 1, 1}));
+  EXPECT_EQ(c.segment({2.5, 2.9, 2.1}, {2.5, 2.9, 2.1}), (vola::raycast::RayHit{v, 0.0, {0, 0, 0}}));
+  EXPECT_FALSE(c.segment({-1, 2.5, 2.5}, {-1, 2.5, 2.5}));
+  EXPECT_THROW(c.segment({1e300, 1, 1}, {1e300, 1, 1}), vola::InvalidArgument);
   EXPECT_THROW(c.sphere({1, 1, 1}, -1), vola::InvalidArgument);
   // Squares of 1e308 overflowed to infinity, and infinity <= infinity "hit".
   EXPECT_THROW(c.sphere({1e308, 1e308, 1e308}, 1e308), vola::InvalidArgument);

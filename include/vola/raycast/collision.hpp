@@ -1,6 +1,7 @@
 // Collision queries against the occupied voxels, in voxel-grid coordinates (voxel
 // (i, j, k) is the closed cube [i, i+1] x [j, j+1] x [k, k+1]):
 //   segment: the first voxel the segment a -> b visits (the ray rules of ray.hpp, t in [0, 1]);
+//            a segment of no length (a == b) is its point: the voxel holding it, at t = 0;
 //   sphere:  is any voxel within distance <= radius of the centre (touching counts);
 //   box:     does any voxel's interior overlap the box's interior (touching faces do not count).
 // Sphere and box descend the tree only into nodes whose cube passes the same test.
