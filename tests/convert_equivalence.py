@@ -13,7 +13,12 @@ The two laspy_simple1_3.las cases were recorded again on 2026-11-28, when GeoTIF
 define a CRS by its parts began to be read through GDAL: the file's keys (a projected model
 type, no projection, a linear unit code GDAL does not know) now give GDAL's engineering CRS
 in metres, and the .vol holds its WKT. The same file with its key record renamed away
-still converts to the old bytes, so the voxels did not change.
+still converts to the old bytes, so the voxels did not change. On 2026-11-29 the cases of
+laspy_simple1_4.las (LAS 1.4 with GeoTIFF keys and a WKT record, global encoding bit 4
+clear: the keys are the CRS, by the specification; the WKT record won before) and of
+pdal_extrabytes.las (its extra-bytes field "Intensity" is now the column "Intensity_2",
+apart from the record's intensity) were recorded again; their voxels and values are the
+same (`vola voxels` and `vola info` of both builds' files compared).
 
   convert_equivalence.py --vola build/apps/vola/vola --c-tool build/tests/capi_convert_tool \
       --python-path build/python [--front-ends cli,python,c] [--write-manifest]

@@ -67,19 +67,30 @@ ordered_json xyz(const double* v) { return ordered_json::array({v[0], v[1], v[2]
 
 // Coordinates at the file's precision: a LAS coordinate is offset + scale * integer, and a
 // header's doubles carry the binary noise of that sum (848935.2000000001 for 848935.20 at
-// scale 0.01); rounded to the scale's decimals they print as the file means them.
-ordered_json xyz_at(const double* v, const double* scale) {
+// scale 0.01); rounded to the decimals of its scale and offset they print as the file
+// means them (LasHeader::coordinate_decimals).
+ordered_json xyz_at(const double* v, const io::LasHeader& header) {
   ordered_json out = ordered_json::array();
   for (int i = 0; i < 3; ++i) {
-    const double decimals = scale[i] > 0 ? std::ceil(-std::log10(scale[i]) - 1e-9) : 0.0;
-    if (decimals < 0 || decimals > 12 || !std::isfinite(v[i])) {
+    if (!std::isfinite(v[i])) {
       out.push_back(v[i]);
       continue;
     }
-    const double unit = std::pow(10.0, decimals);
+    const double unit = std::pow(10.0, header.coordinate_decimals(i));
     out.push_back(std::round(v[i] * unit) / unit);
   }
   return out;
+}
+
+// "(x, y, z)" at the LAS file's precision, for the text report.
+std::string las_point_text(const double* v, const io::LasHeader& header) {
+  std::string out = "(";
+  for (int i = 0; i < 3; ++i) {
+    char number[64];
+    std::snprintf(number, sizeof number, "%.*f", header.coordinate_decimals(i), v[i]);
+    out += (i ? ", " : "") + std::string(number);
+  }
+  return out + ")";
 }
 
 void print_compression(const io::LasHeader& hd) {
@@ -200,11 +211,18 @@ Summary summarise_las(io::LasReader& reader) {
   return s;
 }
 
-void print_summary(const Summary& summary) {
+// `header`: a LAS file's, for coordinates at its precision (null: 9 significant digits).
+void print_summary(const Summary& summary, const io::LasHeader* header = nullptr) {
   const Box box = summary.box();
   std::printf("summary:     %llu points read\n", static_cast<unsigned long long>(summary.points()));
-  std::printf("             min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the points')\n", box.min[0],
-              box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
+  if (summary.points() == 0)
+    std::printf("             no points, so no bounds\n");
+  else if (header)
+    std::printf("             min %s\n             max %s (the points')\n",
+                las_point_text(box.min.data(), *header).c_str(), las_point_text(box.max.data(), *header).c_str());
+  else
+    std::printf("             min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the points')\n", box.min[0],
+                box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
   for (const auto& [name, range] : summary.columns())
     std::printf("column:      %s: %.9g .. %.9g\n", name.c_str(), range.first, range.second);
   for (const auto& [code, n] : summary.classes())
@@ -213,12 +231,14 @@ void print_summary(const Summary& summary) {
 }
 
 // print_summary's figures as JSON (pdal info --summary's content, vola's names).
-// `scale`: a LAS file's, for coordinates at its precision (null: as read).
-ordered_json summary_json(const Summary& summary, const double* scale = nullptr) {
+// `header`: a LAS file's, for coordinates at its precision (null: as read).
+ordered_json summary_json(const Summary& summary, const io::LasHeader* header = nullptr) {
   const Box box = summary.box();
-  const auto coordinates = [scale](const Point& p) { return scale ? xyz_at(p.data(), scale) : xyz(p.data()); };
-  ordered_json out = {{"points_read", summary.points()},
-                      {"bounds", {{"min", coordinates(box.min)}, {"max", coordinates(box.max)}}}};
+  const auto coordinates = [header](const Point& p) { return header ? xyz_at(p.data(), *header) : xyz(p.data()); };
+  ordered_json out = {
+      {"points_read", summary.points()},
+      {"bounds", summary.points() > 0 ? ordered_json({{"min", coordinates(box.min)}, {"max", coordinates(box.max)}})
+                                      : ordered_json(nullptr)}};
   ordered_json columns = ordered_json::object();
   for (const auto& [name, range] : summary.columns()) columns[name] = {{"min", range.first}, {"max", range.second}};
   out["columns"] = std::move(columns);
@@ -492,23 +512,21 @@ ordered_json las_dimensions_json(const io::LasHeader& hd) {
 
 void print_las_json(io::LasReader& reader, const std::string& path, bool summary) {
   const io::LasHeader& hd = reader.header();
-  ordered_json doc = {{"file", path},
-                      {"format", hd.copc           ? "COPC"
-                                 : hd.compressed() ? "LAZ"
-                                                   : "LAS"},
-                      {"version", hd.version()},
-                      {"software", hd.generating_software},
-                      {"system", hd.system_identifier},
-                      {"points", hd.point_count},
-                      {"point_format", hd.point_format},
-                      {"record_length", hd.record_length},
-                      {"crs", crs_json(hd.wkt, hd.epsg)},
-                      {"scale", xyz(hd.scale.data())},
-                      {"offset", xyz(hd.offset.data())},
-                      {"bounds",
-                       {{"min", xyz_at(hd.min.data(), hd.scale.data())},
-                        {"max", xyz_at(hd.max.data(), hd.scale.data())},
-                        {"source", "header"}}}};
+  ordered_json doc = {
+      {"file", path},
+      {"format", hd.copc           ? "COPC"
+                 : hd.compressed() ? "LAZ"
+                                   : "LAS"},
+      {"version", hd.version()},
+      {"software", hd.generating_software},
+      {"system", hd.system_identifier},
+      {"points", hd.point_count},
+      {"point_format", hd.point_format},
+      {"record_length", hd.record_length},
+      {"crs", crs_json(hd.wkt, hd.epsg)},
+      {"scale", xyz(hd.scale.data())},
+      {"offset", xyz(hd.offset.data())},
+      {"bounds", {{"min", xyz_at(hd.min.data(), hd)}, {"max", xyz_at(hd.max.data(), hd)}, {"source", "header"}}}};
   doc["dimensions"] = las_dimensions_json(hd);
   ordered_json vlrs = ordered_json::array();
   for (const auto& v : hd.vlrs)
@@ -529,7 +547,7 @@ void print_las_json(io::LasReader& reader, const std::string& path, bool summary
                   {"items", std::move(items)}};
   }
   if (hd.copc) doc["copc"] = copc_json(*hd.copc);
-  if (summary) doc["summary"] = summary_json(summarise_las(reader), hd.scale.data());
+  if (summary) doc["summary"] = summary_json(summarise_las(reader), &hd);
   print_json(doc);
 }
 
@@ -551,8 +569,8 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
   std::printf("crs:         %s\n", crs_text(crs_definition(hd.wkt, hd.epsg)).c_str());
   std::printf("scale:       %.9g %.9g %.9g, offset %.9g %.9g %.9g\n", hd.scale[0], hd.scale[1], hd.scale[2],
               hd.offset[0], hd.offset[1], hd.offset[2]);
-  std::printf("bounds:      min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the header's)\n", hd.min[0],
-              hd.min[1], hd.min[2], hd.max[0], hd.max[1], hd.max[2]);
+  std::printf("bounds:      min %s\n             max %s (the header's)\n", las_point_text(hd.min.data(), hd).c_str(),
+              las_point_text(hd.max.data(), hd).c_str());
   std::printf("dimensions:  x y z");
   for (const auto& a : io::las_columns(hd).attributes) std::printf(" %s", a.name.c_str());
   std::printf("\n");
@@ -563,7 +581,7 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
                 v.description.c_str());
   if (hd.compressed()) print_compression(hd);
   if (hd.copc) print_copc(*hd.copc);
-  if (summary) print_summary(summarise_las(reader));
+  if (summary) print_summary(summarise_las(reader), &hd);
 }
 
 }  // namespace vola::cli

@@ -37,6 +37,8 @@ struct RecordField {
   std::uint64_t mask = ~std::uint64_t{0};
   double scale = 1.0, add = 0.0;
   bool scaled = true;
+  bool has_no_data = false;  // the loaded value no_data (before scale and add) gives NaN
+  double no_data = 0.0;
 };
 
 // A column of values in memory: value i of the attribute is the field at

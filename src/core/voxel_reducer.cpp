@@ -495,13 +495,15 @@ inline double field_value(const RecordField& f, const std::uint8_t* p) noexcept 
     case Kind::f32: x = load_le<float>(p); break;
     default: x = load_le<double>(p); break;
   }
+  if (f.has_no_data && x == f.no_data) return std::numeric_limits<double>::quiet_NaN();
   return f.scaled ? x * f.scale + f.add : x;
 }
 
 // The largest value of a field that is a whole number in a known range (u8 or u16, no
 // scale or offset), or -1.
 double whole_field_max(const RecordField& f) noexcept {
-  if ((f.kind != Kind::u8 && f.kind != Kind::u16) || (f.scaled && (f.scale != 1.0 || f.add != 0.0)) || f.shift >= 16)
+  if ((f.kind != Kind::u8 && f.kind != Kind::u16) || (f.scaled && (f.scale != 1.0 || f.add != 0.0)) || f.shift >= 16 ||
+      f.has_no_data)
     return -1.0;
   const std::uint64_t top = (f.kind == Kind::u8 ? 255u : 65535u) >> f.shift;
   return static_cast<double>(std::min<std::uint64_t>(top, f.mask));

@@ -6,8 +6,10 @@ namespace vola::filters {
 
 std::string dimension_key(const std::string& name) {
   std::string key;
+  // Spaces and bytes outside printable ASCII too: the text and PLY writers turn them into
+  // '_' ("echo width" is echo_width in an .xyz header), so either spelling finds the column.
   for (const char c : name)
-    if (c != '_') key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (c != '_' && c > ' ' && c <= '~') key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return key;
 }
 

@@ -55,7 +55,7 @@ void decode_las_records(const LasHeader& hd, std::span<const std::uint8_t> recor
     }
     for (std::size_t f = 0; f < hd.extra_fields.size(); ++f) {
       const auto& field = hd.extra_fields[f];
-      chunk.extra[f][i] = las::extra_value(r + field.offset, field.data_type) * field.scale + field.add;
+      chunk.extra[f][i] = las::extra_field_value(r, field);
     }
   }
 }

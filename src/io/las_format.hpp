@@ -6,6 +6,9 @@
 #include <cstdint>
 #include <string>
 
+#include <limits>
+
+#include "vola/io/las.hpp"
 #include "vola/little_endian.hpp"
 
 namespace vola::io::las {
@@ -45,6 +48,13 @@ inline double extra_value(const std::uint8_t* p, std::uint8_t type) {
     case 10: return load_le<double>(p);
     default: return 0.0;
   }
+}
+
+// An extra-bytes field's value in a record: scaled and offset, NaN for its no-data value.
+inline double extra_field_value(const std::uint8_t* record, const LasExtraField& f) {
+  const double stored = extra_value(record + f.offset, f.data_type);
+  if (f.no_data && stored == *f.no_data) return std::numeric_limits<double>::quiet_NaN();
+  return stored * f.scale + f.add;
 }
 
 // Whether a path names a LAZ file (".laz", any case; ".copc.laz" too).

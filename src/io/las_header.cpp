@@ -2,6 +2,7 @@
 // keys or WKT) and the extra-bytes fields, each checked against the file's size before
 // anything is allocated for it.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -128,7 +129,13 @@ std::uint64_t read_vlrs(const HeaderSource& src, LasHeader& hd, std::uint32_t co
 void check_point_layout(const HeaderSource& src, LasHeader& hd, std::uint8_t raw_format, std::uint64_t vlrs_end) {
   const auto laszip = std::find_if(hd.vlrs.begin(), hd.vlrs.end(),
                                    [](const LasVlr& v) { return v.user_id == "laszip encoded" && v.record_id == 22204; });
-  if (raw_format & 0xC0 || laszip != hd.vlrs.end()) {  // LAZ: bit 7 (6 in LAZ 1.x) marks compressed records
+  // LAZ: bit 7 (6 in LAZ 1.x) marks compressed records. A laszip VLR left in a file whose
+  // bit is clear (a tool decompressed it and kept the VLR) does not make it LAZ when the
+  // file holds every record uncompressed, as LASzip and laspy read it.
+  const bool left_over_vlr = !(raw_format & 0xC0) && laszip != hd.vlrs.end() && hd.record_length > 0 &&
+                             hd.offset_to_points <= src.file_size &&
+                             hd.point_count <= (src.file_size - hd.offset_to_points) / hd.record_length;
+  if (raw_format & 0xC0 || (laszip != hd.vlrs.end() && !left_over_vlr)) {
     if (laszip == hd.vlrs.end())
       src.fail(104, "the point format says the records are compressed (LAZ) but there is no laszip VLR "
                     "(user \"laszip encoded\", record 22204)");
@@ -162,7 +169,13 @@ void read_evlrs(const HeaderSource& src, LasHeader& hd, std::uint64_t at, std::u
     const std::uint64_t length = load_le<std::uint64_t>(&v[20]);
     vlr.offset = at + 60;
     vlr.length = length;
-    if (vlr.user_id == "LASF_Projection" || vlr.user_id == "LASF_Spec")
+    // Only the records the header is read from are loaded: the CRS and the extra-bytes
+    // descriptors. Waveform data (LASF_Spec 65535) runs to gigabytes, and the others are
+    // copied from the file where they lie.
+    const bool described = (vlr.user_id == "LASF_Projection" &&
+                            (vlr.record_id == 2112 || (vlr.record_id >= 34735 && vlr.record_id <= 34737))) ||
+                           (vlr.user_id == "LASF_Spec" && vlr.record_id == 4);
+    if (described)
       vlr.data = src.read_at(at + 60, length, "EVLR data");
     else if (length > src.file_size - std::min(src.file_size, at + 60))
       src.fail(at + 20, "EVLR length runs past the end of the file");
@@ -281,6 +294,11 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
       f.data_type = base;
       f.size = static_cast<std::uint32_t>(las::extra_size(base));
       f.offset = offset;
+      // no_data, min and max are "anytype" unions: 8 bytes of u64, i64 or double by type.
+      if (options & 1)
+        f.no_data = base >= 9       ? load_le<double>(e + 40 + 8 * k)
+                    : base % 2 == 1 ? static_cast<double>(load_le<std::uint64_t>(e + 40 + 8 * k))
+                                    : static_cast<double>(load_le<std::int64_t>(e + 40 + 8 * k));
       if (options & 8) f.scale = load_le<double>(e + 112 + 8 * k);
       if (options & 16) f.add = load_le<double>(e + 136 + 8 * k);
       hd.extra_fields.push_back(f);
@@ -292,20 +310,94 @@ void parse_extra_bytes(const HeaderSource& src, const LasVlr& vlr, LasHeader& hd
                              std::to_string(hd.record_length));
 }
 
+// A name as the point filters match it: lower case, without '_', spaces and bytes outside
+// printable ASCII (which the text and PLY writers turn into '_').
+std::string name_key(const std::string& name) {
+  std::string key;
+  for (const char c : name)
+    if (c != '_' && c > ' ' && c <= '~') key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return key;
+}
+
+// Extra-bytes fields named like a field of the record, like each other or not at all
+// (the specification forbids none of these, and writers do all three) get names of their
+// own, as the text writers would make them: "classification_2", "a_2", "attribute". So
+// every command, filter and report sees one column per field under one name. The first
+// "height" stays: vola's LAS export writes the voxels' mean z under that name, read back
+// as the height column.
+void give_extra_fields_unique_names(LasHeader& hd) {
+  std::vector<std::string> taken = {"x",
+                                    "y",
+                                    "z",
+                                    "intensity",
+                                    "return_number",
+                                    "number_of_returns",
+                                    "classification",
+                                    "user_data",
+                                    "point_source_id",
+                                    "gps_time",
+                                    "red",
+                                    "green",
+                                    "blue",
+                                    "nir",
+                                    "scan_angle_rank",
+                                    "scan_angle",
+                                    "classification_flags",
+                                    "scan_direction_flag",
+                                    "edge_of_flight_line",
+                                    "scanner_channel",
+                                    "wave_packet_index",
+                                    "wave_offset",
+                                    "wave_packet_size",
+                                    "wave_return_point",
+                                    "wave_dx",
+                                    "wave_dy",
+                                    "wave_dz"};
+  for (auto& key : taken) key = name_key(key);
+  bool height_kept = false;
+  for (LasExtraField& f : hd.extra_fields) {
+    if (f.name == "height" && !height_kept) {
+      height_kept = true;
+      taken.push_back("height");
+      continue;
+    }
+    const std::string base = name_key(f.name).empty() ? "attribute" : f.name;
+    std::string unique = base;
+    for (int n = 2; std::find(taken.begin(), taken.end(), name_key(unique)) != taken.end(); ++n)
+      unique = base + "_" + std::to_string(n);
+    taken.push_back(name_key(unique));
+    f.name = std::move(unique);
+  }
+}
+
 // The CRS (GeoKeys, WKT) and the extra-bytes fields, from the (E)VLRs read.
+//
+// A file holding both GeoTIFF keys and a WKT record states one CRS: in LAS 1.4 the one
+// global encoding bit 4 names (set: the WKT, clear: the keys), before 1.4 (no such bit)
+// the WKT record, as before. The other is not read, so the header's code and WKT never
+// come from two different CRSs (a WKT record gives no code, as when it is alone).
 void parse_crs_and_fields(const HeaderSource& src, LasHeader& hd) {
+  const auto is_keys = [](const LasVlr& v) {
+    return v.user_id == "LASF_Projection" && v.record_id == 34735 && v.data.size() >= 8;
+  };
+  const auto is_wkt = [](const LasVlr& v) { return v.user_id == "LASF_Projection" && v.record_id == 2112; };
+  const bool has_keys = std::any_of(hd.vlrs.begin(), hd.vlrs.end(), is_keys);
+  const bool has_wkt = std::any_of(hd.vlrs.begin(), hd.vlrs.end(), is_wkt);
+  const bool wkt_bit_clear = hd.version_major == 1 && hd.version_minor >= 4 && !(hd.global_encoding & 16);
+  const bool use_keys = has_keys && !(has_wkt && !wkt_bit_clear);
   UnitKeys units;
   bool keys_read = false;  // the first key directory counts, as for GDAL's reading of it
   for (const auto& vlr : hd.vlrs) {
-    if (vlr.user_id == "LASF_Projection" && vlr.record_id == 34735 && vlr.data.size() >= 8 && !keys_read) {
+    if (is_keys(vlr) && use_keys && !keys_read) {
       parse_geokeys(vlr, hd, units);
       keys_read = true;
-    }
-    else if (vlr.user_id == "LASF_Projection" && vlr.record_id == 2112) hd.wkt = text(vlr.data.data(), vlr.data.size());
+    } else if (is_wkt(vlr) && !use_keys)
+      hd.wkt = text(vlr.data.data(), vlr.data.size());
     else if (vlr.user_id == "LASF_Spec" && vlr.record_id == 4) parse_extra_bytes(src, vlr, hd);
   }
   apply_unit_keys(hd, units);
   apply_user_defined_keys(hd, units);
+  give_extra_fields_unique_names(hd);
 }
 
 }  // namespace

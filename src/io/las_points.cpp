@@ -102,9 +102,7 @@ void las_record_attribute_values(const LasHeader& hd, const std::uint8_t* record
   else column([](const std::uint8_t* r) { return static_cast<double>(r[15] & 31u); });
   const LasExtraField* height = height_extra_field(hd);
   if (height) {
-    column([&](const std::uint8_t* r) {
-      return las::extra_value(r + height->offset, height->data_type) * height->scale + height->add;
-    });
+    column([&](const std::uint8_t* r) { return las::extra_field_value(r, *height); });
   } else {
     const double scale = hd.scale[2], offset = hd.offset[2];
     column([&](const std::uint8_t* r) { return static_cast<double>(load_le<std::int32_t>(r + 8)) * scale + offset; });
@@ -112,8 +110,7 @@ void las_record_attribute_values(const LasHeader& hd, const std::uint8_t* record
   if (extended) column([](const std::uint8_t* r) { return static_cast<double>(r[14] >> 4); });
   else column([](const std::uint8_t* r) { return static_cast<double>((r[14] >> 3) & 7u); });
   for (const auto& f : hd.extra_fields)
-    if (f.name != "height")
-      column([&](const std::uint8_t* r) { return las::extra_value(r + f.offset, f.data_type) * f.scale + f.add; });
+    if (f.name != "height") column([&](const std::uint8_t* r) { return las::extra_field_value(r, f); });
 }
 
 bool las_record_fields(const LasHeader& hd, std::vector<RecordField>& fields) {
@@ -131,7 +128,12 @@ bool las_record_fields(const LasHeader& hd, std::vector<RecordField>& fields) {
                             Kind::i32, Kind::u64, Kind::i64, Kind::f32, Kind::f64};
   const auto extra = [&](const LasExtraField& f) {
     if (f.data_type < 1 || f.data_type > 10) return false;
-    fields.push_back({.kind = kinds[f.data_type - 1], .offset = f.offset, .scale = f.scale, .add = f.add});
+    fields.push_back({.kind = kinds[f.data_type - 1],
+                      .offset = f.offset,
+                      .scale = f.scale,
+                      .add = f.add,
+                      .has_no_data = f.no_data.has_value(),
+                      .no_data = f.no_data.value_or(0.0)});
     return true;
   };
   const LasExtraField* height = height_extra_field(hd);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -24,6 +25,26 @@ bool LasHeader::has_rgb() const noexcept {
 }
 
 bool LasHeader::has_gps_time() const noexcept { return point_format != 0 && point_format != 2; }
+
+int LasHeader::coordinate_decimals(int axis) const noexcept {
+  const auto a = static_cast<std::size_t>(axis);
+  const auto whole_at = [](double v, int decimals) {
+    // Within the rounding of a double and of the product (0.00025 * 1e5 is 25.000000000000004).
+    const double scaled = std::abs(v) * std::pow(10.0, decimals);
+    return std::abs(scaled - std::round(scaled)) <= 4e-16 * scaled + 1e-9;
+  };
+  int decimals = 0;
+  while (decimals < 12 && !(whole_at(scale[a], decimals) && whole_at(offset[a], decimals))) ++decimals;
+  double magnitude = 0;
+  for (const double v : {min[a], max[a], offset[a]})
+    if (std::isfinite(v)) magnitude = std::max(magnitude, std::abs(v));
+  const int integer_digits = magnitude >= 1 ? static_cast<int>(std::floor(std::log10(magnitude))) + 1 : 1;
+  return std::clamp(decimals, 0, std::max(0, 15 - integer_digits));
+}
+
+int LasHeader::coordinate_decimals() const noexcept {
+  return std::max({coordinate_decimals(0), coordinate_decimals(1), coordinate_decimals(2)});
+}
 
 void LasChunk::clear() {
   xyz.clear();

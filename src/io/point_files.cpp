@@ -162,9 +162,7 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
   table.format = "las";
   table.epsg = hd.epsg;
   table.wkt = hd.wkt;
-  // Coordinates at the file's own precision: as many decimals as the finest scale needs.
-  const double finest = std::min({hd.scale[0], hd.scale[1], hd.scale[2]});
-  table.coordinate_digits = std::clamp(static_cast<int>(std::ceil(-std::log10(finest) - 1e-9)), 0, 12);
+  table.coordinate_digits = hd.coordinate_decimals();  // the file's own precision
   table.cloud = las_columns(hd);
   for_each_las_chunk(
       reader,

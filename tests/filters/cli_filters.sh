@@ -185,4 +185,51 @@ echo "[\"$autzen\", \"$tmp/pipe_crs.ply\"]" > "$tmp/crs.json"
 grep -q "PLY has no place for the CRS" "$tmp/err.txt" || fail "no CRS warning from a pipeline: $(cat "$tmp/err.txt")"
 "$vola" translate "$tmp/crs.ply" "$tmp/crs2.xyz" -q 2> "$tmp/err.txt" || fail "translate PLY to XYZ failed"
 [ ! -s "$tmp/err.txt" ] || fail "a warning for a file with no CRS: $(cat "$tmp/err.txt")"
+# A point file's return numbers (the PDAL-written PCD has returns 1-4) are counted into the
+# LAS header's points by return (they were all counted as return 1), and the WKT bit set.
+pcd=$data/pcd/pdal_autzen-utm.pcd
+if [ -f "$pcd" ]; then
+  "$vola" translate "$pcd" "$tmp/frompcd.las" -q
+  "$vola" translate "$pcd" "$tmp/frompcd.xyz" -q 2> /dev/null
+  "${VOLA_PYTHON:-python3}" - "$tmp/frompcd.las" "$tmp/frompcd.xyz" <<'PY' || fail "points by return of a PCD written as LAS"
+import collections, struct, sys
+head = open(sys.argv[1], "rb").read(375)
+lines = open(sys.argv[2]).read().splitlines()
+names = lines[0].lstrip("# ").split()
+returns = collections.Counter(int(float(l.split()[names.index("return_number")])) for l in lines[1:])
+stated = struct.unpack_from("<15Q", head, 255)
+assert list(stated) == [returns.get(r, 0) for r in range(1, 16)], (stated, returns)
+assert len(returns) > 1 and struct.unpack_from("<H", head, 6)[0] & 16, (returns, head[6:8])
+PY
+fi
+
+# An extra-bytes name with a space ("echo width", as some writers name it) is found by the
+# spelling the text and PLY writers give it (echo_width).
+"${VOLA_PYTHON:-python3}" - "$tmp/spaced.las" <<'PY'
+import struct, sys
+vlr_data = bytearray(192)
+vlr_data[2] = 3  # uint16
+vlr_data[4:14] = b"echo width"
+points = []
+for i in range(10):
+    r = bytearray(22)
+    struct.pack_into("<3i", r, 0, i * 100, i * 100, i * 100)
+    r[14] = 9
+    struct.pack_into("<H", r, 20, i * 50)
+    points.append(bytes(r))
+vlr = bytearray(54)
+vlr[2:11] = b"LASF_Spec"
+struct.pack_into("<HH", vlr, 18, 4, len(vlr_data))
+head = bytearray(227)
+head[0:4] = b"LASF"
+head[24:26] = bytes([1, 2])
+struct.pack_into("<HIIBHI", head, 94, 227, 227 + 54 + 192, 1, 0, 22, 10)
+struct.pack_into("<3d", head, 131, 0.01, 0.01, 0.01)
+struct.pack_into("<6d", head, 179, 9, 0, 9, 0, 9, 0)
+open(sys.argv[1], "wb").write(head + vlr + vlr_data + b"".join(points))
+PY
+"$vola" translate "$tmp/spaced.las" "$tmp/spaced.xyz" --where "echo_width > 200" -q 2> /dev/null ||
+  fail "--where echo_width on a field named 'echo width' failed"
+[ "$(grep -vc '^#' "$tmp/spaced.xyz")" = 5 ] || fail "--where echo_width > 200 kept $(grep -vc '^#' "$tmp/spaced.xyz") of 10"
+
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

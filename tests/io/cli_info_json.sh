@@ -25,12 +25,20 @@ info, line = json.load(open(sys.argv[1])), sys.argv[2]
 assert info["points"] == int(re.search(r" n=(\d+)", line).group(1)), info["points"]
 assert info["point_format"] == int(re.search(r" pf=(\d+)", line).group(1))
 lo, hi = re.search(r"bounds=\[([^\]]*)\]\.\.\[([^\]]*)\]", line).groups()
+def decimals(scale, offset, magnitude):
+    # the fewest decimals holding scale and offset exactly, within a double's 15 digits
+    d = next((d for d in range(13) if all(abs(abs(v) * 10**d - round(abs(v) * 10**d)) <= 4e-16 * abs(v) * 10**d + 1e-9
+                                       for v in (scale, offset))), 12)
+    return min(d, max(0, 15 - (math.floor(math.log10(magnitude)) + 1 if magnitude >= 1 else 1)))
 for got, want in ((info["bounds"]["min"], lo), (info["bounds"]["max"], hi)):
-    for g, w, s in zip(got, (float(v) for v in want.split(",")), info["scale"]):
+    for axis, (g, w, s) in enumerate(zip(got, (float(v) for v in want.split(",")), info["scale"])):
         assert abs(g - w) <= max(s, 0.01) / 2 + 1e-9, (got, want)
-        # at the file's precision: no binary noise beyond the scale's decimals
-        decimals = max(0, math.ceil(-math.log10(s) - 1e-9))
-        assert round(g, decimals) == g, (g, s)
+        # at the file's precision: no binary noise beyond the decimals of scale and offset
+        o = info["offset"][axis]
+        d = decimals(s, o, max(abs(o), abs(info["bounds"]["min"][axis]), abs(info["bounds"]["max"][axis])))
+        assert round(g, d) == g, (g, s, o, d)
+if info["scale"] == [0.00025] * 3:  # RiSCAN's quarter millimetres take five decimals, not four
+    assert info["bounds"]["max"][0] == 515400.00175, info["bounds"]
 classes = re.search(r"classes=\{([^}]*)\}", line)
 if classes:
     want = {int(k): int(v) for k, v in re.findall(r"(\d+): (\d+)", classes.group(1))}

@@ -11,8 +11,9 @@
 
 namespace vola::filters {
 
-// The name a column is matched by: lower case, underscores dropped
-// ("ReturnNumber" and "return_number" both give "returnnumber").
+// The name a column is matched by: lower case, underscores, spaces and bytes outside
+// printable ASCII dropped ("ReturnNumber" and "return_number" both give "returnnumber",
+// "echo width" and "echo_width" "echowidth").
 std::string dimension_key(const std::string& name);
 
 // Where a dimension lives in a cloud: an axis (0 x, 1 y, 2 z) or an attribute column.

@@ -40,6 +40,9 @@ struct LasExtraField {
   std::uint32_t offset = 0;    // byte offset inside the record
   std::uint32_t size = 0;
   double scale = 1.0, add = 0.0;
+  // Options bit 0: this stored value (before scale and offset) means "no data"; such
+  // values are read as NaN, which the voxel reductions and summaries skip.
+  std::optional<double> no_data;
 };
 
 struct LasHeader {
@@ -66,6 +69,14 @@ struct LasHeader {
   bool has_gps_time() const noexcept;
   bool extended_format() const noexcept { return point_format >= 6; }
   std::string version() const { return std::to_string(version_major) + "." + std::to_string(version_minor); }
+  // Decimals that print axis `axis`'s coordinates (offset + scale * n) as the file means
+  // them: the fewest for which the scale and the offset are whole multiples of 10^-d
+  // (0.00025 takes 5, 0.01 with offset 7350.194653 takes 6; a negative scale as its
+  // magnitude), at most 12, and no more than a double's 15 significant digits carry at
+  // the axis's magnitude (header bounds and offset).
+  int coordinate_decimals(int axis) const noexcept;
+  // The most of the three: one precision for every coordinate of a point file.
+  int coordinate_decimals() const noexcept;
 };
 
 // Structure of arrays for one chunk of points.
