@@ -3,6 +3,7 @@
 // scripts can write `if vola collide site.vol --segment ...; then`.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "open_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/raycast/collision.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -46,6 +48,29 @@ void print_segment_hit(const CollideArgs& a, const Point& from, const Point& to,
                 distance, units, hit.normal[0], hit.normal[1], hit.normal[2]);
 }
 
+// The voxels of unknown space (a state map's: neither free nor occupied, or off its grid) a
+// segment in grid coordinates passes through, sampled at a quarter of a voxel.
+std::uint64_t unknown_voxels_on(const Tree& states, const Point& from, const Point& to) {
+  double length = 0;
+  for (int i = 0; i < 3; ++i) length += (to[i] - from[i]) * (to[i] - from[i]);
+  const auto steps = static_cast<std::uint64_t>(std::ceil(std::sqrt(length) * 4)) + 1;
+  if (steps > (std::uint64_t{1} << 26)) return 0;  // a segment of 16 M voxels: not sampled
+  std::uint64_t unknown = 0;
+  std::optional<Voxel> last;
+  const double side = static_cast<double>(states.side());
+  for (std::uint64_t s = 0; s <= steps; ++s) {
+    const double t = static_cast<double>(s) / static_cast<double>(steps);
+    Point p;
+    for (int i = 0; i < 3; ++i) p[i] = std::floor(from[i] + t * (to[i] - from[i]));
+    const bool inside = p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] < side && p[1] < side && p[2] < side;
+    const Voxel v = inside ? Voxel{std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2])} : Voxel{};
+    if (inside && last && *last == v) continue;
+    if (inside) last = v;
+    if (!inside || map::state_at(states, v) == map::VoxelState::unknown) ++unknown;
+  }
+  return unknown;
+}
+
 int run_collide(const CollideArgs& a) {
   const int queries = !a.segment.empty() + !a.sphere.empty() + !a.box.empty();
   if (queries != 1) throw InvalidArgument("give exactly one of --segment, --sphere or --box");
@@ -65,7 +90,18 @@ int run_collide(const CollideArgs& a) {
     const auto& s = a.segment;
     const Point from{s[0], s[1], s[2]}, to{s[3], s[4], s[5]};
     const auto hit = collider.segment(to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5]));
-    if (!hit) return report(false, "no occupied voxel on the segment");
+    if (!hit) {
+      // A state map (vola map) knows where it has not seen: say so, as OctoMap's ray
+      // casts stop there and vola plan takes it for an obstacle.
+      const Tree file = open_mapped(a.input);
+      const std::uint64_t unknown =
+          map::is_state_map(file) ? unknown_voxels_on(file, to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5])) : 0;
+      if (unknown == 0) return report(false, "no occupied voxel on the segment");
+      const std::string what = "no occupied voxel on the segment, but it passes through unknown space (" +
+                               std::to_string(unknown) +
+                               " of them the map has not seen; vola plan takes unknown space for an obstacle)";
+      return report(false, what.c_str());
+    }
     if (!a.quiet) print_segment_hit(a, from, to, *hit);
     return kCollisionStatus;
   }
@@ -96,6 +132,9 @@ void add_collide(CLI::App& app) {
       "  --sphere   any occupied voxel within the radius of the centre (touching counts);\n"
       "  --box      any occupied voxel overlapping the box's interior (touching faces do not count).\n"
       "Prints 'free: ...' or 'hit: ...'. Exit status: 0 free, 3 collision, 1 error (another status: a usage error).\n"
+      "A state map (vola map) is checked against its occupied voxels; a free segment that passes through\n"
+      "space the map has not seen says so (unknown space is not free: vola plan takes it for an obstacle).\n"
+      "A segment of no length is its point.\n"
       "Examples:\n"
       "  vola collide site.vol --segment 636500 849500 120  636900 849800 90\n"
       "  vola collide site.vol --sphere 636500 849500 120 2.5\n"

@@ -21,10 +21,18 @@ constexpr std::uint8_t kOccupiedPixel = 0, kFreePixel = 254, kUnknownPixel = 205
 constexpr std::uint8_t kOccupiedInBand = 1, kFreeInBand = 2, kOccupiedBelow = 4;
 constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 28;  // 16384 x 16384, as the reader takes
 
+// The shortest text that reads back as `value`, spelled as YAML 1.1 spells a float (a
+// point in it: PyYAML read "5e+05", what the shortest form of 500000 is, as a string).
 std::string ros_map_number(double value) {
-  char digits[32];
-  const auto result = std::to_chars(digits, digits + sizeof digits, value);  // shortest exact text
-  return std::string(digits, result.ptr);
+  char digits[400];
+  const bool plain = value == 0 || (std::abs(value) >= 1e-4 && std::abs(value) < 1e15);
+  const auto result = plain ? std::to_chars(digits, digits + sizeof digits, value, std::chars_format::fixed)
+                            : std::to_chars(digits, digits + sizeof digits, value, std::chars_format::scientific);
+  std::string text(digits, result.ptr);
+  if (!std::isfinite(value) || text.find('.') != std::string::npos) return text;
+  const auto exponent = text.find('e');
+  text.insert(exponent == std::string::npos ? text.size() : exponent, ".0");
+  return text;
 }
 
 // The voxel layers k in [lowest, highest] (the map's) whose centres

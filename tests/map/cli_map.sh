@@ -103,6 +103,13 @@ printf '1 2 3
 "$vola" get "$tmp/map.vol" --world --points "$tmp/bad_points.txt" 2> "$tmp/err" && fail "a bad point line was accepted"
 grep -q 'bad_points.txt: line 2: expected three finite numbers' "$tmp/err" || fail "message: $(cat "$tmp/err")"
 
+# collide on the state map: along the known free voxels, free; into space never seen,
+# free of occupied voxels but said to pass through unknown space.
+out=$("$vola" collide "$tmp/map.vol" --segment 0.125 0.125 0.125 0.875 0.125 0.125) || fail "collide along known free voxels"
+[ "$out" = "free: no occupied voxel on the segment" ] || fail "collide along known space: $out"
+out=$("$vola" collide "$tmp/map.vol" --segment 0.125 0.125 0.125 0.375 0.375 0.125) || fail "collide into unknown space"
+echo "$out" | grep -q '^free: .*passes through unknown space (1 of them the map has not seen' || fail "collide into unknown space: $out"
+
 # plan on the state map: unknown space is an obstacle by default. Along x the known free
 # voxels lead from the sensor's voxel to (0.875, 0.125); (0.375, 0.375) was never seen.
 "$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.875 0.125 0.125 -o "$tmp/path.csv" -q \
