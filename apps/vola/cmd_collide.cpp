@@ -97,9 +97,9 @@ int run_collide(const CollideArgs& a) {
       const std::uint64_t unknown =
           map::is_state_map(file) ? unknown_voxels_on(file, to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5])) : 0;
       if (unknown == 0) return report(false, "no occupied voxel on the segment");
-      const std::string what = "no occupied voxel on the segment, but it passes through unknown space (" +
-                               std::to_string(unknown) +
-                               " of them the map has not seen; vola plan takes unknown space for an obstacle)";
+      const std::string what = "no occupied voxel on the segment, but it passes through " + std::to_string(unknown) +
+                               (unknown == 1 ? " voxel" : " voxels") +
+                               " the map has not seen (unknown space, which vola plan takes for an obstacle)";
       return report(false, what.c_str());
     }
     if (!a.quiet) print_segment_hit(a, from, to, *hit);
