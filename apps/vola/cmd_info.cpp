@@ -158,7 +158,11 @@ void run_info(const InfoArgs& a) {
   std::printf("header:      version %u, %s, depth %d (%u^3 voxels), nbits %u\n", h.version, mode, tree.depth(),
               tree.side(), h.nbits);
   std::printf("crs:         %s\n", crs_line(crs, h.epsg).c_str());
-  std::printf("header:      EPSG code %u, bbox centre lat %.9f lon %.9f\n", h.epsg, h.lat, h.lon);
+  // With no CRS the reference writes its placeholder code and the centre's latitude and
+  // longitude as if the coordinates were in it: a place on Earth that means nothing.
+  const bool placeholder = !crs.description && crs.problem.empty();
+  std::printf("header:      EPSG code %u, bbox centre lat %.9f lon %.9f%s\n", h.epsg, h.lat, h.lon,
+              placeholder ? " (under the placeholder code: not where the data is)" : "");
   // Coordinates as the shortest text that reads back as the same double: the file's own
   // precision (636001.76, not 636001.76000000001, nor 6.36001760e+05 cut to 9 digits).
   const auto triple = [](const Point& p) { return shortest_text(p[0]) + ", " + shortest_text(p[1]) + ", " + shortest_text(p[2]); };

@@ -67,7 +67,32 @@ struct RosYaml {
   std::map<std::string, std::size_t> at;
 };
 
-RosYaml parse_ros_yaml(const std::string& path, const std::string& text) {
+// A document written as one flow mapping ({image: map.pgm, resolution: 0.05, ...}, what
+// some tools and yaml.dump(default_flow_style=True) write) as block lines: the braces
+// become spaces and the commas between keys line breaks, so every byte keeps its offset.
+// Empty when the document is not one.
+std::string flow_mapping_as_lines(const std::string& text) {
+  const std::size_t open = text.find_first_not_of(" \t\r\n");
+  const std::size_t close = text.find_last_not_of(" \t\r\n");
+  if (open == std::string::npos || text[open] != '{' || text[close] != '}') return {};
+  std::string lines = text;
+  lines[open] = lines[close] = ' ';
+  int depth = 0;  // inside [ ] a comma separates list items, not keys
+  for (std::size_t i = open + 1; i < close; ++i) {
+    if (lines[i] == '[')
+      ++depth;
+    else if (lines[i] == ']')
+      --depth;
+    else if (lines[i] == '\n')
+      lines[i] = ' ';  // a flow mapping may wrap anywhere
+    else if (lines[i] == ',' && depth == 0)
+      lines[i] = '\n';
+  }
+  return lines;
+}
+
+// `flow`: the lines come from flow_mapping_as_lines, whose keys follow a space.
+RosYaml parse_ros_yaml_lines(const std::string& path, const std::string& text, bool flow) {
   RosYaml out;
   std::string list_key;  // the key whose "- item" lines follow
   std::size_t start = 0;
@@ -79,7 +104,7 @@ RosYaml parse_ros_yaml(const std::string& path, const std::string& text) {
     start = end + 1;
     const std::string_view line = ros_yaml_trimmed(raw);
     if (line.empty() || line.front() == '#' || line == "---" || line == "...") continue;
-    const bool indented = std::isspace(static_cast<unsigned char>(raw.front()));
+    const bool indented = !flow && std::isspace(static_cast<unsigned char>(raw.front()));
     if (line.front() == '-' && (line.size() == 1 || line[1] == ' ')) {
       if (list_key.empty()) throw FormatError(path, line_at, "a list item outside a key's list");
       out.values[list_key].push_back(ros_yaml_scalar(line.substr(1)));
@@ -119,6 +144,12 @@ RosYaml parse_ros_yaml(const std::string& path, const std::string& text) {
     }
   }
   return out;
+}
+
+RosYaml parse_ros_yaml(const std::string& path, const std::string& text) {
+  if (const std::string lines = flow_mapping_as_lines(text); !lines.empty())
+    return parse_ros_yaml_lines(path, lines, true);
+  return parse_ros_yaml_lines(path, text, false);
 }
 
 double ros_yaml_number(const RosYaml& yaml, const std::string& path, const std::string& key, std::size_t index,

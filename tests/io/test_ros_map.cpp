@@ -2,6 +2,7 @@
 // slow way: every column's voxels looked at one by one, centres compared with the band.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <random>
@@ -117,9 +118,14 @@ TEST(RosMap, EveryCellFollowsTheRule) {
       EXPECT_EQ(fields.at("mode"), "trinary");
       EXPECT_EQ(fields.at("resolution"), "0.25");
       // The image's lower-left corner: the lowest column's corner in world coordinates.
-      std::ostringstream origin;
-      origin << "[" << -3.5 + 0.25 * x0 << ", " << 100.25 + 0.25 * y0 << ", 0.0]";
-      EXPECT_EQ(fields.at("origin"), origin.str());
+      // Numbers as YAML floats, with a point (PyYAML reads "5e+05" or "-3" otherwise).
+      const std::string origin = fields.at("origin");
+      double ox = 0, oy = 0, oz = 1;
+      ASSERT_EQ(std::sscanf(origin.c_str(), "[%lf, %lf, %lf]", &ox, &oy, &oz), 3) << origin;
+      EXPECT_EQ(ox, -3.5 + 0.25 * x0);
+      EXPECT_EQ(oy, 100.25 + 0.25 * y0);
+      EXPECT_EQ(oz, 0.0);
+      EXPECT_EQ(std::count(origin.begin(), origin.end(), '.'), 3) << origin;
       EXPECT_EQ(fields.at("negate"), "0");
       EXPECT_EQ(fields.at("occupied_thresh"), "0.65");
       EXPECT_EQ(fields.at("free_thresh"), "0.196");
@@ -223,6 +229,10 @@ TEST(RosMap, MapServerVariantsRead) {
   write_text(dir / "e.yaml", "image: raw.pgm\nmode: raw\nresolution: 1\norigin: [0, 0, 0]\n");
   EXPECT_EQ(voxel_set(vola::io::read_ros_map((dir / "e.yaml").string(), 0).voxels),
             (std::set<std::array<std::uint32_t, 3>>{{0, 0, 0}}));
+  // One flow mapping, as yaml.dump(default_flow_style=True) writes it, wrapped over lines.
+  write_text(dir / "f.yaml", "{image: text.pgm, resolution: 0.5,\n  origin: [1.0, -2.0, 0.0], occupied_thresh: 0.5}\n");
+  EXPECT_EQ(voxel_set(vola::io::read_ros_map((dir / "f.yaml").string(), 0).voxels),
+            voxel_set(vola::io::read_ros_map((dir / "b.yaml").string(), 0).voxels));
 }
 
 // A map saved as PNG (map_saver --fmt png) reads as its PGM: grey as it is, colour
