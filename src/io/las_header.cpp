@@ -110,6 +110,11 @@ HeaderCounts parse_public_block(const HeaderSource& src, LasHeader& hd) {
 std::uint64_t read_vlrs(const HeaderSource& src, LasHeader& hd, std::uint32_t count) {
   std::uint64_t at = hd.header_size;
   for (std::uint32_t i = 0; i < count; ++i) {
+    // A count too high would read the points as VLRs: name the two fields that disagree.
+    if (at + 54 > hd.offset_to_points)
+      src.fail(100, "the " + std::to_string(count) + " VLRs the header counts (byte 100) do not fit before the " +
+                        "offset to point data " + std::to_string(hd.offset_to_points) + " (byte 96); " +
+                        std::to_string(i) + " of them end before it: the VLR count or the offset is wrong");
     const auto v = src.read_at(at, 54, "VLR header");
     LasVlr vlr;
     vlr.user_id = text(&v[2], 16);
@@ -151,9 +156,18 @@ void check_point_layout(const HeaderSource& src, LasHeader& hd, std::uint8_t raw
     src.fail(105, "record length " + std::to_string(hd.record_length) + " is shorter than format " +
                       std::to_string(hd.point_format) + " needs (" +
                       std::to_string(las::kMinRecordLength[hd.point_format]) + ")");
-  if (hd.offset_to_points < vlrs_end || hd.offset_to_points > src.file_size)
-    src.fail(96, "offset to point data " + std::to_string(hd.offset_to_points) + " is before the end of the VLRs (" +
-                     std::to_string(vlrs_end) + ") or past the end of the file");
+  if (hd.offset_to_points > src.file_size)
+    src.fail(96, "offset to point data " + std::to_string(hd.offset_to_points) + " is past the end of the " +
+                     std::to_string(src.file_size) + "-byte file");
+  if (hd.offset_to_points < vlrs_end) {
+    // Either field may lie: say how many of the counted VLRs end before the points.
+    std::size_t fit = 0;
+    while (fit < hd.vlrs.size() && hd.vlrs[fit].offset + hd.vlrs[fit].length <= hd.offset_to_points) ++fit;
+    src.fail(fit < hd.vlrs.size() ? 100 : 96,
+             "the " + std::to_string(hd.vlrs.size()) + " VLRs the header counts (byte 100) end at byte " +
+                 std::to_string(vlrs_end) + ", past the offset to point data " + std::to_string(hd.offset_to_points) +
+                 " (byte 96); " + std::to_string(fit) + " of them end before it: the VLR count or the offset is wrong");
+  }
 }
 
 // The EVLRs (LAS 1.4). Waveform data can be huge and is not needed: only the records

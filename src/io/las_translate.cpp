@@ -226,7 +226,16 @@ void translate_las(const std::string& input, const std::string& output,
   head[104] = static_cast<std::uint8_t>(hd.point_format | (laz_out ? 0x80 : 0));
   store(head, 96, static_cast<std::uint32_t>(points_at));
   store(head, 100, vlr_count);
-  if (edits) rewrite_point_fields(head, hd, edits->points);
+  if (edits) {
+    rewrite_point_fields(head, hd, edits->points);
+  } else if (hd.version_minor >= 4 && head.size() >= 255) {
+    // The count the records were read by, in the 64-bit field too: a LAS 1.4 file of
+    // format 0-5 with only its legacy count set (against the specification) read as that
+    // many points, but its copy said 0 to readers that take the 64-bit field.
+    std::uint64_t stated = 0;
+    std::memcpy(&stated, head.data() + 247, 8);
+    if (stated == 0) store(head, 247, static_cast<std::uint64_t>(hd.point_count));
+  }
 
   OutputFile out(output);
   out.write(head.data(), head.size());

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "vola/error.hpp"
 #include "vola/io/las.hpp"
 
 namespace {
@@ -208,6 +209,19 @@ TEST(LasVariants, ALaszipRecordLeftInAnUncompressedFileIsIgnored) {
   vola::io::LasChunk chunk;
   ASSERT_EQ(reader.read(chunk, 10), 4u);
   EXPECT_DOUBLE_EQ(chunk.xyz[3 * 3 + 2], 9.0);
+}
+
+TEST(LasVariants, AVlrCountPastThePointsNamesBothFields) {
+  Bytes file = las_file(2, 0, {}, 4, 0, [](std::size_t) { return Bytes{}; });
+  put_at<std::uint32_t>(file, 100, 3);  // three VLRs that are not there
+  try {
+    vola::io::LasReader reader(file, "count.las");
+    ADD_FAILURE() << "a VLR count past the points was accepted";
+  } catch (const vola::FormatError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("the 3 VLRs the header counts (byte 100) do not fit"), std::string::npos) << message;
+    EXPECT_NE(message.find("0 of them end before it"), std::string::npos) << message;
+  }
 }
 
 TEST(LasVariants, WaveformRecordsAreNotReadIntoMemory) {
