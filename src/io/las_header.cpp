@@ -340,33 +340,13 @@ std::string name_key(const std::string& name) {
 // "height" stays: vola's LAS export writes the voxels' mean z under that name, read back
 // as the height column.
 void give_extra_fields_unique_names(LasHeader& hd) {
-  std::vector<std::string> taken = {"x",
-                                    "y",
-                                    "z",
-                                    "intensity",
-                                    "return_number",
-                                    "number_of_returns",
-                                    "classification",
-                                    "user_data",
-                                    "point_source_id",
-                                    "gps_time",
-                                    "red",
-                                    "green",
-                                    "blue",
-                                    "nir",
-                                    "scan_angle_rank",
-                                    "scan_angle",
-                                    "classification_flags",
-                                    "scan_direction_flag",
-                                    "edge_of_flight_line",
-                                    "scanner_channel",
-                                    "wave_packet_index",
-                                    "wave_offset",
-                                    "wave_packet_size",
-                                    "wave_return_point",
-                                    "wave_dx",
-                                    "wave_dy",
-                                    "wave_dz"};
+  // clang-format off
+  std::vector<std::string> taken = {
+      "x", "y", "z", "intensity", "return_number", "number_of_returns", "classification", "user_data",
+      "point_source_id", "gps_time", "red", "green", "blue", "nir", "scan_angle_rank", "scan_angle",
+      "classification_flags", "scan_direction_flag", "edge_of_flight_line", "scanner_channel", "wave_packet_index",
+      "wave_offset", "wave_packet_size", "wave_return_point", "wave_dx", "wave_dy", "wave_dz"};
+  // clang-format on
   for (auto& key : taken) key = name_key(key);
   bool height_kept = false;
   for (LasExtraField& f : hd.extra_fields) {
