@@ -2,11 +2,14 @@
 // round trips vola -> OctoMap -> vola; free voxels through the MapVoxels API; placement
 // of grids that do not line up with OctoMap's cells; damaged files refused with an error.
 #include <octomap/AbstractOcTree.h>
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
+#include <array>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -253,6 +256,53 @@ TEST(OctomapImport, PrunedNodesExpandToCells) {
   EXPECT_EQ(back.frame().origin, (vola::Point{-4.0, 0.0, 0.0}));
 }
 
+// A ColorOcTree .ot (octomap_server's and RTAB-Map's coloured maps) written by liboctomap:
+// its occupied cells, log-odds and colours, pruned nodes expanded; every cut an error.
+TEST(OctomapImport, ColorOcTreeCellsCarryTheirColours) {
+  vola_test::TempDir dir;
+  octomap::ColorOcTree tree(0.25);
+  for (octomap::key_type x = 32768; x < 32770; ++x)
+    for (octomap::key_type y = 32768; y < 32770; ++y)
+      for (octomap::key_type z = 32768; z < 32770; ++z) {
+        tree.updateNode(octomap::OcTreeKey(x, y, z), true);
+        tree.setNodeColor(octomap::OcTreeKey(x, y, z), 200, 100, 50);
+      }
+  tree.updateNode(octomap::OcTreeKey(32780, 32768, 32768), true);
+  tree.setNodeColor(octomap::OcTreeKey(32780, 32768, 32768), 10, 20, 30);
+  tree.updateNode(octomap::OcTreeKey(32781, 32768, 32768), false);  // a free leaf: no voxel
+  const auto path = dir / "colour.ot";
+  ASSERT_TRUE(tree.write(path.string()));
+  const vola::Tree back = vola::convert(path.string(), {});
+  const auto cells = cells_of(back);
+  EXPECT_EQ(cells.size(), 9u);
+  EXPECT_EQ(back.frame().origin, (vola::Point{0.0, 0.0, 0.0}));
+  const auto& attributes = back.attributes();
+  ASSERT_NE(attributes.find("red"), nullptr);
+  ASSERT_NE(attributes.find("log_odds"), nullptr);
+  std::map<std::array<double, 3>, std::size_t> seen;
+  back.for_each_voxel([&](const vola::Voxel& v) {
+    const std::uint64_t rank = back.rank(v).value();
+    const std::array<double, 3> rgb{attributes.find("red")->get(rank), attributes.find("green")->get(rank),
+                                    attributes.find("blue")->get(rank)};
+    EXPECT_EQ(rgb, (v.x == 12 ? std::array<double, 3>{10, 20, 30} : std::array<double, 3>{200, 100, 50})) << v.x;
+    EXPECT_GT(attributes.find("log_odds")->get(rank), 0.0);
+    ++seen[rgb];
+  });
+  EXPECT_EQ(seen.size(), 2u);
+  const std::vector<std::uint8_t> bytes = vola_test::read_bytes(path);
+  const auto header_end = std::string(bytes.begin(), bytes.end()).find("data\n") + 5;
+  for (std::size_t cut = header_end + 1; cut < bytes.size(); ++cut) {
+    const auto cut_path = dir / "cut.ot";
+    vola_test::write_bytes(cut_path, std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + cut));
+    try {
+      vola::convert(cut_path.string(), {});
+      ADD_FAILURE() << "cut at " << cut << " accepted";
+    } catch (const vola::Error& e) {
+      EXPECT_NE(std::string(e.what()).find(cut_path.string()), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ---- damaged files: an error naming the file, never a crash ----
 
 std::string error_of(const vola_test::fs::path& path) {
@@ -302,8 +352,12 @@ TEST(OctomapImport, CraftedFilesAreRefused) {
             std::string::npos);
   EXPECT_NE(error_of(write("old.bt", std::string("\x03\x00\x00\x00", 4) + std::string(20, '\0'))).find("not an OctoMap file"),
             std::string::npos);
-  EXPECT_NE(error_of(write("color.ot", "# Octomap OcTree file\nid ColorOcTree\nsize 1\nres 0.1\ndata\n" + std::string(8, '\0')))
-                .find("ColorOcTree"),
+  EXPECT_NE(error_of(write("stamped.ot", "# Octomap OcTree file\nid OcTreeStamped\nsize 1\nres 0.1\ndata\n" + std::string(9, '\0')))
+                .find("an .ot file of a OcTreeStamped"),
+            std::string::npos);
+  // A ColorOcTree node is 8 bytes (log-odds, r, g, b, child bits): 5 of them are cut short.
+  EXPECT_NE(error_of(write("color.ot", "# Octomap OcTree file\nid ColorOcTree\nsize 1\nres 0.1\ndata\n" + std::string(5, '\0')))
+                .find("ends inside a node"),
             std::string::npos);
   std::string nan_node(5, '\0');
   const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -43,8 +43,8 @@ bool read_header(std::istream& s, std::string& id, unsigned& size, double& resol
 
 class NodeWalk {
  public:
-  NodeWalk(std::string_view bytes, std::size_t offset, const std::string& path, std::uint64_t max_cells)
-      : bytes_(bytes), at_(offset), path_(path), max_cells_(max_cells) {}
+  NodeWalk(std::string_view bytes, std::size_t offset, const std::string& path, std::uint64_t max_cells, bool colour)
+      : bytes_(bytes), at_(offset), path_(path), max_cells_(max_cells), node_data_(colour ? 7 : 4) {}
 
   // readBinaryNode: two bytes of 2-bit child codes, child i's code = bit 2i + 2 * bit 2i+1
   // of the little-endian 16 (1 free leaf, 2 occupied leaf, 3 inner node, 0 unknown), then
@@ -66,19 +66,20 @@ class NodeWalk {
     for (int n = 0; n < inner; ++n) binary_node(depth + 1);
   }
 
-  // readNodesRecurs for OcTreeNode: a float log-odds, one byte of child bits, the children.
+  // readNodesRecurs: the node's data (OcTreeNode: a float log-odds; ColorOcTreeNode: the
+  // log-odds and three bytes r, g, b), one byte of child bits, the children.
   void text_node(int depth) {
-    const std::size_t at = need(5, depth);
+    const std::size_t at = need(node_data_ + 1, depth);
     float value;
     std::memcpy(&value, bytes_.data() + at, sizeof value);
     if (!std::isfinite(value)) fail(at, "a log-odds that is not finite");
-    const auto children = static_cast<unsigned char>(bytes_[at + 4]);
+    const auto children = static_cast<unsigned char>(bytes_[at + node_data_]);
     ++nodes_;
     if (children == 0) {
       if (value >= 0.0f) add_occupied(depth);  // OcTree's default threshold: probability 0.5
       return;
     }
-    if (depth >= kOctomapDepth) fail(at + 4, "children below OctoMap's 16 levels");
+    if (depth >= kOctomapDepth) fail(at + node_data_, "children below OctoMap's 16 levels");
     for (int i = 0; i < 8; ++i)
       if (children & (1u << i)) text_node(depth + 1);
   }
@@ -108,6 +109,7 @@ class NodeWalk {
   std::size_t at_;
   const std::string& path_;
   std::uint64_t max_cells_;
+  std::size_t node_data_;
   std::uint64_t nodes_ = 0;
   std::uint64_t occupied_ = 0;
 };
@@ -139,11 +141,13 @@ OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& pat
   if (!(std::isfinite(layout.resolution) && layout.resolution > 0.0 && std::isfinite(layout.resolution * 65536.0) &&
         std::isfinite(1.0 / layout.resolution)))
     throw FormatError(path, std::nullopt, "the resolution ('res') is not a finite number > 0 whose 65536 cells are finite");
-  if (!layout.binary && layout.id != "OcTree")
+  if (!layout.binary && layout.id != "OcTree" && layout.id != "ColorOcTree")
     throw FormatError(path, std::nullopt,
-                      "an .ot file of a " + layout.id + ": vola reads OcTree maps (occupancy log-odds per node)");
+                      "an .ot file of a " + layout.id +
+                          ": vola reads OcTree and ColorOcTree maps (occupancy log-odds per node, and colour)");
+  layout.colour = !layout.binary && layout.id == "ColorOcTree";
 
-  NodeWalk walk(bytes, layout.data_offset, path, max_cells);
+  NodeWalk walk(bytes, layout.data_offset, path, max_cells, layout.colour);
   if (layout.binary) {
     if (size == 0) return layout;  // readBinary reads no nodes then
     walk.binary_node(0);           // the root's children (the root itself is not coded)

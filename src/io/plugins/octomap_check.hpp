@@ -16,6 +16,7 @@ namespace vola::io {
 struct OctomapLayout {
   bool binary = false;             // "# Octomap OcTree binary file" (.bt) or "# Octomap OcTree file" (.ot)
   std::string id;                  // the tree type the header names
+  bool colour = false;             // a ColorOcTree: each .ot node holds r, g, b after its log-odds
   double resolution = 0.0;
   std::size_t data_offset = 0;     // where the node stream starts
   std::uint64_t nodes = 0;         // nodes in the stream, the root included (0: an empty tree)
@@ -28,8 +29,8 @@ inline constexpr int kOctomapDepth = 16;
 
 // Throws FormatError naming `path` and the byte offset: an unknown first line (old binary
 // files without it included), no `data` line, a resolution that is not finite and > 0 (or
-// whose 65536 cells or inverse are not), an .ot tree type other than OcTree (its nodes
-// hold other data), a node stream cut short or deeper than 16 levels, a non-finite
+// whose 65536 cells or inverse are not), an .ot tree type other than OcTree and
+// ColorOcTree (its nodes hold other data), a node stream cut short or deeper than 16 levels, a non-finite
 // log-odds, a .bt node count that differs from the header's size (liboctomap refuses it
 // too), or more than `max_cells` occupied cells.
 OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& path, std::uint64_t max_cells);

@@ -2,6 +2,7 @@
 // voxels (write_octomap decides the shift) and checks the file's structure first
 // (octomap_check.hpp); liboctomap does the rest: keys, tree, pruning, the encodings.
 #include <octomap/AbstractOcTree.h>
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
 #include <fcntl.h>
@@ -14,6 +15,7 @@
 #include <iostream>
 #include <iterator>
 #include <memory>
+#include <type_traits>
 
 #include "../reader_plugin.hpp"
 #include "node_census.hpp"
@@ -66,7 +68,10 @@ class QuietOctomap {
   int saved_fd_ = -1;
 };
 
-std::unique_ptr<octomap::OcTree> parse(const std::string& bytes, const OctomapLayout& layout, const std::string& path) {
+// The tree liboctomap reads: an OcTree from a .bt (readBinary) or an .ot of an OcTree, a
+// ColorOcTree from an .ot of one (AbstractOcTree's factory knows both).
+std::unique_ptr<octomap::AbstractOcTree> parse(const std::string& bytes, const OctomapLayout& layout,
+                                               const std::string& path) {
   const QuietOctomap quiet;
   ViewBuffer buffer(bytes);
   std::istream in(&buffer);
@@ -76,9 +81,10 @@ std::unique_ptr<octomap::OcTree> parse(const std::string& bytes, const OctomapLa
     return tree;
   }
   std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(in));
-  if (!dynamic_cast<octomap::OcTree*>(tree.get()))
-    throw FormatError(path, std::nullopt, "liboctomap could not read an OcTree from it");
-  return std::unique_ptr<octomap::OcTree>(static_cast<octomap::OcTree*>(tree.release()));
+  const bool expected = layout.colour ? dynamic_cast<octomap::ColorOcTree*>(tree.get()) != nullptr
+                                      : dynamic_cast<octomap::OcTree*>(tree.get()) != nullptr;
+  if (!expected) throw FormatError(path, std::nullopt, "liboctomap could not read an " + layout.id + " from it");
+  return tree;
 }
 
 // liboctomap's nodes for these keys: a node per distinct cell of every depth 0..16, each
@@ -100,19 +106,18 @@ std::uint64_t octree_bytes(const std::vector<octomap::OcTreeKey>& keys) {
 
 }  // namespace
 
-VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes) {
-  const std::string bytes = read_whole(path);
-  const OctomapLayout layout = check_octomap_bytes(bytes, path, kMaxMapVoxels);
-  VoxelGrid grid;
-  grid.voxel_size = layout.resolution;
-  grid.fixed_voxel_size = true;
-  if (layout.occupied_cells == 0) return grid;
-  const std::unique_ptr<octomap::OcTree> tree = parse(bytes, layout, path);
+namespace {
 
+// The occupied leaves of `tree` (an OcTree or a ColorOcTree) as the grid's voxels, pruned
+// leaves expanded to cells of the resolution; with `attributes`, an .ot's log-odds and a
+// ColorOcTree's colour as columns.
+template <class Tree>
+void gather_cells(const Tree& tree, const OctomapLayout& layout, bool attributes, const std::string& path,
+                  VoxelGrid& grid) {
   // A leaf at depth d is a cube of 2^(16 - d) cells from its lowest key (getIndexKey).
   std::array<unsigned, 3> low{65535, 65535, 65535}, high{0, 0, 0};
-  for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it) {
-    if (!tree->isNodeOccupied(*it)) continue;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
     const octomap::OcTreeKey key = it.getIndexKey();
     const unsigned span = 1u << (kOctomapDepth - it.getDepth());
     for (int a = 0; a < 3; ++a) {
@@ -121,18 +126,33 @@ VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes)
     }
   }
   grid.voxels.reserve(layout.occupied_cells);
-  PointAttribute log_odds{"log_odds", ValueType::f32, Reduction::last, {}};
+  constexpr bool kColour = std::is_same_v<Tree, octomap::ColorOcTree>;
+  std::vector<PointAttribute> columns;
   const bool keep_log_odds = attributes && !layout.binary;  // a .bt holds occupancy only
-  if (keep_log_odds) log_odds.values.reserve(layout.occupied_cells);
-  for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it) {
-    if (!tree->isNodeOccupied(*it)) continue;
+  if (keep_log_odds) columns.push_back({"log_odds", ValueType::f32, Reduction::last, {}});
+  if (kColour && attributes)
+    for (const char* name : {"red", "green", "blue"}) columns.push_back({name, ValueType::u8, Reduction::mean, {}});
+  for (auto& column : columns) column.values.reserve(layout.occupied_cells);
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
     const octomap::OcTreeKey key = it.getIndexKey();
     const unsigned span = 1u << (kOctomapDepth - it.getDepth());
     const Voxel first{key[0] - low[0], key[1] - low[1], key[2] - low[2]};
     for (unsigned z = 0; z < span; ++z)
       for (unsigned y = 0; y < span; ++y)
         for (unsigned x = 0; x < span; ++x) grid.voxels.push_back({first.x + x, first.y + y, first.z + z});
-    if (keep_log_odds) log_odds.values.insert(log_odds.values.end(), std::size_t{span} * span * span, it->getLogOdds());
+    const std::size_t cells = std::size_t{span} * span * span;
+    if (keep_log_odds) columns[0].values.insert(columns[0].values.end(), cells, it->getLogOdds());
+    if constexpr (kColour) {
+      if (attributes) {
+        const auto colour = it->getColor();
+        const std::uint8_t channels[3] = {colour.r, colour.g, colour.b};
+        for (std::size_t k = 0; k < 3; ++k) {
+          auto& values = columns[(keep_log_odds ? 1 : 0) + k].values;
+          values.insert(values.end(), cells, channels[k]);
+        }
+      }
+    }
   }
   if (grid.voxels.size() != layout.occupied_cells)
     throw FormatError(path, std::nullopt,
@@ -143,7 +163,21 @@ VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes)
     grid.origin[a] = (static_cast<double>(low[a]) - static_cast<double>(kOctomapKeyCentre)) * layout.resolution;
     grid.dims[a] = high[a] - low[a] + 1;
   }
-  if (keep_log_odds) grid.attributes.push_back(std::move(log_odds));
+  for (auto& column : columns) grid.attributes.push_back(std::move(column));
+}
+
+}  // namespace
+
+VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes) {
+  const std::string bytes = read_whole(path);
+  const OctomapLayout layout = check_octomap_bytes(bytes, path, kMaxMapVoxels);
+  VoxelGrid grid;
+  grid.voxel_size = layout.resolution;
+  grid.fixed_voxel_size = true;
+  if (layout.occupied_cells == 0) return grid;
+  const std::unique_ptr<octomap::AbstractOcTree> tree = parse(bytes, layout, path);
+  if (layout.colour) gather_cells(static_cast<const octomap::ColorOcTree&>(*tree), layout, attributes, path, grid);
+  else gather_cells(static_cast<const octomap::OcTree&>(*tree), layout, attributes, path, grid);
   return grid;
 }
 
