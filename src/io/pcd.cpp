@@ -199,7 +199,13 @@ struct OtherField {
   std::string name;
   ValueType type;
   Reduction reduction;
+  std::uint64_t element = 0;  // of a field with COUNT > 1: which of its values
 };
+
+// A field of COUNT > 1 up to this many values (a normal's 3, a colour's 4, a short
+// histogram) becomes one column per value, name_0, name_1, ... as LAS arrays do;
+// descriptors (FPFH's 33, SHOT's 352) are not read.
+constexpr std::uint64_t kMaxFieldElements = 16;
 
 // The fields vola uses, found by (lower-case) name.
 struct Layout {
@@ -244,20 +250,23 @@ Layout find_layout(const Header& h, const std::string& name) {
         scale == colour_scale(kind(l.channels[2]), l.channels[2]->size))
       l.channel_scale = scale;
   }
-  // Every other scalar field (normals, curvature, labels, ring, time, ...); fields of
-  // COUNT > 1 (histograms, descriptors) and PCL's "_" padding are not read. A second
-  // field of a name already taken stays unread, as in PLY.
+  // Every other field (normals, curvature, labels, ring, time, ...), one column per value
+  // of a field of COUNT 2..kMaxFieldElements; longer ones (descriptors) and PCL's "_"
+  // padding are not read. A second field of a name already taken stays unread, as in PLY.
   std::unordered_set<std::string> taken = {"x", "y", "z"};  // 80,000 fields took seconds with a search per name
   if (l.packed_rgb || l.channel_scale) taken.insert({"red", "green", "blue"});
   if (l.intensity) taken.insert("intensity");
   for (const Field& f : h.fields) {
     const bool used = &f == l.xyz[0] || &f == l.xyz[1] || &f == l.xyz[2] || &f == l.packed_rgb || &f == l.intensity ||
                       (l.channel_scale && (&f == l.channels[0] || &f == l.channels[1] || &f == l.channels[2]));
-    if (used || !scalar(f) || f.name.find_first_not_of('_') == std::string::npos) continue;
-    std::string column = point_column_name(f.name);
-    if (!taken.insert(column).second) continue;
-    const Reduction reduction = point_column_reduction(column, f.name);
-    l.others.push_back({&f, std::move(column), field_value_type(f), reduction});
+    if (used || f.count > kMaxFieldElements || f.name.find_first_not_of('_') == std::string::npos) continue;
+    const std::string base = point_column_name(f.name);
+    for (std::uint64_t element = 0; element < f.count; ++element) {
+      std::string column = scalar(f) ? base : base + "_" + std::to_string(element);
+      if (!taken.insert(column).second) continue;
+      const Reduction reduction = point_column_reduction(column, f.name);
+      l.others.push_back({&f, std::move(column), field_value_type(f), reduction, element});
+    }
   }
   return l;
 }
@@ -337,7 +346,10 @@ void read_records(const std::uint8_t* base, bool columns, const Header& h, const
     } else if (l.channel_scale) {
       for (int c = 0; c < 3; ++c) rgb[c] = field_value(at(*l.channels[c], i), *l.channels[c]);
     }
-    for (std::size_t k = 0; k < l.others.size(); ++k) others[k] = field_value(at(*l.others[k].field, i), *l.others[k].field);
+    for (std::size_t k = 0; k < l.others.size(); ++k) {
+      const OtherField& o = l.others[k];
+      others[k] = field_value(at(*o.field, i) + o.element * o.field->size, *o.field);
+    }
     sink.add(xyz, rgb, l.intensity ? field_value(at(*l.intensity, i), *l.intensity) : 0.0, others);
   }
 }
@@ -363,13 +375,14 @@ void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSi
     };
     if (words.size() != h.components)
       fail(std::to_string(words.size()) + " values, the header's fields need " + std::to_string(h.components));
-    auto number = [&](const Field& f) {
-      std::string_view w = words[static_cast<std::size_t>(f.component)];
+    auto number = [&](const Field& f, std::uint64_t element = 0) {
+      std::string_view w = words[static_cast<std::size_t>(f.component + element)];
       if (!w.empty() && w.front() == '+') w.remove_prefix(1);
       double v = 0.0;
       const auto r = std::from_chars(w.data(), w.data() + w.size(), v);
       // (append, not "'" + string: GCC 12 warns falsely of overlapping copies when inlined)
-      if (r.ec != std::errc() || r.ptr != w.data() + w.size()) fail(std::string(1, '\'').append(w).append("' is not a number"));
+      if (r.ec != std::errc() || r.ptr != w.data() + w.size())
+        fail(std::string(1, '\'').append(w).append("' is not a number"));
       // As the binary kinds would store it: a SIZE 4 float field holds a float.
       return f.type == 'F' && f.size == 4 ? static_cast<double>(static_cast<float>(v)) : v;
     };
@@ -390,7 +403,7 @@ void read_ascii(std::string_view text, const Header& h, const Layout& l, PointSi
     } else if (l.channel_scale) {
       for (int c = 0; c < 3; ++c) rgb[c] = number(*l.channels[c]);
     }
-    for (std::size_t k = 0; k < l.others.size(); ++k) others[k] = number(*l.others[k].field);
+    for (std::size_t k = 0; k < l.others.size(); ++k) others[k] = number(*l.others[k].field, l.others[k].element);
     sink.add(xyz, rgb, l.intensity ? number(*l.intensity) : 0.0, others);
     ++i;
   }

@@ -206,12 +206,14 @@ Bytes pcd_bytes(const Sample& s, const std::string& data_kind, bool doubles, boo
 
 void expect_sample(const vola::PointCloud& cloud, const Sample& s, bool doubles) {
   std::size_t k = 0;
-  // red, green, blue, intensity, then label (I8, a class: majority); normal has COUNT 3.
-  ASSERT_EQ(cloud.attributes.size(), 5u);
+  // red, green, blue, intensity, then normal (COUNT 3: normal_0, _1, _2) and label (I8, a
+  // class: majority).
+  ASSERT_EQ(cloud.attributes.size(), 8u);
   EXPECT_EQ(cloud.attributes[3].name, "intensity");
-  EXPECT_EQ(cloud.attributes[4].name, "label");
-  EXPECT_EQ(cloud.attributes[4].type, vola::ValueType::i64);
-  EXPECT_EQ(cloud.attributes[4].reduction, vola::Reduction::majority);
+  for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(cloud.attributes[4 + c].name, "normal_" + std::to_string(c));
+  EXPECT_EQ(cloud.attributes[7].name, "label");
+  EXPECT_EQ(cloud.attributes[7].type, vola::ValueType::i64);
+  EXPECT_EQ(cloud.attributes[7].reduction, vola::Reduction::majority);
   for (std::size_t i = 0; i < s.xyz.size(); ++i) {
     if (!std::isfinite(s.xyz[i][0]) || !std::isfinite(s.xyz[i][1]) || !std::isfinite(s.xyz[i][2])) continue;
     ASSERT_LT(k, cloud.size());
@@ -221,7 +223,10 @@ void expect_sample(const vola::PointCloud& cloud, const Sample& s, bool doubles)
                            static_cast<double>(s.rgb[i] & 255)};
     for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(cloud.attributes[c].values[k], rgb[c]) << "point " << i;
     EXPECT_EQ(cloud.attributes[3].values[k], s.intensity[i]);
-    EXPECT_EQ(cloud.attributes[4].values[k], static_cast<double>(-static_cast<std::int64_t>(i) * 1000000007));
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_EQ(cloud.attributes[4 + c].values[k], static_cast<double>(i) + 0.5 * static_cast<double>(c))
+          << "point " << i;
+    EXPECT_EQ(cloud.attributes[7].values[k], static_cast<double>(-static_cast<std::int64_t>(i) * 1000000007));
     EXPECT_EQ(cloud.payload[k], std::uint64_t{s.rgb[i] >> 16} | std::uint64_t{(s.rgb[i] >> 8) & 255} << 8 |
                                     std::uint64_t{s.rgb[i] & 255} << 16);
     ++k;
@@ -261,6 +266,21 @@ TEST(Pcd, SeparateColourFieldsAndNoColours) {
   EXPECT_EQ(p.xyz, (std::vector<double>{1, 2, 3}));
   EXPECT_TRUE(p.attributes.empty());
   EXPECT_TRUE(p.payload.empty());  // the builder's default payload, as for any colourless input
+}
+
+// A field of a few values (COUNT <= 16) is a column per value; a descriptor (FPFH's 33)
+// is not read, and the values after it still land in their own columns.
+TEST(Pcd, FieldsOfSeveralValuesBecomeAColumnEachUpToSixteen) {
+  std::string text =
+      "FIELDS x y z fpfh uv\nSIZE 4 4 4 4 4\nTYPE F F F F F\nCOUNT 1 1 1 33 2\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3";
+  for (int k = 0; k < 33; ++k) text += " " + std::to_string(100 + k);
+  text += " 0.25 0.75\n";
+  const auto cloud = vola::io::parse_pcd(Bytes(text.begin(), text.end()), "uv.pcd", {});
+  ASSERT_EQ(cloud.attributes.size(), 2u);
+  EXPECT_EQ(cloud.attributes[0].name, "uv_0");
+  EXPECT_EQ(cloud.attributes[1].name, "uv_1");
+  EXPECT_EQ(cloud.attributes[0].values, (std::vector<double>{0.25}));
+  EXPECT_EQ(cloud.attributes[1].values, (std::vector<double>{0.75}));
 }
 
 TEST(Pcd, EveryTruncationOfBinaryDataIsAFormatError) {
