@@ -30,8 +30,9 @@ Points random_points(std::uint64_t seed, std::size_t n) {
   for (const auto& s : p.specs) p.cloud.attributes.push_back({s.name, s.type, s.reduction, {}});
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) p.cloud.xyz.push_back(coordinate(rng));
-    // Few distinct values so that majorities and ties happen.
-    p.cloud.attributes[0].values.push_back(small(rng) * 0.25);
+    // Few distinct values so that majorities and ties happen; means skip NaN (no value).
+    const bool no_value = byte(rng) < 40;
+    p.cloud.attributes[0].values.push_back(no_value ? std::numeric_limits<double>::quiet_NaN() : small(rng) * 0.25);
     p.cloud.attributes[1].values.push_back(byte(rng));
     p.cloud.attributes[2].values.push_back(small(rng) - 2);
     p.cloud.attributes[3].values.push_back(byte(rng));
@@ -78,8 +79,12 @@ TEST_P(StreamBuilderEqualsBuild, ForRandomChunks) {
       const auto& g = got.attributes().columns()[c];
       const auto& e = expected.attributes().columns()[c];
       ASSERT_EQ(g.name(), e.name());
-      for (std::size_t v = 0; v < g.size(); ++v)  // means may differ in the order of summation only
-        ASSERT_NEAR(g.get(v), e.get(v), 1e-9) << g.name() << " voxel " << v;
+      for (std::size_t v = 0; v < g.size(); ++v) {  // means may differ in the order of summation only
+        if (std::isnan(e.get(v)))
+          ASSERT_TRUE(std::isnan(g.get(v))) << g.name() << " voxel " << v;
+        else
+          ASSERT_NEAR(g.get(v), e.get(v), 1e-9) << g.name() << " voxel " << v;
+      }
     }
     EXPECT_EQ(builder.points_in(), p.cloud.size());
   }
@@ -109,14 +114,16 @@ TEST(StreamBuilder, PayloadsWithoutAttributes) {
 
 // NaN in a majority column is one value among others, sorting after the numbers (it
 // once made the reduction loop forever: NaN != NaN); max and min skip NaN unless every
-// value is NaN. Built at once and streamed one
-// point per chunk (so that the merges combine the histograms), the same answers.
+// value is NaN; a mean is over the values that are numbers (NaN is a point without a
+// value: a LAS no_data). Built at once and streamed one point per chunk (so that the
+// merges combine the histograms and the counts of NaN), the same answers.
 TEST(StreamBuilder, MajorityWithNaNValues) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   vola::PointCloud cloud;
   cloud.xyz = {0.1, 0.1, 0.1, 0.2, 0.2, 0.2, 0.3, 0.3, 0.3, 5.1, 5.1, 5.1, 5.2, 5.2, 5.2, 9.9, 9.9, 9.9};
   cloud.attributes.push_back({"m", vola::ValueType::f64, vola::Reduction::majority, {nan, 1.0, nan, 2.0, nan, nan}});
   cloud.attributes.push_back({"hi", vola::ValueType::f64, vola::Reduction::max, {nan, 1.0, nan, nan, 2.0, nan}});
+  cloud.attributes.push_back({"avg", vola::ValueType::f64, vola::Reduction::mean, {nan, 1.0, 4.0, nan, 2.0, nan}});
   vola::BuildOptions options;
   options.quantization = vola::Quantization::grid;
   options.voxel_size = 1.0;
@@ -125,11 +132,13 @@ TEST(StreamBuilder, MajorityWithNaNValues) {
   vola::BuildOptions resolved = options;
   vola::StreamBuilder builder(vola::resolve_quantizer(cloud.bounds(), resolved),
                               {{"m", vola::ValueType::f64, vola::Reduction::majority},
-                               {"hi", vola::ValueType::f64, vola::Reduction::max}},
+                               {"hi", vola::ValueType::f64, vola::Reduction::max},
+                               {"avg", vola::ValueType::f64, vola::Reduction::mean}},
                               false);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const std::vector<std::span<const double>> values{{cloud.attributes[0].values.data() + i, 1},
-                                                      {cloud.attributes[1].values.data() + i, 1}};
+                                                      {cloud.attributes[1].values.data() + i, 1},
+                                                      {cloud.attributes[2].values.data() + i, 1}};
     builder.add({cloud.xyz.data() + 3 * i, 3}, values, {});
   }
   const vola::Tree streamed = builder.finish();
@@ -144,6 +153,10 @@ TEST(StreamBuilder, MajorityWithNaNValues) {
     EXPECT_EQ(high.get(0), 1.0);
     EXPECT_EQ(high.get(1), 2.0);
     EXPECT_TRUE(std::isnan(high.get(2)));
+    const auto& mean = tree->attributes().columns()[2];
+    EXPECT_EQ(mean.get(0), 2.5);           // NaN, 1, 4: the mean of 1 and 4
+    EXPECT_EQ(mean.get(1), 2.0);           // NaN, 2
+    EXPECT_TRUE(std::isnan(mean.get(2)));  // no value at all
   }
 }
 
@@ -172,9 +185,13 @@ TEST(StreamBuilder, ExpectPointsIsOnlyAHint) {
     ASSERT_EQ(std::vector<std::uint64_t>(got.voxel_payloads().begin(), got.voxel_payloads().end()),
               std::vector<std::uint64_t>(expected.voxel_payloads().begin(), expected.voxel_payloads().end()));
     for (std::size_t c = 0; c < got.attributes().size(); ++c)
-      for (std::size_t v = 0; v < got.attributes().columns()[c].size(); ++v)
-        ASSERT_NEAR(got.attributes().columns()[c].get(v), expected.attributes().columns()[c].get(v), 1e-9)
-            << "hint " << hint << " column " << c << " voxel " << v;
+      for (std::size_t v = 0; v < got.attributes().columns()[c].size(); ++v) {
+        const double g = got.attributes().columns()[c].get(v), e = expected.attributes().columns()[c].get(v);
+        if (std::isnan(e))
+          ASSERT_TRUE(std::isnan(g)) << "hint " << hint << " column " << c << " voxel " << v;
+        else
+          ASSERT_NEAR(g, e, 1e-9) << "hint " << hint << " column " << c << " voxel " << v;
+      }
   }
 }
 

@@ -33,7 +33,7 @@ vola::PointCloud random_cloud(std::uint64_t seed, std::size_t n) {
     for (int a = 0; a < 3; ++a) cloud.xyz.push_back(coordinate(rng));
     const bool nan = rng() % 7 == 0;
     cloud.attributes[0].values.push_back(any(rng));  // means of large values: the order of summation shows
-    cloud.attributes[1].values.push_back(small(rng) * 0.1);
+    cloud.attributes[1].values.push_back(nan ? kNaN : small(rng) * 0.1);  // a mean skips NaN
     cloud.attributes[2].values.push_back(byte(rng));
     cloud.attributes[3].values.push_back(small(rng) - 2);
     cloud.attributes[4].values.push_back(byte(rng));
@@ -339,6 +339,52 @@ TEST(VoxelReducer, NarrowSlotsWidenWhenAValueDoesNotFit) {
       a.values[15000] = odd;
     }
     expect_reducer_equals_build(cloud, unit_grid(), 4, 3000);
+  }
+}
+
+// A mean is over the points with a value: NaN (a LAS no_data) is skipped, and a voxel
+// with no value at all is NaN, whether the values come as doubles or as record fields
+// with a no_data value, and whenever the first NaN comes (the slots widen to count them).
+TEST(VoxelReducer, MeansSkipPointsWithoutAValue) {
+  // Voxels of rank 0, 1, 2: {1, no data, 4, no data, 7}, {no data, no data}, {2}.
+  const std::vector<std::uint64_t> ranks = {0, 0, 1, 0, 2, 0, 1, 0};
+  const std::vector<std::int32_t> stored = {1, -9999, -9999, 4, 2, -9999, -9999, 7};
+  std::vector<double> values;
+  for (const std::int32_t x : stored) values.push_back(x == -9999 ? kNaN : x);
+  const std::vector<vola::AttributeSpec> specs = {{"mean_u16", vola::ValueType::u16, vola::Reduction::mean},
+                                                  {"mean_f64", vola::ValueType::f64, vola::Reduction::mean}};
+  const auto expect_means = [](const std::vector<vola::AttributeColumn>& columns) {
+    for (const auto& column : columns) {
+      SCOPED_TRACE(column.name());
+      EXPECT_EQ(column.get(0), 4.0);
+      EXPECT_EQ(column.get(2), 2.0);
+      if (column.type() == vola::ValueType::f64)
+        EXPECT_TRUE(std::isnan(column.get(1)));
+      else
+        EXPECT_EQ(column.get(1), 0.0);  // an integer column stores NaN as 0
+    }
+  };
+  for (const std::size_t split : {std::size_t{0}, std::size_t{1}, std::size_t{4}}) {
+    SCOPED_TRACE(split);
+    vola::VoxelReducer as_values(specs, 3);
+    const std::span<const std::uint64_t> r(ranks);
+    const std::span<const double> v(values);
+    const std::vector<std::span<const double>> first{v.first(split), v.first(split)};
+    const std::vector<std::span<const double>> rest{v.subspan(split), v.subspan(split)};
+    as_values.add(r.first(split), first);
+    as_values.add(r.subspan(split), rest);
+    expect_means(as_values.finish());
+
+    // The same as an int32 field whose no_data is -9999 (after a whole-number field).
+    vola::VoxelReducer as_records(specs, 3);
+    const vola::RecordField field{.kind = vola::RecordField::Kind::i32, .has_no_data = true, .no_data = -9999};
+    const std::vector<vola::RecordField> fields{field, field};
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(stored.data());
+    const std::vector<std::uint32_t> index = {0, 1, 2, 3, 4, 5, 6, 7};
+    const std::span<const std::uint32_t> at(index);
+    as_records.add_records(r.first(split), bytes, 4, at.first(split), fields);
+    as_records.add_records(r.subspan(split), bytes, 4, at.subspan(split), fields);
+    expect_means(as_records.finish());
   }
 }
 

@@ -21,7 +21,9 @@ VOLA_INLINE_NAMESPACE_BEGIN
 
 enum class ValueType : std::uint8_t { u8 = 0, u16, u32, u64, i8, i16, i32, i64, f32, f64 };
 
-// How several points falling in one voxel become that voxel's value.
+// How several points falling in one voxel become that voxel's value. A NaN value is a
+// point without a value: mean, max and min skip it (NaN when every value is NaN); last
+// takes it if it comes last; majority counts NaN as one value after every number.
 enum class Reduction : std::uint8_t { last = 0, mean, max, min, majority };
 
 // Bytes of one value (inline: called per value by columns).

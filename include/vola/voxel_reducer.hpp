@@ -6,9 +6,10 @@
 //
 // Points fold in the order they are added, so the values equal vola::build's over the
 // same points in the same order, bit for bit (means: the same summation order).
-// Reductions and their NaN rules are those of reductions.hpp: mean, max, min (NaN
-// skipped unless every value is NaN), last, majority (exact counts; ties to the
-// smallest value; NaN one value after every number). A voxel no point reached gets 0.
+// Reductions and their NaN rules are those of reductions.hpp: mean (NaN, a point without
+// a value, skipped; NaN when every value is), max, min (NaN skipped unless every value
+// is NaN), last, majority (exact counts; ties to the smallest value; NaN one value after
+// every number). A voxel no point reached gets 0.
 #pragma once
 
 #include <cstdint>

@@ -35,10 +35,11 @@ double reduce(const std::vector<double>& values, std::span<const std::uint32_t> 
     return detail::majority_of(scratch);
   }
   const auto n = static_cast<std::uint32_t>(points.size());
-  const double partial = detail::with_reduction(reduction, [&](auto r) {
-    return detail::fold<decltype(r)::value>([&](std::uint32_t k) { return values[points[k]]; }, n);
-  });
-  return detail::finish(reduction, partial, n);
+  const auto value_at = [&](std::uint32_t k) { return values[points[k]]; };
+  const double partial =
+      detail::with_reduction(reduction, [&](auto r) { return detail::fold<decltype(r)::value>(value_at, n); });
+  const std::uint32_t with_value = reduction == Reduction::mean ? n - detail::count_nan(value_at, n) : n;
+  return detail::finish(reduction, partial, with_value);
 }
 
 // ---- Depth <= 5, many keys: leaf blocks marked in a dense bitmap instead of sorting ----

@@ -2,8 +2,10 @@
 // once for the in-memory builder (build) and the streaming builder (StreamBuilder).
 // Every reduction but majority keeps one partial value per voxel, and partials combine
 // associatively (older points first), so a voxel's value does not depend on how its
-// points were chunked. NaN rules: max and min skip NaN unless every value is NaN
-// (fmax/fmin); majority counts NaN as one value that sorts after every number.
+// points were chunked. NaN rules: NaN is a point without a value (a LAS no_data, a
+// scanner's missing return): mean skips it (the mean of the voxel's numbers; NaN when
+// it has none), max and min skip it unless every value is NaN (fmax/fmin); majority
+// counts NaN as one value that sorts after every number.
 #pragma once
 
 #include <algorithm>
@@ -34,6 +36,11 @@ inline double canonical_value(double v) noexcept {
   return v == 0.0 ? 0.0 : v;
 }
 
+// What a value adds to a mean's sum: NaN adds -0, the sum's identity (-0 + x is x for
+// every x, -0 and +0 included), so the sum is that of the voxel's numbers in input
+// order, bit for bit, whichever path folds them.
+inline double mean_summand(double v) noexcept { return std::isnan(v) ? -0.0 : v; }
+
 // The partial of older points combined with the partial of newer ones. mean: the sum
 // (finish() divides); last: the newer. Not for majority, whose partial is a histogram.
 template <Reduction R>
@@ -57,15 +64,31 @@ decltype(auto) with_reduction(Reduction r, F&& f) {
   }
 }
 
-// The partial of n >= 1 points, value_at(k) the k-th in input order.
+// The partial of n >= 1 points, value_at(k) the k-th in input order (a mean's: the sum
+// of the values that are numbers).
 template <Reduction R, class ValueAt>
 inline double fold(ValueAt&& value_at, std::uint32_t n) {
-  double partial = value_at(0);
-  for (std::uint32_t k = 1; k < n; ++k) partial = combine<R>(partial, value_at(k));
-  return partial;
+  if constexpr (R == Reduction::mean) {
+    double sum = mean_summand(value_at(0));
+    for (std::uint32_t k = 1; k < n; ++k) sum += mean_summand(value_at(k));
+    return sum;
+  } else {
+    double partial = value_at(0);
+    for (std::uint32_t k = 1; k < n; ++k) partial = combine<R>(partial, value_at(k));
+    return partial;
+  }
 }
 
-// A voxel's value from its partial and its number of points.
+// How many of n values, value_at(k) the k-th, are NaN (a mean's points without a value).
+template <class ValueAt>
+inline std::uint32_t count_nan(ValueAt&& value_at, std::uint32_t n) {
+  std::uint32_t nans = 0;
+  for (std::uint32_t k = 0; k < n; ++k) nans += std::isnan(value_at(k)) ? 1u : 0u;
+  return nans;
+}
+
+// A voxel's value from its partial and its number of points; for a mean, `points` counts
+// the points with a value (a mean of none is NaN: -0 / 0).
 inline double finish(Reduction r, double partial, std::uint64_t points) noexcept {
   return r == Reduction::mean ? partial / static_cast<double>(points) : partial;
 }

@@ -227,6 +227,16 @@ void StreamBuilder::add(std::span<const double> xyz, std::span<const std::span<c
                                                       starts[v + 1] - starts[v]);
       }
     });
+    // A mean counts its points without a value, where the chunk has any.
+    p.nans.clear();
+    if (reduction == Reduction::mean &&
+        std::any_of(values[a].begin(), values[a].end(), [](double x) { return std::isnan(x); })) {
+      p.nans.resize(voxels);
+      for (std::size_t v = 0; v < voxels; ++v) {
+        const std::uint32_t* points = index + starts[v];
+        p.nans[v] = detail::count_nan([&](std::uint32_t k) { return values_of[points[k]]; }, starts[v + 1] - starts[v]);
+      }
+    }
   }
   s.push(std::move(run));
 }
@@ -292,8 +302,11 @@ Tree StreamBuilder::finish() {
       store_majority(all.keys, p, column);
     } else {
       const bool counted = spec.reduction == Reduction::mean;  // points per voxel are kept for means only
-      for (std::size_t v = 0; v < voxels; ++v)
-        column.set(v, detail::finish(spec.reduction, p.value[v], counted ? all.points[v] : 1));
+      const bool nans = !p.nans.empty();
+      for (std::size_t v = 0; v < voxels; ++v) {
+        const std::uint64_t with_value = counted ? all.points[v] - (nans ? p.nans[v] : 0) : 1;
+        column.set(v, detail::finish(spec.reduction, p.value[v], with_value));
+      }
     }
     p = Partial{};  // the column holds it now
     tree.attributes().add(std::move(column));

@@ -109,6 +109,7 @@ void merge_pairs(Partial& a, const Partial& b) {
 // by column, so that each pass is a tight loop over arrays.
 void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> specs, bool payload,
                 std::vector<Source>& plan_buffer) {
+  const std::size_t older_voxels = older.keys.size(), newer_voxels = newer.keys.size();
   const std::size_t voxels = plan_merge(older.keys, newer.keys, plan_buffer);
   const std::span<const Source> plan(plan_buffer.data(), voxels);
   merge_column(older.keys, newer.keys, plan, [](Key k, Key) { return k; });
@@ -124,6 +125,15 @@ void merge_into(Run& older, const Run& newer, std::span<const AttributeSpec> spe
     detail::with_reduction(specs[a].reduction, [&](auto reduction) {
       merge_column(p, r, plan, [](double x, double y) { return detail::combine<decltype(reduction)::value>(x, y); });
     });
+    Column<std::uint32_t>& older_nans = older.partials[a].nans;
+    const Column<std::uint32_t>& newer_nans = newer.partials[a].nans;
+    if (older_nans.empty() && newer_nans.empty()) continue;  // no point without a value yet
+    if (older_nans.empty()) older_nans.assign(older_voxels, 0);
+    if (newer_nans.empty()) {
+      merge_column(older_nans, Column<std::uint32_t>(newer_voxels, 0), plan, std::plus<>());
+    } else {
+      merge_column(older_nans, newer_nans, plan, std::plus<>());
+    }
   }
 }
 

@@ -68,6 +68,8 @@ using Column = std::vector<T, KeyAllocator<T>>;
 struct Partial {
   // mean: the sum; max, min, last: the value; one per voxel (majority: unused)
   Column<double> value;
+  // mean: the points without a value (NaN) per voxel; empty while the run has none
+  Column<std::uint32_t> nans;
   // majority: the run's distinct (voxel key, value) pairs, sorted, with the number of
   // points of each: flat arrays, so that merging two runs is one linear pass
   KeyVector pair_key;
@@ -75,7 +77,8 @@ struct Partial {
   Column<std::uint32_t> pair_count;
 
   std::size_t memory_bytes() const noexcept {
-    return value.capacity() * 8 + pair_key.capacity() * 8 + pair_value.capacity() * 8 + pair_count.capacity() * 4;
+    return value.capacity() * 8 + nans.capacity() * 4 + pair_key.capacity() * 8 + pair_value.capacity() * 8 +
+           pair_count.capacity() * 4;
   }
 };
 

@@ -10,7 +10,9 @@
 // u8 and u16 columns whose values fit. Every other slot is a double. The first value
 // that does not fit a narrow slot (a fraction, a negative number, NaN) turns that
 // attribute's slots into doubles for all voxels before it is added, holding the same
-// partials, so results never depend on which slots were narrow.
+// partials, so results never depend on which slots were narrow. A mean's first NaN (a
+// point without a value, which the mean skips) widens its slots once more, to the sum
+// and a count of such points.
 #include "vola/voxel_reducer.hpp"
 
 #include <algorithm>
@@ -38,14 +40,17 @@ namespace {
 
 // How one attribute's partial is kept in a row.
 enum class Slot : std::uint8_t {
-  f64,       // double: the sum (mean), the value (max, min, last), the first value (majority)
-  sum_u32,   // mean of whole numbers in [0, 65535]: the sum's low 32 bits (carries beside)
-  small_u8,  // max, min, last, majority of whole numbers in [0, 255]
-  small_u16  // the same in [0, 65535]
+  f64,          // double: the sum (mean), the value (max, min, last), the first value (majority)
+  sum_u32,      // mean of whole numbers in [0, 65535]: the sum's low 32 bits (carries beside)
+  small_u8,     // max, min, last, majority of whole numbers in [0, 255]
+  small_u16,    // the same in [0, 65535]
+  sum_f64_nans  // mean with points without a value: the sum (double), then how many were NaN (u32)
 };
 
 std::size_t slot_bytes(Slot s) noexcept {
   switch (s) {
+    case Slot::sum_f64_nans:
+      return 12;
     case Slot::f64: return 8;
     case Slot::sum_u32: return 4;
     case Slot::small_u16: return 2;
@@ -72,6 +77,12 @@ bool all_whole(const double* v, std::size_t n, double hi) noexcept {
     ok &= in && static_cast<double>(static_cast<std::uint32_t>(in ? x : 0.0)) == x;
   }
   return ok;
+}
+
+bool any_nan(const double* v, std::size_t n) noexcept {
+  bool nan = false;
+  for (std::size_t i = 0; i < n; ++i) nan |= std::isnan(v[i]);
+  return nan;
 }
 
 bool fits(Slot s, const double* v, std::size_t n) noexcept {
@@ -226,7 +237,7 @@ struct VoxelReducer::State {
     // x86-64), then the narrow slots, widest first.
     offset.assign(specs.size(), 0);
     std::size_t next = 4;
-    for (const std::size_t width : {8, 4, 2, 1})
+    for (const std::size_t width : {12, 8, 4, 2, 1})
       for (std::size_t a = 0; a < specs.size(); ++a)
         if (slot_bytes(slot[a]) == width) offset[a] = next, next += width;
     stride = next;
@@ -234,7 +245,9 @@ struct VoxelReducer::State {
 
   double slot_value(const std::byte* row, std::size_t a, std::uint64_t rank) const {
     switch (slot[a]) {
-      case Slot::f64: return load<double>(row + offset[a]);
+      case Slot::f64:
+      case Slot::sum_f64_nans:
+        return load<double>(row + offset[a]);
       case Slot::sum_u32: {
         std::uint64_t sum = load<std::uint32_t>(row + offset[a]);
         if (!carries[a].empty()) {
@@ -248,14 +261,15 @@ struct VoxelReducer::State {
     }
   }
 
-  // Attribute a's slots become doubles holding the same partials (voxels without points
-  // keep zero bytes: their slots are written before they are read).
-  void widen(std::size_t a) {
+  // Attribute a's slots become `wider` (f64, or sum_f64_nans for a mean) holding the same
+  // partials, no NaN counted yet (voxels without points keep zero bytes: their slots are
+  // written before they are read).
+  void widen(std::size_t a, Slot wider) {
     State next;
     next.specs = specs;
     next.voxels = voxels;
     next.slot = slot;
-    next.slot[a] = Slot::f64;
+    next.slot[a] = wider;
     next.layout();
     next.rows = RowMemory(next.stride * voxels);
     for (std::uint64_t v = 0; v < voxels; ++v) {
@@ -265,8 +279,12 @@ struct VoxelReducer::State {
       if (count == 0) continue;
       put(to, count);
       for (std::size_t b = 0; b < specs.size(); ++b) {
-        if (b == a) put(to + next.offset[b], slot_value(from, b, v));
-        else std::memcpy(to + next.offset[b], from + offset[b], slot_bytes(slot[b]));
+        if (b == a) {
+          put(to + next.offset[b], slot_value(from, b, v));
+          if (next.slot[b] == Slot::sum_f64_nans) put(to + next.offset[b] + 8, std::uint32_t{0});
+        } else {
+          std::memcpy(to + next.offset[b], from + offset[b], slot_bytes(slot[b]));
+        }
       }
     }
     slot = std::move(next.slot);
@@ -332,16 +350,29 @@ inline void update_majority(std::byte* p, V v, bool first, Others& others, std::
 
 // What one attribute does per point, resolved once per call.
 enum class Op : std::uint8_t {
-  f64_mean, f64_max, f64_min, f64_last, f64_majority,
+  f64_mean,
+  f64_max,
+  f64_min,
+  f64_last,
+  f64_majority,
+  f64_mean_nans,
   u32_sum,
-  u8_max, u8_min, u8_last, u8_majority,
-  u16_max, u16_min, u16_last, u16_majority
+  u8_max,
+  u8_min,
+  u8_last,
+  u8_majority,
+  u16_max,
+  u16_min,
+  u16_last,
+  u16_majority
 };
 
 Op op_of(Slot s, Reduction r) noexcept {
   const int k = r == Reduction::max ? 1 : r == Reduction::min ? 2 : r == Reduction::last ? 3 : r == Reduction::majority ? 4 : 0;
   switch (s) {
     case Slot::f64: return static_cast<Op>(static_cast<int>(Op::f64_mean) + k);
+    case Slot::sum_f64_nans:
+      return Op::f64_mean_nans;
     case Slot::sum_u32: return Op::u32_sum;
     case Slot::small_u8: return static_cast<Op>(static_cast<int>(Op::u8_max) + k - 1);
     default: return static_cast<Op>(static_cast<int>(Op::u16_max) + k - 1);
@@ -357,6 +388,15 @@ inline void fold(Op op, std::byte* p, double v, bool first, std::uint64_t rank, 
     case Op::f64_max: update_f64<Reduction::max>(p, v, first); break;
     case Op::f64_min: update_f64<Reduction::min>(p, v, first); break;
     case Op::f64_last: put(p, v); break;
+    case Op::f64_mean_nans: {
+      const std::uint32_t nan = std::isnan(v) ? 1 : 0;
+      const double x = detail::mean_summand(v);
+      if (first)
+        put(p, x), put(p + 8, nan);
+      else
+        put(p, load<double>(p) + x), put(p + 8, load<std::uint32_t>(p + 8) + nan);
+      break;
+    }
     case Op::f64_majority: {
       if (first) put(p, v);
       else if (const double f = load<double>(p); !detail::same_value(f, v)) ++others[PairKey{rank, bits_of(v)}];
@@ -411,9 +451,16 @@ void VoxelReducer::add_now(std::span<const std::uint64_t> ranks, std::span<const
   if (s.specs.empty()) return;
   check_ranks(ranks);
   // A value a narrow slot cannot hold widens the attribute first (before any count of
-  // this call is taken, so the widened partials are those of the earlier points).
-  for (std::size_t a = 0; a < s.specs.size(); ++a)
-    if (s.slot[a] != Slot::f64 && !fits(s.slot[a], values[a].data(), ranks.size())) s.widen(a);
+  // this call is taken, so the widened partials are those of the earlier points), and a
+  // mean's first NaN widens it to count them.
+  for (std::size_t a = 0; a < s.specs.size(); ++a) {
+    if (s.specs[a].reduction == Reduction::mean && s.slot[a] != Slot::sum_f64_nans &&
+        any_nan(values[a].data(), ranks.size()))
+      s.widen(a, Slot::sum_f64_nans);
+    else if (s.slot[a] != Slot::f64 && s.slot[a] != Slot::sum_f64_nans &&
+             !fits(s.slot[a], values[a].data(), ranks.size()))
+      s.widen(a, Slot::f64);
+  }
 
   struct Column {
     Op op;
@@ -499,6 +546,13 @@ inline double field_value(const RecordField& f, const std::uint8_t* p) noexcept 
   return f.scaled ? x * f.scale + f.add : x;
 }
 
+// Whether a field's decoded value can be NaN: a float, a no_data value, or a scale or
+// offset that is not a finite number.
+bool may_be_nan(const RecordField& f) noexcept {
+  return f.kind == Kind::f32 || f.kind == Kind::f64 || f.has_no_data ||
+         (f.scaled && (!std::isfinite(f.scale) || !std::isfinite(f.add)));
+}
+
 // The largest value of a field that is a whole number in a known range (u8 or u16, no
 // scale or offset), or -1.
 double whole_field_max(const RecordField& f) noexcept {
@@ -539,16 +593,23 @@ void VoxelReducer::add_fields(std::span<const std::uint64_t> ranks, std::span<co
   std::vector<RecordField> fields;
   for (const FieldColumn& c : columns) fields.push_back(c.field);
   // A narrow slot takes a whole-number field whose range it holds as is; any other field
-  // is checked value by value first (and widens the slot as add() would).
+  // is checked value by value first (and widens the slot as add() would), and so is a
+  // mean's field that can be NaN, whose first NaN widens it to count them.
   std::vector<double> check;
   for (std::size_t a = 0; a < na; ++a) {
-    if (s.slot[a] == Slot::f64) continue;
+    const bool narrow = s.slot[a] != Slot::f64 && s.slot[a] != Slot::sum_f64_nans;
     const double top = whole_field_max(fields[a]);
     const double hi = s.slot[a] == Slot::small_u8 ? 255.0 : 65535.0;
-    if (top >= 0.0 && top <= hi) continue;
+    const bool narrow_unsure = narrow && !(top >= 0.0 && top <= hi);
+    const bool nan_unsure =
+        s.specs[a].reduction == Reduction::mean && s.slot[a] != Slot::sum_f64_nans && may_be_nan(fields[a]);
+    if (!narrow_unsure && !nan_unsure) continue;
     check.resize(n);
     for (std::size_t i = 0; i < n; ++i) check[i] = field_value(fields[a], record_of(columns[a], i) + fields[a].offset);
-    if (!fits(s.slot[a], check.data(), n)) s.widen(a);
+    if (nan_unsure && any_nan(check.data(), n))
+      s.widen(a, Slot::sum_f64_nans);
+    else if (narrow_unsure && !fits(s.slot[a], check.data(), n))
+      s.widen(a, Slot::f64);
   }
 
   // Per attribute, what a point does: whole-number fields into narrow slots fold as
@@ -566,8 +627,13 @@ void VoxelReducer::add_fields(std::span<const std::uint64_t> ranks, std::span<co
     RecordField f = fields[a];
     const std::uint8_t* data = columns[a].data + f.offset;
     f.offset = 0;
-    cols[a] = {op_of(s.slot[a], s.specs[a].reduction), s.slot[a] != Slot::f64 && whole_field_max(f) >= 0.0,
-               static_cast<std::uint32_t>(s.offset[a]), f, data, columns[a].stride};
+    const bool narrow = s.slot[a] != Slot::f64 && s.slot[a] != Slot::sum_f64_nans;
+    cols[a] = {op_of(s.slot[a], s.specs[a].reduction),
+               narrow && whole_field_max(f) >= 0.0,
+               static_cast<std::uint32_t>(s.offset[a]),
+               f,
+               data,
+               columns[a].stride};
   }
 
   std::byte* const base = s.rows.data();
@@ -680,6 +746,15 @@ void VoxelReducer::finish_range(std::uint64_t first, std::uint64_t last, std::sp
         };
         switch (s.slot[a]) {
           case Slot::f64: run([](const std::byte* p, std::uint64_t) { return load<double>(p); }); break;
+          case Slot::sum_f64_nans:  // the sum over the points with a value
+            for (std::uint64_t v = first; v < last; ++v) {
+              const std::byte* slot = rows + v * stride;
+              const std::uint32_t count = load<std::uint32_t>(slot - s.offset[a]);
+              const double value =
+                  count == 0 ? 0.0 : detail::finish(r, load<double>(slot), count - load<std::uint32_t>(slot + 8));
+              detail::store_as<T>(to + (v - first) * sizeof(T), value);
+            }
+            break;
           case Slot::sum_u32:
             if (s.carries[a].empty())
               run([](const std::byte* p, std::uint64_t) { return static_cast<double>(load<std::uint32_t>(p)); });

@@ -181,6 +181,21 @@ TEST(LasVariants, ExtraBytesNoDataReadsAsNaN) {
   EXPECT_EQ(values.back()[3], 3.0);
   EXPECT_TRUE(fields.back().has_no_data);
   EXPECT_EQ(fields.back().no_data, -9999.0);
+
+  // A voxel's mean is over its points with data: all ten points in one voxel, points 0
+  // and 5 without data, so (1 + 2 + 3 + 4 + 6 + 7 + 8 + 9) / 8. With payloads too (the
+  // StreamBuilder path).
+  for (const bool payload : {false, true}) {
+    reader.rewind();
+    vola::BuildOptions options;
+    options.quantization = vola::Quantization::grid;
+    options.voxel_size = 100.0;
+    const vola::Tree tree = vola::io::build_las(reader, options, true, payload, nullptr);
+    ASSERT_EQ(tree.voxel_count(), 1u);
+    const auto* column = tree.attributes().find("d");
+    ASSERT_NE(column, nullptr);
+    EXPECT_EQ(column->get(0), 5.0) << "payload " << payload;
+  }
 }
 
 TEST(LasVariants, KeysAndWktTheGlobalEncodingBitChooses) {

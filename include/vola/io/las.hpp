@@ -41,8 +41,8 @@ struct LasExtraField {
   std::uint32_t size = 0;
   double scale = 1.0, add = 0.0;
   // Options bit 0: this stored value (before scale and offset) means "no data"; such
-  // values are read as NaN, which max, min and summaries skip (a voxel mean over one is
-  // NaN: means do not skip NaN).
+  // values are read as NaN (a point without a value), which means, max, min and
+  // summaries skip.
   std::optional<double> no_data;
 };
 
