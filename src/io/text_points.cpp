@@ -273,8 +273,8 @@ std::optional<TextHeader> read_header_line(const std::string& path, int skip_lin
     const std::size_t mark = byte_order_mark(rest, number);
     rest.remove_prefix(mark);
     offset += mark;
-    while (!rest.empty() && is_separator(rest.front(), false)) rest.remove_prefix(1);
-    if (rest.empty()) continue;
+    if (std::all_of(rest.begin(), rest.end(), [](char c) { return is_separator(c, false); })) continue;  // blank
+    while (rest.front() == ' ' || rest.front() == '\t') rest.remove_prefix(1);  // a leading comma is an empty name
     TextHeader header;
     header.line = number;
     header.offset = offset;
@@ -283,15 +283,39 @@ std::optional<TextHeader> read_header_line(const std::string& path, int skip_lin
     names.clear();
     bool all_names = true;
     const bool decimal_comma = uses_decimal_comma(rest);
-    for (std::size_t i = 0; i < rest.size();) {
-      while (i < rest.size() && is_separator(rest[i], decimal_comma)) ++i;
-      const std::size_t end = field_end(rest, i, decimal_comma);
-      if (end > i) {
-        const std::string_view word = unquoted(rest.substr(i, end - i));
-        all_names = all_names && !word.empty() && !is_number(word, decimal_comma);
+    if (!header.comment && !decimal_comma && rest.find(',') != std::string_view::npos) {
+      // A CSV header: one name between each two commas, an empty one too (pandas writes
+      // its unnamed index column first, ",x,y,z", and R `"","x","y","z"`): skipping it
+      // as a run of separators put every name one column to the left of its values.
+      const std::string_view line_text = rest;
+      for (std::size_t i = 0; i <= line_text.size();) {
+        std::size_t end = i;
+        if (end < line_text.size() && (line_text[end] == '"' || line_text[end] == '\'')) {
+          const std::size_t close = line_text.find(line_text[end], end + 1);
+          if (close != std::string_view::npos) end = close + 1;
+        }
+        end = std::min(line_text.find(',', end), line_text.size());
+        std::string_view word = line_text.substr(i, end - i);
+        while (!word.empty() && is_separator(word.front(), true)) word.remove_prefix(1);
+        while (!word.empty() && is_separator(word.back(), true)) word.remove_suffix(1);
+        word = unquoted(word);
+        all_names = all_names && (word.empty() || !is_number(word, false));
         names.emplace_back(word);
+        i = end + 1;
       }
-      i = end;
+      while (!names.empty() && names.back().empty()) names.pop_back();  // "x,y,z," ends with a separator
+      all_names = all_names && std::any_of(names.begin(), names.end(), [](const std::string& n) { return !n.empty(); });
+    } else {
+      for (std::size_t i = 0; i < rest.size();) {
+        while (i < rest.size() && is_separator(rest[i], decimal_comma)) ++i;
+        const std::size_t end = field_end(rest, i, decimal_comma);
+        if (end > i) {
+          const std::string_view word = unquoted(rest.substr(i, end - i));
+          all_names = all_names && !word.empty() && !is_number(word, decimal_comma);
+          names.emplace_back(word);
+        }
+        i = end;
+      }
     }
     const bool named = all_names && !names.empty();
     if (header.comment) {

@@ -55,6 +55,23 @@ TEST(TextHeader, PdalsQuotedCsvNamesEveryColumn) {
   EXPECT_EQ(column(cloud, "red").type, vola::ValueType::u16);
 }
 
+// pandas' DataFrame.to_csv writes its unnamed index column first (",x,y,z,..."), R's
+// write.csv the same quoted (`"","x","y","z"`): the empty name is a column of its own,
+// unread. Skipping it as a separator once put x on the index, y on x, z on y.
+TEST(TextHeader, AnEmptyCsvNameIsAnUnnamedColumn) {
+  TempDir dir;
+  const std::string rows = "0,1.5,2.25,3.0,0\n1,4,5.5,6.75,10\n";
+  for (const std::string& head :
+       {std::string(",x,y,z,intensity\n"), std::string("\"\",\"x\",\"y\",\"z\",\"intensity\"\n"),
+        std::string("index, x, y, z, intensity,\n")}) {
+    SCOPED_TRACE(head);
+    const auto cloud = read_text(dir, head + rows);
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_EQ(cloud.xyz, (std::vector<double>{1.5, 2.25, 3.0, 4, 5.5, 6.75}));
+    EXPECT_EQ(column(cloud, "intensity").values, (std::vector<double>{0, 10}));
+  }
+}
+
 // Identifiers and labels are reduced by majority, as classes are: lidR's treeID, PDAL's
 // EPT OriginId, segmentation output; the mean of two tree ids is a third tree. A name
 // that merely ends in "id" (geoid, centroid) is a measurement and keeps the mean.
