@@ -160,6 +160,13 @@ TEST_P(DensePayload, FilesFollowTheReferenceRuleAndReadBackPerWord) {
     const std::size_t w = static_cast<std::size_t>((v[0] + s * v[1] + s * s * v[2]) / 64);
     ASSERT_EQ(back.voxel_payload(to_voxel(v)), expected[leaf_payload + w]);
   }
+  // Written dense again, the same bytes: the coarse words are kept as read, since a
+  // voxel's payload (its run's word) cannot give them back where some point's payload
+  // is 0 (one in four here).
+  EXPECT_EQ(vola::serialize(back, {.layout = vola::Layout::dense}), bytes);
+  vola::Tree changed = back;
+  changed.set_voxel_payloads(std::vector<std::uint64_t>(back.voxel_payloads().begin(), back.voxel_payloads().end()));
+  EXPECT_TRUE(changed.dense_coarse_payloads().empty());  // new payloads: the coarse words follow them
 }
 
 INSTANTIATE_TEST_SUITE_P(Depths, Payload, ::testing::Values(1, 2, 3, 5, 8, 10),

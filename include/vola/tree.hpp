@@ -199,8 +199,16 @@ class Tree {
   // occupancy_state needs payload words (InvalidArgument otherwise).
   void set_payload_meaning(PayloadMeaning meaning);
   std::span<const std::uint64_t> voxel_payloads() const noexcept { return voxel_payloads_; }
-  // One payload per voxel in rank order (size voxel_count()).
+  // One payload per voxel in rank order (size voxel_count()). Drops the dense file's
+  // coarse payload words (below): they described the payloads before.
   void set_voxel_payloads(std::vector<std::uint64_t> payloads);
+  // A tree read from a dense file keeps the payload words of its coarse levels (levels
+  // 0 .. depth-2, each level's words in the dense layout, one after another): each is the
+  // payload of the greatest voxel with a non-zero payload in its cells, which per-voxel
+  // payloads cannot give back (a voxel read from a dense file has its 64-cell run's
+  // word, not its own point's payload), so that writing the tree dense again keeps them.
+  std::span<const std::uint64_t> dense_coarse_payloads() const noexcept { return dense_coarse_payloads_; }
+  void set_dense_coarse_payloads(std::vector<std::uint64_t> words) { dense_coarse_payloads_ = std::move(words); }
 
  private:
   struct Location {
@@ -342,6 +350,7 @@ class Tree {
   std::optional<Frame> frame_;
   Attributes attributes_;
   std::vector<std::uint64_t> voxel_payloads_;
+  std::vector<std::uint64_t> dense_coarse_payloads_;
   PayloadMeaning payload_meaning_ = PayloadMeaning::reference;
 };
 

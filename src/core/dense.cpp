@@ -1,5 +1,7 @@
 #include "dense.hpp"
 
+#include <algorithm>
+
 #include "emit.hpp"
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
@@ -20,6 +22,13 @@ std::uint64_t dense_level_offset(int level, bool payload) noexcept {
   for (int l = 0; l < level; ++l) at += dense_level_words(l) * (payload ? 2 : 1);
   return at;
 }
+
+// Payload words of the levels above the leaf level (Tree::dense_coarse_payloads).
+std::size_t coarse_payload_words(int depth) noexcept {
+  std::size_t words = 0;
+  for (int l = 0; l + 1 < depth; ++l) words += dense_level_words(l);
+  return words;
+}
 }  // namespace
 
 std::uint64_t dense_body_words(int depth, bool payload) noexcept { return dense_level_offset(depth, payload); }
@@ -36,6 +45,16 @@ std::vector<std::uint64_t> encode_dense(const Tree& tree) {
     });
   }
   if (!payload) return body;
+  // A tree read from a dense file gives its coarse levels' words back as read.
+  const std::span<const std::uint64_t> kept = tree.dense_coarse_payloads();
+  const int computed_from = kept.size() == coarse_payload_words(depth) ? depth - 1 : 0;
+  std::size_t at = 0;
+  for (int level = 0; level < computed_from; ++level) {
+    const std::uint64_t n = dense_level_words(level);
+    std::copy_n(kept.begin() + static_cast<std::ptrdiff_t>(at), n,
+                body.begin() + static_cast<std::ptrdiff_t>(dense_level_offset(level, true) + n));
+    at += n;
+  }
   // Payload of a dense word: that of the lexicographically greatest (x, y, z) voxel
   // with a non-zero payload among the voxels whose level-L cell lies in the word.
   // Voxels come in key order, so keep the best order seen per word.
@@ -51,7 +70,7 @@ std::vector<std::uint64_t> encode_dense(const Tree& tree) {
       const std::uint64_t p = tree.voxel_payload_at_rank(rank++, block);
       if (p == 0) continue;
       const std::uint64_t order = ((std::uint64_t{v.x} << 40) | (std::uint64_t{v.y} << 20) | v.z) + 1;
-      for (int level = 0; level < depth; ++level) {
+      for (int level = computed_from; level < depth; ++level) {
         const int shift = 2 * (depth - 1 - level);
         const std::uint64_t w = dense_index(Voxel{v.x >> shift, v.y >> shift, v.z >> shift}, level) >> 6;
         if (order > best[level][w]) {
@@ -93,7 +112,16 @@ Tree decode_dense(std::span<const std::uint64_t> words, int depth, bool payload,
     for (std::size_t i = 0; i < keys.size(); ++i) voxel_payloads[i] = word_payload[order[i]];
   }
   Tree tree = emit_levels(keys, depth, voxel_payloads, payload);
-  if (payload) tree.set_voxel_payloads(std::move(voxel_payloads));
+  if (payload) {
+    tree.set_voxel_payloads(std::move(voxel_payloads));
+    std::vector<std::uint64_t> coarse;
+    coarse.reserve(coarse_payload_words(depth));
+    for (int level = 0; level + 1 < depth; ++level) {
+      const std::uint64_t* at = words.data() + dense_level_offset(level, true) + dense_level_words(level);
+      coarse.insert(coarse.end(), at, at + dense_level_words(level));
+    }
+    tree.set_dense_coarse_payloads(std::move(coarse));
+  }
 
   for (int level = 0; level + 1 < depth; ++level) {
     const std::uint64_t* occupancy = words.data() + dense_level_offset(level, payload);

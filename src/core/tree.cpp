@@ -286,6 +286,7 @@ void Tree::set_voxel_payloads(std::vector<std::uint64_t> payloads) {
     VOLA_THROW(InvalidArgument("voxel payloads: " + std::to_string(payloads.size()) + " values for " +
                           std::to_string(voxel_count()) + " voxels"));
   voxel_payloads_ = std::move(payloads);
+  dense_coarse_payloads_.clear();
 }
 
 void Tree::set_payload_meaning(PayloadMeaning meaning) {
