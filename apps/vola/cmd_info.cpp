@@ -1,6 +1,8 @@
 // vola info: what a .vol file holds, level by level (and what a LAS/LAZ/COPC file says).
 #include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <optional>
 #include <string>
 
@@ -120,21 +122,39 @@ void run_info(const InfoArgs& a) {
   const NamedCrs crs = name_crs(tree);
   std::optional<map::StateCounts> states;
   if (map::is_state_map(tree)) states = map::state_counts(tree);
+  // The words a level takes in the file: every dense word, or the sparse tree's blocks.
+  const auto file_blocks = [&](int l) {
+    return h.layout == Layout::dense ? (std::size_t{1} << (6 * l)) : tree.occupancy(l).size();
+  };
   if (a.json) {
-    std::printf("{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
-                "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %.17g,\n"
-                "  \"lon\": %.17g,\n  \"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g],\n"
-                "  \"voxels\": %llu,\n  \"bits_per_voxel\": %.4f,\n  \"quantization\": \"%s\",\n"
-                "  \"voxel_size\": %.17g,\n  \"origin\": [%.17g, %.17g, %.17g],\n  \"levels\": [",
-                quoted(a.file).c_str(), static_cast<unsigned long long>(layout.file_size), h.version, mode,
-                tree.depth(), tree.side(), h.nbits, h.epsg, h.lat, h.lon, h.bbox.min[0], h.bbox.min[1],
-                h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2],
-                static_cast<unsigned long long>(tree.voxel_count()), bits,
-                frame.quantization == Quantization::grid ? "grid" : "toolkit", frame.voxel_size, frame.origin[0],
-                frame.origin[1], frame.origin[2]);
+    // JSON has no infinity or NaN: a reference file may hold them (PROJ's lat/lon of a
+    // centre it cannot place is inf; a "nan" input line makes a NaN bbox), printed as null.
+    const auto real = [](double v) {
+      if (!std::isfinite(v)) return std::string("null");
+      char text[32];
+      std::snprintf(text, sizeof text, "%.17g", v);
+      return std::string(text);
+    };
+    const auto reals = [&](std::initializer_list<double> values) {
+      std::string out;
+      for (const double v : values) out += (out.empty() ? "" : ", ") + real(v);
+      return out;
+    };
+    std::printf(
+        "{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
+        "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %s,\n"
+        "  \"lon\": %s,\n  \"bbox\": [%s],\n"
+        "  \"voxels\": %llu,\n  \"bits_per_voxel\": %.4f,\n  \"quantization\": \"%s\",\n"
+        "  \"voxel_size\": %s,\n  \"origin\": [%s],\n  \"levels\": [",
+        quoted(a.file).c_str(), static_cast<unsigned long long>(layout.file_size), h.version, mode, tree.depth(),
+        tree.side(), h.nbits, h.epsg, real(h.lat).c_str(), real(h.lon).c_str(),
+        reals({h.bbox.min[0], h.bbox.min[1], h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2]}).c_str(),
+        static_cast<unsigned long long>(tree.voxel_count()), bits,
+        frame.quantization == Quantization::grid ? "grid" : "toolkit", real(frame.voxel_size).c_str(),
+        reals({frame.origin[0], frame.origin[1], frame.origin[2]}).c_str());
     for (int l = 0; l < tree.depth(); ++l)
-      std::printf("%s\n    {\"level\": %d, \"blocks\": %zu, \"occupied\": %llu}", l ? "," : "", l,
-                  tree.occupancy(l).size(), static_cast<unsigned long long>(tree.node_count(l)));
+      std::printf("%s\n    {\"level\": %d, \"blocks\": %zu, \"occupied\": %llu}", l ? "," : "", l, file_blocks(l),
+                  static_cast<unsigned long long>(tree.node_count(l)));
     std::printf("\n  ],\n  \"attributes\": [");
     const auto& columns = tree.attributes().columns();
     for (std::size_t i = 0; i < columns.size(); ++i)
@@ -181,7 +201,7 @@ void run_info(const InfoArgs& a) {
                 static_cast<unsigned long long>(tree.voxel_count()), bits);
   std::printf("levels:      level  blocks      occupied cells  bytes\n");
   for (int l = 0; l < tree.depth(); ++l) {
-    const std::size_t blocks = h.layout == Layout::dense ? (std::size_t{1} << (6 * l)) : tree.occupancy(l).size();
+    const std::size_t blocks = file_blocks(l);
     std::printf("             %-5d  %-10zu  %-14llu  %llu\n", l, blocks,
                 static_cast<unsigned long long>(tree.node_count(l)),
                 static_cast<unsigned long long>(8 * blocks * (h.nbits ? 2 : 1)));

@@ -181,6 +181,26 @@ assert d['summary']['points_read'] == 2130 and d['crs']['epsg'] == 32610, d
 "$vola" coords "$tmp/ept_root.vol" 2>/dev/null | cmp -s - <("$vola" coords "$tmp/simple.vol" 2>/dev/null) ||
   fail "EPT --level 0: not the root node's voxels"
 
+# A .vol whose header holds what JSON cannot write: the reference writes PROJ's lat/lon of
+# a centre it cannot place (inf) and a NaN bbox from a "nan" input line. They print as
+# null; a dense file's levels count its words, as the text report does.
+printf '0 0 0\n5 6 7\n' > "$tmp/two.xyz"
+"$vola" convert "$tmp/two.xyz" "$tmp/two.dvol" --quantize toolkit --depth 2 --dense -q || fail "convert two.xyz dense"
+"${VOLA_PYTHON:-python3}" -c "
+import struct, sys
+b = bytearray(open(sys.argv[1], 'rb').read())
+b[16:40] = struct.pack('<3d', float('inf'), float('-inf'), float('nan'))  # lat, lon, min x
+open(sys.argv[1], 'wb').write(b)
+" "$tmp/two.dvol"
+"$vola" info --json "$tmp/two.dvol" > "$tmp/two.json" || fail "info --json on a header with inf and NaN"
+"${VOLA_PYTHON:-python3}" -c "
+import json, sys
+d = json.loads(open(sys.argv[1]).read(), parse_constant=lambda c: sys.exit('not JSON: ' + c))
+assert d['lat'] is None and d['lon'] is None and d['bbox'][0] is None and d['bbox'][1] == 0, d
+assert [l['blocks'] for l in d['levels']] == [1, 64], d['levels']
+" "$tmp/two.json" || fail "info --json with inf and NaN: $(cat "$tmp/two.json")"
+"$vola" info "$tmp/two.dvol" | grep -q "^ *1 *64 " || fail "info: dense level 1's words: $("$vola" info "$tmp/two.dvol")"
+
 # E57: the scans as the XML states them, invalid points said, and a conversion of the points.
 if [ -n "$e57_writer" ]; then
   "$e57_writer" --write-corpus "$tmp/e57" > /dev/null || fail "could not write the E57 files"
