@@ -18,7 +18,13 @@ laspy_simple1_4.las (LAS 1.4 with GeoTIFF keys and a WKT record, global encoding
 clear: the keys are the CRS, by the specification; the WKT record won before) and of
 pdal_extrabytes.las (its extra-bytes field "Intensity" is now the column "Intensity_2",
 apart from the record's intensity) were recorded again; their voxels and values are the
-same (`vola voxels` and `vola info` of both builds' files compared).
+same (`vola voxels` and `vola info` of both builds' files compared). Later on 2026-11-29 the
+four cases of trimesh_ballA.off and modelnet's bathtub_0001.off were recorded again, when
+vola began to read OFF itself, in double precision, instead of through Assimp's 32-bit
+floats: the header's bbox now holds the file's decimals (-10.9128, not -10.912799835...);
+bathtub's voxels are the same, ballA's differ by one voxel of 306,792 at depth 4 (a
+vertex on a cell boundary, checked by converting a copy of the file with its coordinates
+rounded to 32-bit floats: the old voxels again).
 
   convert_equivalence.py --vola build/apps/vola/vola --c-tool build/tests/capi_convert_tool \
       --python-path build/python [--front-ends cli,python,c] [--write-manifest]

@@ -169,7 +169,7 @@ std::vector<InputFormat> make_formats() {
       {"binvox", {".binvox"}, "binvox occupancy grids", read_binvox_input},
       {"mesh",
        {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"},
-       "meshes through Assimp: STL, OBJ, OFF, glTF, COLLADA, 3DS",
+       "meshes: STL and OFF (vola), OBJ, glTF, COLLADA, 3DS (Assimp)",
        read_mesh_input},
       {"dem",
        {".tif", ".tiff", ".dem", ".img"},

@@ -13,8 +13,9 @@
 
 #include "column_names.hpp"
 #include "file_bytes.hpp"
-#include "point_colours.hpp"
 #include "header_words.hpp"
+#include "point_colours.hpp"
+#include "polygon_triangles.hpp"
 #include "vola/error.hpp"
 #include "vola/little_endian.hpp"
 
@@ -342,7 +343,8 @@ std::uint64_t whole_number(In& in, double v, const char* what) {
 }
 
 struct Mesh {
-  std::vector<std::uint32_t> corners;  // three vertex indices per triangle
+  std::vector<std::uint32_t> corners;  // the vertex indices of every polygon, one after another
+  std::vector<std::uint32_t> sizes;    // the corners of each polygon (3 or more)
 };
 
 template <class In>
@@ -419,9 +421,12 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
                     std::to_string(vertex->count));
           polygon.push_back(static_cast<std::uint32_t>(index));
         }
-        // A polygon of n corners becomes the fan (0, k, k+1); fewer than 3 corners make no triangle.
-        for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
-          mesh.corners.insert(mesh.corners.end(), {polygon[0], polygon[k], polygon[k + 1]});
+        // Polygons are cut into triangles once every vertex is read (a face element may
+        // come first); fewer than 3 corners make no triangle.
+        if (polygon.size() >= 3) {
+          mesh.corners.insert(mesh.corners.end(), polygon.begin(), polygon.end());
+          mesh.sizes.push_back(static_cast<std::uint32_t>(polygon.size()));
+        }
       }
       if (&e == vertex) {
         out.cloud.xyz.insert(out.cloud.xyz.end(), {v[0], v[1], v[2]});
@@ -473,14 +478,20 @@ Input parse_ply(std::span<const std::uint8_t> bytes, const std::string& name, co
     read_body(in, h, options, out, mesh, remaining);
   }
   const auto& xyz = out.cloud.xyz;
-  out.triangles.reserve(mesh.corners.size() / 3);
-  for (std::size_t t = 0; t + 2 < mesh.corners.size(); t += 3) {
-    Triangle tri;
-    for (int c = 0; c < 3; ++c) {
-      const std::size_t v = mesh.corners[t + static_cast<std::size_t>(c)];
-      tri[static_cast<std::size_t>(c)] = {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
+  out.triangles.reserve(mesh.corners.size() - 2 * mesh.sizes.size());
+  std::vector<Point> polygon;
+  std::vector<std::array<std::uint32_t, 3>> cut;
+  std::size_t at = 0;
+  for (const std::uint32_t n : mesh.sizes) {
+    polygon.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t v = mesh.corners[at + k];
+      polygon.push_back({xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
     }
-    out.triangles.push_back(tri);
+    at += n;
+    cut.clear();
+    triangulate_polygon(polygon, cut);  // concave polygons by their ears (polygon_triangles.hpp)
+    for (const auto& t : cut) out.triangles.push_back({polygon[t[0]], polygon[t[1]], polygon[t[2]]});
   }
   if (options.progress) options.progress(bytes.size(), bytes.size());
   return out;

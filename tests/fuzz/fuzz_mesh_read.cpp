@@ -1,17 +1,20 @@
-// Fuzz entry point of the mesh reader through Assimp (io::read_mesh_with_assimp, what the
-// Assimp plugin runs, compiled into this program): the first byte picks the file kind
-// (STL, OBJ, OFF, COLLADA, glTF: modulo 5; vola reads PLY itself, not through Assimp), the rest is the file, written to a scratch file
-// with that extension. Only vola::Error may escape; what parses must hold at least one
-// and at most kMaxMeshTriangles triangles.
+// Fuzz entry point of the mesh readers: the first byte picks the file kind (STL, OBJ,
+// OFF, COLLADA, glTF: modulo 5; vola reads PLY itself), the rest is the file. OFF and
+// STL go to vola's own readers (io::parse_off, io::parse_stl), the others through Assimp
+// (io::read_mesh_with_assimp, what the Assimp plugin runs, compiled into this program),
+// from a scratch file with that extension. Only vola::Error may escape; what parses must
+// hold at least one and at most kMaxMeshTriangles triangles.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <span>
+#include <vector>
 
 #include "fuzz_seeds.hpp"
+#include "mesh_files.hpp"  // src/io: the OFF and STL readers
+#include "readers.hpp"     // src/io/plugins: the reader itself, not its plugin
 #include "scratch_file.hpp"
 #include "vola/error.hpp"
-#include "readers.hpp"  // src/io/plugins: the reader itself, not its plugin
 #include "vola/io/mesh.hpp"
 
 namespace vola_fuzz {
@@ -22,10 +25,17 @@ const char* const kMeshExtensions[5] = {"stl", "obj", "off", "dae", "gltf"};
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  const std::string path =
-      vola_fuzz::scratch_file("mesh", vola_fuzz::kMeshExtensions[data[0] % 5], std::span(data + 1, size - 1));
+  const int kind = data[0] % 5;
+  const std::span<const std::uint8_t> file(data + 1, size - 1);
   try {
-    const auto triangles = vola::io::read_mesh_with_assimp(path);
+    std::vector<vola::io::Triangle> triangles;
+    if (kind == 0)
+      triangles = vola::io::parse_stl(file, "fuzz.stl");
+    else if (kind == 2)
+      triangles = vola::io::parse_off(file, "fuzz.off");
+    else
+      triangles =
+          vola::io::read_mesh_with_assimp(vola_fuzz::scratch_file("mesh", vola_fuzz::kMeshExtensions[kind], file));
     if (triangles.empty() || triangles.size() > vola::io::kMaxMeshTriangles) std::abort();
   } catch (const vola::Error&) {
     ++vola_fuzz::stats().refused;

@@ -1,5 +1,5 @@
-// Meshes through Assimp: STL (ascii and binary), OBJ, OFF, glTF, COLLADA, 3DS and
-// whatever else Assimp reads when asked by --format mesh.
+// Meshes: OFF and STL (ascii and binary) read by vola (src/io/mesh_files.hpp), OBJ,
+// glTF, COLLADA and 3DS through Assimp.
 #pragma once
 
 #include <cstdint>
@@ -16,8 +16,9 @@ inline constexpr std::uint64_t kMaxMeshTriangles = std::uint64_t{1} << 27;
 // Every face of every mesh the scene's nodes place, with the node transforms applied,
 // polygons triangulated. Lines and points become degenerate triangles (a, b, b) and
 // (a, a, a), so they still voxelize to what they touch; vertices no face uses are left
-// out (they widen no toolkit frame). Assimp stores coordinates as 32-bit floats. Throws FormatError with Assimp's message when it cannot read the
-// file, or when the scene holds no geometry.
+// out (they widen no toolkit frame). Assimp stores coordinates as 32-bit floats, STL
+// defines them so. Throws FormatError (Assimp's message through Assimp) when it cannot
+// read the file, or when the scene holds no geometry; IoError when it cannot open it.
 std::vector<Triangle> read_mesh_triangles(const std::string& path);
 
 }  // namespace vola::io

@@ -14,7 +14,6 @@
 
 #include "../reader_plugin.hpp"
 #include "gltf_draco.hpp"
-#include "off_header.hpp"
 #include "readers.hpp"
 #include "vola/error.hpp"
 #include "vola/io/mesh.hpp"
@@ -47,10 +46,11 @@ Point transform(const Matrix& m, const aiVector3D& v) {
   return p;
 }
 
-// The extensions of the mesh formats vola documents (input.cpp's format table). Assimp
-// reads some forty formats, chosen by extension and then by content; the others
-// (some with references to further files, most never fuzzed here) are not opened.
-constexpr std::array<std::string_view, 7> kMeshExtensions = {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"};
+// The extensions of the mesh formats vola documents (input.cpp's format table) that
+// Assimp reads here (vola reads PLY, OFF and STL itself). Assimp reads some forty
+// formats, chosen by extension and then by content; the others (some with references
+// to further files, most never fuzzed here) are not opened.
+constexpr std::array<std::string_view, 5> kMeshExtensions = {".obj", ".gltf", ".glb", ".dae", ".3ds"};
 
 std::string lowercase_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -62,34 +62,9 @@ void check_mesh_extension(const std::string& path) {
   const std::string ext = lowercase_extension(path);
   if (std::find(kMeshExtensions.begin(), kMeshExtensions.end(), ext) == kMeshExtensions.end())
     throw FormatError(path, std::nullopt,
-                      "meshes are read from .stl, .obj, .off, .gltf, .glb, .dae and .3ds files only, not '" + ext + "'");
-}
-
-// Assimp's OFF importer allocates the header's vertex and face counts before reading
-// them: a 38-byte file made it allocate 8.8 GB. Each vertex or face takes at least two
-// bytes of text, so counts the file cannot hold are refused first, read as Assimp reads
-// them (off_header.hpp).
-void check_off_counts(const std::string& path) {
-  if (lowercase_extension(path) != ".off") return;  // Assimp picks its OFF importer by extension
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream whole;
-  whole << in.rdbuf();
-  if (!in) throw IoError("cannot read " + path);
-  const std::string text = std::move(whole).str();
-  // Assimp converts UTF-16 and UTF-32 text first; OFF is ASCII, so those are refused
-  // rather than parsed differently from Assimp.
-  if (text.starts_with("\xff\xfe") || text.starts_with("\xfe\xff") || text.starts_with(std::string("\0\0\xfe\xff", 4)))
-    throw FormatError(path, 0, "an OFF file in UTF-16 or UTF-32 (OFF is ASCII text)");
-  std::size_t skipped = 0;
-  if (text.starts_with("\xef\xbb\xbf")) skipped = 3;  // the UTF-8 byte order mark, which Assimp drops
-  const auto counts = off_header_counts(std::string_view(text).substr(skipped));
-  if (!counts) return;  // Assimp refuses the header itself
-  const std::uint64_t bytes = text.size();
-  if (counts->vertices > bytes / 2 || counts->faces > bytes / 2 || std::uint64_t{counts->vertices} + counts->faces > bytes / 2)
-    throw FormatError(path, skipped + counts->vertices_at,
-                      "the OFF header declares " + std::to_string(counts->vertices) + " vertices and " +
-                          std::to_string(counts->faces) + " faces (as 32-bit counts), more than the file's " +
-                          std::to_string(bytes) + " bytes can hold");
+                      "meshes are read from .stl, .off, .obj, .gltf, .glb, .dae and .3ds files only (and .ply as "
+                      "points and faces), not '" +
+                          ext + "'");
 }
 
 // Assimp opens whatever files a scene names: a glTF buffer's URI (an absolute path, a
@@ -163,7 +138,6 @@ std::optional<std::string> decoded_draco_scene(const std::string& path) {
 
 std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   check_mesh_extension(path);
-  check_off_counts(path);
   // A glTF with Draco-compressed primitives goes to Assimp with them decoded (gltf_draco.hpp).
   const std::optional<std::string> draco_decoded = decoded_draco_scene(path);
   Assimp::Importer importer;
