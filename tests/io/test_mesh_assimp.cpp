@@ -307,6 +307,14 @@ TEST(MeshAssimp, BadFilesThrowFormatErrorsNamingTheFile) {
     EXPECT_NE(error->cause().find("more than the file's"), std::string::npos) << error->cause();
   }
   expect_error("nothing.obj", "# only a comment\n");
+  // Only the importer of the file's extension reads it: this .gltf went to Assimp's
+  // Quick3D importer (whose signature it begins with), which asked for 1.5 TB.
+  const std::string quick3d("quick3ds\x80\x02\x00\x00\x10\x02\x00\x00JSON{\"asset\":{\"version\":\"2.0\"}}", 47);
+  write_file(dir / "quick3d.gltf", quick3d);
+  const auto not_gltf =
+      vola_test::format_error_of([&] { vola::io::read_mesh_triangles((dir / "quick3d.gltf").string()); });
+  ASSERT_TRUE(not_gltf.has_value());
+  EXPECT_EQ(not_gltf->cause().find("Quick3D"), std::string::npos) << not_gltf->cause();
   EXPECT_THROW(vola::io::read_mesh_triangles((dir / "missing.stl").string()), vola::IoError);
   EXPECT_TRUE(vola_test::format_error_of([&] { vola::io::read_mesh_triangles((dir / "missing.obj").string()); }));
 }

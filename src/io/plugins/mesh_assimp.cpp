@@ -1,14 +1,15 @@
+#include <assimp/BaseImporter.h>
+#include <assimp/DefaultIOSystem.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <algorithm>
 #include <array>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string_view>
-#include <assimp/DefaultIOSystem.h>
-#include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <utility>
 #include <vector>
 
@@ -124,6 +125,22 @@ bool structurally_sound(const aiScene& scene) {
   return true;
 }
 
+// Assimp falls back to any importer whose signature matches when the one of the file's
+// extension refuses it: fuzz_mesh_read found a .gltf beginning "quick3ds" sent to the
+// Quick3D importer, which asked for 1.5 TB. Only the importers of `extension` (no dot)
+// are left registered, so nothing else reads the file.
+void keep_only_importers_of(Assimp::Importer& importer, const std::string& extension) {
+  for (std::size_t i = importer.GetImporterCount(); i-- > 0;) {
+    const aiImporterDesc* info = importer.GetImporterInfo(i);
+    std::istringstream extensions(info && info->mFileExtensions ? info->mFileExtensions : "");
+    bool claims = false;
+    for (std::string e; extensions >> e;) claims = claims || e == extension;
+    if (claims) continue;
+    Assimp::BaseImporter* other = importer.GetImporter(i);
+    if (importer.UnregisterLoader(other) == aiReturn_SUCCESS) delete other;  // the importer owns only those registered
+  }
+}
+
 std::optional<std::string> decoded_draco_scene(const std::string& path) {
   const std::string ext = lowercase_extension(path);
   if (ext != ".gltf" && ext != ".glb") return std::nullopt;
@@ -141,6 +158,7 @@ std::vector<Triangle> read_mesh_with_assimp(const std::string& path) {
   // A glTF with Draco-compressed primitives goes to Assimp with them decoded (gltf_draco.hpp).
   const std::optional<std::string> draco_decoded = decoded_draco_scene(path);
   Assimp::Importer importer;
+  keep_only_importers_of(importer, draco_decoded ? "glb" : lowercase_extension(path).substr(1));
   auto* io = new ConfinedIOSystem(path);
   importer.SetIOHandler(io);  // the importer owns it
   const auto import = [&](unsigned flags) {
