@@ -121,7 +121,11 @@ void run_census(const CensusArgs& a) {
     j["heights"] = histogram_json(c.heights);
     j["attributes"] = nlohmann::json::array();
     for (const auto& at : c.attributes) {
-      nlohmann::json col{{"name", at.name}, {"count", at.count}, {"mean", at.mean}, {"histogram", histogram_json(at.histogram)}};
+      nlohmann::json col{{"name", at.name},
+                         {"count", at.count},
+                         {"without_value", at.without_value},
+                         {"mean", at.mean},
+                         {"histogram", histogram_json(at.histogram)}};
       if (at.name == "classification") {
         col["classes"] = nlohmann::json::array();
         for (const auto& k : at.classes)
@@ -151,8 +155,9 @@ void run_census(const CensusArgs& a) {
   std::printf("  voxel centre z:\n");
   print_histogram(c.heights);
   for (const auto& at : c.attributes) {
-    std::printf("  attribute %s: %llu values, mean %.6g\n", at.name.c_str(), static_cast<unsigned long long>(at.count),
-                at.mean);
+    std::printf("  attribute %s: %llu values, mean %.6g%s\n", at.name.c_str(),
+                static_cast<unsigned long long>(at.count), at.mean,
+                at.without_value ? (" (" + std::to_string(at.without_value) + " voxels without a value)").c_str() : "");
     if (at.name == "classification")
       for (const auto& k : at.classes)
         std::printf("    %3d %-38s %12llu\n", k.code, std::string(analysis::asprs_class_name(k.code)).c_str(),
@@ -175,6 +180,8 @@ void add_census(CLI::App& app) {
       "Volume and footprint area need a GIS grid (vola convert --voxel-size).\n"
       "A state map (vola map) counts its occupied voxels, after a line (JSON: \"states\") with its\n"
       "occupied, free and unknown voxel counts (unknown: within the box of the known voxels).\n"
+      "An attribute's figures are over the voxels with a value: a NaN value (no point of the voxel\n"
+      "had one, a LAS no_data) is counted apart (JSON: \"without_value\").\n"
       "Example: vola census autzen.vol --box 636000,849000,400,637000,850000,500 --json");
   cmd->add_option("file", args->file, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", args->json, "Print JSON instead of a table");

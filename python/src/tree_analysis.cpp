@@ -78,6 +78,7 @@ py::dict census(const Tree& tree, int bins) {
     py::dict d;
     d["name"] = a.name;
     d["count"] = a.count;
+    d["without_value"] = a.without_value;
     d["mean"] = a.mean;
     d["histogram"] = histogram(a.histogram);
     py::list classes;

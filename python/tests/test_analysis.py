@@ -111,3 +111,12 @@ def test_plan_solid_ground_keeps_the_path_out_from_under_a_sheet():
     assert solid["cost"] > free["cost"]
     with pytest.raises(vola.InvalidArgument, match="or the ground"):
         tree.plan((2.5, 8.5, 1.5), (13.5, 8.5, 5.5), solid_ground=True)
+
+
+def test_census_leaves_voxels_without_a_value_out():
+    # NaN is a voxel without a value (a LAS no_data): numpy's figures over the others.
+    tree = vola.build(np.array([[0.5, 0.5, 0.5], [1.5, 0.5, 0.5], [2.5, 0.5, 0.5], [3.5, 0.5, 0.5]]), voxel_size=1.0,
+                      attributes={"deviation": np.array([1.0, np.nan, 3.0, 5.0])})
+    column = tree.census(bins=4)["attributes"][0]
+    assert (column["count"], column["without_value"], column["mean"]) == (3, 1, 3.0)
+    assert list(column["histogram"]["counts"]) == list(np.histogram([1.0, 3.0, 5.0], bins=4)[0])

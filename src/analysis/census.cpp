@@ -22,22 +22,28 @@ std::string_view asprs_class_name(int code) noexcept {
 
 namespace {
 
-// Two passes over `values(i)` for i < n: range, then bins.
+// Two passes over `values(i)` for i < n: range, then bins. NaN (a voxel without a value)
+// is left out of both.
 template <class Values>
 Histogram histogram(std::uint64_t n, int bins, Values values) {
   Histogram h;
   h.counts.assign(static_cast<std::size_t>(bins), 0);
-  if (n == 0) return h;
   h.min = INFINITY;
   h.max = -INFINITY;
   for (std::uint64_t i = 0; i < n; ++i) {
     const double v = values(i);
+    if (std::isnan(v)) continue;
     h.min = std::min(h.min, v);
     h.max = std::max(h.max, v);
+  }
+  if (h.min > h.max) {  // no value at all
+    h.min = h.max = 0.0;
+    return h;
   }
   const double width = (h.max - h.min) / bins;
   for (std::uint64_t i = 0; i < n; ++i) {
     const double v = values(i);
+    if (std::isnan(v)) continue;
     auto bin = width > 0 ? static_cast<std::int64_t>((v - h.min) / width) : 0;
     bin = std::clamp<std::int64_t>(bin, 0, bins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
@@ -105,14 +111,22 @@ Census take_census(const Tree& tree, const CensusOptions& options) {
   for (const AttributeColumn& column : tree.attributes().columns()) {
     AttributeCensus a;
     a.name = column.name();
-    a.count = column.size();
     double sum = 0;
-    for (std::size_t i = 0; i < column.size(); ++i) sum += column.get(i);
+    for (std::size_t i = 0; i < column.size(); ++i) {
+      const double v = column.get(i);
+      if (std::isnan(v))
+        ++a.without_value;
+      else
+        sum += v;
+    }
+    a.count = column.size() - a.without_value;
     a.mean = a.count ? sum / static_cast<double>(a.count) : 0.0;
-    a.histogram = histogram(a.count, options.bins, [&](std::uint64_t i) { return column.get(static_cast<std::size_t>(i)); });
+    a.histogram = histogram(column.size(), options.bins,
+                            [&](std::uint64_t i) { return column.get(static_cast<std::size_t>(i)); });
     if (column.name() == "classification") {
       std::map<int, std::uint64_t> counts;
-      for (std::size_t i = 0; i < column.size(); ++i) ++counts[static_cast<int>(column.get(i))];
+      for (std::size_t i = 0; i < column.size(); ++i)
+        if (const double v = column.get(i); !std::isnan(v)) ++counts[static_cast<int>(v)];
       for (const auto& [code, n] : counts) a.classes.push_back({code, n});
     }
     c.attributes.push_back(std::move(a));

@@ -1,6 +1,8 @@
 // Census and change counts against direct counts over std::set models.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <map>
 #include <numeric>
 
@@ -64,6 +66,34 @@ TEST(Census, ClassificationCountsAndNames) {
   EXPECT_EQ(vola::analysis::asprs_class_name(40), "Reserved");
   EXPECT_DOUBLE_EQ(a.mean, 15.0 / 4);
   EXPECT_FALSE(c.voxel_size);  // no GIS grid recorded
+}
+
+// A voxel whose value is NaN (none of its points had one: a LAS no_data) has no value:
+// left out of the count, the mean and the histogram, counted apart.
+TEST(Census, VoxelsWithoutAValueAreLeftOutOfTheFigures) {
+  vola::Tree t = tree_of({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 3, 3}}, 1);
+  vola::AttributeColumn deviation("deviation", vola::ValueType::f64, vola::Reduction::mean, 4);
+  const double values[] = {1.0, std::nan(""), 3.0, 5.0};
+  for (std::size_t i = 0; i < 4; ++i) deviation.set(i, values[i]);
+  t.attributes().add(std::move(deviation));
+  vola::AttributeColumn none("none", vola::ValueType::f64, vola::Reduction::mean, 4);
+  for (std::size_t i = 0; i < 4; ++i) none.set(i, std::nan(""));
+  t.attributes().add(std::move(none));
+  vola::analysis::CensusOptions options;
+  options.bins = 4;
+  const auto c = vola::analysis::take_census(t, options);
+  const auto& a = c.attributes[0];
+  EXPECT_EQ(a.count, 3u);
+  EXPECT_EQ(a.without_value, 1u);
+  EXPECT_DOUBLE_EQ(a.mean, 3.0);
+  EXPECT_EQ(a.histogram.counts, (std::vector<std::uint64_t>{1, 0, 1, 1}));  // numpy.histogram of 1, 3, 5
+  EXPECT_EQ(a.histogram.min, 1.0);
+  EXPECT_EQ(a.histogram.max, 5.0);
+  const auto& b = c.attributes[1];
+  EXPECT_EQ(b.count, 0u);
+  EXPECT_EQ(b.without_value, 4u);
+  EXPECT_EQ(b.histogram.counts, (std::vector<std::uint64_t>(4, 0)));
+  EXPECT_EQ(b.histogram.min, 0.0);
 }
 
 TEST(Change, CountsMatchTheSets) {

@@ -38,9 +38,10 @@ struct ClassCount {
 
 struct AttributeCensus {
   std::string name;
-  std::uint64_t count = 0;
-  double mean = 0.0;
-  Histogram histogram;             // every column
+  std::uint64_t count = 0;          // voxels with a value
+  std::uint64_t without_value = 0;  // voxels whose value is NaN (no point of theirs had one)
+  double mean = 0.0;                // over the voxels with a value
+  Histogram histogram;              // every column, its values (NaN left out)
   std::vector<ClassCount> classes; // the "classification" column: voxels per code, ascending
 };
 
