@@ -209,14 +209,22 @@ Tree convert(const std::filesystem::path& path, int depth, double voxel_size, co
   options.dense = dense;
   options.compress = compress;
   options.compress_max = compress_max;
-  py::gil_scoped_release release;
-  return with_python_names([&] {
-    Tree tree = vola::convert(path.string(), options, interruptible());
-    if (output) {
-      vola::write(tree, output->string(), vola::write_options_of(options));
-    }
-    return tree;
-  });
+  vola::ConvertReport report;
+  std::optional<Tree> tree;
+  {
+    py::gil_scoped_release release;
+    tree = with_python_names([&] {
+      // The CLI's refusals first: the input itself as output, or a .vol under another format's name.
+      if (output) vola::check_convert_output(path.string(), output->string());
+      Tree converted = vola::convert(path.string(), options, interruptible(), &report);
+      if (output) vola::write(converted, output->string(), vola::write_options_of(options));
+      return converted;
+    });
+  }
+  // What the CLI warns of (a CRS relabelled, z left in feet, voxels in degrees), as warnings.
+  for (const std::string& warning : report.warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) < 0) throw py::error_already_set();
+  return std::move(*tree);
 }
 
 }  // namespace
@@ -290,7 +298,9 @@ void bind_building(py::module_& m) {
         "map's occupied cells columns H high; grid='NAME' picks a .vdb grid or "
         "an .npz array.\n"
         "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
-        "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).");
+        "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).\n"
+        "output= the input itself, or a name with another format's extension (a.las), is refused as the CLI refuses\n"
+        "it; what the CLI warns of (a CRS relabelled, heights left in feet) comes as UserWarning.");
   m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output,
                         const std::vector<std::string>& filters) {
         std::vector<std::string> warnings;

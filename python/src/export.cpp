@@ -152,9 +152,10 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
   m.def(
       "_export_format",
       [](const std::filesystem::path& path, bool slices, bool map, bool occupancy_above, bool raster, bool resolution,
-         bool ascii, bool cubes, bool bits, bool free, bool band) {
+         bool ascii, bool cubes, bool bits, bool free, bool band, const std::string& format) {
         vola::io::ExportRequest request;
         request.output = path.string();
+        request.format = format;
         request.slices = slices;
         request.map = map;
         request.occupancy_above = occupancy_above;
@@ -169,9 +170,10 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
       },
       py::arg("path"), py::arg("slices"), py::arg("map"), py::arg("occupancy_above"), py::arg("raster"),
       py::arg("resolution"), py::arg("ascii"), py::arg("cubes"), py::arg("bits"), py::arg("free"),
-      py::arg("band") = false,
+      py::arg("band") = false, py::arg("format") = "auto",
       "vola.export's format ('ply', 'xyz', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap') from the\n"
-      "path's extension and which options were given (True: given), by the rule `vola export` uses;\n"
+      "path's extension (or format, when not 'auto') and which options were given (True: given), by the rule `vola "
+      "export` uses;\n"
       "InvalidArgument when an option does not apply to the format.");
   tree.def("raster", &raster, py::arg("product") = "dsm", py::arg("resolution") = 0.0, py::arg("depth") = 0,
            "The grid `vola export --raster PRODUCT` writes, in memory: (values (H, W) float32, row 0 the\n"

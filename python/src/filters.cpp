@@ -7,6 +7,7 @@
 
 #include "vola/crs_rules.hpp"
 #include "vola/filters/stages.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/pipeline.hpp"
 
 namespace vola::python {
@@ -23,6 +24,14 @@ py::dict filter_points(const py::handle& points, const py::dict& attributes, con
   vola::PointCloud cloud = point_cloud_of(points, attributes);
   const std::optional<std::uint32_t> epsg = crs.empty() ? std::nullopt : vola::epsg_code_of(crs);
   const std::string wkt = epsg ? std::string() : crs;
+  // A CRS PROJ does not know is refused, as vola.build refuses one: taken as no CRS, SMRF
+  // and hag read feet as metres.
+  if (!crs.empty()) try {
+      (void)vola::geo::crs_wkt(epsg ? "EPSG:" + std::to_string(*epsg) : crs);
+    } catch (const vola::Error& e) {
+      throw vola::InvalidArgument("crs='" + crs.substr(0, 40) + (crs.size() > 40 ? "...'" : "'") +
+                                  " is not a CRS PROJ knows: " + e.what());
+    }
   vola::filters::FilterResult result;
   {
     py::gil_scoped_release release;

@@ -101,6 +101,9 @@ inline vola::PointCloud point_cloud_of(const py::handle& points, const py::dict&
   cloud.xyz.assign(xyz.data(), xyz.data() + 3 * n);
   for (const auto& [key, value] : attributes) {
     vola::PointAttribute a;
+    if (!py::isinstance<py::str>(key))
+      throw py::type_error("attributes: the keys are column names (str), not " +
+                           py::cast<std::string>(py::str(py::type::of(key).attr("__name__"))));
     a.name = py::cast<std::string>(key);
     const py::array raw = py::array::ensure(value);
     if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "vola/map/state_map.hpp"
 #include "vola/raycast/camera.hpp"
 #include "vola/raycast/render.hpp"
 #include "vola/raycast/world.hpp"
@@ -59,6 +60,11 @@ py::dict images(vola::raycast::Rendering&& image) {
 py::dict render_tree(const Tree& tree, std::optional<std::array<double, 3>> eye, std::optional<std::array<double, 3>> look_at,
                      std::array<double, 3> up, double fov, std::array<std::int64_t, 2> size, bool world,
                      std::optional<std::array<std::uint32_t, 2>> orbit, unsigned threads) {
+  // A state map (vola.read, vola.open(..., states=True)) is seen by its occupied voxels, as
+  // `vola render` sees the file: rays pass through its free voxels.
+  std::optional<Tree> occupied;
+  if (vola::map::is_state_map(tree)) occupied = vola::map::occupied_tree(tree);
+  const Tree& scene = occupied ? *occupied : tree;
   const vola::Frame frame = tree.frame();
   // A camera given in world coordinates moves to the grid before the orbit turns it, as the CLI does.
   if (eye && look_at && world) {
@@ -70,12 +76,12 @@ py::dict render_tree(const Tree& tree, std::optional<std::array<double, 3>> eye,
     look_at = given.look_at;
   }
   const auto camera = camera_of(eye, look_at, up, fov, size, orbit, [&](const vola::raycast::PinholeCamera& s) {
-    return vola::raycast::overview_camera(tree, s);
+    return vola::raycast::overview_camera(scene, s);
   });
   vola::raycast::Rendering image;
   {
     py::gil_scoped_release release;
-    const vola::raycast::RayCaster caster(tree);
+    const vola::raycast::RayCaster caster(scene);
     image = vola::raycast::render(caster, camera, threads);
     if (world)
       for (double& d : image.depth) d *= frame.voxel_size;

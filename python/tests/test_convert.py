@@ -78,6 +78,25 @@ def test_convert_errors_name_the_problem(tmp_path, las_file):
     assert ".las" in formats["las"] and ".npy" in formats["npy"]
 
 
+def test_convert_refuses_the_outputs_the_cli_refuses(tmp_path, las_file):
+    # output= the input overwrote the survey with a .vol; a .las name got .vol bytes.
+    survey = tmp_path / "survey.las"
+    survey.write_bytes(pathlib.Path(las_file).read_bytes())
+    before = survey.read_bytes()
+    with pytest.raises(vola.InvalidArgument, match="is the input"):
+        vola.convert(survey, voxel_size=4.0, output=survey)
+    assert survey.read_bytes() == before
+    with pytest.raises(vola.InvalidArgument, match="writes a .vol file, not las"):
+        vola.convert(survey, voxel_size=4.0, output=tmp_path / "voxels.las")
+    assert not (tmp_path / "voxels.las").exists()
+
+
+def test_convert_warns_as_the_cli_does(tmp_path, shared_data):
+    # autzen_trim states its own CRS (in feet): relabelling it is warned of, as `vola convert` warns.
+    with pytest.warns(UserWarning, match="relabels its coordinates without moving them"):
+        vola.convert(shared_data / "las" / "pdal_autzen_trim.las", voxel_size=10.0, assign_crs="EPSG:32610")
+
+
 def _las_records(path):
     """The point records of a LAS file: count x record length bytes after the offset."""
     data = pathlib.Path(path).read_bytes()

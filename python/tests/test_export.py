@@ -153,6 +153,9 @@ def test_export_by_extension_writes_what_the_cli_writes(autzen, vola_cli, tmp_pa
             assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     assert vola.export(autzen, tmp_path / "x.PLY") == {"vertices": len(autzen), "faces": 0}
     assert vola.export(autzen, tmp_path / "slices", slices=True, depth=3) > 0
+    # A path without an extension takes format=, as the error for it says (`vola export --format`).
+    assert vola.export(autzen, tmp_path / "points", format="xyz") == vola.export(autzen, tmp_path / "points.xyz")
+    assert (tmp_path / "points").read_bytes() == (tmp_path / "points.xyz").read_bytes()
 
 
 def test_export_refuses_what_the_cli_refuses(autzen, tmp_path):

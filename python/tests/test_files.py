@@ -52,6 +52,11 @@ def test_a_file_cut_while_mapped_is_refused_not_read_as_zeros(tree, tmp_path):
     assert not (tmp_path / "copy.vol").exists()
     with pytest.raises(vola.IoError, match="was cut"):
         vola.union(other, mapped)
+    # Maps and distance fields built from it too (an empty map, distances at the cap before).
+    with pytest.raises(vola.IoError, match="was cut"):
+        vola.Map.from_tree(mapped)
+    with pytest.raises(vola.IoError, match="was cut"):
+        vola.DistanceField(mapped, 2.0, lo=(0, 0, 0), hi=(8, 8, 8))
     mapped.census  # an attribute lookup alone reads nothing
     with pytest.raises(vola.IoError, match="was cut"):
         mapped.check_mapped()

@@ -75,3 +75,9 @@ def test_bad_filters_raise_in_python_words(autzen):
         vola.filter_points(points["xyz"], {"classification": points["classification"]}, ["where:Clasification == 2"])
     with pytest.raises(vola.InvalidArgument, match="one value per point"):
         vola.filter_points(points["xyz"], {"classification": points["classification"][:5]})
+    # A CRS PROJ does not know is refused (taken as none, SMRF read feet as metres).
+    for crs in ("EPSG:29920", "feet"):
+        with pytest.raises(vola.InvalidArgument, match="is not a CRS PROJ knows"):
+            vola.filter_points(points["xyz"], filters=["smrf"], crs=crs)
+    with pytest.raises(TypeError, match="column names"):
+        vola.filter_points(points["xyz"], {1: points["classification"]})

@@ -229,3 +229,17 @@ def test_a_state_map_raycasts_exports_and_answers_contains_by_its_occupied_voxel
     vola.export(tree, tmp_path / "map.ply")
     vola.export(occupied, tmp_path / "occupied.ply")
     assert (tmp_path / "map.ply").read_bytes() == (tmp_path / "occupied.ply").read_bytes()
+
+
+def test_a_state_map_renders_its_occupied_voxels(tmp_path):
+    # Rays pass through free space, as `vola render` of the file sees it (they stopped
+    # at the first free voxel before).
+    m = vola.Map(0.5)
+    m.insert(np.array([[5.2, 0.3, 0.3], [5.2, 1.3, 0.3], [5.2, 0.3, 1.3]]), origin=(0.1, 0.1, 0.1))
+    m.save(tmp_path / "m.vol")
+    states = vola.read(tmp_path / "m.vol")
+    occupied = vola.occupied_tree(states)
+    camera = dict(eye=(-5.0, 0.5, 0.5), look_at=(5.0, 0.5, 0.5), size=(32, 24), world=True)
+    got, want = states.render(**camera), occupied.render(**camera)
+    assert got["hits"] == want["hits"] > 0
+    np.testing.assert_array_equal(got["depth"], want["depth"])

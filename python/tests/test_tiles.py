@@ -75,3 +75,5 @@ def test_bad_index_raises_format_error(tmp_path: pathlib.Path) -> None:
     bad.write_text('{"type": "FeatureCollection"}')
     with pytest.raises(vola.FormatError, match="vola"):
         vola.open_tiles(bad)
+    with pytest.raises(vola.IoError, match="is a folder; open the tile set's index"):
+        vola.open_tiles(tmp_path)  # a bare RuntimeError from the stream before

@@ -147,7 +147,15 @@ for _name in ("difference", "export_binvox", "export_height_map", "export_las", 
               "export_occupancy_above", "export_ply", "export_raster", "export_ros_map", "export_slices", "export_xyz", "free_tree",
               "intersect", "occupied_tree", "probability", "state", "union", "_export_format"):
     globals()[_name] = _refusing_cut_mappings(globals()[_name])
-del _name, _member
+# Maps and distance fields built from a tree read it too (Map.from_tree, DistanceField(tree),
+# DistanceField.update): a cut mapping gave an empty map or distances at the cap.
+for _class in (Map, DistanceField):
+    for _name, _member in list(vars(_class).items()):
+        if isinstance(_member, staticmethod):
+            setattr(_class, _name, staticmethod(_refusing_cut_mappings(_member.__func__)))
+        elif type(_member).__name__ == "instancemethod" and (_name == "__init__" or not _name.startswith("__")):
+            setattr(_class, _name, _refusing_cut_mappings(_member))
+del _name, _member, _class
 
 __all__ = [
     "FREE",
@@ -243,9 +251,12 @@ def pipeline(spec: Union[PathLike, list, dict]) -> list:
 def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resolution: float = 0.0,
            map: bool = False, bits: int = 16, occupancy_above: Optional[int] = None,  # noqa: A002 (--map)
            slices: bool = False, ascii: bool = False, cubes: bool = False,  # noqa: A002 (--ascii)
-           free: Optional[Tree] = None, band: Optional[Tuple[float, float]] = None, depth: int = 0) -> Any:
+           free: Optional[Tree] = None, band: Optional[Tuple[float, float]] = None, depth: int = 0,
+           format: str = "auto") -> Any:  # noqa: A002 (--format)
     """`vola export TREE OUT` in one call: the format from path's extension (.ply, .xyz, .las,
-    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb, .yaml), options as the CLI's flags:
+    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb, .yaml), or format= one of 'ply', 'xyz',
+    'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap' for a path without one
+    (`vola export --format`); options as the CLI's flags:
     raster='dsm'|'dtm'|'intensity'|'density'|'count' (+ resolution) for a GeoTIFF; map=True
     (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
     for PLY; free= for maps; band=(zmin, zmax) for a ROS map (.yaml, the robot's height band).
@@ -256,7 +267,7 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
     refuses them. Returns what the export_* function for the format returns."""
     fmt = _export_format(os.fspath(path), slices=slices, map=map, occupancy_above=occupancy_above is not None,
                          raster=raster is not None, resolution=bool(resolution), ascii=ascii, cubes=cubes,
-                         bits=bits != 16, free=free is not None, band=band is not None)
+                         bits=bits != 16, free=free is not None, band=band is not None, format=format)
     if fmt == "tif":
         return export_raster(tree, path, raster, resolution, depth)
     if fmt == "png":

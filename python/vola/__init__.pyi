@@ -1,5 +1,5 @@
 import os
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 from ._vola import (
     FREE as FREE,
@@ -29,6 +29,7 @@ from ._vola import (
     export_occupancy_above as export_occupancy_above,
     export_ply as export_ply,
     export_raster as export_raster,
+    export_ros_map as export_ros_map,
     export_slices as export_slices,
     export_xyz as export_xyz,
     filter_points as filter_points,
@@ -63,5 +64,7 @@ def export(
     ascii: bool = False,
     cubes: bool = False,
     free: Optional[Tree] = None,
+    band: Optional[Tuple[float, float]] = None,
     depth: int = 0,
+    format: str = "auto",
 ) -> Any: ...

@@ -161,6 +161,10 @@ void write_tile_index(const TileIndexFile& index, const std::string& path) {
 }
 
 TileIndexFile read_tile_index(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))  // the tile folder: its index is the file inside
+    throw IoError(path + ": is a folder; open the tile set's index, " +
+                  (std::filesystem::path(path) / "index.geojson").string());
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
   json root;
