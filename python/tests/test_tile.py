@@ -49,6 +49,8 @@ def test_refusals_and_warnings_in_python_words(autzen, shared_data, tmp_path):
         vola.tile([geographic], tmp_path / "deg", tile_size=1.0, depth=3)
     with pytest.raises(vola.InvalidArgument, match="not a regular file"):
         vola.tile([tmp_path], tmp_path / "dir", tile_size=100.0, depth=3)
+    with pytest.raises(vola.IoError, match="missing.las: cannot open: No such file"):  # as vola.convert says it
+        vola.tile([tmp_path / "missing.las"], tmp_path / "gone", tile_size=100.0, depth=3)
     relabelled = vola.tile([autzen], tmp_path / "relabel", tile_size=2000.0, depth=3, assign_crs="32610", overviews=False)
     (warning,) = relabelled["warnings"]
     assert "assign_crs 32610 relabels its coordinates" in warning and "--" not in warning

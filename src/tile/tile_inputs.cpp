@@ -15,6 +15,8 @@ namespace {
 std::unique_ptr<PointSource> open_source(const std::string& path, std::size_t chunk_points, bool attributes) {
   // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
   std::error_code error;
+  if (!std::filesystem::exists(path, error))  // as every reader says it (an IoError, as vola convert's)
+    throw IoError(path + ": cannot open: No such file or directory");
   if (!std::filesystem::is_regular_file(path, error))
     throw InvalidArgument(path + ": not a regular file (inputs are point files on this machine)");
   std::string ext = path.substr(std::min(path.size(), path.rfind('.') == std::string::npos ? path.size() : path.rfind('.')));

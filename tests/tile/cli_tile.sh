@@ -203,10 +203,12 @@ grep -q -- "--crs is now --assign-crs" "$tmp/err.txt" || fail "old --crs note: $
 grep -q -- "--memory 'lots'" "$tmp/err.txt" || fail "--memory message: $(cat "$tmp/err.txt")"
 "$vola" tile --tile-size 256 --depth 4 -o "$tmp/none" 2> "$tmp/err.txt" && fail "no input accepted"
 grep -q "no input" "$tmp/err.txt" || fail "no-input message: $(cat "$tmp/err.txt")"
-# Inputs are regular files: a GDAL network path or a directory never reaches a reader.
-for input in "/vsicurl/http://127.0.0.1:9/dem.tif" "$tmp/one"; do
+# Inputs are regular files: a GDAL network path (no such file here) or a directory never
+# reaches a reader.
+for case in "/vsicurl/http://127.0.0.1:9/dem.tif|cannot open: No such file" "$tmp/one|not a regular file"; do
+  input=${case%|*} message=${case#*|}
   "$vola" tile "$input" --tile-size 256 --depth 4 -o "$tmp/notfile" 2> "$tmp/err.txt" && fail "input $input accepted"
-  grep -q "not a regular file" "$tmp/err.txt" || fail "input $input message: $(cat "$tmp/err.txt")"
+  grep -q "$message" "$tmp/err.txt" || fail "input $input message: $(cat "$tmp/err.txt")"
 done
 
 # A tile gone from the set: queries that need it say which file, and do not crash.
