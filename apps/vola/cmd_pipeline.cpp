@@ -58,19 +58,22 @@ void add_pipeline(CLI::App& app) {
   auto* cmd = app.add_subcommand("pipeline", "Run a PDAL-style JSON pipeline: a reader, point filters, writers");
   cmd->footer(
       "A JSON array (or {\"pipeline\": [...]}): the input file first, filters, then outputs.\n"
-      "A file name right after the input is the output only when it is the last stage: PDAL reads\n"
-      "[\"a.las\", \"b.las\", \"out.las\"] as two inputs, vola reads one and refuses it. No output may\n"
-      "be the input.\n"
+      "A file named without a type is the input when first, an output when last, and anywhere else\n"
+      "another input to PDAL (merged with the first): vola reads one and refuses it. Give the other\n"
+      "outputs a type. No output may be the input.\n"
       "Filters: filters.smrf (cell, slope, window, threshold, scalar; metres), filters.range (limits,\n"
       "e.g. \"Classification[2:2]\", \"Z[:500)\", \"Classification![7:7]\"), filters.expression (expression),\n"
-      "filters.hag_nn, filters.outlier (mean_k, multiplier), filters.crop (bounds \"([x0, x1], [y0, y1])\" or\n"
-      "polygon WKT), filters.sample (radius), filters.voxelcenternearestneighbor (cell).\n"
+      "filters.hag_nn, filters.outlier (mean_k, multiplier; drops the outliers, PDAL marks them class 7),\n"
+      "filters.crop (bounds \"([x0, x1], [y0, y1])\", \"[x0, y0, x1, y1]\" or {\"minx\": ...}; or polygon WKT),\n"
+      "filters.sample (radius or cell), filters.voxelcenternearestneighbor (cell, 1 by default).\n"
       "Writers: .las/.laz (writers.las: the input's records, classification updated), .ply, .xyz\n"
-      "(every column), .vol (writers.vola: voxel_size, depth, compress, dense, attributes).\n"
+      "(writers.text: every column, space-separated, not PDAL's CSV), .vol (writers.vola: voxel_size,\n"
+      "depth, compress, dense, attributes).\n"
       "Example (ground.json):\n"
       "  [\"autzen.laz\", {\"type\": \"filters.smrf\"},\n"
       "   {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"},\n"
-      "   \"ground.laz\", {\"type\": \"writers.vola\", \"filename\": \"ground.vol\", \"voxel_size\": 3}]\n"
+      "   {\"type\": \"writers.las\", \"filename\": \"ground.laz\"},\n"
+      "   {\"type\": \"writers.vola\", \"filename\": \"ground.vol\", \"voxel_size\": 3}]\n"
       "  vola pipeline ground.json");
   cmd->add_option("file", args->file, "The pipeline's JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");

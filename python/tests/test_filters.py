@@ -42,7 +42,7 @@ def test_pipeline_from_a_file_text_or_lists_writes_what_the_cli_writes(shared_da
     def spec(prefix):
         return [str(autzen), {"type": "filters.smrf"},
                 {"type": "filters.range", "limits": "Classification[2:2]"},
-                str(tmp_path / f"{prefix}ground.laz"),
+                {"type": "writers.las", "filename": str(tmp_path / f"{prefix}ground.laz")},
                 {"type": "writers.vola", "filename": str(tmp_path / f"{prefix}ground.vol"), "voxel_size": 3}]
 
     (tmp_path / "cli.json").write_text(json.dumps(spec("cli_")))

@@ -232,7 +232,8 @@ def pipeline(spec: Union[PathLike, list, dict]) -> list:
     """Runs a PDAL-style pipeline as `vola pipeline FILE.json` does (docs/FILTERS.md): a
     reader, point filters, writers. spec: the JSON file's path, the JSON text, or the same
     as Python lists and dicts, e.g. ["autzen.laz", {"type": "filters.smrf"},
-    {"type": "filters.range", "limits": "Classification[2:2]"}, "ground.laz"]. Returns one
+    {"type": "filters.range", "limits": "Classification[2:2]"}, "ground.laz"] (a name without a
+    type between the first and the last is another input to PDAL, and refused). Returns one
     dict per writer: input, output, voxels (a .vol written), voxel_count, filters (the
     conversion's filter lines), stages (per stage: spec, points_in, points_out, ground),
     warnings (what the user should know: a CRS relabelled, a CRS a PLY cannot keep)."""

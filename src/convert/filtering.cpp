@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "georeference.hpp"
+
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
 #include "vola/filters/stages.hpp"
@@ -56,6 +58,15 @@ PointCloud las_voxel_columns(PointCloud&& table) {
   return cloud;
 }
 
+// The CRS the filters measure in: the one `assign_crs` (or `epsg`) gives, else the file's.
+// SMRF's metres become the CRS's units; a relabelled file's feet must count as feet.
+std::pair<std::optional<std::uint32_t>, std::string> filters_crs(const ConvertOptions& options,
+                                                                 const std::optional<std::uint32_t>& epsg,
+                                                                 const std::string& wkt) {
+  if (const std::string given = given_crs(options); !given.empty()) return {std::nullopt, crs_definition_of(given)};
+  return {epsg, wkt};
+}
+
 }  // namespace
 
 std::string describe(const filters::StageReport& stage) {
@@ -71,7 +82,8 @@ io::Input read_filtered(const std::string& path, const io::InputFormat& format, 
     io::InputOptions whole = input_options;
     whole.stream = false;
     io::Input text = format.read(path, whole);
-    const filters::FilterResult result = filters::run_stages(stages, text.cloud, text.epsg, text.wkt);
+    const auto [epsg, wkt] = filters_crs(options, text.epsg, text.wkt);
+    const filters::FilterResult result = filters::run_stages(stages, text.cloud, epsg, wkt);
     report = result.stages;
     return text;
   }
@@ -82,7 +94,8 @@ io::Input read_filtered(const std::string& path, const io::InputFormat& format, 
   } catch (const InvalidArgument& e) {
     throw OptionError("filters", std::string("apply to point input only: ") + e.what());
   }
-  const filters::FilterResult result = filters::run_stages(stages, table.cloud, table.epsg, table.wkt);
+  const auto [epsg, wkt] = filters_crs(options, table.epsg, table.wkt);
+  const filters::FilterResult result = filters::run_stages(stages, table.cloud, epsg, wkt);
   report = result.stages;
   io::Input input;
   input.format = table.format;

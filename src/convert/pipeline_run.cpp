@@ -1,9 +1,12 @@
+#include <algorithm>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "vola/convert.hpp"
 #include "vola/error.hpp"
 #include "vola/filters/pipeline.hpp"
 #include "vola/io/file_checks.hpp"
+#include "vola/io/input.hpp"
 #include "vola/io/translate.hpp"
 #include "vola/pipeline.hpp"
 
@@ -37,15 +40,48 @@ ConvertOptions convert_options(const filters::PipelineWriter& writer, const std:
   return options;
 }
 
+// Every .vol writer's options, checked before any writer runs: a mistake in the last
+// writer left the earlier ones' files behind, and was said in the CLI's flags.
+bool reads_points(const std::string& input) {
+  static const char* const kPointFormats[] = {"las", "text", "ply", "pcd", "kitti", "ept", "ptx", "e57"};
+  try {
+    const std::string format = io::find_input_format(input).name;
+    return std::find(std::begin(kPointFormats), std::end(kPointFormats), format) != std::end(kPointFormats);
+  } catch (const Error&) {
+    return false;  // said when the input is read
+  }
+}
+
+void check_voxel_writer(const std::string& input, const filters::PipelineWriter& writer,
+                        const std::vector<std::string>& stages) {
+  const ConvertOptions options = convert_options(writer, stages);
+  // Points need a voxel size (a map or grid input maps cell for cell without one).
+  if (options.voxel_size <= 0.0 && options.depth <= 0 && reads_points(input))
+    throw InvalidArgument("pipeline writer " + writer.filename +
+                          ": how fine should the voxels be? Give \"voxel_size\" (the voxel edge in the input's units, "
+                          "e.g. the point spacing) or \"depth\" (4^depth voxels along the longest side, 1..10)");
+  try {
+    options.check();
+  } catch (const OptionError& e) {
+    std::string cause = e.cause();
+    for (char& c : cause)
+      if (c == '`') c = '"';
+    throw InvalidArgument("pipeline writer " + writer.filename + ": " +
+                          (e.option().empty() || e.option() == "filters" ? "" : "\"" + e.option() + "\" ") + cause);
+  }
+}
+
 }  // namespace
 
 std::vector<PipelineOutputReport> run_pipeline(const std::string& json, const std::string& name) {
   const filters::Pipeline pipeline = filters::parse_pipeline(json, name);
   const std::vector<filters::Stage> stages = filters::parse_stages(pipeline.stages);
   // Before any writer runs: a later writer over the input would read it half written.
-  for (const auto& writer : pipeline.writers)
+  for (const auto& writer : pipeline.writers) {
     io::refuse_output_over_input(pipeline.input, writer.filename,
                                  "a pipeline's writers write new files (" + name + "); give this one another name");
+    if (writer.voxels()) check_voxel_writer(pipeline.input, writer, pipeline.stages);
+  }
   std::vector<PipelineOutputReport> reports;
   for (const auto& writer : pipeline.writers) {
     PipelineOutputReport out;

@@ -68,8 +68,10 @@ std::vector<bool> statistical_outliers(std::span<const double> xyz, const Outlie
   const double average = total / static_cast<double>(n);
   double squares = 0.0;
   for (const double m : mean) squares += (m - average) * (m - average);
-  const double limit = average + options.multiplier * std::sqrt(squares / static_cast<double>(n));
-  for (std::size_t i = 0; i < n; ++i) outlier[i] = mean[i] > limit;
+  // As PDAL's filters.outlier: the sample standard deviation (n - 1), and a point at the
+  // limit is an outlier.
+  const double limit = average + options.multiplier * std::sqrt(squares / static_cast<double>(n - 1));
+  for (std::size_t i = 0; i < n; ++i) outlier[i] = mean[i] >= limit;
   return outlier;
 }
 

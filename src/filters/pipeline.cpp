@@ -1,9 +1,12 @@
 #include "vola/filters/pipeline.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "vola/error.hpp"
 #include "vola/filters/dimensions.hpp"
@@ -53,6 +56,7 @@ class StageReader {
   [[noreturn]] void fail(const std::string& what) const { throw InvalidArgument(prefix_ + what); }
   bool has(const char* key) const { return stage_.contains(key); }
   double number(const char* key) const {
+    if (!stage_.contains(key)) fail(std::string("needs \"") + key + "\"");
     try {
       return numeric(stage_.at(key), std::string("\"") + key + "\"");
     } catch (const InvalidArgument& e) {
@@ -88,8 +92,9 @@ class StageReader {
       if (!params.empty()) spec += ":" + params;
     } else if (type_ == "filters.range") {
       only({"limits"});
+      const std::string limits = text("limits");
       try {
-        spec = "where:" + range_expression(text("limits"));
+        spec = "where:" + range_expression(limits);
       } catch (const InvalidArgument& e) {
         fail(e.what());
       }
@@ -111,13 +116,16 @@ class StageReader {
     } else if (type_ == "filters.crop") {
       only({"bounds", "polygon"});
       if (has("bounds") == has("polygon")) fail("give \"bounds\" or \"polygon\" (one of them)");
-      spec = has("bounds") ? crop_bounds(text("bounds")) : "polygon:" + text("polygon");
+      spec = has("bounds") ? crop_bounds(stage_.at("bounds")) : "polygon:" + text("polygon");
     } else if (type_ == "filters.sample") {
-      only({"radius"});
-      spec = "poisson:" + number_text(number("radius"));
+      // PDAL takes the radius, or the cell of a voxel that sphere circumscribes.
+      only({"radius", "cell"});
+      if (has("radius") == has("cell")) fail("give \"radius\" or \"cell\" (one of them)");
+      const double radius = has("radius") ? number("radius") : number("cell") * std::sqrt(3.0) / 2.0;
+      spec = "poisson:" + number_text(radius);
     } else if (type_ == "filters.voxelcenternearestneighbor") {
       only({"cell"});
-      spec = "voxel:" + number_text(number("cell"));
+      spec = "voxel:" + number_text(has("cell") ? number("cell") : 1.0);  // PDAL's default cell: 1
     } else {
       fail("unknown stage type (vola runs readers.*, filters.smrf, filters.range, filters.expression, filters.hag_nn, "
            "filters.outlier, filters.crop, filters.sample, filters.voxelcenternearestneighbor, writers.las, writers.ply, "
@@ -132,54 +140,144 @@ class StageReader {
   }
 
  private:
-  // PDAL's "([minx, maxx], [miny, maxy])" or with "[minz, maxz]".
-  std::string crop_bounds(const std::string& bounds) const {
-    std::vector<double> v;
-    std::string digits;
-    for (const char c : bounds + ",") {
-      if (std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+' || c == 'e' || c == 'E') {
-        digits += c;
-      } else if (!digits.empty()) {
-        v.push_back(numeric(json(digits), "a bound"));
-        digits.clear();
+  // PDAL's bounds, in its three forms: "([minx, maxx], [miny, maxy])" or with
+  // "[minz, maxz]"; a GeoJSON bbox [minx, miny, maxx, maxy] or [minx, miny, minz, maxx,
+  // maxy, maxz]; an object {"minx": ..., "miny": ..., "maxx": ..., "maxy": ...} with
+  // "minz" and "maxz" or without. As text or as JSON itself.
+  std::string crop_bounds(const json& value) const {
+    const std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    const char* forms =
+        "\"bounds\" must be \"([minx, maxx], [miny, maxy])\" (or with \"[minz, maxz]\"), a GeoJSON bbox "
+        "[minx, miny, maxx, maxy] (or [minx, miny, minz, maxx, maxy, maxz]), or {\"minx\": ..., \"miny\": ..., "
+        "\"maxx\": ..., \"maxy\": ...} (with \"minz\" and \"maxz\" or without)";
+    // min x, min y, max x, max y (and min z, max z)
+    std::vector<double> box;
+    const json parsed = json::parse(text, nullptr, false);
+    if (!parsed.is_discarded() && parsed.is_array()) {
+      for (const json& v : parsed) box.push_back(numeric(v, "a bound"));
+      if (box.size() == 6)
+        box = {box[0], box[1], box[3], box[4], box[2], box[5]};
+      else if (box.size() != 4)
+        fail(std::string(forms) + ", not " + text);
+    } else if (!parsed.is_discarded() && parsed.is_object()) {
+      for (const auto& [key, v] : parsed.items())
+        if (key != "minx" && key != "miny" && key != "minz" && key != "maxx" && key != "maxy" && key != "maxz")
+          fail(std::string(forms) + ": no key \"" + key + "\"");
+      for (const char* key : {"minx", "miny", "maxx", "maxy"}) {
+        if (!parsed.contains(key)) fail(std::string(forms) + ": \"" + key + "\" is missing");
+        box.push_back(numeric(parsed.at(key), std::string("\"") + key + "\""));
       }
+      if (parsed.contains("minz") != parsed.contains("maxz"))
+        fail(std::string(forms) + ": \"minz\" and \"maxz\" go together");
+      if (parsed.contains("minz")) {
+        box.push_back(numeric(parsed.at("minz"), "\"minz\""));
+        box.push_back(numeric(parsed.at("maxz"), "\"maxz\""));
+      }
+    } else {
+      box = classic_bounds(text, forms);
     }
-    if (v.size() == 4) return "crop:" + number_text(v[0]) + "," + number_text(v[2]) + "," + number_text(v[1]) + "," + number_text(v[3]);
-    if (v.size() == 6)
-      return "crop:" + number_text(v[0]) + "," + number_text(v[2]) + "," + number_text(v[4]) + "," + number_text(v[1]) +
-             "," + number_text(v[3]) + "," + number_text(v[5]);
-    fail("\"bounds\" must be \"([minx, maxx], [miny, maxy])\" or with \"[minz, maxz]\"");
+    if (box.size() == 4)
+      return "crop:" + number_text(box[0]) + "," + number_text(box[1]) + "," + number_text(box[2]) + "," +
+             number_text(box[3]);
+    return "crop:" + number_text(box[0]) + "," + number_text(box[1]) + "," + number_text(box[4]) + "," +
+           number_text(box[2]) + "," + number_text(box[3]) + "," + number_text(box[5]);
+  }
+  // "([minx, maxx], [miny, maxy])" or with "[minz, maxz]": minx, miny, maxx, maxy (minz, maxz).
+  std::vector<double> classic_bounds(const std::string& text, const char* forms) const {
+    std::vector<std::pair<double, double>> pairs;
+    std::size_t i = 0;
+    const auto skip = [&] {
+      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    };
+    const auto expect = [&](char c) {
+      skip();
+      if (i >= text.size() || text[i] != c) fail(std::string(forms) + ", not " + text);
+      ++i;
+    };
+    const auto number_until = [&](char end) {
+      const std::size_t stop = text.find(end, i);
+      if (stop == std::string::npos) fail(std::string(forms) + ", not " + text);
+      std::string digits = text.substr(i, stop - i);
+      digits.erase(0, digits.find_first_not_of(" \t"));
+      digits.erase(digits.find_last_not_of(" \t") + 1);
+      i = stop + 1;
+      return numeric(json(digits), "a bound");
+    };
+    expect('(');
+    do {
+      expect('[');
+      const double low = number_until(',');
+      const double high = number_until(']');
+      pairs.emplace_back(low, high);
+      skip();
+    } while (i < text.size() && text[i] == ',' && ++i);
+    expect(')');
+    skip();
+    if (i != text.size() || (pairs.size() != 2 && pairs.size() != 3)) fail(std::string(forms) + ", not " + text);
+    std::vector<double> box{pairs[0].first, pairs[1].first, pairs[0].second, pairs[1].second};
+    if (pairs.size() == 3) box.insert(box.end(), {pairs[2].first, pairs[2].second});
+    return box;
   }
   const json& stage_;
   std::string type_, prefix_;
 };
 
-// A file named without a type: the input when first; PDAL reads every other name but the
-// last as one more input, merged with the first, where vola pipelines read one. A name
-// right after the input that is not the last stage is therefore refused (taken as a
-// writer, it would overwrite a second input); after a filter or a writer, and last, a
-// name is an output.
+// A file named without a type is what PDAL makes of it: the input when first, the output
+// when last, and another input anywhere else (PDAL merges it with the first). vola
+// pipelines read one input, so a name in between is refused: taken as a writer, it
+// would overwrite a file PDAL reads.
+void refuse_untyped_middle(const std::string& file, std::size_t index, std::size_t stages) {
+  if (index == 0 || index + 1 == stages) return;
+  throw InvalidArgument("pipeline stage " + std::to_string(index) + ": " + file +
+                        ": a file named without a type between the first and the last stage is another input to "
+                        "PDAL (merged with the first), and vola pipelines read one; merge the inputs first, or give "
+                        "an output its type ({\"type\": \"writers.las\", \"filename\": \"" +
+                        file + "\"})");
+}
+
 void add_untyped_file(const std::string& file, std::size_t index, std::size_t stages, Pipeline& pipeline) {
-  if (index == 0) {
+  refuse_untyped_middle(file, index, stages);
+  if (index == 0)
     pipeline.input = file;
-    return;
-  }
-  const bool right_after_the_input = pipeline.stages.empty() && pipeline.writers.empty();
-  if (right_after_the_input && index + 1 != stages)
-    throw InvalidArgument("pipeline stage " + std::to_string(index) + ": " + file +
-                          ": a second file right after the input is another input to PDAL (merged with the first), "
-                          "and vola pipelines read one; merge the inputs first, or give an output its type "
-                          "({\"type\": \"writers.las\", \"filename\": \"" + file + "\"})");
-  pipeline.writers.push_back({file, {}});
+  else
+    pipeline.writers.push_back({file, {}});
+}
+
+// The reader PDAL would infer from a name's extension (the label of its messages).
+std::string reader_type_of(const std::string& filename) {
+  const std::string extension = lower_extension(filename);
+  if (extension == ".las" || extension == ".laz") return "readers.las";
+  if (extension == ".xyz" || extension == ".txt" || extension == ".csv") return "readers.text";
+  return extension.size() > 1 ? "readers." + extension.substr(1) : "readers.las";
+}
+
+// The writer PDAL would infer from a name's extension; empty when vola writes no such file.
+std::string writer_type_of(const std::string& filename) {
+  const std::string extension = lower_extension(filename);
+  return extension == ".vol"                          ? "writers.vola"
+         : extension == ".las" || extension == ".laz" ? "writers.las"
+         : extension == ".ply"                        ? "writers.ply"
+         : extension == ".xyz" || extension == ".txt" ? "writers.text"
+                                                      : "";
 }
 
 // One object stage into `pipeline`: a reader, a writer or a filter.
 void read_stage(const json& element, std::size_t index, std::size_t stages, Pipeline& pipeline) {
   const StageReader stage(element, index);
   const std::string& type = stage.type();
-  if (type.empty() && element.contains("filename")) {  // PDAL infers the kind from the position
-    add_untyped_file(stage.text("filename"), index, stages, pipeline);
-  } else if (type.rfind("readers.", 0) == 0) {
+  if (type.empty() && element.contains("filename")) {
+    // PDAL infers the kind from the position: checked as that stage, options and all
+    // (options on an untyped stage were dropped without a word).
+    const std::string file = stage.text("filename");
+    refuse_untyped_middle(file, index, stages);
+    json typed = element;
+    typed["type"] = index == 0 ? reader_type_of(file) : writer_type_of(file);
+    if (index != 0 && typed["type"] == "")
+      stage.fail(file + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz or .txt");
+    read_stage(typed, index, stages, pipeline);
+    return;
+  }
+  if (type.rfind("readers.", 0) == 0) {
     if (index != 0) stage.fail("a reader must come first (vola pipelines read one input)");
     stage.only({"filename"});
     pipeline.input = stage.text("filename");
@@ -189,11 +287,7 @@ void read_stage(const json& element, std::size_t index, std::size_t stages, Pipe
     // The output's name decides what is written: a type that says otherwise is refused
     // (writers.vola named o.las wrote LAS and dropped voxel_size without a word).
     const std::string extension = lower_extension(writer.filename);
-    const std::string wants = extension == ".vol"                      ? "writers.vola"
-                              : extension == ".las" || extension == ".laz" ? "writers.las"
-                              : extension == ".ply"                      ? "writers.ply"
-                              : extension == ".xyz" || extension == ".txt" ? "writers.text"
-                                                                           : "";
+    const std::string wants = writer_type_of(writer.filename);
     if (wants.empty())
       stage.fail(writer.filename + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz or .txt");
     if (type != wants)
@@ -261,8 +355,11 @@ std::string range_expression(const std::string& limits) {
     const std::string low = limits.substr(i, colon - i), high = limits.substr(colon + 1, close - colon - 1);
     const bool open_high = limits[close] == ')';
     std::string range;
-    const auto bound = [&](const std::string& text, const char* closed_op, const char* open_op, bool open) {
-      if (text.find_first_not_of(' ') == std::string::npos) return std::optional<double>();
+    const auto bound = [&](std::string text, const char* closed_op, const char* open_op, bool open) {
+      // Spaces around a limit are allowed, as PDAL reads it: "Z[ 420 : 430 ]".
+      text.erase(0, text.find_first_not_of(" \t"));
+      text.erase(text.find_last_not_of(" \t") + 1);
+      if (text.empty()) return std::optional<double>();
       const double v = numeric(json(text), "a limit");
       range += std::string(range.empty() ? "" : " && ") + name + " " + (open ? open_op : closed_op) + " " + number_text(v);
       return std::optional<double>(v);

@@ -32,12 +32,13 @@ Units units_of_crs(const std::optional<std::uint32_t>& epsg, const std::string& 
   }
   const auto horizontal = metres_per_unit(crs.horizontal_unit);
   if (!horizontal)
-    throw OptionError("",
-                      "smrf: the points' CRS (" + crs.name + ") has coordinates in " +
-                          (crs.horizontal_unit.empty() ? std::string("no length unit") : crs.horizontal_unit) +
-                          ", not a length, and SMRF's cell, window and thresholds are metres; filters run before any "
-                          "reprojection, so reproject the points with another tool first (PDAL's "
-                          "filters.reprojection), or relabel them with `assign_crs` if the label is wrong");
+    throw OptionError(
+        "", "smrf: the points' CRS (" + crs.name + ") has coordinates in " +
+                (crs.horizontal_unit.empty() ? std::string("no length unit") : crs.horizontal_unit) +
+                ", not a length, and SMRF's cell, window and thresholds are metres; filters run before any "
+                "reprojection, so reproject the points with another tool first (PDAL's "
+                "filters.reprojection), or, if the label is wrong, relabel them (vola convert's `assign_crs`; "
+                "translate and pipeline keep the file's CRS)");
   Units units;
   units.horizontal = *horizontal;
   units.vertical = *horizontal;

@@ -191,19 +191,36 @@ void append_binary(std::string& out, ValueType type, double v) {
   out.append(reinterpret_cast<const char*>(bytes), size_of(type));
 }
 
+// The PLY type of each column. 16-bit colour columns whose values all fit in 8 bits (as
+// in many LAS files, and colours read from text) are uchar, what PLY readers expect of
+// colours, as vola export writes them.
+std::vector<ValueType> ply_column_types(const PointCloud& cloud) {
+  const auto colour = [](const PointAttribute& a) { return a.name == "red" || a.name == "green" || a.name == "blue"; };
+  bool wide_colours = false;
+  for (const auto& a : cloud.attributes)
+    if (colour(a) && a.type == ValueType::u16)
+      wide_colours = wide_colours || std::any_of(a.values.begin(), a.values.end(), [](double v) { return v > 255; });
+  std::vector<ValueType> types;
+  for (const auto& a : cloud.attributes)
+    types.push_back(colour(a) && a.type == ValueType::u16 && !wide_colours ? ValueType::u8 : a.type);
+  return types;
+}
+
 void write_ply_points(const PointCloud& cloud, const std::string& path) {
   const auto names = column_names(cloud);
+  const std::vector<ValueType> types = ply_column_types(cloud);
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by vola translate\nelement vertex " +
                        std::to_string(cloud.size()) + "\nproperty double x\nproperty double y\nproperty double z\n";
   for (std::size_t c = 0; c < names.size(); ++c)
-    header += std::string("property ") + ply_type(cloud.attributes[c].type) + " " + names[c] + "\n";
+    header += std::string("property ") + ply_type(types[c]) + " " + names[c] + "\n";
   header += "end_header\n";
   OutputFile out(path);
   out.write(header);
   std::string buffer;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     buffer.append(reinterpret_cast<const char*>(&cloud.xyz[3 * i]), 3 * sizeof(double));
-    for (const auto& a : cloud.attributes) append_binary(buffer, a.type, a.values[i]);
+    for (std::size_t c = 0; c < cloud.attributes.size(); ++c)
+      append_binary(buffer, types[c], cloud.attributes[c].values[i]);
     if (buffer.size() >= (std::size_t{1} << 16)) {
       out.write(buffer);
       buffer.clear();

@@ -230,9 +230,13 @@ std::optional<std::array<int, 3>> xyz_columns(const std::vector<std::string>& na
   return at;
 }
 
-// Red, green and blue from a header hold 8-bit or 16-bit colours: the narrowest type
-// that holds every value (u8 is what the LAS writer scales to 16 bits), else f64.
-void type_colours(PointCloud& cloud) {
+// Red, green and blue from a header: u16 when every value is a whole 0..65535, else f64.
+// Text says nothing of a colour's bit depth, so the values go on as written, as PDAL's
+// readers.text and LAStools' txt2las take them: a LAS file written as text and read back
+// keeps its colours (typed u8, 0..255 colours were widened to 16 bits by the LAS writer).
+// A PLY output still writes colours of 0..255 as uchar. Colours scaled from 0..1
+// (`eight_bit`) are 8-bit colours, u8.
+void type_colours(PointCloud& cloud, bool eight_bit) {
   for (PointAttribute& a : cloud.attributes) {
     if (a.name != "red" && a.name != "green" && a.name != "blue") continue;
     double most = 0;
@@ -241,7 +245,7 @@ void type_colours(PointCloud& cloud) {
       whole = whole && v >= 0 && v == std::floor(v);
       most = std::max(most, v);
     }
-    a.type = !whole || most > 65535 ? ValueType::f64 : most > 255 ? ValueType::u16 : ValueType::u8;
+    a.type = !whole || most > 65535 ? ValueType::f64 : eight_bit ? ValueType::u8 : ValueType::u16;
   }
 }
 
@@ -329,17 +333,18 @@ std::optional<TextHeader> read_header_line(const std::string& path, int skip_lin
 }
 
 // Open3D writes .xyzrgb colours in 0..1; other writers of the extension may give 0..255,
-// which are kept as they are rather than clamped to white.
-void unit_colours_to_bytes(PointCloud& cloud) {
+// which are kept as they are rather than clamped to white. True when they were scaled.
+bool unit_colours_to_bytes(PointCloud& cloud) {
   const auto is_colour = [](const PointAttribute& a) {
     return a.name == "red" || a.name == "green" || a.name == "blue";
   };
   for (const PointAttribute& a : cloud.attributes)
     if (is_colour(a) && std::any_of(a.values.begin(), a.values.end(), [](double v) { return !(v >= 0 && v <= 1); }))
-      return;
+      return false;
   for (PointAttribute& a : cloud.attributes)
     if (is_colour(a))
       for (double& v : a.values) v = colour_attribute(v, ColourScale::unit);
+  return true;
 }
 
 }  // namespace
@@ -446,8 +451,9 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     buffer.erase(0, kept);
     if (progress) progress(consumed, total);
   }
-  if (named && !header->line && lower_extension(path) == ".xyzrgb") unit_colours_to_bytes(cloud);
-  if (named) type_colours(cloud);
+  const bool unit_colours =
+      named && !header->line && lower_extension(path) == ".xyzrgb" && unit_colours_to_bytes(cloud);
+  if (named) type_colours(cloud, unit_colours);
   return cloud;
 }
 

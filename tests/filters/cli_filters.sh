@@ -62,7 +62,7 @@ cmp "$tmp/kept.vol" "$tmp/where.vol" || fail "convert --where differs from conve
 # A pipeline gives the files of the same flags.
 cat > "$tmp/p.json" <<JSON
 ["$autzen", {"type": "filters.smrf"}, {"type": "filters.range", "limits": "Classification[2:2]"},
- "$tmp/pipe.las", {"type": "writers.vola", "filename": "$tmp/pipe.vol", "voxel_size": 3}]
+ {"type": "writers.las", "filename": "$tmp/pipe.las"}, {"filename": "$tmp/pipe.vol", "voxel_size": 3}]
 JSON
 "$vola" pipeline "$tmp/p.json" -q
 "$vola" translate "$autzen" "$tmp/flags.las" --filter smrf --where "Classification == 2" -q
@@ -140,7 +140,7 @@ grep -q "writers.vola cannot write .*o.las: vola writes by the name's extension,
 cp "$autzen" "$tmp/second.las"
 echo "[\"$autzen\", \"$tmp/second.las\", \"$tmp/out.las\"]" > "$tmp/two.json"
 if "$vola" pipeline "$tmp/two.json" 2> "$tmp/err.txt"; then fail "a second input was taken as an output"; fi
-grep -q "pipeline stage 1: .*second.las: a second file right after the input is another input to PDAL" "$tmp/err.txt" \
+grep -q "pipeline stage 1: .*second.las: a file named without a type between the first and the last stage is another input to PDAL" "$tmp/err.txt" \
   || fail "error: $(cat "$tmp/err.txt")"
 cmp -s "$autzen" "$tmp/second.las" || fail "the second input was changed"
 # A range that holds no value is refused naming it, as --crop refuses an upside-down box
@@ -231,5 +231,71 @@ PY
 "$vola" translate "$tmp/spaced.las" "$tmp/spaced.xyz" --where "echo_width > 200" -q 2> /dev/null ||
   fail "--where echo_width on a field named 'echo width' failed"
 [ "$(grep -vc '^#' "$tmp/spaced.xyz")" = 5 ] || fail "--where echo_width > 200 kept $(grep -vc '^#' "$tmp/spaced.xyz") of 10"
+
+# PDAL's three forms of crop bounds keep the same points (the GeoJSON bbox's four numbers
+# were read as the classic form's minx, maxx, miny, maxy: 48,856 points instead of 17,864).
+classic='([636500, 636800.5], [849000, 849200])'
+for bounds in "\"$classic\"" '"[636500, 849000, 636800.5, 849200]"' '[636500, 849000, 636800.5, 849200]' \
+              '{"minx": 636500, "miny": 849000, "maxx": 636800.5, "maxy": 849200}' \
+              '"{\"minx\": 636500, \"miny\": 849000, \"maxx\": 636800.5, \"maxy\": 849200}"'; do
+  echo "[\"$autzen\", {\"type\": \"filters.crop\", \"bounds\": $bounds}, \"$tmp/crop.las\"]" > "$tmp/crop.json"
+  "$vola" pipeline "$tmp/crop.json" > "$tmp/crop.txt" || fail "crop bounds $bounds: $(cat "$tmp/crop.txt")"
+  grep -q "110000 -> 17864 points" "$tmp/crop.txt" || fail "crop bounds $bounds: $(cat "$tmp/crop.txt")"
+done
+echo "[\"$autzen\", {\"type\": \"filters.crop\", \"bounds\": \"[1, 2, 3]\"}, \"$tmp/crop.las\"]" > "$tmp/crop.json"
+if "$vola" pipeline "$tmp/crop.json" 2> "$tmp/err.txt"; then fail "three bounds were taken"; fi
+grep -q 'pipeline stage 1 (filters.crop): "bounds" must be' "$tmp/err.txt" || fail "bad bounds: $(cat "$tmp/err.txt")"
+# A name without a type between the first and the last stage is another input to PDAL,
+# after a filter too: refused, the file untouched (it was written over as an output).
+cp "$data/las/pdal_1.2-with-color.las" "$tmp/other.las"
+echo "[\"$autzen\", {\"type\": \"filters.range\", \"limits\": \"Classification[2:2]\"}, \"$tmp/other.las\", \"$tmp/m.las\"]" \
+  > "$tmp/mid.json"
+if "$vola" pipeline "$tmp/mid.json" 2> "$tmp/err.txt"; then fail "a middle name was taken as an output"; fi
+grep -q "pipeline stage 2: .*other.las: a file named without a type between the first and the last stage" "$tmp/err.txt" ||
+  fail "middle name: $(cat "$tmp/err.txt")"
+cmp -s "$data/las/pdal_1.2-with-color.las" "$tmp/other.las" || fail "the middle file was changed"
+# A stage without a type is the stage its place makes it, options checked as that stage's
+# (PDAL's own examples give writers scale_x; vola dropped every option without a word).
+echo "[{\"filename\": \"$autzen\", \"override_srs\": \"EPSG:26910\"}, \"$tmp/u.las\"]" > "$tmp/u.json"
+if "$vola" pipeline "$tmp/u.json" 2> "$tmp/err.txt"; then fail "a reader's override_srs was dropped"; fi
+grep -q 'pipeline stage 0 (readers.las): no option "override_srs"' "$tmp/err.txt" || fail "untyped reader: $(cat "$tmp/err.txt")"
+echo "[\"$autzen\", {\"filename\": \"$tmp/u.las\", \"scale_x\": 0.1}]" > "$tmp/u.json"
+if "$vola" pipeline "$tmp/u.json" 2> "$tmp/err.txt"; then fail "a writer's scale_x was dropped"; fi
+grep -q 'pipeline stage 1 (writers.las): no option "scale_x"' "$tmp/err.txt" || fail "untyped writer: $(cat "$tmp/err.txt")"
+# Every .vol writer is checked before any writer runs (the LAS one was left behind).
+echo "[\"$autzen\", {\"type\": \"writers.las\", \"filename\": \"$tmp/first.las\"}, {\"type\": \"writers.vola\", \"filename\": \"$tmp/v.vol\"}]" \
+  > "$tmp/v.json"
+if "$vola" pipeline "$tmp/v.json" 2> "$tmp/err.txt"; then fail "a .vol writer without a voxel size ran"; fi
+grep -q 'pipeline writer .*v.vol: how fine should the voxels be? Give "voxel_size"' "$tmp/err.txt" || fail "vola writer: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/first.las" ] || fail "the first writer ran before the last was checked"
+# PDAL's defaults and spellings: a voxel filter's cell is 1 by default; spaces around range
+# limits; filters.sample by cell.
+echo "[\"$autzen\", {\"type\": \"filters.voxelcenternearestneighbor\"}, {\"type\": \"filters.range\", \"limits\": \"Z[ 420 : 430 ]\"}, {\"type\": \"filters.sample\", \"cell\": 2}, \"$tmp/d.las\"]" \
+  > "$tmp/d.json"
+"$vola" pipeline "$tmp/d.json" > "$tmp/d.txt" || fail "PDAL defaults: $(cat "$tmp/d.txt")"
+grep -q "voxel:1: " "$tmp/d.txt" && grep -q "where:(Z >= 420 && Z <= 430)" "$tmp/d.txt" && grep -q "poisson:1.73205" "$tmp/d.txt" ||
+  fail "PDAL defaults: $(cat "$tmp/d.txt")"
+# filters.outlier as PDAL computes it (the sample standard deviation, a mean at the limit
+# is an outlier): PDAL's formula keeps 2,863 of warsaw_small's 3,000 points (vola kept 2,862).
+"$vola" translate "$data/las/pdal_warsaw_small.las" "$tmp/o.las" --filter outlier > "$tmp/o.txt"
+grep -q "outlier: 3000 -> 2863 points" "$tmp/o.txt" || fail "outlier: $(cat "$tmp/o.txt")"
+# SMRF measures in the CRS --assign-crs gives (it read the file's, or none: feet as metres).
+"$vola" translate "$autzen" "$tmp/nocrs.xyz" -q 2> /dev/null
+"$vola" convert "$tmp/nocrs.xyz" "$tmp/nocrs.vol" --voxel-size 5 --assign-crs EPSG:2994 --filter smrf > "$tmp/a.txt"
+grep -q "smrf: 110000 -> 110000 points, $ground ground" "$tmp/a.txt" || fail "smrf under --assign-crs: $(cat "$tmp/a.txt")"
+# LAS -> XYZ -> LAS keeps the colours as they were (8-bit values in 16-bit fields were
+# widened to 16 bits: red 84 came back 21,588), as PDAL's readers.text keeps them.
+"$vola" translate "$tmp/nocrs.xyz" "$tmp/back.las" -q 2> /dev/null
+"${VOLA_PYTHON:-python3}" - "$autzen" "$tmp/back.las" <<'PY' || fail "colours changed through XYZ"
+import struct, sys
+def colours(path):
+    d = open(path, "rb").read()
+    offset, length, count = struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<H", d, 105)[0], struct.unpack_from("<I", d, 107)[0]
+    if count == 0 and d[25] >= 4:  # LAS 1.4: the 64-bit count
+        count = struct.unpack_from("<Q", d, 247)[0]
+    at = {3: 28, 7: 30}[d[104] & 63]
+    return [struct.unpack_from("<3H", d, offset + i * length + at) for i in range(count)]
+assert colours(sys.argv[1]) == colours(sys.argv[2])
+PY
 
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

@@ -106,7 +106,9 @@ TEST(TextHeader, CommentHeadersOfCloudCompareAndVolaExport) {
   const auto cc = read_text(dir, "//X,Y,Z,R,G,B\n1,2,3,255,0,7\n4,5,6,0,10,0\n");
   EXPECT_EQ(cc.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6}));
   EXPECT_EQ(names(cc), (std::vector<std::string>{"red", "green", "blue"}));
-  EXPECT_EQ(column(cc, "red").type, vola::ValueType::u8);  // 8-bit colours
+  // Text says no bit depth: the values go on as written (LAS gets 255, as from PDAL's
+  // readers.text), u16.
+  EXPECT_EQ(column(cc, "red").type, vola::ValueType::u16);
   EXPECT_EQ(column(cc, "blue").values, (std::vector<double>{7, 0}));
   // vola export's XYZ, after a descriptive comment: the names are on the second line.
   const auto own = read_text(dir, "# made by hand\n# x y z intensity classification\n0.5 1.5 2.5 7 2\n");
