@@ -14,6 +14,7 @@
 #include "vola/convert.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
+#include "vola/geo/crs.hpp"
 #include "vola/io/input.hpp"
 
 namespace vola::cli {
@@ -44,7 +45,11 @@ void print_summary(const ConvertArgs& a, const Tree& tree, const ConvertReport& 
   const std::uint64_t in_bytes = report.bytes_total.value_or(std::filesystem::file_size(a.input));
   const auto out_bytes = std::filesystem::file_size(a.output);
   const Frame frame = tree.frame();
-  if (report.crs_wkt_only)
+  const auto definition = geo::crs_definition(tree.georef());
+  const std::string crs = definition ? crs_summary_line(std::nullopt, *definition) : "";
+  if (!crs.empty())  // as vola info names it: a compound CRS's vertical part too
+    std::printf("crs:            %s\n", crs.c_str());
+  else if (report.crs_wkt_only)
     std::printf("crs:            WKT from the input, no EPSG code for it (kept in the extension; header code %u)\n",
                 tree.georef().epsg);
   else if (!report.epsg)

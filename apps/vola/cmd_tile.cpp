@@ -109,8 +109,11 @@ void run_tile(const TileArgs& a) {
     if (!talk) return;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("inputs:         %zu (%llu points)\n", opened.sources.size(), static_cast<unsigned long long>(opened.points));
-    std::printf("crs:            %s\n", options.epsg ? ("EPSG:" + std::to_string(*options.epsg)).c_str()
-                                                     : (options.crs_wkt.empty() ? "none known" : "WKT from the input"));
+    const std::string crs = crs_summary_line(options.epsg, options.crs_wkt);
+    std::printf("crs:            %s\n", !crs.empty()              ? crs.c_str()
+                                        : options.epsg            ? ("EPSG:" + std::to_string(*options.epsg)).c_str()
+                                        : options.crs_wkt.empty() ? "none known"
+                                                                  : "WKT from the input");
     std::printf("grid:           tiles of %.6g at depth %d (%u^3 voxels of %.6g), origin %.6g %.6g %.6g\n",
                 options.grid.tile_size, options.grid.depth, side_of(options.grid.depth), options.grid.voxel_size(),
                 options.grid.origin[0], options.grid.origin[1], options.grid.origin[2]);

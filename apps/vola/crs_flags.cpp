@@ -2,6 +2,9 @@
 
 #include <cstdio>
 
+#include "vola/error.hpp"
+#include "vola/geo/crs.hpp"
+
 namespace vola::cli {
 
 void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target_crs, bool& allow_geographic,
@@ -21,6 +24,15 @@ void add_crs_options(CLI::App& cmd, std::string& assign_crs, std::string& target
       ->each([](const std::string&) {
         std::fprintf(stderr, "vola: --crs is now --assign-crs (it relabels; --target-crs moves the points)\n");
       });
+}
+
+std::string crs_summary_line(const std::optional<std::uint32_t>& epsg, const std::string& wkt) {
+  if (wkt.empty() && !epsg) return "";
+  try {
+    return geo::crs_summary(geo::describe_crs(!wkt.empty() ? wkt : "EPSG:" + std::to_string(*epsg)));
+  } catch (const Error&) {
+    return "";
+  }
 }
 
 }  // namespace vola::cli

@@ -213,7 +213,7 @@ std::vector<std::string> clamped_value_warnings(const std::string& path, const P
 // A WKT record PROJ cannot read (pdal_warsaw_small.las holds "''") states no CRS: kept,
 // it would travel into the .vol and make every export that hands it to GDAL fail. Left
 // out, with a warning saying so; nothing when the WKT reads.
-std::optional<std::string> drop_unreadable_wkt(const std::string& path, io::Input& input) {
+std::optional<std::string> drop_unreadable_wkt(const std::string& path, io::Input& input, bool crs_given) {
   if (input.wkt.find_first_not_of(std::string(" \t\r\n\0", 5)) == std::string::npos) {
     input.wkt.clear();
     return std::nullopt;
@@ -225,7 +225,9 @@ std::optional<std::string> drop_unreadable_wkt(const std::string& path, io::Inpu
     const std::string shown = input.wkt.size() > 40 ? input.wkt.substr(0, 40) + "..." : input.wkt;
     input.wkt.clear();
     return path + ": its WKT record (" + shown + ") is not a CRS PROJ can read: it is not kept" +
-           (input.epsg ? " (the EPSG code is)" : "; give `assign_crs` if you know the CRS");
+           (input.epsg  ? " (the EPSG code is)"
+            : crs_given ? ""
+                        : "; give `assign_crs` if you know the CRS");
   }
 }
 
@@ -272,7 +274,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
                                " points lie outside the bbox given: toolkit quantization puts them on the border "
                                "voxels, as the reference toolkit clips them; grid quantization (a voxel size) "
                                "drops what lies outside its grid, and `crop` cuts the points first");
-  if (const auto dropped = drop_unreadable_wkt(path, input)) value_warnings.push_back(*dropped);
+  if (const auto dropped = drop_unreadable_wkt(path, input, !given_crs(options).empty()))
+    value_warnings.push_back(*dropped);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);
   const BuildOptions build = build_options(options, header_epsg(crs.epsg));

@@ -174,8 +174,11 @@ std::string unconverted_heights(const std::string& source, const std::string& ta
              to.vertical_name + "): the source has no vertical part for PROJ to convert them from; give it one " +
              "(`assign_crs` with a compound CRS, such as EPSG:2994+6360 for Oregon Lambert feet and NAVD88 feet) " +
              "to convert them";
+    // Metres beside a geographic 2D CRS are what such a CRS means (its heights are metres
+    // above the ellipsoid), so a metre source going to degrees keeps the right unit.
     if (!from.vertical_name.empty() || !to.vertical_name.empty() || from.horizontal_unit == "degree" ||
-        from.horizontal_unit == to.horizontal_unit)
+        from.horizontal_unit == to.horizontal_unit ||
+        (to.horizontal_unit == "degree" && from.horizontal_unit == "metre"))
       return "";
     return "heights (z) stay in " + from.horizontal_unit + " while x and y go to " + to.horizontal_unit +
            ": neither CRS has a vertical axis to convert them by (PROJ and PDAL do the same); give both a "

@@ -32,9 +32,10 @@ std::string geographic_name(const std::string& definition) {
   }
 }
 
-// The CRS the input is read in: what its file states, else what the options give.
-std::string stated_or_given(const std::string& stated, const std::string& given) {
-  return !stated.empty() ? stated : given.empty() ? std::string() : crs_definition_of(given);
+// The CRS the input is read in: what the options give (`assign_crs` relabels the file),
+// else what its file states; as resolve_crs and vola tile decide it.
+std::string given_or_stated(const std::string& stated, const std::string& given) {
+  return !given.empty() ? crs_definition_of(given) : stated;
 }
 
 // The sentence of vola::implausible_degrees for the points read whole, else for the box
@@ -97,8 +98,8 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
       out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `assign_crs` " +
                     given.substr(0, 60) + " relabels its coordinates without moving them (to move them, " +
                     "give `target_crs`)");
-    if (!options.target_crs.empty() && !stated_or_given(stated, given).empty())
-      if (const std::string heights = unconverted_heights(stated_or_given(stated, given), options.target_crs);
+    if (!options.target_crs.empty() && !given_or_stated(stated, given).empty())
+      if (const std::string heights = unconverted_heights(given_or_stated(stated, given), options.target_crs);
           !heights.empty())
         out.push_back(path + ": " + heights);
     const std::string result = result_definition(crs);

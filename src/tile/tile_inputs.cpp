@@ -125,6 +125,12 @@ OpenedInputs open_inputs(const TileInputs& in, TileOptions& options) {
   reproject_sources(in, out.sources);
   // After a reprojection every source states the target.
   resolve_tile_crs(in.target_crs.empty() ? in.assign_crs : std::string(), in.allow_geographic, out.sources, options);
+  // Heights in another unit than x and y (US feet under metres): as vola convert says it.
+  const std::string crs = !options.crs_wkt.empty() ? options.crs_wkt
+                          : options.epsg           ? "EPSG:" + std::to_string(*options.epsg)
+                                                   : std::string();
+  if (!crs.empty())
+    if (std::string mixed = mixed_units(crs); !mixed.empty()) out.warnings.push_back(std::move(mixed));
   for (const auto& s : out.sources) out.points += s->point_count();
   return out;
 }

@@ -351,6 +351,22 @@ TEST(Convert, ReprojectedHeightsAreInTheTargetsUnits) {
   EXPECT_NE(compound_target.warnings[0].find("heights (z) stay in foot though the target says metre (NAVD88 height)"),
             std::string::npos)
       << compound_target.warnings[0];
+  // A compound CRS assigned to the file gives PROJ the heights' unit: they are converted,
+  // and nothing is said (the warning read the file's own 2D CRS, not the assigned one).
+  options.assign_crs = "EPSG:2994+6360";
+  vola::ConvertReport assigned;
+  const vola::Tree assigned_tree =
+      vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &assigned);
+  EXPECT_TRUE(assigned.warnings.empty()) << assigned.warnings[0];
+  EXPECT_LT(assigned_tree.georef().bbox.max[2], 200.0);  // 520 ft is 158 m
+  options.assign_crs.clear();
+  // To degrees, metres stay what a geographic 2D CRS's heights are: nothing to say.
+  options.target_crs = "EPSG:4326";
+  options.allow_geographic = true;
+  vola::ConvertReport to_degrees;
+  vola::convert((data / "las" / "pdal_autzen-utm.las").string(), options, {}, &to_degrees);
+  for (const std::string& w : to_degrees.warnings) EXPECT_EQ(w.find("heights (z)"), std::string::npos) << w;
+  options.allow_geographic = false;
   options.target_crs = "EPSG:2994";  // the file's own unit: nothing to say
   vola::ConvertReport same_unit;
   vola::convert((data / "las" / "pdal_autzen_trim.las").string(), options, {}, &same_unit);

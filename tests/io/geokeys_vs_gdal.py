@@ -216,18 +216,22 @@ def made_up_keys(vola, tmp, failures):
     checked = 0
     for keys in ([(1024, 1), (3072, 26995), (3076, 9003)],
                  [(1024, 1), (3072, 26910), (4099, 9003)],
-                 [(1024, 1), (3072, 26910), (3076, 9002), (4099, 9003)]):
+                 [(1024, 1), (3072, 26910), (3076, 9002), (4099, 9003)],
+                 # A geographic code with heights in feet: degrees have no metres, so only
+                 # the heights' unit is compared (vola read it as 2D, heights taken as metres).
+                 [(1024, 2), (2048, 4326), (4099, 9003)]):
         las, tiff = Path(tmp) / "keys.las", Path(tmp) / "made_up.tif"
         las_with_keys(keys, las)
         geotiff_with_keys({34735: las.read_bytes()[227 + 54:227 + 54 + 8 + 8 * len(keys)]}, tiff)
         gdal.SetConfigOption("GTIFF_REPORT_COMPD_CS", "YES")
         srs = gdal.Open(str(tiff)).GetSpatialRef()
         gdal.SetConfigOption("GTIFF_REPORT_COMPD_CS", None)
+        geographic = (1024, 2) in keys
         horizontal = srs.GetLinearUnits()
         vertical = srs.GetTargetLinearUnits("VERT_CS") if srs.IsCompound() else horizontal
         crs = json.loads(subprocess.run([vola, "info", "--json", str(las)], check=True, capture_output=True,
                                         text=True).stdout).get("crs") or {}
-        got_h = METRES.get(crs.get("unit"))
+        got_h = horizontal if geographic and crs.get("unit") == "degree" else METRES.get(crs.get("unit"))
         got_v = METRES.get(crs.get("vertical_unit") or crs.get("unit"))
         print(f"keys {keys}: GDAL metres per unit {horizontal:.10g} / {vertical:.10g}, vola {got_h} / {got_v}")
         checked += 1

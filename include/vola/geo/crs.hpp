@@ -23,16 +23,18 @@ std::pair<double, double> centre_lat_lon(const std::string& crs, const Box& bbox
 // The CRS as WKT2 (2019), or throws vola::Error for an unknown code.
 std::string crs_wkt(std::uint32_t epsg);
 
-// The projected CRS EPSG:`epsg` as a GeoTIFF key directory (LAS files carry one)
-// qualifies it, as GDAL reads the keys, in WKT2 (2019); empty when the code alone says it
-// all (or is not a projected CRS PROJ knows). Unit arguments are EPSG unit codes (0 or
-// anything that is not a length unit: none):
+// The projected or geographic 2D CRS EPSG:`epsg` as a GeoTIFF key directory (LAS files
+// carry one) qualifies it, as GDAL reads the keys, in WKT2 (2019); empty when the code
+// alone says it all (or is neither kind of CRS PROJ knows). Unit arguments are EPSG unit
+// codes (0 or anything that is not a length unit: none):
 //  - `linear_unit` (ProjLinearUnitsGeoKey) other than the code's own: the code's CRS with
 //    its coordinates in that unit (the parameters keep their meaning: a false easting of
 //    700000 m is 2296583.33 US survey feet). pdal_mvk-thin.las is NAD83 / Mississippi West
 //    (EPSG:26995, metres) in US survey feet.
+//    A geographic CRS's degrees take no linear unit.
 //  - `vertical_unit` (VerticalUnitsGeoKey, for files that name no vertical CRS) other than
-//    the horizontal unit: a compound CRS whose vertical part, of unknown datum, is in that
+//    the horizontal unit (for a geographic CRS: other than metres, the unit its heights
+//    have without one): a compound CRS whose vertical part, of unknown datum, is in that
 //    unit (GDAL's reading with GTIFF_REPORT_COMPD_CS), so that heights are not taken in
 //    the unit of x and y.
 // Throws vola::Error when PROJ cannot be loaded or fails outside these rules.

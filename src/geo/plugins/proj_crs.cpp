@@ -373,14 +373,22 @@ double axis_metres(PJ_CONTEXT* ctx, const PJ* crs) {
 
 bool same_length(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(a, b); }
 
-// The projected CRS EPSG:`epsg` as GeoTIFF keys qualify it (geo::keyed_projected_crs).
+// The projected (or geographic 2D) CRS EPSG:`epsg` as GeoTIFF keys qualify it
+// (geo::keyed_projected_crs).
 std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, std::uint32_t vertical_unit) {
   Context ctx = make_context();
   const std::string code = std::to_string(epsg);
   Pj crs(proj_create_from_database(ctx.get(), "EPSG", code.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
-  if (!crs || proj_get_type(crs.get()) != PJ_TYPE_PROJECTED_CRS) return {};
+  if (!crs) return {};
+  const PJ_TYPE type = proj_get_type(crs.get());
+  if (type != PJ_TYPE_PROJECTED_CRS && type != PJ_TYPE_GEOGRAPHIC_2D_CRS) return {};
+  const bool geographic = type == PJ_TYPE_GEOGRAPHIC_2D_CRS;
+  // Heights beside degrees are metres unless the keys say otherwise (GDAL reads a
+  // geographic code with a VerticalUnitsGeoKey of feet as heights in feet).
+  const double height_metres = geographic ? 1.0 : axis_metres(ctx.get(), crs.get());
   bool changed = false;
-  if (const auto unit = length_unit(ctx.get(), linear_unit); unit && !same_length(axis_metres(ctx.get(), crs.get()), unit->second)) {
+  if (const auto unit = length_unit(ctx.get(), linear_unit);
+      !geographic && unit && !same_length(axis_metres(ctx.get(), crs.get()), unit->second)) {
     const std::string unit_code = std::to_string(linear_unit);
     Pj altered(proj_crs_alter_cs_linear_unit(ctx.get(), crs.get(), unit->first.c_str(), unit->second, "EPSG",
                                              unit_code.c_str()));
@@ -388,7 +396,8 @@ std::string keyed_projected_crs(std::uint32_t epsg, std::uint32_t linear_unit, s
     crs = std::move(altered);
     changed = true;
   }
-  if (const auto unit = length_unit(ctx.get(), vertical_unit); unit && !same_length(axis_metres(ctx.get(), crs.get()), unit->second)) {
+  if (const auto unit = length_unit(ctx.get(), vertical_unit);
+      unit && !same_length(changed ? axis_metres(ctx.get(), crs.get()) : height_metres, unit->second)) {
     // Heights in another unit than x and y, with no vertical CRS named: a vertical CRS of
     // unknown datum in that unit, as GDAL reads such keys (GTIFF_REPORT_COMPD_CS).
     const Pj vertical(proj_create_vertical_crs(ctx.get(), "unknown", "unknown", unit->first.c_str(), unit->second));
