@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "info_points.hpp"
+#include "info_tiles.hpp"
 #include "text_output.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -98,6 +99,11 @@ std::string json_crs(const NamedCrs& crs) {
 }
 
 void run_info(const InfoArgs& a) {
+  if (const auto index = tile_index_of(a.file)) {  // a tile set, or its folder
+    if (a.summary || !a.grid.empty())
+      throw InvalidArgument("--summary and --grid read one file; " + a.file + " is a tile set");
+    return print_tile_index_info(*index, a.json);
+  }
   io::refuse_non_regular_input(a.file);  // before its first bytes are read
   if (is_point_file(a.file) || !is_vol_file(a.file)) {
     if (!a.grid.empty() && is_point_file(a.file))
@@ -231,11 +237,13 @@ void run_info(const InfoArgs& a) {
 void add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   auto* cmd = app.add_subcommand("info", "A .vol file's header, levels, bytes and metadata; a LAS/LAZ/COPC file's header, CRS, compression and octree; any other input's size, CRS and bounds");
-  cmd->add_option("file", args->file,
-                  ".vol file, a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI), a mesh (OBJ, STL, OFF, PLY, ...), a "
-                  "voxel grid or map (binvox, NPY occupancy, .bt/.ot, .vdb) or a DEM (GeoTIFF, ...)")
+  cmd->add_option(
+         "file", args->file,
+         ".vol file, a point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI), a mesh (OBJ, STL, OFF, PLY, ...), a "
+         "voxel grid or map (binvox, NPY occupancy, .bt/.ot, .vdb), a DEM (GeoTIFF, ...) or a tile set (its "
+         "index.geojson or folder, from vola tile)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   cmd->add_flag("--json", args->json, "Print JSON instead of a table (every kind of file)");
   cmd->add_flag("--summary", args->summary,
                 "Point files and DEMs: read every point (cell) for their own bounds, column ranges and points per class "

@@ -51,6 +51,24 @@ for f in index["features"]:
         assert -123.2 < lon < -122.9 and 43.9 < lat < 44.2, (lon, lat)
 assert len(v["overviews"]) >= 2 and v["overviews"][-1]["level"] >= 1
 PY
+# vola info on the tile set (its folder or its index): the index's own figures (it said
+# "--format: ... say which", an option info does not have, and "File is actually a directory").
+"$vola" info "$tmp/one" --json > "$tmp/info.json" || fail "vola info on the tile folder failed"
+"$vola" info "$index" > "$tmp/info.txt" || fail "vola info on index.geojson failed"
+python3 - "$index" "$tmp/info.json" "$tmp/info.txt" <<'PY' || fail "vola info of the tile set"
+import json, sys
+v = json.load(open(sys.argv[1]))["vola"]
+info = json.load(open(sys.argv[2]))
+text = open(sys.argv[3]).read()
+assert info["kind"] == "tile index" and info["tiles"] == v["tiles"], info
+assert info["points"] == 110000 and info["grid"]["depth"] == 4 and info["grid"]["tile_size"] == 256, info
+assert "classification" in info["attributes"] and info["crs"]["unit"] == "foot", info
+assert [o["level"] for o in info["overviews"]] == sorted({o["level"] for o in v["overviews"]}), info["overviews"]
+assert f"tiles:       {v['tiles']}," in text and "crs:         NAD_1983_HARN_Lambert_Conformal_Conic" in text, text
+PY
+"$vola" info "$tmp/bare/overviews" 2> "$tmp/err.txt" && fail "info on a folder without an index succeeded"
+grep -q "overviews is a folder with no index.geojson" "$tmp/err.txt" || fail "info on a folder: $(cat "$tmp/err.txt")"
+
 # As QGIS opens them, through OGR: the GeoJSON in WGS84, the GeoPackage in the survey's
 # own CRS (a WKT with no EPSG code), both with the tiles' extent.
 command -v ogrinfo > /dev/null || skip "ogrinfo not installed (apt-get install gdal-bin)"
