@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "text_output.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -58,6 +59,10 @@ std::vector<analysis::Region> parse_regions(const CensusArgs& a) {
   for (const std::string& b : a.boxes) {
     const auto v = parse_numbers(b, "--box");
     if (v.size() != 6) throw InvalidArgument("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+    for (int i = 0; i < 3; ++i)  // an upside-down box counted 0 voxels without a word; crop refuses one too
+      if (!(v[i] <= v[i + 3]))
+        throw InvalidArgument("--box " + b + ": its " + "xyz"[i] + " range runs from " + shortest_text(v[i]) +
+                              " down to " + shortest_text(v[i + 3]) + " (give the minima first)");
     regions.push_back({"box " + b, Box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}}, {}});
   }
   for (const std::string& p : a.polygons) {

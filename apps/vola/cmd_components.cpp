@@ -29,6 +29,7 @@ struct ComponentsArgs {
   std::string split_dir, labels_out;
   bool per_class = false;
   bool json = false;
+  bool overwrite = false;  // --split: remove an earlier run's component files first
 };
 
 // Components that pass the filters: a prefix of the size-sorted list.
@@ -42,6 +43,24 @@ Tree with_georef_of(Tree t, const Tree& source) {
   t.georef() = source.georef();
   if (source.stored_frame()) t.set_frame(*source.stored_frame());
   return t;
+}
+
+// An earlier run's component_NNNNNN.vol files would mix with this run's (a run keeping
+// fewer components left the rest behind): refused, or removed with --overwrite.
+void clear_or_refuse_split(const std::string& dir, bool overwrite) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  std::vector<std::filesystem::path> earlier;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("component_", 0) == 0 && entry.path().extension() == ".vol") earlier.push_back(entry.path());
+  }
+  if (earlier.empty()) return;
+  if (!overwrite)
+    throw InvalidArgument(dir + " holds " + std::to_string(earlier.size()) +
+                          " component files of an earlier run, which would mix with this run's: give an empty "
+                          "folder, or --overwrite to remove them first");
+  for (const auto& path : earlier) std::filesystem::remove(path);
 }
 
 void write_split(const Tree& tree, const analysis::ComponentLabels& r, std::size_t kept, const std::string& dir) {
@@ -126,7 +145,10 @@ void run_components(const ComponentsArgs& a) {
     }
     if (kept > a.list) std::printf("... %zu more (--list N)\n", kept - a.list);
   }
-  if (!a.split_dir.empty()) write_split(tree, r, kept, a.split_dir);
+  if (!a.split_dir.empty()) {
+    clear_or_refuse_split(a.split_dir, a.overwrite);
+    write_split(tree, r, kept, a.split_dir);
+  }
   if (!a.labels_out.empty()) write_labels(tree, r, kept, a.labels_out);
 }
 
@@ -146,6 +168,8 @@ void add_components(CLI::App& app) {
   cmd->add_option("--largest", args->largest, "Keep only the N largest components (0 = all)");
   cmd->add_option("--list", args->list, "Rows to print");
   cmd->add_option("--split", args->split_dir, "Write each kept component as its own .vol into this folder");
+  cmd->add_flag("--overwrite", args->overwrite,
+                "--split: remove the component_*.vol files an earlier run left in the folder (refused otherwise)");
   cmd->add_option("--labels", args->labels_out, "Write the input with a 'component' attribute column");
   cmd->add_flag("--per-class", args->per_class, "Components per classification code (needs a classification column)");
   cmd->add_flag("--json", args->json, "Print JSON");

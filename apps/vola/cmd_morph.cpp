@@ -30,6 +30,7 @@ struct MorphArgs {
   int depth = 1;
   std::uint64_t min_voxels = 1;
   bool quiet = false;
+  bool keep_grid = false;  // dilate: clip to the input's grid
 };
 
 CLI::App* add_io(CLI::App& app, const char* name, const char* help, const std::shared_ptr<MorphArgs>& args) {
@@ -73,12 +74,32 @@ void add_morph(CLI::App& app) {
   {
     auto args = std::make_shared<MorphArgs>();
     auto* cmd = add_io(app, "dilate", "Grow the voxels by a radius (inflate obstacles)", args);
-    cmd->footer(std::string("Example: vola dilate obstacles.vol --radius 3 inflated.vol\n") + kDropped);
+    cmd->footer(
+        "Where the voxels come within the radius of the grid's faces (a converted map's origin sits on its data's\n"
+        "minimum), the grid grows so that nothing is cut: its origin moves down by whole voxels and its depth rises\n"
+        "when needed, every voxel staying at its world place (the summary says so); --keep-grid clips instead.\n"
+        "Attribute columns and payloads are dropped.\n"
+        "Example: vola dilate obstacles.vol --radius 3 inflated.vol");
     add_radius(cmd, args);
+    cmd->add_flag("--keep-grid", args->keep_grid,
+                  "Keep the input's grid: what the dilation reaches beyond its faces is cut off");
     cmd->callback([args] {
       const Tree in = open_voxels(args->input);
-      finish(*args, "dilate", in,
-             morph_with_progress<&analysis::dilate>(*args, in, element_of(args->element), "dilating"));
+      const Tree out =
+          args->keep_grid
+              ? morph_with_progress<&analysis::dilate>(*args, in, element_of(args->element), "dilating")
+              : morph_with_progress<&analysis::dilate_unclipped>(*args, in, element_of(args->element), "dilating");
+      std::string grown;
+      const Frame before = in.frame(), after = out.frame();
+      if (out.depth() != in.depth() || before.origin != after.origin) {
+        char text[160];
+        std::snprintf(text, sizeof text, " (grid grown: origin moved by %.0f %.0f %.0f voxels, depth %d -> %d)",
+                      (after.origin[0] - before.origin[0]) / before.voxel_size,
+                      (after.origin[1] - before.origin[1]) / before.voxel_size,
+                      (after.origin[2] - before.origin[2]) / before.voxel_size, in.depth(), out.depth());
+        grown = text;
+      }
+      finish(*args, "dilate", in, out, grown);
     });
   }
   {

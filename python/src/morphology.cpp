@@ -28,6 +28,13 @@ Tree morph(const Tree& tree, int radius, const std::string& element) {
   return Op(tree, radius, kind, interruptible());
 }
 
+Tree dilate(const Tree& tree, int radius, const std::string& element, bool keep_grid) {
+  const auto kind = element_of(element);
+  py::gil_scoped_release release;
+  return keep_grid ? vola::analysis::dilate(tree, radius, kind, interruptible())
+                   : vola::analysis::dilate_unclipped(tree, radius, kind, interruptible());
+}
+
 py::tuple fill(const Tree& tree) {
   vola::analysis::FillReport report;
   Tree out;
@@ -61,8 +68,10 @@ Tree downsample(const Tree& tree, int depth, std::uint64_t min_voxels) {
 }  // namespace
 
 void bind_morphology(py::class_<Tree>& tree) {
-  tree.def("dilate", &morph<&vola::analysis::dilate>, py::arg("radius"), py::arg("element") = "sphere",
-           "The voxels within `radius` voxels of an occupied voxel (`vola dilate`), clipped to the grid.\n"
+  tree.def("dilate", &dilate, py::arg("radius"), py::arg("element") = "sphere", py::arg("keep_grid") = false,
+           "The voxels within `radius` voxels of an occupied voxel (`vola dilate`). Where they come within\n"
+           "`radius` of the grid's faces the grid grows (origin moved down by whole voxels, depth raised), so\n"
+           "nothing is cut and every voxel keeps its world place; keep_grid=True clips to the grid instead.\n"
            "element: 'sphere' (dx^2+dy^2+dz^2 <= r^2) or 'cube' (max |d| <= r). Attributes are dropped.")
       .def("erode", &morph<&vola::analysis::erode>, py::arg("radius"), py::arg("element") = "sphere",
            "The voxels whose whole element of `radius` is occupied (`vola erode`); cells outside the grid\n"

@@ -32,9 +32,16 @@ def test_dilate_and_erode_match_scipy(element):
     tree, grid = scene()
     for radius in (1, 2):
         structure = ball(radius, element)
-        np.testing.assert_array_equal(tree.dilate(radius, element).to_dense(),
+        np.testing.assert_array_equal(tree.dilate(radius, element, keep_grid=True).to_dense(),
                                       ndimage.binary_dilation(grid, structure=structure))
-        solid = tree.dilate(3, element)
+        # Unclipped: the grid grows by the radius where the voxels reach its faces, and the
+        # result is scipy's dilation of the grid padded by the radius, at the same world place.
+        grown = tree.dilate(radius, element)
+        padded = ndimage.binary_dilation(np.pad(grid, radius), structure=structure)
+        assert grown.depth == 4 and np.allclose(grown.origin, np.array(tree.origin) - radius * tree.voxel_size)
+        np.testing.assert_array_equal(grown.to_dense()[:padded.shape[0], :padded.shape[1], :padded.shape[2]], padded)
+        assert grown.to_dense().sum() == padded.sum()
+        solid = tree.dilate(3, element, keep_grid=True)
         np.testing.assert_array_equal(solid.erode(radius, element).to_dense(),
                                       ndimage.binary_erosion(solid.to_dense(), structure=structure, border_value=0))
     with pytest.raises(vola.InvalidArgument):

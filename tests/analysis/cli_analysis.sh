@@ -42,6 +42,18 @@ assert any(r["name"] == "Ground" for r in rows)
 PY
 done
 
+# --split refuses a folder holding an earlier run's components (a run keeping fewer left the
+# rest behind, mixed with its own), and --overwrite removes them first.
+mkdir -p "$tmp/old_parts" && echo > "$tmp/old_parts/component_000007.vol" && echo notes > "$tmp/old_parts/notes.txt"
+"$vola" components "$tmp/t.vol" --largest 2 --split "$tmp/old_parts" > /dev/null 2> "$tmp/err.txt" && fail "--split mixed runs"
+grep -q "old_parts holds 1 component files of an earlier run" "$tmp/err.txt" || fail "--split: $(cat "$tmp/err.txt")"
+"$vola" components "$tmp/t.vol" --largest 2 --split "$tmp/old_parts" --overwrite > /dev/null
+[ "$(ls "$tmp/old_parts" | tr '\n' ' ')" = "component_000000.vol component_000001.vol notes.txt " ] ||
+  fail "--overwrite left: $(ls "$tmp/old_parts")"
+# An upside-down census box is refused (it counted 0 voxels without a word).
+"$vola" census "$tmp/t.vol" --box 637000,849000,0,636000,850000,1000 2> "$tmp/err.txt" && fail "an upside-down box was counted"
+grep -q "its x range runs from 637000 down to 636000" "$tmp/err.txt" || fail "census box: $(cat "$tmp/err.txt")"
+
 # --split writes one file per kept component; together they hold the kept voxels.
 "$vola" components "$tmp/t.vol" --connectivity 26 --min-voxels 50 --list 1000000 --split "$tmp/parts" --json > "$tmp/comp.json"
 kept=$("$py" -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["kept"], sum(c["voxels"] for c in d["list"]))' "$tmp/comp.json")
@@ -57,9 +69,15 @@ labelled=$("$vola" voxels "$tmp/labels.vol" --attributes | grep -v '^#' | awk '$
 distinct=$("$vola" voxels "$tmp/labels.vol" --attributes | grep -v '^#' | awk '$NF != 4294967295 {print $NF}' | sort -u | wc -l)
 [ "$labelled" -eq "$2" ] && [ "$distinct" -eq "$1" ] || fail "--labels: $labelled voxels in $distinct components, --split: $2 in $1"
 
-# Morphology keeps the grid; dilate then diff counts what was added.
-"$vola" dilate "$tmp/t.vol" --radius 1 --element cube "$tmp/d.vol" > /dev/null
-"$vola" info "$tmp/d.vol" | grep -q "voxel size 2, origin (636000" || fail "dilate lost the grid"
+# dilate grows the grid where the voxels reach its faces (a converted survey's origin sits
+# on its data's minimum: the inflation below it was cut off); --keep-grid keeps the grid and
+# cuts. Then diff counts what was added (the grids differ; diff compares world places).
+"$vola" dilate "$tmp/t.vol" --radius 1 --element cube --keep-grid "$tmp/k.vol" > /dev/null
+"$vola" info "$tmp/k.vol" | grep -q "voxel size 2, origin (636000" || fail "dilate --keep-grid lost the grid"
+"$vola" dilate "$tmp/t.vol" --radius 1 --element cube "$tmp/d.vol" > "$tmp/d.txt"
+grep -q "(grid grown: origin moved by -1 -1 -1 voxels, depth 5 -> 5)" "$tmp/d.txt" || fail "dilate summary: $(cat "$tmp/d.txt")"
+"$vola" info "$tmp/d.vol" | grep -q "voxel size 2, origin (635998, 848932, 404)" || fail "dilate did not grow the grid"
+[ "$("$vola" voxels "$tmp/d.vol" | wc -l)" -gt "$("$vola" voxels "$tmp/k.vol" | wc -l)" ] || fail "the grown grid holds no more"
 out=$("$vola" diff "$tmp/t.vol" "$tmp/d.vol" --outputs "$tmp/change")
 n_t=$("$vola" voxels "$tmp/t.vol" | wc -l)
 n_d=$("$vola" voxels "$tmp/d.vol" | wc -l)

@@ -31,6 +31,39 @@ TEST(Morphology, DilateAndErodeMatchTheModel) {
   }
 }
 
+// A converted map's origin sits on its data's minimum: a clipped dilation lost the
+// inflation below it. dilate_unclipped grows the grid where the voxels come within the
+// radius of a face, and equals the model's dilation of the voxels moved onto that grid.
+TEST(Morphology, DilateUnclippedGrowsTheGridInsteadOfCuttingAtItsFaces) {
+  const XyzSet at_faces{{0, 0, 0}, {5, 6, 7}, {63, 63, 2}, {30, 0, 40}};  // depth 3: side 64
+  vola::Tree t = tree_of(at_faces, 3);
+  t.set_frame(vola::Frame{vola::Quantization::grid, {10, 20, 30}, 0.5});
+  for (Element e : {Element::sphere, Element::cube})
+    for (int r : {1, 2, 3}) {
+      SCOPED_TRACE((e == Element::cube ? "cube r" : "sphere r") + std::to_string(r));
+      const vola::Tree out = vola::analysis::dilate_unclipped(t, r, e);
+      const auto u = static_cast<std::uint32_t>(r);
+      XyzSet moved;  // every axis has a voxel at 0: the origin moves down by r on each
+      for (const Xyz& v : at_faces) moved.insert({v[0] + u, v[1] + u, v[2] + u});
+      EXPECT_EQ(out.depth(), 4);  // 63 + 2r needs more than 64 cells
+      EXPECT_EQ(vola_test::voxel_set(out), model_dilate(moved, 4, r, e));
+      const vola::Frame f = out.frame();
+      EXPECT_EQ(f.quantization, vola::Quantization::grid);
+      EXPECT_EQ(f.origin, (vola::Point{10 - 0.5 * r, 20 - 0.5 * r, 30 - 0.5 * r}));
+      EXPECT_EQ(f.voxel_size, 0.5);
+      EXPECT_GT(out.voxel_count(), vola::analysis::dilate(t, r, e).voxel_count());
+    }
+  // Voxels clear of every face: the grid stays, and the result is dilate's.
+  const XyzSet inside{{10, 10, 10}, {40, 41, 42}};
+  const vola::Tree clear = tree_of(inside, 3);
+  const vola::Tree same = vola::analysis::dilate_unclipped(clear, 3, Element::sphere);
+  EXPECT_EQ(same.depth(), 3);
+  EXPECT_EQ(vola_test::voxel_set(same), model_dilate(inside, 3, 3, Element::sphere));
+  // A grid that would need more than depth 10 is refused, naming the way out.
+  EXPECT_THROW(vola::analysis::dilate_unclipped(tree_of({{1048575, 5, 5}}, 10), 3, Element::cube),
+               vola::InvalidArgument);
+}
+
 // Solid boxes straddling block edges of every level (the walk gathers each block's
 // neighbours from the level above) and touching the grid's edges, at radii that need
 // one brick of halo, several cube steps (radius > 4) or wider windows (sphere radius

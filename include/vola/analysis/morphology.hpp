@@ -24,6 +24,14 @@ using MorphProgress = std::function<void(std::uint64_t done, std::uint64_t total
 // The voxels within the element of radius r of an occupied voxel, clipped to the grid.
 // r = 0 copies. Throws InvalidArgument for r < 0 or r >= the grid side.
 Tree dilate(const Tree& tree, int radius, Element element, const MorphProgress& progress = {});
+// dilate without the clipping: where the voxels come within r of the grid's faces, the
+// result's grid is grown first (its origin moved down by whole voxels, its depth raised
+// when the far side needs room), so every voxel within r of an occupied one is there,
+// at the same world place. A grid-mode file's origin sat on its data's minimum, so a
+// clipped dilation lost the inflation below every map (and `collide` found the inflated
+// map free where the map itself was hit). The result is grid-quantized. Throws
+// InvalidArgument when the grown grid would need more than depth 10 (dilate clips).
+Tree dilate_unclipped(const Tree& tree, int radius, Element element, const MorphProgress& progress = {});
 // The voxels whose whole element of radius r is occupied; cells outside the grid
 // count as empty (scipy.ndimage.binary_erosion's border_value = 0), so voxels within r
 // of the grid's edge are removed. Computed on the input's own bricks (AND over the
