@@ -139,6 +139,24 @@ cmp -s city.vol special/kept.vol || fail "the read-only file was replaced"
 ln -s ../city.vol special/link.vol
 refused "export over its input" "is the input: vola export writes another file" \
   "$vola" export special/link.vol city.vol --format xyz -q
+# A PNG, CSV, WAV or map written over the scene, recording or scan list it comes from:
+# refused (render, plan, sonify and map replaced their input and exited 0).
+cp room.vol special/scene.vol
+cp "$dry" special/dry.wav
+refused "render over its input" "scene.vol is the input: vola render writes new files" \
+  "$vola" render special/scene.vol -o special/scene.vol --size 32x24 -q
+refused "plan over its input" "scene.vol is the input: vola plan writes new files" \
+  "$vola" plan special/scene.vol --from 1 1 1 --to 5 3 2 -o special/scene.vol -q
+refused "sonify over its recording" "dry.wav is the input: vola sonify writes new files" \
+  "$vola" sonify special/scene.vol --source 1 1 1 --listener 5 3 2 --in special/dry.wav --out special/dry.wav -q
+cmp -s room.vol special/scene.vol || fail "an output replaced the scene"
+cmp -s "$dry" special/dry.wav || fail "sonify replaced the recording"
+cp room.xyz special/scan.xyz
+echo "scan.xyz 0 0 0 0 0 0 1" > special/scanlist.txt
+refused "map over its scan list" "scanlist.txt is the input: vola map writes new files" \
+  "$vola" map special/scanlist.txt -o special/scanlist.txt --voxel-size 1 -q
+refused "map over a scan" "scan.xyz is the input: vola map writes new files" \
+  "$vola" map special/scanlist.txt -o special/scan.xyz --voxel-size 1 -q
 cp room.vol special/target.vol
 ln -s target.vol special/through.vol
 "$vola" lod city.vol --depth 2 special/through.vol > /dev/null || fail "writing through a link failed"

@@ -33,12 +33,9 @@ struct CollideArgs {
 void print_segment_hit(const CollideArgs& a, const Point& from, const Point& to,
                        const raycast::RayHit& hit) {
   Point entry{};
-  double length = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    entry[i] = from[i] + hit.t * (to[i] - from[i]);
-    length += (to[i] - from[i]) * (to[i] - from[i]);
-  }
-  const double distance = hit.t * std::sqrt(length);
+  for (int i = 0; i < 3; ++i) entry[i] = from[i] + hit.t * (to[i] - from[i]);
+  // hypot: the squares of a segment 1e300 long overflowed, and the distance printed "inf".
+  const double distance = hit.t * std::hypot(to[0] - from[0], to[1] - from[1], to[2] - from[2]);
   const char* units = a.grid ? "voxels" : "world units";
   if (hit.t == 0.0)
     std::printf("hit: the segment starts inside voxel %u %u %u\n", hit.voxel.x, hit.voxel.y, hit.voxel.z);

@@ -59,7 +59,7 @@ std::vector<Point> read_points(const std::string& path) {
 // --points: one line per point, "occupied P", "free P" or "unknown" for a state map (P the
 // occupancy probability from the voxel's log-odds), "occupied" or "free" for any other
 // tree (space outside its voxels is free there). Voxel coordinates without --world are the
-// voxel's corner, so a point's voxel is its integer part.
+// voxel's corner, so a point's voxel is its integer part; one outside the grid is an error.
 void print_states(const GetArgs& a) {
   if (tile::is_tile_index_path(a.file)) throw InvalidArgument("--points takes a .vol file, not a tile index");
   const std::vector<Point> points = read_points(a.points);
@@ -71,15 +71,21 @@ void print_states(const GetArgs& a) {
     const map::StateLookup lookup(tree);
     for (const Point& p : points) found.push_back(lookup.at(p));
   } else {
+    // A voxel coordinate outside the grid names no voxel: most often world coordinates
+    // given without --world, which were all answered "free".
     const AttributeColumn* log_odds = tree.attributes().find("log_odds");
-    for (const Point& p : points) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Point& p = points[i];
+      if (!(p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] < tree.side() && p[1] < tree.side() && p[2] < tree.side()))
+        throw InvalidArgument(a.points + ": point " + std::to_string(i + 1) + " (" + shortest_text(p[0]) + ", " +
+                              shortest_text(p[1]) + ", " + shortest_text(p[2]) + ") is not a voxel coordinate in 0.." +
+                              std::to_string(tree.side() - 1) + " (use --world for CRS coordinates)");
       map::WorldState s{states ? map::VoxelState::unknown : map::VoxelState::free, {}};
-      if (p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] < tree.side() && p[1] < tree.side() && p[2] < tree.side()) {
-        const Voxel v{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]), static_cast<std::uint32_t>(p[2])};
-        s.state = map::state_at(tree, v);
-        if (log_odds && s.state != map::VoxelState::unknown)
-          if (const auto rank = tree.rank(v)) s.log_odds = static_cast<float>(log_odds->get(*rank));
-      }
+      const Voxel v{static_cast<std::uint32_t>(p[0]), static_cast<std::uint32_t>(p[1]),
+                    static_cast<std::uint32_t>(p[2])};
+      s.state = map::state_at(tree, v);
+      if (log_odds && s.state != map::VoxelState::unknown)
+        if (const auto rank = tree.rank(v)) s.log_odds = static_cast<float>(log_odds->get(*rank));
       found.push_back(s);
     }
   }

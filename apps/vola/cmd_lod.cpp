@@ -35,7 +35,10 @@ void run_lod(const LodArgs& a) {
 void add_lod(CLI::App& app) {
   auto args = std::make_shared<LodArgs>();
   auto* cmd = app.add_subcommand("lod", "Write a coarser copy: the first DEPTH levels, each voxel a 4^k-voxel cell");
-  cmd->footer("Example: vola lod city.vol --depth 4 city_lod4.vol");
+  cmd->footer(
+      "The copy keeps the occupancy and the georeference; attribute columns are not kept (vola downsample\n"
+      "keeps cells by how many voxels they hold).\n"
+      "Example: vola lod city.vol --depth 4 city_lod4.vol");
   cmd->add_option("input", args->input, "Input .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("--depth", args->depth, "Depth of the copy, 1..depth of the input")->required()->check(CLI::Range(1, 10));
   cmd->add_option("output", args->output, "Output .vol")->required();

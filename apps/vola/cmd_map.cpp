@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "number_checks.hpp"
+#include "output_checks.hpp"
 #include "progress.hpp"
 #include "text_output.hpp"
 #include "vola/error.hpp"
@@ -121,6 +122,9 @@ map::OccupancyMap resumed_map(const MapArgs& a) {
 void run_map(const MapArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<map::ScanEntry> scans = map::read_scan_list(a.list);
+  std::vector<std::string> inputs{a.list};
+  for (const map::ScanEntry& scan : scans) inputs.push_back(scan.file);
+  refuse_outputs_over_inputs(inputs, {a.output, a.free ? free_path(a.output) : std::string()}, "vola map");
   map::OccupancyMap m = a.from.empty() ? map::OccupancyMap(a.voxel_size) : resumed_map(a);
   std::unique_ptr<Progress> progress;
   if (!a.quiet) progress = std::make_unique<Progress>("inserting scans");

@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "open_voxels.hpp"
 #include "ir_plot.hpp"
+#include "open_voxels.hpp"
+#include "output_checks.hpp"
 #include "vola/audio/binaural.hpp"
 #include "vola/audio/convolve.hpp"
 #include "vola/audio/materials.hpp"
@@ -262,6 +263,9 @@ double scale_scene_to_metres(Tree& tree, const SonifyArgs& a) {
 }
 
 void run_sonify(SonifyArgs& a) {
+  std::vector<std::string> inputs = a.inputs;
+  inputs.insert(inputs.end(), {a.scene, a.materials, a.hrtf});
+  refuse_outputs_over_inputs(inputs, {a.output, a.ir, a.plot}, "vola sonify");
   if (a.payload_coefficients && !a.materials.empty())
     throw InvalidArgument("--payload-coefficients and --materials both say where coefficients come from: give one");
   const bool physical = a.model == "physical";

@@ -102,6 +102,12 @@ printf '1 2 3
 ' > "$tmp/bad_points.txt"
 "$vola" get "$tmp/map.vol" --world --points "$tmp/bad_points.txt" 2> "$tmp/err" && fail "a bad point line was accepted"
 grep -q 'bad_points.txt: line 2: expected three finite numbers' "$tmp/err" || fail "message: $(cat "$tmp/err")"
+# Without --world the points are voxel coordinates: one outside the grid (world coordinates
+# given without --world, all answered "free") is refused, as the single-point form refuses it.
+printf '1 2 3\n-0.5 0 0\n' > "$tmp/off_grid.txt"
+"$vola" get "$tmp/map.vol" --points "$tmp/off_grid.txt" 2> "$tmp/err" && fail "a point outside the grid was answered"
+grep -q 'off_grid.txt: point 2 (-0.5, 0, 0) is not a voxel coordinate in 0\.\..* (use --world for CRS coordinates)' "$tmp/err" ||
+  fail "message: $(cat "$tmp/err")"
 
 # collide on the state map: along the known free voxels, free; into space never seen,
 # free of occupied voxels but said to pass through unknown space.

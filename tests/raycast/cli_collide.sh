@@ -37,6 +37,9 @@ expect 3 '^hit: voxel 8 10 10, entered at 8 10.5 10.5 \(grid\), 7.5 voxels from 
   "$tmp/wall.vol" --grid --segment 0.5 10.5 10.5 14.5 10.5 10.5
 expect 3 '^hit: voxel 8 3 4, entered at 9 3.5 4.5 \(grid\), 5.5 voxels from the start through face 1 0 0$' \
   "$tmp/wall.vol" --grid --segment 14.5 3.5 4.5 0.5 3.5 4.5
+# A segment 1e300 long: the distance is still 7.5 (its squared length overflowed to inf).
+expect 3 '^hit: voxel 8 10 10, entered at 8 10.5 10.5 \(grid\), 7.5 voxels from the start through face -1 0 0$' \
+  "$tmp/wall.vol" --grid --segment 0.5 10.5 10.5 1e300 10.5 10.5
 expect 0 '^free: no occupied voxel on the segment$' "$tmp/wall.vol" --grid --segment 0.5 10.5 10.5 7.9 10.5 10.5
 expect 0 '^free' "$tmp/wall.vol" --segment 101 231 41 115.9 221 31
 expect 3 '^hit: the segment starts inside voxel 2 2 2$' "$tmp/wall.vol" --grid --segment 2.5 2.5 2.5 2.5 2.5 5.5
