@@ -144,7 +144,7 @@ Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions&
     if (report.points_in == 0) throw no_points(path, input, options);
     return tree;
   }
-  if (input.grid) input.cloud = grid_cell_centres(*input.grid);
+  if (input.grid) input.cloud = grid_cell_points(*input.grid, build);
   if (input.is_mesh()) return tree_from_mesh(input, build, options.solid, report);
   if (input.cloud.size() == 0) throw no_points(path, input, options);
   return input.terrain ? tree_from_terrain(input, build, report) : vola::build(input.cloud, build, &report);

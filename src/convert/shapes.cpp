@@ -58,6 +58,56 @@ PointCloud grid_cell_centres(const io::VoxelGrid& grid) {
   return cloud;
 }
 
+PointCloud grid_cell_points(const io::VoxelGrid& grid, const BuildOptions& options) {
+  PointCloud centres = grid_cell_centres(grid);
+  if (centres.size() == 0) return centres;
+  // The voxel the build will make: the given size, or the one the centres' extent gives
+  // (the points filling the cells reach further, so the build's voxel is no smaller).
+  double voxel = options.voxel_size;
+  if (options.quantization != Quantization::grid || !(voxel > 0.0)) {
+    Box box{{centres.xyz[0], centres.xyz[1], centres.xyz[2]}, {centres.xyz[0], centres.xyz[1], centres.xyz[2]}};
+    for (std::size_t i = 0; i < centres.size(); ++i)
+      for (int a = 0; a < 3; ++a) {
+        box.min[a] = std::min(box.min[a], centres.xyz[3 * i + a]);
+        box.max[a] = std::max(box.max[a], centres.xyz[3 * i + a]);
+      }
+    voxel = resolve_quantizer(options.bbox ? *options.bbox : box, options).frame().voxel_size;
+  }
+  if (!(voxel > 0.0) || voxel >= grid.voxel_size) return centres;
+  const double per_axis = std::ceil(grid.voxel_size / voxel);
+  constexpr double kMaxPoints = 268435456.0;  // 2^28: 6 GiB of coordinates
+  if (per_axis * per_axis * per_axis * static_cast<double>(centres.size()) > kMaxPoints)
+    throw InvalidArgument("voxels of " + std::to_string(voxel) + " in cells of " + std::to_string(grid.voxel_size) +
+                          ": filling each of the " + std::to_string(centres.size()) + " cells would take " +
+                          std::to_string(static_cast<std::uint64_t>(per_axis)) +
+                          "^3 points, more than 2^28; give a larger voxel size (the grid's own is " +
+                          std::to_string(grid.voxel_size) + ")");
+  const auto k = static_cast<std::size_t>(per_axis);
+  const double step = grid.voxel_size / per_axis;
+  PointCloud filled;
+  filled.xyz.reserve(3 * centres.size() * k * k * k);
+  filled.attributes = centres.attributes;
+  for (auto& a : filled.attributes) {
+    a.values.clear();
+    a.values.reserve(centres.size() * k * k * k);
+  }
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    const double corner[3] = {centres.xyz[3 * i] - 0.5 * grid.voxel_size,
+                              centres.xyz[3 * i + 1] - 0.5 * grid.voxel_size,
+                              centres.xyz[3 * i + 2] - 0.5 * grid.voxel_size};
+    for (std::size_t z = 0; z < k; ++z)
+      for (std::size_t y = 0; y < k; ++y)
+        for (std::size_t x = 0; x < k; ++x) {
+          filled.xyz.push_back(corner[0] + (static_cast<double>(x) + 0.5) * step);
+          filled.xyz.push_back(corner[1] + (static_cast<double>(y) + 0.5) * step);
+          filled.xyz.push_back(corner[2] + (static_cast<double>(z) + 0.5) * step);
+          for (std::size_t c = 0; c < filled.attributes.size(); ++c)
+            filled.attributes[c].values.push_back(centres.attributes[c].values[i]);
+        }
+  }
+  return filled;
+}
+
 Tree tree_from_mesh(const io::Input& input, const BuildOptions& options, bool solid, BuildReport& report) {
   if (options.payload) throw OptionError("nbits", "mesh input carries no payload");
   const Box bbox = options.bbox ? *options.bbox : mesh::triangle_bounds(input.triangles);
