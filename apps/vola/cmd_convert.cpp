@@ -26,7 +26,7 @@ struct ConvertArgs {
   ConvertOptions options;
   std::vector<double> origin, bbox;
   bool no_attributes = false, quiet = false;
-  std::vector<int> columns{1, 2, 3};
+  std::vector<int> columns;  // given: x y z, 1-based
 };
 
 ConvertOptions options_of(ConvertArgs& a) {
@@ -36,7 +36,7 @@ ConvertOptions options_of(ConvertArgs& a) {
   if (!a.origin.empty()) options.origin = Point{a.origin[0], a.origin[1], a.origin[2]};
   if (!a.bbox.empty()) options.bbox = Box{{a.bbox[0], a.bbox[1], a.bbox[2]}, {a.bbox[3], a.bbox[4], a.bbox[5]}};
   options.attributes = !a.no_attributes;
-  std::copy(a.columns.begin(), a.columns.end(), options.columns.begin());
+  if (!a.columns.empty()) options.columns = std::array<int, 3>{a.columns[0], a.columns[1], a.columns[2]};
   return options;
 }
 

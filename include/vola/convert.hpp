@@ -64,7 +64,9 @@ struct ConvertOptions {
   std::string grid;
   bool attributes = true;  // keep the per-point attributes the format carries (LAS, PLY, PCD, ...)
   // Text input (XYZ/TXT/CSV); column numbers count from 1, as a user reads the file.
-  std::array<int, 3> columns{1, 2, 3};  // x y z
+  // x y z columns (1-based); none given: found by name in a header line, else 1 2 3. Given
+  // (1 2 3 too), they win over the header's names.
+  std::optional<std::array<int, 3>> columns;
   std::vector<int> payload_columns;     // nbits 1: payload bytes 0..7 (default: every column after x y z)
   // Columns kept as attributes: NAME=COLUMN[:TYPE[:REDUCTION]], e.g. "intensity=4:u16:mean";
   // TYPE u8..u64 i8..i64 f32 f64 (default f32), REDUCTION last mean max min majority (default:

@@ -178,7 +178,7 @@ typedef struct vola_convert_options {
   const char *target_crs;              /* NULL, or reproject points into this CRS (EPSG code, WKT, PROJ string) */
   int level;                           /* COPC: read octree levels 0..level only; -1 (default) = all */
   int attributes;                      /* keep the format's per-point attributes (default 1) */
-  int columns[3];                      /* text: x y z columns (default 1 2 3) */
+  int columns[3]; /* text: x y z columns from 1; 0 0 0 (default): by a header's names, else 1 2 3 */
   const int *payload_columns;          /* text, nbits 1: payload byte columns (default: all after x y z) */
   size_t payload_column_count;
   const char *const *text_attributes;  /* text: "NAME=COLUMN[:TYPE[:REDUCTION]]" each */

@@ -177,7 +177,7 @@ Tree from_dense(const py::handle& input, std::optional<std::array<double, 3>> or
 Tree convert(const std::filesystem::path& path, int depth, double voxel_size, const std::string& quantize,
              const std::string& format, std::optional<std::uint32_t> epsg, bool solid, bool attributes,
              std::optional<double> dem_base, bool dem_surface_only, std::optional<std::array<double, 3>> origin,
-             std::optional<std::array<double, 6>> bbox, int nbits, std::array<int, 3> columns,
+             std::optional<std::array<double, 6>> bbox, int nbits, std::optional<std::array<int, 3>> columns,
              std::vector<int> payload_columns, std::vector<std::string> text_attributes, int skip_lines, bool dense,
              bool compress, const std::optional<std::filesystem::path>& output, const std::string& target_crs,
              std::optional<int> level, const std::string& assign_crs, bool allow_geographic, const std::string& grid,
@@ -198,7 +198,7 @@ Tree convert(const std::filesystem::path& path, int depth, double voxel_size, co
   options.level = level;
   options.grid = grid;
   options.attributes = attributes;
-  options.columns = columns;
+  options.columns = columns;  // None: by a header's names, else 1 2 3
   options.payload_columns = std::move(payload_columns);
   options.text_attributes = std::move(text_attributes);
   options.skip_lines = skip_lines;
@@ -275,7 +275,7 @@ void bind_building(py::module_& m) {
         py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(), py::arg("solid") = false,
         py::arg("attributes") = true, py::arg("dem_base") = py::none(), py::arg("dem_surface_only") = false,
         py::arg("origin") = py::none(), py::arg("bbox") = py::none(), py::arg("nbits") = 0,
-        py::arg("columns") = std::array<int, 3>{1, 2, 3}, py::arg("payload_columns") = std::vector<int>{},
+        py::arg("columns") = py::none(), py::arg("payload_columns") = std::vector<int>{},
         py::arg("text_attributes") = std::vector<std::string>{}, py::arg("skip_lines") = 0, py::arg("dense") = false,
         py::arg("compress") = false, py::arg("output") = py::none(), py::arg("target_crs") = "",
         py::arg("level") = py::none(), py::arg("assign_crs") = "", py::arg("allow_geographic") = false,

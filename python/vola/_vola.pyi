@@ -228,7 +228,7 @@ def convert(
     origin: Optional[Tuple[float, float, float]] = None,
     bbox: Optional[Tuple[float, float, float, float, float, float]] = None,
     nbits: int = 0,
-    columns: Tuple[int, int, int] = (1, 2, 3),
+    columns: Optional[Tuple[int, int, int]] = None,
     payload_columns: Sequence[int] = (),
     text_attributes: Sequence[str] = (),
     skip_lines: int = 0,

@@ -35,7 +35,9 @@ vola::ConvertOptions convert_options(const vola_convert_options& c) {
   if (c.level >= 0) o.level = c.level;
   if (c.grid) o.grid = c.grid;
   o.attributes = c.attributes != 0;
-  for (int i = 0; i < 3; ++i) o.columns[static_cast<std::size_t>(i)] = c.columns[i];
+  // 0 0 0 (the default): by a header's names, else 1 2 3; any other: given, 1 2 3 too.
+  if (c.columns[0] != 0 || c.columns[1] != 0 || c.columns[2] != 0)
+    o.columns = std::array<int, 3>{c.columns[0], c.columns[1], c.columns[2]};
   o.payload_columns.assign(c.payload_columns, c.payload_columns + c.payload_column_count);
   for (std::size_t i = 0; i < c.text_attribute_count; ++i) {
     vola::capi::require(c.text_attributes[i] != nullptr, "text_attributes holds a NULL");
@@ -85,9 +87,6 @@ void vola_convert_options_init(vola_convert_options* options) {
   options->quantization = VOLA_QUANTIZE_AUTO;
   options->attributes = 1;
   options->level = -1;
-  options->columns[0] = 1;
-  options->columns[1] = 2;
-  options->columns[2] = 3;
 }
 
 vola_status vola_convert(const char* input, const vola_convert_options* options, vola_tree** out,

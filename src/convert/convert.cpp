@@ -49,7 +49,7 @@ io::Input read(const std::string& path, const io::InputFormat& format, const Con
   if (format.name != "text") {
     const std::string why = "apply to text input only (" + path + " is " + format.name + ")";
     if (!options.text_attributes.empty()) throw OptionError("text_attributes", why);
-    if (options.columns != std::array<int, 3>{1, 2, 3}) throw OptionError("columns", why);
+    if (options.columns) throw OptionError("columns", why);
     if (!options.payload_columns.empty()) throw OptionError("payload_columns", why);
     if (options.skip_lines != 0) throw OptionError("skip_lines", why);
   }

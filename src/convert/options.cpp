@@ -80,14 +80,15 @@ BuildOptions build_options(const ConvertOptions& options, std::uint32_t epsg) {
 
 io::TextColumns text_columns(const std::string& input, const ConvertOptions& options) {
   io::TextColumns columns;
-  columns.x = options.columns[0] - 1;
-  columns.y = options.columns[1] - 1;
-  columns.z = options.columns[2] - 1;
+  const std::array<int, 3> xyz = options.columns.value_or(std::array<int, 3>{1, 2, 3});
+  columns.x = xyz[0] - 1;
+  columns.y = xyz[1] - 1;
+  columns.z = xyz[2] - 1;
   columns.skip_lines = options.skip_lines;
   // A header line lays the columns out unless the options do: all of them when no column
-  // option is given, x, y and z (--columns 1 2 3 being the default) when only payload or
-  // attribute columns are.
-  const bool xyz_given = options.columns != std::array<int, 3>{1, 2, 3};
+  // option is given, x, y and z when only payload or attribute columns are. `columns`
+  // given, 1 2 3 too, place x, y and z (taken for the default, 1 2 3 was ignored).
+  const bool xyz_given = options.columns.has_value();
   columns.from_header = !xyz_given && options.payload_columns.empty() && options.text_attributes.empty() &&
                         options.nbits == 0;
   columns.named_attributes = options.attributes;
@@ -124,8 +125,9 @@ void ConvertOptions::check() const {
   if (dense && compress) throw OptionError("compress", "compressed files are sparse (dense and compress together)");
   if (dense && compress_max)
     throw OptionError("compress_max", "compressed files are sparse, not `dense`");
-  for (int c : columns)
-    if (c < 1) throw OptionError("columns", "column numbers count from 1");
+  if (columns)
+    for (int c : *columns)
+      if (c < 1) throw OptionError("columns", "column numbers count from 1");
   for (int c : payload_columns)
     if (c < 1) throw OptionError("payload_columns", "column numbers count from 1");
   if (payload_columns.size() > 8) throw OptionError("payload_columns", "a payload word holds at most 8 bytes");

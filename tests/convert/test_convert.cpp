@@ -255,6 +255,25 @@ TEST(DescribeCrs, DefinitionsCannotReadOtherLocalFiles) {
   EXPECT_EQ(vola::geo::epsg_from_wkt(vola::geo::crs_wkt(32633)), 32633u);
 }
 
+// Columns given win over a header's names, 1 2 3 too (taken for the default, they were
+// ignored: x came from the header's "x", column 2, without a word).
+TEST(Convert, ColumnsGivenWinOverAHeaderEvenOneTwoThree) {
+  vola_test::TempDir dir;
+  const std::string text = "y x z intensity\n1 2 3 10\n4 5 6 20\n";
+  vola_test::write_bytes(dir / "yx.xyz", std::vector<std::uint8_t>(text.begin(), text.end()));
+  const std::string path = (dir / "yx.xyz").string();
+  vola::ConvertOptions by_name;
+  by_name.voxel_size = 1.0;
+  EXPECT_EQ(vola::convert(path, by_name).georef().bbox.min, (vola::Point{2, 1, 3}));  // x is the header's column 2
+  vola::ConvertOptions given = by_name;
+  given.columns = std::array<int, 3>{1, 2, 3};
+  EXPECT_EQ(vola::convert(path, given).georef().bbox.min, (vola::Point{1, 2, 3}));
+  // A header naming none of x, y and z converts when the columns are given.
+  const std::string unnamed = "a b c\n1 2 3\n";
+  vola_test::write_bytes(dir / "abc.xyz", std::vector<std::uint8_t>(unnamed.begin(), unnamed.end()));
+  EXPECT_EQ(vola::convert((dir / "abc.xyz").string(), given).georef().bbox.min, (vola::Point{1, 2, 3}));
+}
+
 TEST(Convert, LasStreamsToTheTreeTheWholeCloudBuilds) {
   VOLA_REQUIRE_DATA(data);
   const std::string las = (data / "las" / "pdal_autzen_trim.las").string();
