@@ -33,7 +33,7 @@ std::vector<std::string> token_names(const std::vector<std::string>& names, std:
   std::vector<std::string> out;
   for (std::string name : names) {
     for (char& c : name)
-      if (c <= ' ' || c > '~') c = '_';
+      if (c <= ' ' || c > '~' || c == ',' || c == ';' || c == '"') c = '_';
     if (name.empty()) name = "attribute";
     std::string unique = name;
     for (int n = 2; std::find(taken.begin(), taken.end(), unique) != taken.end(); ++n)

@@ -14,8 +14,10 @@ namespace vola::io {
 // (writers index columns by voxel rank).
 void require_complete_columns(const Tree& tree);
 
-// One name per column: characters that are not printable ASCII (or are spaces) become
-// '_', and a name equal to one in `taken` or to an earlier column's gets "_2", "_3"...
+// One name per column: characters that are not printable ASCII, spaces, and the text
+// reader's separators and quotes (, ; ") become '_' (a header "M3C2 distance","a,b" read
+// back as one more column than the values), and a name equal to one in `taken` or to an
+// earlier column's gets "_2", "_3"...
 std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken);
 std::vector<std::string> token_names(const std::vector<std::string>& names, std::vector<std::string> taken);
 

@@ -36,6 +36,7 @@ struct Field {
   std::uint64_t count = 1;
   std::uint64_t offset = 0;     // byte offset inside a point record
   std::uint64_t component = 0;  // index of its first value on an ascii line
+  std::string spelled;          // as the file spells it: treeID names an identifier, treeid does not
 };
 
 enum class DataKind { ascii, binary, binary_compressed };
@@ -58,7 +59,8 @@ std::string lower(std::string_view s) {
 
 // What the header's lines say, before it is checked as a whole.
 struct HeaderLines {
-  std::vector<std::string> fields;
+  std::vector<std::string> fields;   // lower case
+  std::vector<std::string> spelled;  // as written
   std::vector<int> sizes;
   std::vector<char> types;
   std::vector<std::uint64_t> counts;
@@ -99,7 +101,11 @@ HeaderLines read_header_lines(std::string_view text, const std::string& name, He
       // Nothing to check: the layout lines say everything the data needs.
     } else if (key == "fields" || key == "columns") {
       lines.fields.clear();
-      for (std::size_t i = 1; i <= n; ++i) lines.fields.push_back(lower(words[i]));
+      lines.spelled.clear();
+      for (std::size_t i = 1; i <= n; ++i) {
+        lines.fields.push_back(lower(words[i]));
+        lines.spelled.emplace_back(words[i]);
+      }
     } else if (key == "size") {
       numbers(lines.sizes, "SIZE");
     } else if (key == "type") {
@@ -144,7 +150,12 @@ Header parse_header(std::span<const std::uint8_t> bytes, const std::string& name
          std::to_string(lines.sizes.size()) + ", " + std::to_string(lines.types.size()) + ")");
   if (!lines.counts.empty() && lines.counts.size() != fields) fail("COUNT does not name every field");
   for (std::size_t f = 0; f < fields; ++f) {
-    Field field{lines.fields[f], lines.types[f], lines.sizes[f], lines.counts.empty() ? 1 : lines.counts[f]};
+    Field field;
+    field.name = lines.fields[f];
+    field.type = lines.types[f];
+    field.size = lines.sizes[f];
+    field.count = lines.counts.empty() ? 1 : lines.counts[f];
+    field.spelled = lines.spelled[f];
     const bool valid = (field.type == 'F' && (field.size == 4 || field.size == 8)) ||
                        ((field.type == 'I' || field.type == 'U') &&
                         (field.size == 1 || field.size == 2 || field.size == 4 || field.size == 8));
@@ -264,7 +275,7 @@ Layout find_layout(const Header& h, const std::string& name) {
     for (std::uint64_t element = 0; element < f.count; ++element) {
       std::string column = scalar(f) ? base : base + "_" + std::to_string(element);
       if (!taken.insert(column).second) continue;
-      const Reduction reduction = point_column_reduction(column, f.name);
+      const Reduction reduction = point_column_reduction(column, f.spelled);
       l.others.push_back({&f, std::move(column), field_value_type(f), reduction, element});
     }
   }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "export_test_support.hpp"
+#include "vola/builder.hpp"
 #include "vola/io/export.hpp"
 #include "vola/io/input.hpp"
 
@@ -80,6 +81,24 @@ TEST(XyzExport, ToolkitFileRoundTripsThroughToolkitQuantization) {
   options.bbox = tree.georef().bbox;
   EXPECT_EQ(vola_test::voxel_set(vola::build(in.cloud, options)), vola_test::voxel_set(tree));
   EXPECT_EQ(vola_test::voxel_set(tree), vola_test::read_voxel_list(golden / "crs29902_sparse" / "expected_voxels.txt"));
+}
+
+// Names the text reader splits at (a PDAL CSV's "a,b" or "x;y", quotes) become '_': the
+// export reads back with one column per value (it was one more name than values).
+TEST(XyzExport, NamesWithSeparatorsReadBackAsOneColumnEach) {
+  vola::Tree tree = vola::build_from_voxels(std::vector<vola::Voxel>{{0, 0, 0}, {1, 2, 3}}, 2);
+  for (const char* name : {"M3C2 distance", "a,b", "c;d", "\"q\""}) {
+    vola::AttributeColumn column(name, vola::ValueType::f64, vola::Reduction::mean, 2);
+    column.set(0, 1.5);
+    column.set(1, -2.0);
+    tree.attributes().add(std::move(column));
+  }
+  TempDir dir;
+  vola::io::write_xyz(tree, (dir / "s.xyz").string());
+  EXPECT_EQ(lines_of(dir / "s.xyz")[0], "# x y z M3C2_distance a_b c_d _q_");
+  const vola::io::Input in = vola::io::read_input((dir / "s.xyz").string(), "auto", {});
+  ASSERT_EQ(in.cloud.attributes.size(), 4u);
+  for (const auto& a : in.cloud.attributes) EXPECT_EQ(a.values, (std::vector<double>{1.5, -2.0})) << a.name;
 }
 
 TEST(XyzExport, EmptyTreeHasOnlyTheHeader) {

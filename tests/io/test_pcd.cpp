@@ -91,8 +91,11 @@ TEST(Pcd, PdalsLasFieldsComeOutAsTheLasReadersColumns) {
                            "edge_of_flight_line", "classification", "scan_angle_rank", "user_data", "point_source_id",
                            "gps_time", "red", "green", "blue"})
     EXPECT_TRUE(find(name)) << name;
-  ASSERT_TRUE(find("classification") && find("number_of_returns"));
+  ASSERT_TRUE(find("classification") && find("number_of_returns") && find("point_source_id"));
   EXPECT_EQ(find("classification")->reduction, vola::Reduction::majority);
+  // PointSourceId is an identifier by its spelling (the lower-cased pointsourceid is not):
+  // a voxel takes its points' most common one, as from LAS, PLY and NPY, not their mean.
+  EXPECT_EQ(find("point_source_id")->reduction, vola::Reduction::majority);
   EXPECT_EQ(find("number_of_returns")->reduction, vola::Reduction::max);
   // The same survey as LAS (EXPECTED.txt: both 1065 points): classes point for point.
   const auto las = vola::io::read_input((data / "las" / "pdal_autzen-utm.las").string(), "auto", {});
