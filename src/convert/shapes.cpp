@@ -58,6 +58,16 @@ PointCloud grid_cell_centres(const io::VoxelGrid& grid) {
   return cloud;
 }
 
+namespace {
+
+std::string shortest(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+}  // namespace
+
 PointCloud grid_cell_points(const io::VoxelGrid& grid, const BuildOptions& options) {
   PointCloud centres = grid_cell_centres(grid);
   if (centres.size() == 0) return centres;
@@ -75,13 +85,18 @@ PointCloud grid_cell_points(const io::VoxelGrid& grid, const BuildOptions& optio
   }
   if (!(voxel > 0.0) || voxel >= grid.voxel_size) return centres;
   const double per_axis = std::ceil(grid.voxel_size / voxel);
-  constexpr double kMaxPoints = 268435456.0;  // 2^28: 6 GiB of coordinates
-  if (per_axis * per_axis * per_axis * static_cast<double>(centres.size()) > kMaxPoints)
-    throw InvalidArgument("voxels of " + std::to_string(voxel) + " in cells of " + std::to_string(grid.voxel_size) +
-                          ": filling each of the " + std::to_string(centres.size()) + " cells would take " +
-                          std::to_string(static_cast<std::uint64_t>(per_axis)) +
-                          "^3 points, more than 2^28; give a larger voxel size (the grid's own is " +
-                          std::to_string(grid.voxel_size) + ")");
+  // 2^25 points: 800 MB of coordinates. A toolkit depth of 5 over a small grid asks for
+  // hundreds of voxels a cell side (a 2 x 3 x 4 grid: 81 million points).
+  constexpr double kMaxPoints = 33554432.0;
+  const double points = per_axis * per_axis * per_axis * static_cast<double>(centres.size());
+  if (points > kMaxPoints)
+    throw InvalidArgument("cells of " + shortest(grid.voxel_size) + " at voxels of " + shortest(voxel) +
+                          ": filling each of the " + std::to_string(centres.size()) +
+                          " occupied cells would set up to " + std::to_string(static_cast<std::uint64_t>(points)) +
+                          " voxels (" + std::to_string(static_cast<std::uint64_t>(per_axis)) +
+                          "^3 a cell), more than 2^25; give a larger voxel size or a smaller depth (the grid's own "
+                          "cell size, " +
+                          shortest(grid.voxel_size) + ", gives one voxel a cell)");
   const auto k = static_cast<std::size_t>(per_axis);
   const double step = grid.voxel_size / per_axis;
   PointCloud filled;

@@ -3,9 +3,10 @@
 #
 #   cli_io_formats.sh VOLA_BINARY DATA_DIR       ($VOLA_SHARED/data wins when set)
 #
-# Each converts with `--quantize toolkit --depth 5` into a non-empty tree of at most as
-# many voxels as points; binvox and NPY grids convert one cell to one voxel by default
-# (the voxel count equals the file's occupied count: EXPECTED.txt for the binvox).
+# Each point file converts with `--quantize toolkit --depth 5` into a non-empty tree of at
+# most as many voxels as points; binvox and NPY grids convert one cell to one voxel by
+# default (the voxel count equals the file's occupied count: EXPECTED.txt for the binvox)
+# and fill their cells on a finer grid (refused beyond 2^25 voxels).
 # Exit status: 0 all good, 1 failures, 77 data folder missing (outside CI).
 set -uo pipefail
 
@@ -58,7 +59,13 @@ while (((10 + ${#header} + 1) % 64 != 0)); do header+=" "; done
   printf '%s\n' "$header"
   printf '\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x01'
 } > "$npy"
-convert_toolkit "$npy" 3
+# At toolkit depth 5 its cells span hundreds of voxels a side: filling them is refused,
+# naming the grid's own cell size (each cell's centre alone left isolated voxels).
+if message=$("$vola" convert "$npy" "$tmp/deep.vol" --quantize toolkit --depth 5 -q 2>&1); then
+  fail "a 2x3x4 grid filled at depth 5"
+elif [[ $message != *"more than 2^25"*"the grid's own cell size, 1, gives one voxel a cell"* ]]; then
+  fail "grid.npy at depth 5: $message"
+fi
 if "$vola" convert "$npy" "$tmp/grid.vol" -q; then
   [[ $(voxels "$tmp/grid.vol") == 3 ]] || fail "grid.npy: $(voxels "$tmp/grid.vol") voxels, expected 3 (one per cell)"
 else
@@ -68,7 +75,13 @@ fi
 # binvox: one voxel per occupied cell by default.
 chair=$data/binvox/trimesh_chair_model.binvox
 occupied=$(sed -n 's/^trimesh_chair_model.binvox .* occupied=\([0-9]*\).*/\1/p' "$data/EXPECTED.txt")
-convert_toolkit "$chair" "$occupied"
+# At toolkit depth 3 (64 voxels over its 32-cell extent) every cell fills 2^3 voxels.
+if "$vola" convert "$chair" "$tmp/chair3.vol" --quantize toolkit --depth 3 -q; then
+  n=$(voxels "$tmp/chair3.vol")
+  [[ $n -gt $occupied && $n -le $((8 * occupied)) ]] || fail "$chair at depth 3: $n voxels for $occupied cells of 2^3"
+else
+  fail "vola convert $chair --quantize toolkit --depth 3"
+fi
 if "$vola" convert "$chair" "$tmp/chair.vol" -q; then
   n=$(voxels "$tmp/chair.vol")
   if [[ $n != "$occupied" ]]; then fail "$chair: $n voxels, EXPECTED.txt says occupied=$occupied"
