@@ -149,6 +149,17 @@ refused "plan over its input" "scene.vol is the input: vola plan writes new file
   "$vola" plan special/scene.vol --from 1 1 1 --to 5 3 2 -o special/scene.vol -q
 refused "sonify over its recording" "dry.wav is the input: vola sonify writes new files" \
   "$vola" sonify special/scene.vol --source 1 1 1 --listener 5 3 2 --in special/dry.wav --out special/dry.wav -q
+for op in "lod --depth 2" "dilate --radius 1" "crop --min 0,0,0 --max 3,3,3"; do
+  # shellcheck disable=SC2086
+  refused "${op%% *} over its input" "scene.vol is the input: vola ${op%% *} writes new files" \
+    "$vola" ${op%% *} special/scene.vol special/scene.vol ${op#* } -q
+done
+refused "union over an input" "scene.vol is the input: vola union writes new files" \
+  "$vola" union room.vol special/scene.vol special/scene.vol -q
+cp room.vol special/removed.vol
+refused "diff --outputs over an input" "removed.vol is the input: vola diff writes new files" \
+  "$vola" diff room.vol special/removed.vol --outputs special -q
+cmp -s room.vol special/removed.vol || fail "diff --outputs replaced its input"
 cmp -s room.vol special/scene.vol || fail "an output replaced the scene"
 cmp -s "$dry" special/dry.wav || fail "sonify replaced the recording"
 cp room.xyz special/scan.xyz

@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "open_voxels.hpp"
+#include "output_checks.hpp"
 #include "vola/analysis/census.hpp"
 #include "vola/analysis/components.hpp"
 #include "vola/builder.hpp"
@@ -113,6 +114,7 @@ void per_class(const Tree& tree, const ComponentsArgs& a, analysis::Connectivity
 }
 
 void run_components(const ComponentsArgs& a) {
+  refuse_outputs_over_inputs({a.file}, {a.labels_out}, "vola components --labels");
   const Tree tree = open_voxels(a.file);
   const analysis::Connectivity c = analysis::parse_connectivity(a.connectivity);
   if (a.per_class) return per_class(tree, a, c);
@@ -149,7 +151,7 @@ void run_components(const ComponentsArgs& a) {
     clear_or_refuse_split(a.split_dir, a.overwrite);
     write_split(tree, r, kept, a.split_dir);
   }
-  if (!a.labels_out.empty()) write_labels(tree, r, kept, a.labels_out);
+  if (!a.labels_out.empty()) write_labels(tree, r, kept, a.labels_out);  // its input refused before the work
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "open_voxels.hpp"
+#include "output_checks.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
 
@@ -18,6 +19,7 @@ struct LodArgs {
 };
 
 void run_lod(const LodArgs& a) {
+  refuse_outputs_over_inputs({a.input}, {a.output}, "vola lod");
   const Tree tree = open_voxels(a.input);
   if (a.depth > tree.depth())
     throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +

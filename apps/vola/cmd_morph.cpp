@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "number_checks.hpp"
 #include "open_voxels.hpp"
+#include "output_checks.hpp"
 #include "progress.hpp"
 #include "vola/analysis/crop.hpp"
 #include "vola/analysis/downsample.hpp"
@@ -61,6 +62,12 @@ analysis::Element element_of(const std::string& name) {
   return name == "cube" ? analysis::Element::cube : analysis::Element::sphere;
 }
 
+// The input, once the output is known not to be it (the result would replace it).
+Tree open_input(const MorphArgs& a, const char* name) {
+  refuse_outputs_over_inputs({a.input}, {a.output}, std::string("vola ") + name);
+  return open_voxels(a.input);
+}
+
 void finish(const MorphArgs& a, const char* name, const Tree& in, const Tree& out, const std::string& extra = {}) {
   write(out, a.output);
   if (!a.quiet)
@@ -84,7 +91,7 @@ void add_morph(CLI::App& app) {
     cmd->add_flag("--keep-grid", args->keep_grid,
                   "Keep the input's grid: what the dilation reaches beyond its faces is cut off");
     cmd->callback([args] {
-      const Tree in = open_voxels(args->input);
+      const Tree in = open_input(*args, "dilate");
       const Tree out =
           args->keep_grid
               ? morph_with_progress<&analysis::dilate>(*args, in, element_of(args->element), "dilating")
@@ -108,7 +115,7 @@ void add_morph(CLI::App& app) {
     cmd->footer(std::string("Cells outside the grid count as empty.\n") + kDropped);
     add_radius(cmd, args);
     cmd->callback([args] {
-      const Tree in = open_voxels(args->input);
+      const Tree in = open_input(*args, "erode");
       finish(*args, "erode", in,
              morph_with_progress<&analysis::erode>(*args, in, element_of(args->element), "eroding"));
     });
@@ -118,7 +125,7 @@ void add_morph(CLI::App& app) {
     auto* cmd = add_io(app, "fill", "Fill enclosed cavities (empty cells the outside cannot reach face to face)", args);
     cmd->footer(std::string("Works in the voxels' bounding box, refused beyond 2^33 cells (crop first).\n") + kDropped);
     cmd->callback([args] {
-      const Tree in = open_voxels(args->input);
+      const Tree in = open_input(*args, "fill");
       analysis::FillReport report;
       const Tree out = analysis::fill_cavities(in, &report);
       finish(*args, "fill", in, out, " (" + std::to_string(report.filled) + " cavity cells filled)");
@@ -131,7 +138,7 @@ void add_morph(CLI::App& app) {
     cmd->add_option("--min", args->min, "x,y,z of the first voxel (inclusive)")->required()->delimiter(',')->expected(3);
     cmd->add_option("--max", args->max, "x,y,z of the last voxel (inclusive)")->required()->delimiter(',')->expected(3);
     cmd->callback([args] {
-      const Tree in = open_voxels(args->input);
+      const Tree in = open_input(*args, "crop");
       const auto& lo = args->min;
       const auto& hi = args->max;
       finish(*args, "crop", in, analysis::crop(in, {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}));
@@ -145,7 +152,7 @@ void add_morph(CLI::App& app) {
     cmd->add_option("--depth", args->depth, "Depth of the result")->required()->check(CLI::Range(1, 10));
     cmd->add_option("--min-voxels", args->min_voxels, "Voxels a coarse cell needs to be kept")->check(positive_number());
     cmd->callback([args] {
-      const Tree in = open_voxels(args->input);
+      const Tree in = open_input(*args, "downsample");
       finish(*args, "downsample", in, analysis::downsample(in, args->depth, args->min_voxels));
     });
   }

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "open_voxels.hpp"
+#include "output_checks.hpp"
 #include "vola/analysis/change.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
@@ -53,6 +54,7 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args, op, name] {
+    refuse_outputs_over_inputs({args->a, args->b}, {args->output}, std::string("vola ") + name);
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);
     if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
@@ -82,6 +84,11 @@ void add_diff(CLI::App& app) {
   cmd->add_flag("--ignore-frame", args->ignore_frame, "Combine voxel indices even when the grids or CRSs differ");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] {
+    std::vector<std::string> outputs{args->output};
+    if (!args->outputs_dir.empty())
+      for (const char* file : {"added.vol", "removed.vol", "unchanged.vol"})
+        outputs.push_back((std::filesystem::path(args->outputs_dir) / file).string());
+    refuse_outputs_over_inputs({args->a, args->b}, outputs, "vola diff");
     const Tree a = open_voxels(args->a);
     const Tree b = open_voxels(args->b);
     if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
