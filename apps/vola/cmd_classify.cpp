@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -70,10 +71,20 @@ void print_segmentation(const learn::Segmentation& s, double vote_degrees) {
                 s.footprint_angle * 180 / 3.14159265358979323846, vote_degrees);
 }
 
-// The model file --model names, else the committed one for the task.
+// The model file --model names (a path, or a committed model's name such as
+// modelnet10-small-room, looked for where the default is), else the committed one for
+// the task.
 std::string model_path(const ClassifyArgs& a) {
-  if (!a.model.empty()) return a.model;
-  return learn::default_model_path(a.segment ? learn::kSegmentedRoomModelFile : learn::kDefaultModelFile);
+  if (a.model.empty())
+    return learn::default_model_path(a.segment ? learn::kSegmentedRoomModelFile : learn::kDefaultModelFile);
+  std::error_code error;
+  if (std::filesystem::exists(a.model, error) || a.model.find('/') != std::string::npos) return a.model;
+  const std::string file = a.model.ends_with(".pt") ? a.model : a.model + ".pt";
+  try {
+    return learn::default_model_path(file);
+  } catch (const IoError& e) {
+    throw IoError("--model " + a.model + ": no such file here, nor a committed model of that name (" + e.what() + ")");
+  }
 }
 
 learn::Classifier load_classifier(const ClassifyArgs& a, const std::string& path) {
@@ -292,6 +303,7 @@ constexpr const char* kModelFooter =
     "$VOLA_MODEL (the model file, or a folder holding it; a name that is neither is an error),\n"
     "<vola's folder>/../share/vola/models/ (installed), <vola's folder>/../models/, ../../models/ and\n"
     "../../../models/ (a build folder in the source tree), then the source tree vola was built from.\n"
+    "--model takes a file, or a committed model's name (modelnet10-small-room), looked for in the same places.\n"
     "`vola evaluate` prints the model file it used.\n";
 
 }  // namespace
@@ -299,34 +311,36 @@ constexpr const char* kModelFooter =
 void add_classify(CLI::App& app) {
   auto args = std::make_shared<ClassifyArgs>();
   auto* classify = app.add_subcommand("classify", kClassifySummary);
-  classify->footer(std::string(kModelFooter) +
-                   "Prints the most likely class and its probability, then all ten probabilities.\n"
-                   "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
-                   "With --segment the object is first found in a scene (a room with floor, walls, clutter: `vola\n"
-                   "dataset --background`, or a voxelised scan): the class lines come first, then the planes removed,\n"
-                   "the pieces left and the object kept (voxels, box, the turn of its footprint, the vote kept).\n"
-                   "A scene with no object left once its planes are removed is an error.\n"
-                   "Examples:\n  vola classify data/clean/val/chair/chair_01234.vol\n"
-                   "  vola classify data/room/val/chair/chair_01234.vol --model models/modelnet10-small-room.pt --votes 12\n"
-                   "  vola classify data/room/val/chair/chair_01234.vol --segment        # the room-segmented model\n"
-                   "  vola classify data/room/val/chair/chair_01234.vol --segment --model models/modelnet10-small-full-circle.pt \\\n"
-                   "    --votes 12 --orientations mean");
+  classify->footer(
+      std::string(kModelFooter) +
+      "Prints the most likely class and its probability, then all ten probabilities.\n"
+      "Files are 64^3 trees as `vola dataset` writes (finer grids are read at 64^3 or 32^3).\n"
+      "With --segment the object is first found in a scene (a room with floor, walls, clutter: `vola\n"
+      "dataset --background`, or a voxelised scan): the class lines come first, then the planes removed,\n"
+      "the pieces left and the object kept (voxels, box, the turn of its footprint, the vote kept).\n"
+      "A scene with no object left once its planes are removed is an error.\n"
+      "Examples:\n  vola classify data/clean/val/chair/chair_01234.vol\n"
+      "  vola classify data/room/val/chair/chair_01234.vol --model modelnet10-small-room --votes 12\n"
+      "  vola classify data/room/val/chair/chair_01234.vol --segment        # the room-segmented model\n"
+      "  vola classify data/room/val/chair/chair_01234.vol --segment --model modelnet10-small-full-circle \\\n"
+      "    --votes 12 --orientations mean");
   classify->add_option("file", args->inputs, ".vol files")->required()->check(CLI::ExistingFile);
   add_model_options(classify, *args);
   classify->callback([args] { run_classify(*args); });
 
   auto eargs = std::make_shared<ClassifyArgs>();
   auto* evaluate = app.add_subcommand("evaluate", kEvaluateSummary);
-  evaluate->footer(std::string(kModelFooter) +
-                   "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
-                   "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
-                   "with the lines `mean per-class accuracy: 0.xxxx (N classes)` and `accuracy: 0.xxxx`.\n"
-                   "With --segment each scene's object is found first (see `vola classify --help`); scenes where none\n"
-                   "is found count as wrong and are said.\n"
-                   "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"
-                   "  vola evaluate data/room/val --model models/modelnet10-small-room.pt --votes 12\n"
-                   "  vola evaluate data/room/val --segment                 # the room-segmented model, 4 votes\n"
-                   "  vola evaluate data/room/val --segment --model models/modelnet10-small-full-circle.pt --votes 12 --orientations mean");
+  evaluate->footer(
+      std::string(kModelFooter) +
+      "DIR holds <class>/*.vol (as `vola dataset` writes). Prints the speed, per-class accuracy and\n"
+      "the confusion matrix, writes it as a PNG heat map (rows true, columns predicted), and ends\n"
+      "with the lines `mean per-class accuracy: 0.xxxx (N classes)` and `accuracy: 0.xxxx`.\n"
+      "With --segment each scene's object is found first (see `vola classify --help`); scenes where none\n"
+      "is found count as wrong and are said.\n"
+      "Examples:\n  vola evaluate data/clean/val --png val_confusion.png\n"
+      "  vola evaluate data/room/val --model modelnet10-small-room --votes 12\n"
+      "  vola evaluate data/room/val --segment                 # the room-segmented model, 4 votes\n"
+      "  vola evaluate data/room/val --segment --model modelnet10-small-full-circle --votes 12 --orientations mean");
   evaluate->add_option("dir", eargs->inputs, "Dataset folder")->required()->expected(1)->check(CLI::ExistingDirectory);
   evaluate->add_option("--png", eargs->png, "Confusion matrix image ('' for none)")->capture_default_str();
   evaluate->add_option("--json", eargs->json,

@@ -157,7 +157,7 @@ void add_render(CLI::App& app) {
       "each tile mapped when a ray first reaches it; depths are in world units.\n"
       "Examples:\n"
       "  vola render city.vol -o city.png                         (the whole scene, from above a corner)\n"
-      "  vola render city.vol --camera 100 -50 80 512 512 0 --size 1280x720 -o view.png\n"
+      "  vola render city.vol --grid --camera 100 -50 80 512 512 0 --size 1280x720 -o view.png\n"
       "  vola render city.vol --grid --camera 0 0 300 512 512 0 --orbit 36 -o orbit.png  (orbit_0000.png ...)\n"
       "  vola render tiles/index.geojson --size 1024x768 -o survey.png");
   cmd->add_option("input", args->input, "Input .vol or tile index (.geojson)")->required()->check(CLI::ExistingFile);

@@ -81,6 +81,15 @@ model_dir=$(dirname "$(sed -n 's/^model: //p' "$work/eval.txt")")
 VOLA_MODEL=$model_dir "$vola" classify "$monitor" | head -n 1 | grep -q "^monitor " || fail "VOLA_MODEL as a folder"
 if "$vola" classify --model "$model_dir" "$monitor" > /dev/null 2> "$work/err.txt"; then fail "a folder as --model"; fi
 grep -q "a folder, not a model file" "$work/err.txt" || fail "--model folder: $(cat "$work/err.txt")"
+# --model takes a committed model's name, found where the default is; an unknown name says
+# where it looked.
+(cd "$work" && "$vola" classify --model modelnet10-small "$monitor") | head -n 1 | grep -q "^monitor " ||
+  fail "--model by a committed model's name"
+if (cd "$work" && "$vola" classify --model no-such-model "$monitor") > /dev/null 2> "$work/err.txt"; then
+  fail "an unknown model name was accepted"
+fi
+grep -q -- "--model no-such-model: no such file here, nor a committed model of that name" "$work/err.txt" ||
+  fail "--model unknown name: $(cat "$work/err.txt")"
 if "$vola" classify --orientations mean "$monitor" 2> "$work/err.txt" > /dev/null; then fail "--orientations without --segment"; fi
 grep -q -- "--orientations applies only with --segment" "$work/err.txt" || fail "orientations: $(cat "$work/err.txt")"
 "$vola" diff "$monitor" "$monitor" "$work/empty.vol" > /dev/null
