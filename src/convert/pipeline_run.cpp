@@ -40,8 +40,7 @@ ConvertOptions convert_options(const filters::PipelineWriter& writer, const std:
   return options;
 }
 
-// Every .vol writer's options, checked before any writer runs: a mistake in the last
-// writer left the earlier ones' files behind, and was said in the CLI's flags.
+// Whether the input is a point format (a voxel grid or map needs no voxel size).
 bool reads_points(const std::string& input) {
   static const char* const kPointFormats[] = {"las", "text", "ply", "pcd", "kitti", "ept", "ptx", "e57"};
   try {
@@ -52,6 +51,8 @@ bool reads_points(const std::string& input) {
   }
 }
 
+// A .vol writer's options, checked before any writer runs: a mistake in the last writer
+// left the earlier ones' files behind, and was said in the CLI's flags.
 void check_voxel_writer(const std::string& input, const filters::PipelineWriter& writer,
                         const std::vector<std::string>& stages) {
   const ConvertOptions options = convert_options(writer, stages);

@@ -55,6 +55,14 @@ class StageReader {
   const std::string& type() const { return type_; }
   [[noreturn]] void fail(const std::string& what) const { throw InvalidArgument(prefix_ + what); }
   bool has(const char* key) const { return stage_.contains(key); }
+  // A number of an option's value, its error said with the stage's prefix.
+  double number_in(const json& value, const std::string& what) const {
+    try {
+      return numeric(value, what);
+    } catch (const InvalidArgument& e) {
+      fail(e.what());
+    }
+  }
   double number(const char* key) const {
     if (!stage_.contains(key)) fail(std::string("needs \"") + key + "\"");
     try {
@@ -154,7 +162,7 @@ class StageReader {
     std::vector<double> box;
     const json parsed = json::parse(text, nullptr, false);
     if (!parsed.is_discarded() && parsed.is_array()) {
-      for (const json& v : parsed) box.push_back(numeric(v, "a bound"));
+      for (const json& v : parsed) box.push_back(number_in(v, "a bound"));
       if (box.size() == 6)
         box = {box[0], box[1], box[3], box[4], box[2], box[5]};
       else if (box.size() != 4)
@@ -165,13 +173,13 @@ class StageReader {
           fail(std::string(forms) + ": no key \"" + key + "\"");
       for (const char* key : {"minx", "miny", "maxx", "maxy"}) {
         if (!parsed.contains(key)) fail(std::string(forms) + ": \"" + key + "\" is missing");
-        box.push_back(numeric(parsed.at(key), std::string("\"") + key + "\""));
+        box.push_back(number_in(parsed.at(key), std::string("\"") + key + "\""));
       }
       if (parsed.contains("minz") != parsed.contains("maxz"))
         fail(std::string(forms) + ": \"minz\" and \"maxz\" go together");
       if (parsed.contains("minz")) {
-        box.push_back(numeric(parsed.at("minz"), "\"minz\""));
-        box.push_back(numeric(parsed.at("maxz"), "\"maxz\""));
+        box.push_back(number_in(parsed.at("minz"), "\"minz\""));
+        box.push_back(number_in(parsed.at("maxz"), "\"maxz\""));
       }
     } else {
       box = classic_bounds(text, forms);
@@ -201,7 +209,7 @@ class StageReader {
       digits.erase(0, digits.find_first_not_of(" \t"));
       digits.erase(digits.find_last_not_of(" \t") + 1);
       i = stop + 1;
-      return numeric(json(digits), "a bound");
+      return number_in(json(digits), "a bound");
     };
     expect('(');
     do {
