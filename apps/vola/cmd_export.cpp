@@ -170,6 +170,9 @@ void run_export(const ExportArgs& a) {
   } else if (format == "xyz") {
     io::write_xyz(tree, a.output);
     say("XYZ: " + std::to_string(voxels) + " voxel centres");
+  } else if (format == "csv") {
+    io::write_csv(tree, a.output);
+    say("CSV: " + std::to_string(voxels) + " voxel centres");
   } else if (format == "las") {
     const io::LasReport r = io::write_las(tree, a.output);
     std::string what = std::string(io::lower_extension(a.output) == ".laz" ? "LAZ" : "LAS") + " 1.4 point format " +
@@ -238,6 +241,7 @@ void add_export(CLI::App& app) {
       "  .ply     voxel centres with every attribute as a vertex property (binary; --ascii),\n"
       "           or with --cubes the voxels' outer surface as quads (shared faces removed)\n"
       "  .xyz     \"x y z [attributes]\" text, full double precision\n"
+      "  .csv     the same as CSV with PDAL's writers.text header (\"X\",\"Y\",\"Z\",\"Intensity\",...)\n"
       "  .las     LAS 1.4 point format 6 (7 with red/green/blue): voxel centres, attributes\n"
       "           restored, the CRS as WKT\n"
       "  .laz     the same, LASzip-compressed (vola's own LAZ codec)\n"
@@ -300,8 +304,9 @@ void add_export(CLI::App& app) {
   cmd->add_option("input", args->input, "Input .vol file")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output file (a directory with --slices)")->required();
   cmd->add_option("--format", args->format,
-                  "auto (from OUT's extension), ply, xyz, las, binvox, npy, png, tif, octomap, vdb, rosmap")
-      ->check(CLI::IsMember({"auto", "ply", "xyz", "las", "binvox", "npy", "png", "tif", "octomap", "vdb", "rosmap"}))
+                  "auto (from OUT's extension), ply, xyz, csv, las, binvox, npy, png, tif, octomap, vdb, rosmap")
+      ->check(CLI::IsMember(
+          {"auto", "ply", "xyz", "csv", "las", "binvox", "npy", "png", "tif", "octomap", "vdb", "rosmap"}))
       ->capture_default_str();
   cmd->add_flag("--ascii", args->ascii, "PLY: ascii instead of binary little-endian");
   cmd->add_flag("--cubes", args->cubes, "PLY: the voxels' outer surface as a quad mesh instead of centre points");

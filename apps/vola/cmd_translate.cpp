@@ -1,5 +1,5 @@
 // vola translate: point files to point files, point by point, no voxels (PDAL's
-// translate): LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI in; LAS, LAZ, PLY, XYZ out.
+// translate): LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI in; LAS, LAZ, PLY, XYZ, CSV out.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -76,7 +76,8 @@ void add_translate(CLI::App& app) {
       "Every point record is copied as it is, in order: coordinates, returns, classes, GPS time,\n"
       "colour, NIR, extra bytes; the header, the CRS and the other (E)VLRs too. A .laz output is\n"
       "LASzip-compressed (compressor 2 for point formats 0-5, 3 for 6-10) in chunks of 50000 points.\n"
-      "A .ply (binary) or .xyz output holds x y z and every field as a named column, from any\n"
+      "A .ply (binary), .xyz or .csv output (PDAL's CSV: \"X\",\"Y\",\"Z\",\"Intensity\",...) holds x y z and\n"
+      "every field as a named column, from any\n"
       "point file vola reads (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI), but not the CRS (a\n"
       "warning says so). Other inputs to LAS/LAZ become LAS 1.4 point format 6 or 7 records with\n"
       "the fields LAS has (colour, intensity, classification, returns, GPS time, ...).\n"
@@ -93,7 +94,7 @@ void add_translate(CLI::App& app) {
       std::string(kFilterHelp));
   cmd->add_option("input", args->input, "Input point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("output", args->output, "Output .las, .laz, .ply or .xyz")->required();
+  cmd->add_option("output", args->output, "Output .las, .laz, .ply, .xyz or .csv")->required();
   add_filter_options(*cmd, args->filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_translate(*args); });

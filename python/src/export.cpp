@@ -171,7 +171,8 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
       py::arg("path"), py::arg("slices"), py::arg("map"), py::arg("occupancy_above"), py::arg("raster"),
       py::arg("resolution"), py::arg("ascii"), py::arg("cubes"), py::arg("bits"), py::arg("free"),
       py::arg("band") = false, py::arg("format") = "auto",
-      "vola.export's format ('ply', 'xyz', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap') from the\n"
+      "vola.export's format ('ply', 'xyz', 'csv', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap') "
+      "from the\n"
       "path's extension (or format, when not 'auto') and which options were given (True: given), by the rule `vola "
       "export` uses;\n"
       "InvalidArgument when an option does not apply to the format.");
@@ -204,6 +205,14 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
         write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_xyz(t, path.string()); }); });
       }, py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
       "'x y z [attributes]' text per voxel centre, full double precision (`vola export TREE OUT.xyz`).");
+  m.def(
+      "export_csv",
+      [](const Tree& tree, const std::filesystem::path& path, int depth) {
+        write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_csv(t, path.string()); }); });
+      },
+      py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
+      "The voxel centres as CSV with PDAL's writers.text header (\"X\",\"Y\",\"Z\",\"Intensity\",...)\n"
+      "(`vola export TREE OUT.csv`): pandas.read_csv reads it by name.");
   m.def("export_las", &export_las, py::arg("tree"), py::arg("path"), py::arg("depth") = 0,
         "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
         "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"

@@ -27,6 +27,7 @@ def test_point_and_grid_files_match_the_cli(autzen, vola_cli, tmp_path):
         ("b.ply", ["--ascii", "--cubes", "--depth", "4"], autzen,
          lambda t, p: vola.export_ply(t, p, ascii=True, cubes=True, depth=4)),
         ("c.xyz", [], autzen, vola.export_xyz),
+        ("c.csv", [], autzen, vola.export_csv),
         ("d.las", [], autzen, vola.export_las),
         ("e.laz", [], autzen, vola.export_las),
         ("f.binvox", ["--depth", "4"], coarse, vola.export_binvox),
@@ -131,6 +132,7 @@ def test_export_by_extension_writes_what_the_cli_writes(autzen, vola_cli, tmp_pa
     runs = (
         ("a.ply", ["--ascii"], {"ascii": True}),
         ("b.xyz", [], {}),
+        ("b.csv", [], {}),
         ("c.laz", [], {}),
         ("d.npy", ["--depth", "4"], {"depth": 4}),
         ("e.png", ["--map", "--bits", "8"], {"map": True, "bits": 8}),

@@ -80,6 +80,7 @@ from ._vola import (
     describe_crs,
     difference,
     export_binvox,
+    export_csv,
     export_height_map,
     export_las,
     export_map,
@@ -143,7 +144,7 @@ def _refusing_cut_mappings(function):
 for _name, _member in list(vars(Tree).items()):
     if type(_member).__name__ == "instancemethod" and _name not in ("__repr__", "__len__", "__setstate__", "check_mapped"):
         setattr(Tree, _name, _refusing_cut_mappings(_member))
-for _name in ("difference", "export_binvox", "export_height_map", "export_las", "export_map", "export_npy",
+for _name in ("difference", "export_binvox", "export_csv", "export_height_map", "export_las", "export_map", "export_npy",
               "export_occupancy_above", "export_ply", "export_raster", "export_ros_map", "export_slices", "export_xyz", "free_tree",
               "intersect", "occupied_tree", "probability", "state", "union", "_export_format"):
     globals()[_name] = _refusing_cut_mappings(globals()[_name])
@@ -179,6 +180,7 @@ __all__ = [
     "difference",
     "export",
     "export_binvox",
+    "export_csv",
     "export_height_map",
     "export_las",
     "export_map",
@@ -254,9 +256,9 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
            slices: bool = False, ascii: bool = False, cubes: bool = False,  # noqa: A002 (--ascii)
            free: Optional[Tree] = None, band: Optional[Tuple[float, float]] = None, depth: int = 0,
            format: str = "auto") -> Any:  # noqa: A002 (--format)
-    """`vola export TREE OUT` in one call: the format from path's extension (.ply, .xyz, .las,
-    .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb, .yaml), or format= one of 'ply', 'xyz',
-    'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap' for a path without one
+    """`vola export TREE OUT` in one call: the format from path's extension (.ply, .xyz, .csv,
+    .las, .laz, .binvox, .npy, .tif, .png, .bt, .ot, .vdb, .yaml), or format= one of 'ply', 'xyz',
+    'csv', 'las', 'binvox', 'npy', 'png', 'tif', 'octomap', 'vdb', 'rosmap' for a path without one
     (`vola export --format`); options as the CLI's flags:
     raster='dsm'|'dtm'|'intensity'|'density'|'count' (+ resolution) for a GeoTIFF; map=True
     (+ bits) or occupancy_above=Z for a PNG, slices=True for a directory of PNGs; ascii/cubes
@@ -283,4 +285,5 @@ def export(tree: Tree, path: PathLike, *, raster: Optional[str] = None, resoluti
         return export_map(tree, path, free, depth)
     if fmt == "rosmap":
         return export_ros_map(tree, path, tuple(band), free, depth)
-    return {"xyz": export_xyz, "las": export_las, "binvox": export_binvox, "npy": export_npy}[fmt](tree, path, depth)
+    return {"xyz": export_xyz, "csv": export_csv, "las": export_las, "binvox": export_binvox,
+            "npy": export_npy}[fmt](tree, path, depth)

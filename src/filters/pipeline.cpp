@@ -262,11 +262,11 @@ std::string reader_type_of(const std::string& filename) {
 // The writer PDAL would infer from a name's extension; empty when vola writes no such file.
 std::string writer_type_of(const std::string& filename) {
   const std::string extension = lower_extension(filename);
-  return extension == ".vol"                          ? "writers.vola"
-         : extension == ".las" || extension == ".laz" ? "writers.las"
-         : extension == ".ply"                        ? "writers.ply"
-         : extension == ".xyz" || extension == ".txt" ? "writers.text"
-                                                      : "";
+  return extension == ".vol"                                                 ? "writers.vola"
+         : extension == ".las" || extension == ".laz"                        ? "writers.las"
+         : extension == ".ply"                                               ? "writers.ply"
+         : extension == ".xyz" || extension == ".txt" || extension == ".csv" ? "writers.text"
+                                                                             : "";
 }
 
 // One object stage into `pipeline`: a reader, a writer or a filter.
@@ -281,7 +281,7 @@ void read_stage(const json& element, std::size_t index, std::size_t stages, Pipe
     json typed = element;
     typed["type"] = index == 0 ? reader_type_of(file) : writer_type_of(file);
     if (index != 0 && typed["type"] == "")
-      stage.fail(file + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz or .txt");
+      stage.fail(file + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz, .txt or .csv");
     read_stage(typed, index, stages, pipeline);
     return;
   }
@@ -297,7 +297,7 @@ void read_stage(const json& element, std::size_t index, std::size_t stages, Pipe
     const std::string extension = lower_extension(writer.filename);
     const std::string wants = writer_type_of(writer.filename);
     if (wants.empty())
-      stage.fail(writer.filename + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz or .txt");
+      stage.fail(writer.filename + ": vola writes by the name's extension: .vol, .las, .laz, .ply, .xyz, .txt or .csv");
     if (type != wants)
       stage.fail(type + " cannot write " + writer.filename + ": vola writes by the name's extension, and " + extension +
                  " is " + wants);

@@ -66,6 +66,9 @@ std::string point_column_name(std::string_view raw) {
       {"userdata", "user_data"},
       {"pointsourceid", "point_source_id"},
       {"gpstime", "gps_time"},
+      {"classflags", "classification_flags"},  // PDAL's names of the LAS 1.4 fields
+      {"scannerchannel", "scanner_channel"},
+      {"infrared", "nir"},
       {"r", "red"},
       {"g", "green"},
       {"b", "blue"},

@@ -1,5 +1,8 @@
 #include "export_columns.hpp"
 
+#include <string_view>
+#include <utility>
+
 #include <algorithm>
 #include <charconv>
 #include <cstdint>
@@ -48,6 +51,40 @@ std::vector<std::string> token_names(const Attributes& attributes, std::vector<s
   std::vector<std::string> names;
   for (const auto& column : attributes.columns()) names.push_back(column.name());
   return token_names(names, std::move(taken));
+}
+
+std::string text_header(const std::vector<std::string>& names, bool csv) {
+  if (!csv) {
+    std::string line = "# x y z";
+    for (const auto& name : names) line += " " + name;
+    return line + '\n';
+  }
+  static constexpr std::pair<std::string_view, std::string_view> kPdalNames[] = {
+      {"intensity", "Intensity"},
+      {"return_number", "ReturnNumber"},
+      {"number_of_returns", "NumberOfReturns"},
+      {"scan_direction_flag", "ScanDirectionFlag"},
+      {"edge_of_flight_line", "EdgeOfFlightLine"},
+      {"classification", "Classification"},
+      {"scan_angle_rank", "ScanAngleRank"},
+      {"user_data", "UserData"},
+      {"point_source_id", "PointSourceId"},
+      {"gps_time", "GpsTime"},
+      {"red", "Red"},
+      {"green", "Green"},
+      {"blue", "Blue"},
+      {"classification_flags", "ClassFlags"},
+      {"scanner_channel", "ScannerChannel"},
+      {"nir", "Infrared"},
+  };
+  std::string line = "\"X\",\"Y\",\"Z\"";
+  for (const auto& name : names) {
+    std::string_view shown = name;
+    for (const auto& [ours, pdal] : kPdalNames)
+      if (name == ours) shown = pdal;
+    line += ",\"" + std::string(shown) + "\"";
+  }
+  return line + '\n';
 }
 
 const char* ply_type(ValueType type) {

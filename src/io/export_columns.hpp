@@ -21,6 +21,11 @@ void require_complete_columns(const Tree& tree);
 std::vector<std::string> token_names(const Attributes& attributes, std::vector<std::string> taken);
 std::vector<std::string> token_names(const std::vector<std::string>& names, std::vector<std::string> taken);
 
+// The text outputs' header line: "# x y z NAME..." (vola's XYZ, space-separated), or, for
+// CSV, PDAL's writers.text header, "X","Y","Z","Intensity",...: the LAS dimensions in
+// PDAL's spelling, which the text reader maps back to the same columns.
+std::string text_header(const std::vector<std::string>& names, bool csv);
+
 // The PLY property type of a column's values (64-bit integers, which PLY lacks: double).
 const char* ply_type(ValueType type);
 

@@ -15,6 +15,7 @@ std::string format_from_extension(const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ply") return "ply";
   if (ext == ".xyz" || ext == ".txt") return "xyz";
+  if (ext == ".csv") return "csv";
   if (ext == ".las" || ext == ".laz") return "las";
   if (ext == ".binvox") return "binvox";
   if (ext == ".npy") return "npy";
@@ -24,7 +25,7 @@ std::string format_from_extension(const std::string& path) {
   if (ext == ".vdb") return "vdb";
   if (ext == ".yaml" || ext == ".yml") return "rosmap";
   throw OptionError("format", path + ": cannot tell the format from the extension '" + ext +
-                                  "'; say `format` (ply, xyz, las, binvox, npy, png, tif, octomap, vdb, rosmap)");
+                                  "'; say `format` (ply, xyz, csv, las, binvox, npy, png, tif, octomap, vdb, rosmap)");
 }
 
 }  // namespace

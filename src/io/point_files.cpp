@@ -245,18 +245,18 @@ void append_fixed(std::string& out, double v, int digits) {
   out.append(s, std::to_chars(s, s + sizeof s, v).ptr);
 }
 
-void write_xyz_points(const PointCloud& cloud, const std::string& path, int coordinate_digits) {
-  std::string line = "# x y z";
-  for (const auto& name : column_names(cloud)) line += " " + name;
-  line += '\n';
+// vola's XYZ ("# x y z ..." and spaces) or CSV (PDAL's quoted header and commas).
+void write_text_points(const PointCloud& cloud, const std::string& path, int coordinate_digits, bool csv) {
+  std::string line = text_header(column_names(cloud), csv);
+  const char separator = csv ? ',' : ' ';
   OutputFile out(path);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
-      if (a) line += ' ';
+      if (a) line += separator;
       append_fixed(line, cloud.xyz[3 * i + static_cast<std::size_t>(a)], coordinate_digits);
     }
     for (const auto& attribute : cloud.attributes) {
-      line += ' ';
+      line += separator;
       append_number(line, attribute.values[i]);
     }
     line += '\n';
@@ -323,8 +323,9 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
   const std::string out_ext = lower_extension(output);
   const bool las_in = find_input_format(input, "auto").name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";
-  if (!las_out && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
-    throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply and .xyz (or .txt)");
+  const bool csv = out_ext == ".csv";
+  if (!las_out && !csv && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
+    throw InvalidArgument(output + ": vola translate writes .las, .laz, .ply, .xyz (or .txt) and .csv");
   if (las_out && las_in && !edit) {
     translate_las(input, output, progress);
     return {};
@@ -346,12 +347,17 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
                        " (an organized cloud's missing points) are not read, so not written");
   if (las_out) drop_points_las_cannot_hold(input, table.cloud, warnings);
   if (!las_out && (table.epsg || !table.wkt.empty()))
-    warnings.push_back(output + ": " + (out_ext == ".ply" ? "PLY" : "XYZ") + " has no place for the CRS of " + input +
-                       " (" + (table.epsg ? "EPSG:" + std::to_string(*table.epsg) : "a WKT with no EPSG code") +
+    warnings.push_back(output + ": " +
+                       (out_ext == ".ply" ? "PLY"
+                        : csv             ? "CSV"
+                                          : "XYZ") +
+                       " has no place for the CRS of " + input + " (" +
+                       (table.epsg ? "EPSG:" + std::to_string(*table.epsg) : "a WKT with no EPSG code") +
                        "): it is not kept; a .las or .laz output keeps it");
   if (out_ext == ".ply") write_ply_points(table.cloud, output);
   else if (las_out) write_las(table.cloud, output, table.epsg, table.wkt);
-  else write_xyz_points(table.cloud, output, table.coordinate_digits);
+  else
+    write_text_points(table.cloud, output, table.coordinate_digits, csv);
   return warnings;
 }
 

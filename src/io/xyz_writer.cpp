@@ -1,27 +1,29 @@
-// XYZ text: one voxel centre per line, "x y z [attribute values...]".
+// XYZ text: one voxel centre per line, "x y z [attribute values...]"; CSV the same with
+// commas and PDAL's quoted header.
 #include "export_columns.hpp"
 #include "vola/output_file.hpp"
 #include "vola/io/export.hpp"
 
 namespace vola::io {
 
-void write_xyz(const Tree& tree, const std::string& path) {
+namespace {
+
+void write_text(const Tree& tree, const std::string& path, bool csv) {
   require_complete_columns(tree);
   OutputFile out(path);
   const auto& columns = tree.attributes().columns();
-  std::string line = "# x y z";
-  for (const auto& name : token_names(tree.attributes(), {"x", "y", "z"})) line += " " + name;
-  line += '\n';
+  const char separator = csv ? ',' : ' ';
+  std::string line = text_header(token_names(tree.attributes(), {"x", "y", "z"}), csv);
   const Quantizer quantizer = tree.quantizer();
   std::size_t rank = 0;
   tree.for_each_voxel([&](const Voxel& v) {
     const Point p = quantizer.center(v);
     for (int a = 0; a < 3; ++a) {
-      if (a) line += ' ';
+      if (a) line += separator;
       append_number(line, p[a]);
     }
     for (const auto& column : columns) {
-      line += ' ';
+      line += separator;
       append_value(line, column, rank);
     }
     line += '\n';
@@ -34,5 +36,11 @@ void write_xyz(const Tree& tree, const std::string& path) {
   out.write(line);
   out.commit();
 }
+
+}  // namespace
+
+void write_xyz(const Tree& tree, const std::string& path) { write_text(tree, path, false); }
+
+void write_csv(const Tree& tree, const std::string& path) { write_text(tree, path, true); }
 
 }  // namespace vola::io

@@ -297,5 +297,27 @@ def colours(path):
     return [struct.unpack_from("<3H", d, offset + i * length + at) for i in range(count)]
 assert colours(sys.argv[1]) == colours(sys.argv[2])
 PY
+# CSV (PDAL's writers.text: "X","Y","Z","Intensity",...) reads back into the same fields.
+"$vola" translate "$autzen" "$tmp/pdal.csv" -q 2> /dev/null
+head -c 60 "$tmp/pdal.csv" | grep -q '^"X","Y","Z","Intensity","ReturnNumber","NumberOfReturns"' ||
+  fail "CSV header: $(head -c 120 "$tmp/pdal.csv")"
+"$vola" translate "$tmp/pdal.csv" "$tmp/from_csv.las" -q 2> /dev/null
+"${VOLA_PYTHON:-python3}" - "$autzen" "$tmp/from_csv.las" <<'PY' || fail "fields changed through CSV"
+import struct, sys
+def fields(path):
+    d = open(path, "rb").read()
+    offset, length, count = struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<H", d, 105)[0], struct.unpack_from("<I", d, 107)[0]
+    if count == 0 and d[25] >= 4:
+        count = struct.unpack_from("<Q", d, 247)[0]
+    fmt = d[104] & 63
+    colour, intensity = {3: 28, 7: 30}[fmt], 12
+    cls = (lambda r: r[15] & 31) if fmt < 6 else (lambda r: r[16])
+    out = []
+    for i in range(count):
+        r = d[offset + i * length:offset + (i + 1) * length]
+        out.append((struct.unpack_from("<H", r, intensity)[0], cls(r), struct.unpack_from("<3H", r, colour)))
+    return out
+assert fields(sys.argv[1]) == fields(sys.argv[2])
+PY
 
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

@@ -101,6 +101,33 @@ TEST(XyzExport, NamesWithSeparatorsReadBackAsOneColumnEach) {
   for (const auto& a : in.cloud.attributes) EXPECT_EQ(a.values, (std::vector<double>{1.5, -2.0})) << a.name;
 }
 
+// CSV: PDAL's writers.text header, the LAS columns in PDAL's spelling; read back by the
+// text reader into the same columns and values.
+TEST(XyzExport, CsvCarriesPdalsHeaderAndReadsBack) {
+  const Sample s = random_sample(77, 3, true);
+  TempDir dir;
+  vola::io::write_csv(s.tree, (dir / "out.csv").string());
+  const auto lines = lines_of(dir / "out.csv");
+  ASSERT_EQ(lines.size(), 1 + s.tree.voxel_count());
+  EXPECT_EQ(lines[0],
+            "\"X\",\"Y\",\"Z\",\"Red\",\"Green\",\"Blue\",\"Intensity\",\"Classification\",\"NumberOfReturns\","
+            "\"reflectance\",\"temperature\",\"pulse\"");
+  const vola::io::Input in = vola::io::read_input((dir / "out.csv").string(), "auto", {});
+  EXPECT_EQ(vola_test::voxel_set(rebuild(in, s.grid)), s.voxels);
+  const auto& columns = s.tree.attributes().columns();
+  ASSERT_EQ(in.cloud.attributes.size(), columns.size());
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    EXPECT_EQ(in.cloud.attributes[c].name, columns[c].name());
+    for (std::size_t i = 0; i < columns[c].size(); ++i) {
+      const double read = in.cloud.attributes[c].values[i], written = columns[c].get(i);
+      if (columns[c].type() == vola::ValueType::f32)  // written as the shortest text of the float
+        ASSERT_EQ(static_cast<float>(read), static_cast<float>(written)) << columns[c].name() << " " << i;
+      else
+        ASSERT_EQ(read, written) << columns[c].name() << " " << i;
+    }
+  }
+}
+
 TEST(XyzExport, EmptyTreeHasOnlyTheHeader) {
   TempDir dir;
   vola::io::write_xyz(vola::Tree(), (dir / "e.xyz").string());

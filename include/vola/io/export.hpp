@@ -42,6 +42,9 @@ PlyReport write_ply(const Tree& tree, const std::string& path, const PlyOptions&
 // "x y z [attribute values...]" per voxel centre, shortest text that reads back as the
 // same double; a first line "# x y z NAME..." names the columns.
 void write_xyz(const Tree& tree, const std::string& path);
+// The same as CSV, with PDAL's writers.text header ("X","Y","Z","Intensity",...), which
+// vola's text reader, PDAL, pandas and spreadsheets read by name.
+void write_csv(const Tree& tree, const std::string& path);
 
 // ---- LAS ----
 // LAS 1.4, point format 7 when the tree has red, green and blue columns, else 6. The
