@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "files_read.hpp"
 #include "number_checks.hpp"
 #include "output_checks.hpp"
 #include "vola/error.hpp"
@@ -125,7 +126,7 @@ bool use_hierarchical(const PlanArgs& a, const Point& from, const Point& to) {
 }
 
 void run_plan(const PlanArgs& a) {
-  refuse_outputs_over_inputs({a.input}, {a.output, a.ply}, "vola plan");
+  refuse_outputs_over_inputs(files_read(a.input), {a.output, a.ply}, "vola plan");
   if (a.avoid && a.solid_ground)
     throw InvalidArgument("--solid-ground: --avoid sees the voxels only, not the ground below them");
   const Scene scene = load_scene(a);

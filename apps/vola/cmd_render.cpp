@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "files_read.hpp"
 #include "open_voxels.hpp"
 #include "output_checks.hpp"
 #include "png_writer.hpp"
@@ -74,7 +75,7 @@ std::vector<std::uint16_t> depth_image(const raycast::Rendering& r) {
 void write_images(const RenderArgs& a, const raycast::Rendering& image, const std::string& shaded, std::uint32_t width,
                   std::uint32_t height) {
   const std::string depth = with_suffix(shaded, "_depth");
-  refuse_outputs_over_inputs({a.input}, {shaded, depth}, "vola render");
+  refuse_outputs_over_inputs(files_read(a.input), {shaded, depth}, "vola render");
   write_png_rgb8(shaded, width, height, image.rgb);
   write_png_gray16(depth, width, height, depth_image(image));
   if (!a.quiet)

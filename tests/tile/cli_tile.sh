@@ -66,6 +66,12 @@ assert "classification" in info["attributes"] and info["crs"]["unit"] == "foot",
 assert [o["level"] for o in info["overviews"]] == sorted({o["level"] for o in v["overviews"]}), info["overviews"]
 assert f"tiles:       {v['tiles']}," in text and "crs:         NAD_1983_HARN_Lambert_Conformal_Conic" in text, text
 PY
+# render and plan read the tiles an index names: an output over one of them is refused.
+a_tile=$(ls "$tmp/one/.generation-1/"tile_*.vol | head -1)
+cp "$a_tile" "$tmp/tile_before.vol"
+"$vola" render "$index" -o "$a_tile" --size 32x24 -q 2> "$tmp/err.txt" && fail "render wrote over a tile it reads"
+grep -q "is the input: vola render writes new files" "$tmp/err.txt" || fail "render over a tile: $(cat "$tmp/err.txt")"
+cmp -s "$a_tile" "$tmp/tile_before.vol" || fail "render replaced a tile"
 "$vola" info "$tmp/bare/overviews" 2> "$tmp/err.txt" && fail "info on a folder without an index succeeded"
 grep -q "overviews is a folder with no index.geojson" "$tmp/err.txt" || fail "info on a folder: $(cat "$tmp/err.txt")"
 
