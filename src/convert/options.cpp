@@ -89,8 +89,8 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
   // option is given, x, y and z when only payload or attribute columns are. `columns`
   // given, 1 2 3 too, place x, y and z (taken for the default, 1 2 3 was ignored).
   const bool xyz_given = options.columns.has_value();
-  columns.from_header = !xyz_given && options.payload_columns.empty() && options.text_attributes.empty() &&
-                        options.nbits == 0;
+  columns.from_header = options.payload_columns.empty() && options.text_attributes.empty() && options.nbits == 0;
+  columns.xyz_given = xyz_given;  // the header's other columns stay attributes
   columns.named_attributes = options.attributes;
   std::optional<std::array<int, 3>> named;
   if (!xyz_given && !columns.from_header)

@@ -358,14 +358,20 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
 std::optional<std::array<int, 3>> named_xyz_columns(const TextHeader& header) { return xyz_columns(header.names); }
 
 TextColumns text_columns_of(const TextHeader& header) {
-  TextColumns columns;
   const auto xyz = xyz_columns(header.names);
   if (!xyz) throw InvalidArgument("the header names no x, y and z columns");
-  columns.x = (*xyz)[0], columns.y = (*xyz)[1], columns.z = (*xyz)[2];
+  return text_columns_of(header, (*xyz)[0], (*xyz)[1], (*xyz)[2]);
+}
+
+TextColumns text_columns_of(const TextHeader& header, int x, int y, int z) {
+  TextColumns columns;
+  columns.x = x, columns.y = y, columns.z = z;
+  const auto named = xyz_columns(header.names);  // columns the header calls x, y, z: never attributes
   std::unordered_set<std::string> taken;  // a header of 80,000 names took seconds with a search per name
   for (std::size_t c = 0; c < header.names.size(); ++c) {
     const int column = static_cast<int>(c);
     if (column == columns.x || column == columns.y || column == columns.z) continue;
+    if (named && (column == (*named)[0] || column == (*named)[1] || column == (*named)[2])) continue;
     std::string name = point_column_name(header.names[c]);
     if (name.empty() || !taken.insert(name).second) continue;  // a second column of one name stays unread, as in PLY
     const Reduction reduction = point_column_reduction(name, header.names[c]);
@@ -413,10 +419,10 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
   TextColumns layout = columns;
   const bool named = header && columns.from_header;
   if (named) {
-    if (!xyz_columns(header->names))
+    if (!columns.xyz_given && !xyz_columns(header->names))
       throw FormatError(path, header->offset, "line " + std::to_string(header->line) + " names its columns but none of them x, y and z;"
                                  " say which columns hold them (--columns X Y Z, counted from 1)");
-    layout = text_columns_of(*header);
+    layout = columns.xyz_given ? text_columns_of(*header, columns.x, columns.y, columns.z) : text_columns_of(*header);
     layout.skip_lines = columns.skip_lines;
     if (!columns.named_attributes) layout.attributes.clear(), layout.attribute_columns.clear();
   }

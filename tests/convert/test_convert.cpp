@@ -267,7 +267,13 @@ TEST(Convert, ColumnsGivenWinOverAHeaderEvenOneTwoThree) {
   EXPECT_EQ(vola::convert(path, by_name).georef().bbox.min, (vola::Point{2, 1, 3}));  // x is the header's column 2
   vola::ConvertOptions given = by_name;
   given.columns = std::array<int, 3>{1, 2, 3};
-  EXPECT_EQ(vola::convert(path, given).georef().bbox.min, (vola::Point{1, 2, 3}));
+  const vola::Tree placed = vola::convert(path, given);
+  EXPECT_EQ(placed.georef().bbox.min, (vola::Point{1, 2, 3}));
+  // The header's other columns are still kept (given columns dropped them all).
+  const vola::AttributeColumn* intensity = placed.attributes().find("intensity");
+  ASSERT_NE(intensity, nullptr);
+  EXPECT_EQ(intensity->get(0), 10.0);
+  EXPECT_EQ(placed.attributes().columns().size(), 1u);  // not the header's x and y
   // A header naming none of x, y and z converts when the columns are given.
   const std::string unnamed = "a b c\n1 2 3\n";
   vola_test::write_bytes(dir / "abc.xyz", std::vector<std::uint8_t>(unnamed.begin(), unnamed.end()));

@@ -38,6 +38,9 @@ struct TextColumns {
   bool from_header = true;
   // With from_header: keep the header's other columns as attributes (false: x, y, z only).
   bool named_attributes = true;
+  // With from_header: x, y and z are the columns above (--columns), not the header's; its
+  // other named columns are still kept (--columns 1 2 3 on a header dropped them all).
+  bool xyz_given = false;
 };
 
 // The column names of a header line (see above), or none when the first line after
@@ -55,10 +58,13 @@ std::optional<TextHeader> read_text_header(const std::string& path, int skip_lin
 
 // The columns a header names: x, y, z by name (any case) and every other column as an
 // attribute (f64; classification/class/label by majority, number_of_returns by maximum,
-// red/green/blue as u8 or u16 once their values are known, the rest by mean), PDAL's
+// red/green/blue as u16 when their values are whole 0..65535, the rest by mean), PDAL's
 // spellings of LAS fields (ReturnNumber, GpsTime, ...) and CloudCompare's R, G, B under
 // the LAS reader's names.
 TextColumns text_columns_of(const TextHeader& header);
+// The same with x, y and z in the given columns (0-based); the header's other named
+// columns (not those it calls x, y, z) are the attributes.
+TextColumns text_columns_of(const TextHeader& header, int x, int y, int z);
 // The columns (0-based) a header names x, y and z, or none when it does not name all three.
 std::optional<std::array<int, 3>> named_xyz_columns(const TextHeader& header);
 
