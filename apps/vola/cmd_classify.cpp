@@ -81,7 +81,7 @@ std::string model_path(const ClassifyArgs& a) {
   if (std::filesystem::exists(a.model, error) || a.model.find('/') != std::string::npos) return a.model;
   const std::string file = a.model.ends_with(".pt") ? a.model : a.model + ".pt";
   try {
-    return learn::default_model_path(file);
+    return learn::default_model_path(file, true);
   } catch (const IoError& e) {
     throw IoError("--model " + a.model + ": no such file here, nor a committed model of that name (" + e.what() + ")");
   }

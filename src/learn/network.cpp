@@ -487,7 +487,7 @@ std::vector<std::array<float, kClassCount>> Classifier::classify(std::span<const
   return result;
 }
 
-std::string default_model_path(std::string_view file) {
+std::string default_model_path(std::string_view file, bool named) {
   namespace fs = std::filesystem;
   std::vector<fs::path> candidates;
   std::error_code error;
@@ -496,6 +496,8 @@ std::string default_model_path(std::string_view file) {
   if (const char* env = std::getenv("VOLA_MODEL"); env && *env) {
     if (fs::is_directory(env, error))
       candidates.push_back(fs::path(env) / file);
+    else if (fs::is_regular_file(env, error) && named && fs::path(env).filename() != file)
+      candidates.push_back(fs::path(env).parent_path() / file);
     else if (fs::is_regular_file(env, error))
       return fs::path(env).lexically_normal().string();
     else

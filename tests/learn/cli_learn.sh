@@ -90,6 +90,11 @@ if (cd "$work" && "$vola" classify --model no-such-model "$monitor") > /dev/null
 fi
 grep -q -- "--model no-such-model: no such file here, nor a committed model of that name" "$work/err.txt" ||
   fail "--model unknown name: $(cat "$work/err.txt")"
+# A $VOLA_MODEL naming another model file lends its folder to a name, not itself (the
+# default model answered for --model modelnet10-small-full-circle, without a word).
+VOLA_MODEL=$model_dir/modelnet10-small.pt "$vola" evaluate "$(dirname "$(dirname "$monitor")")" \
+  --model modelnet10-small-full-circle --threads 1 > "$work/named.txt"
+grep -q "^model: .*modelnet10-small-full-circle.pt$" "$work/named.txt" || fail "VOLA_MODEL file and --model NAME: $(head -n 3 "$work/named.txt")"
 if "$vola" classify --orientations mean "$monitor" 2> "$work/err.txt" > /dev/null; then fail "--orientations without --segment"; fi
 grep -q -- "--orientations applies only with --segment" "$work/err.txt" || fail "orientations: $(cat "$work/err.txt")"
 "$vola" diff "$monitor" "$monitor" "$work/empty.vol" > /dev/null

@@ -134,6 +134,8 @@ inline constexpr std::string_view kDefaultModelFile = "modelnet10-small.pt";
 // The model for objects found in rooms (`classify --segment`): trained on what
 // segment_object and normalise_object give.
 inline constexpr std::string_view kSegmentedRoomModelFile = "modelnet10-small-room-segmented.pt";
-std::string default_model_path(std::string_view file = kDefaultModelFile);
+// `named`: `file` was asked for by name (--model NAME): a $VOLA_MODEL that is a model file
+// of another name lends its folder only, not itself.
+std::string default_model_path(std::string_view file = kDefaultModelFile, bool named = false);
 
 }  // namespace vola::learn
