@@ -1,12 +1,12 @@
 #include "export_columns.hpp"
 
-#include <string_view>
-#include <utility>
-
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
+#include <string_view>
+#include <utility>
 
 #include "vola/error.hpp"
 
@@ -77,12 +77,23 @@ std::string text_header(const std::vector<std::string>& names, bool csv) {
       {"scanner_channel", "ScannerChannel"},
       {"nir", "Infrared"},
   };
+  // No name twice once spelled as PDAL does, case aside (a PLY's intensity and Intensity
+  // both became "Intensity", and the reader kept one): later ones get _2, _3, ...
+  const auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  std::vector<std::string> taken{"x", "y", "z"};
   std::string line = "\"X\",\"Y\",\"Z\"";
   for (const auto& name : names) {
-    std::string_view shown = name;
+    std::string shown = name;
     for (const auto& [ours, pdal] : kPdalNames)
-      if (name == ours) shown = pdal;
-    line += ",\"" + std::string(shown) + "\"";
+      if (name == ours) shown = std::string(pdal);
+    std::string unique = shown;
+    for (int n = 2; std::find(taken.begin(), taken.end(), lower(unique)) != taken.end(); ++n)
+      unique = shown + "_" + std::to_string(n);
+    taken.push_back(lower(unique));
+    line += ",\"" + unique + "\"";
   }
   return line + '\n';
 }

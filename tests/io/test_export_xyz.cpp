@@ -128,6 +128,21 @@ TEST(XyzExport, CsvCarriesPdalsHeaderAndReadsBack) {
   }
 }
 
+// Two names PDAL's spelling makes one (intensity and Intensity; x): each stays its own
+// column in the CSV header (the reader kept one of the two Intensity columns).
+TEST(XyzExport, CsvNamesStayDistinctOnceSpelledAsPdalSpellsThem) {
+  vola::Tree tree = vola::build_from_voxels(std::vector<vola::Voxel>{{0, 0, 0}}, 1);
+  for (const char* name : {"intensity", "Intensity", "X"}) {
+    vola::AttributeColumn column(name, vola::ValueType::f64, vola::Reduction::mean, 1);
+    column.set(0, 3.0);
+    tree.attributes().add(std::move(column));
+  }
+  TempDir dir;
+  vola::io::write_csv(tree, (dir / "d.csv").string());
+  EXPECT_EQ(lines_of(dir / "d.csv")[0], "\"X\",\"Y\",\"Z\",\"Intensity\",\"Intensity_2\",\"X_2\"");
+  EXPECT_EQ(vola::io::read_input((dir / "d.csv").string(), "auto", {}).cloud.attributes.size(), 3u);
+}
+
 TEST(XyzExport, EmptyTreeHasOnlyTheHeader) {
   TempDir dir;
   vola::io::write_xyz(vola::Tree(), (dir / "e.xyz").string());
