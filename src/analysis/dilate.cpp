@@ -56,9 +56,8 @@ Tree with_margin(const Tree& tree, int margin) {
   while (depth <= kMaxDepth && side_of(depth) <= reach) ++depth;
   if (shift == std::array<std::uint64_t, 3>{} && depth == tree.depth()) return tree;
   if (depth > kMaxDepth)
-    throw InvalidArgument("radius " + std::to_string(margin) +
-                          ": the grid grown to hold the whole dilation would need " + "more than depth " +
-                          std::to_string(kMaxDepth) +
+    throw InvalidArgument("radius " + std::to_string(margin) + ": the grid grown to hold the whole dilation would " +
+                          "need more than depth " + std::to_string(kMaxDepth) +
                           " (4^10 voxels a side); dilate within the grid instead (vola dilate --keep-grid)");
   std::vector<Voxel> moved;
   moved.reserve(tree.voxel_count());

@@ -92,8 +92,7 @@ PointCloud grid_cell_points(const io::VoxelGrid& grid, const BuildOptions& optio
   if (points > kMaxPoints)
     throw InvalidArgument("cells of " + shortest(grid.voxel_size) + " at voxels of " + shortest(voxel) +
                           ": filling each of the " + std::to_string(centres.size()) +
-                          " occupied cells would set up to " + std::to_string(static_cast<std::uint64_t>(points)) +
-                          " voxels (" + std::to_string(static_cast<std::uint64_t>(per_axis)) +
+                          " occupied cells would set up to " + shortest(points) + " voxels (" + shortest(per_axis) +
                           "^3 a cell), more than 2^25; give a larger voxel size or a smaller depth (the grid's own "
                           "cell size, " +
                           shortest(grid.voxel_size) + ", gives one voxel a cell)");

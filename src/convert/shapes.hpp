@@ -15,7 +15,7 @@ PointCloud grid_cell_centres(const io::VoxelGrid& grid);
 // The same for the grid `options` will build: the centres, or, when its voxels are smaller
 // than the cells (a binvox read at a finer voxel size), k^3 points a cell, spaced at most
 // one voxel apart, so that the voxels a cell covers are all set (centres alone gave walls
-// of isolated voxels k apart). Throws InvalidArgument above 2^25 points.
+// of isolated voxels k apart); a voxel across a cell's face may be set too. Throws InvalidArgument above 2^25 points.
 PointCloud grid_cell_points(const io::VoxelGrid& grid, const BuildOptions& options);
 // Triangles -> surface voxels (and the inside when solid). Toolkit mode frames the
 // vertices' bbox, as a point cloud's bbox frames its points.

@@ -203,12 +203,6 @@ const std::vector<InputFormat>& input_formats() {
   return formats;
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 namespace {
 
 // "las" for a file beginning "LASF" (LAS, LAZ, COPC), "e57" for "ASTM-E57"; else null.
