@@ -87,7 +87,8 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
   columns.skip_lines = options.skip_lines;
   // A header line lays the columns out unless the options do: all of them when no column
   // option is given, x, y and z when only payload or attribute columns are. `columns`
-  // given, 1 2 3 too, place x, y and z (taken for the default, 1 2 3 was ignored).
+  // given, 1 2 3 too, place x, y and z while the header still names the other columns
+  // (taken for the default, 1 2 3 was ignored).
   const bool xyz_given = options.columns.has_value();
   columns.from_header = options.payload_columns.empty() && options.text_attributes.empty() && options.nbits == 0;
   columns.xyz_given = xyz_given;  // the header's other columns stay attributes
