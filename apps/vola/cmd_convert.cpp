@@ -101,13 +101,12 @@ void run_convert(ConvertArgs& a) {
 
 }  // namespace
 
-// "las (.las .laz), text (.xyz ...), ...": every reader this build has, for the help.
 std::string known_formats() {
   std::string out;
   for (const auto& f : io::input_formats()) {
     out += (out.empty() ? "" : ", ") + f.name + " (";
     for (std::size_t i = 0; i < f.extensions.size(); ++i) out += (i ? " " : "") + f.extensions[i];
-    out += ")";
+    out += f.extensions.empty() ? "by name only)" : ")";
   }
   return out;
 }

@@ -28,6 +28,7 @@ struct InfoArgs {
   bool json = false;
   bool summary = false;
   std::string grid;
+  std::string format = "auto";
 };
 
 // A JSON string: control characters escaped, bytes that are not UTF-8 (a name from a
@@ -105,6 +106,16 @@ void run_info(const InfoArgs& a) {
     return print_tile_index_info(*index, a.json);
   }
   io::refuse_non_regular_input(a.file);  // before its first bytes are read
+  if (a.format != "auto") {              // the reader named, whatever the extension says
+    const std::string format = io::find_input_format(a.file, a.format).name;
+    if (format == "las")
+      print_point_file_info(a.file, a.summary, a.json);
+    else if (format == "ept")
+      print_ept_info(a.file, a.summary, a.json);
+    else
+      print_point_cloud_info(a.file, a.summary, a.json, a.grid, a.format);
+    return;
+  }
   if (is_point_file(a.file) || !is_vol_file(a.file)) {
     if (!a.grid.empty() && is_point_file(a.file))
       throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + a.file + " is a LAS/LAZ file");
@@ -248,6 +259,9 @@ void add_info(CLI::App& app) {
   cmd->add_flag("--summary", args->summary,
                 "Point files and DEMs: read every point (cell) for their own bounds, column ranges and points per class "
                 "(like pdal info --summary)");
+  cmd->add_option("--format", args->format,
+                  "Input format: auto (a .vol file, or a reader chosen by the extension) or one of " + known_formats())
+      ->capture_default_str();
   cmd->add_option("--grid", args->grid,
                   "OpenVDB: the grid to show (a file of several names them when none is given); NumPy .npz: the array");
   cmd->callback([args] { run_info(*args); });

@@ -22,6 +22,7 @@ namespace {
 struct TranslateArgs {
   std::string input, output;
   std::vector<std::string> filters;
+  std::string format = "auto";
   bool quiet = false;
 };
 
@@ -44,7 +45,7 @@ void run_translate(const TranslateArgs& a) {
       [&](std::uint64_t done, std::uint64_t total) {
         if (progress) progress->update(done, total);
       },
-      edit);
+      edit, a.format);
   if (progress) progress->finish();
   for (const auto& warning : warnings) std::fprintf(stderr, "vola: warning: %s\n", warning.c_str());  // -q too
   if (!progress) return;
@@ -95,6 +96,8 @@ void add_translate(CLI::App& app) {
   cmd->add_option("input", args->input, "Input point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .las, .laz, .ply, .xyz or .csv")->required();
+  cmd->add_option("--format", args->format, "Input format: auto (from the extension) or one of " + known_formats())
+      ->capture_default_str();
   add_filter_options(*cmd, args->filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args] { run_translate(*args); });

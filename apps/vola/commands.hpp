@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+
 namespace vola::cli {
 
 void add_convert(CLI::App& app);
@@ -31,6 +33,10 @@ void add_tile(CLI::App& app);
 void add_translate(CLI::App& app);
 void add_pipeline(CLI::App& app);
 void add_map(CLI::App& app);
+
+// "las (.las .laz), text (.xyz ...), ...": every input reader this build has, for the
+// --format options' help (cmd_convert.cpp).
+std::string known_formats();
 
 // One-line summaries of the subcommands that run in companion executables, shared by the
 // companion (its --help) and vola (its list of subcommands).

@@ -384,16 +384,17 @@ void print_e57_scans(const io::E57Summary& e) {
   }
 }
 
-void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part) {
+void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part,
+                            const std::string& format_name) {
   io::InputOptions options;
   options.attributes = true;
   options.grid = part;
   if (!part.empty()) {
-    const std::string format = io::find_input_format(path, "auto").name;
+    const std::string format = io::find_input_format(path, format_name).name;
     if (format != "vdb" && format != "npy")
       throw OptionError("grid", "applies to OpenVDB (.vdb) and NumPy .npz files; " + path + " is " + format);
   }
-  const io::Input in = io::read_input(path, "auto", options);
+  const io::Input in = io::read_input(path, format_name, options);
   if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json, part);
   const bool e57 = in.format == "e57";
   if (json) {

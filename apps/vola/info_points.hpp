@@ -20,6 +20,7 @@ void print_point_file_info(const std::string& path, bool summary, bool json);
 // cells) or a DEM (cells with a height): what vola convert reads, with its CRS and bounds.
 // `json`: the same as one JSON object on stdout (pdal info --summary's content). `part`:
 // the grid of an OpenVDB file or the array of an .npz archive to show (empty: the default).
-void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part = {});
+void print_point_cloud_info(const std::string& path, bool summary, bool json, const std::string& part = {},
+                            const std::string& format = "auto");
 
 }  // namespace vola::cli

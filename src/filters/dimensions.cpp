@@ -29,6 +29,11 @@ std::optional<Dimension> find_dimension(const PointCloud& cloud, const std::stri
   const std::string key = vola_spelling(dimension_key(name));
   for (std::size_t c = 0; c < cloud.attributes.size(); ++c)
     if (dimension_key(cloud.attributes[c].name) == key) return Dimension{-1, c};
+  static constexpr const char* kFlagBits[] = {"synthetic", "keypoint", "withheld", "overlap"};
+  for (int bit = 0; bit < 4; ++bit)
+    if (key == kFlagBits[bit])
+      for (std::size_t c = 0; c < cloud.attributes.size(); ++c)
+        if (cloud.attributes[c].name == "classification_flags") return Dimension{-1, c, bit};
   if (key == "x") return Dimension{0, 0};
   if (key == "y") return Dimension{1, 0};
   if (key == "z") return Dimension{2, 0};
@@ -42,7 +47,7 @@ std::string dimension_list(const PointCloud& cloud) {
 }
 
 std::size_t ensure_column(PointCloud& cloud, const std::string& name, ValueType type, Reduction reduction) {
-  if (const auto d = find_dimension(cloud, name); d && d->axis < 0) return d->column;
+  if (const auto d = find_dimension(cloud, name); d && d->axis < 0 && d->bit < 0) return d->column;
   cloud.attributes.push_back({name, type, reduction, std::vector<double>(cloud.size(), 0.0)});
   return cloud.attributes.size() - 1;
 }

@@ -67,7 +67,9 @@ std::string point_column_name(std::string_view raw) {
       {"pointsourceid", "point_source_id"},
       {"gpstime", "gps_time"},
       {"classflags", "classification_flags"},  // PDAL's names of the LAS 1.4 fields
+      {"scanchannel", "scanner_channel"},
       {"scannerchannel", "scanner_channel"},
+      {"keypoint", "key_point"},
       {"infrared", "nir"},
       {"r", "red"},
       {"g", "green"},

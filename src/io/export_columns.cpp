@@ -74,7 +74,11 @@ std::string text_header(const std::vector<std::string>& names, bool csv) {
       {"green", "Green"},
       {"blue", "Blue"},
       {"classification_flags", "ClassFlags"},
-      {"scanner_channel", "ScannerChannel"},
+      {"synthetic", "Synthetic"},
+      {"key_point", "KeyPoint"},
+      {"withheld", "Withheld"},
+      {"overlap", "Overlap"},
+      {"scanner_channel", "ScanChannel"},
       {"nir", "Infrared"},
   };
   // No name twice once spelled as PDAL does, case aside (a PLY's intensity and Intensity

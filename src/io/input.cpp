@@ -7,6 +7,7 @@
 #include <memory>
 #include <string_view>
 
+#include "file_bytes.hpp"
 #include "vola/error.hpp"
 #include "vola/io/binvox.hpp"
 #include "vola/io/dem.hpp"
@@ -79,6 +80,14 @@ Input read_kitti_input(const std::string& path, const InputOptions& options) {
   Input in;
   in.format = "kitti";
   in.cloud = read_kitti(path, options);
+  return in;
+}
+
+// nuScenes and Lyft sweeps whatever their name (Lyft names them plain .bin).
+Input read_nuscenes_input(const std::string& path, const InputOptions& options) {
+  Input in;
+  in.format = "nuscenes";
+  in.cloud = parse_nuscenes(read_file_bytes(path), path, options);
   return in;
 }
 
@@ -166,6 +175,10 @@ std::vector<InputFormat> make_formats() {
        {".bin"},
        "KITTI velodyne float32 x y z reflectance (nuScenes .pcd.bin: x y z intensity ring)",
        read_kitti_input},
+      {"nuscenes",
+       {},
+       "nuScenes and Lyft lidar sweeps, float32 x y z intensity ring, whatever the name (--format nuscenes)",
+       read_nuscenes_input},
       {"binvox", {".binvox"}, "binvox occupancy grids", read_binvox_input},
       {"mesh",
        {".stl", ".obj", ".off", ".gltf", ".glb", ".dae", ".3ds"},

@@ -26,10 +26,14 @@ std::uint8_t kitti_reflectance_byte(float reflectance) noexcept {
 PointCloud parse_kitti(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options) {
   constexpr std::size_t kRecord = 16;
   if (bytes.size() % kRecord != 0)
-    throw FormatError(name, bytes.size() - bytes.size() % kRecord,
-                      "a KITTI scan is 16-byte records (x y z reflectance as float32), but the file has " +
-                          std::to_string(bytes.size()) + " bytes, " + std::to_string(bytes.size() % kRecord) +
-                          " past the last whole record");
+    throw FormatError(
+        name, bytes.size() - bytes.size() % kRecord,
+        "a KITTI scan is 16-byte records (x y z reflectance as float32), but the file has " +
+            std::to_string(bytes.size()) + " bytes, " + std::to_string(bytes.size() % kRecord) +
+            " past the last whole record" +
+            (bytes.size() % 20 == 0 ? "; its size is a whole number of 20-byte records, as a nuScenes or Lyft sweep's "
+                                      "(x y z intensity ring): give --format nuscenes"
+                                    : std::string()));
   const std::size_t n = bytes.size() / kRecord;
   PointCloud cloud;
   cloud.xyz.resize(3 * n);

@@ -96,6 +96,9 @@ struct LasColumns {
   const AttributeColumn* gps_time = nullptr;
   const AttributeColumn* scan_angle = nullptr;            // degrees
   const AttributeColumn* classification_flags = nullptr;  // 4 bits
+  // PDAL's one-bit dimensions of the same flags (synthetic, key_point, withheld, overlap:
+  // what a CSV from PDAL holds), OR'ed into them.
+  const AttributeColumn* flag_bits[4] = {};
   const AttributeColumn* scanner_channel = nullptr;       // 2 bits
   const AttributeColumn* scan_direction = nullptr;        // 1 bit
   const AttributeColumn* edge = nullptr;                  // 1 bit
@@ -123,6 +126,8 @@ LasColumns sort_columns(const Attributes& a) {
   c.gps_time = a.find("gps_time");
   c.scan_angle = a.find("scan_angle_rank");
   c.classification_flags = a.find("classification_flags");
+  static constexpr const char* kFlagBits[] = {"synthetic", "key_point", "withheld", "overlap"};
+  for (int bit = 0; bit < 4; ++bit) c.flag_bits[bit] = a.find(kFlagBits[bit]);
   c.scanner_channel = a.find("scanner_channel");
   c.scan_direction = a.find("scan_direction_flag");
   c.edge = a.find("edge_of_flight_line");
@@ -131,6 +136,7 @@ LasColumns sort_columns(const Attributes& a) {
     const bool standard = name == "intensity" || name == "classification" || name == "number_of_returns" ||
                           name == "return_number" || name == "user_data" || name == "point_source_id" ||
                           name == "gps_time" || name == "scan_angle_rank" || name == "classification_flags" ||
+                          name == "synthetic" || name == "key_point" || name == "withheld" || name == "overlap" ||
                           name == "scanner_channel" || name == "scan_direction_flag" || name == "edge_of_flight_line" ||
                           (c.rgb() && (name == "red" || name == "green" || name == "blue"));
     if (standard) continue;
@@ -303,8 +309,10 @@ std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasC
     if (columns.intensity && columns.intensity->get(rank) > 65535.0) ++clamped_intensities;
     const auto [number, count] = returns_of(columns, rank);
     record[14] = static_cast<std::uint8_t>(number | count << 4);
-    record[15] = static_cast<std::uint8_t>(field_value(columns.classification_flags, rank, 15.0, 0) |
-                                           field_value(columns.scanner_channel, rank, 3.0, 0) << 4 |
+    std::uint32_t flags = field_value(columns.classification_flags, rank, 15.0, 0);
+    for (int bit = 0; bit < 4; ++bit)
+      if (columns.flag_bits[bit] && field_value(columns.flag_bits[bit], rank, 1.0, 0) != 0) flags |= 1u << bit;
+    record[15] = static_cast<std::uint8_t>(flags | field_value(columns.scanner_channel, rank, 3.0, 0) << 4 |
                                            field_value(columns.scan_direction, rank, 1.0, 0) << 6 |
                                            field_value(columns.edge, rank, 1.0, 0) << 7);
     record[16] = static_cast<std::uint8_t>(field_value(columns.classification, rank, 255.0, 0));

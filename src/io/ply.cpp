@@ -147,7 +147,7 @@ PlyHeader parse_ply_header(std::span<const std::uint8_t> bytes, const std::strin
 }
 
 // What a property means to vola.
-enum class Role : std::uint8_t { x, y, z, red, green, blue, indices, skip, attribute };
+enum class Role : std::uint8_t { x, y, z, red, green, blue, indices, strip, skip, attribute };
 
 ValueType value_type_of(PlyType t) {
   switch (t) {
@@ -347,14 +347,43 @@ struct Mesh {
   std::vector<std::uint32_t> sizes;    // the corners of each polygon (3 or more)
 };
 
+// A triangle strip: each index after the first two makes a triangle with the two before
+// it; -1 restarts the strip. Triangles with a repeated corner (strips use them to turn)
+// are no surface and are left out.
+template <class In>
+void read_strip(In& in, PlyType type, std::uint64_t n, std::uint64_t vertices, Mesh& mesh) {
+  in.expect(type, n);
+  std::uint32_t run[3] = {0, 0, 0};
+  std::size_t length = 0;  // indices of the current strip so far
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const double v = in.read(type);
+    if (v == -1) {
+      length = 0;
+      continue;
+    }
+    if (!(v >= 0) || v != std::floor(v) || v >= static_cast<double>(vertices))
+      in.fail("strip index " + std::to_string(v) + " is neither -1 nor the index of one of the " +
+              std::to_string(vertices) + " vertices");
+    run[0] = run[1];
+    run[1] = run[2];
+    run[2] = static_cast<std::uint32_t>(v);
+    if (++length < 3) continue;
+    if (run[0] == run[1] || run[1] == run[2] || run[0] == run[2]) continue;
+    mesh.corners.insert(mesh.corners.end(), {run[0], run[1], run[2]});
+    mesh.sizes.push_back(3);
+  }
+}
+
 template <class In>
 void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& out, Mesh& mesh,
                std::size_t remaining_bytes) {
   const Element* vertex = nullptr;
   const Element* face = nullptr;
+  const Element* strips = nullptr;  // triangle strips (tinyply, the Stanford models' .ply)
   for (const auto& e : h.elements) {
     if (e.name == "vertex" && !vertex) vertex = &e;
     if (e.name == "face" && !face) face = &e;
+    if (e.name == "tristrips" && !strips) strips = &e;
   }
   for (const auto& e : h.elements) {
     // An element without properties has no bytes: nothing to read, however large its count.
@@ -387,10 +416,10 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
         colours->reserve(static_cast<std::size_t>(reservable));
       }
       if (options.attributes) column = attribute_columns(e.properties, roles, out.cloud);
-    } else if (&e == face) {
+    } else if (&e == face || &e == strips) {
       for (std::size_t p = 0; p < e.properties.size(); ++p)
         if (e.properties[p].list && (e.properties[p].name == "vertex_indices" || e.properties[p].name == "vertex_index")) {
-          roles[p] = Role::indices;
+          roles[p] = &e == face ? Role::indices : Role::strip;
           break;
         }
     }
@@ -408,6 +437,10 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
           continue;
         }
         const std::uint64_t n = whole_number(in, in.read(prop.count_type), "list length");
+        if (role == Role::strip) {
+          read_strip(in, prop.type, n, vertex->count, mesh);
+          continue;
+        }
         if (role != Role::indices) {
           in.skip(prop.type, n);
           continue;

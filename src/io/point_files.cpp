@@ -245,9 +245,32 @@ void append_fixed(std::string& out, double v, int digits) {
   out.append(s, std::to_chars(s, s + sizeof s, v).ptr);
 }
 
+// The LAS flag bits (classification_flags: synthetic, key-point, withheld, overlap) as
+// PDAL's dimensions of the same names, one 0/1 column each: CSV is read by PDAL's
+// readers.text, and PDAL's LAS writer takes the flags from these (its ClassFlags is
+// deprecated and ignored), so a CSV of a LAS file goes back to LAS with them.
+constexpr const char* kFlagBitNames[] = {"synthetic", "key_point", "withheld", "overlap"};
+
 // vola's XYZ ("# x y z ..." and spaces) or CSV (PDAL's quoted header and commas).
 void write_text_points(const PointCloud& cloud, const std::string& path, int coordinate_digits, bool csv) {
-  std::string line = text_header(column_names(cloud), csv);
+  struct Column {
+    const std::vector<double>* values;
+    int bit;  // >= 0: that bit of the values, 0 or 1
+  };
+  std::vector<std::string> names;
+  std::vector<Column> columns;
+  for (const auto& a : cloud.attributes) {
+    if (csv && a.name == "classification_flags") {
+      for (int bit = 0; bit < 4; ++bit) {
+        names.push_back(kFlagBitNames[bit]);
+        columns.push_back({&a.values, bit});
+      }
+      continue;
+    }
+    names.push_back(a.name);
+    columns.push_back({&a.values, -1});
+  }
+  std::string line = text_header(token_names(names, {"x", "y", "z"}), csv);
   const char separator = csv ? ',' : ' ';
   OutputFile out(path);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -255,9 +278,13 @@ void write_text_points(const PointCloud& cloud, const std::string& path, int coo
       if (a) line += separator;
       append_fixed(line, cloud.xyz[3 * i + static_cast<std::size_t>(a)], coordinate_digits);
     }
-    for (const auto& attribute : cloud.attributes) {
+    for (const Column& c : columns) {
       line += separator;
-      append_number(line, attribute.values[i]);
+      const double v = (*c.values)[i];
+      if (c.bit < 0)
+        append_number(line, v);
+      else
+        line += (static_cast<std::uint32_t>(v) >> c.bit) & 1u ? '1' : '0';
     }
     line += '\n';
     if (line.size() >= (std::size_t{1} << 16)) {
@@ -317,11 +344,11 @@ void drop_points_las_cannot_hold(const std::string& input, PointCloud& cloud, st
 
 std::vector<std::string> translate_points(const std::string& input, const std::string& output,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress,
-                                          const PointEdit& edit) {
+                                          const PointEdit& edit, const std::string& format) {
   refuse_output_over_input(input, output, "vola translate writes a new point file; give it another name");
   refuse_unopenable_input(input);
   const std::string out_ext = lower_extension(output);
-  const bool las_in = find_input_format(input, "auto").name == "las";
+  const bool las_in = find_input_format(input, format).name == "las";
   const bool las_out = out_ext == ".las" || out_ext == ".laz";
   const bool csv = out_ext == ".csv";
   if (!las_out && !csv && out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".txt")
@@ -330,7 +357,7 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
     translate_las(input, output, progress);
     return {};
   }
-  PointTable table = read_point_table(input, progress);
+  PointTable table = read_point_table(input, progress, format);
   if (edit) {
     const std::vector<std::uint64_t> kept = edit(table);
     if (las_out && las_in) {

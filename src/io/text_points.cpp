@@ -102,11 +102,16 @@ bool parse_number(std::string_view text, bool decimal_comma, double& value) {
 
 class LineParser {
  public:
-  // `header_line`: a line of column names to pass over (0: none).
+  // `header_line`: a line of column names to pass over (0: none), naming `header_columns`.
   // `count_lines`: lines of one integer are a PTS file's point counts, passed over.
   LineParser(const std::string& path, const TextColumns& columns, PointCloud& cloud, std::uint64_t header_line,
-             bool count_lines)
-      : path_(path), columns_(columns), cloud_(cloud), header_line_(header_line), count_lines_(count_lines) {
+             std::size_t header_columns, bool count_lines)
+      : path_(path),
+        columns_(columns),
+        cloud_(cloud),
+        header_line_(header_line),
+        header_columns_(static_cast<int>(std::min<std::size_t>(header_columns, 1u << 20))),
+        count_lines_(count_lines) {
     max_column_ = std::max({columns.x, columns.y, columns.z});
     for (int c : columns.payload) max_column_ = std::max(max_column_, c);
     for (int c : columns.attribute_columns) max_column_ = std::max(max_column_, c);
@@ -158,7 +163,14 @@ class LineParser {
     if (columns_per_line_ == 0) {
       columns_per_line_ = column;
       first_line_ = line_number;
+      first_offset_ = offset;
     } else if (column != columns_per_line_) {
+      // The first point is the odd one out: blame it, not every line after it.
+      if (column == header_columns_)
+        fail(first_line_, first_offset_,
+             "the first point has " + std::to_string(columns_per_line_) + " columns where the header (line " +
+                 std::to_string(header_line_) + ") names " + std::to_string(header_columns_) + " and line " +
+                 std::to_string(line_number) + " has " + std::to_string(column) + " (a stray value on this line?)");
       fail(line_number, offset, "has " + std::to_string(column) + " columns where line " + std::to_string(first_line_) +
                                     ", the first point, has " + std::to_string(columns_per_line_));
     }
@@ -189,11 +201,13 @@ class LineParser {
   const TextColumns& columns_;
   PointCloud& cloud_;
   std::uint64_t header_line_;
+  int header_columns_;
   bool count_lines_;
   int max_column_ = 2;
   std::vector<double> values_;
   int columns_per_line_ = 0;  // the first point's
   std::uint64_t first_line_ = 0;
+  std::uint64_t first_offset_ = 0;
 };
 
 // Where the field starting at `i` ends: at the next separator, or, for a quoted field
@@ -349,9 +363,20 @@ bool unit_colours_to_bytes(PointCloud& cloud) {
 
 }  // namespace
 
+// A Leica PTS file's columns by their count, as PDAL's readers.pts lays them out:
+// x y z, x y z intensity, or x y z intensity red green blue.
+std::optional<std::vector<std::string>> pts_names(const std::string& path, int skip_lines) {
+  if (!has_count_lines(path)) return std::nullopt;
+  const int columns = count_text_columns(path, skip_lines);
+  if (columns == 4) return std::vector<std::string>{"x", "y", "z", "intensity"};
+  if (columns == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "red", "green", "blue"};
+  return std::nullopt;
+}
+
 std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
   if (auto header = read_header_line(path, skip_lines)) return header;
   if (auto names = names_of_extension(path)) return TextHeader{std::move(*names), 0, 0, true};
+  if (auto names = pts_names(path, skip_lines)) return TextHeader{std::move(*names), 0, 0, true};
   return std::nullopt;
 }
 
@@ -427,7 +452,9 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
     if (!columns.named_attributes) layout.attributes.clear(), layout.attribute_columns.clear();
   }
   PointCloud cloud;
-  LineParser parser(path, layout, cloud, header && !header->comment ? header->line : 0, has_count_lines(path));
+  const bool names_line = header && !header->comment;  // a line of names to pass over
+  LineParser parser(path, layout, cloud, names_line ? header->line : 0, names_line ? header->names.size() : 0,
+                    has_count_lines(path));
   constexpr std::size_t kChunk = 8 << 20;
   std::string buffer;
   std::uint64_t consumed = 0;  // file offset of buffer[0]

@@ -319,5 +319,41 @@ def fields(path):
     return out
 assert fields(sys.argv[1]) == fields(sys.argv[2])
 PY
+# PDAL's LAS 1.4 dimensions in a CSV PDAL could have written: ScanChannel and the four
+# one-bit flags go into the LAS fields, come back out under PDAL's names, and --where
+# reads the flags of a LAS file by those names.
+cat > "$tmp/flags.csv" <<'CSV'
+"X","Y","Z","Classification","Synthetic","KeyPoint","Withheld","Overlap","ScanChannel"
+1.00,2.00,3.00,2,1,0,0,0,0
+4.00,5.00,6.00,1,0,1,1,0,3
+7.00,8.00,9.00,5,0,0,1,1,2
+CSV
+"$vola" translate "$tmp/flags.csv" "$tmp/flags.las" -q 2> /dev/null
+"${VOLA_PYTHON:-python3}" - "$tmp/flags.las" <<'PY' || fail "PDAL's flag dimensions did not reach the LAS fields"
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+offset, length = struct.unpack_from("<I", d, 96)[0], struct.unpack_from("<H", d, 105)[0]
+assert d[104] & 63 >= 6, d[104]
+got = [(d[offset + i * length + 15] & 15, d[offset + i * length + 15] >> 4 & 3) for i in range(3)]
+assert got == [(0b0001, 0), (0b0110, 3), (0b1100, 2)], got
+PY
+"$vola" translate "$tmp/flags.las" "$tmp/flags_back.csv" -q 2> /dev/null
+"${VOLA_PYTHON:-python3}" - "$tmp/flags.csv" "$tmp/flags_back.csv" <<'PY' || fail "flags through LAS and back to CSV: $(head -2 "$tmp/flags_back.csv")"
+import csv, sys
+def table(path):
+    rows = list(csv.reader(open(path)))
+    names = rows[0]
+    wanted = ["Classification", "Synthetic", "KeyPoint", "Withheld", "Overlap", "ScanChannel"]
+    return [[float(r[names.index(n)]) for n in wanted] for r in rows[1:]]
+assert table(sys.argv[1]) == table(sys.argv[2]), (table(sys.argv[1]), table(sys.argv[2]))
+PY
+"$vola" translate "$tmp/flags.las" "$tmp/withheld.xyz" --where "Withheld == 1 && ScanChannel == 2" -q 2> /dev/null
+[ "$(grep -vc '^#' "$tmp/withheld.xyz")" == 1 ] || fail "--where on Withheld and ScanChannel: $(cat "$tmp/withheld.xyz")"
+# An infrared column goes to a format 6 LAS as extra bytes, and comes back by its name
+# (format 6 has no NIR field for it to clash with).
+printf 'x y z Infrared\n1 2 3 500\n' > "$tmp/nir.xyz"
+"$vola" translate "$tmp/nir.xyz" "$tmp/nir.las" -q 2> /dev/null
+"$vola" translate "$tmp/nir.las" "$tmp/nir_back.xyz" -q 2> /dev/null
+head -1 "$tmp/nir_back.xyz" | grep -q ' nir$' || fail "infrared through LAS: $(head -1 "$tmp/nir_back.xyz")"
 
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

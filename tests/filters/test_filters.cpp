@@ -57,6 +57,28 @@ TEST(Dimensions, PdalNamesFindVolaColumns) {
   EXPECT_EQ(find_dimension(cloud, "Z")->axis, 2);
 }
 
+// PDAL's one-bit flag dimensions are bits 0-3 of the LAS classification flags, unless the
+// points carry columns of their own by those names (a CSV that PDAL wrote).
+TEST(Dimensions, PdalFlagDimensionsAreBitsOfTheClassificationFlags) {
+  vola::PointCloud cloud;
+  cloud.xyz = {0, 0, 0, 1, 1, 1};
+  cloud.attributes.push_back({"classification_flags", vola::ValueType::u8, vola::Reduction::last, {0b0101, 0b1010}});
+  const char* names[] = {"Synthetic", "KeyPoint", "Withheld", "Overlap"};
+  for (int bit = 0; bit < 4; ++bit) {
+    const auto d = find_dimension(cloud, names[bit]);
+    ASSERT_TRUE(d) << names[bit];
+    EXPECT_EQ(value_of(cloud, *d, 0), (0b0101 >> bit) & 1) << names[bit];
+    EXPECT_EQ(value_of(cloud, *d, 1), (0b1010 >> bit) & 1) << names[bit];
+  }
+  // ensure_column never hands a flag bit out as a whole column.
+  EXPECT_EQ(ensure_column(cloud, "withheld", vola::ValueType::u8, vola::Reduction::last), 1u);
+  const auto own = find_dimension(cloud, "Withheld");
+  ASSERT_TRUE(own);
+  EXPECT_EQ(own->column, 1u);
+  EXPECT_LT(own->bit, 0);
+  EXPECT_FALSE(find_dimension(vola::PointCloud{}, "Overlap"));
+}
+
 TEST(KdTree, NearestEqualsBruteForceIn2dAnd3d) {
   const auto xyz = random_points(2000, 1);
   const KdTree<3> tree3(xyz, 3);

@@ -101,6 +101,19 @@ else
   echo "ok: no voxel size -> $message"
 fi
 
+# A Lyft sweep (five float32 a point, named plain .bin): --format nuscenes in info,
+# translate and convert; without it KITTI's error says so.
+"${VOLA_PYTHON:-python3}" -c 'import struct, sys; open(sys.argv[1], "wb").write(struct.pack("<10f", 1, 2, 3, 40, 1, 4, 5, 6, 80, 2))' "$tmp/lyft.bin"
+if message=$("$vola" info "$tmp/lyft.bin" 2>&1); then
+  fail "a 40-byte .bin read as KITTI"
+elif [[ $message != *"--format nuscenes"* ]]; then
+  fail "the KITTI error does not point to --format nuscenes: $message"
+fi
+"$vola" info "$tmp/lyft.bin" --format nuscenes | grep -q "points: *2" || fail "vola info --format nuscenes"
+"$vola" translate "$tmp/lyft.bin" "$tmp/lyft.xyz" --format nuscenes -q 2> /dev/null
+[ "$(tail -n +2 "$tmp/lyft.xyz" | tr '\n' ' ')" == "1 2 3 40 1 4 5 6 80 2 " ] || fail "translate --format nuscenes: $(cat "$tmp/lyft.xyz")"
+"$vola" convert "$tmp/lyft.bin" "$tmp/lyft.vol" --format nuscenes --voxel-size 1 -q || fail "convert --format nuscenes"
+
 if ((failures > 0)); then
   echo "$failures failure(s)" >&2
   exit 1

@@ -117,6 +117,16 @@ TEST(Kitti, NuscenesSweepsAreFiveFloatsAPoint) {
     EXPECT_EQ(error->offset(), n / 20 * 20);
     EXPECT_NE(error->cause().find("20-byte records"), std::string::npos);
   }
+  // Lyft names its sweeps plain .bin: --format nuscenes reads any name, and KITTI's size
+  // error points there when the size is a whole number of 20-byte records.
+  const auto lyft = dir / "host-a017_lidar1_1236118886501000046.bin";
+  vola_test::write_bytes(lyft, Bytes(bytes.begin(), bytes.begin() + 60));  // three records
+  const vola::io::Input as_nuscenes = vola::io::read_input(lyft.string(), "nuscenes", {});
+  EXPECT_EQ(as_nuscenes.format, "nuscenes");
+  EXPECT_EQ(as_nuscenes.cloud.xyz, (std::vector<double>{1, 2, 3, -1, -2, -3, 4.5, 5.5, 6.5}));
+  const auto error = vola_test::format_error_of([&] { vola::io::read_input(lyft.string(), "auto", {}); });
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->cause().find("--format nuscenes"), std::string::npos) << error->cause();
 }
 
 }  // namespace

@@ -283,6 +283,27 @@ TEST(Ply, FacesBeforeVerticesAndPointsWithoutFaces) {
   EXPECT_EQ(p.cloud.xyz, (std::vector<double>{1, 2, 3}));
 }
 
+// Triangle strips (tinyply's and the Stanford models' "tristrips" element): each index
+// after the first two makes a triangle, -1 restarts, repeated corners make none.
+TEST(Ply, TriangleStripsBecomeTriangles) {
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n"
+      "9 0 1 2 3 -1 2 3 3 4\n";
+  const auto in = vola::io::parse_ply(Bytes(text.begin(), text.end()), "strip.ply");
+  ASSERT_EQ(in.cloud.size(), 5u);
+  // 0 1 2, 1 2 3; after the restart 2 3 3 and 3 3 4 repeat a corner.
+  ASSERT_EQ(in.triangles.size(), 2u);
+  EXPECT_EQ(in.triangles[0], (vola::io::Triangle{vola::Point{0, 0, 0}, vola::Point{1, 0, 0}, vola::Point{0, 1, 0}}));
+  EXPECT_EQ(in.triangles[1], (vola::io::Triangle{vola::Point{1, 0, 0}, vola::Point{0, 1, 0}, vola::Point{1, 1, 0}}));
+  std::string bad = text;
+  bad.replace(bad.rfind("4\n"), 2, "5\n");
+  const auto error = vola_test::format_error_of([&] { vola::io::parse_ply(Bytes(bad.begin(), bad.end()), "bad.ply"); });
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->cause().find("strip index 5"), std::string::npos) << error->cause();
+}
+
 TEST(Ply, EveryTruncationOfABinaryFileIsAFormatError) {
   for (const std::string encoding : {"binary_little_endian", "binary_big_endian"}) {
     const Bytes full = ply_bytes(ply_sample(), encoding, true);

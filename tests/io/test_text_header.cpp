@@ -267,6 +267,36 @@ TEST(TextLines, PtsCountLinesArePassedOver) {
   EXPECT_THROW(read_text(dir, "2\n1 2 3\n"), vola::FormatError);
 }
 
+// Its columns by their count, as PDAL's readers.pts takes them: x y z intensity [r g b].
+TEST(TextLines, PtsColumnsAreIntensityAndColour) {
+  TempDir dir;
+  const auto path = dir / "scan.pts";
+  std::ofstream(path, std::ios::binary) << "2\n1.0 2.0 3.0 -1200 255 0 0\n4 5 6 -900 0 255 0\n1\n7 8 9 0 0 0 255\n";
+  const auto coloured = vola::io::read_text_points(path.string(), {});
+  EXPECT_EQ(names(coloured), (std::vector<std::string>{"intensity", "red", "green", "blue"}));
+  EXPECT_EQ(column(coloured, "intensity").values, (std::vector<double>{-1200, -900, 0}));
+  EXPECT_EQ(column(coloured, "green").values, (std::vector<double>{0, 255, 0}));
+  std::ofstream(path, std::ios::binary) << "1\n1 2 3 17\n";
+  EXPECT_EQ(names(vola::io::read_text_points(path.string(), {})), (std::vector<std::string>{"intensity"}));
+  std::ofstream(path, std::ios::binary) << "1\n1 2 3 4 5\n";  // no such layout: nothing named
+  EXPECT_TRUE(vola::io::read_text_points(path.string(), {}).attributes.empty());
+}
+
+// A header of three names and a first point of four (PDAL's test file utm17_3.txt): the
+// first point is the odd one, not every line after it.
+TEST(TextLines, AFirstPointUnlikeTheHeaderIsTheOneBlamed) {
+  TempDir dir;
+  try {
+    read_text(dir, "X, Y, Z\n\n1.5 , 2.5 , 3.5,27\n4 , 5 , 6\n");
+    FAIL() << "read";
+  } catch (const vola::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3: the first point has 4 columns where the header (line 1) names 3 and "
+                                         "line 4 has 3"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Each name of a header was looked for among the names before it: 80,000 columns took
 // seconds. Bounded here at a second for 100,000, far above what a hash set needs.
 TEST(TextHeader, ManyColumnsAreNamedInLinearTime) {

@@ -3,6 +3,7 @@
 // HeightAboveGround) name the same column; case and underscores do not matter.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,16 +21,21 @@ std::string dimension_key(const std::string& name);
 struct Dimension {
   int axis = -1;             // 0..2, or -1 for a column
   std::size_t column = 0;    // index into PointCloud::attributes when axis is -1
+  int bit = -1;              // >= 0: that bit of the column's values (0 or 1)
 };
 
-// The dimension `name` names in `cloud`, or nothing.
+// The dimension `name` names in `cloud`, or nothing. PDAL's one-bit flags (Synthetic,
+// KeyPoint, Withheld, Overlap) are bits 0-3 of classification_flags when the cloud has no
+// column of that name.
 std::optional<Dimension> find_dimension(const PointCloud& cloud, const std::string& name);
 // "x, y, z, intensity, ...": what a cloud offers, for error messages.
 std::string dimension_list(const PointCloud& cloud);
 
 // The value of dimension `d` for point i.
 inline double value_of(const PointCloud& cloud, const Dimension& d, std::size_t i) {
-  return d.axis >= 0 ? cloud.xyz[3 * i + static_cast<std::size_t>(d.axis)] : cloud.attributes[d.column].values[i];
+  if (d.axis >= 0) return cloud.xyz[3 * i + static_cast<std::size_t>(d.axis)];
+  const double v = cloud.attributes[d.column].values[i];
+  return d.bit < 0 ? v : static_cast<double>((static_cast<std::uint32_t>(v) >> d.bit) & 1u);
 }
 
 // The attribute column named `name` (vola's spelling), added with `type` and `reduction`

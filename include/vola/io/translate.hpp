@@ -58,9 +58,10 @@ using PointEdit = std::function<std::vector<std::uint64_t>(PointTable&)>;
 // column) and the header's counts and bounds; columns the record has no field for (a
 // new one such as height_above_ground) go to PLY and XYZ outputs only.
 // Returns warnings for the user: what the output cannot hold (a PLY or XYZ file has no
-// place for the input's CRS).
+// place for the input's CRS). `format`: the input's reader, "auto" (from the extension) or
+// a name from input_formats().
 std::vector<std::string> translate_points(const std::string& input, const std::string& output,
                                           const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
-                                          const PointEdit& edit = {});
+                                          const PointEdit& edit = {}, const std::string& format = "auto");
 
 }  // namespace vola::io
