@@ -126,6 +126,8 @@ void run_train(TrainArgs& a) {
                       {"max_shift", options.max_shift},
                       {"hollow", options.hollow},
                       {"quarter_turns", options.quarter_turns},
+                      {"orientation_bins", options.orientation_bins},
+                      {"orientation_weight", options.orientation_weight},
                       {"balanced", options.balanced},
                       {"threads", options.threads}};
     run["model"] = options.model_path;
@@ -199,6 +201,16 @@ void add_train(CLI::App& app) {
   cmd->add_flag("--quarter-turns", args->options.quarter_turns,
                 "Augmentation: turn each object by a random multiple of 90 degrees as well (for data from "
                 "vola dataset --segment, aligned to the object's footprint up to a quarter turn)");
+  cmd->add_option("--orientation-bins", args->options.orientation_bins,
+                  "Auxiliary orientation target: turn each object by a random one of N equal steps of the "
+                  "full circle as well (on top of --max-rotation) and train a second output to name the step, "
+                  "as ORION (Sedaghat et al. 2017) does; the model file keeps the classifier alone (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 360));
+  cmd->add_option("--orientation-weight", args->options.orientation_weight,
+                  "The orientation output's weight in the loss (with --orientation-bins)")
+      ->capture_default_str()
+      ->check(non_negative_number());
   cmd->add_flag("--balanced", args->options.balanced,
                 "Weigh the loss by 1/sqrt(class share) so rare classes count more");
   cmd->add_option("--threads", args->options.threads, "Threads (0: all cores)")->capture_default_str()->check(non_negative_number());

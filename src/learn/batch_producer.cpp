@@ -44,6 +44,7 @@ void BatchProducer::run() {
     std::uniform_real_distribution<double> shift(-a.max_shift, a.max_shift);
     std::bernoulli_distribution hollow(a.hollow);
     std::uniform_int_distribution<int> quarter(0, 3);
+    std::uniform_int_distribution<int> step(0, std::max(1, a.orientation_bins) - 1);
     const std::size_t cells = std::size_t(side_) * side_ * side_;
     for (std::size_t first = 0; first < order_.size(); first += batch_size_) {
       const std::size_t count = std::min(batch_size_, order_.size() - first);
@@ -56,6 +57,11 @@ void BatchProducer::run() {
         placement.angle_radians = a.max_rotation > 0 ? angle(random) : 0.0;
         // Drawn only when asked for, as hollow below.
         if (a.quarter_turns) placement.angle_radians += quarter(random) * std::numbers::pi / 2;
+        if (a.orientation_bins > 0) {
+          const int turn = step(random);
+          placement.angle_radians += turn * 2 * std::numbers::pi / a.orientation_bins;
+          batch.orientations.push_back(turn);
+        }
         if (a.max_scale > 0) placement.scale = scale(random);
         if (a.max_shift > 0)
           for (double& d : placement.shift) d = shift(random);

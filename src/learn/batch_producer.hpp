@@ -24,12 +24,14 @@ struct Augmentation {
   double max_shift = 0;
   double hollow = 0;  // probability of a sample's input being its surface shell (keep_surface)
   bool quarter_turns = false;  // a random multiple of 90 degrees added to the angle
+  int orientation_bins = 0;    // > 0: a random multiple of 360 / bins degrees added, and kept
 };
 
 struct Batch {
   std::vector<float> inputs;          // count * side^3
   std::vector<std::int64_t> labels;   // count
   std::vector<std::size_t> indices;   // which samples, in order
+  std::vector<std::int64_t> orientations;  // count, with Augmentation::orientation_bins: the step
   std::size_t count() const noexcept { return labels.size(); }
 };
 
@@ -38,7 +40,8 @@ class BatchProducer {
   // Batches of `batch_size` (the last may be smaller) over samples[order[...]] at input
   // grid `side`. Angles are uniform in [-max_rotation, max_rotation] radians, drawn in
   // order from a generator seeded with `seed` (0 radians when max_rotation is 0), plus
-  // a random quarter turn with `quarter_turns`; then,
+  // a random quarter turn with `quarter_turns` or a random step of the full circle with
+  // `orientation_bins` (the step kept in Batch::orientations); then,
   // when augmentation asks for them, a scale uniform in [1 - max_scale, 1 + max_scale]
   // and a shift uniform in [-max_shift, max_shift] tree voxels along each axis; then, with
   // probability `hollow`, only the input's surface shell (keep_surface). At most

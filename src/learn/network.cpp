@@ -38,12 +38,14 @@ struct PaperNet : Network {
     register_module("dropout", dropout);
     register_module("fc", fc);
   }
-  torch::Tensor forward(torch::Tensor x) override {
+  torch::Tensor features(torch::Tensor x) override {
     x = torch::relu(conv1(x));  // 57^3
     x = torch::relu(conv2(x));  // 50^3
     x = torch::relu(conv3(x));  // 43^3
-    return fc(dropout(x.flatten(1)));
+    return dropout(x.flatten(1));
   }
+  torch::Tensor last_layer(torch::Tensor x) override { return fc(x); }
+  std::int64_t feature_size() const override { return 16 * 43 * 43 * 43; }
 };
 
 // Batch norm (eval mode) folded into the convolution before it: weights and bias of one
@@ -74,12 +76,14 @@ struct SmallNet : Network {
     register_module("dropout2", dropout2);
     register_module("fc2", fc2);
   }
-  torch::Tensor forward(torch::Tensor x) override {
+  torch::Tensor features(torch::Tensor x) override {
     x = torch::leaky_relu(norm1(conv1(x)), 0.1);           // 14^3
     x = torch::max_pool3d(torch::relu(norm2(conv2(x))), 2);  // 12^3 -> 6^3
     x = torch::relu(fc1(dropout1(x.flatten(1))));
-    return fc2(dropout2(x));
+    return dropout2(x);
   }
+  torch::Tensor last_layer(torch::Tensor x) override { return fc2(x); }
+  std::int64_t feature_size() const override { return 128; }
 
   // Inference (eval mode, no autograd): the same function as forward() up to float
   // rounding, computed faster on one core (bench/learn_inference: 13 ms -> about 1.3 ms
@@ -146,14 +150,16 @@ struct WideNet : Network {
     register_module("dropout2", dropout2);
     register_module("fc2", fc2);
   }
-  torch::Tensor forward(torch::Tensor x) override {
+  torch::Tensor features(torch::Tensor x) override {
     x = torch::leaky_relu(norm1(conv1(x)), 0.1);             // 14^3
     x = torch::relu(norm2(conv2(x)));                        // 12^3
     x = torch::max_pool3d(torch::relu(norm3(conv3(x))), 2);  // 10^3 -> 5^3
     x = torch::max_pool3d(torch::relu(norm4(conv4(x))), 3, 2);  // 5^3 -> 2^3
     x = torch::relu(fc1(dropout1(x.flatten(1))));
-    return fc2(dropout2(x));
+    return dropout2(x);
   }
+  torch::Tensor last_layer(torch::Tensor x) override { return fc2(x); }
+  std::int64_t feature_size() const override { return 256; }
 
   // As SmallNet's: batch norm folded into the convolutions, every layer with weights in
   // oneDNN (fc1 as a convolution over the whole 2^3 map), ReLU after the max pools.

@@ -16,7 +16,13 @@ namespace vola::learn {
 
 // A classification network: (N, 1, S, S, S) occupancy -> (N, 10) logits.
 struct Network : torch::nn::Module {
-  virtual torch::Tensor forward(torch::Tensor input) = 0;
+  // forward(x) is last_layer(features(x)): `features` is what the last fully connected
+  // layer reads (after its dropout), feature_size() values a sample, so that another
+  // output (train.cpp's orientation head) can read them too.
+  torch::Tensor forward(torch::Tensor input) { return last_layer(features(input)); }
+  virtual torch::Tensor features(torch::Tensor input) = 0;
+  virtual torch::Tensor last_layer(torch::Tensor features) = 0;
+  virtual std::int64_t feature_size() const = 0;
   // For a network that will only infer (eval mode, weights fixed from here on): computes
   // what infer() needs. infer() is forward() up to float rounding, for InferenceMode.
   virtual void prepare_inference() {}

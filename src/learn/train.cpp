@@ -43,12 +43,24 @@ double accuracy(Network& network, const std::vector<Sample>& samples, int side, 
   return double(correct) / double(samples.size());
 }
 
-void save_checkpoint(Network& network, torch::optim::Adam& optimizer, Architecture architecture, int epochs_done,
-                     const std::string& path) {
+// The auxiliary orientation output (TrainOptions::orientation_bins): a linear layer on
+// the network's features, trained with it, kept in checkpoints but not in model files.
+struct OrientationHead {
+  torch::nn::Linear layer{nullptr};
+  explicit operator bool() const { return !layer.is_empty(); }
+};
+
+void save_checkpoint(Network& network, const OrientationHead& head, torch::optim::Adam& optimizer,
+                     Architecture architecture, int epochs_done, const std::string& path) {
   torch::serialize::OutputArchive archive, weights, optimizer_state;
   write_architecture(archive, architecture);
   network.save(weights);
   archive.write("model", weights);
+  if (head) {
+    torch::serialize::OutputArchive head_weights;
+    head.layer->save(head_weights);
+    archive.write("orientation_head", head_weights);
+  }
   optimizer.save(optimizer_state);
   archive.write("optimizer", optimizer_state);
   archive.write("epochs_done", torch::tensor(static_cast<std::int64_t>(epochs_done)));
@@ -56,7 +68,8 @@ void save_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectu
 }
 
 // Loads a checkpoint into network and optimizer; returns the epochs it had done.
-int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architecture architecture, const std::string& path) {
+int load_checkpoint(Network& network, OrientationHead& head, torch::optim::Adam& optimizer, Architecture architecture,
+                    const std::string& path) {
   torch::serialize::InputArchive archive;
   const RecordSizes records = load_archive(archive, path);
   if (read_architecture(archive, path) != architecture)
@@ -64,11 +77,20 @@ int load_checkpoint(Network& network, torch::optim::Adam& optimizer, Architectur
                                           std::string(architecture_name(architecture)));
   read_weights(archive, network, path);
   try {
-    torch::serialize::InputArchive optimizer_state;
+    torch::serialize::InputArchive optimizer_state, head_weights;
     torch::Tensor epochs_done;
     if (!archive.try_read("optimizer", optimizer_state)) throw FormatError(path, std::nullopt, "not a checkpoint: no optimizer state");
+    const bool has_head = archive.try_read("orientation_head", head_weights);
+    if (has_head != bool(head))
+      throw OptionError(
+          "orientation-bins",
+          path + (has_head ? ": checkpoint trained with an orientation output; give its --orientation-bins"
+                           : ": checkpoint trained without an orientation output"));
+    if (head) head.layer->load(head_weights);
     optimizer.load(optimizer_state);
     std::vector<torch::Tensor> tensors = network_tensors(network);
+    if (head)
+      for (const auto& t : head.layer->parameters()) tensors.push_back(t);
     for (const auto& [key, state] : optimizer.state()) {
       const auto& adam = static_cast<const torch::optim::AdamParamState&>(*state);
       for (const torch::Tensor& t : {adam.exp_avg(), adam.exp_avg_sq(), adam.max_exp_avg_sq()}) tensors.push_back(t);
@@ -99,13 +121,24 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
   torch::manual_seed(options.seed);
   const int side = input_side(options.architecture);
   const std::shared_ptr<Network> network = make_network(options.architecture);
-  torch::optim::Adam optimizer(network->parameters(),
+  std::vector<torch::Tensor> parameters = network->parameters();
+  OrientationHead head;
+  if (options.orientation_bins > 0) {
+    if (options.quarter_turns)
+      throw InvalidArgument("orientation bins and quarter turns both turn the samples: give one");
+    if (options.architecture == Architecture::paper)
+      throw InvalidArgument("the paper network has no orientation output (its last layer reads 1.3 M values)");
+    if (options.orientation_bins > 360) throw InvalidArgument("orientation bins must be 1 to 360");
+    head.layer = torch::nn::Linear(network->feature_size(), options.orientation_bins);
+    for (const auto& p : head.layer->parameters()) parameters.push_back(p);
+  }
+  torch::optim::Adam optimizer(parameters,
                                torch::optim::AdamOptions(options.learning_rate).weight_decay(options.weight_decay));
 
   int first_epoch = 0;
   std::error_code error;
   if (options.resume && !options.checkpoint_path.empty() && std::filesystem::exists(options.checkpoint_path, error)) {
-    first_epoch = load_checkpoint(*network, optimizer, options.architecture, options.checkpoint_path);
+    first_epoch = load_checkpoint(*network, head, optimizer, options.architecture, options.checkpoint_path);
     if (callbacks.on_resume) callbacks.on_resume(first_epoch + 1);
   }
 
@@ -116,6 +149,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
   augmentation.max_shift = options.max_shift;
   augmentation.hollow = options.hollow;
   augmentation.quarter_turns = options.quarter_turns;
+  augmentation.orientation_bins = options.orientation_bins;
   // Class weights of the loss: 1 / sqrt(share of the class), normalised to a mean of 1
   // over the classes present, so rare classes (bathtub) count more without dominating.
   torch::Tensor class_weights;
@@ -150,6 +184,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
     const std::size_t steps = (order.size() + std::size_t(options.batch_size) - 1) / std::size_t(options.batch_size);
 
     network->train();
+    if (head) head.layer->train();
     BatchProducer producer(train_set, std::move(order), std::size_t(options.batch_size), side,
                            epoch_seed(options.seed, epoch, 2), augmentation);
     double loss_sum = 0;
@@ -158,9 +193,15 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
       const torch::Tensor labels = torch::from_blob(batch->labels.data(), {static_cast<std::int64_t>(batch->count())},
                                                     torch::kInt64);
       optimizer.zero_grad();
-      const torch::Tensor logits = network->forward(input_tensor(*batch, side));
-      const torch::Tensor loss = torch::nn::functional::cross_entropy(
+      const torch::Tensor features = network->features(input_tensor(*batch, side));
+      const torch::Tensor logits = network->last_layer(features);
+      torch::Tensor loss = torch::nn::functional::cross_entropy(
           logits, labels, torch::nn::functional::CrossEntropyFuncOptions().weight(class_weights));
+      if (head) {
+        const torch::Tensor turns =
+            torch::from_blob(batch->orientations.data(), {static_cast<std::int64_t>(batch->count())}, torch::kInt64);
+        loss = loss + options.orientation_weight * torch::nn::functional::cross_entropy(head.layer(features), turns);
+      }
       loss.backward();
       optimizer.step();
       const double value = loss.item<double>();
@@ -174,7 +215,7 @@ std::vector<EpochReport> train(const std::vector<Sample>& train_set, const std::
     report.validation_accuracy = accuracy(*network, validation_set, side, std::size_t(options.batch_size));
     if (!options.model_path.empty()) save_model(*network, options.architecture, options.model_path);
     if (!options.checkpoint_path.empty())
-      save_checkpoint(*network, optimizer, options.architecture, epoch + 1, options.checkpoint_path);
+      save_checkpoint(*network, head, optimizer, options.architecture, epoch + 1, options.checkpoint_path);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     reports.push_back(report);
     if (callbacks.on_epoch) callbacks.on_epoch(report);

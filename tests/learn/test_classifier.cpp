@@ -92,6 +92,51 @@ TEST(Classifier, ResumedRunRepeatsTheUninterruptedOne) {
   EXPECT_THROW(train(samples, samples, options), vola::InvalidArgument);
 }
 
+// The auxiliary orientation output (ORION's): trained beside the classes, kept in the
+// checkpoint (a resumed run repeats the uninterrupted one), left out of the model file.
+TEST(Classifier, OrientationOutputResumesAndStaysOutOfTheModel) {
+  vola_test::TempDir dir;
+  const auto samples = shape_samples(1, 7);
+  TrainOptions options;
+  options.epochs = 2;
+  options.batch_size = 5;
+  options.threads = 1;
+  options.max_rotation_degrees = 15;
+  options.orientation_bins = 4;
+  options.model_path = (dir / "whole.pt").string();
+  options.checkpoint_path = (dir / "whole.ckpt").string();
+  const auto whole = train(samples, samples, options);
+  ASSERT_EQ(whole.size(), 2u);
+
+  options.model_path = (dir / "parts.pt").string();
+  options.checkpoint_path = (dir / "parts.ckpt").string();
+  options.resume = true;
+  options.max_epochs_this_run = 1;
+  train(samples, samples, options);
+  const auto second = train(samples, samples, options);
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_DOUBLE_EQ(second[0].train_loss, whole[1].train_loss);
+  // The model file holds the classifier alone: it loads and classifies like any other.
+  const Classifier a((dir / "whole.pt").string()), b((dir / "parts.pt").string());
+  const vola::Tree* trees[] = {&samples[2].tree};
+  EXPECT_EQ(a.classify(trees), b.classify(trees));
+  // A checkpoint with the output does not resume a run without it, nor the other way.
+  options.orientation_bins = 0;
+  options.epochs = 3;
+  EXPECT_THROW(train(samples, samples, options), vola::OptionError);
+  // Orientation bins turn the samples themselves: not with quarter turns, not for the
+  // paper network (its last layer reads 1.3 M values).
+  options.resume = false;
+  options.checkpoint_path.clear();
+  options.model_path.clear();
+  options.orientation_bins = 4;
+  options.quarter_turns = true;
+  EXPECT_THROW(train(samples, samples, options), vola::InvalidArgument);
+  options.quarter_turns = false;
+  options.architecture = Architecture::paper;
+  EXPECT_THROW(train(samples, samples, options), vola::InvalidArgument);
+}
+
 TEST(Classifier, CommittedModelKnowsTrainingSamples) {
   VOLA_REQUIRE_DATA(data);
   const Classifier classifier(vola_learn_test::committed_model_path());

@@ -234,6 +234,33 @@ TEST(Augmentation, QuarterTurnsTurnTheSampleByWholeQuarters) {
   EXPECT_NE(turned[0], turned[1]);  // the shape is not symmetric under a quarter turn
 }
 
+// --orientation-bins 4 alone: each input is the sample turned by the step its label says.
+TEST(Augmentation, OrientationBinsLabelTheTurnEachInputGot) {
+  const vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
+  const std::size_t cells = std::size_t(64) * 64 * 64;
+  std::vector<std::vector<float>> turned(4, std::vector<float>(cells));
+  for (int q = 0; q < 4; ++q) fill_occupancy(turn_quarters(tree, q), 64, 0.0, turned[std::size_t(q)]);
+  const std::vector<Sample> samples(40, Sample{tree, 0});
+  std::vector<std::size_t> order(samples.size());
+  std::iota(order.begin(), order.end(), 0);
+  Augmentation augmentation;
+  augmentation.orientation_bins = 4;
+  BatchProducer producer(samples, order, samples.size(), 64, 5, augmentation);
+  const std::optional<Batch> batch = producer.next();
+  ASSERT_TRUE(batch && batch->count() == samples.size());
+  ASSERT_EQ(batch->orientations.size(), samples.size());
+  std::set<std::int64_t> seen;
+  for (std::size_t k = 0; k < batch->count(); ++k) {
+    const std::vector<float> input(batch->inputs.begin() + std::ptrdiff_t(k * cells),
+                                   batch->inputs.begin() + std::ptrdiff_t((k + 1) * cells));
+    const std::int64_t step = batch->orientations[k];
+    ASSERT_TRUE(step >= 0 && step < 4) << step;
+    EXPECT_EQ(input, turned[std::size_t(step)]) << "input " << k << " is not turned by its label's quarter";
+    seen.insert(step);
+  }
+  EXPECT_EQ(seen.size(), 4u);
+}
+
 TEST(Dataset, BalancedSplitHoldsOutAFixedCountPerClass) {
   std::vector<int> labels;
   const int sizes[kClassCount] = {106, 515, 889, 200, 200, 465, 200, 680, 392, 344};  // ModelNet10's train split

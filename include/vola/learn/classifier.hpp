@@ -60,6 +60,12 @@ struct TrainOptions {
   bool quarter_turns = false;        // augmentation: a random multiple of 90 degrees about z on
                                      // top of the angle (for objects aligned to their footprint's
                                      // axes up to a quarter turn, as --segment gives them)
+  int orientation_bins = 0;          // > 0: each training turn gets a random step of
+                                     // 360 / bins degrees on top of the angle, and a second
+                                     // output, trained beside the classes, names the step (an
+                                     // auxiliary orientation target, as ORION's); the model
+                                     // file holds the classifier alone
+  double orientation_weight = 0.5;   // that output's share of the loss
   bool balanced = false;             // loss weights 1/sqrt(class share), normalised to mean 1
   int threads = 0;                  // torch intra-op threads; 0: all cores
   std::string model_path;           // the trained weights, written after every epoch
