@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -21,6 +22,7 @@
 #include "vola/io/ept.hpp"
 #include "vola/io/input.hpp"
 #include "vola/io/las.hpp"
+#include "vola/io/npy.hpp"
 #include "vola/io/text_points.hpp"
 #include "vola/io/translate.hpp"
 
@@ -211,7 +213,23 @@ Summary summarise_las(io::LasReader& reader) {
   return s;
 }
 
-// `header`: a LAS file's, for coordinates at its precision (null: 9 significant digits).
+// A value as short as reads back: a float's shortest text when the value is one (PLY and
+// PCD coordinates, float columns: 0.1f is "0.1", not 0.10000000149011612), else the
+// double's (1234567890.12345 stays whole, where 9 significant digits made it 1.23456789e+09).
+std::string value_text(double v) {
+  char text[32];
+  const float f = static_cast<float>(v);
+  const auto r = std::isfinite(v) && static_cast<double>(f) == v ? std::to_chars(text, text + sizeof text, f)
+                                                                 : std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
+
+std::string point_text(const std::array<double, 3>& p) {
+  return "(" + value_text(p[0]) + ", " + value_text(p[1]) + ", " + value_text(p[2]) + ")";
+}
+
+// `header`: a LAS file's, for coordinates at its precision (null: each value as short as
+// reads back).
 void print_summary(const Summary& summary, const io::LasHeader* header = nullptr) {
   const Box box = summary.box();
   std::printf("summary:     %llu points read\n", static_cast<unsigned long long>(summary.points()));
@@ -221,10 +239,11 @@ void print_summary(const Summary& summary, const io::LasHeader* header = nullptr
     std::printf("             min %s\n             max %s (the points')\n",
                 las_point_text(box.min.data(), *header).c_str(), las_point_text(box.max.data(), *header).c_str());
   else
-    std::printf("             min (%.9g, %.9g, %.9g)\n             max (%.9g, %.9g, %.9g) (the points')\n", box.min[0],
-                box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]);
+    std::printf("             min %s\n             max %s (the points')\n", point_text(box.min).c_str(),
+                point_text(box.max).c_str());
   for (const auto& [name, range] : summary.columns())
-    std::printf("column:      %s: %.9g .. %.9g\n", name.c_str(), range.first, range.second);
+    std::printf("column:      %s: %s .. %s\n", name.c_str(), value_text(range.first).c_str(),
+                value_text(range.second).c_str());
   for (const auto& [code, n] : summary.classes())
     std::printf("class:       %3d %-38s %llu\n", code, std::string(analysis::asprs_class_name(code)).c_str(),
                 static_cast<unsigned long long>(n));
@@ -434,6 +453,15 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
           "             (each line holds %d values: the %d after x y z have no names and are not read; a first "
           "line '# x y z NAME ...', one name a column, names them)\n",
           values, values - 3);
+  }
+  // So are the columns of a plain (N, K) array after its first three.
+  if (in.format == "npy" && in.cloud.attributes.empty() && io::lower_extension(path) == ".npy") {
+    const io::NpyArray array = io::read_npy(path);
+    if (array.kind != 'V' && array.shape.size() == 2 && array.shape[1] > 3)
+      std::printf(
+          "             (each row holds %llu values: the %llu after x y z are not read; --nbits 1 reads up to 8 of "
+          "them as payload bytes, a structured array keeps its named fields as columns)\n",
+          static_cast<unsigned long long>(array.shape[1]), static_cast<unsigned long long>(array.shape[1] - 3));
   }
   if (summary) print_summary(summarise(in.cloud));
 }

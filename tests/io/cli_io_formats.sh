@@ -114,6 +114,18 @@ fi
 [ "$(tail -n +2 "$tmp/lyft.xyz" | tr '\n' ' ')" == "1 2 3 40 1 4 5 6 80 2 " ] || fail "translate --format nuscenes: $(cat "$tmp/lyft.xyz")"
 "$vola" convert "$tmp/lyft.bin" "$tmp/lyft.vol" --format nuscenes --voxel-size 1 -q || fail "convert --format nuscenes"
 
+# vola info says what it does not read of a plain (N, 6) array, and --summary gives each
+# value as short as reads back (9 significant digits made 1234567890.25 1.23456789e+09).
+"${VOLA_PYTHON:-python3}" - "$tmp/six.npy" <<'PY'
+import struct, sys
+header = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 6), }"
+header += " " * (63 - (10 + len(header)) % 64) + "\n"
+open(sys.argv[1], "wb").write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode() + struct.pack("<12f", *range(12)))
+PY
+"$vola" info "$tmp/six.npy" | grep -q "the 3 after x y z are not read" || fail "vola info of an (N, 6) array: $("$vola" info "$tmp/six.npy")"
+printf 'x y z\n0.1 2 1234567890.25\n' > "$tmp/big.xyz"
+"$vola" info "$tmp/big.xyz" --summary | grep -q "max (0.1, 2, 1234567890.25)" || fail "summary digits: $("$vola" info "$tmp/big.xyz" --summary)"
+
 if ((failures > 0)); then
   echo "$failures failure(s)" >&2
   exit 1
