@@ -379,7 +379,7 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
                std::size_t remaining_bytes) {
   const Element* vertex = nullptr;
   const Element* face = nullptr;
-  const Element* strips = nullptr;  // triangle strips (tinyply, the Stanford models' .ply)
+  const Element* strips = nullptr;  // triangle strips ("tristrips", as in tinyply's test models)
   for (const auto& e : h.elements) {
     if (e.name == "vertex" && !vertex) vertex = &e;
     if (e.name == "face" && !face) face = &e;

@@ -363,6 +363,8 @@ bool unit_colours_to_bytes(PointCloud& cloud) {
 
 }  // namespace
 
+namespace {
+
 // A Leica PTS file's columns by their count, as PDAL's readers.pts lays them out:
 // x y z, x y z intensity, or x y z intensity red green blue.
 std::optional<std::vector<std::string>> pts_names(const std::string& path, int skip_lines) {
@@ -372,6 +374,8 @@ std::optional<std::vector<std::string>> pts_names(const std::string& path, int s
   if (columns == 7) return std::vector<std::string>{"x", "y", "z", "intensity", "red", "green", "blue"};
   return std::nullopt;
 }
+
+}  // namespace
 
 std::optional<TextHeader> read_text_header(const std::string& path, int skip_lines) {
   if (auto header = read_header_line(path, skip_lines)) return header;

@@ -283,7 +283,7 @@ TEST(Ply, FacesBeforeVerticesAndPointsWithoutFaces) {
   EXPECT_EQ(p.cloud.xyz, (std::vector<double>{1, 2, 3}));
 }
 
-// Triangle strips (tinyply's and the Stanford models' "tristrips" element): each index
+// Triangle strips (the "tristrips" element of tinyply's test models): each index
 // after the first two makes a triangle, -1 restarts, repeated corners make none.
 TEST(Ply, TriangleStripsBecomeTriangles) {
   const std::string text =

@@ -207,55 +207,57 @@ TEST(Occupancy, QuarterTurnThenVoteAngleEqualsTheLaterVoteAngle) {
   EXPECT_NE(a, b);
 }
 
+// An asymmetric object, its four quarter turns as 64^3 inputs, and one batch of 40 copies
+// of it made with `augmentation`.
+struct TurnedBatch {
+  static constexpr std::size_t kCells = std::size_t(64) * 64 * 64;
+  vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
+  std::vector<std::vector<float>> turned = std::vector<std::vector<float>>(4, std::vector<float>(kCells));
+  std::vector<Sample> samples = std::vector<Sample>(40, Sample{tree, 0});
+  std::optional<Batch> batch;
+
+  explicit TurnedBatch(const Augmentation& augmentation) {
+    for (int q = 0; q < 4; ++q) fill_occupancy(turn_quarters(tree, q), 64, 0.0, turned[std::size_t(q)]);
+    std::vector<std::size_t> order(samples.size());
+    std::iota(order.begin(), order.end(), 0);
+    BatchProducer producer(samples, order, samples.size(), 64, 5, augmentation);
+    batch = producer.next();
+  }
+  std::vector<float> input(std::size_t k) const {
+    return {batch->inputs.begin() + std::ptrdiff_t(k * kCells),
+            batch->inputs.begin() + std::ptrdiff_t((k + 1) * kCells)};
+  }
+};
+
 // --quarter-turns alone: every training input is the sample turned by a whole number of
 // quarter turns (the exact turn_quarters grid), and all four turns occur.
 TEST(Augmentation, QuarterTurnsTurnTheSampleByWholeQuarters) {
-  const vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
-  const std::size_t cells = std::size_t(64) * 64 * 64;
-  std::vector<std::vector<float>> turned(4, std::vector<float>(cells));
-  for (int q = 0; q < 4; ++q) fill_occupancy(turn_quarters(tree, q), 64, 0.0, turned[std::size_t(q)]);
-  const std::vector<Sample> samples(40, Sample{tree, 0});
-  std::vector<std::size_t> order(samples.size());
-  std::iota(order.begin(), order.end(), 0);
   Augmentation augmentation;
   augmentation.quarter_turns = true;
-  BatchProducer producer(samples, order, samples.size(), 64, 5, augmentation);
-  const std::optional<Batch> batch = producer.next();
-  ASSERT_TRUE(batch && batch->count() == samples.size());
+  const TurnedBatch t(augmentation);
+  ASSERT_TRUE(t.batch && t.batch->count() == t.samples.size());
   std::set<int> seen;
-  for (std::size_t k = 0; k < batch->count(); ++k) {
-    const std::vector<float> input(batch->inputs.begin() + std::ptrdiff_t(k * cells),
-                                   batch->inputs.begin() + std::ptrdiff_t((k + 1) * cells));
-    const auto match = std::find(turned.begin(), turned.end(), input);
-    ASSERT_NE(match, turned.end()) << "input " << k << " is not a quarter turn of the sample";
-    seen.insert(int(match - turned.begin()));
+  for (std::size_t k = 0; k < t.batch->count(); ++k) {
+    const auto match = std::find(t.turned.begin(), t.turned.end(), t.input(k));
+    ASSERT_NE(match, t.turned.end()) << "input " << k << " is not a quarter turn of the sample";
+    seen.insert(int(match - t.turned.begin()));
   }
   EXPECT_EQ(seen.size(), 4u);
-  EXPECT_NE(turned[0], turned[1]);  // the shape is not symmetric under a quarter turn
+  EXPECT_NE(t.turned[0], t.turned[1]);  // the shape is not symmetric under a quarter turn
 }
 
 // --orientation-bins 4 alone: each input is the sample turned by the step its label says.
 TEST(Augmentation, OrientationBinsLabelTheTurnEachInputGot) {
-  const vola::Tree tree = clean_scene(shape_grid(3, 7), 32);
-  const std::size_t cells = std::size_t(64) * 64 * 64;
-  std::vector<std::vector<float>> turned(4, std::vector<float>(cells));
-  for (int q = 0; q < 4; ++q) fill_occupancy(turn_quarters(tree, q), 64, 0.0, turned[std::size_t(q)]);
-  const std::vector<Sample> samples(40, Sample{tree, 0});
-  std::vector<std::size_t> order(samples.size());
-  std::iota(order.begin(), order.end(), 0);
   Augmentation augmentation;
   augmentation.orientation_bins = 4;
-  BatchProducer producer(samples, order, samples.size(), 64, 5, augmentation);
-  const std::optional<Batch> batch = producer.next();
-  ASSERT_TRUE(batch && batch->count() == samples.size());
-  ASSERT_EQ(batch->orientations.size(), samples.size());
+  const TurnedBatch t(augmentation);
+  ASSERT_TRUE(t.batch && t.batch->count() == t.samples.size());
+  ASSERT_EQ(t.batch->orientations.size(), t.samples.size());
   std::set<std::int64_t> seen;
-  for (std::size_t k = 0; k < batch->count(); ++k) {
-    const std::vector<float> input(batch->inputs.begin() + std::ptrdiff_t(k * cells),
-                                   batch->inputs.begin() + std::ptrdiff_t((k + 1) * cells));
-    const std::int64_t step = batch->orientations[k];
+  for (std::size_t k = 0; k < t.batch->count(); ++k) {
+    const std::int64_t step = t.batch->orientations[k];
     ASSERT_TRUE(step >= 0 && step < 4) << step;
-    EXPECT_EQ(input, turned[std::size_t(step)]) << "input " << k << " is not turned by its label's quarter";
+    EXPECT_EQ(t.input(k), t.turned[std::size_t(step)]) << "input " << k << " is not turned by its label's quarter";
     seen.insert(step);
   }
   EXPECT_EQ(seen.size(), 4u);
