@@ -8,6 +8,8 @@
 #include <span>
 #include <string>
 
+#include "vola/frame.hpp"
+
 namespace vola {
 
 // What one input says its CRS is.
@@ -66,5 +68,11 @@ std::string mixed_units(const std::string& definition);
 // UTM metres). The sentence to tell the user, from the points' or tiles' box (min x, min y,
 // max x, max y); else "" (in range, not geographic, or what PROJ cannot read).
 std::string implausible_degrees(const std::string& definition, double min_x, double min_y, double max_x, double max_y);
+
+// Points whose box centre lies nowhere near the earth's surface (closer to its centre than
+// 6200 km or farther than 6500 km) under a geocentric CRS `definition` (PDAL's
+// lone-star.laz: keys saying geocentric WGS 84 over UTM metres). The sentence to tell the
+// user; else "" (plausible, not geocentric, or what PROJ cannot read).
+std::string implausible_geocentric(const std::string& definition, const Box& box);
 
 }  // namespace vola

@@ -297,7 +297,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     if (input.bytes_read) report.bytes_read = input.bytes_read();
     if (input.bytes_total) report.bytes_total = input.bytes_total;
     report.warnings = crs_warnings(path, options, input, crs);
-    if (const std::string label = implausible_degrees(path, crs, tree.georef().bbox); !label.empty())
+    if (const std::string label = implausible_label(path, crs, tree.georef().bbox); !label.empty())
       report.warnings.push_back(label);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
     for (const auto& stage : filter_report) report.filters.push_back(describe(stage));

@@ -218,4 +218,30 @@ std::string implausible_degrees(const std::string& definition, double min_x, dou
          ": the CRS label is likely wrong (metres of a projected CRS?); give the right one with `assign_crs`";
 }
 
+std::string implausible_geocentric(const std::string& definition, const Box& box) {
+  if (definition.empty()) return "";
+  std::string name;
+  try {
+    const geo::CrsDescription d = geo::describe_crs(definition, geo::EpsgLookup::own_id_only);
+    if (d.kind != "geocentric") return "";
+    name = d.name;
+  } catch (const Error&) {
+    return "";
+  }
+  double r2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double c = (box.min[a] + box.max[a]) / 2.0;
+    r2 += c * c;
+  }
+  const double km = std::sqrt(r2) / 1000.0;
+  // The earth's radius is 6357-6378 km; the deepest trench and the highest flights lie
+  // within 20 km of it. Outside 6200-6500 km the coordinates are no earth-centred ones.
+  if (!std::isfinite(km) || (km > 6200.0 && km < 6500.0)) return "";
+  char where[96];
+  std::snprintf(where, sizeof where, "the points lie %.0f km from the earth's centre", km);
+  return std::string(where) + ", not near its surface (about 6370 km), under " + name +
+         ", a geocentric CRS: the CRS label is likely wrong (metres of a projected CRS?); give the right one with "
+         "`assign_crs`";
+}
+
 }  // namespace vola

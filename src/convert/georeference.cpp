@@ -38,23 +38,24 @@ std::string given_or_stated(const std::string& stated, const std::string& given)
   return !given.empty() ? crs_definition_of(given) : stated;
 }
 
-// The sentence of vola::implausible_degrees for the points read whole, else for the box
-// the file's header states (a LAS file streams later).
+// The sentence of vola::implausible_degrees (or implausible_geocentric) for the points
+// read whole, else for the box the file's header states (a LAS file streams later).
 std::string label_doubt(const std::string& definition, const io::Input& input) {
   const PointCloud& cloud = input.cloud;
+  Box box;
   if (cloud.xyz.size() < 3) {
     if (!input.stated_bounds) return "";
-    const Box& b = *input.stated_bounds;
-    return vola::implausible_degrees(definition, b.min[0], b.min[1], b.max[0], b.max[1]);
+    box = *input.stated_bounds;
+  } else {
+    box = {{cloud.xyz[0], cloud.xyz[1], cloud.xyz[2]}, {cloud.xyz[0], cloud.xyz[1], cloud.xyz[2]}};
+    for (std::size_t i = 0; i + 2 < cloud.xyz.size(); i += 3)
+      for (std::size_t a = 0; a < 3; ++a) {
+        box.min[a] = std::min(box.min[a], cloud.xyz[i + a]);
+        box.max[a] = std::max(box.max[a], cloud.xyz[i + a]);
+      }
   }
-  double min_x = cloud.xyz[0], max_x = min_x, min_y = cloud.xyz[1], max_y = min_y;
-  for (std::size_t i = 0; i + 2 < cloud.xyz.size(); i += 3) {
-    min_x = std::min(min_x, cloud.xyz[i]);
-    max_x = std::max(max_x, cloud.xyz[i]);
-    min_y = std::min(min_y, cloud.xyz[i + 1]);
-    max_y = std::max(max_y, cloud.xyz[i + 1]);
-  }
-  return vola::implausible_degrees(definition, min_x, min_y, max_x, max_y);
+  const std::string degrees = vola::implausible_degrees(definition, box.min[0], box.min[1], box.max[0], box.max[1]);
+  return !degrees.empty() ? degrees : vola::implausible_geocentric(definition, box);
 }
 
 }  // namespace
@@ -114,9 +115,10 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
   return out;
 }
 
-std::string implausible_degrees(const std::string& path, const ResolvedCrs& crs, const Box& bounds) {
-  const std::string label =
-      vola::implausible_degrees(result_definition(crs), bounds.min[0], bounds.min[1], bounds.max[0], bounds.max[1]);
+std::string implausible_label(const std::string& path, const ResolvedCrs& crs, const Box& bounds) {
+  const std::string definition = result_definition(crs);
+  std::string label = vola::implausible_degrees(definition, bounds.min[0], bounds.min[1], bounds.max[0], bounds.max[1]);
+  if (label.empty()) label = vola::implausible_geocentric(definition, bounds);
   return label.empty() ? label : path + ": " + label;
 }
 
@@ -162,7 +164,8 @@ CentreLatLon::CentreLatLon(const std::optional<std::uint32_t>& known, const std:
 }
 
 std::pair<double, double> CentreLatLon::lat_lon(const Box& bbox) {
-  const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0, 0.0};
+  const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0,
+                     (bbox.min[2] + bbox.max[2]) / 2.0};  // z places a geocentric CRS's points
   const Point lon_lat = transform_.get().transform(centre);
   return {lon_lat[1], lon_lat[0]};
 }

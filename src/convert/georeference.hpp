@@ -38,9 +38,10 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
                                       const ResolvedCrs& crs);
 
 // Under a geographic CRS, coordinates no longitude or latitude can be (|x| > 180 or
-// |y| > 90: a scanner's export labelled WGS 84 that holds UTM metres): the sentence that
-// says the label is likely wrong; else "".
-std::string implausible_degrees(const std::string& path, const ResolvedCrs& crs, const Box& bounds);
+// |y| > 90: a scanner's export labelled WGS 84 that holds UTM metres), or under a
+// geocentric one, points nowhere near the earth's surface: the sentence that says the
+// label is likely wrong; else "".
+std::string implausible_label(const std::string& path, const ResolvedCrs& crs, const Box& bounds);
 
 // Before the points are reprojected: a `height` column (each point's z, or a LAS
 // extra-bytes height, a z too) is reprojected as the z of its point's x and y, so that

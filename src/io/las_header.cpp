@@ -204,7 +204,8 @@ struct UnitKeys {
   std::uint32_t vertical = 0;  // VerticalUnitsGeoKey, when no VerticalCSTypeGeoKey names a vertical CRS
   // The CRS is defined by its parts, not by a code: a user-defined (32767) projected CRS
   // (its geographic code, if any, is only its base), or a model type that says projected
-  // with no projected code, or a user-defined geographic CRS with no projected one.
+  // or geocentric with no projected code, or a user-defined geographic CRS with no
+  // projected one.
   bool user_defined = false;
 };
 
@@ -231,9 +232,11 @@ void parse_geokeys(const LasVlr& vlr, LasHeader& hd, UnitKeys& units) {
   if (vertical_crs) units.vertical = 0;
   // A code of 0 is no code (GDAL reads it so).
   const auto coded = [](const std::optional<std::uint32_t>& v) { return v && *v != las::kUserDefined && *v != 0; };
-  units.user_defined =
-      !coded(projected) && (projected == las::kUserDefined || model == 1u ||
-                            (!coded(geographic) && geographic == las::kUserDefined));
+  // A geocentric model (3) on a geographic code is that datum's geocentric CRS, not the
+  // geographic one: GDAL builds it from the keys (PDAL's lone-star.laz, EPSG:4326 keys on
+  // earth-centred coordinates).
+  units.user_defined = !coded(projected) && (projected == las::kUserDefined || model == 1u || model == 3u ||
+                                             (!coded(geographic) && geographic == las::kUserDefined));
   if (units.user_defined) return;
   if (coded(projected)) hd.epsg = *projected;
   else if (coded(geographic)) hd.epsg = *geographic;

@@ -19,7 +19,8 @@ void TileGeoref::apply(Tree& tree, const Box& bbox) const {
   g.crs_wkt = crs_wkt_;
   g.bbox = bbox;
   if (!to_wgs84_) return;
-  const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0, 0.0};
+  const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0,
+                     (bbox.min[2] + bbox.max[2]) / 2.0};  // z places a geocentric CRS's points
   try {
     const std::lock_guard lock(mutex_);
     const Point lon_lat = to_wgs84_->transform(centre);

@@ -595,7 +595,8 @@ std::vector<AttributeSpec> common_attributes(const std::vector<const PointSource
 }
 
 // What to tell the user when the tiles' points lie beyond any longitude and latitude under
-// a geographic CRS (a label that is likely wrong): the index can place none of them.
+// a geographic CRS, or nowhere near the earth's surface under a geocentric one (a label
+// that is likely wrong): the index can place none of them.
 std::string implausible_label(const TileIndexFile& index) {
   if (index.tiles.empty()) return "";
   const std::string crs = !index.crs_wkt.empty() ? index.crs_wkt
@@ -603,14 +604,15 @@ std::string implausible_label(const TileIndexFile& index) {
                                                  : "";
   Box extent = index.tiles.front().bbox;
   for (const TileEntry& t : index.tiles)
-    for (int a = 0; a < 2; ++a) {
+    for (int a = 0; a < 3; ++a) {
       extent.min[a] = std::min(extent.min[a], t.bbox.min[a]);
       extent.max[a] = std::max(extent.max[a], t.bbox.max[a]);
     }
   const std::string label = implausible_degrees(crs, extent.min[0], extent.min[1], extent.max[0], extent.max[1]);
-  return label.empty() ? label
-                       : "the points' " + label + "; " + kIndexFileName +
-                             " gives tiles beyond them no footprint (a null geometry)";
+  if (!label.empty())
+    return "the points' " + label + "; " + kIndexFileName + " gives tiles beyond them no footprint (a null geometry)";
+  const std::string far = implausible_geocentric(crs, extent);
+  return far.empty() ? far : far + "; " + kIndexFileName + " gives the tiles no footprint (a null geometry)";
 }
 
 // This run's spill folder, removed with its files; its parent too when it is vola's own

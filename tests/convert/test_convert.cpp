@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <regex>
 #include <string>
 #include <vector>
@@ -623,31 +624,51 @@ TEST(Convert, GeographicGridVoxelsAreRefusedUnlessAllowed) {
   relabelled.voxel_size = 10.0;
   relabelled.assign_crs = "4326";
   EXPECT_THROW(vola::convert((data / "las" / "pdal_autzen_trim.las").string(), relabelled), vola::OptionError);
-  // A RiSCAN export labelled WGS 84 that holds UTM-sized metres (x 515393): the label is
-  // said to be likely wrong when it is allowed through, on top of the degrees warning.
+  // A RiSCAN export whose keys say geocentric WGS 84 (GTModelType 3 on code 4326, as GDAL
+  // and PDAL read them) over UTM-sized metres (x 515393): converted, with a warning that
+  // the label is likely wrong (the points lie ~4900 km from the earth's centre)...
   vola::ConvertOptions mislabelled;
   mislabelled.voxel_size = 10.0;
-  mislabelled.allow_geographic = true;
   vola::ConvertReport mislabelled_report;
   vola::convert((data / "laz" / "pdal_lone-star-split-1.laz").string(), mislabelled, {}, &mislabelled_report);
-  ASSERT_EQ(mislabelled_report.warnings.size(), 2u);
-  EXPECT_NE(mislabelled_report.warnings[1].find("beyond any longitude and latitude, under WGS 84"), std::string::npos)
-      << mislabelled_report.warnings[1];
-  // Refused (not allowed), the label is what the error blames; so it is when reprojecting
-  // from it, where PROJ failed on the first point with a message naming nothing to fix.
-  for (const char* target : {"", "EPSG:32610"}) {
-    vola::ConvertOptions refused;
-    refused.voxel_size = 10.0;
-    refused.target_crs = target;
-    try {
-      vola::convert((data / "laz" / "pdal_lone-star-split-1.laz").string(), refused);
-      ADD_FAILURE() << "the mislabelled file was converted, target '" << target << "'";
-    } catch (const vola::OptionError& e) {
-      EXPECT_NE(e.cause().find("x reaches 515400.0017 and y 4918365, beyond any longitude and latitude, under WGS 84: "
-                               "the CRS label is likely wrong"),
-                std::string::npos)
-          << e.cause();
-    }
+  ASSERT_EQ(mislabelled_report.warnings.size(), 1u);
+  EXPECT_NE(mislabelled_report.warnings[0].find("km from the earth's centre, not near its surface"), std::string::npos)
+      << mislabelled_report.warnings[0];
+  EXPECT_NE(mislabelled_report.warnings[0].find("a geocentric CRS: the CRS label is likely wrong"), std::string::npos)
+      << mislabelled_report.warnings[0];
+  // ... and refused when reprojecting from it, where PROJ would put the points on the
+  // equator (or fail) with a message naming nothing to fix.
+  vola::ConvertOptions refused;
+  refused.voxel_size = 10.0;
+  refused.target_crs = "EPSG:32610";
+  try {
+    vola::convert((data / "laz" / "pdal_lone-star-split-1.laz").string(), refused);
+    ADD_FAILURE() << "the mislabelled file was reprojected";
+  } catch (const vola::OptionError& e) {
+    EXPECT_NE(e.cause().find("the CRS label is likely wrong"), std::string::npos) << e.cause();
+    EXPECT_NE(e.cause().find("to reproject from"), std::string::npos) << e.cause();
+  }
+  // Earth-centred points under a geocentric CRS: placed by all three coordinates (the
+  // header's latitude was 0, computed with z = 0), and no warning.
+  {
+    vola_test::TempDir dir;
+    const auto path = dir / "ecef.xyz";
+    const double lat = 45.0 * std::numbers::pi / 180, lon = 7.0 * std::numbers::pi / 180;
+    const double a = 6378137.0, e2 = 6.69437999014e-3, n = a / std::sqrt(1 - e2 * std::sin(lat) * std::sin(lat));
+    std::ofstream out(path);
+    out.precision(17);
+    for (int k = 0; k < 3; ++k)
+      out << n * std::cos(lat) * std::cos(lon) + k << ' ' << n * std::cos(lat) * std::sin(lon) << ' '
+          << n * (1 - e2) * std::sin(lat) << '\n';
+    out.close();
+    vola::ConvertOptions ecef;
+    ecef.voxel_size = 1.0;
+    ecef.assign_crs = "4978";
+    vola::ConvertReport ecef_report;
+    const vola::Tree tree = vola::convert(path.string(), ecef, {}, &ecef_report);
+    EXPECT_NEAR(tree.georef().lat, 45.0, 1e-4);
+    EXPECT_NEAR(tree.georef().lon, 7.0, 1e-4);
+    EXPECT_TRUE(ecef_report.warnings.empty()) << ecef_report.warnings.front();
   }
   // A geographic target is the target's fault, not the file's (which is in feet).
   vola::ConvertOptions to_degrees;

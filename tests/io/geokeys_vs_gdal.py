@@ -158,6 +158,9 @@ AS_GDAL_READS = [
     ("a 3-byte citation", TM_KEYS + [(3073, ("ascii", 0, 3))], TM_DOUBLES, b"ab|", ()),
     # A projected model with projected code 0 over a geographic code: not that code.
     ("projected code 0 over WGS 84", [(1024, 1), (2048, 4326), (3072, 0)], (), b"", ()),
+    # A geocentric model over a geographic code (PDAL's lone-star.laz): that datum's
+    # earth-centred CRS, not the geographic one (vola read EPSG:4326 degrees).
+    ("geocentric model over WGS 84", [(1024, 3), (2048, 4326)], (), b"", ()),
     # Two key directories: the first one counts.
     ("two directories, user-defined first", TM_KEYS, TM_DOUBLES, b"",
      ((34735, key_directory([(1024, 1), (3072, 32617)])),)),

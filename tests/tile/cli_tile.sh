@@ -195,14 +195,14 @@ grep -q "^vola: .*pdal_epsg_4326.las is in WGS 84, a geographic CRS.*--allow-geo
   fail "degrees message: $(cat "$tmp/err.txt")"
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" --allow-geographic -q || fail "--allow-geographic refused"
 "$vola" tile "$geo" --tile-size 200 --depth 4 -o "$tmp/degrees_utm" --target-crs 32615 -q || fail "degrees to UTM refused"
-# A WGS 84 label on UTM metres (a RiSCAN export: x = 515393) forced through: a warning
-# says the label is likely wrong, and the index gives those tiles a null geometry rather
-# than an empty polygon (what OGR's antimeridian cut made of them).
+# A geocentric WGS 84 label on UTM metres (a RiSCAN export: x = 515393, ~4900 km from the
+# earth's centre): a warning says the label is likely wrong, and the index gives the tiles
+# a null geometry (a geocentric x and y are no map position).
 mislabelled=$data/laz/pdal_lone-star-split-1.laz
 if [ -f "$mislabelled" ]; then
-  "$vola" tile "$mislabelled" --tile-size 100 --depth 4 -o "$tmp/mislabelled" --allow-geographic -q 2> "$tmp/err.txt" ||
-    fail "--allow-geographic on the mislabelled file refused: $(cat "$tmp/err.txt")"
-  grep -q "beyond any longitude and latitude, under WGS 84.*null geometry" "$tmp/err.txt" ||
+  "$vola" tile "$mislabelled" --tile-size 100 --depth 4 -o "$tmp/mislabelled" -q 2> "$tmp/err.txt" ||
+    fail "the mislabelled file refused: $(cat "$tmp/err.txt")"
+  grep -q "km from the earth's centre.*geocentric CRS: the CRS label is likely wrong.*null geometry" "$tmp/err.txt" ||
     fail "no warning about the likely wrong label: $(cat "$tmp/err.txt")"
   python3 - "$tmp/mislabelled/index.geojson" <<'PY' || fail "mislabelled tiles' geometries are not null"
 import json, sys

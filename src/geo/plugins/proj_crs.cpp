@@ -125,7 +125,10 @@ std::pair<double, double> centre_lat_lon(const std::string& source, const Box& b
   if (!normalized) throw Error("PROJ cannot normalise the axis order of " + source);
   const double cx = (bbox.min[0] + bbox.max[0]) / 2.0;
   const double cy = (bbox.min[1] + bbox.max[1]) / 2.0;
-  const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, 0, 0));
+  // The height too: in a geocentric CRS it is a third of the position (at z = 0 every
+  // point lies on the equatorial plane).
+  const double cz = (bbox.min[2] + bbox.max[2]) / 2.0;
+  const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, std::isfinite(cz) ? cz : 0.0, 0));
   if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
     throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source.substr(0, 60) +
                 " to WGS84: " + last_error(ctx.get()));  // NOLINT
@@ -284,7 +287,8 @@ class Wgs84Transformation {
   }
 
   Point transform(const Point& p) const {
-    const PJ_COORD out = proj_trans(transform_.get(), PJ_FWD, proj_coord(p[0], p[1], 0, 0));
+    const PJ_COORD out =
+        proj_trans(transform_.get(), PJ_FWD, proj_coord(p[0], p[1], std::isfinite(p[2]) ? p[2] : 0.0, 0));
     if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
       throw Error("PROJ cannot transform (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") from " +
                   source_ + " to WGS84: " + last_error(ctx_.get()));

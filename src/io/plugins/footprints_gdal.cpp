@@ -181,7 +181,9 @@ std::vector<std::uint8_t> footprints_geojson_with_ogr(const FootprintLayer& laye
   GDALDriver& geojson = driver("GeoJSON");
   QuietGdalErrors quiet;
   const std::unique_ptr<OGRSpatialReference> srs = spatial_reference(layer.crs_wkt);
-  const std::unique_ptr<OGRCoordinateTransformation> transform = srs ? to_wgs84(*srs) : nullptr;
+  // A geocentric CRS's x and y are no map position (a rectangle of them lies across the
+  // equatorial plane): its footprints have no RFC 7946 geometry.
+  const std::unique_ptr<OGRCoordinateTransformation> transform = srs && !srs->IsGeocentric() ? to_wgs84(*srs) : nullptr;
   const bool placed = transform != nullptr;
   const MemoryFolder folder;
   const std::string name = folder.path() + "/footprints.geojson";
