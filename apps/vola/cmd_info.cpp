@@ -183,12 +183,15 @@ void run_info(const InfoArgs& a) {
       std::printf(",\n  \"state_map\": {\"occupied\": %llu, \"free\": %llu, \"unknown_in_bounds\": %llu}",
                   static_cast<unsigned long long>(states->occupied), static_cast<unsigned long long>(states->free),
                   static_cast<unsigned long long>(states->unknown_in_bounds));
-    std::printf(",\n  \"compressed\": %s,\n  \"level_coding\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
-                "  \"crs_named\": %s\n}\n",
-                layout.compressed_levels ? "true" : "false",
-                layout.compressed_levels ? quoted(level_coding(layout)).c_str() : "null",
-                static_cast<unsigned long long>(layout.extension_bytes),
-                quoted(tree.georef().crs_wkt).c_str(), json_crs(crs).c_str());
+    // "crs_placeholder": the header's code is the reference's placeholder for no CRS, so
+    // "crs", "lat" and "lon" say nothing of where the data is.
+    std::printf(
+        ",\n  \"compressed\": %s,\n  \"level_coding\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
+        "  \"crs_named\": %s,\n  \"crs_placeholder\": %s\n}\n",
+        layout.compressed_levels ? "true" : "false",
+        layout.compressed_levels ? quoted(level_coding(layout)).c_str() : "null",
+        static_cast<unsigned long long>(layout.extension_bytes), quoted(tree.georef().crs_wkt).c_str(),
+        json_crs(crs).c_str(), !crs.description && crs.problem.empty() ? "true" : "false");
     return;
   }
   std::printf("file:        %s (%llu bytes)\n", a.file.c_str(), static_cast<unsigned long long>(layout.file_size));

@@ -221,4 +221,10 @@ assert d['summary']['points_read'] == 41, d
   "$vola" convert "$tmp/e57/typed.e57" "$tmp/typed.vol" --voxel-size 0.5 -q || fail "convert an E57 file"
   "$vola" info "$tmp/typed.vol" | grep -q "red" || fail "E57 colours not kept: $("$vola" info "$tmp/typed.vol")"
 fi
+# A .vol with no CRS holds the reference's placeholder code: JSON says so, as the text does.
+printf '0 0 0\n1 1 1\n' > "$tmp/nocrs.xyz"
+"$vola" convert "$tmp/nocrs.xyz" "$tmp/nocrs.vol" --voxel-size 1 -q
+"$vola" info --json "$tmp/nocrs.vol" | grep -q '"crs_placeholder": true' || fail "no CRS, yet crs_placeholder is not true"
+"$vola" convert "$data/las/pdal_autzen_trim.las" "$tmp/autzen.vol" --voxel-size 20 -q
+"$vola" info --json "$tmp/autzen.vol" | grep -q '"crs_placeholder": false' || fail "a CRS, yet crs_placeholder is not false"
 echo "cli_info_json: OK ($checked LAS/LAZ files)"
