@@ -301,8 +301,10 @@ void bind_building(py::module_& m) {
         "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).\n"
         "output= the input itself, or a name with another format's extension (a.las), is refused as the CLI refuses\n"
         "it; what the CLI warns of (a CRS relabelled, heights left in feet) comes as UserWarning.");
-  m.def("translate", [](const std::filesystem::path& input, const std::filesystem::path& output,
-                        const std::vector<std::string>& filters) {
+  m.def(
+      "translate",
+      [](const std::filesystem::path& input, const std::filesystem::path& output,
+         const std::vector<std::string>& filters, const std::string& format) {
         std::vector<std::string> warnings;
         {
           py::gil_scoped_release release;
@@ -313,16 +315,18 @@ void bind_building(py::module_& m) {
               edit = [&](vola::io::PointTable& table) {
                 return vola::filters::run_stages(stages, table.cloud, table.epsg, table.wkt).kept;
               };
-            warnings = vola::io::translate_points(input.string(), output.string(), {}, edit);
+            warnings = vola::io::translate_points(input.string(), output.string(), {}, edit, format);
           });
         }
         for (const auto& w : warnings)  // what the output cannot hold (a PLY has no CRS)
           if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) < 0) throw py::error_already_set();
-      }, py::arg("input"), py::arg("output"), py::arg("filters") = std::vector<std::string>{},
+      },
+      py::arg("input"), py::arg("output"), py::arg("filters") = std::vector<std::string>{}, py::arg("format") = "auto",
       "Point file to point file, point by point, no voxels (`vola translate`): LAS, LAZ, COPC, PLY, PCD, XYZ,\n"
       "NPY or KITTI in; LAS, LAZ (record for record from LAS/LAZ), PLY or XYZ out, chosen by the extension.\n"
       "filters=['smrf'] etc. as `vola translate --filter` (docs/FILTERS.md): LAS/LAZ out keeps the records left,\n"
-      "classification updated.");
+      "classification updated. format='nuscenes' (or any name of input_formats()) reads the input by that\n"
+      "reader whatever its extension (a Lyft sweep is a plain .bin of five floats a point).");
   m.def("input_formats", [] {
         std::vector<std::pair<std::string, std::vector<std::string>>> out;
         for (const auto& f : vola::io::input_formats()) out.emplace_back(f.name, f.extensions);

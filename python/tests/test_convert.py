@@ -122,3 +122,14 @@ def test_translate_and_export_las_like_the_cli(tmp_path, shared_data, vola_cli):
     assert _las_records(tmp_path / "tree_back.las") == _las_records(tmp_path / "tree.las")
     with pytest.raises(vola.InvalidArgument, match="writes .las, .laz, .ply"):
         vola.translate(laz, tmp_path / "points.obj")
+
+
+def test_translate_reads_by_the_format_named(tmp_path):
+    # A Lyft sweep: five float32 a point under a plain .bin name, which KITTI cannot read.
+    sweep = tmp_path / "host-a017_lidar1.bin"
+    np.array([[1, 2, 3, 40, 1], [4, 5, 6, 80, 2]], dtype=np.float32).tofile(sweep)
+    with pytest.raises(vola.FormatError, match="nuscenes"):
+        vola.translate(sweep, tmp_path / "kitti.xyz")
+    vola.translate(sweep, tmp_path / "sweep.xyz", format="nuscenes")
+    rows = [line.split() for line in (tmp_path / "sweep.xyz").read_text().splitlines()[1:]]
+    assert rows == [["1", "2", "3", "40", "1"], ["4", "5", "6", "80", "2"]]
