@@ -187,7 +187,7 @@ void run_export(const ExportArgs& a) {
     }
     say(what);
     if (r.clamped_intensities)  // a warning, even with -q: values were changed
-      std::fprintf(stderr, "vola: warning: %llu intensities above LAS's 65535 were written as 65535\n",
+      std::fprintf(stderr, "vola: warning: %llu intensities outside LAS's 0..65535 were clamped to it\n",
                    static_cast<unsigned long long>(r.clamped_intensities));
   } else if (format == "binvox") {
     io::write_binvox(tree, a.output);

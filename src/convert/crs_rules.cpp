@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "vola/error.hpp"
+#include "vola/filters/units.hpp"
 #include "vola/geo/crs.hpp"
 
 namespace vola {
@@ -220,26 +221,37 @@ std::string implausible_degrees(const std::string& definition, double min_x, dou
 
 std::string implausible_geocentric(const std::string& definition, const Box& box) {
   if (definition.empty()) return "";
-  std::string name;
+  geo::CrsDescription d;
   try {
-    const geo::CrsDescription d = geo::describe_crs(definition, geo::EpsgLookup::own_id_only);
-    if (d.kind != "geocentric") return "";
-    name = d.name;
+    d = geo::describe_crs(definition, geo::EpsgLookup::own_id_only);
   } catch (const Error&) {
     return "";
   }
-  double r2 = 0;
+  if (d.kind != "geocentric") return "";
+  // GDAL's reading of geocentric keys without a unit key says "unknown" (factor 1): metres.
+  const double metres =
+      d.horizontal_unit == "unknown" ? 1.0 : filters::metres_per_unit(d.horizontal_unit).value_or(0.0);
+  if (!(metres > 0)) return "";
+  // The box's nearest point to the earth's centre and its farthest corner, in km.
+  double near2 = 0, far2 = 0;
   for (int a = 0; a < 3; ++a) {
-    const double c = (box.min[a] + box.max[a]) / 2.0;
-    r2 += c * c;
+    const double lo = box.min[a] * metres, hi = box.max[a] * metres;
+    const double nearest = lo > 0 ? lo : hi < 0 ? hi : 0.0;
+    near2 += nearest * nearest;
+    far2 += std::max(lo * lo, hi * hi);
   }
-  const double km = std::sqrt(r2) / 1000.0;
+  const double near_km = std::sqrt(near2) / 1000.0, far_km = std::sqrt(far2) / 1000.0;
   // The earth's radius is 6357-6378 km; the deepest trench and the highest flights lie
-  // within 20 km of it. Outside 6200-6500 km the coordinates are no earth-centred ones.
-  if (!std::isfinite(km) || (km > 6200.0 && km < 6500.0)) return "";
-  char where[96];
-  std::snprintf(where, sizeof where, "the points lie %.0f km from the earth's centre", km);
-  return std::string(where) + ", not near its surface (about 6370 km), under " + name +
+  // within 20 km of it. A box wholly inside 6200 km or wholly beyond 6500 km holds no
+  // earth-centred point (a continent-wide survey's box reaches the shell: its centre lies
+  // deep inside the earth, its corners do not).
+  if (!std::isfinite(near_km) || !std::isfinite(far_km) || (far_km >= 6200.0 && near_km <= 6500.0)) return "";
+  char where[128];
+  if (far_km < 6200.0)
+    std::snprintf(where, sizeof where, "the points lie at most %.0f km from the earth's centre", far_km);
+  else
+    std::snprintf(where, sizeof where, "the points lie at least %.0f km from the earth's centre", near_km);
+  return std::string(where) + ", not near its surface (about 6370 km), under " + d.name +
          ", a geocentric CRS: the CRS label is likely wrong (metres of a projected CRS?); give the right one with "
          "`assign_crs`";
 }

@@ -1,6 +1,7 @@
 #include "filtering.hpp"
 
 #include <algorithm>
+#include <set>
 
 #include "georeference.hpp"
 
@@ -25,7 +26,9 @@ bool dropped_las_field(const std::string& name) {
 
 // The table of every LAS field (Reduction::last) as the columns io::las_attributes
 // lists, in its order and with its types and reductions, then the filters' own columns.
-PointCloud las_voxel_columns(PointCloud&& table) {
+// `extra_bytes`: the names of the file's extra-bytes columns, kept whatever their name (a
+// format 6 file's extra "nir" is no NIR field to drop).
+PointCloud las_voxel_columns(PointCloud&& table, const std::set<std::string>& extra_bytes) {
   PointCloud cloud;
   cloud.xyz = std::move(table.xyz);
   std::vector<PointAttribute> columns = std::move(table.attributes);
@@ -50,7 +53,7 @@ PointCloud las_voxel_columns(PointCloud&& table) {
   }
   take("number_of_returns", ValueType::u8, Reduction::max);
   for (auto& column : columns) {
-    if (dropped_las_field(column.name)) continue;
+    if (dropped_las_field(column.name) && !extra_bytes.contains(column.name)) continue;
     column.type = ValueType::f64;
     column.reduction = io::default_reduction(column.name);
     cloud.attributes.push_back(std::move(column));
@@ -94,6 +97,9 @@ io::Input read_filtered(const std::string& path, const io::InputFormat& format, 
   } catch (const InvalidArgument& e) {
     throw OptionError("filters", std::string("apply to point input only: ") + e.what());
   }
+  std::set<std::string> extra_bytes;
+  for (std::size_t c = table.record_fields; c < table.cloud.attributes.size(); ++c)
+    extra_bytes.insert(table.cloud.attributes[c].name);
   const auto [epsg, wkt] = filters_crs(options, table.epsg, table.wkt);
   const filters::FilterResult result = filters::run_stages(stages, table.cloud, epsg, wkt);
   report = result.stages;
@@ -101,7 +107,7 @@ io::Input read_filtered(const std::string& path, const io::InputFormat& format, 
   input.format = table.format;
   input.epsg = table.epsg;
   input.wkt = std::move(table.wkt);
-  input.cloud = table.format == "las" ? las_voxel_columns(std::move(table.cloud)) : std::move(table.cloud);
+  input.cloud = table.format == "las" ? las_voxel_columns(std::move(table.cloud), extra_bytes) : std::move(table.cloud);
   if (!options.attributes) input.cloud.attributes.clear();
   return input;
 }

@@ -126,8 +126,17 @@ LasColumns sort_columns(const Attributes& a) {
   c.gps_time = a.find("gps_time");
   c.scan_angle = a.find("scan_angle_rank");
   c.classification_flags = a.find("classification_flags");
+  // Only columns of 0s and 1s are flags: an "overlap" of 0.3 or 47.5 is some other
+  // measurement, kept as extra bytes.
+  const auto holds_bits = [](const AttributeColumn& column) {
+    for (std::size_t i = 0; i < column.size(); ++i)
+      if (const double v = column.get(i); !(v == 0 || v == 1 || std::isnan(v))) return false;
+    return true;
+  };
   static constexpr const char* kFlagBits[] = {"synthetic", "key_point", "withheld", "overlap"};
-  for (int bit = 0; bit < 4; ++bit) c.flag_bits[bit] = a.find(kFlagBits[bit]);
+  for (int bit = 0; bit < 4; ++bit)
+    if (const AttributeColumn* column = a.find(kFlagBits[bit]); column && holds_bits(*column))
+      c.flag_bits[bit] = column;
   c.scanner_channel = a.find("scanner_channel");
   c.scan_direction = a.find("scan_direction_flag");
   c.edge = a.find("edge_of_flight_line");
@@ -136,7 +145,7 @@ LasColumns sort_columns(const Attributes& a) {
     const bool standard = name == "intensity" || name == "classification" || name == "number_of_returns" ||
                           name == "return_number" || name == "user_data" || name == "point_source_id" ||
                           name == "gps_time" || name == "scan_angle_rank" || name == "classification_flags" ||
-                          name == "synthetic" || name == "key_point" || name == "withheld" || name == "overlap" ||
+                          std::find(std::begin(c.flag_bits), std::end(c.flag_bits), &column) != std::end(c.flag_bits) ||
                           name == "scanner_channel" || name == "scan_direction_flag" || name == "edge_of_flight_line" ||
                           (c.rgb() && (name == "red" || name == "green" || name == "blue"));
     if (standard) continue;
@@ -295,7 +304,7 @@ std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumn
 }
 
 // One point record per position, in order, written in 64 KiB batches.
-// Returns how many intensities were above the field's 65535 (written as 65535).
+// Returns how many intensities were outside the field's 0..65535 (clamped to it).
 std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns,
                             const RecordLayout& layout, const LasCoordinates& coords) {
   std::uint64_t clamped_intensities = 0;
@@ -306,7 +315,10 @@ std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasC
     std::fill(record.begin(), record.end(), 0);
     for (int a = 0; a < 3; ++a) put<std::int32_t>(record, 4 * static_cast<std::size_t>(a), coords.integer(p, a));
     put<std::uint16_t>(record, 12, static_cast<std::uint16_t>(field_value(columns.intensity, rank, 65535.0, 0)));
-    if (columns.intensity && columns.intensity->get(rank) > 65535.0) ++clamped_intensities;
+    if (columns.intensity) {
+      const double v = columns.intensity->get(rank);
+      if (v > 65535.0 || v < 0.0) ++clamped_intensities;  // a PTS file's go down to -2048
+    }
     const auto [number, count] = returns_of(columns, rank);
     record[14] = static_cast<std::uint8_t>(number | count << 4);
     std::uint32_t flags = field_value(columns.classification_flags, rank, 15.0, 0);

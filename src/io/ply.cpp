@@ -348,8 +348,9 @@ struct Mesh {
 };
 
 // A triangle strip: each index after the first two makes a triangle with the two before
-// it; -1 restarts the strip. Triangles with a repeated corner (strips use them to turn)
-// are no surface and are left out.
+// it, every second one with its first two corners swapped so that all face the same way;
+// -1 restarts the strip. Triangles with a repeated corner (strips use them to turn) are
+// no surface and are left out.
 template <class In>
 void read_strip(In& in, PlyType type, std::uint64_t n, std::uint64_t vertices, Mesh& mesh) {
   in.expect(type, n);
@@ -369,7 +370,10 @@ void read_strip(In& in, PlyType type, std::uint64_t n, std::uint64_t vertices, M
     run[2] = static_cast<std::uint32_t>(v);
     if (++length < 3) continue;
     if (run[0] == run[1] || run[1] == run[2] || run[0] == run[2]) continue;
-    mesh.corners.insert(mesh.corners.end(), {run[0], run[1], run[2]});
+    if ((length - 3) % 2 == 0)
+      mesh.corners.insert(mesh.corners.end(), {run[0], run[1], run[2]});
+    else
+      mesh.corners.insert(mesh.corners.end(), {run[1], run[0], run[2]});
     mesh.sizes.push_back(3);
   }
 }

@@ -164,6 +164,7 @@ PointTable las_point_table(const std::string& path, const std::function<void(std
   table.wkt = hd.wkt;
   table.coordinate_digits = hd.coordinate_decimals();  // the file's own precision
   table.cloud = las_columns(hd);
+  table.record_fields = table.cloud.attributes.size() - hd.extra_fields.size();
   for_each_las_chunk(
       reader,
       [&](const PointCloud& chunk) {
@@ -284,7 +285,7 @@ void write_text_points(const PointCloud& cloud, const std::string& path, int coo
       if (c.bit < 0)
         append_number(line, v);
       else
-        line += (static_cast<std::uint32_t>(v) >> c.bit) & 1u ? '1' : '0';
+        line += v >= 0 && v <= 255 && (static_cast<std::uint32_t>(v) >> c.bit) & 1u ? '1' : '0';  // NaN: 0
     }
     line += '\n';
     if (line.size() >= (std::size_t{1} << 16)) {
@@ -382,8 +383,11 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
                        (table.epsg ? "EPSG:" + std::to_string(*table.epsg) : "a WKT with no EPSG code") +
                        "): it is not kept; a .las or .laz output keeps it");
   if (out_ext == ".ply") write_ply_points(table.cloud, output);
-  else if (las_out) write_las(table.cloud, output, table.epsg, table.wkt);
-  else
+  else if (las_out) {
+    if (const LasReport r = write_las(table.cloud, output, table.epsg, table.wkt); r.clamped_intensities)
+      warnings.push_back(output + ": " + std::to_string(r.clamped_intensities) +
+                         " intensities outside LAS's 0..65535 were clamped to it");
+  } else
     write_text_points(table.cloud, output, table.coordinate_digits, csv);
   return warnings;
 }

@@ -86,7 +86,17 @@ int load_checkpoint(Network& network, OrientationHead& head, torch::optim::Adam&
           "orientation-bins",
           path + (has_head ? ": checkpoint trained with an orientation output; give its --orientation-bins"
                            : ": checkpoint trained without an orientation output"));
-    if (head) head.layer->load(head_weights);
+    if (head) {
+      // load() takes the checkpoint's tensors whatever their shape: a head of other bins
+      // would train on silently (or fail deep in libtorch).
+      const std::int64_t bins = head.layer->weight.size(0);
+      head.layer->load(head_weights);
+      if (head.layer->weight.dim() != 2 || head.layer->weight.size(0) != bins)
+        throw OptionError("orientation-bins",
+                          path + ": checkpoint trained with " +
+                              std::to_string(head.layer->weight.dim() == 2 ? head.layer->weight.size(0) : 0) +
+                              " orientation bins, not " + std::to_string(bins) + "; give its count");
+    }
     optimizer.load(optimizer_state);
     std::vector<torch::Tensor> tensors = network_tensors(network);
     if (head)

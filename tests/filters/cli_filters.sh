@@ -355,5 +355,14 @@ printf 'x y z Infrared\n1 2 3 500\n' > "$tmp/nir.xyz"
 "$vola" translate "$tmp/nir.xyz" "$tmp/nir.las" -q 2> /dev/null
 "$vola" translate "$tmp/nir.las" "$tmp/nir_back.xyz" -q 2> /dev/null
 head -1 "$tmp/nir_back.xyz" | grep -q ' nir$' || fail "infrared through LAS: $(head -1 "$tmp/nir_back.xyz")"
+# ... and a filtered conversion keeps it as a plain one does (it dropped "nir" as a field).
+"$vola" convert "$tmp/nir.las" "$tmp/nir.vol" --voxel-size 1 --where "Z > 0" -q 2> /dev/null
+"$vola" info "$tmp/nir.vol" | grep -q "nir" || fail "filtered convert lost the extra-bytes nir: $("$vola" info "$tmp/nir.vol")"
+# A column named like a flag that holds other values than 0 and 1 is no flag: extra bytes.
+printf 'x y z overlap\n1 2 3 0.5\n' > "$tmp/overlap.xyz"
+"$vola" translate "$tmp/overlap.xyz" "$tmp/overlap.las" -q 2> /dev/null
+"$vola" translate "$tmp/overlap.las" "$tmp/overlap_back.xyz" -q 2> /dev/null
+[ "$(head -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == overlap ] && [ "$(tail -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == 0.5 ] ||
+  fail "an overlap column of 0.5 through LAS: $(cat "$tmp/overlap_back.xyz")"
 
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

@@ -120,9 +120,32 @@ TEST(Classifier, OrientationOutputResumesAndStaysOutOfTheModel) {
   const Classifier a((dir / "whole.pt").string()), b((dir / "parts.pt").string());
   const vola::Tree* trees[] = {&samples[2].tree};
   EXPECT_EQ(a.classify(trees), b.classify(trees));
-  // A checkpoint with the output does not resume a run without it, nor the other way.
-  options.orientation_bins = 0;
+  // The model file holds no orientation output (its archive's pickle names no such key),
+  // the checkpoint does.
+  const auto pickle_names_head = [](const std::filesystem::path& file) {
+    int zip_error = 0;
+    zip_t* archive = zip_open(file.string().c_str(), ZIP_RDONLY, &zip_error);
+    if (!archive) throw std::runtime_error("cannot open " + file.string());
+    std::string pickle;
+    for (zip_int64_t i = 0; i < zip_get_num_entries(archive, 0); ++i) {
+      const std::string name = zip_get_name(archive, static_cast<zip_uint64_t>(i), 0);
+      if (!name.ends_with("data.pkl")) continue;
+      zip_file_t* f = zip_fopen_index(archive, static_cast<zip_uint64_t>(i), 0);
+      char buffer[4096];
+      for (zip_int64_t n; f && (n = zip_fread(f, buffer, sizeof buffer)) > 0;) pickle.append(buffer, std::size_t(n));
+      if (f) zip_fclose(f);
+    }
+    zip_close(archive);
+    return pickle.find("orientation_head") != std::string::npos;
+  };
+  EXPECT_FALSE(pickle_names_head(dir / "whole.pt"));
+  EXPECT_TRUE(pickle_names_head(dir / "whole.ckpt"));
+  // A checkpoint with the output does not resume a run without it, nor the other way, nor
+  // one of another count of bins.
   options.epochs = 3;
+  options.orientation_bins = 12;
+  EXPECT_THROW(train(samples, samples, options), vola::OptionError);
+  options.orientation_bins = 0;
   EXPECT_THROW(train(samples, samples, options), vola::OptionError);
   // Orientation bins turn the samples themselves: not with quarter turns, not for the
   // paper network (its last layer reads 1.3 M values).

@@ -35,7 +35,9 @@ std::string dimension_list(const PointCloud& cloud);
 inline double value_of(const PointCloud& cloud, const Dimension& d, std::size_t i) {
   if (d.axis >= 0) return cloud.xyz[3 * i + static_cast<std::size_t>(d.axis)];
   const double v = cloud.attributes[d.column].values[i];
-  return d.bit < 0 ? v : static_cast<double>((static_cast<std::uint32_t>(v) >> d.bit) & 1u);
+  if (d.bit < 0) return v;
+  // Flags are a byte; anything else (NaN, negative, a text file's 1e12) holds no flag.
+  return v >= 0 && v <= 255 ? static_cast<double>((static_cast<std::uint32_t>(v) >> d.bit) & 1u) : 0.0;
 }
 
 // The attribute column named `name` (vola's spelling), added with `type` and `reduction`

@@ -61,7 +61,7 @@ struct LasReport {
   double scale = 0.0;
   bool has_crs = false;                  // false: the tree's CRS is unknown
   std::vector<std::string> extra_bytes;  // columns written as extra-bytes fields
-  std::uint64_t clamped_intensities = 0;  // intensities above LAS's 16 bits, written as 65535
+  std::uint64_t clamped_intensities = 0;  // intensities outside LAS's 0..65535, clamped to it
 };
 // A path ending in .laz gets the same records LASzip-compressed (vola/io/laz.hpp:
 // compressor 3, point format 6 or 7).

@@ -21,6 +21,9 @@ struct PointTable {
   std::string wkt;
   int coordinate_digits = -1;  // LAS: decimals of the finest scale; -1 elsewhere
   std::uint64_t not_finite = 0;  // points the reader left out (io::Input::not_finite)
+  // LAS: how many of cloud's columns, first, are fields of the point record; the rest are
+  // extra bytes (which may be named like a field this point format does not have).
+  std::size_t record_fields = 0;
 };
 // LAS/LAZ/COPC input gives intensity, return_number, number_of_returns, classification,
 // user_data, point_source_id, gps_time, red/green/blue and extra bytes by name; other
