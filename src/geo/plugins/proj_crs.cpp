@@ -117,6 +117,12 @@ std::string last_error(PJ_CONTEXT* ctx) {
   return code ? proj_context_errno_string(ctx, code) : "unknown error";
 }
 
+// Whether `definition` is a geocentric (earth-centred Cartesian) CRS.
+bool geocentric(PJ_CONTEXT* ctx, const std::string& definition) {
+  const Pj crs(proj_create(ctx, definition.c_str()));
+  return crs && proj_get_type(crs.get()) == PJ_TYPE_GEOCENTRIC_CRS;
+}
+
 std::pair<double, double> centre_lat_lon(const std::string& source, const Box& bbox) {
   Context ctx = make_context();
   Pj transform(proj_create_crs_to_crs(ctx.get(), source.c_str(), "EPSG:4326", nullptr));
@@ -125,9 +131,11 @@ std::pair<double, double> centre_lat_lon(const std::string& source, const Box& b
   if (!normalized) throw Error("PROJ cannot normalise the axis order of " + source);
   const double cx = (bbox.min[0] + bbox.max[0]) / 2.0;
   const double cy = (bbox.min[1] + bbox.max[1]) / 2.0;
-  // The height too: in a geocentric CRS it is a third of the position (at z = 0 every
-  // point lies on the equatorial plane).
-  const double cz = (bbox.min[2] + bbox.max[2]) / 2.0;
+  // A geocentric CRS's z is a third of the position (at z = 0 every point lies on the
+  // equatorial plane); any other CRS is placed at height 0, as the reference toolkit
+  // places it (a datum shift moves the longitude by ~1e-8 degrees with the height, and
+  // the header must match the reference's byte for byte).
+  const double cz = geocentric(ctx.get(), source) ? (bbox.min[2] + bbox.max[2]) / 2.0 : 0.0;
   const PJ_COORD out = proj_trans(normalized.get(), PJ_FWD, proj_coord(cx, cy, std::isfinite(cz) ? cz : 0.0, 0));
   if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
     throw Error("PROJ cannot transform (" + std::to_string(cx) + ", " + std::to_string(cy) + ") from " + source.substr(0, 60) +
@@ -278,7 +286,8 @@ std::string crs_wkt1(const std::string& definition) {
 // A transformation to WGS84 longitude/latitude (x = easting/longitude in and out).
 class Wgs84Transformation {
  public:
-  explicit Wgs84Transformation(const std::string& definition) : ctx_(make_context()), source_(definition.substr(0, 60)) {
+  explicit Wgs84Transformation(const std::string& definition)
+      : ctx_(make_context()), source_(definition.substr(0, 60)), geocentric_(geocentric(ctx_.get(), definition)) {
     Pj transform(proj_create_crs_to_crs(ctx_.get(), definition.c_str(), "EPSG:4326", nullptr));
     if (!transform) throw Error("CRS " + source_ + " is not known to PROJ: " + last_error(ctx_.get()));
     // EPSG:4326 is latitude first; normalised, PROJ takes and gives x = easting/longitude.
@@ -287,8 +296,8 @@ class Wgs84Transformation {
   }
 
   Point transform(const Point& p) const {
-    const PJ_COORD out =
-        proj_trans(transform_.get(), PJ_FWD, proj_coord(p[0], p[1], std::isfinite(p[2]) ? p[2] : 0.0, 0));
+    const double z = geocentric_ && std::isfinite(p[2]) ? p[2] : 0.0;  // as centre_lat_lon places points
+    const PJ_COORD out = proj_trans(transform_.get(), PJ_FWD, proj_coord(p[0], p[1], z, 0));
     if (!std::isfinite(out.xy.x) || !std::isfinite(out.xy.y))
       throw Error("PROJ cannot transform (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ") from " +
                   source_ + " to WGS84: " + last_error(ctx_.get()));
@@ -299,6 +308,7 @@ class Wgs84Transformation {
   Context ctx_;
   Pj transform_;
   std::string source_;
+  bool geocentric_ = false;
 };
 
 // A CRS's name as PROJ gives it ("WGS 84 / UTM zone 10N"), else the definition's start:
