@@ -360,9 +360,8 @@ VoxelGrid read_ros_map(const std::string& yaml_path, double height) {
     for (std::uint32_t col = 0; col < image.width; ++col)
       if (occupied(image.pixels[std::size_t{row} * image.width + col]))
         for (std::uint32_t k = 0; k < layers; ++k) grid.voxels.push_back({col, image.height - 1 - row, k});
-  if (grid.voxels.empty())
-    throw FormatError(yaml_path, std::nullopt,
-                      "the map has no occupied cell (occupied_thresh " + std::to_string(occupied_thresh) + ")");
+  // A map with no occupied cell (a robot's first map, an empty room) is read as an empty
+  // grid, as an empty binvox is: `vola info` reports 0 occupied cells.
   return grid;
 }
 

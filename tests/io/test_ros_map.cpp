@@ -293,7 +293,17 @@ TEST(RosMap, BadMapsAreFormatErrorsNamingTheFile) {
   EXPECT_NE(error_of("png.yaml", "image: noimage.yaml\nresolution: 1\norigin: [0, 0, 0]\n")
                 .find("not a PGM (P5 or P2) or PNG image"),
             std::string::npos);
-  write_text(dir / "white.pgm", "P5\n2 2\n255\n" + std::string(4, '\xfe'));
-  EXPECT_NE(error_of("empty.yaml", "image: white.pgm\nresolution: 1\norigin: [0, 0, 0]\n").find("no occupied cell"),
-            std::string::npos);
+}
+
+TEST(RosMap, AMapWithNoOccupiedCellIsAnEmptyGrid) {
+  // A robot's first map or an empty room: every cell free or unknown. It is read, not
+  // refused, so `vola info` describes it (0 occupied cells) as it does an empty binvox.
+  vola_test::TempDir dir;
+  write_text(dir / "white.pgm", "P5\n3 2\n255\n" + std::string(5, '\xfe') + std::string(1, '\xcd'));
+  write_text(dir / "empty.yaml", "image: white.pgm\nresolution: 0.5\norigin: [1, 2, 0]\n");
+  const vola::io::VoxelGrid grid = vola::io::read_ros_map((dir / "empty.yaml").string(), 0);
+  EXPECT_TRUE(grid.voxels.empty());
+  EXPECT_EQ(grid.dims, (std::array<std::uint32_t, 3>{3, 2, 1}));
+  EXPECT_EQ(grid.origin, (vola::Point{1, 2, 0}));
+  EXPECT_EQ(grid.voxel_size, 0.5);
 }
