@@ -172,7 +172,8 @@ void add_convert(CLI::App& app) {
   cmd->add_option("--columns", args->columns, "Text: the x y z column numbers, counting from 1 (default: found by name in a header line such as "
                   "'x,y,z,intensity', which also keeps the other columns as attributes; else 1 2 3)")->expected(3)->capture_default_str();
   cmd->add_option("--payload-columns", args->options.payload_columns,
-                  "Text with --nbits 1: columns holding payload bytes 0..7 (default: every column after x y z)");
+                  "Text with --nbits 1: columns holding payload bytes 0..7 (default: every column after x y z; more "
+                  "than 8 are refused)");
   cmd->add_option(
       "--attribute", args->options.text_attributes,
       "Text: keep a column as a per-voxel attribute, NAME=COLUMN[:TYPE[:REDUCTION]], "

@@ -105,8 +105,14 @@ io::TextColumns text_columns(const std::string& input, const ConvertOptions& opt
       // header naming x, y and z: every other column).
       const int n = io::count_text_columns(input, options.skip_lines);
       const int last_xyz = std::max({columns.x, columns.y, columns.z});
-      for (int c = named ? 0 : last_xyz + 1; c < n && columns.payload.size() < 8; ++c)
+      for (int c = named ? 0 : last_xyz + 1; c < n; ++c)
         if (c != columns.x && c != columns.y && c != columns.z) columns.payload.push_back(c);
+      // The reference refuses such a file too (a byte past the word overflows); dropping
+      // the columns after the eighth would be a silent choice.
+      if (columns.payload.size() > 8)
+        throw OptionError("nbits", input + " has " + std::to_string(columns.payload.size()) +
+                                       " columns besides x, y and z, and a 64-bit payload word holds 8 bytes: name "
+                                       "the payload columns (--payload-columns, at most 8)");
     }
   }
   for (const auto& spec : options.text_attributes) {

@@ -780,6 +780,23 @@ TEST(Convert, TextHeadersPlaceXyzWhateverColumnsAreKept) {
   EXPECT_EQ(centres(with_payload), (std::vector<std::array<double, 3>>{{1.5, 1.5, 1.5}, {5.5, 5.5, 5.5}}));
   ASSERT_EQ(with_payload.voxel_payloads().size(), 2u);
   EXPECT_EQ(with_payload.voxel_payloads()[0], 0x1e140aull);  // 10, 20, 30
+  // Nine columns after x y z do not fit the word: refused (the reference overflows and
+  // writes nothing) rather than the ninth dropped unsaid; named columns still convert.
+  const std::string nine = (dir / "nine.xyz").string();
+  const std::string nine_text = "1 1 1 1 2 3 4 5 6 7 8 9\n";
+  vola_test::write_bytes(nine, std::vector<std::uint8_t>(nine_text.begin(), nine_text.end()));
+  payload.nbits = 2;
+  try {
+    vola::convert(nine, payload);
+    ADD_FAILURE() << "nine payload columns were converted";
+  } catch (const vola::OptionError& e) {
+    EXPECT_EQ(e.option(), "nbits");
+    EXPECT_NE(e.cause().find("has 9 columns besides x, y and z"), std::string::npos) << e.cause();
+  }
+  payload.payload_columns = {4, 5, 6, 7, 8, 9, 10, 11};
+  const vola::Tree eight = vola::convert(nine, payload);
+  ASSERT_EQ(eight.voxel_payloads().size(), 1u);
+  EXPECT_EQ(eight.voxel_payloads()[0], 0x0807060504030201ull);
 }
 
 TEST(Convert, ValuesAnIntegerAttributeCannotHoldAreSaid) {
