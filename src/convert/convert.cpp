@@ -287,7 +287,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   // Points the reader left out count as the file's points, dropped as not finite.
   report.build.points_in += input.not_finite;
   report.build.points_outside += input.not_finite;
-  georeference(tree, crs, tree.frame().quantization, centre);
+  const std::optional<std::string> outside_domain = georeference(tree, crs, tree.frame().quantization, centre);
   if (options.nbits > 1) tree.set_nbits(static_cast<std::uint32_t>(options.nbits));
   if (report_out) {
     report.unit = unit_of(input);
@@ -299,6 +299,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     report.warnings = crs_warnings(path, options, input, crs);
     if (const std::string label = implausible_label(path, crs, tree.georef().bbox); !label.empty())
       report.warnings.push_back(label);
+    else if (outside_domain)
+      report.warnings.push_back(path + ": " + *outside_domain);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
     for (const auto& stage : filter_report) report.filters.push_back(describe(stage));
     report.filter_stages = std::move(filter_report);

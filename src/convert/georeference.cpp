@@ -1,6 +1,8 @@
 #include "georeference.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <limits>
 
 #include "vola/error.hpp"
 #include "vola/geo/crs.hpp"
@@ -163,26 +165,48 @@ CentreLatLon::CentreLatLon(const std::optional<std::uint32_t>& known, const std:
   transform_ = std::async(std::launch::async, [definition] { return geo::ToWgs84(definition); });
 }
 
-std::pair<double, double> CentreLatLon::lat_lon(const Box& bbox) {
+std::optional<std::pair<double, double>> CentreLatLon::lat_lon(const Box& bbox) {
   const Point centre{(bbox.min[0] + bbox.max[0]) / 2.0, (bbox.min[1] + bbox.max[1]) / 2.0,
                      (bbox.min[2] + bbox.max[2]) / 2.0};  // z places a geocentric CRS's points
-  const Point lon_lat = transform_.get().transform(centre);
-  return {lon_lat[1], lon_lat[0]};
+  const geo::ToWgs84 transform = transform_.get();        // throws for a CRS PROJ does not know
+  try {
+    const Point lon_lat = transform.transform(centre);
+    return std::pair{lon_lat[1], lon_lat[0]};
+  } catch (const Error&) {
+    return std::nullopt;  // outside the CRS's domain
+  }
 }
 
-void georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization, CentreLatLon& centre) {
+std::optional<std::string> georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization,
+                                        CentreLatLon& centre) {
   Georef& georef = tree.georef();
   georef.epsg = header_epsg(crs.epsg);
+  std::optional<std::string> warning;
   try {
-    const auto [lat, lon] = centre.lat_lon(georef.bbox);
-    georef.lat = lat;
-    georef.lon = lon;
+    if (const auto lat_lon = centre.lat_lon(georef.bbox)) {
+      georef.lat = lat_lon->first;
+      georef.lon = lat_lon->second;
+    } else {
+      // PROJ gives no position there, and the reference toolkit writes what pyproj then
+      // returns, +inf for both: the file is still the reference's, byte for byte.
+      georef.lat = georef.lon = std::numeric_limits<double>::infinity();
+      if (crs.given || crs.stated) {
+        char at[96];
+        std::snprintf(at, sizeof at, "(%.10g, %.10g)", (georef.bbox.min[0] + georef.bbox.max[0]) / 2,
+                      (georef.bbox.min[1] + georef.bbox.max[1]) / 2);
+        warning = "the bbox centre " + std::string(at) + " lies outside the domain of " +
+                  (crs.epsg ? "EPSG:" + std::to_string(*crs.epsg) : std::string("the CRS")) +
+                  ": PROJ gives it no latitude and longitude, so the header's lat/lon are inf, as the reference "
+                  "toolkit writes them (is the CRS the points' own?)";
+      }
+    }
   } catch (const Error&) {
     if (crs.given) throw;
   }
   // A code given for input that states no CRS stays out of a toolkit file, which is then
   // byte-identical to the reference's.
   if (!crs.given || crs.stated || quantization == Quantization::grid) georef.crs_wkt = crs.wkt;
+  return warning;
 }
 
 }  // namespace vola::convert_detail

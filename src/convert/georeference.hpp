@@ -60,16 +60,20 @@ class CentreLatLon {
   // The CRS the header's lat/lon are computed from: the known code (or the reference's
   // default), else the WKT.
   CentreLatLon(const std::optional<std::uint32_t>& known, const std::string& wkt);
-  std::pair<double, double> lat_lon(const Box& bbox);
+  // (lat, lon), or none when the centre lies outside the CRS's domain. Call once.
+  std::optional<std::pair<double, double>> lat_lon(const Box& bbox);
 
  private:
   std::future<geo::ToWgs84> transform_;
 };
 
 // The tree's georeference after the build: the header code, the WGS84 lat/lon of the
-// bbox centre (through PROJ; 0, 0 when PROJ cannot place a CRS nobody named), and the CRS
+// bbox centre (through PROJ; 0, 0 when PROJ cannot place a CRS nobody named; +inf, as the
+// reference toolkit writes them, for a centre outside the CRS's domain), and the CRS
 // as WKT in the extension whenever it is known, except for a toolkit conversion of
-// CRS-less input, which stays byte-identical to the reference's file.
-void georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization, CentreLatLon& centre);
+// CRS-less input, which stays byte-identical to the reference's file. Returns a warning
+// for a centre outside the domain of a CRS the input or the user named.
+std::optional<std::string> georeference(Tree& tree, const ResolvedCrs& crs, Quantization quantization,
+                                        CentreLatLon& centre);
 
 }  // namespace vola::convert_detail

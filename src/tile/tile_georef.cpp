@@ -1,5 +1,7 @@
 #include "tile_georef.hpp"
 
+#include <limits>
+
 #include "vola/error.hpp"
 
 namespace vola::tile::detail {
@@ -27,6 +29,9 @@ void TileGeoref::apply(Tree& tree, const Box& bbox) const {
     g.lat = lon_lat[1];
     g.lon = lon_lat[0];
   } catch (const Error&) {
+    // Outside the CRS's domain: no position, written as vola convert (and the reference
+    // toolkit) write it, +inf, rather than a tile placed at (0, 0).
+    g.lat = g.lon = std::numeric_limits<double>::infinity();
   }
 }
 

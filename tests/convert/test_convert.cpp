@@ -702,6 +702,31 @@ std::string convert_error(const std::string& path, const vola::ConvertOptions& o
 // Finite points whose extent overflows a double (-1e308 .. 1e308) all fell into voxel 0
 // with NaN centres, exit 0, under toolkit quantization; a grid too large for any depth
 // blamed --depth, which was not given. Each is refused naming the file.
+TEST(Convert, ACentreOutsideTheCrsDomainHasInfiniteLatLonAsTheReferenceWrites) {
+  // EPSG:2000 (the reference's default) cannot place x = 1e9: PROJ returns no position,
+  // and the reference toolkit writes pyproj's +inf for lat and lon. vola writes the same
+  // file (it refused the conversion before) and, for a CRS the user gave, says why.
+  vola_test::TempDir dir;
+  const auto path = dir / "far.xyz";
+  std::ofstream(path) << "1000000000.5 1000000000.25 3\n1000000999.0 1000000299.5 20\n";
+  for (const bool given : {true, false}) {
+    vola::ConvertOptions options;
+    options.depth = 3;
+    options.quantization = vola::Quantization::toolkit;
+    if (given) options.assign_crs = "2000";
+    vola::ConvertReport report;
+    const vola::Tree tree = vola::convert(path.string(), options, {}, &report);
+    EXPECT_EQ(tree.georef().lat, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(tree.georef().lon, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(tree.voxel_count(), 2u);
+    const bool warned = std::any_of(report.warnings.begin(), report.warnings.end(), [](const std::string& w) {
+      return w.find("(1000000500, 1000000150) lies outside the domain of EPSG:2000") != std::string::npos &&
+             w.find("lat/lon are inf") != std::string::npos;
+    });
+    EXPECT_EQ(warned, given) << (report.warnings.empty() ? "" : report.warnings.front());
+  }
+}
+
 TEST(Convert, GridsThePointsCannotBePutOnAreRefusedNamingTheFile) {
   vola_test::TempDir dir;
   const std::string overflow = (dir / "overflow.xyz").string();
