@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <random>
@@ -82,6 +83,69 @@ TEST(MappedShrink, LookupsOfALevelOfDetailAfterTheCutAreReportedToo) {
     return 6;
   });
   EXPECT_EQ(status, 0) << (status == -SIGBUS ? "died of SIGBUS" : "exit status / -signal");
+}
+
+// `cp other.vol mapped.vol` truncates the file and writes the other's bytes: unless a
+// read falls in the moment it is short, no SIGBUS comes, and the mapping shows the
+// other file's words under this one's counts (Python's voxels() wrote past its array).
+// check_mapped() finds the rewrite by the file's size and time, and the mapping reads
+// zeros from then on, as a cut one.
+TEST(MappedShrink, AFileRewrittenInPlaceIsReportedAsCut) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "small.vol", other = dir.path() / "big.vol";
+  const std::vector<vola::Voxel> two{{1, 2, 3}, {4, 5, 6}};
+  vola::write(vola::build_from_voxels(two, 7), path.string());
+  vola::write(scattered_tree(), other.string());
+  const vola::Tree mapped = vola::open_mapped(path.string());
+  EXPECT_NO_THROW(vola::check_mapped(mapped));
+  fs::copy_file(other, path, fs::copy_options::overwrite_existing);  // in place, as cp does
+  try {
+    vola::check_mapped_often(mapped);  // its first look at the file
+    ADD_FAILURE() << "the rewrite went unreported";
+  } catch (const vola::IoError& e) {
+    EXPECT_EQ(std::string(e.what()).find(path.string()), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rewritten in place"), std::string::npos) << e.what();
+  }
+  std::uint64_t seen = 0;
+  mapped.for_each_voxel([&](const vola::Voxel&) { ++seen; });
+  EXPECT_EQ(seen, 0u);  // zeros, as after a cut: never the other file's 200,000 voxels
+  EXPECT_THROW(vola::check_mapped(mapped), vola::IoError);
+}
+
+// In a loop that checks once per point, the file is looked at once a millisecond at most:
+// a rewrite between two looks is found by the next one.
+TEST(MappedShrink, ChecksInALoopFindARewriteWithinAMillisecond) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "loop.vol", other = dir.path() / "other.vol";
+  const std::vector<vola::Voxel> two{{1, 2, 3}, {4, 5, 6}};
+  vola::write(vola::build_from_voxels(two, 7), path.string());
+  vola::write(scattered_tree(), other.string());
+  const vola::Tree mapped = vola::open_mapped(path.string());
+  vola::check_mapped_often(mapped);  // looked at: the next look is a millisecond away
+  fs::copy_file(other, path, fs::copy_options::overwrite_existing);
+  const auto start = std::chrono::steady_clock::now();
+  bool found = false;
+  while (!found && std::chrono::steady_clock::now() - start < std::chrono::milliseconds(50)) try {
+      vola::check_mapped_often(mapped);
+    } catch (const vola::IoError&) {
+      found = true;
+    }
+  EXPECT_TRUE(found) << "no look at the file in 50 ms of checks";
+}
+
+// A file renamed over the path (how vola::write and most tools replace a file) leaves
+// the mapped one whole: nothing to report, and the tree reads its own voxels.
+TEST(MappedShrink, AFileReplacedByARenameLeavesTheMappingWhole) {
+  vola_test::TempDir dir;
+  const fs::path path = dir.path() / "kept.vol";
+  const std::vector<vola::Voxel> two{{1, 2, 3}, {4, 5, 6}};
+  vola::write(vola::build_from_voxels(two, 7), path.string());
+  const vola::Tree mapped = vola::open_mapped(path.string());
+  vola::write(scattered_tree(), path.string());  // a temporary file renamed over it
+  EXPECT_NO_THROW(vola::check_mapped(mapped));
+  EXPECT_NO_THROW(vola::check_mapped_often(mapped));
+  EXPECT_EQ(mapped.voxel_count(), 2u);
+  EXPECT_TRUE(mapped.contains(4, 5, 6));
 }
 
 TEST(MappedShrink, FilesReadIntoMemoryAndUncutMappingsSayNothing) {

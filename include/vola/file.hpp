@@ -92,12 +92,18 @@ Tree read(const std::string& path, FileLayout* layout = nullptr);
 // zero pages (a SIGBUS handler installed by the first open_mapped(), which passes every
 // other SIGBUS to the handler that was there before): reads go on, return zeros and
 // mean nothing, and check_mapped() says so. A program that installs its own SIGBUS
-// handler afterwards replaces this guard.
+// handler afterwards replaces this guard. A file rewritten in place to as many bytes or
+// more (`cp other.vol mapped.vol`) raises no SIGBUS: check_mapped() finds it by the
+// file's size and modification time and treats it as cut.
 Tree open_mapped(const std::string& path, FileLayout* layout = nullptr);
 // Throws IoError naming the file when `tree` (or a tree sharing its words, e.g. a level
-// of detail) maps a file that was cut since it was opened; does nothing otherwise. Call
-// it after reading a mapped tree and before trusting what was read.
+// of detail) maps a file that was cut or rewritten in place since it was opened; does
+// nothing otherwise. Call it after reading a mapped tree and before trusting what was read.
+// It asks the file system each time (a stat call, about a microsecond).
 void check_mapped(const Tree& tree);
+// The same for loops that check once per point or ray: a cut is found at once, a rewrite
+// in place by a look at the file at most once a millisecond per mapped file.
+void check_mapped_often(const Tree& tree);
 
 Header decode_header(std::span<const std::uint8_t> bytes, const std::string& name);
 void encode_header(const Header& header, std::uint8_t* out);

@@ -28,14 +28,20 @@ py::array_t<std::uint32_t> voxels_of(const Tree& tree, int level) {
   const auto n = static_cast<py::ssize_t>(tree.node_count(level));
   py::array_t<std::uint32_t> out({n, py::ssize_t{3}});
   std::uint32_t* p = out.mutable_data();
+  std::uint32_t* const end = p + 3 * n;
   {
     py::gil_scoped_release release;
+    // A mapped file rewritten meanwhile may hold more voxels than the count read at its
+    // opening: the rows stop at the array's end (the wrapper's check_mapped then fails the
+    // call) rather than run past it.
     tree.for_each_node(level, [&](const Voxel& v) {
+      if (p == end) return;
       p[0] = v.x;
       p[1] = v.y;
       p[2] = v.z;
       p += 3;
     });
+    std::fill(p, end, 0u);  // fewer: a cut mapping's zeros
   }
   return out;
 }
@@ -59,16 +65,19 @@ py::array_t<double> centers_of(const Tree& tree) {
   const auto n = static_cast<py::ssize_t>(tree.voxel_count());
   py::array_t<double> out({n, py::ssize_t{3}});
   double* p = out.mutable_data();
+  double* const end = p + 3 * n;
   const vola::Quantizer quantizer = placed_quantizer(tree, "centers");
   {
     py::gil_scoped_release release;
     tree.for_each_voxel([&](const Voxel& v) {
+      if (p == end) return;  // a rewritten mapping, as in voxels_of
       const vola::Point c = quantizer.center(v);
       p[0] = c[0];
       p[1] = c[1];
       p[2] = c[2];
       p += 3;
     });
+    std::fill(p, end, 0.0);  // fewer: a cut mapping's zeros
   }
   return out;
 }

@@ -1,6 +1,7 @@
 """Writing, reading, parsing and memory-mapping .vol files; errors from bad bytes."""
 
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -60,6 +61,22 @@ def test_a_file_cut_while_mapped_is_refused_not_read_as_zeros(tree, tmp_path):
     mapped.census  # an attribute lookup alone reads nothing
     with pytest.raises(vola.IoError, match="was cut"):
         mapped.check_mapped()
+
+
+def test_a_file_copied_over_in_place_is_refused_not_read_past(tmp_path):
+    # shutil.copyfile, like cp, truncates the file and writes the other's bytes: no read
+    # fell in the moment it was short, so the mapping showed the larger file's words
+    # under the small one's counts, and voxels() wrote past its array (heap corruption).
+    rng = np.random.default_rng(0)
+    path, big = tmp_path / "small.vol", tmp_path / "big.vol"
+    vola.build(rng.uniform(0, 10, (1000, 3)), voxel_size=0.5).write(path)
+    vola.build(rng.uniform(0, 100, (200000, 3)), voxel_size=0.5).write(big)
+    mapped = vola.open(path)
+    shutil.copyfile(big, path)
+    with pytest.raises(vola.IoError, match="small.vol: the file was cut"):
+        mapped.voxels()
+    with pytest.raises(vola.IoError, match="was cut"):
+        mapped.centers()
 
 
 @pytest.mark.parametrize("call", ["level_of_detail", "downsample"])

@@ -46,7 +46,7 @@ std::vector<const vola::Tree*>& trees_in_use() noexcept;
 // The handle's tree, refused when NULL or when its mapped file was cut before the call.
 inline const vola::Tree& tree_of(const vola_tree* handle) {
   if (handle == nullptr) throw vola::InvalidArgument("tree is NULL");
-  vola::check_mapped(handle->tree);
+  vola::check_mapped_often(handle->tree);
   trees_in_use().push_back(&handle->tree);
   return handle->tree;
 }
@@ -54,7 +54,7 @@ inline const vola::Tree& tree_of(const vola_tree* handle) {
 // Called by an entry point before it writes its out-parameters: a tree the call read that
 // was cut meanwhile fails the call first, so that the out-parameters stay untouched.
 inline void check_trees_in_use() {
-  for (const vola::Tree* tree : trees_in_use()) vola::check_mapped(*tree);
+  for (const vola::Tree* tree : trees_in_use()) vola::check_mapped_often(*tree);
 }
 
 template <class Body>

@@ -340,13 +340,23 @@ Tree open_mapped(const std::string& path, FileLayout* layout) {
 #endif
 }
 
-void check_mapped(const Tree& tree) {
+namespace {
+
+void check_mapped(const Tree& tree, bool at_most_every_millisecond) {
   if (!tree.is_mapped()) return;
-  if (const detail::MappedFile* lost = detail::MappedFile::lost_at(tree.words().data()))
+  const void* words = tree.words().data();
+  const detail::MappedFile* lost = detail::MappedFile::lost_at(words);
+  if (!lost) lost = detail::MappedFile::rewritten_at(words, at_most_every_millisecond);
+  if (lost)
     VOLA_THROW(IoError(lost->path() +
                        ": the file was cut (truncated or rewritten in place) while mapped; what was read from it "
                        "since is void: open it again"));
 }
+
+}  // namespace
+
+void check_mapped(const Tree& tree) { check_mapped(tree, false); }
+void check_mapped_often(const Tree& tree) { check_mapped(tree, true); }
 
 VOLA_INLINE_NAMESPACE_END
 }  // namespace vola

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <ctime>
 #include <mutex>
 
 #include "vola/error.hpp"
@@ -30,6 +31,7 @@ struct Slot {
   std::atomic<std::uintptr_t> begin{0};
   std::atomic<std::uintptr_t> end{0};
   std::atomic<const MappedFile*> owner{nullptr};
+  std::atomic<std::int64_t> next_look_ns{0};  // rewritten_at: when to stat the file again
 };
 Slot slots[kSlots];
 struct sigaction previous_bus_action {};
@@ -37,6 +39,24 @@ std::once_flag bus_handler_once;
 // How many mappings were ever lost: lets lost_at() answer "none" with one load, so that
 // a check per ray or per tile costs nothing.
 std::atomic<int> lost_mappings{0};
+
+// Replaces slot s's mapping with zero pages and marks it lost (the SIGBUS handler does
+// the same from inside a fault: only atomics and mmap). False when the pages could not be replaced.
+bool lose(Slot& s) noexcept {
+  const std::uintptr_t begin = s.begin.load(std::memory_order_relaxed);
+  const std::uintptr_t end = s.end.load(std::memory_order_relaxed);
+  void* zeros =
+      ::mmap(reinterpret_cast<void*>(begin), end - begin, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0);
+  if (zeros == MAP_FAILED) return false;
+  int live = kLive;
+  if (s.state.compare_exchange_strong(live, kLost, std::memory_order_release))
+    lost_mappings.fetch_add(1, std::memory_order_release);
+  return true;
+}
+
+std::int64_t nanoseconds(const struct timespec& t) noexcept {
+  return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
+}
 
 // Runs on the faulting thread, inside the fault. Only atomics and mmap(): mmap is not
 // on POSIX's list of async-signal-safe functions, but it takes no lock of the C library
@@ -52,11 +72,7 @@ void on_bus_error(int signal, siginfo_t* info, void* context) {
     const std::uintptr_t begin = s.begin.load(std::memory_order_relaxed);
     const std::uintptr_t end = s.end.load(std::memory_order_relaxed);
     if (address < begin || address >= end) continue;
-    void* zeros = ::mmap(reinterpret_cast<void*>(begin), end - begin, PROT_READ,
-                         MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0);
-    if (zeros == MAP_FAILED) break;
-    s.state.store(kLost, std::memory_order_release);
-    lost_mappings.fetch_add(1, std::memory_order_release);
+    if (!lose(s)) break;
     return;  // the faulting load is restarted and reads 0
   }
   // Not one of ours: what would have happened without us.
@@ -89,17 +105,17 @@ int claim_slot(const void* data, std::size_t size, const MappedFile* owner) noex
     slots[i].begin.store(reinterpret_cast<std::uintptr_t>(data), std::memory_order_relaxed);
     slots[i].end.store(reinterpret_cast<std::uintptr_t>(data) + size, std::memory_order_relaxed);
     slots[i].owner.store(owner, std::memory_order_relaxed);
+    slots[i].next_look_ns.store(0, std::memory_order_relaxed);
     slots[i].state.store(kLive, std::memory_order_release);
     return i;
   }
   return -1;
 }
 
-int open_regular(const std::string& path, std::size_t& size) {
+int open_regular(const std::string& path, struct stat& st) {
   // O_NONBLOCK: opening a FIFO would wait for a writer; it is refused below instead.
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) VOLA_THROW(IoError(path + ": cannot open: " + std::strerror(errno)));
-  struct stat st {};
   if (::fstat(fd, &st) != 0) {
     const int e = errno;
     ::close(fd);
@@ -109,7 +125,6 @@ int open_regular(const std::string& path, std::size_t& size) {
     ::close(fd);
     VOLA_THROW(IoError(path + ": not a regular file (a FIFO, device or directory): inputs are files"));
   }
-  size = static_cast<std::size_t>(st.st_size);
   return fd;
 }
 
@@ -134,8 +149,9 @@ void read_into(int fd, const std::string& path, std::vector<std::uint8_t>& out, 
 }  // namespace
 
 std::shared_ptr<const MappedFile> MappedFile::load(const std::string& path) {
-  std::size_t size = 0;
-  const int fd = open_regular(path, size);
+  struct stat st {};
+  const int fd = open_regular(path, st);
+  const auto size = static_cast<std::size_t>(st.st_size);
   std::shared_ptr<MappedFile> file(new MappedFile());
   file->path_ = path;
   read_into(fd, path, file->copy_, size);
@@ -146,10 +162,15 @@ std::shared_ptr<const MappedFile> MappedFile::load(const std::string& path) {
 }
 
 std::shared_ptr<const MappedFile> MappedFile::open(const std::string& path) {
-  std::size_t size = 0;
-  const int fd = open_regular(path, size);
+  struct stat st {};
+  const int fd = open_regular(path, st);
+  const auto size = static_cast<std::size_t>(st.st_size);
   std::shared_ptr<MappedFile> file(new MappedFile());
   file->path_ = path;
+  file->device_ = static_cast<std::uint64_t>(st.st_dev);
+  file->inode_ = static_cast<std::uint64_t>(st.st_ino);
+  file->file_size_ = static_cast<std::int64_t>(st.st_size);
+  file->modified_ns_ = nanoseconds(st.st_mtim);
   if (size == 0) {
     ::close(fd);
     return file;
@@ -185,6 +206,39 @@ const MappedFile* MappedFile::lost_at(const void* address) noexcept {
       return s.owner.load(std::memory_order_relaxed);
   }
   return nullptr;
+}
+
+const MappedFile* MappedFile::rewritten_at(const void* address, bool at_most_every_millisecond) noexcept {
+  const auto a = reinterpret_cast<std::uintptr_t>(address);
+  const auto holds = [a](const Slot& s) {
+    return s.state.load(std::memory_order_acquire) == kLive && a >= s.begin.load(std::memory_order_relaxed) &&
+           a < s.end.load(std::memory_order_relaxed);
+  };
+  // Looked up by a scan of the table; a thread's next look is mostly at the same mapping.
+  thread_local int last = 0;
+  int at = holds(slots[last]) ? last : -1;
+  for (int i = 0; i < kSlots && at < 0; ++i)
+    if (holds(slots[i])) at = i;
+  if (at < 0) return nullptr;
+  last = at;
+  Slot& s = slots[at];
+  if (at_most_every_millisecond) {
+    struct timespec now {};
+    ::clock_gettime(CLOCK_MONOTONIC_COARSE, &now);
+    std::int64_t next = s.next_look_ns.load(std::memory_order_relaxed);
+    if (nanoseconds(now) < next ||
+        !s.next_look_ns.compare_exchange_strong(next, nanoseconds(now) + 1000000, std::memory_order_relaxed))
+      return nullptr;  // looked at within the last millisecond, or another thread looks now
+  }
+  const MappedFile* owner = s.owner.load(std::memory_order_relaxed);
+  struct stat st {};
+  if (::stat(owner->path_.c_str(), &st) != 0 || static_cast<std::uint64_t>(st.st_dev) != owner->device_ ||
+      static_cast<std::uint64_t>(st.st_ino) != owner->inode_)
+    return nullptr;  // the path names another file now (renamed over it): this one is whole
+  if (static_cast<std::int64_t>(st.st_size) == owner->file_size_ && nanoseconds(st.st_mtim) == owner->modified_ns_)
+    return nullptr;
+  lose(s);
+  return owner;
 }
 
 MappedFile::~MappedFile() {

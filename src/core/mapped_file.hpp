@@ -12,6 +12,13 @@
 // A fault outside our mappings goes to the previous handler (or the default action).
 // When the table is full the file is read into memory instead: no mapping, nothing
 // to lose.
+//
+// A file rewritten in place with as many bytes or more (`cp other.vol mapped.vol`
+// truncates it, then writes) raises no SIGBUS unless a read falls in the moment it is
+// short: the mapping then shows the other file's bytes under this file's decoded
+// structure. rewritten_at() looks for that by the file's size and modification time
+// (each time, or at most once a millisecond per mapping for callers that run once per
+// point) and treats a rewritten mapping as a cut one: zero pages, lost.
 #pragma once
 
 #include <cstdint>
@@ -36,6 +43,12 @@ class MappedFile {
   // The mapping holding `address` if the file was cut under it (its pages are zeros
   // now), else null (also for addresses in no mapping).
   static const MappedFile* lost_at(const void* address) noexcept;
+  // The mapping holding `address` if its file now has another size or modification time
+  // than when it was mapped (under the same path and inode: a file renamed over the path
+  // leaves this mapping's file whole); that mapping is then lost, as a cut one. Null
+  // otherwise; with `at_most_every_millisecond`, also when the last such look at this
+  // mapping is less than a millisecond old.
+  static const MappedFile* rewritten_at(const void* address, bool at_most_every_millisecond) noexcept;
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
@@ -50,6 +63,9 @@ class MappedFile {
   const std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
   int slot_ = -1;                   // in the table of live mappings, or -1 (not mapped)
+  // The file as it was mapped, to tell a rewrite in place (rewritten_at).
+  std::uint64_t device_ = 0, inode_ = 0;
+  std::int64_t file_size_ = 0, modified_ns_ = 0;
   std::vector<std::uint8_t> copy_;  // the bytes, when not mapped
   std::string path_;
 };

@@ -107,7 +107,7 @@ TileLookup TileSet::locate(const Point& world) const {
   if (!t) return out;
   out.in_tile = true;
   out.rank = t->rank(out.voxel);
-  check_mapped(*t);  // a tile cut since it was opened reads as zeros: an error, not an answer
+  check_mapped_often(*t);  // a tile cut since it was opened reads as zeros: an error, not an answer
   return out;
 }
 
@@ -175,7 +175,7 @@ std::optional<TileHit> TileSet::cast_in_tile(const TileIndex& t, const raycast::
   });
   const raycast::Ray local = raycast::world_ray_to_grid(index_.grid.tile_frame(t), world_ray);
   const auto hit = opened->caster->cast(local);
-  check_mapped(opened->tree);
+  check_mapped_often(opened->tree);
   if (!hit) return std::nullopt;
   return TileHit{t, hit->voxel, hit->t * index_.grid.voxel_size(), hit->normal};
 }
@@ -232,7 +232,7 @@ Tree TileSet::mosaic(const Box& box) const {
     const auto oy = static_cast<std::uint32_t>((t.j - first[1]) * side);
     const auto oz = static_cast<std::uint32_t>((t.k - first[2]) * side);
     tree->for_each_voxel([&](const Voxel& v) { keys.push_back(encode(ox + v.x, oy + v.y, oz + v.z)); });
-    check_mapped(*tree);
+    check_mapped_often(*tree);
   }
   Tree out = build_from_keys(std::move(keys), g.depth + extra);
   const TileIndex corner{static_cast<std::int32_t>(first[0]), static_cast<std::int32_t>(first[1]),
