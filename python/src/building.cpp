@@ -142,7 +142,8 @@ Tree from_dense(const py::handle& input, std::optional<std::array<double, 3>> or
                 int depth) {
   const py::array raw = py::array::ensure(input);
   if (!raw || raw.ndim() != 3) throw py::value_error("from_dense: expected a 3-D array indexed [x, y, z]");
-  const auto grid = CArray<bool>::ensure(raw.attr("astype")(py::dtype::of<bool>(), py::arg("copy") = false));
+  const auto grid = ensure_array<bool>(raw.attr("astype")(py::dtype::of<bool>(), py::arg("copy") = false));
+  if (!grid) throw py::type_error("from_dense: the grid's values cannot be read as booleans");
   const auto largest = std::max({grid.shape(0), grid.shape(1), grid.shape(2), py::ssize_t{1}});
   if (depth == 0)
     for (depth = 1; depth < vola::kMaxDepth && vola::side_of(depth) < largest; ++depth) {
@@ -269,38 +270,42 @@ void bind_building(py::module_& m) {
         "uncompressed file's level words are used in place.");
   m.def("parse", [](py::bytes data, const std::string& name) {
           const std::string bytes = data;
+          py::gil_scoped_release release;
           return vola::parse(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), name);
         }, py::arg("data"), py::arg("name") = "<bytes>", "Parses the bytes of a .vol file.");
-  m.def("convert", &convert, py::arg("path"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0,
-        py::arg("quantize") = "", py::arg("format") = "auto", py::arg("epsg") = py::none(), py::arg("solid") = false,
-        py::arg("attributes") = true, py::arg("dem_base") = py::none(), py::arg("dem_surface_only") = false,
-        py::arg("origin") = py::none(), py::arg("bbox") = py::none(), py::arg("nbits") = 0,
-        py::arg("columns") = py::none(), py::arg("payload_columns") = std::vector<int>{},
-        py::arg("text_attributes") = std::vector<std::string>{}, py::arg("skip_lines") = 0, py::arg("dense") = false,
-        py::arg("compress") = false, py::arg("output") = py::none(), py::arg("target_crs") = "",
-        py::arg("level") = py::none(), py::arg("assign_crs") = "", py::arg("allow_geographic") = false,
-        py::arg("grid") = "", py::arg("filters") = std::vector<std::string>{}, py::arg("compress_max") = false,
-        py::arg("map_height") = 0.0,
-        "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
-        "OpenVDB .vdb) and builds its\n"
-        "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
-        "it (dense=, compress=, compress_max=: smallest, slower to open). Every `vola convert` option is a keyword: "
-        "quantize ('grid', default with\n"
-        "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
-        "maxx, maxy, maxz), nbits, epsg, attributes (False: occupancy only), text input's columns (x y z, from 1),\n"
-        "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
-        "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
-        "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
-        "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
-        "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
-        "maps (.bt, .ot, .vdb, ROS .yaml) keep their own cells (another voxel_size is refused); map_height=H makes a "
-        "ROS\n"
-        "map's occupied cells columns H high; grid='NAME' picks a .vdb grid or "
-        "an .npz array.\n"
-        "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
-        "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).\n"
-        "output= the input itself, or a name with another format's extension (a.las), is refused as the CLI refuses\n"
-        "it; what the CLI warns of (a CRS relabelled, heights left in feet) comes as UserWarning.");
+  m.def(
+      "convert", &convert, py::arg("path"), py::arg("depth") = 0, py::arg("voxel_size") = 0.0, py::arg("quantize") = "",
+      py::arg("format") = "auto", py::arg("epsg") = py::none(), py::arg("solid") = false, py::arg("attributes") = true,
+      py::arg("dem_base") = py::none(), py::arg("dem_surface_only") = false, py::arg("origin") = py::none(),
+      py::arg("bbox") = py::none(), py::arg("nbits") = 0, py::arg("columns") = py::none(),
+      py::arg("payload_columns") = std::vector<int>{}, py::arg("text_attributes") = std::vector<std::string>{},
+      py::arg("skip_lines") = 0, py::arg("dense") = false, py::arg("compress") = false, py::arg("output") = py::none(),
+      py::arg("target_crs") = "", py::arg("level") = py::none(), py::arg("assign_crs") = "",
+      py::arg("allow_geographic") = false, py::arg("grid") = "", py::arg("filters") = std::vector<std::string>{},
+      py::arg("compress_max") = false, py::arg("map_height") = 0.0,
+      "Reads any input `vola convert` reads (LAS, text, NPY, PLY, PCD, KITTI, binvox, meshes, DEM, OctoMap .bt/.ot,\n"
+      "OpenVDB .vdb) and builds its\n"
+      "tree through the same pipeline (LAS streams: memory follows voxels, not points); with output=, also writes\n"
+      "it (dense=, compress=, compress_max=: smallest, slower to open). Every `vola convert` option is a keyword: "
+      "quantize ('grid', default with\n"
+      "voxel_size/origin, or 'toolkit', needs depth), depth, voxel_size, origin=(x, y, z), bbox=(minx, miny, minz,\n"
+      "maxx, maxy, maxz) (the box to quantize against instead of the points' bounds, not a crop: toolkit quantization\n"
+      "puts points outside it on its border voxels, as the reference clips them, with a warning; grid quantization\n"
+      "drops those outside the grid it makes; to cut points, filters=['crop:...']), nbits, epsg, attributes (False: "
+      "occupancy only), text input's columns (x y z, from 1),\n"
+      "payload_columns, text_attributes=['NAME=COLUMN[:TYPE[:REDUCTION]]', ...], skip_lines; solid (meshes);\n"
+      "dem_base, dem_surface_only (DEM); target_crs='EPSG:32610' (or WKT, a PROJ string) reprojects the points\n"
+      "first (grid options then in its units); assign_crs= (or epsg=) relabels the input's CRS without moving it;\n"
+      "a geographic CRS's degrees are refused as grid voxels unless allow_geographic=True; level=L reads a COPC\n"
+      "file's octree down to level L. Voxel grids map cell to voxel unless another grid is asked for;\n"
+      "maps (.bt, .ot, .vdb, ROS .yaml) keep their own cells (another voxel_size is refused); map_height=H makes a "
+      "ROS\n"
+      "map's occupied cells columns H high; grid='NAME' picks a .vdb grid or "
+      "an .npz array.\n"
+      "filters=['smrf', 'hag', 'where:HeightAboveGround > 2', 'voxel:1', 'outlier', 'crop:X0,Y0,X1,Y1', ...]: point\n"
+      "filters run in order before voxelising, as `vola convert --filter/--where/--crop` (docs/FILTERS.md).\n"
+      "output= the input itself, or a name with another format's extension (a.las), is refused as the CLI refuses\n"
+      "it; what the CLI warns of (a CRS relabelled, heights left in feet) comes as UserWarning.");
   m.def(
       "translate",
       [](const std::filesystem::path& input, const std::filesystem::path& output,

@@ -84,7 +84,7 @@ py::dict collide_segment(const Tree& tree, const py::handle& starts_in, const py
 py::object collide_sphere(const Tree& tree, const py::handle& centres_in, const py::handle& radius_in, bool world) {
   const auto centres = rows_of_three<double>(centres_in, "centres");
   const auto n = centres.shape(0);
-  auto radii = CArray<double>::ensure(radius_in);
+  auto radii = ensure_array<double>(radius_in);
   if (!radii || radii.ndim() > 1 || (radii.ndim() == 1 && radii.shape(0) != n))
     throw vola::InvalidArgument("collide_sphere: radius must be one number or one per centre (" + std::to_string(n) + ")");
   const bool one_radius = radii.ndim() == 0;
@@ -104,7 +104,7 @@ py::object collide_sphere(const Tree& tree, const py::handle& centres_in, const 
 }
 
 py::object collide_box(const Tree& tree, const py::handle& boxes_in, bool world) {
-  auto boxes = CArray<double>::ensure(boxes_in);
+  auto boxes = ensure_array<double>(boxes_in);
   if (boxes && boxes.ndim() == 1 && boxes.shape(0) == 6) boxes = boxes.reshape({py::ssize_t{1}, py::ssize_t{6}});
   if (!boxes || boxes.ndim() != 2 || boxes.shape(1) != 6)
     throw vola::InvalidArgument("collide_box: expected boxes (xmin, ymin, zmin, xmax, ymax, zmax) as shape (6,) or (N, 6)");

@@ -55,12 +55,20 @@ struct PyMap {
   std::shared_ptr<std::shared_mutex> guard = std::make_shared<std::shared_mutex>();
 };
 
+// A distance field and its lock, as PyMap: update() runs without the GIL, and a read
+// while it ran mixed the old field with the new (78 of 763 concurrent reads).
+struct PyDistanceField {
+  map::DistanceField field;
+  std::shared_ptr<std::shared_mutex> guard = std::make_shared<std::shared_mutex>();
+};
+
 // The locks are taken without the GIL: a thread holding the GIL while it waits would stop
 // the inserting thread from ever handing its result back.
-std::shared_lock<std::shared_mutex> reading(const PyMap& self) {
+std::shared_lock<std::shared_mutex> reading(const std::shared_ptr<std::shared_mutex>& guard) {
   py::gil_scoped_release release;
-  return std::shared_lock(*self.guard);
+  return std::shared_lock(*guard);
 }
+std::shared_lock<std::shared_mutex> reading(const PyMap& self) { return reading(self.guard); }
 
 // map::RayExtent's guard, as `vola map --max-ray-voxels` applies it.
 void check_ray_extent(std::span<const double> xyz, const std::array<double, 3>& origin, const PyMap& self,
@@ -203,52 +211,58 @@ void bind_map(py::module_& m) {
     const auto l = lo.cast<std::array<std::int64_t, 3>>(), h = hi.cast<std::array<std::int64_t, 3>>();
     return map::GridBox{l, h};
   };
-  py::class_<map::DistanceField>(m, "DistanceField",
-                                 "Exact Euclidean distances (world units) from voxel centres to the nearest obstacle voxel's\n"
-                                 "centre, capped at max_distance (vola/map/distance_field.hpp): the ESDF planners use.")
+  py::class_<PyDistanceField>(
+      m, "DistanceField",
+      "Exact Euclidean distances (world units) from voxel centres to the nearest obstacle voxel's\n"
+      "centre, capped at max_distance (vola/map/distance_field.hpp): the ESDF planners use.")
       .def(py::init([box_of](const Tree& tree, double max_distance, const py::object& lo, const py::object& hi) {
              if (lo.is_none() != hi.is_none()) throw InvalidArgument("give both lo and hi, or neither");
              const std::optional<map::GridBox> box = lo.is_none() ? std::nullopt : std::optional(box_of(lo, hi));
              py::gil_scoped_release release;
-             return box ? std::make_unique<map::DistanceField>(tree, *box, max_distance)
-                        : std::make_unique<map::DistanceField>(tree, max_distance);
+             return std::make_unique<PyDistanceField>(box ? map::DistanceField(tree, *box, max_distance)
+                                                          : map::DistanceField(tree, max_distance));
            }),
            py::arg("tree"), py::arg("max_distance"), py::arg("lo") = py::none(), py::arg("hi") = py::none(),
            "The field of the tree's voxels (a state map's occupied ones) over grid voxels lo..hi-1 (default: the\n"
            "voxels' box grown by max_distance).")
-      .def("distance",
-           [](const map::DistanceField& self, const py::handle& points) {
-             return per_point<double>(points, [&](const Point& p) { return self.distance(p); });
-           },
-           py::arg("points"), "(N,) distance at each world point (its voxel's value; max_distance outside the box).")
-      .def("gradient",
-           [](const map::DistanceField& self, const py::handle& points) {
-             const auto xyz = rows_of_three<double>(points, "points");
-             const auto n = static_cast<std::size_t>(xyz.shape(0));
-             std::vector<double> out(3 * n);
-             const double* p = xyz.data();
-             {
-               py::gil_scoped_release release;
-               for (std::size_t i = 0; i < n; ++i) {
-                 const Point g = self.gradient(Point{p[3 * i], p[3 * i + 1], p[3 * i + 2]});
-                 std::copy(g.begin(), g.end(), out.begin() + static_cast<std::ptrdiff_t>(3 * i));
-               }
-             }
-             return owning_array(std::move(out), {static_cast<py::ssize_t>(n), 3});
-           },
-           py::arg("points"), "(N, 3) gradient of the distance at each world point (away from the nearest obstacle).")
-      .def("update",
-           [box_of](map::DistanceField& self, const Tree& tree, const py::handle& lo, const py::handle& hi) {
-             const map::GridBox box = box_of(lo, hi);
-             py::gil_scoped_release release;
-             self.update(tree, box);
-           },
-           py::arg("tree"), py::arg("lo"), py::arg("hi"),
-           "Recomputes the cells near grid voxels lo..hi-1, where `tree` (same grid) changed.")
-      .def_property_readonly("box", [](const map::DistanceField& self) {
-        return py::make_tuple(self.box().lo, self.box().hi);
-      })
-      .def_property_readonly("max_distance", &map::DistanceField::max_distance);
+      .def(
+          "distance",
+          [](const PyDistanceField& self, const py::handle& points) {
+            const auto lock = reading(self.guard);
+            return per_point<double>(points, [&](const Point& p) { return self.field.distance(p); });
+          },
+          py::arg("points"), "(N,) distance at each world point (its voxel's value; max_distance outside the box).")
+      .def(
+          "gradient",
+          [](const PyDistanceField& self, const py::handle& points) {
+            const auto xyz = rows_of_three<double>(points, "points");
+            const auto lock = reading(self.guard);
+            const auto n = static_cast<std::size_t>(xyz.shape(0));
+            std::vector<double> out(3 * n);
+            const double* p = xyz.data();
+            {
+              py::gil_scoped_release release;
+              for (std::size_t i = 0; i < n; ++i) {
+                const Point g = self.field.gradient(Point{p[3 * i], p[3 * i + 1], p[3 * i + 2]});
+                std::copy(g.begin(), g.end(), out.begin() + static_cast<std::ptrdiff_t>(3 * i));
+              }
+            }
+            return owning_array(std::move(out), {static_cast<py::ssize_t>(n), 3});
+          },
+          py::arg("points"), "(N, 3) gradient of the distance at each world point (away from the nearest obstacle).")
+      .def(
+          "update",
+          [box_of](PyDistanceField& self, const Tree& tree, const py::handle& lo, const py::handle& hi) {
+            const map::GridBox box = box_of(lo, hi);
+            py::gil_scoped_release release;
+            const std::unique_lock lock(*self.guard);
+            self.field.update(tree, box);
+          },
+          py::arg("tree"), py::arg("lo"), py::arg("hi"),
+          "Recomputes the cells near grid voxels lo..hi-1, where `tree` (same grid) changed.")
+      .def_property_readonly(
+          "box", [](const PyDistanceField& self) { return py::make_tuple(self.field.box().lo, self.field.box().hi); })
+      .def_property_readonly("max_distance", [](const PyDistanceField& self) { return self.field.max_distance(); });
   m.def("occupied_tree", &map::occupied_tree, py::arg("tree"),
         "A state map's occupied voxels as a plain tree (columns kept); any other tree as it is.");
   m.def("free_tree", &map::free_tree, py::arg("tree"), "A state map's free voxels as a plain tree (columns kept).");

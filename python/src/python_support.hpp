@@ -35,6 +35,19 @@ using vola::Voxel;
 template <class T>
 using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
 
+// CArray<T>::ensure(input), except that a MemoryError (numpy had no room for the
+// converted copy) is raised as one: ensure() swallows every error and gives a null
+// array, which callers took for "not an array" or, unchecked, used as one (a crash).
+template <class T>
+CArray<T> ensure_array(const py::handle& input) {
+  try {
+    return CArray<T>(py::reinterpret_borrow<py::object>(input));
+  } catch (py::error_already_set& e) {
+    if (e.matches(PyExc_MemoryError)) throw;
+    return py::reinterpret_steal<CArray<T>>(py::handle());
+  }
+}
+
 // A numpy array that owns `values` (moved, not copied).
 template <class T>
 inline py::array_t<T> owning_array(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
@@ -53,7 +66,7 @@ inline py::array readonly_view(py::dtype dtype, std::vector<py::ssize_t> shape, 
 // (N, 3) from an array of N rows of three, or a single row of three (N = 1).
 template <class T>
 CArray<T> rows_of_three(const py::handle& input, const char* what) {
-  auto array = CArray<T>::ensure(input);
+  auto array = ensure_array<T>(input);
   if (!array) throw py::type_error(std::string(what) + ": expected an array of shape (N, 3)");
   if (array.ndim() == 1 && array.shape(0) == 3) array = array.reshape({py::ssize_t{1}, py::ssize_t{3}});
   if (array.ndim() != 2 || array.shape(1) != 3)
@@ -68,7 +81,7 @@ CArray<T> rows_of_three(const py::handle& input, const char* what) {
 inline CArray<std::int64_t> voxel_rows(const py::handle& input, const char* what) {
   const py::array raw = py::array::ensure(input);
   if (raw && raw.dtype().kind() == 'f') {
-    const auto values = CArray<double>::ensure(raw);
+    const auto values = ensure_array<double>(raw);
     const double* v = values.data();
     for (py::ssize_t i = 0; i < values.size(); ++i)
       if (!(std::isfinite(v[i]) && v[i] == std::floor(v[i])))
@@ -92,6 +105,22 @@ inline vola::ValueType value_type_of(const py::dtype& dtype) {
   throw py::type_error("attribute dtype " + py::cast<std::string>(dtype.attr("name")) + " is not a number type");
 }
 
+// Columns hold doubles: a 64-bit integer above 2^53 in size comes back rounded (2^53 + 1
+// as 2^53). Said with a warning rather than stored wrong without a word.
+inline void warn_inexact_integers(const py::array& raw, const std::string& name) {
+  const char kind = raw.dtype().kind();
+  if ((kind != 'i' && kind != 'u') || raw.dtype().itemsize() != 8) return;
+  const py::int_ limit(std::int64_t{1} << 53);  // compared as integers: 2^53 + 1 as a double is 2^53
+  py::object too_large = raw.attr("__gt__")(limit);
+  if (kind == 'i') too_large = too_large.attr("__or__")(raw.attr("__lt__")(py::int_(-(std::int64_t{1} << 53))));
+  const auto count = py::cast<std::uint64_t>(py::module_::import("numpy").attr("count_nonzero")(too_large));
+  if (count == 0) return;
+  const std::string warning = "attribute '" + name + "': " + std::to_string(count) +
+                              " values are larger than 2^53 and are kept rounded to the nearest double (columns "
+                              "hold doubles); store offsets from a base value to keep them exact";
+  if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) < 0) throw py::error_already_set();
+}
+
 // An (N, 3) array of points and {name: (N,) array} as a point cloud: each column typed by
 // its dtype (reduction mean; callers set others), one value per point or an error.
 inline vola::PointCloud point_cloud_of(const py::handle& points, const py::dict& attributes) {
@@ -108,7 +137,9 @@ inline vola::PointCloud point_cloud_of(const py::handle& points, const py::dict&
     const py::array raw = py::array::ensure(value);
     if (!raw) throw py::type_error("attribute '" + a.name + "': expected an array");
     a.type = value_type_of(raw.dtype());
-    const auto column = CArray<double>::ensure(raw);
+    const auto column = ensure_array<double>(raw);
+    if (!column) throw py::type_error("attribute '" + a.name + "': its values cannot be read as numbers");
+    warn_inexact_integers(raw, a.name);
     if (column.ndim() != 1 || static_cast<std::size_t>(column.shape(0)) != n)
       throw vola::InvalidArgument("attribute '" + a.name + "': expected one value per point (" + std::to_string(n) +
                                   "), got shape " + std::string(py::str(raw.attr("shape"))));

@@ -140,11 +140,22 @@ py::tuple world_to_voxel(const Tree& tree, const py::handle& input) {
   bool* ok = inside.mutable_data();
   const double* p = xyz.data();
   const vola::Quantizer quantizer = placed_quantizer(tree, "world_to_voxel");
+  // Without a grid frame, a bbox of no extent along an axis (one point, or coincident
+  // ones, placed by the toolkit's rule) gives every coordinate on that axis voxel 0:
+  // only the bbox's own coordinate lies in it (every world point was "inside" voxel 0).
+  const auto frame = tree.stored_frame();
+  const bool toolkit = !frame || frame->quantization != vola::Quantization::grid;
+  const vola::Box box = tree.georef().bbox;
+  const auto on_flat_axes = [&](const double* q) {
+    for (int a = 0; a < 3; ++a)
+      if (toolkit && !(box.max[a] > box.min[a]) && q[a] != box.min[a]) return false;
+    return true;
+  };
   {
     py::gil_scoped_release release;
     for (py::ssize_t i = 0; i < n; ++i, p += 3, v += 3) {
       Voxel cell;
-      ok[i] = quantizer.to_voxel(vola::Point{p[0], p[1], p[2]}, cell);
+      ok[i] = quantizer.to_voxel(vola::Point{p[0], p[1], p[2]}, cell) && on_flat_axes(p);
       v[0] = ok[i] ? std::int64_t{cell.x} : -1;
       v[1] = ok[i] ? std::int64_t{cell.y} : -1;
       v[2] = ok[i] ? std::int64_t{cell.z} : -1;
@@ -206,7 +217,11 @@ vola::WriteOptions write_options(bool dense, bool compress, bool compress_max) {
 
 py::bytes to_bytes(const Tree& tree, bool dense, bool compress, bool compress_max) {
   const vola::WriteOptions options = write_options(dense, compress, compress_max);
-  const auto bytes = vola::serialize(tree, options);
+  std::vector<std::uint8_t> bytes;
+  {
+    py::gil_scoped_release release;  // compressing takes seconds for a large tree
+    bytes = vola::serialize(tree, options);
+  }
   return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 }
 

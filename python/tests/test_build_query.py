@@ -268,6 +268,59 @@ def test_points_that_are_not_finite_are_left_out_with_a_warning():
         vola.build(points[[0, 1, 2]], voxel_size=1)
 
 
+def test_64_bit_integers_a_double_cannot_hold_are_said():
+    """Columns hold doubles: 2**53 + 1 came back as 2**53 without a word."""
+    points = np.array([[0.0, 0.0, 0.0], [5.0, 5.0, 5.0]])
+    ids = np.array([2**53 + 1, 7], dtype=np.int64)
+    with pytest.warns(UserWarning, match="'id': 1 values are larger than 2\\^53"):
+        tree = vola.build(points, voxel_size=1, attributes={"id": ids}, reductions={"id": "last"})
+    assert tree.attribute("id")[0] == 2**53  # rounded, as the warning says
+    with pytest.warns(UserWarning, match="'id': 1 values"):
+        vola.build(points, voxel_size=1, attributes={"id": np.array([-(2**53) - 1, 0], dtype=np.int64)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # within 2^53 (and narrower types): nothing to say
+        vola.build(points, voxel_size=1, attributes={"id": np.array([2**53, -(2**53)], dtype=np.int64)})
+        vola.build(points, voxel_size=1, attributes={"id": np.array([2**53, 1], dtype=np.uint64)})
+
+
+def test_one_point_placed_by_the_toolkit_holds_only_its_own_coordinates():
+    """A toolkit tree of one point (or coincident ones) has a bbox of no extent: every
+    world point, however far, was 'inside' voxel 0."""
+    tree = vola.build(np.array([[10.0, 20.0, 30.0]] * 3), depth=3, quantize="toolkit")
+    voxels, inside = tree.world_to_voxel(np.array([[10.0, 20.0, 30.0], [1000.0, -5.0, 3.0], [10.0, 20.0, 31.0]]))
+    assert inside.tolist() == [True, False, False]
+    assert voxels.tolist() == [[0, 0, 0], [-1, -1, -1], [-1, -1, -1]]
+    assert tree.contains(voxels[inside]).all()
+
+
+def test_no_room_for_a_converted_copy_is_a_memory_error(tmp_path):
+    """pybind11's array ensure() swallowed numpy's MemoryError: from_dense and contains on
+    a float array crashed, build said the array had the wrong shape."""
+    import subprocess
+    import sys
+    script = tmp_path / "oom.py"
+    script.write_text(
+        "import resource, numpy as np, vola\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))\n"
+        "calls = {\n"
+        "  'from_dense': lambda: vola.from_dense(np.broadcast_to(np.ones(1, bool), (1500, 1500, 1500))),\n"
+        "  'contains': lambda: vola.build(np.zeros((1, 3)), voxel_size=1).contains(\n"
+        "      np.broadcast_to(np.zeros(3, np.float32), (150_000_000, 3))),\n"
+        "  'build': lambda: vola.build(np.broadcast_to(np.zeros(3), (150_000_000, 3)), voxel_size=1),\n"
+        "}\n"
+        "for name, call in calls.items():\n"
+        "    try:\n"
+        "        call()\n"
+        "        print(name, 'returned')\n"
+        "    except MemoryError:\n"
+        "        print(name, 'MemoryError')\n"
+        "    except Exception as e:\n"
+        "        print(name, type(e).__name__, e)\n")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split("\n")[:3] == ["from_dense MemoryError", "contains MemoryError", "build MemoryError"], run.stdout
+
+
 def test_a_file_that_cannot_be_opened_is_an_os_error(tmp_path):
     """vola.IoError is an OSError too, with the system's reason, whatever reads the file."""
     assert issubclass(vola.IoError, OSError) and issubclass(vola.IoError, vola.Error)
