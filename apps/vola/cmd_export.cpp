@@ -186,9 +186,8 @@ void run_export(const ExportArgs& a) {
       for (const auto& name : r.extra_bytes) what += " " + name;
     }
     say(what);
-    if (r.clamped_intensities)  // a warning, even with -q: values were changed
-      std::fprintf(stderr, "vola: warning: %llu intensities outside LAS's 0..65535 were clamped to it\n",
-                   static_cast<unsigned long long>(r.clamped_intensities));
+    for (const std::string& unfit : r.unfit_values)  // a warning, even with -q: values were changed
+      std::fprintf(stderr, "vola: warning: %s: %s\n", a.output.c_str(), unfit.c_str());
   } else if (format == "binvox") {
     io::write_binvox(tree, a.output);
     say("binvox: " + std::to_string(voxels) + " voxels");

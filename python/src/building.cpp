@@ -89,7 +89,11 @@ Tree build_points(const py::handle& points, int depth, double voxel_size, const 
     // As the readers reduce a column of that name: classes and ids by majority, ...
     a.reduction = vola::io::default_reduction(a.name);
     if (!reductions.contains(a.name)) continue;
-    const auto name = py::cast<std::string>(reductions[py::str(a.name)]);
+    const py::object given = reductions[py::str(a.name)];
+    if (!py::isinstance<py::str>(given))
+      throw py::type_error("reductions['" + a.name + "']: a reduction's name (last, mean, max, min, majority), not " +
+                           py::cast<std::string>(py::repr(given)));
+    const auto name = py::cast<std::string>(given);
     const auto r = vola::parse_reduction(name);
     if (!r) throw vola::InvalidArgument("attribute '" + a.name + "': reduction '" + name + "' is not one of last mean max min majority");
     a.reduction = *r;

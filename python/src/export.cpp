@@ -89,6 +89,9 @@ py::dict export_las(const Tree& tree, const std::filesystem::path& path, int dep
   out["has_crs"] = r.has_crs;
   out["extra_bytes"] = r.extra_bytes;
   out["clamped_intensities"] = r.clamped_intensities;
+  out["unfit_values"] = r.unfit_values;
+  for (const std::string& unfit : r.unfit_values)  // values were changed: said as the CLI says it
+    if (PyErr_WarnEx(PyExc_UserWarning, (path.string() + ": " + unfit).c_str(), 1) < 0) throw py::error_already_set();
   return out;
 }
 
@@ -217,7 +220,8 @@ void bind_export(py::module_& m, py::class_<Tree>& tree) {
         "The tree's voxel centres as LAS 1.4 points (`vola export TREE OUT.las`): colour, intensity,\n"
         "classification and returns into their fields, other columns as extra bytes, the CRS as WKT; a path\n"
         "ending in .laz is LASzip-compressed. Returns {point_format, scale, has_crs, extra_bytes,\n"
-        "clamped_intensities}.");
+        "clamped_intensities, unfit_values}: values a field cannot hold (a classification of 300, a NaN\n"
+        "intensity) are written clamped (NaN as 0), each field's count said in unfit_values and a UserWarning.");
   m.def("export_binvox", [](const Tree& tree, const std::filesystem::path& path, int depth) {
         write_released([&] { at_depth(tree, depth, [&](const Tree& t) { vola::io::write_binvox(t, path.string()); }); });
       }, py::arg("tree"), py::arg("path"), py::arg("depth") = 0, "A binvox voxel grid (`vola export TREE OUT.binvox`), side <= 4096.");

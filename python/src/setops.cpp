@@ -29,9 +29,11 @@ Tree combine(const Tree& a, const Tree& b, bool ignore_frame) {
 
 void bind_setops(py::module_& m, py::class_<Tree>& tree) {
   constexpr const char* kCarried =
-      "\nBoth trees must have the same depth, grid (origin and voxel size) and CRS, else InvalidArgument, as the CLI\n"
-      "says; ignore_frame=True combines voxel indices anyway. The result keeps a's frame and CRS; payloads and\n"
-      "attribute columns are not carried.";
+      "\nBoth trees must lie on one grid, else InvalidArgument, as the CLI says: the same depth, origin and voxel\n"
+      "size, or grid trees of one voxel size whose origins are whole voxels apart (any depths: the result is on\n"
+      "the lower origin, at the smallest depth that holds both); and the same CRS when both state one (a tree\n"
+      "with none takes the other's). ignore_frame=True combines voxel indices anyway. The result keeps a's frame\n"
+      "and CRS otherwise; payloads and attribute columns are not carried.";
   m.def("union", &combine<&vola::unite>, py::arg("a"), py::arg("b"), py::arg("ignore_frame") = false,
         (std::string("Voxels in a or b (`vola union`; also a | b).") + kCarried).c_str());
   m.def("intersect", &combine<&vola::intersect>, py::arg("a"), py::arg("b"), py::arg("ignore_frame") = false,

@@ -243,6 +243,9 @@ def test_a_bad_argument_is_a_value_error():
     assert issubclass(vola.InvalidArgument, ValueError) and issubclass(vola.InvalidArgument, vola.Error)
     with pytest.raises(ValueError, match="voxel_size"):
         vola.build(np.zeros((3, 3)), voxel_size=-1)
+    # A reduction that is not a name was "RuntimeError: Unable to cast Python instance".
+    with pytest.raises(TypeError, match=r"reductions\['i'\]: a reduction's name .*, not 3"):
+        vola.build(np.zeros((3, 3)), voxel_size=1, attributes={"i": np.arange(3)}, reductions={"i": 3})
 
 
 def test_a_crs_proj_does_not_know_is_refused_before_building():

@@ -140,3 +140,13 @@ def test_bad_arguments_raise():
         vola.build(np.zeros((4, 3)))
     with pytest.raises(TypeError):
         vola.build(np.zeros((4, 3)), voxel_size=1.0, attributes={"s": np.array(["a"] * 4)})
+
+
+def test_the_type_stubs_name_every_public_name():
+    """export_csv was exported but missing from vola/__init__.pyi: type checkers and IDEs
+    did not know it."""
+    import re
+    from pathlib import Path
+    stub = (Path(vola.__file__).parent / "__init__.pyi").read_text()
+    named = set(re.findall(r"\b(\w+) as \1\b", stub)) | set(re.findall(r"^def (\w+)", stub, re.M))
+    assert set(vola.__all__) - named == set()

@@ -22,6 +22,7 @@ from ._vola import (
     describe_crs as describe_crs,
     difference as difference,
     export_binvox as export_binvox,
+    export_csv as export_csv,
     export_height_map as export_height_map,
     export_las as export_las,
     export_map as export_map,

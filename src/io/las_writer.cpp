@@ -303,11 +303,63 @@ std::vector<std::uint8_t> public_header(const LasPoints& points, const LasColumn
   return h;
 }
 
-// One point record per position, in order, written in 64 KiB batches.
-// Returns how many intensities were outside the field's 0..65535 (clamped to it).
-std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns,
-                            const RecordLayout& layout, const LasCoordinates& coords) {
+// A standard field fed from a column whose type can hold values the field cannot (a
+// classification of i32, an intensity of f32): the values written otherwise, counted.
+struct UnfitValues {
+  const char* field;
+  const AttributeColumn* column;
+  double max;
+  std::uint64_t outside = 0, not_numbers = 0;
+};
+
+bool column_fits(ValueType type, double max) {
+  return (type == ValueType::u8 && max >= 255.0) || (type == ValueType::u16 && max >= 65535.0);
+}
+
+std::vector<UnfitValues> watched_fields(const LasColumns& c) {
+  const std::vector<UnfitValues> all = {
+      {"intensity", c.intensity, 65535.0},        {"classification", c.classification, 255.0},
+      {"user_data", c.user_data, 255.0},          {"point_source_id", c.point_source_id, 65535.0},
+      {"number_of_returns", c.returns, 15.0},     {"return_number", c.return_number, 15.0},
+      {"scanner_channel", c.scanner_channel, 3.0}, {"classification_flags", c.classification_flags, 15.0},
+      {"red", c.red, 65535.0},                    {"green", c.green, 65535.0},
+      {"blue", c.blue, 65535.0}};
+  std::vector<UnfitValues> watched;
+  for (const UnfitValues& f : all)
+    if (f.column && !column_fits(f.column->type(), f.max)) watched.push_back(f);
+  return watched;
+}
+
+void count_unfit(std::vector<UnfitValues>& watched, std::size_t rank) {
+  for (UnfitValues& f : watched) {
+    const double v = f.column->get(rank);
+    if (std::isnan(v)) ++f.not_numbers;
+    else if (std::nearbyint(v) < 0.0 || std::nearbyint(v) > f.max) ++f.outside;
+  }
+}
+
+// One sentence per field whose values were changed to fit it.
+std::vector<std::string> describe_unfit(const std::vector<UnfitValues>& watched) {
+  std::vector<std::string> out;
+  for (const UnfitValues& f : watched) {
+    if (f.outside == 0 && f.not_numbers == 0) continue;
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "0..%.0f", f.max);
+    std::string s = std::string(f.field) + ": ";
+    if (f.outside) s += std::to_string(f.outside) + " values outside LAS's " + limit + " were clamped to it";
+    if (f.outside && f.not_numbers) s += ", ";
+    if (f.not_numbers) s += std::to_string(f.not_numbers) + " values that are not numbers were written as 0";
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// One point record per position, in order, written in 64 KiB batches. Counts in
+// `report` the values the standard fields could not hold.
+void write_records(OutputFile& out, const LasPoints& points, const LasColumns& columns, const RecordLayout& layout,
+                   const LasCoordinates& coords, LasReport& report) {
   std::uint64_t clamped_intensities = 0;
+  std::vector<UnfitValues> watched = watched_fields(columns);
   std::vector<std::uint8_t> record(layout.length);
   std::string buffer;
   std::size_t rank = 0;
@@ -319,6 +371,7 @@ std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasC
       const double v = columns.intensity->get(rank);
       if (v > 65535.0 || v < 0.0) ++clamped_intensities;  // a PTS file's go down to -2048
     }
+    count_unfit(watched, rank);
     const auto [number, count] = returns_of(columns, rank);
     record[14] = static_cast<std::uint8_t>(number | count << 4);
     std::uint32_t flags = field_value(columns.classification_flags, rank, 15.0, 0);
@@ -355,7 +408,8 @@ std::uint64_t write_records(OutputFile& out, const LasPoints& points, const LasC
     ++rank;
   });
   out.write(buffer);
-  return clamped_intensities;
+  report.clamped_intensities = clamped_intensities;
+  report.unfit_values = describe_unfit(watched);
 }
 
 // The points as LAS (or, for a .laz path, LAS records then compressed by translate_las).
@@ -381,7 +435,7 @@ LasReport write_points(const LasPoints& points, const LasCoordinates& coords, co
   OutputFile out(las_path);
   out.write(header.data(), header.size());
   for (const auto& v : vlrs) out.write(v.data(), v.size());
-  report.clamped_intensities = write_records(out, points, columns, layout, coords);
+  write_records(out, points, columns, layout, coords, report);
   out.commit();
   if (laz) translate_las(las_path, path);
   return report;

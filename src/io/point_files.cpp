@@ -384,9 +384,8 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
                        "): it is not kept; a .las or .laz output keeps it");
   if (out_ext == ".ply") write_ply_points(table.cloud, output);
   else if (las_out) {
-    if (const LasReport r = write_las(table.cloud, output, table.epsg, table.wkt); r.clamped_intensities)
-      warnings.push_back(output + ": " + std::to_string(r.clamped_intensities) +
-                         " intensities outside LAS's 0..65535 were clamped to it");
+    const LasReport r = write_las(table.cloud, output, table.epsg, table.wkt);
+    for (const std::string& unfit : r.unfit_values) warnings.push_back(output + ": " + unfit);
   } else
     write_text_points(table.cloud, output, table.coordinate_digits, csv);
   return warnings;

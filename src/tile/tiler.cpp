@@ -645,6 +645,11 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   if (options.memory_budget < (std::uint64_t{1} << 20))
     throw OptionError("memory_budget", "must be at least 1 MiB (got " + std::to_string(options.memory_budget) + " bytes)");
   const unsigned workers = resolve_thread_count(options.threads);
+  std::error_code error;
+  if (fs::exists(options.output_dir, error) && !fs::is_directory(options.output_dir, error))
+    throw OptionError("output_dir", options.output_dir +
+                                        " is a file, not a folder: give a folder for the tiles and their index (new "
+                                        "or one an earlier vola tile wrote)");
   fs::create_directories(options.output_dir);
   const detail::Generation generation = detail::begin_generation(options.output_dir, comm);
   const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);

@@ -262,6 +262,36 @@ TEST(LasExport, IntensitiesAboveSixteenBitsAreCounted) {
   TempDir dir;
   const auto report = vola::io::write_las(tree, (dir / "wide.las").string());
   EXPECT_EQ(report.clamped_intensities, 2u);
+  EXPECT_EQ(report.unfit_values, std::vector<std::string>{"intensity: 2 values outside LAS's 0..65535 were clamped to it"});
+}
+
+// Every standard field fed from a column wider than it says what it changed: a
+// classification of 300 became 255, a NaN intensity 0, without a word.
+TEST(LasExport, ValuesAStandardFieldCannotHoldAreSaid) {
+  vola::Tree tree = vola::build_from_voxels(std::vector<vola::Voxel>{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}, 1);
+  vola::AttributeColumn classification("classification", vola::ValueType::i32, vola::Reduction::majority, 3);
+  classification.set(0, 300);
+  classification.set(1, -1);
+  classification.set(2, 6);
+  vola::AttributeColumn intensity("intensity", vola::ValueType::f32, vola::Reduction::mean, 3);
+  intensity.set(0, std::nan(""));
+  intensity.set(1, 12.5);
+  intensity.set(2, 40);
+  vola::AttributeColumn user_data("user_data", vola::ValueType::u8, vola::Reduction::last, 3);  // fits: not watched
+  tree.attributes().add(std::move(classification));
+  tree.attributes().add(std::move(intensity));
+  tree.attributes().add(std::move(user_data));
+  TempDir dir;
+  const auto report = vola::io::write_las(tree, (dir / "unfit.las").string());
+  EXPECT_EQ(report.clamped_intensities, 0u);
+  EXPECT_EQ(report.unfit_values,
+            (std::vector<std::string>{"intensity: 1 values that are not numbers were written as 0",
+                                      "classification: 2 values outside LAS's 0..255 were clamped to it"}));
+  vola::io::LasReader reader((dir / "unfit.las").string());
+  vola::io::LasChunk points;
+  ASSERT_EQ(reader.read(points, 10), 3u);
+  EXPECT_EQ(points.classification, (std::vector<std::uint8_t>{255, 0, 6}));
+  EXPECT_EQ(points.intensity, (std::vector<std::uint16_t>{0, 12, 40}));
 }
 
 TEST(LasExport, EmptyTree) {

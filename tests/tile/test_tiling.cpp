@@ -172,6 +172,22 @@ TEST(Tiler, EveryTileHoldsExactlyItsPointsVoxels) {
   EXPECT_FALSE(fs::exists(dir / "tiles" / ".spill" / "rank-0")) << "spill files are removed";
 }
 
+// An output that names a file was a bare "filesystem error: cannot create directories".
+TEST(Tiler, AnOutputThatIsAFileIsRefusedNamingIt) {
+  vola_test::TempDir dir;
+  const PointsInMemory points(100, 7, 1);
+  const fs::path file = dir / "tiles";
+  std::ofstream(file) << "not a folder";
+  auto comm = tile::single_process();
+  try {
+    tile::make_tiles({&points}, small_grid(file), *comm);
+    ADD_FAILURE() << "tiled into a file";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.option(), "output_dir");
+    EXPECT_NE(e.cause().find(file.string() + " is a file, not a folder"), std::string::npos) << e.cause();
+  }
+}
+
 TEST(Tiler, SameBytesForAnyThreadCountChunkingAndBudget) {
   vola_test::TempDir dir;
   auto comm = tile::single_process();

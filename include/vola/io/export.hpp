@@ -62,6 +62,10 @@ struct LasReport {
   bool has_crs = false;                  // false: the tree's CRS is unknown
   std::vector<std::string> extra_bytes;  // columns written as extra-bytes fields
   std::uint64_t clamped_intensities = 0;  // intensities outside LAS's 0..65535, clamped to it
+  // Standard fields given values they cannot hold (a classification of 300, a NaN
+  // intensity): one sentence each, "classification: 2 values outside LAS's 0..255 were
+  // clamped to it", for the front ends to warn with.
+  std::vector<std::string> unfit_values;
 };
 // A path ending in .laz gets the same records LASzip-compressed (vola/io/laz.hpp:
 // compressor 3, point format 6 or 7).
