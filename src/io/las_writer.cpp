@@ -317,13 +317,17 @@ bool column_fits(ValueType type, double max) {
 }
 
 std::vector<UnfitValues> watched_fields(const LasColumns& c) {
-  const std::vector<UnfitValues> all = {
-      {"intensity", c.intensity, 65535.0},        {"classification", c.classification, 255.0},
-      {"user_data", c.user_data, 255.0},          {"point_source_id", c.point_source_id, 65535.0},
-      {"number_of_returns", c.returns, 15.0},     {"return_number", c.return_number, 15.0},
-      {"scanner_channel", c.scanner_channel, 3.0}, {"classification_flags", c.classification_flags, 15.0},
-      {"red", c.red, 65535.0},                    {"green", c.green, 65535.0},
-      {"blue", c.blue, 65535.0}};
+  const std::vector<UnfitValues> all = {{"intensity", c.intensity, 65535.0},
+                                        {"classification", c.classification, 255.0},
+                                        {"user_data", c.user_data, 255.0},
+                                        {"point_source_id", c.point_source_id, 65535.0},
+                                        {"number_of_returns", c.returns, 15.0},
+                                        {"return_number", c.return_number, 15.0},
+                                        {"scanner_channel", c.scanner_channel, 3.0},
+                                        {"classification_flags", c.classification_flags, 15.0},
+                                        {"red", c.red, 65535.0},
+                                        {"green", c.green, 65535.0},
+                                        {"blue", c.blue, 65535.0}};
   std::vector<UnfitValues> watched;
   for (const UnfitValues& f : all)
     if (f.column && !column_fits(f.column->type(), f.max)) watched.push_back(f);
@@ -333,8 +337,10 @@ std::vector<UnfitValues> watched_fields(const LasColumns& c) {
 void count_unfit(std::vector<UnfitValues>& watched, std::size_t rank) {
   for (UnfitValues& f : watched) {
     const double v = f.column->get(rank);
-    if (std::isnan(v)) ++f.not_numbers;
-    else if (std::nearbyint(v) < 0.0 || std::nearbyint(v) > f.max) ++f.outside;
+    if (std::isnan(v))
+      ++f.not_numbers;
+    else if (std::nearbyint(v) < 0.0 || std::nearbyint(v) > f.max)
+      ++f.outside;
   }
 }
 

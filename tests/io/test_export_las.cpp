@@ -262,7 +262,8 @@ TEST(LasExport, IntensitiesAboveSixteenBitsAreCounted) {
   TempDir dir;
   const auto report = vola::io::write_las(tree, (dir / "wide.las").string());
   EXPECT_EQ(report.clamped_intensities, 2u);
-  EXPECT_EQ(report.unfit_values, std::vector<std::string>{"intensity: 2 values outside LAS's 0..65535 were clamped to it"});
+  EXPECT_EQ(report.unfit_values,
+            std::vector<std::string>{"intensity: 2 values outside LAS's 0..65535 were clamped to it"});
 }
 
 // Every standard field fed from a column wider than it says what it changed: a
