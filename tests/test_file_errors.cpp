@@ -106,6 +106,9 @@ TEST(FileErrors, OtherFormatsAreNamed) {
   expect_format_error(bytes_of("{\n\"type\": \"FeatureCollection\",\n\"vola\": { \"format\": \"vola-tile-index\""), 0,
                       "not a .vol file: a vola tile index: this command takes one .vol file");
   expect_format_error(bytes_of("  {\"type\": \"Feature\"}"), 0, "not a .vol file: JSON text");
+  // Text: a README or an XYZ file (its header size read 1870012451).
+  const std::string xyz = "1.5 2.25 3\n4 5 6\n7 8 9\n10 11 12\n13 14 15\n16 17 18\n19 20 21\n";
+  expect_format_error(std::vector<std::uint8_t>(xyz.begin(), xyz.end()), 0, "not a .vol file: text (a point file");
   // Short ones too: the signature comes before the header's length.
   expect_format_error({'L', 'A', 'S', 'F', 1, 2}, 0, "a LAS/LAZ point file");
 }

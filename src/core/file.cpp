@@ -257,6 +257,13 @@ const char* other_format(std::span<const std::uint8_t> bytes) {
              "take tile indexes; or give one of the tiles it names)";
     return "JSON text (a GeoJSON?), not a .vol file";
   }
+  // Text (a README, a CSV, an XYZ point file) read as a header said "header size
+  // 1870012451 is not the 80 this format knows".
+  const std::size_t head = std::min<std::size_t>(bytes.size(), 64);
+  if (head >= 8 && std::all_of(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(head), [](std::uint8_t c) {
+        return c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c != 0x7f);  // printable ASCII or UTF-8
+      }))
+    return "text (a point file such as XYZ or CSV? `vola convert` makes voxels of it)";
   return nullptr;
 }
 
@@ -269,7 +276,10 @@ Header decode_header(std::span<const std::uint8_t> bytes, const std::string& nam
   Header h;
   h.header_size = r.get<std::uint32_t>("header size");
   if (h.header_size != kHeaderSize)
-    VOLA_THROW(FormatError(name, 0, "header size " + std::to_string(h.header_size) + " is not the 80 this format knows"));
+    VOLA_THROW(
+        FormatError(name, 0,
+                    "header size " + std::to_string(h.header_size) +
+                        " is not the 80 this format knows: not a .vol file, or one whose first bytes are damaged"));
   h.version = r.get<std::uint16_t>("version");
   if (h.version != kVersionPlain && h.version != kVersionCompressed)
     VOLA_THROW(FormatError(name, 4, "version " + std::to_string(h.version) + " is not known (1 = reference, 2 = vola compressed)"));
