@@ -20,6 +20,7 @@
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/ros_map.hpp"
 #include "vola/map/state_map.hpp"
+#include "vola/setops.hpp"
 
 namespace vola::cli {
 
@@ -59,7 +60,10 @@ std::string resolve_format(const ExportArgs& a) {
 }
 
 // The free voxels: a state map's own (vola map), else --free's plain tree, else none.
-std::optional<Tree> free_voxels(const ExportArgs& a) {
+// At a coarser --depth, a cell holding occupied and free voxels is occupied (as OctoMap's
+// inner nodes take their children's largest occupancy): it was both, and the .bt/.ot
+// writers refused the map while the .vdb one wrote the cell into both grids.
+std::optional<Tree> free_voxels(const ExportArgs& a, const Tree& occupied) {
   std::optional<Tree> free;
   const Tree input = open_mapped(a.input);
   if (map::is_state_map(input)) {
@@ -69,12 +73,12 @@ std::optional<Tree> free_voxels(const ExportArgs& a) {
   } else if (!a.free.empty()) {
     free = open_mapped(a.free);
   }
-  if (free && a.depth > 0 && a.depth < free->depth()) free = free->level_of_detail(a.depth);
+  if (free && a.depth > 0 && a.depth < free->depth()) free = vola::subtract(free->level_of_detail(a.depth), occupied);
   return free;
 }
 
 void export_map(const ExportArgs& a, const Tree& tree, const std::string& format) {
-  const std::optional<Tree> free = free_voxels(a);
+  const std::optional<Tree> free = free_voxels(a, tree);
   const io::MapVoxels voxels = io::map_voxels(tree, free ? &*free : nullptr);
   const io::MapExportReport r = format == "vdb" ? io::write_vdb(voxels, a.output) : io::write_octomap(voxels, a.output);
   for (const auto& warning : r.warnings) std::fprintf(stderr, "vola: warning: %s\n", warning.c_str());  // even with -q
@@ -112,7 +116,7 @@ io::RosMapOptions band_heights(const std::string& band) {
 }
 
 void export_ros_map(const ExportArgs& a, const Tree& tree) {
-  const std::optional<Tree> free = free_voxels(a);
+  const std::optional<Tree> free = free_voxels(a, tree);
   const io::MapVoxels voxels = io::map_voxels(tree, free ? &*free : nullptr);
   const io::RosMapReport r = io::write_ros_map(voxels, a.output, band_heights(a.band));
   if (a.quiet) return;

@@ -17,6 +17,7 @@
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/ros_map.hpp"
 #include "vola/map/state_map.hpp"
+#include "vola/setops.hpp"
 
 namespace vola::python {
 
@@ -108,8 +109,11 @@ vola::io::MapVoxels gathered_map(const Tree& given, const Tree* given_free, int 
   }
   const Tree& tree = occupied ? *occupied : given;
   const Tree* free = own_free ? &*own_free : given_free;
+  // A coarse cell holding occupied and free voxels is occupied, as in `vola export`.
   const std::optional<Tree> coarse_free =
-      free && depth > 0 && depth < free->depth() ? std::optional<Tree>(free->level_of_detail(depth)) : std::nullopt;
+      free && depth > 0 && depth < free->depth()
+          ? std::optional<Tree>(vola::subtract(free->level_of_detail(depth), tree.level_of_detail(depth)))
+          : std::nullopt;
   return at_depth(tree, depth,
                   [&](const Tree& t) { return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free); });
 }

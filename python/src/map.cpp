@@ -224,7 +224,8 @@ void bind_map(py::module_& m) {
            }),
            py::arg("tree"), py::arg("max_distance"), py::arg("lo") = py::none(), py::arg("hi") = py::none(),
            "The field of the tree's voxels (a state map's occupied ones) over grid voxels lo..hi-1 (default: the\n"
-           "voxels' box grown by max_distance).")
+           "voxels' box grown by max_distance); the box may reach past the grid's faces, where cells lie near the\n"
+           "obstacles on them, and is clipped max_distance beyond them.")
       .def(
           "distance",
           [](const PyDistanceField& self, const py::handle& points) {

@@ -23,11 +23,13 @@ std::uint64_t cells_of(const GridBox& b) {
   return n;
 }
 
-GridBox grown(const GridBox& b, std::int64_t margin, std::int64_t side) {
+// Not clipped to the grid: the cells just outside it lie near the obstacles on its faces
+// (a field clipped to the grid read max_distance a voxel below a map's lowest obstacle).
+GridBox grown(const GridBox& b, std::int64_t margin) {
   GridBox g;
   for (int a = 0; a < 3; ++a) {
-    g.lo[a] = std::max<std::int64_t>(0, b.lo[a] - margin);
-    g.hi[a] = std::min<std::int64_t>(side, b.hi[a] + margin);
+    g.lo[a] = b.lo[a] - margin;
+    g.hi[a] = b.hi[a] + margin;
   }
   return g;
 }
@@ -86,10 +88,12 @@ DistanceField::DistanceField(const Tree& tree, const GridBox& box, double max_di
     throw InvalidArgument("max_distance must be finite and > 0");
   max_voxels_ = max_distance / frame_.voxel_size;
   margin_ = static_cast<std::int64_t>(std::ceil(max_voxels_));
-  box_ = clipped(box, GridBox{{0, 0, 0}, {side_, side_, side_}});
+  // Beyond max_distance around the grid every cell is max_distance: no need to store it.
+  const std::int64_t side = side_;
+  box_ = clipped(box, GridBox{{-margin_, -margin_, -margin_}, {side + margin_, side + margin_, side + margin_}});
   const std::uint64_t cells = cells_of(box_);
-  if (cells == 0) throw InvalidArgument("the distance field's box holds no voxel of the grid");
-  if (cells > kMaxCells || cells_of(grown(box_, margin_, side_)) > 2 * kMaxCells)
+  if (cells == 0) throw InvalidArgument("the distance field's box holds no voxel within max_distance of the grid");
+  if (cells > kMaxCells || cells_of(grown(box_, margin_)) > 2 * kMaxCells)
     throw InvalidArgument("a distance field of " + std::to_string(cells) + " cells is more than " +
                           std::to_string(kMaxCells) + ": give a smaller box");
   values_.assign(cells, static_cast<float>(max_voxels_));
@@ -109,7 +113,7 @@ GridBox voxel_bounds(const Tree& tree, double max_distance) {
   });
   if (tree.voxel_count() == 0) b = GridBox{};
   const auto margin = static_cast<std::int64_t>(std::ceil(max_distance / tree.frame().voxel_size));
-  return grown(b, margin, tree.side());
+  return grown(b, margin);
 }
 
 }  // namespace
@@ -120,7 +124,7 @@ DistanceField::DistanceField(const Tree& tree, double max_distance)
 void DistanceField::update(const Tree& tree, const GridBox& changed) {
   if (tree.side() != side_ || !(tree.frame() == frame_))
     throw InvalidArgument("update: the tree is on another grid than the distance field");
-  const GridBox region = clipped(grown(changed, margin_, side_), box_);
+  const GridBox region = clipped(grown(changed, margin_), box_);
   if (cells_of(region) > 0) compute(tree, region);
 }
 
@@ -128,7 +132,7 @@ void DistanceField::compute(const Tree& tree, const GridBox& region) {
   std::optional<Tree> occupied;
   if (is_state_map(tree)) occupied = occupied_tree(tree);
   const Tree& obstacles = occupied ? *occupied : tree;
-  const GridBox g = grown(region, margin_, side_);
+  const GridBox g = grown(region, margin_);
   const std::array<std::size_t, 3> n{static_cast<std::size_t>(g.hi[0] - g.lo[0]),
                                      static_cast<std::size_t>(g.hi[1] - g.lo[1]),
                                      static_cast<std::size_t>(g.hi[2] - g.lo[2])};
@@ -146,9 +150,10 @@ void DistanceField::compute(const Tree& tree, const GridBox& region) {
       f[at(c[0], c[1], c[2])] = 0.0;
     });
   } else {
-    for (std::int64_t z = g.lo[2]; z < g.hi[2]; ++z)
-      for (std::int64_t y = g.lo[1]; y < g.hi[1]; ++y)
-        for (std::int64_t x = g.lo[0]; x < g.hi[0]; ++x)
+    const GridBox in_grid = clipped(g, GridBox{{0, 0, 0}, {side_, side_, side_}});  // obstacles lie on the grid
+    for (std::int64_t z = in_grid.lo[2]; z < in_grid.hi[2]; ++z)
+      for (std::int64_t y = in_grid.lo[1]; y < in_grid.hi[1]; ++y)
+        for (std::int64_t x = in_grid.lo[0]; x < in_grid.hi[0]; ++x)
           if (obstacles.contains(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
                                  static_cast<std::uint32_t>(z)))
             f[at(x, y, z)] = 0.0;

@@ -86,6 +86,18 @@ grep -q "^OpenVDB grids log_odds free_log_odds: 2 occupied and 7 free" "$tmp/out
 expect_error "has no grid named 'density'" "$vola" info "$tmp/map.vdb" --grid density
 expect_error "applies to OpenVDB (.vdb) and NumPy .npz files" "$vola" info "$tmp/map.vol" --grid occupied
 
+# At a coarser --depth a cell holding occupied and free voxels is occupied, not both (the
+# .ot writer refused "voxel ... is given as occupied and as free"; the .vdb one wrote the
+# cell into both grids).
+"$vola" export "$tmp/map.vol" "$tmp/lod.ot" --depth 1 >"$tmp/out" 2>"$tmp/err" || fail "export --depth 1: $(cat "$tmp/err")"
+grep -q ": 2 occupied and 1 free voxels of 1 " "$tmp/out" || fail "lod.ot summary: $(cat "$tmp/out")"
+"$vola" export "$tmp/map.vol" "$tmp/lod.vdb" --depth 1 -q || fail "export lod.vdb"
+"$vola" convert "$tmp/lod.vdb" "$tmp/lod_occupied.vol" --grid occupied -q || fail "convert lod.vdb occupied"
+"$vola" convert "$tmp/lod.vdb" "$tmp/lod_free.vol" --grid free -q || fail "convert lod.vdb free"
+[[ $("$vola" voxels "$tmp/lod_free.vol") == "0 0 0" ]] || fail "lod.vdb free cells: $("$vola" voxels "$tmp/lod_free.vol")"
+"$vola" intersect "$tmp/lod_occupied.vol" "$tmp/lod_free.vol" "$tmp/lod_both.vol" -q || fail "intersect"
+"$vola" info "$tmp/lod_both.vol" | grep -q "^voxels: *0 occupied" || fail "lod.vdb has cells both occupied and free"
+
 # Plain trees take their free voxels from --free (here the state map's two halves; the
 # union keeps no log-odds, so the occupied leaves get OctoMap's clamping maximum).
 "$vola" union "$tmp/map.vol" "$tmp/map.vol" "$tmp/occupied.vol" -q || fail "union: the occupied voxels as a plain tree"

@@ -61,6 +61,26 @@ TEST(DistanceField, EveryVoxelHoldsTheExactCappedDistance) {
   }
 }
 
+// Cells past the grid's faces lie near the obstacles on them: the field was clipped to
+// the grid, so a point a voxel below a map's lowest obstacle read max_distance ("far")
+// while a sphere there collided.
+TEST(DistanceField, CellsPastTheGridsFacesHoldTheirDistanceToo) {
+  const std::vector<vola::Voxel> obstacles{{0, 0, 0}, {15, 7, 15}, {3, 0, 9}};
+  const vola::Tree tree = vola::build_from_voxels(obstacles, 2);  // 16^3, voxel size 1
+  const DistanceField by_default(tree, 3.0);                      // the voxels' box grown by 3
+  EXPECT_EQ(by_default.box().lo, (std::array<std::int64_t, 3>{-3, -3, -3}));
+  EXPECT_EQ(by_default.box().hi, (std::array<std::int64_t, 3>{19, 11, 19}));
+  expect_exact(by_default, obstacles, 3.0);
+  EXPECT_NEAR(by_default.voxels_at({-1, 0, 0}), 1.0, 1e-6);  // the voxel left of (0, 0, 0), outside the grid
+  // A box asked far past the grid is kept max_distance beyond it: the rest is all cap.
+  const DistanceField wide(tree, GridBox{{-10, -10, -10}, {30, 30, 30}}, 2.0);
+  EXPECT_EQ(wide.box().lo, (std::array<std::int64_t, 3>{-2, -2, -2}));
+  EXPECT_EQ(wide.box().hi, (std::array<std::int64_t, 3>{18, 18, 18}));
+  expect_exact(wide, obstacles, 2.0);
+  EXPECT_EQ(wide.voxels_at({-9, 0, 0}), 2.0f);
+  EXPECT_THROW(DistanceField(tree, GridBox{{-10, 0, 0}, {-5, 4, 4}}, 2.0), vola::InvalidArgument);
+}
+
 TEST(DistanceField, AnUpdateEqualsAFreshField) {
   auto obstacles = random_voxels(9, 10, 16);
   DistanceField field(vola::build_from_voxels(obstacles, 2), GridBox{{0, 0, 0}, {16, 16, 16}}, 4.0);

@@ -27,7 +27,7 @@
 namespace vola::map {
 
 struct GridBox {
-  std::array<std::int64_t, 3> lo{0, 0, 0};  // first voxel, inclusive (the tree's grid)
+  std::array<std::int64_t, 3> lo{0, 0, 0};  // first voxel, inclusive (the tree's grid's indices, may be < 0)
   std::array<std::int64_t, 3> hi{0, 0, 0};  // last voxel + 1
 };
 
@@ -35,11 +35,13 @@ class DistanceField {
  public:
   static constexpr std::uint64_t kMaxCells = std::uint64_t{1} << 28;
 
-  // The field of `tree`'s obstacles over `box` (clipped to the tree's grid), distances in
-  // world units up to max_distance (> 0). Throws InvalidArgument for an empty box, a
-  // non-positive max_distance or a box above kMaxCells cells.
+  // The field of `tree`'s obstacles over `box`, distances in world units up to
+  // max_distance (> 0). The box may reach past the grid's faces (cells there lie near the
+  // obstacles on them); it is clipped max_distance beyond them, where every cell is
+  // max_distance. Throws InvalidArgument for an empty box, a non-positive max_distance or
+  // a box above kMaxCells cells.
   DistanceField(const Tree& tree, const GridBox& box, double max_distance);
-  // The box of the tree's voxels grown by max_distance (clipped to the grid).
+  // The box of the tree's voxels grown by max_distance (past the grid's faces too).
   DistanceField(const Tree& tree, double max_distance);
 
   // Recomputes the cells within max_distance of `changed` (the tree's grid) from `tree`
