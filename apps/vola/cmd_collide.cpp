@@ -1,6 +1,8 @@
 // vola collide: is a segment, a sphere or an axis-aligned box free of occupied voxels?
 // Prints "free" or what was hit; the exit status answers too (0 free, 3 collision), so
 // scripts can write `if vola collide site.vol --segment ...; then`.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -68,6 +70,35 @@ std::uint64_t unknown_voxels_on(const Tree& states, const Point& from, const Poi
   return unknown;
 }
 
+// The voxels of unknown space among the cells [lo, hi) (grid indices, per axis) that
+// `touches` accepts; 0 when the region spans more than 2^26 cells (not counted).
+template <class Touches>
+std::uint64_t unknown_voxels_in(const Tree& states, const std::array<double, 3>& lo, const std::array<double, 3>& hi,
+                                const Touches& touches) {
+  double cells = 1;
+  for (int i = 0; i < 3; ++i) cells *= std::max(0.0, hi[i] - lo[i]);
+  if (!(cells <= double(std::uint64_t{1} << 26))) return 0;
+  const double side = static_cast<double>(states.side());
+  std::uint64_t unknown = 0;
+  for (double z = lo[2]; z < hi[2]; ++z)
+    for (double y = lo[1]; y < hi[1]; ++y)
+      for (double x = lo[0]; x < hi[0]; ++x) {
+        if (!touches(x, y, z)) continue;
+        const bool inside = x >= 0 && y >= 0 && z >= 0 && x < side && y < side && z < side;
+        if (!inside || map::state_at(states, Voxel{std::uint32_t(x), std::uint32_t(y), std::uint32_t(z)}) ==
+                           map::VoxelState::unknown)
+          ++unknown;
+      }
+  return unknown;
+}
+
+// "no occupied voxel ...", and on a state map the unknown voxels the query reaches.
+std::string free_answer(const char* what, std::uint64_t unknown) {
+  if (unknown == 0) return what;
+  return std::string(what) + ", but it reaches " + std::to_string(unknown) + (unknown == 1 ? " voxel" : " voxels") +
+         " the map has not seen (unknown space, which vola plan takes for an obstacle)";
+}
+
 int run_collide(const CollideArgs& a) {
   const int queries = !a.segment.empty() + !a.sphere.empty() + !a.box.empty();
   if (queries != 1) throw InvalidArgument("give exactly one of --segment, --sphere or --box");
@@ -105,15 +136,48 @@ int run_collide(const CollideArgs& a) {
   if (!a.sphere.empty()) {
     const auto& s = a.sphere;
     if (!(s[3] >= 0.0)) throw InvalidArgument("--sphere: the radius must be >= 0");
-    const bool hit = collider.sphere(to_grid(s[0], s[1], s[2]), a.grid ? s[3] : s[3] / frame.voxel_size);
-    return report(hit, hit ? "an occupied voxel is within the radius" : "no occupied voxel within the radius");
+    const Point centre = to_grid(s[0], s[1], s[2]);
+    const double radius = a.grid ? s[3] : s[3] / frame.voxel_size;
+    const bool hit = collider.sphere(centre, radius);
+    if (hit) return report(true, "an occupied voxel is within the radius");
+    const Tree file = open_mapped(a.input);
+    std::uint64_t unknown = 0;
+    if (map::is_state_map(file)) {
+      std::array<double, 3> lo{}, hi{};
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = std::floor(centre[i] - radius);
+        hi[i] = std::floor(centre[i] + radius) + 1;
+      }
+      unknown = unknown_voxels_in(file, lo, hi, [&](double x, double y, double z) {
+        const double cell[3] = {x, y, z};
+        double d2 = 0;  // from the centre to the nearest point of the cell's cube (touching counts)
+        for (int i = 0; i < 3; ++i) {
+          const double gap = std::max({cell[i] - centre[i], 0.0, centre[i] - (cell[i] + 1)});
+          d2 += gap * gap;
+        }
+        return d2 <= radius * radius;
+      });
+    }
+    return report(false, free_answer("no occupied voxel within the radius", unknown).c_str());
   }
   const auto& b = a.box;
   for (int i = 0; i < 3; ++i)
     if (!(b[i] <= b[i + 3]))
       throw InvalidArgument("--box: expected XMIN YMIN ZMIN XMAX YMAX ZMAX with each min <= max");
-  const bool hit = collider.box(Box{to_grid(b[0], b[1], b[2]), to_grid(b[3], b[4], b[5])});
-  return report(hit, hit ? "an occupied voxel overlaps the box" : "no occupied voxel overlaps the box");
+  const Point low = to_grid(b[0], b[1], b[2]), high = to_grid(b[3], b[4], b[5]);
+  const bool hit = collider.box(Box{low, high});
+  if (hit) return report(true, "an occupied voxel overlaps the box");
+  const Tree file = open_mapped(a.input);
+  std::uint64_t unknown = 0;
+  if (map::is_state_map(file)) {  // the cells overlapping the box's interior
+    std::array<double, 3> lo{}, hi{};
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::floor(low[i]);
+      hi[i] = std::ceil(high[i]);
+    }
+    unknown = unknown_voxels_in(file, lo, hi, [](double, double, double) { return true; });
+  }
+  return report(false, free_answer("no occupied voxel overlaps the box", unknown).c_str());
 }
 
 }  // namespace
@@ -129,8 +193,8 @@ void add_collide(CLI::App& app) {
       "  --sphere   any occupied voxel within the radius of the centre (touching counts);\n"
       "  --box      any occupied voxel overlapping the box's interior (touching faces do not count).\n"
       "Prints 'free: ...' or 'hit: ...'. Exit status: 0 free, 3 collision, 1 error (another status: a usage error).\n"
-      "A state map (vola map) is checked against its occupied voxels; a free segment that passes through\n"
-      "space the map has not seen says so (unknown space is not free: vola plan takes it for an obstacle).\n"
+      "A state map (vola map) is checked against its occupied voxels; a free segment, sphere or box that\n"
+      "reaches space the map has not seen says so (unknown space is not free: vola plan takes it for an obstacle).\n"
       "A segment of no length is its point.\n"
       "Examples:\n"
       "  vola collide site.vol --segment 636500 849500 120  636900 849800 90\n"

@@ -115,6 +115,15 @@ out=$("$vola" collide "$tmp/map.vol" --segment 0.125 0.125 0.125 0.875 0.125 0.1
 [ "$out" = "free: no occupied voxel on the segment" ] || fail "collide along known space: $out"
 out=$("$vola" collide "$tmp/map.vol" --segment 0.125 0.125 0.125 0.375 0.375 0.125) || fail "collide into unknown space"
 echo "$out" | grep -q '^free: .*passes through 1 voxel the map has not seen (unknown space' || fail "collide into unknown space: $out"
+# Spheres and boxes too (they answered "free" in unknown space without a word).
+out=$("$vola" collide "$tmp/map.vol" --sphere 0.625 0.125 0.125 0.05) || fail "sphere in known free space"
+[ "$out" = "free: no occupied voxel within the radius" ] || fail "sphere in known space: $out"
+out=$("$vola" collide "$tmp/map.vol" --sphere 0.375 0.375 0.125 0.05) || fail "sphere in unknown space"
+echo "$out" | grep -q '^free: no occupied voxel within the radius, but it reaches 1 voxel the map has not seen' ||
+  fail "sphere in unknown space: $out"
+out=$("$vola" collide "$tmp/map.vol" --box 0.3 0.3 0.05 0.45 0.45 0.2) || fail "box in unknown space"
+echo "$out" | grep -q '^free: no occupied voxel overlaps the box, but it reaches 1 voxel the map has not seen' ||
+  fail "box in unknown space: $out"
 
 # plan on the state map: unknown space is an obstacle by default. Along x the known free
 # voxels lead from the sensor's voxel to (0.875, 0.125); (0.375, 0.375) was never seen.
