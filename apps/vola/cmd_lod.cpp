@@ -20,7 +20,7 @@ struct LodArgs {
 
 void run_lod(const LodArgs& a) {
   refuse_outputs_over_inputs({a.input}, {a.output}, "vola lod");
-  const Tree tree = open_voxels(a.input);
+  const Tree tree = open_voxels_to_write(a.input, "vola lod");
   if (a.depth > tree.depth())
     throw InvalidArgument("--depth " + std::to_string(a.depth) + " is deeper than the file's depth " +
                           std::to_string(tree.depth()));

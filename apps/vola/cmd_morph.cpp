@@ -65,7 +65,7 @@ analysis::Element element_of(const std::string& name) {
 // The input, once the output is known not to be it (the result would replace it).
 Tree open_input(const MorphArgs& a, const char* name) {
   refuse_outputs_over_inputs({a.input}, {a.output}, std::string("vola ") + name);
-  return open_voxels(a.input);
+  return open_voxels_to_write(a.input, std::string("vola ") + name);
 }
 
 void finish(const MorphArgs& a, const char* name, const Tree& in, const Tree& out, const std::string& extra = {}) {

@@ -55,8 +55,8 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");
   cmd->callback([args, op, name] {
     refuse_outputs_over_inputs({args->a, args->b}, {args->output}, std::string("vola ") + name);
-    const Tree a = open_voxels(args->a);
-    const Tree b = open_voxels(args->b);
+    const Tree a = open_voxels_to_write(args->a, std::string("vola ") + name);
+    const Tree b = open_voxels_to_write(args->b, std::string("vola ") + name);
     if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
     const Tree result = op(a, b, args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal);
     write(result, args->output);
@@ -89,8 +89,9 @@ void add_diff(CLI::App& app) {
       for (const char* file : {"added.vol", "removed.vol", "unchanged.vol"})
         outputs.push_back((std::filesystem::path(args->outputs_dir) / file).string());
     refuse_outputs_over_inputs({args->a, args->b}, outputs, "vola diff");
-    const Tree a = open_voxels(args->a);
-    const Tree b = open_voxels(args->b);
+    const bool writes = !args->output.empty() || !args->outputs_dir.empty();
+    const Tree a = writes ? open_voxels_to_write(args->a, "vola diff") : open_voxels(args->a);
+    const Tree b = writes ? open_voxels_to_write(args->b, "vola diff") : open_voxels(args->b);
     if (!args->ignore_frame) check_same_crs(args->a, a, args->b, b);
     const FrameCheck check = args->ignore_frame ? FrameCheck::ignore : FrameCheck::require_equal;
     const Tree removed = subtract(a, b, check);  // also checks depths and frames

@@ -10,19 +10,18 @@
 
 int main(int argc, char** argv) {
   vola::cli::exec_companion_if_asked(argc, argv);
-  CLI::App app{
-      "vola " VOLA_VERSION_STRING
-      " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
-      "one word per 4x4x4 block, one bit per voxel, children found by counting bits.\n\n"
-      "Examples:\n"
-      "  vola convert scan.xyz scan.vol --voxel-size 0.25 --assign-crs 29902   # GIS grid, 25 cm voxels\n"
-      "  vola convert pts.txt pts.vol --quantize toolkit --depth 5         # as the reference toolkit\n"
-      "  vola info scan.vol\n"
-      "  vola get scan.vol 10 20 3\n"
-      "  vola lod scan.vol --depth 4 coarse.vol\n"
-      "  vola diff after.vol before.vol added.vol\n"
-      "  vola generate city city.xyz --points 1000000\n"
-      "  vola tile *.las --tile-size 1000 --depth 6 -o tiles/           # a whole survey as tiles\n"};
+  CLI::App app{"vola " VOLA_VERSION_STRING
+               " - the VOLA volumetric format: 3D space as levels of 64-bit words,\n"
+               "one word per 4x4x4 block, one bit per voxel, children found by counting bits.\n\n"
+               "Examples:\n"
+               "  vola convert scan.xyz scan.vol --voxel-size 0.25 --assign-crs 29902   # GIS grid, 25 cm voxels\n"
+               "  vola convert pts.txt pts.vol --quantize toolkit --depth 5         # as the reference toolkit\n"
+               "  vola info scan.vol\n"
+               "  vola get scan.vol 10 20 3\n"
+               "  vola lod scan.vol --depth 4 coarse.vol\n"
+               "  vola diff before.vol after.vol --outputs change/                  # added, removed, unchanged\n"
+               "  vola generate city city.xyz --points 1000000\n"
+               "  vola tile *.las --tile-size 1000 --depth 6 -o tiles/           # a whole survey as tiles\n"};
   app.require_subcommand(1);
   app.set_version_flag("--version", VOLA_VERSION_STRING);
   app.footer("Run 'vola SUBCOMMAND --help' for the options of one subcommand.");

@@ -11,5 +11,9 @@
 namespace vola::cli {
 
 Tree open_voxels(const std::string& path);
+// The same for a command that writes a new .vol of the voxels (lod, morphology, set
+// operations): for a state map it warns (stderr, even with -q) that the output holds the
+// occupied voxels only, so that its unknown space, then read as free, is not a surprise.
+Tree open_voxels_to_write(const std::string& path, const std::string& command);
 
 }  // namespace vola::cli

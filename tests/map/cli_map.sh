@@ -125,6 +125,13 @@ out=$("$vola" collide "$tmp/map.vol" --box 0.3 0.3 0.05 0.45 0.45 0.2) || fail "
 echo "$out" | grep -q '^free: no occupied voxel overlaps the box, but it reaches 1 voxel the map has not seen' ||
   fail "box in unknown space: $out"
 
+# Commands that write a plain tree of a state map's occupied voxels say what is lost.
+"$vola" dilate "$tmp/map.vol" "$tmp/dilated.vol" --radius 1 -q 2> "$tmp/err" || fail "dilate a state map"
+grep -q "map.vol is a state map (occupied, free and unknown space): vola dilate writes its occupied voxels only" \
+  "$tmp/err" || fail "dilate of a state map kept quiet: $(cat "$tmp/err")"
+"$vola" lod "$tmp/map.vol" --depth 1 "$tmp/coarse.vol" -q 2> "$tmp/err" || fail "lod of a state map"
+grep -q "vola lod writes its occupied voxels only" "$tmp/err" || fail "lod of a state map kept quiet: $(cat "$tmp/err")"
+
 # plan on the state map: unknown space is an obstacle by default. Along x the known free
 # voxels lead from the sensor's voxel to (0.875, 0.125); (0.375, 0.375) was never seen.
 "$vola" plan "$tmp/map.vol" --from 0.125 0.125 0.125 --to 0.875 0.125 0.125 -o "$tmp/path.csv" -q \
