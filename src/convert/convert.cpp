@@ -268,6 +268,12 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   std::vector<filters::StageReport> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
   std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
+  if (input.grid && input.grid->free_cells > 0)
+    value_warnings.push_back(path + ": the map's " + std::to_string(input.grid->free_cells) +
+                             " free cells are not kept: the .vol holds its " +
+                             std::to_string(input.grid->voxels.size()) +
+                             " occupied cells, and every other cell, unknown space too, reads as free (vola plan and "
+                             "collide then take unknown space for free space)");
   if (clamps_to_bbox(options) && !input.is_mesh() && !input.terrain)
     if (const std::uint64_t outside = points_outside(input.cloud, *options.bbox))
       value_warnings.push_back(path + ": " + std::to_string(outside) + " of its " + std::to_string(input.cloud.size()) +

@@ -46,6 +46,10 @@ struct VoxelGrid {
   // Maps (OctoMap, OpenVDB): the cells are the map's own; a conversion to another voxel
   // size is refused rather than resampled.
   bool fixed_voxel_size = false;
+  // An OctoMap's free cells, which the grid does not hold (its voxels are the occupied
+  // cells): a conversion says they are not kept, since the .vol reads them as free only
+  // by default, and unknown space alike.
+  std::uint64_t free_cells = 0;
 };
 
 using Triangle = std::array<Point, 3>;

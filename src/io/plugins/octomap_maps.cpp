@@ -117,9 +117,12 @@ void gather_cells(const Tree& tree, const OctomapLayout& layout, bool attributes
   // A leaf at depth d is a cube of 2^(16 - d) cells from its lowest key (getIndexKey).
   std::array<unsigned, 3> low{65535, 65535, 65535}, high{0, 0, 0};
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
-    const octomap::OcTreeKey key = it.getIndexKey();
     const unsigned span = 1u << (kOctomapDepth - it.getDepth());
+    if (!tree.isNodeOccupied(*it)) {
+      grid.free_cells += std::uint64_t{span} * span * span;
+      continue;
+    }
+    const octomap::OcTreeKey key = it.getIndexKey();
     for (int a = 0; a < 3; ++a) {
       low[a] = std::min<unsigned>(low[a], key[a]);
       high[a] = std::max<unsigned>(high[a], key[a] + span - 1);
