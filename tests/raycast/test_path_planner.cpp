@@ -301,7 +301,11 @@ TEST(PathPlanner, ClearErrors) {
         try {
           plan_path(closed, {0.5, 0.5, 0.5}, {6.5, 6.5, 6.5});
         } catch (const vola::InvalidArgument& e) {
-          EXPECT_NE(std::string(e.what()).find("cannot be reached"), std::string::npos);
+          EXPECT_NE(
+              std::string(e.what()).find("cannot be reached from (0.5, 0.5, 0.5): the goal lies in a closed region "
+                                         "of 1 free cells"),
+              std::string::npos)
+              << e.what();
           throw;
         }
       },
@@ -331,6 +335,21 @@ TEST(PathPlanner, ClearErrors) {
     ADD_FAILURE() << "a search past its limit returned";
   } catch (const vola::InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("within the limit of 5 expanded cells"), std::string::npos) << e.what();
+  }
+  // A cavity larger than the check before the search (4096 cells): the search gives up at
+  // its limit, and the message says the goal is sealed in, not "a larger limit may find one".
+  std::vector<vola::Voxel> shell;
+  for (std::uint32_t z = 10; z <= 29; ++z)
+    for (std::uint32_t y = 10; y <= 29; ++y)
+      for (std::uint32_t x = 10; x <= 29; ++x)
+        if (x == 10 || x == 29 || y == 10 || y == 29 || z == 10 || z == 29) shell.push_back({x, y, z});
+  const vola::Tree sealed = vola::build_from_voxels(shell, 3);  // a cavity of 18^3 = 5832 cells
+  try {
+    plan_path(sealed, {0.5, 0.5, 0.5}, {20.5, 20.5, 20.5}, PlanOptions{.max_expansions = 20000});
+    ADD_FAILURE() << "a path into a sealed cavity";
+  } catch (const vola::InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("the goal lies in a closed region of 5832 free cells"), std::string::npos)
+        << e.what();
   }
   // A radius the clearance field cannot reach in one word: refused, naming the way out.
   EXPECT_NE(message({1, 1, 1}, {2, 2, 2}, 30).find("coarser level"), std::string::npos);
