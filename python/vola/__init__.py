@@ -122,7 +122,7 @@ def _refusing_cut_mappings(function):
     def call(*args, **kwargs):
         mapped = [a for a in (*args, *kwargs.values()) if isinstance(a, Tree) and a.is_mapped]
         for tree in mapped:
-            tree.check_mapped()
+            tree._check_mapped_often()
         try:
             result = function(*args, **kwargs)
         except Error:
@@ -135,14 +135,14 @@ def _refusing_cut_mappings(function):
                     raise cut from None
             raise
         for tree in mapped:
-            tree.check_mapped()
+            tree._check_mapped_often()
         return result
 
     return call
 
 
 for _name, _member in list(vars(Tree).items()):
-    if type(_member).__name__ == "instancemethod" and _name not in ("__repr__", "__len__", "__setstate__", "check_mapped"):
+    if type(_member).__name__ == "instancemethod" and _name not in ("__repr__", "__len__", "__setstate__", "check_mapped", "_check_mapped_often"):
         setattr(Tree, _name, _refusing_cut_mappings(_member))
 for _name in ("difference", "export_binvox", "export_csv", "export_height_map", "export_las", "export_map", "export_npy",
               "export_occupancy_above", "export_ply", "export_raster", "export_ros_map", "export_slices", "export_xyz", "free_tree",
@@ -220,7 +220,8 @@ def open(path: Union[str, os.PathLike], mapped: bool = True, states: bool = Fals
     vola.state, vola.probability and vola.free_tree. (vola.read and vola.open_mapped give
     the file as it is.) When another process cuts a mapped file (truncates it, or copies
     another file over it in place), every Tree method and vola function given the tree
-    raises vola.IoError instead of answering from the zeros the mapping then holds."""
+    raises vola.IoError instead of answering from the zeros the mapping then holds (a copy
+    over it is found by the file's size and time, looked at at most once a millisecond)."""
     tree = open_mapped(path) if mapped else read(path)
     if tree.is_state_map and not states:
         return occupied_tree(tree)
