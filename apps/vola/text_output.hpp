@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "vola/number_text.hpp"
 
 namespace vola::cli {
 
@@ -43,8 +44,12 @@ class TextOutput {
     return maybe_flush();
   }
   TextOutput& number(std::uint64_t v) { return format(v); }
-  // Shortest text that reads back as the same double.
-  TextOutput& number(double v) { return format(v); }
+  // Shortest text that reads back as the same double (vola::write_number: "5000000", "0.1", "1e-09").
+  TextOutput& number(double v) {
+    char s[kNumberTextSize];
+    buffer_.append(s, write_number(s, v));
+    return maybe_flush();
+  }
   TextOutput& hex64(std::uint64_t v) {
     char s[19] = "0x";
     for (int i = 0; i < 16; ++i) s[2 + i] = "0123456789abcdef"[(v >> (60 - 4 * i)) & 15u];

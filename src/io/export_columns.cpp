@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "vola/error.hpp"
+#include "vola/number_text.hpp"
 
 namespace vola::io {
 
@@ -119,9 +120,8 @@ const char* ply_type(ValueType type) {
 }
 
 void append_number(std::string& out, double value) {
-  char s[32];
-  const auto r = std::to_chars(s, s + sizeof s, value);
-  out.append(s, r.ptr);
+  char s[kNumberTextSize];
+  out.append(s, write_number(s, value));
 }
 
 void append_value(std::string& out, const AttributeColumn& column, std::size_t rank) {

@@ -29,7 +29,7 @@ std::string text_header(const std::vector<std::string>& names, bool csv);
 // The PLY property type of a column's values (64-bit integers, which PLY lacks: double).
 const char* ply_type(ValueType type);
 
-// The shortest text that reads back as the same double.
+// The shortest text that reads back as the same double (vola::write_number).
 void append_number(std::string& out, double value);
 // A column's value at `rank` as text in the column's own type (64-bit integers exact).
 void append_value(std::string& out, const AttributeColumn& column, std::size_t rank);

@@ -124,6 +124,11 @@ awk 'NR > 1 { lon += $1; lat += $2; n++ } END {
 # z is unchanged.
 cmp -s <(awk 'NR > 1 { print $3 }' "$tmp/wgs84.txt") <("$vola" coords "$irish" | awk '{ print $3 }') ||
   fail "coords --wgs84 changed z"
+# A UTM northing prints as one ("5000000", not "5e+06"); tiny and huge values stay exact.
+printf '500000.5 5000000.5 100.5\n' >"$tmp/utm.xyz"
+"$vola" convert "$tmp/utm.xyz" "$tmp/utm.vol" --voxel-size 2 --origin 499999 4999999 99 -q || fail "convert utm.xyz"
+[[ $("$vola" coords "$tmp/utm.vol" 2>/dev/null) == "500000 5000000 100" ]] ||
+  fail "coords of a UTM voxel: $("$vola" coords "$tmp/utm.vol" 2>/dev/null)"
 # A file without a CRS says so; --crs supplies one.
 nocrs=$golden/d2_sparse/d2_sparse.vol
 expect_error "has no CRS" "$vola" coords "$nocrs" --wgs84
