@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 #include "export_columns.hpp"
 #include "reader_plugin.hpp"
@@ -119,6 +120,24 @@ void MapVoxels::check() const {
   };
   check_list("occupied", occupied, occupied_log_odds);
   check_list("free", free, free_log_odds);
+  // A voxel cannot be both: every writer would otherwise pick a state of its own (OpenVDB
+  // kept it in both grids, OctoMap the one set last).
+  if (occupied.empty() || free.empty()) return;
+  const auto sorted = [](std::vector<Voxel> list) {
+    std::sort(list.begin(), list.end(),
+              [](const Voxel& a, const Voxel& b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
+    return list;
+  };
+  const std::vector<Voxel> a = sorted(occupied), b = sorted(free);
+  for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+    if (std::tie(a[i].x, a[i].y, a[i].z) < std::tie(b[j].x, b[j].y, b[j].z))
+      ++i;
+    else if (std::tie(b[j].x, b[j].y, b[j].z) < std::tie(a[i].x, a[i].y, a[i].z))
+      ++j;
+    else
+      throw InvalidArgument("voxel (" + std::to_string(a[i].x) + ", " + std::to_string(a[i].y) + ", " +
+                            std::to_string(a[i].z) + ") is given as occupied and as free");
+  }
 }
 
 MapVoxels map_voxels(const Tree& occupied, const Tree* free) {

@@ -111,6 +111,14 @@ grep -q ": 2 occupied and 7 free voxels of 0.25" "$tmp/out" || fail "plain.ot su
   fail "plain.ot: the occupied voxels differ from the state map's"
 
 # Errors.
+# A voxel given as occupied and as free is refused by every map writer (the .vdb one wrote
+# it into both grids).
+for map in x.bt x.ot x.vdb; do
+  expect_error "voxel (.*) is given as occupied and as free" "$vola" export "$tmp/occupied.vol" "$tmp/$map" --free "$tmp/occupied.vol"
+done
+expect_error "voxel (.*) is given as occupied and as free" "$vola" export "$tmp/occupied.vol" "$tmp/x.yaml" --band 0:1 \
+  --free "$tmp/occupied.vol"
+[[ ! -e $tmp/x.vdb ]] || fail "a refused map export wrote its output"
 expect_error "is a state map and holds its free voxels" "$vola" export "$tmp/map.vol" "$tmp/x.ot" --free "$tmp/map.free.vol"
 expect_error "is a map of 2 cells" "$vola" convert "$tmp/a.bt" "$tmp/x.vol" --voxel-size 3
 expect_error "its grids: 'occupied'" "$vola" convert "$tmp/a.vdb" "$tmp/x.vol" --grid density

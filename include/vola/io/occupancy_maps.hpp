@@ -37,7 +37,7 @@ struct MapVoxels {
 
   // Throws InvalidArgument when a log-odds list is neither empty nor one per voxel, a
   // log-odds is not finite, a voxel lies beyond a depth-10 grid (2^20 per axis), or the
-  // voxel size is not finite and > 0.
+  // voxel size is not finite and > 0, or a voxel is both occupied and free.
   void check() const;
 };
 

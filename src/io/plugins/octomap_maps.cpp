@@ -213,13 +213,8 @@ void write_octomap_with_liboctomap(const MapVoxels& voxels, bool binary, const P
     const float value = voxels.occupied_log_odds.empty() ? tree.getClampingThresMaxLog() : voxels.occupied_log_odds[n];
     tree.setNodeValue(keys[n], value, true);
   }
-  for (std::size_t n = 0; n < voxels.free.size(); ++n) {
+  for (std::size_t n = 0; n < voxels.free.size(); ++n) {  // none of them occupied: MapVoxels::check
     const octomap::OcTreeKey& key = keys[occupied + n];
-    if (tree.search(key)) {
-      const Voxel& v = voxels.free[n];
-      throw InvalidArgument("voxel (" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
-                            ") is given as occupied and as free");
-    }
     tree.setNodeValue(key, voxels.free_log_odds.empty() ? tree.getClampingThresMinLog() : voxels.free_log_odds[n], true);
   }
   tree.updateInnerOccupancy();  // lazy_eval left the inner nodes' values for one pass here
