@@ -229,6 +229,14 @@ Tree convert(const std::filesystem::path& path, int depth, double voxel_size, co
   // What the CLI warns of (a CRS relabelled, z left in feet, voxels in degrees), as warnings.
   for (const std::string& warning : report.warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) < 0) throw py::error_already_set();
+  // The CLI's summary counts the points left out; here nothing would (vola.build warns of them too).
+  const vola::BuildReport& counts = report.build;
+  if (counts.points_outside > 0 && counts.points_outside < counts.points_in) {
+    const std::string left_out = path.string() + ": " + std::to_string(counts.points_outside) + " of its " +
+                                 std::to_string(counts.points_in) + " " + report.unit +
+                                 " are left out (not finite, or outside the grid given)";
+    if (PyErr_WarnEx(PyExc_UserWarning, left_out.c_str(), 1) < 0) throw py::error_already_set();
+  }
   return std::move(*tree);
 }
 

@@ -97,6 +97,24 @@ def test_convert_warns_as_the_cli_does(tmp_path, shared_data):
         vola.convert(shared_data / "las" / "pdal_autzen_trim.las", voxel_size=10.0, assign_crs="EPSG:32610")
 
 
+def test_convert_warns_of_the_points_it_leaves_out(tmp_path):
+    # The CLI's summary counts them ("points dropped: 10"); vola.build warns of the same points.
+    points = np.random.default_rng(3).uniform(0, 10, (100, 3))
+    points[:10] = np.nan
+    np.save(tmp_path / "some_nan.npy", points)
+    with pytest.warns(UserWarning, match="10 of its 100 points are left out"):
+        tree = vola.convert(tmp_path / "some_nan.npy", voxel_size=1.0)
+    assert tree.voxel_count == vola.build(points[10:], voxel_size=1.0).voxel_count
+    # Nothing left at all is an empty tree, said as such.
+    np.save(tmp_path / "all_nan.npy", np.full((5, 3), np.nan))
+    with pytest.warns(UserWarning, match="every one of its 5 points was dropped"):
+        assert vola.convert(tmp_path / "all_nan.npy", voxel_size=1.0).voxel_count == 0
+    # x, y and z saved as rows: refused, not read as three points.
+    np.save(tmp_path / "rows.npy", points[10:].T)
+    with pytest.raises(vola.FormatError, match=r"points\.T"):
+        vola.convert(tmp_path / "rows.npy", voxel_size=1.0)
+
+
 def _las_records(path):
     """The point records of a LAS file: count x record length bytes after the offset."""
     data = pathlib.Path(path).read_bytes()

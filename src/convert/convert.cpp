@@ -308,6 +308,10 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
     else if (outside_domain)
       report.warnings.push_back(path + ": " + *outside_domain);
     report.warnings.insert(report.warnings.end(), value_warnings.begin(), value_warnings.end());
+    if (report.build.points_in > 0 && tree.voxel_count() == 0)
+      report.warnings.push_back(path + ": every one of its " + std::to_string(report.build.points_in) + " " +
+                                report.unit +
+                                " was dropped (not finite, or outside the grid given): the tree is empty");
     for (const auto& stage : filter_report) report.filters.push_back(describe(stage));
     report.filter_stages = std::move(filter_report);
     *report_out = std::move(report);

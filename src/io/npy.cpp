@@ -253,6 +253,15 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
                                     (array.shape.size() == 2 ? " and " + std::to_string(array.shape[1]) + " columns" : ""));
   const std::uint64_t n = array.shape[0];
   const std::uint64_t columns = array.shape[1];
+  // Points are rows. Three rows of more columns than x, y, z and a whole 8-byte payload
+  // can hold is a cloud saved with x, y and z as rows (numpy's `points.T`, a common slip):
+  // read as rows it would be three points, silently.
+  if (n == 3 && columns > 3 + 8)
+    throw FormatError(name, {},
+                      "the array's shape (" + std::to_string(n) + ", " + std::to_string(columns) + ") reads as " +
+                          std::to_string(n) + " points of " + std::to_string(columns) +
+                          " columns; points are rows, (N, 3): for " + std::to_string(columns) +
+                          " points stored as rows x, y, z, save the transpose (numpy.save(path, points.T))");
   PointCloud cloud;
   cloud.xyz.resize(3 * n);
   // Element (row i, column c) lies at i * row_step + c * column_step values.

@@ -107,6 +107,23 @@ TEST(NpyGrid, PointArraysStayPointsAndStacksAreRefused) {
   EXPECT_TRUE(vola_test::format_error_of([&] { vola::io::npy_input(flat, "flat.npy", {}); }));
 }
 
+TEST(NpyGrid, PointsSavedAsRowsOfXYZAreRefusedNotReadAsThreePoints) {
+  // numpy.save(f, points.T): 3 rows of 12 columns read as rows would be 3 points.
+  Bytes rows;
+  for (int v = 0; v < 36; ++v) put<double>(rows, v);
+  const auto transposed = vola::io::parse_npy(npy_bytes("<f8", {3, 12}, false, rows), "t.npy");
+  const auto error = vola_test::format_error_of([&] { vola::io::npy_input(transposed, "t.npy", {}); });
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->cause().find("(3, 12) reads as 3 points of 12 columns"), std::string::npos) << error->what();
+  EXPECT_NE(error->cause().find("points.T"), std::string::npos) << error->what();
+  // Three points of x, y, z and an 8-column payload are three points; twelve are twelve.
+  const auto payload =
+      vola::io::parse_npy(npy_bytes("<f8", {3, 11}, false, Bytes(rows.begin(), rows.begin() + 264)), "p.npy");
+  EXPECT_EQ(vola::io::npy_input(payload, "p.npy", {}).cloud.size(), 3u);
+  const auto twelve = vola::io::parse_npy(npy_bytes("<f8", {12, 3}, false, rows), "r.npy");
+  EXPECT_EQ(vola::io::npy_input(twelve, "r.npy", {}).cloud.size(), 12u);
+}
+
 TEST(NpyGrid, ReadInputDispatchesOnTheShape) {
   vola_test::TempDir dir;
   Bytes cells(8, 0);
