@@ -135,7 +135,7 @@ int run_collide(const CollideArgs& a) {
   }
   if (!a.sphere.empty()) {
     const auto& s = a.sphere;
-    if (!(s[3] >= 0.0)) throw InvalidArgument("--sphere: the radius must be >= 0");
+    if (!(s[3] >= 0.0) || !std::isfinite(s[3])) throw InvalidArgument("--sphere: the radius must be finite and >= 0");
     const Point centre = to_grid(s[0], s[1], s[2]);
     const double radius = a.grid ? s[3] : s[3] / frame.voxel_size;
     const bool hit = collider.sphere(centre, radius);

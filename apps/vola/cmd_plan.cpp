@@ -113,12 +113,15 @@ Scene load_scene(const PlanArgs& a) {
 constexpr double kAutoHierarchicalVoxels = 1024.0;
 
 // --hierarchical and --exact decide; without either, far-apart points on the finest
-// level (grid coordinates) plan hierarchically, with a note saying so.
-bool use_hierarchical(const PlanArgs& a, const Point& from, const Point& to) {
+// level (grid coordinates) plan hierarchically, with a note saying so. Points outside the
+// grid of `side` voxels (or not finite) get no note: the search refuses them, naming them.
+bool use_hierarchical(const PlanArgs& a, const Point& from, const Point& to, double side) {
   if (a.hierarchical || a.exact) return a.hierarchical;
   if (a.level >= 0) return false;
+  for (int i = 0; i < 3; ++i)
+    if (!(from[i] >= 0.0 && from[i] < side && to[i] >= 0.0 && to[i] < side)) return false;
   const double apart = std::max({std::abs(to[0] - from[0]), std::abs(to[1] - from[1]), std::abs(to[2] - from[2])});
-  if (!(apart >= kAutoHierarchicalVoxels)) return false;  // NaN too: the search refuses it, naming the point
+  if (apart < kAutoHierarchicalVoxels) return false;
   if (!a.quiet)
     std::printf("searching hierarchically: the points are %.0f voxels apart (--exact for the optimal path, slower)\n",
                 apart);
@@ -152,7 +155,7 @@ void run_plan(const PlanArgs& a) {
     flight = fly_to(a, tree, from, to, a.grid ? 1.0 : 1.0 / frame.voxel_size);
     path.points = flight.positions;
   } else {
-    options.hierarchical = use_hierarchical(a, from, to);
+    options.hierarchical = use_hierarchical(a, from, to, static_cast<double>(tree.side()));
     path = raycast::plan_path(tree, from, to, options);
   }
   std::vector<Point> points;

@@ -32,7 +32,7 @@ def test_spheres_and_boxes_match_brute_force():
     assert 0 < overlap.sum() < len(overlap)
     with pytest.raises(vola.InvalidArgument, match="box 0: box: min and max"):
         tree.collide_box([[1, 1, 1, 0, 2, 2], [0, 0, 0, 1, 1, 1]], world=False)
-    with pytest.raises(vola.InvalidArgument, match="radius must be >= 0"):
+    with pytest.raises(vola.InvalidArgument, match="radius must be finite and >= 0"):
         tree.collide_sphere([1.0, 1.0, 1.0], -1.0, world=False)
 
 

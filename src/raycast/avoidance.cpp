@@ -35,7 +35,7 @@ constexpr double kSweepSpacing = 0.25;
 ObstacleAvoider::ObstacleAvoider(const Collider& collider, const AvoidanceOptions& options)
     : collider_(&collider), options_(options) {
   if (!(options.radius >= 0.0) || !std::isfinite(options.radius))
-    throw InvalidArgument("avoidance: the radius must be >= 0");
+    throw InvalidArgument("avoidance: the radius must be finite and >= 0");
   if (!(options.speed > 0.0) || !std::isfinite(options.speed)) throw InvalidArgument("avoidance: the speed must be > 0");
   if (!(options.look_ahead > 0.0) || !std::isfinite(options.look_ahead))
     throw InvalidArgument("avoidance: the look-ahead must be > 0");

@@ -26,7 +26,7 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b :
 
 ClearanceField::ClearanceField(const Tree& obstacles, double radius, const Tree* known, bool solid_ground)
     : side_(obstacles.side()), known_mode_(known != nullptr) {
-  if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("plan: the radius must be >= 0");
+  if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("plan: the radius must be finite and >= 0");
   const double r2 = radius * radius;
   reach_ = 0;
   while (gap2(reach_ + 1) <= r2) {

@@ -56,7 +56,7 @@ bool Collider::sphere(const Point& centre, double radius) const {
   for (const double c : centre)
     if (!std::isfinite(c) || std::abs(c) > kMaxOriginMagnitude)
       throw InvalidArgument("sphere: the centre must be finite and within 1e12 voxels of the grid");
-  if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("sphere: the radius must be >= 0");
+  if (!(radius >= 0.0) || !std::isfinite(radius)) throw InvalidArgument("sphere: the radius must be finite and >= 0");
   if (tree().empty()) return false;
   if (radius > 4 * kMaxOriginMagnitude) return true;  // reaches every cell of any grid from any such centre
   const double r2 = radius * radius;

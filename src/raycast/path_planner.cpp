@@ -442,7 +442,8 @@ std::optional<std::uint64_t> closed_region(ClearanceField& field, const Cell& se
 PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, const PlanOptions& options) {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(start[a]) || !std::isfinite(goal[a])) throw InvalidArgument("plan: start and goal must be finite");
-  if (!(options.radius >= 0.0) || !std::isfinite(options.radius)) throw InvalidArgument("plan: the radius must be >= 0");
+  if (!(options.radius >= 0.0) || !std::isfinite(options.radius))
+    throw InvalidArgument("plan: the radius must be finite and >= 0");
   const int level = options.level < 0 ? tree.depth() - 1 : options.level;
   if (level >= tree.depth())
     throw InvalidArgument("plan: level " + std::to_string(level) + " is finer than the tree (levels 0.." +

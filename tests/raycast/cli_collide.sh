@@ -75,7 +75,8 @@ status=0
 expect 1 'exactly one of --segment, --sphere or --box' "$tmp/wall.vol"
 expect 1 'exactly one of --segment, --sphere or --box' "$tmp/wall.vol" --sphere 1 1 1 1 --box 0 0 0 1 1 1
 expect 1 'min <= max' "$tmp/wall.vol" --box 5 0 0 4 1 1
-expect 1 'radius must be >= 0' "$tmp/wall.vol" --sphere 1 1 1 -1
+expect 1 'radius must be finite and >= 0' "$tmp/wall.vol" --sphere 1 1 1 -1
+expect 1 'radius must be finite and >= 0' "$tmp/wall.vol" --sphere 1 1 1 inf
 expect usage 'At least 6 required' "$tmp/wall.vol" --segment 1 2 3 4 5
 printf 'VOLA but not really' > "$tmp/bad.vol"
 expect 1 'bad.vol' "$tmp/bad.vol" --sphere 1 1 1 1
