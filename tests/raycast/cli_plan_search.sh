@@ -35,6 +35,11 @@ grep -q "searching hierarchically" "$tmp/near.out" && fail "points 898 voxels ap
 "$vola" plan "$tmp/wall.vol" --from 2.5 5.5 2.5 --to 2040.5 5.5 2.5 --exact --hierarchical 2> "$tmp/err" \
   && fail "--exact with --hierarchical was accepted"
 grep -q "exclude" "$tmp/err" || fail "the refusal does not say the flags exclude each other: $(cat "$tmp/err")"
+# A goal far outside the grid is refused as such, with no note of a search by its distance first.
+"$vola" plan "$tmp/wall.vol" --from 2.5 5.5 2.5 --to 1e300 5.5 2.5 -o "$tmp/far.csv" > "$tmp/far.out" 2> "$tmp/err" \
+  && fail "a goal at x = 1e300 was accepted"
+grep -q "outside the volume" "$tmp/err" || fail "the far goal's refusal: $(cat "$tmp/err")"
+grep -q "searching hierarchically" "$tmp/far.out" && fail "a goal outside the grid got a note about its distance"
 
 # Every leg crosses no voxel, and the two lengths are within 1%.
 for path in auto exact; do
