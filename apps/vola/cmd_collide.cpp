@@ -1,8 +1,6 @@
 // vola collide: is a segment, a sphere or an axis-aligned box free of occupied voxels?
 // Prints "free" or what was hit; the exit status answers too (0 free, 3 collision), so
 // scripts can write `if vola collide site.vol --segment ...; then`.
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -13,7 +11,7 @@
 #include "open_voxels.hpp"
 #include "vola/error.hpp"
 #include "vola/file.hpp"
-#include "vola/map/state_map.hpp"
+#include "vola/map/unknown_space.hpp"
 #include "vola/raycast/collision.hpp"
 #include "vola/raycast/world.hpp"
 
@@ -47,55 +45,15 @@ void print_segment_hit(const CollideArgs& a, const Point& from, const Point& to,
                 distance, units, hit.normal[0], hit.normal[1], hit.normal[2]);
 }
 
-// The voxels of unknown space (a state map's: neither free nor occupied, or off its grid) a
-// segment in grid coordinates passes through, sampled at a quarter of a voxel.
-std::uint64_t unknown_voxels_on(const Tree& states, const Point& from, const Point& to) {
-  double length = 0;
-  for (int i = 0; i < 3; ++i) length += (to[i] - from[i]) * (to[i] - from[i]);
-  const auto steps = static_cast<std::uint64_t>(std::ceil(std::sqrt(length) * 4)) + 1;
-  if (steps > (std::uint64_t{1} << 26)) return 0;  // a segment of 16 M voxels: not sampled
-  std::uint64_t unknown = 0;
-  std::optional<Voxel> last;
-  const double side = static_cast<double>(states.side());
-  for (std::uint64_t s = 0; s <= steps; ++s) {
-    const double t = static_cast<double>(s) / static_cast<double>(steps);
-    Point p;
-    for (int i = 0; i < 3; ++i) p[i] = std::floor(from[i] + t * (to[i] - from[i]));
-    const bool inside = p[0] >= 0 && p[1] >= 0 && p[2] >= 0 && p[0] < side && p[1] < side && p[2] < side;
-    const Voxel v = inside ? Voxel{std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2])} : Voxel{};
-    if (inside && last && *last == v) continue;
-    if (inside) last = v;
-    if (!inside || map::state_at(states, v) == map::VoxelState::unknown) ++unknown;
-  }
-  return unknown;
-}
-
-// The voxels of unknown space among the cells [lo, hi) (grid indices, per axis) that
-// `touches` accepts; 0 when the region spans more than 2^26 cells (not counted).
-template <class Touches>
-std::uint64_t unknown_voxels_in(const Tree& states, const std::array<double, 3>& lo, const std::array<double, 3>& hi,
-                                const Touches& touches) {
-  double cells = 1;
-  for (int i = 0; i < 3; ++i) cells *= std::max(0.0, hi[i] - lo[i]);
-  if (!(cells <= double(std::uint64_t{1} << 26))) return 0;
-  const double side = static_cast<double>(states.side());
-  std::uint64_t unknown = 0;
-  for (double z = lo[2]; z < hi[2]; ++z)
-    for (double y = lo[1]; y < hi[1]; ++y)
-      for (double x = lo[0]; x < hi[0]; ++x) {
-        if (!touches(x, y, z)) continue;
-        const bool inside = x >= 0 && y >= 0 && z >= 0 && x < side && y < side && z < side;
-        if (!inside || map::state_at(states, Voxel{std::uint32_t(x), std::uint32_t(y), std::uint32_t(z)}) ==
-                           map::VoxelState::unknown)
-          ++unknown;
-      }
-  return unknown;
-}
-
-// "no occupied voxel ...", and on a state map the unknown voxels the query reaches.
-std::string free_answer(const char* what, std::uint64_t unknown) {
-  if (unknown == 0) return what;
-  return std::string(what) + ", but it reaches " + std::to_string(unknown) + (unknown == 1 ? " voxel" : " voxels") +
+// "no occupied voxel ...", and on a state map the unknown voxels the query reaches
+// (`reaches`: "reaches", "passes through"), or that it reaches too many to count.
+std::string free_answer(const char* what, const char* reaches, std::optional<std::uint64_t> unknown) {
+  if (!unknown)
+    return std::string(what) + ", but it " + reaches + " more than " + std::to_string(map::kMaxUnknownCells) +
+           " voxels, too many to count those the map has not seen";
+  if (*unknown == 0) return what;
+  return std::string(what) + ", but it " + reaches + " " + std::to_string(*unknown) +
+         (*unknown == 1 ? " voxel" : " voxels") +
          " the map has not seen (unknown space, which vola plan takes for an obstacle)";
 }
 
@@ -121,14 +79,9 @@ int run_collide(const CollideArgs& a) {
     if (!hit) {
       // A state map (vola map) knows where it has not seen: say so, as OctoMap's ray
       // casts stop there and vola plan takes it for an obstacle.
-      const Tree file = open_mapped(a.input);
-      const std::uint64_t unknown =
-          map::is_state_map(file) ? unknown_voxels_on(file, to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5])) : 0;
-      if (unknown == 0) return report(false, "no occupied voxel on the segment");
-      const std::string what = "no occupied voxel on the segment, but it passes through " + std::to_string(unknown) +
-                               (unknown == 1 ? " voxel" : " voxels") +
-                               " the map has not seen (unknown space, which vola plan takes for an obstacle)";
-      return report(false, what.c_str());
+      const auto unknown =
+          map::unknown_voxels_on_segment(open_mapped(a.input), to_grid(s[0], s[1], s[2]), to_grid(s[3], s[4], s[5]));
+      return report(false, free_answer("no occupied voxel on the segment", "passes through", unknown).c_str());
     }
     if (!a.quiet) print_segment_hit(a, from, to, *hit);
     return kCollisionStatus;
@@ -140,25 +93,8 @@ int run_collide(const CollideArgs& a) {
     const double radius = a.grid ? s[3] : s[3] / frame.voxel_size;
     const bool hit = collider.sphere(centre, radius);
     if (hit) return report(true, "an occupied voxel is within the radius");
-    const Tree file = open_mapped(a.input);
-    std::uint64_t unknown = 0;
-    if (map::is_state_map(file)) {
-      std::array<double, 3> lo{}, hi{};
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = std::floor(centre[i] - radius);
-        hi[i] = std::floor(centre[i] + radius) + 1;
-      }
-      unknown = unknown_voxels_in(file, lo, hi, [&](double x, double y, double z) {
-        const double cell[3] = {x, y, z};
-        double d2 = 0;  // from the centre to the nearest point of the cell's cube (touching counts)
-        for (int i = 0; i < 3; ++i) {
-          const double gap = std::max({cell[i] - centre[i], 0.0, centre[i] - (cell[i] + 1)});
-          d2 += gap * gap;
-        }
-        return d2 <= radius * radius;
-      });
-    }
-    return report(false, free_answer("no occupied voxel within the radius", unknown).c_str());
+    const auto unknown = map::unknown_voxels_in_sphere(open_mapped(a.input), centre, radius);
+    return report(false, free_answer("no occupied voxel within the radius", "reaches", unknown).c_str());
   }
   const auto& b = a.box;
   for (int i = 0; i < 3; ++i)
@@ -167,17 +103,8 @@ int run_collide(const CollideArgs& a) {
   const Point low = to_grid(b[0], b[1], b[2]), high = to_grid(b[3], b[4], b[5]);
   const bool hit = collider.box(Box{low, high});
   if (hit) return report(true, "an occupied voxel overlaps the box");
-  const Tree file = open_mapped(a.input);
-  std::uint64_t unknown = 0;
-  if (map::is_state_map(file)) {  // the cells overlapping the box's interior
-    std::array<double, 3> lo{}, hi{};
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = std::floor(low[i]);
-      hi[i] = std::ceil(high[i]);
-    }
-    unknown = unknown_voxels_in(file, lo, hi, [](double, double, double) { return true; });
-  }
-  return report(false, free_answer("no occupied voxel overlaps the box", unknown).c_str());
+  const auto unknown = map::unknown_voxels_in_box(open_mapped(a.input), Box{low, high});
+  return report(false, free_answer("no occupied voxel overlaps the box", "reaches", unknown).c_str());
 }
 
 }  // namespace

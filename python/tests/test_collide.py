@@ -93,3 +93,44 @@ def test_same_answers_as_the_cli(autzen_trim, vola_cli, tmp_path):
         assert cli("--sphere", *centres[i], 8.0) == spheres[i]
         assert cli("--box", *(centres[i] - 6), *(centres[i] + 6)) == boxes[i]
     assert 0 < segments["hit"].sum() + spheres.sum() + boxes.sum() < 18
+
+
+def test_unknown_space_a_free_query_reaches_matches_brute_force(tmp_path):
+    """A state map's free spheres and boxes (and segments) count the voxels they reach that the
+    map has not seen, as `vola collide` says of them; brute force over every voxel's state."""
+    m = vola.Map(0.5)
+    rng = np.random.default_rng(9)
+    m.insert(rng.uniform(-3, 3, size=(300, 3)), origin=(0.05, 0.1, 0.15))
+    m.save(tmp_path / "map.vol")
+    tree = vola.read(tmp_path / "map.vol")
+    assert tree.is_state_map
+    side, size, origin = tree.side, tree.voxel_size, np.array(tree.origin)
+    cells = np.stack(np.meshgrid(*[np.arange(-5, side + 5)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)  # every cell a query reaches
+    inside = ((cells >= 0) & (cells < side)).all(axis=1)
+    unknown_cell = ~inside
+    unknown_cell[inside] = vola.state(tree, origin + (cells[inside] + 0.5) * size) == vola.UNKNOWN
+    centres = rng.uniform(-2, side + 2, size=(200, 3))
+    radii = rng.uniform(0, 2.5, size=200)
+    answer = tree.collide_sphere(centres, radii, world=False, unknown=True)
+    nearest = np.clip(centres[:, None, :], cells[None], cells[None] + 1)
+    reached = np.linalg.norm(nearest - centres[:, None, :], axis=2) <= radii[:, None]
+    expected = (reached & unknown_cell[None]).sum(axis=1)
+    free = ~answer["hit"]
+    np.testing.assert_array_equal(answer["hit"], tree.collide_sphere(centres, radii, world=False))
+    np.testing.assert_array_equal(answer["unknown"][free], expected[free])
+    assert (answer["unknown"][~free] == 0).all() and 0 < (answer["unknown"][free] > 0).sum() < free.sum()
+    lo = rng.uniform(-2, side + 1, size=(200, 3))
+    boxes = np.concatenate([lo, lo + rng.uniform(0, 3, size=(200, 3))], axis=1)
+    answer = tree.collide_box(boxes, world=False, unknown=True)
+    overlap = ((cells[None] < boxes[:, None, 3:]) & (cells[None] + 1 > boxes[:, None, :3])).all(axis=2)
+    free = ~answer["hit"]
+    np.testing.assert_array_equal(answer["unknown"][free], (overlap & unknown_cell[None]).sum(axis=1)[free])
+    # One query given as one row answers with plain numbers; a plain tree has no unknown space.
+    one = tree.collide_sphere(centres[0], radii[0], world=False, unknown=True)
+    assert isinstance(one["hit"], bool) and isinstance(one["unknown"], int)
+    plain = vola.build_from_voxels(tree.voxels(), depth=tree.depth)
+    assert (plain.collide_box(boxes, world=False, unknown=True)["unknown"] == 0).all()
+    # Segments: the same count `vola collide --segment` prints.
+    segment = tree.collide_segment(centres[:20], centres[20:40], world=False)
+    assert segment["unknown"].dtype == np.int64 and (segment["unknown"][segment["hit"]] == 0).all()
+    assert (segment["unknown"][~segment["hit"]] > 0).any()
