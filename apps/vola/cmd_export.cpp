@@ -20,7 +20,6 @@
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/ros_map.hpp"
 #include "vola/map/state_map.hpp"
-#include "vola/setops.hpp"
 
 namespace vola::cli {
 
@@ -59,10 +58,8 @@ std::string resolve_format(const ExportArgs& a) {
   return io::resolve_export_format(request);
 }
 
-// The free voxels: a state map's own (vola map), else --free's plain tree, else none.
-// At a coarser --depth, a cell holding occupied and free voxels is occupied (as OctoMap's
-// inner nodes take their children's largest occupancy): it was both, and the .bt/.ot
-// writers refused the map while the .vdb one wrote the cell into both grids.
+// The free voxels: a state map's own (vola map), else --free's plain tree, else none; at a
+// coarser --depth beside the occupied voxels at that depth (map::free_at_depth).
 std::optional<Tree> free_voxels(const ExportArgs& a, const Tree& occupied) {
   std::optional<Tree> free;
   const Tree input = open_mapped(a.input);
@@ -73,7 +70,7 @@ std::optional<Tree> free_voxels(const ExportArgs& a, const Tree& occupied) {
   } else if (!a.free.empty()) {
     free = open_mapped(a.free);
   }
-  if (free && a.depth > 0 && a.depth < free->depth()) free = vola::subtract(free->level_of_detail(a.depth), occupied);
+  if (free) free = map::free_at_depth(*free, occupied, a.depth);
   return free;
 }
 

@@ -17,7 +17,6 @@
 #include "vola/io/occupancy_maps.hpp"
 #include "vola/io/ros_map.hpp"
 #include "vola/map/state_map.hpp"
-#include "vola/setops.hpp"
 
 namespace vola::python {
 
@@ -112,7 +111,7 @@ vola::io::MapVoxels gathered_map(const Tree& given, const Tree* given_free, int 
   // A coarse cell holding occupied and free voxels is occupied, as in `vola export`.
   const std::optional<Tree> coarse_free =
       free && depth > 0 && depth < free->depth()
-          ? std::optional<Tree>(vola::subtract(free->level_of_detail(depth), tree.level_of_detail(depth)))
+          ? std::optional<Tree>(vola::map::free_at_depth(*free, tree.level_of_detail(depth), depth))
           : std::nullopt;
   return at_depth(tree, depth,
                   [&](const Tree& t) { return vola::io::map_voxels(t, coarse_free ? &*coarse_free : free); });

@@ -9,6 +9,7 @@
 
 #include "vola/builder.hpp"
 #include "vola/error.hpp"
+#include "vola/setops.hpp"
 
 namespace vola::map {
 
@@ -94,6 +95,11 @@ Tree occupied_tree(const Tree& state_map) {
 Tree free_tree(const Tree& state_map) {
   require_state_map(state_map, "free_tree");
   return subset(state_map, false);
+}
+
+Tree free_at_depth(const Tree& free, const Tree& occupied_at_depth, int depth) {
+  if (depth <= 0 || depth >= free.depth()) return free;
+  return subtract(free.level_of_detail(depth), occupied_at_depth);
 }
 
 StateCounts state_counts(const Tree& state_map) {

@@ -67,6 +67,12 @@ inline double occupancy_probability(float log_odds) noexcept {
 Tree occupied_tree(const Tree& state_map);
 Tree free_tree(const Tree& state_map);
 
+// A map's free voxels at a coarser `depth`, beside its occupied voxels at that depth: a
+// coarse cell holding both is occupied, as OctoMap's inner nodes take their children's
+// largest occupancy (exports to .bt/.ot/.vdb/ROS maps need each cell in one state).
+// depth 0 or `free`'s own depth: `free` as it is.
+Tree free_at_depth(const Tree& free, const Tree& occupied_at_depth, int depth);
+
 struct StateCounts {
   std::uint64_t occupied = 0;
   std::uint64_t free = 0;
