@@ -311,6 +311,7 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
             {"voxel_size", g.voxel_size},
             {"origin", xyz(g.origin.data())},
             {"occupied", g.voxels.size()},
+            {"free", g.free.size() + g.free_cells_dropped},
             {"columns", std::move(columns)},
             {"fixed_voxel_size", g.fixed_voxel_size}};
   }
@@ -351,6 +352,9 @@ void print_other_input_info(const std::string& path, const io::Input& in, bool s
                 g.dims[2], g.voxel_size, g.origin[0], g.origin[1], g.origin[2],
                 g.fixed_voxel_size ? ", the map's own cells" : "");
     std::printf("occupied:    %zu cells\n", g.voxels.size());
+    if (!g.free.empty() || g.free_cells_dropped > 0)
+      std::printf("free:        %llu cells%s\n", static_cast<unsigned long long>(g.free.size() + g.free_cells_dropped),
+                  g.free.empty() ? "" : " (vola convert keeps them: a state map of occupied, free and unknown space)");
     std::printf("columns:    ");
     for (const auto& a : g.attributes) std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
     std::printf("%s\n", g.attributes.empty() ? " none" : "");

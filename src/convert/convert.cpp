@@ -18,6 +18,7 @@
 #include "vola/geo/crs.hpp"
 #include "vola/io/file_checks.hpp"
 #include "vola/io/input.hpp"
+#include "vola/map/state_map.hpp"
 
 namespace vola {
 
@@ -128,6 +129,19 @@ InvalidArgument no_points(const std::string& path, const io::Input& input, const
   return InvalidArgument(path + ": no points" +
                          (input.not_finite ? " with finite coordinates (" + std::to_string(input.not_finite) + " without)"
                                            : std::string()));
+}
+
+// A map's free cells the tree does not hold (the reader left them out, or the options
+// asked for another grid than the map's), said as a warning: every cell but the occupied
+// ones, unknown space too, then reads as free.
+std::optional<std::string> dropped_free_cells(const std::string& path, const io::Input& input, const Tree& tree) {
+  if (!input.grid || map::is_state_map(tree)) return std::nullopt;
+  const std::uint64_t dropped = input.grid->free_cells_dropped + input.grid->free.size();
+  if (dropped == 0) return std::nullopt;
+  return path + ": the map's " + std::to_string(dropped) + " free cells are not kept: the .vol holds its " +
+         std::to_string(input.grid->voxels.size()) +
+         " occupied cells, and every other cell, unknown space too, reads as free (vola plan and collide then take "
+         "unknown space for free space)";
 }
 
 Tree build_tree(const std::string& path, io::Input& input, const ConvertOptions& options, const BuildOptions& build,
@@ -268,12 +282,6 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   std::vector<filters::StageReport> filter_report;
   io::Input input = read(path, format, options, progress, filter_report);
   std::vector<std::string> value_warnings = clamped_value_warnings(path, input.cloud);
-  if (input.grid && input.grid->free_cells > 0)
-    value_warnings.push_back(path + ": the map's " + std::to_string(input.grid->free_cells) +
-                             " free cells are not kept: the .vol holds its " +
-                             std::to_string(input.grid->voxels.size()) +
-                             " occupied cells, and every other cell, unknown space too, reads as free (vola plan and "
-                             "collide then take unknown space for free space)");
   if (clamps_to_bbox(options) && !input.is_mesh() && !input.terrain)
     if (const std::uint64_t outside = points_outside(input.cloud, *options.bbox))
       value_warnings.push_back(path + ": " + std::to_string(outside) + " of its " + std::to_string(input.cloud.size()) +
@@ -290,6 +298,7 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
   CentreLatLon centre(crs.epsg, crs.wkt.empty() ? input.wkt : crs.wkt);  // PROJ gets ready while the tree is built
   ConvertReport report;
   Tree tree = name_input_in_errors(path, [&] { return build_tree(path, input, options, build, report.build); });
+  if (const auto dropped = dropped_free_cells(path, input, tree)) value_warnings.push_back(*dropped);
   // Points the reader left out count as the file's points, dropped as not finite.
   report.build.points_in += input.not_finite;
   report.build.points_outside += input.not_finite;

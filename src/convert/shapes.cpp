@@ -7,6 +7,7 @@
 
 #include "vola/error.hpp"
 #include "vola/io/dem.hpp"
+#include "vola/map/state_map.hpp"
 #include "vola/mesh/terrain.hpp"
 #include "vola/mesh/voxelize.hpp"
 
@@ -25,7 +26,15 @@ Tree tree_from_grid_cells(const io::VoxelGrid& grid, int requested_depth, BuildR
     throw InvalidArgument(cause + ", the deepest a tree has");
   }
   Tree tree;
-  if (grid.attributes.empty()) {
+  if (!grid.free.empty()) {
+    // A map's free cells too (an OctoMap's): a state map of both states, as `vola map`
+    // writes one, the occupied cells' log-odds from the grid's column when it has one.
+    std::vector<float> occupied_log_odds;
+    for (const PointAttribute& column : grid.attributes)
+      if (column.name == "log_odds") occupied_log_odds.assign(column.values.begin(), column.values.end());
+    tree = map::state_map_from_voxels(grid.voxels, occupied_log_odds, grid.free, grid.free_log_odds, depth,
+                                      Frame{Quantization::grid, grid.origin, grid.voxel_size});
+  } else if (grid.attributes.empty()) {
     tree = build_from_voxels(grid.voxels, depth);
     tree.set_frame(Frame{Quantization::grid, grid.origin, grid.voxel_size});
   } else {
@@ -41,7 +50,7 @@ Tree tree_from_grid_cells(const io::VoxelGrid& grid, int requested_depth, BuildR
   Box box{grid.origin, grid.origin};
   for (int i = 0; i < 3; ++i) box.max[i] += grid.voxel_size * grid.dims[i];
   tree.georef().bbox = box;
-  report.points_in = grid.voxels.size();
+  report.points_in = grid.voxels.size() + grid.free.size();
   report.voxels = tree.voxel_count();
   return tree;
 }

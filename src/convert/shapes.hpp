@@ -7,7 +7,8 @@
 namespace vola::convert_detail {
 
 // A voxel-grid input (binvox, NPY occupancy, maps) cell for cell, its per-cell values as
-// columns; depth 0 = the smallest that holds it.
+// columns; depth 0 = the smallest that holds it. A map with free cells (an OctoMap's)
+// becomes a state map of its occupied and free cells.
 Tree tree_from_grid_cells(const io::VoxelGrid& grid, int depth, BuildReport& report);
 // The cell centres of a voxel-grid input, as points with its per-cell values (to quantize
 // on another grid).

@@ -67,9 +67,20 @@ grep -q "(.ot, log-odds from the log_odds columns) of .* nodes: 2 occupied and 7
   fail "map.ot summary: $(cat "$tmp/out")"
 [[ ! -s $tmp/err ]] || fail "a vola map export warned: $(cat "$tmp/err")"
 "$vola" convert "$tmp/map.ot" "$tmp/map_back.vol" -q 2>"$tmp/err" || fail "convert map.ot"
-# The free cells do not survive the conversion (a .vol of a map holds its occupied cells): said.
+[[ ! -s $tmp/err ]] || fail "convert map.ot warned: $(cat "$tmp/err")"
+# The free cells come back too: a state map with the same states and log-odds as vola map's.
+"$vola" info "$tmp/map_back.vol" | grep -q "state map (vola map): 9 known.*: 2 occupied, 7 free" ||
+  fail "map.ot came back without its free cells: $("$vola" info "$tmp/map_back.vol")"
+cmp -s <("$vola" voxels "$tmp/map_back.vol" --attributes | sort) <("$vola" voxels "$tmp/map.vol" --attributes | sort) ||
+  fail "map.ot round trip: the known voxels or their log-odds differ"
+"$vola" export "$tmp/map.vol" "$tmp/map.bt" -q || fail "export map.bt"
+"$vola" convert "$tmp/map.bt" "$tmp/bt_back.vol" -q || fail "convert map.bt"
+"$vola" info "$tmp/bt_back.vol" | grep -q "state map (vola map): 9 known.*: 2 occupied, 7 free" ||
+  fail "map.bt came back without its free cells: $("$vola" info "$tmp/bt_back.vol")"
+# Occupancy alone asked for: the free cells are not kept, and that is said.
+"$vola" convert "$tmp/map.ot" "$tmp/occupied_only.vol" --no-attributes -q 2>"$tmp/err" || fail "convert map.ot --no-attributes"
 grep -q "map.ot: the map's 7 free cells are not kept: the .vol holds its 2 occupied cells" "$tmp/err" ||
-  fail "convert map.ot kept quiet about the free cells: $(cat "$tmp/err")"
+  fail "convert map.ot --no-attributes kept quiet about the free cells: $(cat "$tmp/err")"
 "$vola" coords "$tmp/map_back.vol" | sort | cmp -s - <("$vola" coords "$tmp/map.vol" | sort) ||
   fail "map.ot round trip: the occupied voxels differ"
 "$vola" voxels "$tmp/map_back.vol" --attributes --header | head -1 | grep -q "log_odds" || fail "map.ot lost the log-odds"

@@ -175,6 +175,56 @@ TEST(StateMap, OccupiedAndFreeTreesPartitionTheKnownVoxels) {
   EXPECT_THROW(vola::map::free_tree(occupied), vola::InvalidArgument);
 }
 
+TEST(StateMap, BuiltFromVoxelListsItEqualsTheFrozenMap) {
+  // The occupied and free voxels of a frozen map, shuffled, with their log-odds: the same
+  // tree as freeze's, word for word and value for value (what a converted OctoMap becomes).
+  const vola::Tree frozen = vola::map::freeze(random_map(17));
+  std::vector<vola::Voxel> occupied, free;
+  std::vector<float> occupied_log_odds, free_log_odds;
+  const vola::AttributeColumn& column = *frozen.attributes().find("log_odds");
+  frozen.for_each_voxel([&](const vola::Voxel& v) {
+    const bool is_occupied = vola::map::state_at(frozen, v) == VoxelState::occupied;
+    (is_occupied ? occupied : free).push_back(v);
+    (is_occupied ? occupied_log_odds : free_log_odds).push_back(static_cast<float>(column.get(*frozen.rank(v))));
+  });
+  std::mt19937_64 rng(3);
+  std::vector<std::size_t> order(free.size());
+  for (std::size_t n = 0; n < order.size(); ++n) order[n] = n;
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<vola::Voxel> shuffled;
+  std::vector<float> shuffled_log_odds;
+  for (std::size_t n : order) {
+    shuffled.push_back(free[n]);
+    shuffled_log_odds.push_back(free_log_odds[n]);
+  }
+  const vola::Tree built = vola::map::state_map_from_voxels(occupied, occupied_log_odds, shuffled, shuffled_log_odds,
+                                                            frozen.depth(), frozen.frame());
+  EXPECT_TRUE(std::ranges::equal(built.words(), frozen.words()));
+  EXPECT_EQ(built.nbits(), frozen.nbits());
+  EXPECT_TRUE(vola::map::is_state_map(built));
+  ASSERT_EQ(built.attributes().find("log_odds")->bytes().size(), column.bytes().size());
+  EXPECT_TRUE(std::ranges::equal(built.attributes().find("log_odds")->bytes(), column.bytes()));
+  // No log-odds: OctoMap's clamping values, by state.
+  const vola::Tree plain = vola::map::state_map_from_voxels(occupied, {}, free, {}, frozen.depth(), frozen.frame());
+  const vola::map::SensorModel model;
+  const vola::AttributeColumn& defaults = *plain.attributes().find("log_odds");
+  plain.for_each_voxel([&](const vola::Voxel& v) {
+    const bool is_occupied = vola::map::state_at(plain, v) == VoxelState::occupied;
+    EXPECT_EQ(defaults.get(*plain.rank(v)), is_occupied ? model.clamp_max : model.clamp_min);
+  });
+  // A voxel in both states, a short log-odds list or a voxel off the grid is refused.
+  std::vector<vola::Voxel> both = free;
+  both.push_back(occupied.front());
+  EXPECT_THROW(vola::map::state_map_from_voxels(occupied, {}, both, {}, frozen.depth(), frozen.frame()),
+               vola::InvalidArgument);
+  const std::vector<float> one_value{1.0f};
+  EXPECT_THROW(vola::map::state_map_from_voxels(occupied, one_value, free, {}, frozen.depth(), frozen.frame()),
+               vola::InvalidArgument);
+  const std::vector<vola::Voxel> outside{{vola::side_of(frozen.depth()), 0, 0}};
+  EXPECT_THROW(vola::map::state_map_from_voxels(outside, {}, {}, {}, frozen.depth(), frozen.frame()),
+               vola::InvalidArgument);
+}
+
 TEST(StateMap, ACoarserLevelOfDetailSaysWhereAnyObstacleIs) {
   const OccupancyMap map = random_map(13);
   const vola::Tree tree = vola::map::freeze(map);

@@ -46,10 +46,16 @@ struct VoxelGrid {
   // Maps (OctoMap, OpenVDB): the cells are the map's own; a conversion to another voxel
   // size is refused rather than resampled.
   bool fixed_voxel_size = false;
-  // An OctoMap's free cells, which the grid does not hold (its voxels are the occupied
-  // cells): a conversion says they are not kept, since the .vol reads them as free only
-  // by default, and unknown space alike.
-  std::uint64_t free_cells = 0;
+  // A map's free cells (OctoMap's free leaves, in the grid's coordinates), with their
+  // log-odds when the file has them (an .ot): a conversion makes a state map of them and
+  // the occupied cells, whose log-odds are then the "log_odds" column (empty: OctoMap's
+  // clamping values, as a .bt's leaves hold).
+  std::vector<Voxel> free;
+  std::vector<float> free_log_odds;
+  // Free cells the reader did not keep (occupancy only asked for, a ColorOcTree, or more
+  // than kMaxMapVoxels of them): a conversion says so, since the .vol then reads them as
+  // free only by default, and unknown space alike.
+  std::uint64_t free_cells_dropped = 0;
 };
 
 using Triangle = std::array<Point, 3>;

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "vola/frame.hpp"
 #include "vola/tree.hpp"
@@ -89,6 +90,16 @@ StateCounts state_counts(const Tree& state_map);
 // cells), the smallest depth that holds every known voxel, "log_odds" for every known
 // voxel. Throws InvalidArgument when the known voxels span more than 4^10 per axis.
 Tree freeze(const OccupancyMap& map);
+
+// A state map of the known voxels given by state (grid voxels below side_of(depth)), each
+// with its log-odds (an empty list: OctoMap's clamping maximum for occupied voxels, its
+// minimum for free ones, as a .bt's maximum-likelihood leaves hold), in `frame`. What a
+// map file read by another library becomes (vola convert of an OctoMap). Throws
+// InvalidArgument for a voxel given twice or outside the grid, a log-odds list of
+// another length or a value that is not finite.
+Tree state_map_from_voxels(std::span<const Voxel> occupied, std::span<const float> occupied_log_odds,
+                           std::span<const Voxel> free, std::span<const float> free_log_odds, int depth,
+                           const Frame& frame);
 
 // The map a state map was frozen from (every known voxel with its log-odds), so that more
 // scans can be inserted and frozen again: freeze(thaw(freeze(m))) == freeze(m), and

@@ -110,41 +110,61 @@ namespace {
 
 // The occupied leaves of `tree` (an OcTree or a ColorOcTree) as the grid's voxels, pruned
 // leaves expanded to cells of the resolution; with `attributes`, an .ot's log-odds and a
-// ColorOcTree's colour as columns.
+// ColorOcTree's colour as columns, and an OcTree's free leaves as the grid's free cells
+// (with their log-odds from an .ot) when there are at most kMaxMapVoxels of them.
 template <class Tree>
 void gather_cells(const Tree& tree, const OctomapLayout& layout, bool attributes, const std::string& path,
                   VoxelGrid& grid) {
+  constexpr bool kColour = std::is_same_v<Tree, octomap::ColorOcTree>;
   // A leaf at depth d is a cube of 2^(16 - d) cells from its lowest key (getIndexKey).
-  std::array<unsigned, 3> low{65535, 65535, 65535}, high{0, 0, 0};
+  struct Bounds {
+    std::array<unsigned, 3> low{65535, 65535, 65535}, high{0, 0, 0};
+    void add(const octomap::OcTreeKey& key, unsigned span) {
+      for (int a = 0; a < 3; ++a) {
+        low[a] = std::min<unsigned>(low[a], key[a]);
+        high[a] = std::max<unsigned>(high[a], key[a] + span - 1);
+      }
+    }
+  } occupied_bounds, known_bounds;
+  std::uint64_t free_cells = 0;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     const unsigned span = 1u << (kOctomapDepth - it.getDepth());
-    if (!tree.isNodeOccupied(*it)) {
-      grid.free_cells += std::uint64_t{span} * span * span;
-      continue;
-    }
-    const octomap::OcTreeKey key = it.getIndexKey();
-    for (int a = 0; a < 3; ++a) {
-      low[a] = std::min<unsigned>(low[a], key[a]);
-      high[a] = std::max<unsigned>(high[a], key[a] + span - 1);
-    }
+    known_bounds.add(it.getIndexKey(), span);
+    if (tree.isNodeOccupied(*it))
+      occupied_bounds.add(it.getIndexKey(), span);
+    else
+      free_cells += std::uint64_t{span} * span * span;
   }
+  const bool keep_free = attributes && !kColour && free_cells <= kMaxMapVoxels;
+  if (!keep_free) grid.free_cells_dropped = free_cells;
+  if (!keep_free && layout.occupied_cells == 0) return;  // no cell to keep
+  const auto& [low, high] = keep_free ? known_bounds : occupied_bounds;
   grid.voxels.reserve(layout.occupied_cells);
-  constexpr bool kColour = std::is_same_v<Tree, octomap::ColorOcTree>;
   std::vector<PointAttribute> columns;
   const bool keep_log_odds = attributes && !layout.binary;  // a .bt holds occupancy only
   if (keep_log_odds) columns.push_back({"log_odds", ValueType::f32, Reduction::last, {}});
   if (kColour && attributes)
     for (const char* name : {"red", "green", "blue"}) columns.push_back({name, ValueType::u8, Reduction::mean, {}});
   for (auto& column : columns) column.values.reserve(layout.occupied_cells);
+  if (keep_free) {
+    grid.free.reserve(free_cells);
+    if (keep_log_odds) grid.free_log_odds.reserve(free_cells);
+  }
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
+    const bool occupied = tree.isNodeOccupied(*it);
+    if (!occupied && !keep_free) continue;
     const octomap::OcTreeKey key = it.getIndexKey();
     const unsigned span = 1u << (kOctomapDepth - it.getDepth());
     const Voxel first{key[0] - low[0], key[1] - low[1], key[2] - low[2]};
+    std::vector<Voxel>& cells_of_state = occupied ? grid.voxels : grid.free;
     for (unsigned z = 0; z < span; ++z)
       for (unsigned y = 0; y < span; ++y)
-        for (unsigned x = 0; x < span; ++x) grid.voxels.push_back({first.x + x, first.y + y, first.z + z});
+        for (unsigned x = 0; x < span; ++x) cells_of_state.push_back({first.x + x, first.y + y, first.z + z});
     const std::size_t cells = std::size_t{span} * span * span;
+    if (!occupied) {
+      if (keep_log_odds) grid.free_log_odds.insert(grid.free_log_odds.end(), cells, it->getLogOdds());
+      continue;
+    }
     if (keep_log_odds) columns[0].values.insert(columns[0].values.end(), cells, it->getLogOdds());
     if constexpr (kColour) {
       if (attributes) {
@@ -177,7 +197,7 @@ VoxelGrid read_octomap_with_liboctomap(const std::string& path, bool attributes)
   VoxelGrid grid;
   grid.voxel_size = layout.resolution;
   grid.fixed_voxel_size = true;
-  if (layout.occupied_cells == 0) return grid;
+  if (layout.nodes == 0) return grid;  // an empty tree
   const std::unique_ptr<octomap::AbstractOcTree> tree = parse(bytes, layout, path);
   if (layout.colour) gather_cells(static_cast<const octomap::ColorOcTree&>(*tree), layout, attributes, path, grid);
   else gather_cells(static_cast<const octomap::OcTree&>(*tree), layout, attributes, path, grid);
