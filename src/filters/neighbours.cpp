@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <unordered_map>
 
 #include "vola/error.hpp"
@@ -12,19 +13,34 @@
 
 namespace vola::filters {
 
+namespace {
+
+// Whether point i of an x y z array has a place: every coordinate finite.
+bool finite_point(std::span<const double> xyz, std::size_t i) {
+  return std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]);
+}
+
+}  // namespace
+
 std::vector<double> height_above_ground(const PointCloud& cloud) {
   const auto cls = find_dimension(cloud, "classification");
   if (!cls || cls->axis >= 0)
     throw InvalidArgument("hag: the points have no classification (run smrf first to find the ground)");
+  // Ground points without a place (a coordinate not finite) cannot be nearest to anything:
+  // left in, they misled the k-d tree's search for every point near them.
   std::vector<std::uint32_t> ground;
   for (std::size_t i = 0; i < cloud.size(); ++i)
-    if (value_of(cloud, *cls, i) == 2) ground.push_back(static_cast<std::uint32_t>(i));
+    if (value_of(cloud, *cls, i) == 2 && finite_point(cloud.xyz, i)) ground.push_back(static_cast<std::uint32_t>(i));
   if (ground.empty())
     throw InvalidArgument("hag: no point is classified ground (2); run smrf first to find the ground");
   const KdTree<2> tree(cloud.xyz, 3, std::move(ground));
   std::vector<double> hag(cloud.size());
   parallel_for(cloud.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
+      if (!finite_point(cloud.xyz, i)) {
+        hag[i] = std::numeric_limits<double>::quiet_NaN();  // no place, no height
+        continue;
+      }
       const auto near = tree.nearest({cloud.xyz[3 * i], cloud.xyz[3 * i + 1]}, 1);
       hag[i] = cloud.xyz[3 * i + 2] - cloud.xyz[3 * std::size_t{near[0].second} + 2];
     }
@@ -46,23 +62,33 @@ void OutlierOptions::check() const {
 
 std::vector<bool> statistical_outliers(std::span<const double> xyz, const OutlierOptions& options) {
   options.check();
-  const std::size_t n = xyz.size() / 3;
-  std::vector<bool> outlier(n, false);
+  // A point without a place (a coordinate not finite) has no neighbours and is never kept,
+  // as in the decimations; left in, its NaN distance made the limit NaN and kept every
+  // outlier of the file.
+  std::vector<std::uint32_t> placed;
+  for (std::size_t i = 0; i < xyz.size() / 3; ++i)
+    if (finite_point(xyz, i)) placed.push_back(static_cast<std::uint32_t>(i));
+  std::vector<bool> outlier(xyz.size() / 3, true);
+  for (const std::uint32_t i : placed) outlier[i] = false;
+  const std::size_t n = placed.size();
   if (n < 2) return outlier;
-  const KdTree<3> tree(xyz, 3);
+  const KdTree<3> tree(xyz, 3, placed);
   const auto k = static_cast<std::size_t>(options.neighbours);
   std::vector<double> mean(n);
-  parallel_for(n, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      // k + 1: the point itself is its own nearest (and is skipped).
-      const auto near = tree.nearest({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}, k + 1);
-      double sum = 0.0;
-      std::size_t used = 0;
-      for (const auto& [d2, j] : near)
-        if (j != i && used < k) sum += std::sqrt(d2), ++used;
-      mean[i] = used ? sum / static_cast<double>(used) : 0.0;
-    }
-  }, {.grain = 4096});
+  parallel_for(n,
+               [&](std::size_t begin, std::size_t end) {
+                 for (std::size_t p = begin; p < end; ++p) {
+                   const std::size_t i = placed[p];
+                   // k + 1: the point itself is its own nearest (and is skipped).
+                   const auto near = tree.nearest({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}, k + 1);
+                   double sum = 0.0;
+                   std::size_t used = 0;
+                   for (const auto& [d2, j] : near)
+                     if (j != i && used < k) sum += std::sqrt(d2), ++used;
+                   mean[p] = used ? sum / static_cast<double>(used) : 0.0;
+                 }
+               },
+               {.grain = 4096});
   double total = 0.0;
   for (const double m : mean) total += m;
   const double average = total / static_cast<double>(n);
@@ -70,8 +96,11 @@ std::vector<bool> statistical_outliers(std::span<const double> xyz, const Outlie
   for (const double m : mean) squares += (m - average) * (m - average);
   // As PDAL's filters.outlier: the sample standard deviation (n - 1), and a point at the
   // limit is an outlier.
+  // With no spread at all (duplicates, two points) every point lies at the limit: PDAL
+  // would mark them all as noise, which dropped the whole file; none stands out, so none is.
+  if (squares == 0.0) return outlier;
   const double limit = average + options.multiplier * std::sqrt(squares / static_cast<double>(n - 1));
-  for (std::size_t i = 0; i < n; ++i) outlier[i] = mean[i] >= limit;
+  for (std::size_t p = 0; p < n; ++p) outlier[placed[p]] = mean[p] >= limit;
   return outlier;
 }
 

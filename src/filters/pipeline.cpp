@@ -32,6 +32,13 @@ std::string number_text(double v) {
   return s.str();
 }
 
+// A JSON value as an error message quotes it: at most 80 characters of its text.
+std::string quoted(const json& value) {
+  std::string text = value.dump();
+  if (text.size() > 80) text = text.substr(0, 77) + "...";
+  return text;
+}
+
 // A stage's numeric option: a JSON number or a string holding one (PDAL takes both).
 double numeric(const json& value, const std::string& where) {
   if (value.is_number()) return value.get<double>();
@@ -41,14 +48,15 @@ double numeric(const json& value, const std::string& where) {
     const double v = std::strtod(text.c_str(), &end);
     if (!text.empty() && *end == '\0') return v;
   }
-  throw InvalidArgument(where + " must be a number, not " + value.dump());
+  throw InvalidArgument(where + " must be a number, not " + quoted(value));
 }
 
 class StageReader {
  public:
   StageReader(const json& stage, std::size_t index) : stage_(stage) {
     prefix_ = "pipeline stage " + std::to_string(index) + ": ";
-    if (stage.contains("type") && !stage["type"].is_string()) fail("\"type\" must be a string, not " + stage["type"].dump());
+    if (stage.contains("type") && !stage["type"].is_string())
+      fail("\"type\" must be a string, not " + quoted(stage["type"]));
     type_ = stage.value("type", "");
     if (!type_.empty()) prefix_ = "pipeline stage " + std::to_string(index) + " (" + type_ + "): ";
   }
@@ -396,10 +404,21 @@ std::string range_expression(const std::string& limits) {
   return expression;
 }
 
+// Deeper than any pipeline needs (a stage's option is a number, a string or a list of
+// bounds): the values are written back out as text, which recurses once per level, and a
+// value nested 100,000 deep took the process down with it.
+constexpr int kMaxPipelineNesting = 64;
+
 Pipeline parse_pipeline(const std::string& text, const std::string& name) {
   json document;
   try {
-    document = json::parse(text);
+    document = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxPipelineNesting)
+        throw InvalidArgument(name + ": JSON nested deeper than " + std::to_string(kMaxPipelineNesting) +
+                              " levels; a pipeline is an array of stages whose options are numbers, strings and "
+                              "short lists");
+      return true;
+    });
   } catch (const json::exception& e) {
     throw InvalidArgument(name + ": not JSON: " + e.what());
   }

@@ -339,7 +339,8 @@ std::string name_key(const std::string& name) {
 // Extra-bytes fields named like a field of the record, like each other or not at all
 // (the specification forbids none of these, and writers do all three) get names of their
 // own, as the text writers would make them: "classification_2", "a_2", "attribute". So
-// every command, filter and report sees one column per field under one name. Only the
+// every command, filter and report sees one column per field under one name (PDAL's names
+// of record fields count too: an extra "Withheld" hid the flag bit from --where). Only the
 // fields this point format has are taken: an extra "nir" of a format 6 file (vola's own
 // LAS of a cloud with an infrared column) keeps its name. The first "height" stays:
 // vola's LAS export writes the voxels' mean z under that name, read back as the height
@@ -349,14 +350,16 @@ void give_extra_fields_unique_names(LasHeader& hd) {
   std::vector<std::string> taken = {
       "x", "y", "z", "intensity", "return_number", "number_of_returns", "classification", "user_data",
       "point_source_id", "scan_angle_rank", "scan_angle", "classification_flags", "scan_direction_flag",
-      "edge_of_flight_line"};
+      "edge_of_flight_line",
+      // PDAL's names of the classification flag bits, which --where takes too.
+      "synthetic", "keypoint", "withheld", "overlap", "classflags"};
   // clang-format on
   const int format = hd.point_format;
   if (format != 0 && format != 2) taken.push_back("gps_time");
   if (format == 2 || format == 3 || format == 5 || format == 7 || format == 8 || format == 10)
     taken.insert(taken.end(), {"red", "green", "blue"});
-  if (format == 8 || format == 10) taken.push_back("nir");
-  if (format >= 6) taken.push_back("scanner_channel");
+  if (format == 8 || format == 10) taken.insert(taken.end(), {"nir", "infrared"});
+  if (format >= 6) taken.insert(taken.end(), {"scanner_channel", "scan_channel"});
   if (format == 4 || format == 5 || format >= 9)
     taken.insert(taken.end(), {"wave_packet_index", "wave_offset", "wave_packet_size", "wave_return_point", "wave_dx",
                                "wave_dy", "wave_dz"});

@@ -360,10 +360,20 @@ std::vector<std::string> translate_points(const std::string& input, const std::s
   }
   PointTable table = read_point_table(input, progress, format);
   if (edit) {
+    std::vector<std::string> read_columns;
+    for (const PointAttribute& a : table.cloud.attributes) read_columns.push_back(a.name);
     const std::vector<std::uint64_t> kept = edit(table);
     if (las_out && las_in) {
       translate_las(input, output, progress, LasRecordEdits{kept, table.cloud});
-      return {};
+      // LAS to LAS copies the records, their classification edited: a column the filters
+      // added (hag's height_above_ground) has no field there, and was dropped without a word.
+      std::string added;
+      for (const PointAttribute& a : table.cloud.attributes)
+        if (std::find(read_columns.begin(), read_columns.end(), a.name) == read_columns.end())
+          added += (added.empty() ? "" : ", ") + a.name;
+      if (added.empty()) return {};
+      return {output + ": " + added + ", which the filters added, is not written: LAS to LAS keeps the input's " +
+              "records and their fields; write .ply, .xyz or .csv to keep it, or use it in the same command (--where)"};
     }
   }
   std::vector<std::string> warnings;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vola/error.hpp"
+#include "vola/filters/dimensions.hpp"
 #include "vola/filters/stages.hpp"
 #include "vola/tile/point_source.hpp"
 
@@ -63,9 +64,28 @@ class FilteredPoints final : public PointSource {
 std::unique_ptr<PointSource> filtered(std::unique_ptr<PointSource> source, const std::vector<std::string>& specs) {
   std::vector<filters::Stage> stages = filters::parse_stages(specs);
   for (const filters::Stage& s : stages)
-    if (!s.per_point())
-      throw OptionError("filters", "'" + s.spec + "' needs each point's neighbours, which vola tile reads chunk by chunk; "
-                                   "run it first with vola translate IN OUT.laz --filter ..., then tile OUT.laz");
+    if (!s.per_point()) {
+      // hag's column has no LAS field: a LAS output would drop it.
+      const std::string out = s.kind == filters::Stage::Kind::hag ? "OUT.ply" : "OUT.laz";
+      throw OptionError("filters", "'" + s.spec +
+                                       "' needs each point's neighbours, which vola tile reads chunk by chunk; "
+                                       "run it first with vola translate IN " +
+                                       out + " --filter ..., then tile " + out);
+    }
+  // The filters see x, y, z and the columns the tiles are made with, not every field of
+  // the file: a field the file has but tile does not read is named as such, up front
+  // (the points were said to have no such dimension, though `vola info` lists it).
+  PointCloud columns;
+  for (const AttributeSpec& spec : source->attributes()) columns.attributes.push_back({spec.name, spec.type, {}, {}});
+  for (const filters::Stage& s : stages) {
+    if (!s.expression) continue;
+    for (const std::string& name : s.expression->dimensions())
+      if (!filters::find_dimension(columns, name))
+        throw OptionError("filters", "'" + s.spec + "': vola tile's filters see x, y, z and the columns it keeps (" +
+                                         filters::dimension_list(columns) + "), not '" + name + "' of " +
+                                         source->name() + "; filter on it first with vola translate IN OUT.laz " +
+                                         "--where ..., then tile OUT.laz");
+  }
   return std::make_unique<FilteredPoints>(std::move(source), std::move(stages));
 }
 

@@ -358,11 +358,35 @@ head -1 "$tmp/nir_back.xyz" | grep -q ' nir$' || fail "infrared through LAS: $(h
 # ... and a filtered conversion keeps it as a plain one does (it dropped "nir" as a field).
 "$vola" convert "$tmp/nir.las" "$tmp/nir.vol" --voxel-size 1 --where "Z > 0" -q 2> /dev/null
 "$vola" info "$tmp/nir.vol" | grep -q "nir" || fail "filtered convert lost the extra-bytes nir: $("$vola" info "$tmp/nir.vol")"
-# A column named like a flag that holds other values than 0 and 1 is no flag: extra bytes.
+# A column named like a flag that holds other values than 0 and 1 is no flag: extra bytes,
+# read back under a name of its own, so that --where "Overlap" is the flag bit.
 printf 'x y z overlap\n1 2 3 0.5\n' > "$tmp/overlap.xyz"
 "$vola" translate "$tmp/overlap.xyz" "$tmp/overlap.las" -q 2> /dev/null
 "$vola" translate "$tmp/overlap.las" "$tmp/overlap_back.xyz" -q 2> /dev/null
-[ "$(head -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == overlap ] && [ "$(tail -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == 0.5 ] ||
+[ "$(head -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == overlap_2 ] && [ "$(tail -1 "$tmp/overlap_back.xyz" | awk '{print $NF}')" == 0.5 ] ||
   fail "an overlap column of 0.5 through LAS: $(cat "$tmp/overlap_back.xyz")"
+"$vola" translate "$tmp/overlap.las" "$tmp/flag.xyz" --where "Overlap == 0 && overlap_2 > 0.4" -q 2> /dev/null
+[ "$(grep -vc '^#' "$tmp/flag.xyz")" == 1 ] || fail "--where on the Overlap flag beside an extra overlap: $(cat "$tmp/flag.xyz")"
+
+# Filters on points without a place: one NaN row kept every outlier of the file.
+"${VOLA_PYTHON:-python3}" -c "
+import random
+random.seed(4)
+rows = ['%.4f %.4f %.4f' % (random.uniform(0, 10), random.uniform(0, 10), random.uniform(0, 10)) for _ in range(500)]
+rows += ['%.1f %.1f %.1f' % (300 + i, 300, 300) for i in range(5)] + ['nan nan nan']
+open('$tmp/nan.xyz', 'w').write('\n'.join(rows) + '\n')"
+"$vola" translate "$tmp/nan.xyz" "$tmp/no_outliers.xyz" --filter outlier -q 2> /dev/null
+awk '$1 > 100' "$tmp/no_outliers.xyz" | grep -q . && fail "outlier kept the far points of a file with a NaN row"
+# A column the filters add does not fit a LAS record: said, not dropped in silence.
+"$vola" translate "$autzen" "$tmp/hag.las" --filter smrf --filter hag -q 2> "$tmp/err"
+grep -q "height_above_ground, which the filters added, is not written" "$tmp/err" ||
+  fail "LAS to LAS dropped the hag column without a word: $(cat "$tmp/err")"
+# A pipeline nested 100,000 deep is refused (writing it back out for an error message took
+# the process down).
+"${VOLA_PYTHON:-python3}" -c "
+d = 100000
+open('$tmp/deep.json', 'w').write('[\"$autzen\", {\"type\": \"filters.outlier\", \"mean_k\": ' + '[' * d + ']' * d + '}, \"$tmp/o.las\"]')"
+"$vola" pipeline "$tmp/deep.json" 2> "$tmp/err" && fail "a pipeline nested 100,000 deep was run"
+grep -q "JSON nested deeper than 64 levels" "$tmp/err" || fail "deep pipeline: $(head -c 300 "$tmp/err")"
 
 echo "cli_filters: smrf $ground ground points; where, pipeline, hag and errors checked"

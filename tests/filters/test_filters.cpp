@@ -238,6 +238,56 @@ TEST(Crop, OverlappingPolygonsAreAUnion) {
   EXPECT_THROW(parse_polygons("MULTIPOLYGON (0 0, 1 0, 1 1)", "flat"), vola::InvalidArgument);
 }
 
+TEST(Outliers, PointsWithoutAPlaceAreDroppedAndChangeNothingElse) {
+  // One NaN or infinite point made the limit NaN, and every outlier was kept.
+  auto xyz = random_points(400, 5, 20.0);
+  for (int a = 0; a < 3; ++a) xyz.push_back(300.0 + a);  // far from everything
+  const std::vector<bool> clean = statistical_outliers(xyz, OutlierOptions{});
+  ASSERT_TRUE(clean.back());
+  auto with_holes = xyz;
+  with_holes.insert(with_holes.end(), {NAN, 1.0, 1.0, 2.0, INFINITY, 2.0});
+  const std::vector<bool> got = statistical_outliers(with_holes, OutlierOptions{});
+  ASSERT_EQ(got.size(), clean.size() + 2);
+  EXPECT_TRUE(std::equal(clean.begin(), clean.end(), got.begin()));
+  EXPECT_TRUE(got[clean.size()] && got[clean.size() + 1]);
+  // No spread at all (duplicates, two points): nothing stands out, nothing is dropped.
+  const std::vector<double> same(300, 1.5);
+  const auto none = statistical_outliers(same, OutlierOptions{});
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+  const auto two = statistical_outliers(std::vector<double>{0, 0, 0, 1, 1, 1}, OutlierOptions{});
+  EXPECT_EQ(std::count(two.begin(), two.end(), true), 0);
+}
+
+TEST(HeightAboveGround, GroundPointsWithoutAPlaceAreNotSearched) {
+  // NaN ground points misled the k-d tree: heights from a ground point 5 m away.
+  vola::PointCloud cloud;
+  cloud.xyz = random_points(1200, 9, 30.0);
+  cloud.attributes.push_back({"classification", vola::ValueType::u8, vola::Reduction::majority, {}});
+  for (std::size_t i = 0; i < cloud.size(); ++i) cloud.attributes[0].values.push_back(i % 3 == 0 ? 2 : 1);
+  for (std::size_t i = 0; i < cloud.size(); i += 30) cloud.xyz[3 * i + (i % 90 == 0 ? 0 : 2)] = NAN;  // ground points
+  add_height_above_ground(cloud);
+  const auto hag = find_dimension(cloud, "HeightAboveGround");
+  ASSERT_TRUE(hag);
+  const auto placed = [&](std::size_t i) {
+    return std::isfinite(cloud.xyz[3 * i]) && std::isfinite(cloud.xyz[3 * i + 1]) &&
+           std::isfinite(cloud.xyz[3 * i + 2]);
+  };
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!placed(i)) {
+      EXPECT_TRUE(std::isnan(value_of(cloud, *hag, i))) << i;
+      continue;
+    }
+    double best = INFINITY;
+    std::size_t nearest = 0;
+    for (std::size_t j = 0; j < cloud.size(); j += 3) {
+      if (!placed(j)) continue;
+      const double d2 = distance2(cloud.xyz, j, &cloud.xyz[3 * i], 2);
+      if (d2 < best) best = d2, nearest = j;
+    }
+    ASSERT_EQ(value_of(cloud, *hag, i), cloud.xyz[3 * i + 2] - cloud.xyz[3 * nearest + 2]) << i;
+  }
+}
+
 TEST(HeightAboveGround, EqualsZMinusTheNearestGroundPointByBruteForce) {
   vola::PointCloud cloud;
   cloud.xyz = random_points(1500, 7, 30.0);

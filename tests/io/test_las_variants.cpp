@@ -150,6 +150,18 @@ TEST(LasVariants, ExtraBytesNamedLikeOtherFieldsGetNamesOfTheirOwn) {
   for (const auto& f : h.extra_fields) names.push_back(f.name);
   EXPECT_EQ(names, (std::vector<std::string>{"classification_2", "a", "a_2", "attribute", "Intensity_2", "height",
                                              "height_2", "echo width"}));
+  // PDAL's names of the flag bits are taken too: an extra "Withheld" hid the flag from
+  // --where while the CSV named it Withheld_2.
+  Bytes pdal_names;
+  for (const auto& name : {"Withheld", "Synthetic", "KeyPoint", "Overlap", "ClassFlags"}) {
+    const Bytes d = descriptor(1, name);
+    pdal_names.insert(pdal_names.end(), d.begin(), d.end());
+  }
+  const auto p =
+      header_of(las_file(4, 0, {{"LASF_Spec", 4, pdal_names}}, 3, 5, [](std::size_t) { return Bytes(5, 1); }));
+  names.clear();
+  for (const auto& f : p.extra_fields) names.push_back(f.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"Withheld_2", "Synthetic_2", "KeyPoint_2", "Overlap_2", "ClassFlags_2"}));
 }
 
 TEST(LasVariants, ExtraBytesNoDataReadsAsNaN) {

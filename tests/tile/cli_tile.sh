@@ -188,6 +188,12 @@ for t in "$tmp"/ground/.generation-1/tile_*.vol; do "$vola" coords "$t"; done | 
 [ -s "$tmp/tiled.txt" ] && cmp -s "$tmp/tiled.txt" "$tmp/converted.txt" || fail "--where: tiles differ from convert --where"
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/smrf" --filter smrf 2> "$tmp/err.txt" && fail "smrf in tile accepted"
 grep -q "needs each point's neighbours.*vola translate" "$tmp/err.txt" || fail "smrf message: $(cat "$tmp/err.txt")"
+# A field the file has but tile does not read: named as such, with what to do (the points
+# were said to have no such dimension).
+"$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/first" --where "ReturnNumber == 1" 2> "$tmp/err.txt" &&
+  fail "--where on a field tile does not read was accepted"
+grep -q "vola tile's filters see x, y, z and the columns it keeps (.*), not 'ReturnNumber'.*vola translate" "$tmp/err.txt" ||
+  fail "ReturnNumber message: $(cat "$tmp/err.txt")"
 # Degrees: tiles in a geographic CRS are refused unless reprojected or forced.
 geo=$data/las/pdal_epsg_4326.las
 "$vola" tile "$geo" --tile-size 0.01 --depth 4 -o "$tmp/degrees" 2> "$tmp/err.txt" && fail "tiles in degrees accepted"
