@@ -124,6 +124,12 @@ void print_voxel(const Tree& tree, const Voxel& v) {
 void get_from_tiles(const GetArgs& a) {
   const tile::TileSet tiles(a.file);
   const Point p{a.position[0], a.position[1], a.position[2]};
+  Key key;
+  tile::TileIndex tile;
+  if (!tiles.index().grid.locate(p, tile, key))  // a .vol refuses such a point too
+    throw InvalidArgument("world point (" + shortest_text(p[0]) + ", " + shortest_text(p[1]) + ", " +
+                          shortest_text(p[2]) + ") is not finite or lies beyond the 2^31 tiles the grid of " + a.file +
+                          " indexes");
   const tile::TileLookup found = tiles.locate(p);
   std::string file = "not in the set (no points there)";
   for (const tile::TileEntry& e : tiles.index().tiles)

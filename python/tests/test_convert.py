@@ -95,6 +95,10 @@ def test_convert_warns_as_the_cli_does(tmp_path, shared_data):
     # autzen_trim states its own CRS (in feet): relabelling it is warned of, as `vola convert` warns.
     with pytest.warns(UserWarning, match="relabels its coordinates without moving them"):
         vola.convert(shared_data / "las" / "pdal_autzen_trim.las", voxel_size=10.0, assign_crs="EPSG:32610")
+    # With a target CRS too: the points are reprojected from the label, which is said.
+    with pytest.warns(UserWarning, match="`target_crs` reprojects them from that label"):
+        vola.convert(shared_data / "las" / "pdal_autzen_trim.las", voxel_size=10.0, assign_crs="EPSG:26910",
+                     target_crs="EPSG:32610")
 
 
 def test_convert_warns_of_the_points_it_leaves_out(tmp_path):

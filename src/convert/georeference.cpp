@@ -96,11 +96,12 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
   const std::string given = given_crs(options);
   try {
     const std::string stated = !input.wkt.empty() ? input.wkt : input.epsg ? "EPSG:" + std::to_string(*input.epsg) : "";
-    if (!given.empty() && options.target_crs.empty() && !stated.empty() &&
-        !geo::same_crs(stated, crs_definition_of(given)))
+    if (!given.empty() && !stated.empty() && !geo::same_crs(stated, crs_definition_of(given)))
       out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `assign_crs` " +
-                    given.substr(0, 60) + " relabels its coordinates without moving them (to move them, " +
-                    "give `target_crs`)");
+                    given.substr(0, 60) + " relabels its coordinates without moving them" +
+                    (options.target_crs.empty() ? " (to move them, give `target_crs`)"
+                                                : ", and `target_crs` reprojects them from that label, not from the "
+                                                  "CRS the file states"));
     if (!options.target_crs.empty() && !given_or_stated(stated, given).empty())
       if (const std::string heights = unconverted_heights(given_or_stated(stated, given), options.target_crs);
           !heights.empty())

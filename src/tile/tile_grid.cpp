@@ -8,7 +8,7 @@ namespace vola::tile {
 
 Locator::Locator(const TileGrid& grid) noexcept
     : origin_(grid.origin),
-      inverse_(1.0 / grid.voxel_size()),
+      voxel_(grid.voxel_size()),
       limit_(std::ldexp(1.0, 31 + 2 * grid.depth)),
       shift_(2 * grid.depth),
       mask_((std::int64_t{1} << (2 * grid.depth)) - 1) {}

@@ -1,7 +1,11 @@
 #include "vola/tile/tile_inputs.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include "vola/crs_rules.hpp"
@@ -11,6 +15,20 @@
 namespace vola::tile {
 
 namespace {
+
+// Every input stays open while the tiles are made, and a survey comes as thousands of
+// files: more than the usual soft limit of 1024 descriptors failed with "Too many open
+// files". The soft limit is raised towards the hard one (what `ulimit -n` would do) when
+// the inputs need it; beyond the hard limit the reader's error says so.
+void allow_open_files(std::size_t inputs) {
+  constexpr rlim_t kSpare = 256;  // spill files, plugins, GDAL, the output
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0) return;
+  const rlim_t wanted = static_cast<rlim_t>(inputs) + kSpare;
+  if (limit.rlim_cur == RLIM_INFINITY || limit.rlim_cur >= wanted) return;
+  limit.rlim_cur = limit.rlim_max == RLIM_INFINITY ? wanted : std::min(wanted, limit.rlim_max);
+  setrlimit(RLIMIT_NOFILE, &limit);
+}
 
 std::unique_ptr<PointSource> open_source(const std::string& path, std::size_t chunk_points, bool attributes) {
   // Readers below (GDAL's above all) would open a directory or a /vsicurl/ URL as well.
@@ -67,34 +85,35 @@ void resolve_tile_crs(const std::string& assign, bool allow_geographic,
   options.crs_wkt = crs.wkt;
 }
 
-// What the user should know about the inputs' CRSs: with target_crs, heights it leaves in
-// another unit than x and y; else assign_crs on an input that says another CRS relabels
-// its coordinates.
+// What the user should know about the inputs' CRSs: assign_crs on an input that says
+// another CRS relabels its coordinates (with target_crs too: it is reprojected from the
+// label, and a UTM survey given a state-plane label moved by kilometres without a word);
+// with target_crs, heights it leaves in another unit than x and y.
 std::vector<std::string> crs_warnings(const TileInputs& in, const std::vector<std::unique_ptr<PointSource>>& sources) {
   std::vector<std::string> warnings;
-  if (!in.target_crs.empty()) {  // heights a reprojection leaves in another unit
-    for (const auto& s : sources) {
-      const std::string said = !in.assign_crs.empty() ? in.assign_crs
-                               : !s->wkt.empty()       ? s->wkt
-                               : s->epsg               ? "EPSG:" + std::to_string(*s->epsg)
-                                                       : "";
-      if (said.empty()) continue;
-      if (const std::string heights = unconverted_heights(said, in.target_crs); !heights.empty())
-        warnings.push_back(s->name() + ": " + heights);
-    }
-    return warnings;
-  }
-  if (in.assign_crs.empty()) return warnings;
   for (const auto& s : sources) {
     const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
+    if (in.assign_crs.empty() || said.empty()) continue;
     try {
-      if (!said.empty() && !geo::same_crs(said, crs_definition_of(in.assign_crs)))
+      if (!geo::same_crs(said, crs_definition_of(in.assign_crs)))
         warnings.push_back(s->name() + " states " + geo::crs_summary(geo::describe_crs(said)) + "; `assign_crs` " +
-                           in.assign_crs.substr(0, 60) +
-                           " relabels its coordinates without moving them (to move them, give `target_crs`)");
+                           in.assign_crs.substr(0, 60) + " relabels its coordinates without moving them" +
+                           (in.target_crs.empty() ? " (to move them, give `target_crs`)"
+                                                  : ", and `target_crs` reprojects them from that label, not from "
+                                                    "the CRS the file states"));
     } catch (const Error&) {
       // A CRS PROJ cannot read: resolve_tile_crs reports what matters.
     }
+  }
+  if (in.target_crs.empty()) return warnings;
+  for (const auto& s : sources) {  // heights a reprojection leaves in another unit
+    const std::string said = !in.assign_crs.empty() ? in.assign_crs
+                             : !s->wkt.empty()      ? s->wkt
+                             : s->epsg              ? "EPSG:" + std::to_string(*s->epsg)
+                                                    : "";
+    if (said.empty()) continue;
+    if (const std::string heights = unconverted_heights(said, in.target_crs); !heights.empty())
+      warnings.push_back(s->name() + ": " + heights);
   }
   return warnings;
 }
@@ -113,7 +132,17 @@ OpenedInputs open_inputs(const TileInputs& in, TileOptions& options) {
   if (!in.assign_crs.empty()) resolve_crs({}, in.assign_crs);  // an unknown CRS fails before any work
   OpenedInputs out;
   const std::size_t chunk_points = in.chunk_points ? in.chunk_points : chunk_points_for(options);
-  for (const std::string& path : in.inputs) out.sources.push_back(open_source(path, chunk_points, options.attributes));
+  allow_open_files(in.inputs.size());
+  for (const std::string& path : in.inputs) {
+    try {
+      out.sources.push_back(open_source(path, chunk_points, options.attributes));
+    } catch (const IoError& e) {
+      if (std::string(e.what()).find(std::strerror(EMFILE)) == std::string::npos) throw;  // not the limit
+      throw IoError(std::string(e.what()) + ": vola tile keeps its " + std::to_string(in.inputs.size()) +
+                    " inputs open at once, more than this process may open; raise the limit (ulimit -n, up to " +
+                    "its hard limit, ulimit -Hn) or tile fewer files at a time");
+    }
+  }
   if (in.generate_survey) {
     SurveyOptions survey = in.survey;
     survey.points = in.generate_survey;

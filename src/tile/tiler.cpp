@@ -360,7 +360,11 @@ void Tiling::bucket(const std::vector<const PointSource*>& sources) {
   // index replaces the previous one.
   std::uint64_t offered = 0;
   for (const PointSource* s : sources) offered += s->point_count();
-  if (tiles.empty() && offered > 0) {
+  if (tiles.empty() && offered == 0 && points_read.load() == 0)
+    throw InvalidArgument(
+        "the inputs hold no point: nothing to tile (an existing tile set in the output folder is left "
+        "as it was)");
+  if (tiles.empty()) {
     char size[32];
     std::snprintf(size, sizeof size, "%.6g", options.grid.tile_size);
     throw InvalidArgument("none of the inputs' " + std::to_string(offered) +
@@ -587,9 +591,22 @@ std::vector<AttributeSpec> common_attributes(const std::vector<const PointSource
                return o.name == spec.name && o.type == spec.type && o.reduction == spec.reduction;
              }))
         ++lacking;
-      if (lacking == of.size()) common.push_back(spec);
-      else warnings.push_back("attribute '" + spec.name + "' is left out: " + sources[lacking]->name() +
-                              " has no such column (of the same type and reduction)");
+      if (lacking == of.size()) {
+        common.push_back(spec);
+        continue;
+      }
+      // Say what differs: a column of the same name in another type (a PCD's 16-bit
+      // intensity read as f32) was reported as missing from the file that has it.
+      const auto same_name = std::find_if(of[lacking].begin(), of[lacking].end(),
+                                          [&](const AttributeSpec& o) { return o.name == spec.name; });
+      if (same_name == of[lacking].end())
+        warnings.push_back("attribute '" + spec.name + "' is left out: " + sources[lacking]->name() +
+                           " has no such column");
+      else
+        warnings.push_back("attribute '" + spec.name + "' is left out: " + sources[lacking]->name() + " holds it as " +
+                           std::string(name_of(same_name->type)) + " (" + std::string(name_of(same_name->reduction)) +
+                           ") where another input holds it as " + std::string(name_of(spec.type)) + " (" +
+                           std::string(name_of(spec.reduction)) + "); tiles keep a column every input holds alike");
     }
   return common;
 }
@@ -699,6 +716,11 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
   for (OverviewEntry& o : index.overviews) o.file = generation.name + "/" + o.file;
   if (run.rank == 0) {
     if (const std::string label = implausible_label(index); !label.empty()) summary.warnings.push_back(label);
+    if (summary.points_outside > 0)  // a warning, so that -q says it too
+      summary.warnings.push_back(std::to_string(summary.points_outside) + " of the " +
+                                 std::to_string(summary.points_in) +
+                                 " points are not tiled: a coordinate not finite, or beyond the 2^31 tiles the grid "
+                                 "indexes from its origin");
     summary.index_path = (fs::path(options.output_dir) / kIndexFileName).string();
     write_tile_index(index, summary.index_path);  // the switch: whole, by rename
   }

@@ -48,7 +48,10 @@ class Locator {
     std::int32_t t[3];
     std::uint32_t local[3];
     for (int a = 0; a < 3; ++a) {
-      const double g = std::floor((p[a] - origin_[a]) * inverse_);
+      // Divided, not multiplied by the inverse: vola::build's and Quantizer's arithmetic, so
+      // that a point on a voxel's face lies in the voxel `vola convert` puts it in (with an
+      // inverse that rounds, such points went to the other side, into the next tile too).
+      const double g = std::floor((p[a] - origin_[a]) / voxel_);
       // 2^31 tiles of 4^D voxels each way: beyond that the index does not fit (NaN fails too).
       if (!(g > -limit_ && g < limit_)) return false;
       const auto global = static_cast<std::int64_t>(g);
@@ -62,7 +65,7 @@ class Locator {
 
  private:
   Point origin_;
-  double inverse_, limit_;
+  double voxel_, limit_;
   int shift_;
   std::int64_t mask_;
 };
