@@ -144,6 +144,13 @@ void run_info(const InfoArgs& a) {
     return h.layout == Layout::dense ? (std::size_t{1} << (6 * l)) : tree.occupancy(l).size();
   };
   if (a.json) {
+    // "crs" is the header's code when it is the data's CRS: a WKT with no EPSG code (US
+    // survey-foot LIDAR) leaves the reference's placeholder 2000 there, which is EPSG:2000
+    // (Anguilla 1957) to any script that reads it; then null, as "lat" and "lon" are for a
+    // file with no CRS at all (computed as if under that placeholder).
+    const bool no_crs = !crs.description && crs.problem.empty();
+    const bool code_is_the_crs =
+        h.epsg != geo::kUnsetEpsg || (crs.description && crs.description->epsg == std::optional<std::uint32_t>(h.epsg));
     // JSON has no infinity or NaN: a reference file may hold them (PROJ's lat/lon of a
     // centre it cannot place is inf; a "nan" input line makes a NaN bbox), printed as null.
     const auto real = [](double v) {
@@ -159,12 +166,13 @@ void run_info(const InfoArgs& a) {
     };
     std::printf(
         "{\n  \"file\": %s,\n  \"file_bytes\": %llu,\n  \"version\": %u,\n  \"mode\": \"%s\",\n"
-        "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %u,\n  \"lat\": %s,\n"
+        "  \"depth\": %d,\n  \"side\": %u,\n  \"nbits\": %u,\n  \"crs\": %s,\n  \"lat\": %s,\n"
         "  \"lon\": %s,\n  \"bbox\": [%s],\n"
         "  \"voxels\": %llu,\n  \"bits_per_voxel\": %.4f,\n  \"quantization\": \"%s\",\n"
         "  \"voxel_size\": %s,\n  \"origin\": [%s],\n  \"levels\": [",
         quoted(a.file).c_str(), static_cast<unsigned long long>(layout.file_size), h.version, mode, tree.depth(),
-        tree.side(), h.nbits, h.epsg, real(h.lat).c_str(), real(h.lon).c_str(),
+        tree.side(), h.nbits, code_is_the_crs ? std::to_string(h.epsg).c_str() : "null",
+        no_crs ? "null" : real(h.lat).c_str(), no_crs ? "null" : real(h.lon).c_str(),
         reals({h.bbox.min[0], h.bbox.min[1], h.bbox.min[2], h.bbox.max[0], h.bbox.max[1], h.bbox.max[2]}).c_str(),
         static_cast<unsigned long long>(tree.voxel_count()), bits,
         frame.quantization == Quantization::grid ? "grid" : "toolkit", real(frame.voxel_size).c_str(),
@@ -183,15 +191,15 @@ void run_info(const InfoArgs& a) {
       std::printf(",\n  \"state_map\": {\"occupied\": %llu, \"free\": %llu, \"unknown_in_bounds\": %llu}",
                   static_cast<unsigned long long>(states->occupied), static_cast<unsigned long long>(states->free),
                   static_cast<unsigned long long>(states->unknown_in_bounds));
-    // "crs_placeholder": the header's code is the reference's placeholder for no CRS, so
-    // "crs", "lat" and "lon" say nothing of where the data is.
+    // "crs_placeholder": the header's code is the reference's placeholder, not the data's
+    // CRS ("crs" is null; "crs_wkt" and "crs_named" say what the CRS is when there is one).
     std::printf(
         ",\n  \"compressed\": %s,\n  \"level_coding\": %s,\n  \"extension_bytes\": %llu,\n  \"crs_wkt\": %s,\n"
         "  \"crs_named\": %s,\n  \"crs_placeholder\": %s\n}\n",
         layout.compressed_levels ? "true" : "false",
         layout.compressed_levels ? quoted(level_coding(layout)).c_str() : "null",
         static_cast<unsigned long long>(layout.extension_bytes), quoted(tree.georef().crs_wkt).c_str(),
-        json_crs(crs).c_str(), !crs.description && crs.problem.empty() ? "true" : "false");
+        json_crs(crs).c_str(), code_is_the_crs ? "false" : "true");
     return;
   }
   std::printf("file:        %s (%llu bytes)\n", a.file.c_str(), static_cast<unsigned long long>(layout.file_size));

@@ -225,6 +225,17 @@ fi
 printf '0 0 0\n1 1 1\n' > "$tmp/nocrs.xyz"
 "$vola" convert "$tmp/nocrs.xyz" "$tmp/nocrs.vol" --voxel-size 1 -q
 "$vola" info --json "$tmp/nocrs.vol" | grep -q '"crs_placeholder": true' || fail "no CRS, yet crs_placeholder is not true"
+"$vola" info --json "$tmp/nocrs.vol" | grep -q '"lat": null' || fail "no CRS, yet a latitude"
+# A CRS with an EPSG code: the header's code is it.
+"$vola" convert "$data/las/pdal_autzen-utm.las" "$tmp/utm.vol" --voxel-size 20 -q
+"$vola" info --json "$tmp/utm.vol" > "$tmp/utm.json"
+grep -q '"crs": 26910,' "$tmp/utm.json" && grep -q '"crs_placeholder": false' "$tmp/utm.json" ||
+  fail "an EPSG code, yet not the header's crs: $(grep crs "$tmp/utm.json")"
+# A WKT with no EPSG code (Oregon feet) leaves the placeholder 2000 in the header, which is
+# EPSG:2000 (Anguilla 1957) to a script: "crs" is null there, and the WKT says what it is.
 "$vola" convert "$data/las/pdal_autzen_trim.las" "$tmp/autzen.vol" --voxel-size 20 -q
-"$vola" info --json "$tmp/autzen.vol" | grep -q '"crs_placeholder": false' || fail "a CRS, yet crs_placeholder is not false"
+"$vola" info --json "$tmp/autzen.vol" > "$tmp/autzen.json"
+grep -q '"crs": null,' "$tmp/autzen.json" && grep -q '"crs_placeholder": true' "$tmp/autzen.json" &&
+  grep -q '"crs_named": {"name": "NAD_1983_HARN_Lambert_Conformal_Conic"' "$tmp/autzen.json" &&
+  ! grep -q '"lat": null' "$tmp/autzen.json" || fail "a WKT CRS without a code: $(grep -E 'crs|lat' "$tmp/autzen.json")"
 echo "cli_info_json: OK ($checked LAS/LAZ files)"
