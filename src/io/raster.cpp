@@ -49,12 +49,17 @@ Raster make_raster(const Tree& tree, const RasterOptions& options) {
     throw InvalidArgument("raster resolution " + number(cell) + " is finer than the voxels (" + number(voxel) +
                           "): give the voxel size or more");
   // The cell holding voxel column i's centre, origin + (i + 0.5) * voxel, counted in
-  // voxels: exact for the ratios users give (R = 2.5 voxels puts the centre of column 2
-  // on the border of cells 0 and 1, and in cell 1).
+  // cells: a centre on a border is in the cell above it, as cells are [k R, (k + 1) R)
+  // (R = 2.5 voxels puts column 2's centre on the border of cells 0 and 1: cell 1). The
+  // quotient of a border rounds to either side when R / voxel is not a binary fraction
+  // (7 / 6: 17.5 / 1.1666... = 14.999999999999998), so a quotient within a billionth of
+  // a whole number is that number; a centre off a border is at least half a voxel from it.
   const double ratio = cell / voxel;
   auto cell_of = [&](std::uint32_t i) -> std::uint64_t {
     if (ratio == 1.0) return i;
-    return static_cast<std::uint64_t>(std::floor((static_cast<double>(i) + 0.5) / ratio));
+    const double q = (static_cast<double>(i) + 0.5) / ratio;
+    const double nearest = std::round(q);
+    return static_cast<std::uint64_t>(std::fabs(q - nearest) <= 1e-9 * std::max(1.0, q) ? nearest : std::floor(q));
   };
 
   std::uint64_t u_min = std::numeric_limits<std::uint64_t>::max(), v_min = u_min, u_max = 0, v_max = 0;

@@ -1,5 +1,5 @@
 // GeoTIFF rasters' cells (vola::io::make_raster) against a slow model computed from the
-// voxel set and the grid: every product, cells of the voxel size and of 2.5 voxels,
+// voxel set and the grid: every product, cells of the voxel size, of 2.5 and of 7/6 voxels,
 // north-up rows, the crop and the geotransform; the refusals. The file itself (GDAL,
 // CRS, COG layout) is read back in tests/io/cli_raster.sh.
 #include <gtest/gtest.h>
@@ -26,12 +26,12 @@ struct Expected {
   std::vector<double> values;  // NaN: no value
 };
 
-// The model: voxel column i is in cell floor((i + 0.5) / ratio); rows from the north.
-Expected slow_raster(const Sample& s, RasterProduct product, double cell) {
-  const double voxel = s.grid.voxel_size, ratio = cell / voxel;
-  auto cell_of = [&](std::uint32_t i) -> std::int64_t {
-    return ratio == 1.0 ? i : static_cast<std::int64_t>(std::floor((i + 0.5) / ratio));
-  };
+// The model: cells of num / den voxels; voxel column i, centred (2i + 1) / 2 voxels from the
+// origin, is in cell floor((2i + 1) den / (2 num)), in integers (a centre on a border in
+// the cell above it); rows from the north.
+Expected slow_raster(const Sample& s, RasterProduct product, std::int64_t num, std::int64_t den) {
+  const double voxel = s.grid.voxel_size, cell = voxel * static_cast<double>(num) / static_cast<double>(den);
+  auto cell_of = [&](std::uint32_t i) -> std::int64_t { return (2 * std::int64_t{i} + 1) * den / (2 * num); };
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<Xyz>> cells;
   for (const Xyz& v : s.voxels) cells[{cell_of(v[0]), cell_of(v[1])}].push_back(v);
   std::int64_t u0 = std::numeric_limits<std::int64_t>::max(), v0 = u0, u1 = -1, v1 = -1;
@@ -69,7 +69,9 @@ TEST_P(RasterCells, MatchTheVoxelColumns) {
   for (std::uint64_t seed = 0; seed < 4; ++seed) {
     const Sample s = random_sample(7100 * depth + seed, depth, false);
     SCOPED_TRACE(s.describe);
-    for (const double ratio : {1.0, 2.5}) {
+    // 7/6: a border's quotient rounds either way in doubles (columns went to either side).
+    for (const auto& [num, den] : {std::pair<std::int64_t, std::int64_t>{1, 1}, {5, 2}, {7, 6}}) {
+      const double ratio = static_cast<double>(num) / static_cast<double>(den);
       for (const RasterProduct product :
            {RasterProduct::dsm, RasterProduct::dtm, RasterProduct::density, RasterProduct::count}) {
         SCOPED_TRACE(std::string(vola::io::raster_product_name(product)) + ", cells of " + std::to_string(ratio) +
@@ -78,7 +80,7 @@ TEST_P(RasterCells, MatchTheVoxelColumns) {
         options.product = product;
         options.resolution = ratio == 1.0 ? 0.0 : ratio * s.grid.voxel_size;
         const vola::io::Raster r = vola::io::make_raster(s.tree, options);
-        const Expected e = slow_raster(s, product, ratio * s.grid.voxel_size);
+        const Expected e = slow_raster(s, product, num, den);
         ASSERT_EQ(r.width, e.width);
         ASSERT_EQ(r.height, e.height);
         for (int i = 0; i < 6; ++i) EXPECT_DOUBLE_EQ(r.geotransform[i], e.geotransform[i]) << "geotransform " << i;
@@ -128,7 +130,7 @@ TEST(RasterAttributes, IntensityOfTopVoxelsAndGroundOnlyDtm) {
     vola::io::RasterOptions options;
     options.product = RasterProduct::intensity;
     const vola::io::Raster r = vola::io::make_raster(s.tree, options);
-    const Expected shape = slow_raster(s, RasterProduct::count, s.grid.voxel_size);
+    const Expected shape = slow_raster(s, RasterProduct::count, 1, 1);
     ASSERT_EQ(r.width, shape.width);
     // The voxel column of the first cell, and the row past the northernmost.
     const double voxel = s.grid.voxel_size;
