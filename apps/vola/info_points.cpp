@@ -228,6 +228,10 @@ std::string point_text(const std::array<double, 3>& p) {
   return "(" + value_text(p[0]) + ", " + value_text(p[1]) + ", " + value_text(p[2]) + ")";
 }
 
+// The LAS minor version whose class table names the codes (4: any other input's, read as
+// LAS 1.4's).
+int las_minor(const io::LasHeader* header) { return header && header->version_major == 1 ? header->version_minor : 4; }
+
 // `header`: a LAS file's, for coordinates at its precision (null: each value as short as
 // reads back).
 void print_summary(const Summary& summary, const io::LasHeader* header = nullptr) {
@@ -245,7 +249,8 @@ void print_summary(const Summary& summary, const io::LasHeader* header = nullptr
     std::printf("column:      %s: %s .. %s\n", name.c_str(), value_text(range.first).c_str(),
                 value_text(range.second).c_str());
   for (const auto& [code, n] : summary.classes())
-    std::printf("class:       %3d %-38s %llu\n", code, std::string(analysis::asprs_class_name(code)).c_str(),
+    std::printf("class:       %3d %-38s %llu\n", code,
+                std::string(analysis::asprs_class_name(code, las_minor(header))).c_str(),
                 static_cast<unsigned long long>(n));
 }
 
@@ -264,7 +269,8 @@ ordered_json summary_json(const Summary& summary, const io::LasHeader* header = 
   if (!summary.classes().empty()) {
     ordered_json list = ordered_json::array();
     for (const auto& [code, n] : summary.classes())
-      list.push_back({{"code", code}, {"name", std::string(analysis::asprs_class_name(code))}, {"points", n}});
+      list.push_back(
+          {{"code", code}, {"name", std::string(analysis::asprs_class_name(code, las_minor(header)))}, {"points", n}});
     out["classes"] = std::move(list);
   }
   return out;

@@ -8,7 +8,25 @@
 
 namespace vola::analysis {
 
-std::string_view asprs_class_name(int code) noexcept {
+std::string_view asprs_class_name(int code, int las_minor) noexcept {
+  if (las_minor < 4) {
+    static constexpr std::string_view kLegacy[] = {"Created, never classified",
+                                                   "Unclassified",
+                                                   "Ground",
+                                                   "Low Vegetation",
+                                                   "Medium Vegetation",
+                                                   "High Vegetation",
+                                                   "Building",
+                                                   "Low Point (noise)",
+                                                   "Model Key-point (mass point)",
+                                                   "Water",
+                                                   "Reserved",
+                                                   "Reserved",
+                                                   "Overlap Points"};
+    if (code >= 0 && code <= 12) return kLegacy[code];
+    if (code >= 13 && code <= 31) return "Reserved";
+    return "Not an ASPRS class";  // 5 bits
+  }
   static constexpr std::string_view kNames[] = {
       "Created, never classified", "Unclassified", "Ground", "Low Vegetation", "Medium Vegetation",
       "High Vegetation", "Building", "Low Point (noise)", "Reserved", "Water", "Rail", "Road Surface", "Reserved",

@@ -238,4 +238,8 @@ grep -q '"crs": 26910,' "$tmp/utm.json" && grep -q '"crs_placeholder": false' "$
 grep -q '"crs": null,' "$tmp/autzen.json" && grep -q '"crs_placeholder": true' "$tmp/autzen.json" &&
   grep -q '"crs_named": {"name": "NAD_1983_HARN_Lambert_Conformal_Conic"' "$tmp/autzen.json" &&
   ! grep -q '"lat": null' "$tmp/autzen.json" || fail "a WKT CRS without a code: $(grep -E 'crs|lat' "$tmp/autzen.json")"
+# Class names from the file's LAS version: 12 is "Overlap Points" in LAS 1.0-1.3 (mvk-thin
+# is 1.2), "Reserved" in 1.4's table, which named every file's classes.
+"$vola" info "$data/las/pdal_mvk-thin.las" --summary | grep -Eq "^class: +12 Overlap Points +3702$" ||
+  fail "LAS 1.2 class 12: $("$vola" info "$data/las/pdal_mvk-thin.las" --summary | grep class)"
 echo "cli_info_json: OK ($checked LAS/LAZ files)"

@@ -15,9 +15,10 @@
 
 namespace vola::analysis {
 
-// ASPRS LAS 1.4 standard class names (codes 0-18), "Reserved" for 19-63 and
-// "User definable" for 64-255.
-std::string_view asprs_class_name(int code) noexcept;
+// ASPRS standard class names: LAS 1.4's (codes 0-18, "Reserved" for 19-63, "User
+// definable" for 64-255), or with `las_minor` below 4 the table of LAS 1.0-1.3, whose
+// codes 0-31 differ (8 "Model Key-point", 12 "Overlap Points", 10, 11 and 13-31 reserved).
+std::string_view asprs_class_name(int code, int las_minor = 4) noexcept;
 
 struct LevelCensus {
   std::uint64_t blocks = 0;  // 64-bit words of the level
