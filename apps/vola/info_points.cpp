@@ -426,11 +426,19 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
   const io::Input in = io::read_input(path, format_name, options);
   if (in.is_mesh() || in.grid || in.terrain) return print_other_input_info(path, in, summary, json, part);
   const bool e57 = in.format == "e57";
+  // Points with a coordinate that is not finite: the PCD reader leaves them out, the other
+  // readers keep them for convert to drop (and count); counted alike here, as convert does.
+  std::uint64_t not_finite = in.not_finite;
+  for (std::size_t i = 0; i < in.cloud.size(); ++i)
+    if (!std::isfinite(in.cloud.xyz[3 * i]) || !std::isfinite(in.cloud.xyz[3 * i + 1]) ||
+        !std::isfinite(in.cloud.xyz[3 * i + 2]))
+      ++not_finite;
+  const std::uint64_t points = in.cloud.size() + in.not_finite - not_finite;
   if (json) {
     ordered_json doc = {{"file", path},
                         {"format", in.format},
-                        {"points", in.cloud.size()},
-                        {"points_not_finite", in.not_finite},
+                        {"points", points},
+                        {"points_not_finite", not_finite},
                         {"crs", crs_json(in.wkt, in.epsg)}};
     ordered_json dimensions = ordered_json::array();
     for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
@@ -441,13 +449,13 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
     return;
   }
   std::printf("file:        %s (%s)\n", path.c_str(), in.format.c_str());
-  std::printf("points:      %zu", in.cloud.size());
+  std::printf("points:      %llu", static_cast<unsigned long long>(points));
   // An organized cloud (PCD) holds its missing points as NaN, an E57 or PTX scan marks
   // them invalid or as 0 0 0: say how many were left out.
-  if (in.not_finite > 0)
+  if (not_finite > 0)
     std::printf(e57 || in.format == "ptx" ? " (and %llu the scanner marked as no return or invalid, left out)"
-                                          : " (and %llu with a coordinate that is not a number, left out)",
-                static_cast<unsigned long long>(in.not_finite));
+                                          : " (and %llu with a coordinate that is not finite, left out)",
+                static_cast<unsigned long long>(not_finite));
   std::printf("\n");
   if (e57) print_e57_scans(io::e57_summary(path));
   std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());

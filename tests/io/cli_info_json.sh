@@ -81,7 +81,7 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 assert (d['points'], d['points_not_finite']) == (209280, 97920), d
 " "$tmp/mug.json" || fail "organized PCD: not 209280 points and 97920 left out"
-"$vola" info "$mug" | grep -q "^points: *209280 (and 97920 with a coordinate that is not a number, left out)" ||
+"$vola" info "$mug" | grep -q "^points: *209280 (and 97920 with a coordinate that is not finite, left out)" ||
   fail "info on an organized PCD does not say that 97920 NaN points were left out"
 
 # Inputs that are not point clouds, against the files' own headers read here: a binary
@@ -238,6 +238,12 @@ grep -q '"crs": 26910,' "$tmp/utm.json" && grep -q '"crs_placeholder": false' "$
 grep -q '"crs": null,' "$tmp/autzen.json" && grep -q '"crs_placeholder": true' "$tmp/autzen.json" &&
   grep -q '"crs_named": {"name": "NAD_1983_HARN_Lambert_Conformal_Conic"' "$tmp/autzen.json" &&
   ! grep -q '"lat": null' "$tmp/autzen.json" || fail "a WKT CRS without a code: $(grep -E 'crs|lat' "$tmp/autzen.json")"
+# Points with a coordinate that is not finite are counted as left out for every reader, as
+# convert counts them (only the PCD reader's were).
+printf 'x y z\n1 2 3\nnan 2 3\n4 inf 6\n7 8 9\n' > "$tmp/nan.xyz"
+"$vola" info "$tmp/nan.xyz" | grep -q "^points: *2 (and 2 with a coordinate that is not finite, left out)" ||
+  fail "info of non-finite rows: $("$vola" info "$tmp/nan.xyz")"
+"$vola" info --json "$tmp/nan.xyz" | grep -q '"points_not_finite": 2' || fail "info --json of non-finite rows"
 # Class names from the file's LAS version: 12 is "Overlap Points" in LAS 1.0-1.3 (mvk-thin
 # is 1.2), "Reserved" in 1.4's table, which named every file's classes.
 "$vola" info "$data/las/pdal_mvk-thin.las" --summary | grep -Eq "^class: +12 Overlap Points +3702$" ||
