@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "column_names.hpp"
+#include "content_kind.hpp"
 #include "las_format.hpp"
 #include "reader_plugin.hpp"
 #include "vola/error.hpp"
@@ -71,7 +72,8 @@ HeaderCounts parse_public_block(const HeaderSource& src, LasHeader& hd) {
     src.fail(src.file_size, "a LAS file has at least a 227-byte header; this file has " + std::to_string(src.file_size) +
                                 " bytes");
   const auto h = src.read_at(0, std::min<std::uint64_t>(src.file_size, 375), "header");
-  if (std::memcmp(h.data(), "LASF", 4) != 0) src.fail(0, "not a LAS file (no LASF signature)");
+  if (std::memcmp(h.data(), "LASF", 4) != 0)
+    src.fail(0, "not a LAS file (no LASF signature)" + content_kind_note(std::span<const std::uint8_t>(h).first(16)));
   hd.global_encoding = load_le<std::uint16_t>(&h[6]);
   hd.version_major = h[24];
   hd.version_minor = h[25];

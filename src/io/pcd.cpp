@@ -19,9 +19,10 @@
 #include <vector>
 
 #include "column_names.hpp"
+#include "content_kind.hpp"
 #include "file_bytes.hpp"
-#include "point_colours.hpp"
 #include "header_words.hpp"
+#include "point_colours.hpp"
 #include "vola/error.hpp"
 #include "vola/little_endian.hpp"
 
@@ -428,6 +429,11 @@ constexpr std::uint64_t kLzfMaxRatio = 88;
 
 PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name, const InputOptions& options,
                      std::uint64_t* not_finite) {
+  // Another format's file (a LAS with --format pcd) is said as what it is, not by its
+  // bytes quoted as a header line.
+  if (const auto kind = content_kind(bytes.first(std::min<std::size_t>(bytes.size(), 16)));
+      kind && kind->find("PCD") == std::string::npos)
+    throw FormatError(name, 0, "not a PCD point file: its first bytes are those of " + *kind);
   const Header h = parse_header(bytes, name);
   const Layout layout = find_layout(h, name);
   const std::uint64_t remaining = bytes.size() - h.body;

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <string_view>
 
+#include "content_kind.hpp"
 #include "mesh_files.hpp"
 #include "polygon_triangles.hpp"
 #include "vola/error.hpp"
@@ -136,6 +137,10 @@ std::vector<Triangle> parse_stl(std::span<const std::uint8_t> bytes, const std::
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   const std::uint64_t size = bytes.size();
   const std::uint64_t declared = size >= kStlHeader ? load_le<std::uint32_t>(bytes.data() + 80) : 0;
+  // A binary STL's header is free text, but not another format's signature: a WAV renamed
+  // .stl whose size fit 50-byte triangles read as 2,741 triangles of +-3.4e38.
+  if (const auto kind = content_kind(bytes.first(std::min<std::size_t>(bytes.size(), 16))))
+    throw FormatError(name, 0, "not an STL mesh: its first bytes are those of " + *kind);
   std::vector<Triangle> triangles;
   if (size >= kStlHeader && size == kStlHeader + kStlTriangle * declared) {
     triangles = stl_binary_triangles(bytes, declared);

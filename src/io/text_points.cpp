@@ -11,6 +11,7 @@
 #include <unordered_set>
 
 #include "column_names.hpp"
+#include "content_kind.hpp"
 #include "point_colours.hpp"
 #include "vola/error.hpp"
 #include "vola/io/input.hpp"
@@ -439,6 +440,10 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
                             const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open");
+  // Another format's file read as text (a WAV renamed .xyz, a LAS with --format text) is
+  // said as what it is, not as a line of names without x, y and z or a column of bytes.
+  if (const auto kind = content_kind_of_file(path))
+    throw FormatError(path, 0, "not a text point file: its first bytes are those of " + *kind);
   in.seekg(0, std::ios::end);
   const std::uint64_t total = static_cast<std::uint64_t>(in.tellg());
   in.seekg(0);
@@ -448,9 +453,10 @@ PointCloud read_text_points(const std::string& path, const TextColumns& columns,
   TextColumns layout = columns;
   const bool named = header && columns.from_header;
   if (named) {
-    if (!columns.xyz_given && !xyz_columns(header->names))
+    if (!columns.xyz_given && !xyz_columns(header->names)) {
       throw FormatError(path, header->offset, "line " + std::to_string(header->line) + " names its columns but none of them x, y and z;"
                                  " say which columns hold them (--columns X Y Z, counted from 1)");
+    }
     layout = columns.xyz_given ? text_columns_of(*header, columns.x, columns.y, columns.z) : text_columns_of(*header);
     layout.skip_lines = columns.skip_lines;
     if (!columns.named_attributes) layout.attributes.clear(), layout.attribute_columns.clear();

@@ -114,6 +114,21 @@ fi
 [ "$(tail -n +2 "$tmp/lyft.xyz" | tr '\n' ' ')" == "1 2 3 40 1 4 5 6 80 2 " ] || fail "translate --format nuscenes: $(cat "$tmp/lyft.xyz")"
 "$vola" convert "$tmp/lyft.bin" "$tmp/lyft.vol" --format nuscenes --voxel-size 1 -q || fail "convert --format nuscenes"
 
+# A file read as another format than its own is named by its first bytes (a WAV renamed
+# .stl read as 2,741 triangles of +-3.4e38; binary read as text asked for --columns).
+wav=$data/audio/alsa_Front_Center.wav
+cp "$wav" "$tmp/sound.stl"
+cp "$wav" "$tmp/sound.xyz"
+for f in sound.stl sound.xyz; do
+  "$vola" convert "$tmp/$f" "$tmp/sound.vol" --voxel-size 1 2> "$tmp/err" && fail "a WAV named $f was converted"
+  grep -q "its first bytes are those of a RIFF file" "$tmp/err" || fail "a WAV named $f: $(cat "$tmp/err")"
+done
+las=$data/las/pdal_autzen_trim.las
+"$vola" info "$las" --format pcd 2> "$tmp/err" && fail "a LAS read as PCD"
+grep -q "not a PCD point file: its first bytes are those of a LAS/LAZ point file" "$tmp/err" || fail "LAS as PCD: $(cat "$tmp/err")"
+"$vola" info "$las" --format text 2> "$tmp/err" && fail "a LAS read as text"
+grep -q "not a text point file" "$tmp/err" || fail "LAS as text: $(cat "$tmp/err")"
+
 # vola info says what it does not read of a plain (N, 6) array, and --summary gives each
 # value as short as reads back (9 significant digits made 1234567890.25 1.23456789e+09).
 "${VOLA_PYTHON:-python3}" - "$tmp/six.npy" <<'PY'
