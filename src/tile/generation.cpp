@@ -1,12 +1,15 @@
 #include "generation.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
 #include <set>
+#include <span>
 
 #include "vola/error.hpp"
 #include "vola/tile/tile_index.hpp"
@@ -41,6 +44,24 @@ std::string host_name() {
 }
 
 }  // namespace
+
+OutputLock::OutputLock(const fs::path& output_dir, Communicator& comm) {
+  std::uint8_t held = 0;  // rank 0: 1 when another process holds the folder
+  if (comm.rank() == 0) {
+    fd_ = ::open((output_dir / ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ >= 0 && ::flock(fd_, LOCK_EX | LOCK_NB) != 0) held = errno == EWOULDBLOCK ? 1 : 0;
+  }
+  const auto answers = comm.all_gather(std::span<const std::uint8_t>(&held, comm.rank() == 0 ? 1 : 0));
+  if (!answers.empty() && !answers[0].empty() && answers[0][0] == 1) {
+    if (fd_ >= 0) ::close(fd_);
+    throw IoError(output_dir.string() + ": another vola tile is writing this tile set (it holds " +
+                  (output_dir / ".lock").string() + "); wait for it to end, or give another folder");
+  }
+}
+
+OutputLock::~OutputLock() {
+  if (fd_ >= 0) ::close(fd_);  // the lock goes with the descriptor
+}
 
 Generation begin_generation(const fs::path& output_dir, Communicator& comm) {
   Generation g;

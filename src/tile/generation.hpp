@@ -21,6 +21,21 @@
 
 namespace vola::tile::detail {
 
+// Rank 0's hold on the output folder for a whole run (flock of OUTDIR/.lock, released
+// when the process ends, however it ends): two runs into one folder both wrote into the
+// same generation, exited 0 and left tiles of either in the set. Every rank learns rank
+// 0's answer; a folder another run holds is an IoError naming it.
+class OutputLock {
+ public:
+  OutputLock(const std::filesystem::path& output_dir, Communicator& comm);
+  ~OutputLock();
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 struct Generation {
   std::filesystem::path output_dir;
   std::string name;  // ".generation-<n>": the prefix of every file the new index names

@@ -668,6 +668,7 @@ TileSummary make_tiles(const std::vector<const PointSource*>& sources, const Til
                                         " is a file, not a folder: give a folder for the tiles and their index (new "
                                         "or one an earlier vola tile wrote)");
   fs::create_directories(options.output_dir);
+  const detail::OutputLock lock(options.output_dir, comm);
   const detail::Generation generation = detail::begin_generation(options.output_dir, comm);
   const fs::path spill_root = options.spill_dir.empty() ? fs::path(options.output_dir) / ".spill" : fs::path(options.spill_dir);
   detail::remove_stale_spill(spill_root);

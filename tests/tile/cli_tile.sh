@@ -214,6 +214,14 @@ grep -q "is not finite or lies beyond" "$tmp/err.txt" || fail "get nan: $(cat "$
   2> "$tmp/err.txt" || fail "tile --assign-crs --target-crs"
 grep -q "relabels its coordinates without moving them, and --target-crs reprojects them from that label" "$tmp/err.txt" ||
   fail "relabel with --target-crs not warned of: $(cat "$tmp/err.txt")"
+# A folder another run is writing is refused (two runs into one folder both exited 0 and
+# left a set mixing their tiles): the lock held here as a running vola tile holds it.
+mkdir -p "$tmp/locked"
+if (flock -x 9 && "$vola" tile "$las" --tile-size 256 --depth 3 -o "$tmp/locked" -q 2> "$tmp/err.txt") 9> "$tmp/locked/.lock"; then
+  fail "a tile set folder another run holds was written"
+fi
+grep -q "another vola tile is writing this tile set" "$tmp/err.txt" || fail "held folder: $(cat "$tmp/err.txt")"
+"$vola" tile "$las" --tile-size 256 --depth 3 -o "$tmp/locked" -q || fail "the folder, released, was refused"
 # A field the file has but tile does not read: named as such, with what to do (the points
 # were said to have no such dimension).
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/first" --where "ReturnNumber == 1" 2> "$tmp/err.txt" &&
