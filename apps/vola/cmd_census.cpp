@@ -126,11 +126,13 @@ void run_census(const CensusArgs& a) {
     j["heights"] = histogram_json(c.heights);
     j["attributes"] = nlohmann::json::array();
     for (const auto& at : c.attributes) {
+      // A column without a single value (a field that is no_data on every point) has no
+      // mean and no histogram: null, not a mean of 0 over 16 empty bins.
       nlohmann::json col{{"name", at.name},
                          {"count", at.count},
                          {"without_value", at.without_value},
-                         {"mean", at.mean},
-                         {"histogram", histogram_json(at.histogram)}};
+                         {"mean", at.count ? nlohmann::json(at.mean) : nlohmann::json(nullptr)},
+                         {"histogram", at.count ? histogram_json(at.histogram) : nlohmann::json(nullptr)}};
       if (at.name == "classification") {
         col["classes"] = nlohmann::json::array();
         for (const auto& k : at.classes)
@@ -160,6 +162,11 @@ void run_census(const CensusArgs& a) {
   std::printf("  voxel centre z:\n");
   print_histogram(c.heights);
   for (const auto& at : c.attributes) {
+    if (at.count == 0) {
+      std::printf("  attribute %s: no value (%llu voxels without one)\n", at.name.c_str(),
+                  static_cast<unsigned long long>(at.without_value));
+      continue;
+    }
     std::printf("  attribute %s: %llu values, mean %.6g%s\n", at.name.c_str(),
                 static_cast<unsigned long long>(at.count), at.mean,
                 at.without_value ? (" (" + std::to_string(at.without_value) + " voxels without a value)").c_str() : "");

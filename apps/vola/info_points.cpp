@@ -25,6 +25,7 @@
 #include "vola/io/npy.hpp"
 #include "vola/io/text_points.hpp"
 #include "vola/io/translate.hpp"
+#include "vola/number_text.hpp"
 
 namespace vola::cli {
 
@@ -614,8 +615,15 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
   std::printf("points:      %llu, point format %u, %u bytes a record\n",
               static_cast<unsigned long long>(hd.point_count), hd.point_format, hd.record_length);
   std::printf("crs:         %s\n", crs_text(crs_definition(hd.wkt, hd.epsg)).c_str());
-  std::printf("scale:       %.9g %.9g %.9g, offset %.9g %.9g %.9g\n", hd.scale[0], hd.scale[1], hd.scale[2],
-              hd.offset[0], hd.offset[1], hd.offset[2]);
+  // As the file holds them, the shortest text that reads back (9 digits made the offset
+  // 674521.9200134277 read 674521.92 beside bounds at 674521.920013428).
+  const auto exact = [](double v) {
+    char text[kNumberTextSize];
+    return std::string(text, write_number(text, v));
+  };
+  std::printf("scale:       %s %s %s, offset %s %s %s\n", exact(hd.scale[0]).c_str(), exact(hd.scale[1]).c_str(),
+              exact(hd.scale[2]).c_str(), exact(hd.offset[0]).c_str(), exact(hd.offset[1]).c_str(),
+              exact(hd.offset[2]).c_str());
   std::printf("bounds:      min %s\n             max %s (the header's)\n", las_point_text(hd.min.data(), hd).c_str(),
               las_point_text(hd.max.data(), hd).c_str());
   std::printf("dimensions:  x y z");

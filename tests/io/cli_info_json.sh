@@ -244,6 +244,13 @@ printf 'x y z\n1 2 3\nnan 2 3\n4 inf 6\n7 8 9\n' > "$tmp/nan.xyz"
 "$vola" info "$tmp/nan.xyz" | grep -q "^points: *2 (and 2 with a coordinate that is not finite, left out)" ||
   fail "info of non-finite rows: $("$vola" info "$tmp/nan.xyz")"
 "$vola" info --json "$tmp/nan.xyz" | grep -q '"points_not_finite": 2' || fail "info --json of non-finite rows"
+# The header's scale and offset as the file holds them (9 digits cut 674521.9200134277).
+"$vola" info "$data/las/pdal_sample_c.las" | grep -q "offset 674521.9200134277 1206740.0800170898 627.530029296875$" ||
+  fail "sample_c offset: $("$vola" info "$data/las/pdal_sample_c.las" | grep scale)"
+# A column without a value (append-bug's Deviation is no_data on every point): no mean of 0.
+"$vola" convert "$data/laz/laspy_append-bug.laz" "$tmp/append.vol" --voxel-size 1 -q 2> /dev/null
+"$vola" census "$tmp/append.vol" | grep -q "attribute Deviation: no value (4035 voxels without one)" ||
+  fail "census of a column without a value: $("$vola" census "$tmp/append.vol" | grep -A1 Deviation)"
 # Class names from the file's LAS version: 12 is "Overlap Points" in LAS 1.0-1.3 (mvk-thin
 # is 1.2), "Reserved" in 1.4's table, which named every file's classes.
 "$vola" info "$data/las/pdal_mvk-thin.las" --summary | grep -Eq "^class: +12 Overlap Points +3702$" ||
