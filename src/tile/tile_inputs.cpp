@@ -151,6 +151,31 @@ OpenedInputs open_inputs(const TileInputs& in, TileOptions& options) {
   if (!in.filters.empty())
     for (auto& s : out.sources) s = filtered(std::move(s), in.filters);
   out.warnings = crs_warnings(in, out.sources);
+  // Filters run in each input's own CRS, before any reprojection: one box or polygon
+  // cannot crop inputs in different CRSs (a crop in UTM metres dropped a whole file in
+  // Oregon feet, exit 0).
+  if (in.assign_crs.empty() && !in.target_crs.empty() &&
+      std::any_of(in.filters.begin(), in.filters.end(),
+                  [](const std::string& f) { return f.rfind("crop:", 0) == 0 || f.rfind("polygon:", 0) == 0; })) {
+    const auto said = [](const PointSource& s) {
+      return !s.wkt.empty() ? s.wkt : s.epsg ? "EPSG:" + std::to_string(*s.epsg) : std::string();
+    };
+    for (const auto& s : out.sources) {
+      const PointSource& first = *out.sources.front();
+      bool same = said(*s) == said(first);
+      try {
+        same = same || (!said(*s).empty() && !said(first).empty() && geo::same_crs(said(*s), said(first)));
+      } catch (const Error&) {
+        // A CRS PROJ cannot read: resolve_tile_crs reports what matters.
+      }
+      if (same) continue;
+      out.warnings.push_back("the crop runs in each input's own CRS, before the reprojection to " + in.target_crs +
+                             ", and " + first.name() + " and " + s->name() +
+                             " are in different CRSs: one box or polygon cannot crop both (crop each with vola "
+                             "translate, or reproject them to one CRS, first)");
+      break;
+    }
+  }
   reproject_sources(in, out.sources);
   // After a reprojection every source states the target.
   resolve_tile_crs(in.target_crs.empty() ? in.assign_crs : std::string(), in.allow_geographic, out.sources, options);

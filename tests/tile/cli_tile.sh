@@ -222,6 +222,11 @@ if (flock -x 9 && "$vola" tile "$las" --tile-size 256 --depth 3 -o "$tmp/locked"
 fi
 grep -q "another vola tile is writing this tile set" "$tmp/err.txt" || fail "held folder: $(cat "$tmp/err.txt")"
 "$vola" tile "$las" --tile-size 256 --depth 3 -o "$tmp/locked" -q || fail "the folder, released, was refused"
+# A crop over inputs in different CRSs runs in each one's own CRS (a whole file was dropped
+# without a word): said.
+"$vola" tile "$data/las/pdal_autzen-utm.las" "$data/las/pdal_autzen_pf1.las" --target-crs EPSG:26910 \
+  --crop 636000 4870000 640000 4890000 --tile-size 256 --depth 3 -o "$tmp/mixed_crop" -q 2> "$tmp/err.txt" || true
+grep -q "the crop runs in each input's own CRS" "$tmp/err.txt" || fail "a crop over two CRSs: $(cat "$tmp/err.txt")"
 # A field the file has but tile does not read: named as such, with what to do (the points
 # were said to have no such dimension).
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/first" --where "ReturnNumber == 1" 2> "$tmp/err.txt" &&
