@@ -2,8 +2,10 @@
 // evaluated per point (no allocation per point).
 #include "vola/filters/expression.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 
 #include "vola/error.hpp"
@@ -262,13 +264,24 @@ bool Expression::eval(const Bound& bound, const PointCloud& cloud, std::size_t n
   }
   const double a = n.a.is_dimension ? value_of(cloud, bound.slots_[n.a.slot], point) : n.a.number;
   const double b = n.b.is_dimension ? value_of(cloud, bound.slots_[n.b.slot], point) : n.b.number;
+  // A number typed against a value: equal within a trillionth, so that `Z == 414.53` finds
+  // the points a LAS file stores as 41453 x 0.01 (414.53000000000003 as a double, which
+  // the text writers print as 414.53), and `Z <= 414.53` keeps them.
+  const bool typed = !n.a.is_dimension || !n.b.is_dimension;
+  const bool equal = a == b || (typed && std::fabs(a - b) <= 1e-12 * std::max(std::fabs(a), std::fabs(b)));
   switch (n.op) {
-    case Compare::eq: return a == b;
-    case Compare::ne: return a != b;
-    case Compare::lt: return a < b;
-    case Compare::le: return a <= b;
-    case Compare::gt: return a > b;
-    case Compare::ge: return a >= b;
+    case Compare::eq:
+      return equal;
+    case Compare::ne:
+      return !equal;
+    case Compare::lt:
+      return a < b && !equal;
+    case Compare::le:
+      return a <= b || equal;
+    case Compare::gt:
+      return a > b && !equal;
+    case Compare::ge:
+      return a >= b || equal;
   }
   return false;
 }

@@ -57,6 +57,28 @@ TEST(Expression, ComparisonsOnAxesAndColumns) {
   expect_same("x < z", [](double x, double z, double, double, double) { return x < z; });
 }
 
+TEST(Expression, ATypedNumberEqualsTheStoredDecimalsOfAValue) {
+  // LAS stores 414.53 as 41453 x 0.01, 414.53000000000003 as a double: `Z == 414.53` found
+  // none of such points, and `Z <= 414.53` dropped them.
+  vola::PointCloud cloud;
+  for (const std::int32_t stored : {41452, 41453, 41453, 41454})
+    cloud.xyz.insert(cloud.xyz.end(), {0.0, 0.0, stored * 0.01});
+  ASSERT_NE(cloud.xyz[5], 414.53);  // the case is real
+  const auto count = [&](const std::string& text) {
+    const std::vector<bool> keep = Expression(text).evaluate(cloud);
+    return std::count(keep.begin(), keep.end(), true);
+  };
+  EXPECT_EQ(count("Z == 414.53"), 2);
+  EXPECT_EQ(count("Z != 414.53"), 2);
+  EXPECT_EQ(count("Z <= 414.53"), 3);
+  EXPECT_EQ(count("Z < 414.53"), 1);
+  EXPECT_EQ(count("Z >= 414.53"), 3);
+  EXPECT_EQ(count("Z > 414.53"), 1);
+  EXPECT_EQ(count("414.53 == Z"), 2);
+  // Values a whole unit of the stored precision apart stay apart.
+  EXPECT_EQ(count("Z == 414.52"), 1);
+}
+
 TEST(Expression, AndBindsTighterThanOr) {
   expect_same("classification == 1 || classification == 2 && intensity > 50",
               [](double, double, double c, double in, double) { return c == 1 || (c == 2 && in > 50); });
