@@ -58,6 +58,11 @@ bool is_geographic_crs(const std::string& definition);
 // vertical part: PROJ moves x and y and leaves z in the source's vertical unit.
 std::string unconverted_heights(const std::string& source, const std::string& target);
 
+// Whether assigning `assigned` to points that state `stated` moves their meaning in x and
+// y: false when it is the same CRS, or a compound CRS whose horizontal part is the stated
+// one (the heights given a vertical datum). Throws vola::Error when PROJ cannot read either.
+bool relabels_horizontally(const std::string& stated, const std::string& assigned);
+
 // A compound CRS whose heights are in another unit than x and y (NAD83 / Oregon Lambert in
 // metres + NAVD88 in US survey feet): voxels of one size in it are not cubes. The sentence
 // to tell the user; else "" (one unit, degrees, or what PROJ cannot read).

@@ -189,6 +189,12 @@ std::string unconverted_heights(const std::string& source, const std::string& ta
   }
 }
 
+bool relabels_horizontally(const std::string& stated, const std::string& assigned) {
+  if (geo::same_crs(stated, assigned)) return false;
+  const geo::CrsDescription a = geo::describe_crs(assigned);
+  return a.vertical_name.empty() || !a.epsg || !geo::same_crs(stated, "EPSG:" + std::to_string(*a.epsg));
+}
+
 std::string mixed_units(const std::string& definition) {
   try {
     const geo::CrsDescription d = geo::describe_crs(crs_definition_of(definition), geo::EpsgLookup::own_id_only);

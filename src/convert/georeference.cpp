@@ -96,7 +96,7 @@ std::vector<std::string> crs_warnings(const std::string& path, const ConvertOpti
   const std::string given = given_crs(options);
   try {
     const std::string stated = !input.wkt.empty() ? input.wkt : input.epsg ? "EPSG:" + std::to_string(*input.epsg) : "";
-    if (!given.empty() && !stated.empty() && !geo::same_crs(stated, crs_definition_of(given)))
+    if (!given.empty() && !stated.empty() && relabels_horizontally(stated, crs_definition_of(given)))
       out.push_back(path + " states " + geo::crs_summary(geo::describe_crs(stated)) + "; `assign_crs` " +
                     given.substr(0, 60) + " relabels its coordinates without moving them" +
                     (options.target_crs.empty() ? " (to move them, give `target_crs`)"

@@ -95,7 +95,7 @@ std::vector<std::string> crs_warnings(const TileInputs& in, const std::vector<st
     const std::string said = !s->wkt.empty() ? s->wkt : s->epsg ? "EPSG:" + std::to_string(*s->epsg) : "";
     if (in.assign_crs.empty() || said.empty()) continue;
     try {
-      if (!geo::same_crs(said, crs_definition_of(in.assign_crs)))
+      if (relabels_horizontally(said, crs_definition_of(in.assign_crs)))
         warnings.push_back(s->name() + " states " + geo::crs_summary(geo::describe_crs(said)) + "; `assign_crs` " +
                            in.assign_crs.substr(0, 60) + " relabels its coordinates without moving them" +
                            (in.target_crs.empty() ? " (to move them, give `target_crs`)"
