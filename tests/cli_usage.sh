@@ -16,6 +16,10 @@ expect_suggestion transalte translate
 expect_suggestion inf info
 if "$vola" xyzzy 2> "$tmp/err.txt"; then fail "'xyzzy' ran"; fi
 grep -q "'xyzzy' is not a vola subcommand (vola --help" "$tmp/err.txt" || fail "xyzzy: $(cat "$tmp/err.txt")"
+# Another tool's word for what a subcommand does: where it is.
+"$vola" raster a.vol out.tif 2> "$tmp/err.txt" && fail "vola raster ran"
+grep -q "'raster' is not a vola subcommand; use vola export FILE.vol OUT.tif --raster dsm" "$tmp/err.txt" ||
+  fail "raster: $(cat "$tmp/err.txt")"
 "$vola" info --help > /dev/null || fail "vola info --help failed"
 
 # A mistyped option gets the nearest of its subcommand's options, after CLI11's own words.

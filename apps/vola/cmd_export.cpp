@@ -320,7 +320,7 @@ void add_export(CLI::App& app) {
   cmd->add_option("--occupancy-above", args->above, "PNG: top-down occupancy map of the voxels at z >= Z (voxel units)")
       ->each([args](const std::string&) { args->above_given = true; });
   cmd->add_option("--raster", args->raster, "GeoTIFF: dsm, dtm, intensity, density or count per cell")
-      ->check(CLI::IsMember({"dsm", "dtm", "intensity", "density", "count"}));
+      ->check(CLI::IsMember({"dsm", "dtm", "intensity", "density", "count"}, CLI::ignore_case));  // DSM too
   cmd->add_option("--resolution", args->resolution, "--raster: cell size in the file's units (default: the voxel size)")
       ->check(positive_number())
       ->each([args](const std::string&) { args->resolution_given = true; });

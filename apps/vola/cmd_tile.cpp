@@ -180,7 +180,9 @@ void add_tile(CLI::App& app) {
   cmd->add_option("--origin", args->origin, "World position of tile (0,0,0)'s corner")->expected(3);
   add_crs_options(*cmd, args->assign_crs, args->target_crs, args->allow_geographic, "--tile-size and --origin");
   add_filter_options(*cmd, args->filters, false);
-  cmd->add_option("--memory", args->memory, "Memory budget per process: key buffers, sorting and merging stay within it")
+  cmd->add_option("--memory", args->memory,
+                  "Memory budget per process, at least 1M: key buffers, sorting and merging stay within it; a tile "
+                  "being built holds its own voxels beyond it (a warning says when the largest tile may need more)")
       ->capture_default_str();
   cmd->add_option("--tmp", args->spill_dir, "Folder for spill files (default: OUTDIR/.spill; removed at the end)");
   cmd->add_option("--threads", args->threads, "Threads per process (0 = all cores)")->capture_default_str();

@@ -435,12 +435,23 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
         !std::isfinite(in.cloud.xyz[3 * i + 2]))
       ++not_finite;
   const std::uint64_t points = in.cloud.size() + in.not_finite - not_finite;
+  // The points' own bounds: the file was read whole anyway (`--help` promised them; only
+  // --summary gave them).
+  std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t i = 0; i < in.cloud.size(); ++i) {
+    const double* p = &in.cloud.xyz[3 * i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  }
+  const bool bounded = points > 0 && lo[0] <= hi[0];
   if (json) {
-    ordered_json doc = {{"file", path},
-                        {"format", in.format},
-                        {"points", points},
-                        {"points_not_finite", not_finite},
-                        {"crs", crs_json(in.wkt, in.epsg)}};
+    ordered_json doc = {
+        {"file", path},
+        {"format", in.format},
+        {"points", points},
+        {"points_not_finite", not_finite},
+        {"crs", crs_json(in.wkt, in.epsg)},
+        {"bounds", bounded ? ordered_json({{"min", xyz(lo.data())}, {"max", xyz(hi.data())}}) : ordered_json(nullptr)}};
     ordered_json dimensions = ordered_json::array();
     for (const auto& a : in.cloud.attributes) dimensions.push_back({{"name", a.name}, {"type", name_of(a.type)}});
     doc["dimensions"] = std::move(dimensions);
@@ -460,6 +471,8 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
   std::printf("\n");
   if (e57) print_e57_scans(io::e57_summary(path));
   std::printf("crs:         %s\n", crs_text(crs_definition(in.wkt, in.epsg)).c_str());
+  if (bounded)
+    std::printf("bounds:      min %s\n             max %s\n", point_text(lo).c_str(), point_text(hi).c_str());
   std::printf("columns:    ");
   for (const auto& a : in.cloud.attributes)
     std::printf(" %s (%s)", a.name.c_str(), std::string(name_of(a.type)).c_str());
@@ -626,6 +639,14 @@ void print_point_file_info(const std::string& path, bool summary, bool json) {
               exact(hd.offset[2]).c_str());
   std::printf("bounds:      min %s\n             max %s (the header's)\n", las_point_text(hd.min.data(), hd).c_str(),
               las_point_text(hd.max.data(), hd).c_str());
+  // A CRS label the coordinates cannot fit (lone-star's geocentric keys over UTM metres),
+  // as vola convert warns of it: info is where a GIS user looks first.
+  if (const std::string definition = crs_definition(hd.wkt, hd.epsg); !definition.empty()) {
+    const Box box{{hd.min[0], hd.min[1], hd.min[2]}, {hd.max[0], hd.max[1], hd.max[2]}};
+    std::string doubt = implausible_geocentric(definition, box);
+    if (doubt.empty()) doubt = implausible_degrees(definition, hd.min[0], hd.min[1], hd.max[0], hd.max[1]);
+    if (!doubt.empty()) std::fprintf(stderr, "vola: warning: %s: %s\n", path.c_str(), doubt.c_str());
+  }
   std::printf("dimensions:  x y z");
   for (const auto& a : io::las_columns(hd).attributes) std::printf(" %s", a.name.c_str());
   std::printf("\n");

@@ -1,6 +1,7 @@
 #include "suggest.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 namespace vola::cli {
@@ -41,6 +42,18 @@ std::optional<std::string> unknown_subcommand(const CLI::App& app, int argc, cha
     }
   }
   std::string message = "'" + word + "' is not a vola subcommand";
+  // Words of other tools for what a vola subcommand does under another name.
+  static const std::pair<const char*, const char*> kElsewhere[] = {
+      {"raster", "vola export FILE.vol OUT.tif --raster dsm"},
+      {"dsm", "vola export FILE.vol OUT.tif --raster dsm"},
+      {"dtm", "vola export FILE.vol OUT.tif --raster dtm"},
+      {"dem", "vola export FILE.vol OUT.tif --raster dtm"},
+      {"merge", "vola union A.vol B.vol OUT.vol"},
+      {"crop", "vola translate IN OUT --crop ..."},
+      {"filter", "vola translate IN OUT --filter ..."},
+      {"classify-ground", "vola translate IN OUT --filter smrf"}};
+  for (const auto& [other, use] : kElsewhere)
+    if (word == other) return message + "; use " + use + " (vola --help lists the subcommands)";
   if (!best.empty()) message += "; did you mean '" + best + "'?";
   return message + " (vola --help lists them)";
 }

@@ -1,6 +1,7 @@
 // GeoTIFF rasters of a tree (vola/io/export.hpp): the cells computed here, the file
 // written by the gdal plugin (src/io/plugins/raster_gdal.cpp).
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -32,9 +33,14 @@ std::string number(double value) {
 }  // namespace
 
 std::optional<RasterProduct> raster_product(std::string_view name) {
+  const auto same = [&](std::string_view known) {  // any case: "DSM" as GIS tools write it
+    return name.size() == known.size() && std::equal(name.begin(), name.end(), known.begin(), [](char a, char b) {
+             return std::tolower(static_cast<unsigned char>(a)) == b;
+           });
+  };
   for (const RasterProduct product : {RasterProduct::dsm, RasterProduct::dtm, RasterProduct::intensity,
                                       RasterProduct::density, RasterProduct::count})
-    if (name == raster_product_name(product)) return product;
+    if (same(raster_product_name(product))) return product;
   return std::nullopt;
 }
 

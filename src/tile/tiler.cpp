@@ -408,6 +408,18 @@ void Tiling::share_statistics(const StatMap& stats, std::uint64_t points_read, s
                   static_cast<unsigned long long>(options.max_tiles));
     throw OptionError("max_tiles", text);
   }
+  // --memory bounds the buffers, sorts and merges; a tile being built holds its own voxels
+  // (about 10 bytes each, 12 more a column: SCALING.md) beyond it. Said when the largest
+  // tile's points could need more than the whole budget (it ran silently at 88 MiB under 1M).
+  std::uint64_t largest = 0;
+  for (const auto& [t, st] : all_stats) largest = std::max(largest, st.points);
+  const std::uint64_t need = largest * (10 + 12 * specs.size());
+  if (rank == 0 && need > options.memory_budget)
+    summary.warnings.push_back("the largest tile holds " + std::to_string(largest) +
+                               " points: building it may take up to " + std::to_string(need >> 20) +
+                               " MiB beyond --memory's " + std::to_string(options.memory_budget >> 20) +
+                               " MiB (which bounds the buffers, sorts and merges); a smaller --tile-size or --depth "
+                               "bounds it");
 }
 
 // 3. Each tile's keys go to its owner (one gather per tile, all ranks in step).

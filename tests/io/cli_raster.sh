@@ -61,6 +61,9 @@ run "$vola" export "$tmp/a.vol" "$tmp/a_dsm6.tif" --raster dsm --resolution 6 -q
 run "$vola" export "$tmp/a.vol" "$tmp/a_count6.tif" --raster count --resolution 6 -q
 run "$vola" export "$tmp/a.vol" "$tmp/a_intensity6.tif" --raster intensity --resolution 6 -q
 run "$vola" export "$tmp/b.vol" "$tmp/b_dsm.tif" --raster dsm -q
+# The products in any case, as GIS tools write them: the same file.
+run "$vola" export "$tmp/b.vol" "$tmp/b_DSM.tif" --raster DSM -q
+cmp -s "$tmp/b_dsm.tif" "$tmp/b_DSM.tif" || fail "--raster DSM wrote another file than --raster dsm"
 run "$vola" export "$tmp/b.vol" "$tmp/b_dtm.tif" --raster dtm -q
 run "$vola" export "$tmp/t.vol" "$tmp/t_dsm.tif" --raster dsm -q
 run "$vola" export "$golden" "$tmp/g_count.tif" --raster count -q

@@ -227,6 +227,11 @@ grep -q "another vola tile is writing this tile set" "$tmp/err.txt" || fail "hel
 "$vola" tile "$data/las/pdal_autzen-utm.las" "$data/las/pdal_autzen_pf1.las" --target-crs EPSG:26910 \
   --crop 636000 4870000 640000 4890000 --tile-size 256 --depth 3 -o "$tmp/mixed_crop" -q 2> "$tmp/err.txt" || true
 grep -q "the crop runs in each input's own CRS" "$tmp/err.txt" || fail "a crop over two CRSs: $(cat "$tmp/err.txt")"
+# --memory bounds buffers, not a tile being built: a tile that may need more is said.
+"$vola" tile "$las" --tile-size 4000 --depth 6 --memory 1M -o "$tmp/big_tile" --no-overviews -q 2> "$tmp/err.txt" ||
+  fail "tile under 1M"
+grep -q "the largest tile holds 110000 points: building it may take up to .* MiB beyond --memory's 1 MiB" "$tmp/err.txt" ||
+  fail "a tile beyond --memory not said: $(cat "$tmp/err.txt")"
 # A field the file has but tile does not read: named as such, with what to do (the points
 # were said to have no such dimension).
 "$vola" tile "$las" --tile-size 256 --depth 4 -o "$tmp/first" --where "ReturnNumber == 1" 2> "$tmp/err.txt" &&
