@@ -429,20 +429,19 @@ void print_point_cloud_info(const std::string& path, bool summary, bool json, co
   const bool e57 = in.format == "e57";
   // Points with a coordinate that is not finite: the PCD reader leaves them out, the other
   // readers keep them for convert to drop (and count); counted alike here, as convert does.
+  // And the points' own bounds: the file was read whole anyway (`--help` promised them;
+  // only --summary gave them). One pass for both.
   std::uint64_t not_finite = in.not_finite;
-  for (std::size_t i = 0; i < in.cloud.size(); ++i)
-    if (!std::isfinite(in.cloud.xyz[3 * i]) || !std::isfinite(in.cloud.xyz[3 * i + 1]) ||
-        !std::isfinite(in.cloud.xyz[3 * i + 2]))
-      ++not_finite;
-  const std::uint64_t points = in.cloud.size() + in.not_finite - not_finite;
-  // The points' own bounds: the file was read whole anyway (`--help` promised them; only
-  // --summary gave them).
   std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (std::size_t i = 0; i < in.cloud.size(); ++i) {
     const double* p = &in.cloud.xyz[3 * i];
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      ++not_finite;
+      continue;
+    }
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
   }
+  const std::uint64_t points = in.cloud.size() + in.not_finite - not_finite;
   const bool bounded = points > 0 && lo[0] <= hi[0];
   if (json) {
     ordered_json doc = {
