@@ -22,7 +22,8 @@ grep -q "'raster' is not a vola subcommand; use vola export FILE.vol OUT.tif --r
   fail "raster: $(cat "$tmp/err.txt")"
 "$vola" info --help > /dev/null || fail "vola info --help failed"
 
-# A mistyped option gets the nearest of its subcommand's options, after CLI11's own words.
+# A mistyped option gets the nearest of its subcommand's options, in one line: CLI11's
+# "arguments were not expected" said the same thing again before it.
 printf '0 0 0\n1000 0 0\n' > "$tmp/pair.xyz"
 expect_option_suggestion() {  # SUBCOMMAND WRONG RIGHT ARGS...
   local command=$1 wrong=$2 right=$3
@@ -30,6 +31,7 @@ expect_option_suggestion() {  # SUBCOMMAND WRONG RIGHT ARGS...
   if "$vola" "$command" "$@" 2> "$tmp/err.txt"; then fail "'$wrong' ran"; fi
   grep -qF -- "'$wrong' is not an option of vola $command; did you mean '$right'?" "$tmp/err.txt" ||
     fail "'$wrong': $(cat "$tmp/err.txt")"
+  [ "$(wc -l < "$tmp/err.txt")" -eq 1 ] || fail "'$wrong' said more than one line: $(cat "$tmp/err.txt")"
 }
 expect_option_suggestion convert --voxelsize --voxel-size "$tmp/pair.xyz" "$tmp/o.vol" --voxelsize 3
 expect_option_suggestion convert --voxel_size --voxel-size "$tmp/pair.xyz" "$tmp/o.vol" --voxel_size=3

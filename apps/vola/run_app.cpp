@@ -22,10 +22,13 @@ int run_app(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int status = app.exit(e);
-    if (status != 0)
-      if (const auto unknown = unknown_option(app, argc, argv)) std::fprintf(stderr, "vola: %s\n", unknown->c_str());
-    return status;
+    // A mistyped option gets vola's one line with a suggestion, not CLI11's text as well.
+    if (e.get_exit_code() != 0)
+      if (const auto unknown = unknown_option(app, argc, argv)) {
+        std::fprintf(stderr, "vola: %s\n", unknown->c_str());
+        return e.get_exit_code();
+      }
+    return app.exit(e);
   } catch (const vola::OptionError& e) {
     std::fprintf(stderr, "vola: %s\n", in_flags(e).c_str());
     return 1;
