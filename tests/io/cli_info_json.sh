@@ -255,8 +255,10 @@ printf 'x y z\n1 2 3\nnan 2 3\n4 inf 6\n7 8 9\n' > "$tmp/nan.xyz"
 # doubts a CRS label the header's bounds cannot fit, as convert does.
 "$vola" info "$data/pcd/pdal_autzen-utm.pcd" | grep -q "^bounds: *min (493994.87, 4877429.62, 123.93)" ||
   fail "PCD bounds: $("$vola" info "$data/pcd/pdal_autzen-utm.pcd")"
-"$vola" info "$data/laz/pdal_lone-star-split-1.laz" 2> "$tmp/err" > /dev/null
+"$vola" info "$data/laz/pdal_lone-star-split-1.laz" 2> "$tmp/err" > "$tmp/out"
 grep -q "a geocentric CRS: the CRS label is likely wrong" "$tmp/err" || fail "lone-star's label: $(cat "$tmp/err")"
+# GDAL's WKT of its keys names the CRS "unnamed"; the code PROJ finds has a name.
+grep -q "^crs: *WGS 84 (EPSG:4978), geocentric, metre$" "$tmp/out" || fail "lone-star's CRS line: $(grep crs "$tmp/out")"
 # Class names from the file's LAS version: 12 is "Overlap Points" in LAS 1.0-1.3 (mvk-thin
 # is 1.2), "Reserved" in 1.4's table, which named every file's classes.
 "$vola" info "$data/las/pdal_mvk-thin.las" --summary | grep -Eq "^class: +12 Overlap Points +3702$" ||

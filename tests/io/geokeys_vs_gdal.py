@@ -26,7 +26,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from osgeo import gdal
+from osgeo import gdal, osr
 
 gdal.UseExceptions()
 gdal.PushErrorHandler("CPLQuietErrorHandler")  # GDAL warns that the unit differs from the code's
@@ -178,6 +178,13 @@ def keys_as_gdal_reads(vola, tmp, failures):
                                         text=True).stdout).get("crs") or {}
         want = (srs.GetName(), srs.GetLinearUnitsName()) if srs else (None, None)
         got = (crs.get("name"), crs.get("unit"))
+        # GDAL names a CRS it assembles from keys "unnamed"; where that CRS is an EPSG
+        # code's, vola gives the code's name (EPSG:4978 is "WGS 84"), as GDAL names the code.
+        if want[0] == "unnamed" and crs.get("epsg"):
+            code = osr.SpatialReference()
+            code.ImportFromEPSG(crs["epsg"])
+            if srs.IsSame(code):
+                want = (code.GetName(), want[1])
         print(f"{what}: GDAL {want}, vola {got}")
         checked += 1
         if got != want:

@@ -261,6 +261,14 @@ CrsDescription describe_with_proj(const std::string& definition, EpsgLookup look
                    : epsg_code(proj_get_id_auth_name(horizontal.get(), 0), proj_get_id_code(horizontal.get(), 0));
     out.horizontal_unit = axis_unit(ctx.get(), horizontal.get());
   }
+  // GDAL names a CRS it builds from GeoTIFF keys "unnamed" (a geocentric model over a
+  // geographic code); the code PROJ identified has a name of its own ("WGS 84").
+  if ((out.name.empty() || out.name == "unnamed" || out.name == "unknown") && out.epsg &&
+      proj_get_type(crs.get()) != PJ_TYPE_COMPOUND_CRS) {
+    const std::string code = std::to_string(*out.epsg);
+    const Pj known(proj_create_from_database(ctx.get(), "EPSG", code.c_str(), PJ_CATEGORY_CRS, 0, nullptr));
+    if (const char* known_name = known ? proj_get_name(known.get()) : nullptr) out.name = known_name;
+  }
   if (proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
     const Pj vertical = unbound(ctx.get(), Pj(proj_crs_get_sub_crs(ctx.get(), crs.get(), 1)));
     if (vertical) {
