@@ -1,12 +1,14 @@
-// vola info on a tile set (the index.geojson vola tile writes, or its folder): the grid,
-// the CRS, the tiles' counts and bounds, the attribute columns and the overview pyramid,
-// from the index alone (no tile is opened).
+// vola info on a tile set (the index.geojson vola tile writes, its folder or the
+// index.gpkg beside it): the grid, the CRS, the tiles' counts and bounds, the attribute
+// columns and the overview pyramid, from the index (no tile is opened; each file's size
+// is checked against the index).
 #include "info_tiles.hpp"
 
 #include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -52,6 +54,29 @@ std::optional<geo::CrsDescription> describe(const tile::TileIndexFile& index) {
   }
 }
 
+// The index's files that are not there, or not of the size it lists (a tile deleted or
+// rewritten since): info reads the index alone, so the set looked whole without this.
+struct FileCheck {
+  std::vector<std::string> missing, resized;
+};
+
+FileCheck check_files(const tile::TileIndexFile& index, const std::string& index_path) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(index_path).parent_path();
+  FileCheck check;
+  std::error_code ec;
+  for (const tile::TileEntry& e : index.tiles) {
+    const std::uintmax_t size = fs::file_size(folder / e.file, ec);
+    if (ec)
+      check.missing.push_back(e.file);
+    else if (e.bytes != 0 && size != e.bytes)
+      check.resized.push_back(e.file);
+  }
+  for (const tile::OverviewEntry& o : index.overviews)
+    if (!fs::is_regular_file(folder / o.file, ec)) check.missing.push_back(o.file);
+  return check;
+}
+
 }  // namespace
 
 std::optional<std::string> tile_index_of(const std::string& path) {
@@ -64,20 +89,38 @@ std::optional<std::string> tile_index_of(const std::string& path) {
                             ": vola info reads a file, or a tile set's folder (vola tile -o FOLDER)");
     return index.string();
   }
-  if (io::lower_extension(path) == ".geojson") return path;
+  const std::string extension = io::lower_extension(path);
+  if (extension == ".geojson") return path;
+  if (extension == ".gpkg") {  // vola tile writes the GeoPackage beside the index it reads
+    const fs::path index = fs::path(path).replace_extension(".geojson");
+    if (fs::is_regular_file(index, ec)) return index.string();
+    throw InvalidArgument(path + ": vola reads a tile set from its GeoJSON index, and there is no " +
+                          index.filename().string() + " beside this GeoPackage");
+  }
   return std::nullopt;
 }
 
 void print_tile_index_info(const std::string& path, bool json) {
   const tile::TileIndexFile index = tile::read_tile_index(path);
   const TileTotals t = totals_of(index);
+  const FileCheck files = check_files(index, path);
+  const std::size_t listed = index.tiles.size() + index.overviews.size();
+  if (!files.missing.empty())
+    std::fprintf(stderr,
+                 "vola: warning: %s lists %zu of its %zu files that are not there (first: %s); run vola tile again\n",
+                 path.c_str(), files.missing.size(), listed, files.missing.front().c_str());
+  if (!files.resized.empty())
+    std::fprintf(stderr,
+                 "vola: warning: %s: %zu tiles are not of the size the index lists (first: %s): changed since vola "
+                 "tile wrote them\n",
+                 path.c_str(), files.resized.size(), files.resized.front().c_str());
   const auto crs = describe(index);
   std::map<int, std::size_t> overviews;  // level -> files
   for (const tile::OverviewEntry& o : index.overviews) ++overviews[o.level];
   const tile::TileGrid& g = index.grid;
   if (json) {
     ordered_json levels = ordered_json::array();
-    for (const auto& [level, files] : overviews) levels.push_back({{"level", level}, {"files", files}});
+    for (const auto& [level, count] : overviews) levels.push_back({{"level", level}, {"files", count}});
     ordered_json doc = {
         {"file", path},
         {"kind", "tile index"},
@@ -101,7 +144,9 @@ void print_tile_index_info(const std::string& path, bool json) {
                                          {"max", {t.bbox.max[0], t.bbox.max[1], t.bbox.max[2]}}})
                          : ordered_json(nullptr)},
         {"attributes", index.attributes},
-        {"overviews", levels}};
+        {"overviews", levels},
+        {"missing_files", files.missing},
+        {"resized_files", files.resized}};
     std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
@@ -127,8 +172,13 @@ void print_tile_index_info(const std::string& path, bool json) {
   for (const std::string& a : index.attributes) columns += (columns.empty() ? "" : ", ") + a;
   std::printf("attributes:  %s\n", columns.empty() ? "none (occupancy only)" : columns.c_str());
   if (overviews.empty()) std::printf("overviews:   none\n");
-  for (const auto& [level, files] : overviews)
-    std::printf("overviews:   level %d (voxels %d times the tiles'), %zu files\n", level, 1 << (2 * level), files);
+  for (const auto& [level, count] : overviews)
+    std::printf("overviews:   level %d (voxels %d times the tiles'), %zu files\n", level, 1 << (2 * level), count);
+  if (files.missing.empty() && files.resized.empty())
+    std::printf("files:       all %zu present, of the sizes listed\n", listed);
+  else
+    std::printf("files:       %zu of %zu missing, %zu of another size\n", files.missing.size(), listed,
+                files.resized.size());
 }
 
 }  // namespace vola::cli

@@ -54,7 +54,28 @@ PY
 # vola info on the tile set (its folder or its index): the index's own figures (it said
 # "--format: ... say which", an option info does not have, and "File is actually a directory").
 "$vola" info "$tmp/one" --json > "$tmp/info.json" || fail "vola info on the tile folder failed"
-"$vola" info "$index" > "$tmp/info.txt" || fail "vola info on index.geojson failed"
+"$vola" info "$index" > "$tmp/info.txt" 2> "$tmp/info_err.txt" || fail "vola info on index.geojson failed"
+[ ! -s "$tmp/info_err.txt" ] || fail "info of a whole tile set warned: $(cat "$tmp/info_err.txt")"
+grep -q "^files:       all [0-9]* present, of the sizes listed$" "$tmp/info.txt" || fail "info's files line: $(cat "$tmp/info.txt")"
+# The GeoPackage beside the index names the same set.
+"$vola" info "$tmp/one/index.gpkg" > "$tmp/info_gpkg.txt" || fail "vola info on index.gpkg failed"
+cmp -s <(sed 1d "$tmp/info.txt") <(sed 1d "$tmp/info_gpkg.txt") || fail "info of index.gpkg differs from index.geojson's"
+# A tile deleted, another cut short since vola tile wrote them: info reads the index, and
+# said the set was whole.
+cp -r "$tmp/one" "$tmp/damaged"
+damaged_tiles=($(ls "$tmp/damaged/.generation-1/"tile_*.vol))
+rm "${damaged_tiles[0]}"
+head -c 100 "${damaged_tiles[1]}" > "$tmp/short.vol" && mv "$tmp/short.vol" "${damaged_tiles[1]}"
+"$vola" info "$tmp/damaged" --json > "$tmp/damaged.json" 2> "$tmp/err.txt" || fail "info of a damaged set failed"
+grep -q "lists 1 of its [0-9]* files that are not there (first: .generation-1/$(basename "${damaged_tiles[0]}"))" "$tmp/err.txt" ||
+  fail "a deleted tile: $(cat "$tmp/err.txt")"
+grep -q "1 tiles are not of the size the index lists (first: .generation-1/$(basename "${damaged_tiles[1]}"))" "$tmp/err.txt" ||
+  fail "a short tile: $(cat "$tmp/err.txt")"
+python3 -c "
+import json, sys
+info = json.load(open(sys.argv[1]))
+assert len(info['missing_files']) == 1 and len(info['resized_files']) == 1, info
+" "$tmp/damaged.json" || fail "info --json of a damaged set"
 python3 - "$index" "$tmp/info.json" "$tmp/info.txt" <<'PY' || fail "vola info of the tile set"
 import json, sys
 v = json.load(open(sys.argv[1]))["vola"]
