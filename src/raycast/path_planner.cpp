@@ -452,12 +452,16 @@ PlannedPath plan_path(const Tree& tree, const Point& start, const Point& goal, c
     throw InvalidArgument("plan: the known voxels' tree has depth " + std::to_string(options.known->depth()) +
                           ", the obstacles' " + std::to_string(tree.depth()) + ": they must share one grid");
   // A coarser level: its cells are occupied when any voxel in them is, known when any is.
-  const Tree planning = level == tree.depth() - 1 ? tree : tree.level_of_detail(level + 1);
-  std::optional<Tree> known_planning;
-  if (options.known) known_planning = level == tree.depth() - 1 ? *options.known : options.known->level_of_detail(level + 1);
+  // The finest level is the tree itself, not a copy (a copy took its attribute columns
+  // too: 54 MB of a city's, which the search never reads).
+  const bool finest = level == tree.depth() - 1;
+  std::optional<Tree> coarse, known_coarse;
+  if (!finest) coarse = tree.level_of_detail(level + 1);
+  if (!finest && options.known) known_coarse = options.known->level_of_detail(level + 1);
+  const Tree& planning = finest ? tree : *coarse;
+  const Tree* known_planning = finest ? options.known : known_coarse ? &*known_coarse : nullptr;
   const double cell_size = std::ldexp(1.0, 2 * (tree.depth() - 1 - level));
-  ClearanceField field(planning, options.radius / cell_size, known_planning ? &*known_planning : nullptr,
-                       options.solid_ground);
+  ClearanceField field(planning, options.radius / cell_size, known_planning, options.solid_ground);
   const Cell from = cell_of(start, cell_size), to = cell_of(goal, cell_size);
   const auto side = static_cast<double>(tree.side());
   for (const auto& [name, p, c] : {std::tuple{"start", start, from}, std::tuple{"goal", goal, to}}) {
