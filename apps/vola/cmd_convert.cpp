@@ -142,9 +142,16 @@ void add_convert(CLI::App& app) {
       "  vola convert autzen.laz ground.vol --voxel-size 3 --where \"Classification == 2\"\n"
       "  vola convert autzen.laz trees.vol --voxel-size 3 --filter smrf --filter hag --where \"HeightAboveGround > 6\"\n" +
       std::string(kFilterHelp));
-  cmd->add_option("input", args->input, "Input file; its extension picks the reader (see --format)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", args->input,
+                  "Input file; its first bytes (LAS/LAZ/COPC, E57), else its extension, pick the reader (see --format)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol file (not the input, nor a name with another format's extension)")->required();
-  cmd->add_option("--format", args->options.format, "Input format: auto (from the extension) or one of " + known_formats())->capture_default_str();
+  cmd->add_option(
+         "--format", args->options.format,
+         "Input format: auto (from the first bytes where they name LAS or E57, else the extension) or one of " +
+             known_formats())
+      ->capture_default_str();
   cmd->add_option("--depth", args->options.depth, "Tree depth 1..10 (grid side 4^depth); grid mode: default from --voxel-size, and a depth given with it must hold the data (the error names the depth that does)")
       ->check(CLI::Range(1, 10));
   cmd->add_option("--voxel-size", args->options.voxel_size, "Voxel edge in input units (grid mode)")->check(positive_number());

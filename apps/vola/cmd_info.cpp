@@ -266,12 +266,19 @@ void add_info(CLI::App& app) {
          "index.geojson or folder, from vola tile)")
       ->required()
       ->check(CLI::ExistingPath);
+  cmd->footer(
+      "Examples:\n"
+      "  vola info survey.vol                      # header, levels, bytes, CRS, attribute columns\n"
+      "  vola info survey.laz --summary --json     # every point read: bounds, ranges, points per class\n"
+      "  vola info tiles/                          # a tile set: grid, CRS, tiles, overviews, missing files");
   cmd->add_flag("--json", args->json, "Print JSON instead of a table (every kind of file)");
   cmd->add_flag("--summary", args->summary,
                 "Point files and DEMs: read every point (cell) for their own bounds, column ranges and points per class "
                 "(like pdal info --summary)");
   cmd->add_option("--format", args->format,
-                  "Input format: auto (a .vol file, or a reader chosen by the extension) or one of " + known_formats())
+                  "Input format: auto (a .vol file, or a reader chosen by the first bytes where they name LAS or E57, "
+                  "else the extension) or one of " +
+                      known_formats())
       ->capture_default_str();
   cmd->add_option("--grid", args->grid,
                   "OpenVDB: the grid to show (a file of several names them when none is given); NumPy .npz: the array");

@@ -112,7 +112,9 @@ void add_morph(CLI::App& app) {
   {
     auto args = std::make_shared<MorphArgs>();
     auto* cmd = add_io(app, "erode", "Keep the voxels whose whole neighbourhood of a radius is occupied", args);
-    cmd->footer(std::string("Cells outside the grid count as empty.\n") + kDropped);
+    cmd->footer(
+        std::string("Cells outside the grid count as empty.\n") + kDropped +
+        "\nExample: vola erode scan.vol --radius 1 core.vol   (the shell: vola diff scan.vol core.vol shell.vol)");
     add_radius(cmd, args);
     cmd->callback([args] {
       const Tree in = open_input(*args, "erode");
@@ -123,7 +125,8 @@ void add_morph(CLI::App& app) {
   {
     auto args = std::make_shared<MorphArgs>();
     auto* cmd = add_io(app, "fill", "Fill enclosed cavities (empty cells the outside cannot reach face to face)", args);
-    cmd->footer(std::string("Works in the voxels' bounding box, refused beyond 2^33 cells (crop first).\n") + kDropped);
+    cmd->footer(std::string("Works in the voxels' bounding box, refused beyond 2^33 cells (crop first).\n") + kDropped +
+                "\nExample: vola fill building.vol solid.vol");
     cmd->callback([args] {
       const Tree in = open_input(*args, "fill");
       analysis::FillReport report;
@@ -148,7 +151,8 @@ void add_morph(CLI::App& app) {
     auto args = std::make_shared<MorphArgs>();
     auto* cmd = add_io(app, "downsample", "Resample to a coarser depth, keeping cells with enough voxels", args);
     cmd->footer(std::string("--min-voxels 1 gives the voxels of vola lod; the voxel size grows 4x per level.\n") +
-                "Attribute columns and payloads are dropped.");
+                "Attribute columns and payloads are dropped.\n"
+                "Example: vola downsample survey.vol --depth 4 --min-voxels 8 coarse.vol");
     cmd->add_option("--depth", args->depth, "Depth of the result")->required()->check(CLI::Range(1, 10));
     cmd->add_option("--min-voxels", args->min_voxels, "Voxels a coarse cell needs to be kept")->check(positive_number());
     cmd->callback([args] {

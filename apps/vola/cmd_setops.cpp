@@ -47,7 +47,9 @@ void add_one(CLI::App& app, const char* name, const char* help, Op op) {
       "Both files must be on one grid and in one CRS (PROJ decides whether two spellings name one\n"
       "CRS): the same voxel size, origins a whole number of voxels apart (maps of separate vola map\n"
       "runs are: their origins follow their data; the result takes the lower origin and the depth\n"
-      "that holds both). Payloads and attributes are not carried into the result.");
+      "that holds both). Payloads and attributes are not carried into the result.\n"
+      "Example: vola " +
+      std::string(name) + " a.vol b.vol out.vol");
   cmd->add_option("a", args->a, "First .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("b", args->b, "Second .vol")->required()->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .vol")->required();

@@ -96,7 +96,10 @@ void add_translate(CLI::App& app) {
   cmd->add_option("input", args->input, "Input point file (LAS, LAZ, COPC, PLY, PCD, XYZ, NPY, KITTI)")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("output", args->output, "Output .las, .laz, .ply, .xyz or .csv")->required();
-  cmd->add_option("--format", args->format, "Input format: auto (from the extension) or one of " + known_formats())
+  cmd->add_option(
+         "--format", args->format,
+         "Input format: auto (from the first bytes where they name LAS or E57, else the extension) or one of " +
+             known_formats())
       ->capture_default_str();
   add_filter_options(*cmd, args->filters);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success but warnings (to stderr)");

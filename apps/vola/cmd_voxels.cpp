@@ -105,6 +105,7 @@ void add_common(CLI::App* cmd, VoxelsArgs& args) {
 void add_voxels(CLI::App& app) {
   auto args = std::make_shared<VoxelsArgs>();
   auto* voxels = app.add_subcommand("voxels", "Print every occupied voxel as integer grid coordinates \"x y z\"");
+  voxels->footer("Example: vola voxels part.vol --header > part.txt   (vola coords for world coordinates)");
   add_common(voxels, *args);
   voxels->callback([args] { run_voxels(*args); });
 

@@ -18,11 +18,11 @@
 
 namespace vola::cli {
 
-// The shortest text that reads back as the same double ("1e-09", "0.1").
+// The shortest text that reads back as the same double ("1e-09", "0.1"), positional
+// for coordinates ("500000", not "5e+05": vola::write_number).
 inline std::string shortest_text(double v) {
-  char text[32];
-  const auto r = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, r.ptr);
+  char text[kNumberTextSize];
+  return std::string(text, write_number(text, v));
 }
 
 class TextOutput {
