@@ -232,6 +232,17 @@ TEST(FileErrors, ExtensionFrameThatIsNotFinite) {
   }
 }
 
+TEST(FileErrors, ExtensionFrameWhoseFarCornerIsNotFinite) {
+  // Finite origin and voxel size whose grid reaches past the doubles: every voxel centre
+  // was infinite, and `vola export F.las` looked for a LAS scale without end.
+  std::uint64_t at = 0;
+  auto bytes = file_with_extension(at);
+  for (std::size_t axis = 0; axis < 3; ++axis) put_le<double>(bytes, at + 32 + 8 + 8 * axis, 1e308);
+  put_le<double>(bytes, at + 32 + 32, 1e307);
+  expect_format_error(bytes, at + 16 + 24,
+                      "the grid's far corner (origin + voxel size x 4^depth) is not a finite number");
+}
+
 TEST(FileErrors, AttributeValueCountDiffersFromTheVoxelCount) {
   // The extension of a 5-voxel tree with an attribute, after a 3-voxel tree's levels.
   vola::PointCloud five;

@@ -195,19 +195,26 @@ void append_extension(const Tree& tree, bool compress_levels, int level, bool mi
 namespace {
 
 // The frame record: quantization, origin and voxel size.
-Frame decode_frame(ByteReader& body, std::uint64_t record_offset) {
-    Frame f;
-    const auto mode = body.get<std::uint8_t>("frame quantization");
-    if (mode > 1) body.fail_at(record_offset + 16, "unknown quantization mode " + std::to_string(mode));
-    f.quantization = static_cast<Quantization>(mode);
-    body.take(7, "frame padding");
-    for (double& o : f.origin) o = body.get<double>("frame origin");
-    f.voxel_size = body.get<double>("frame voxel size");
-    if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
-    if (!std::isfinite(f.voxel_size)) body.fail_at(record_offset + 48, "voxel size is not finite");
-    for (int a = 0; a < 3; ++a)
-      if (!std::isfinite(f.origin[a]))
-        body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a), "frame origin is not finite");
+Frame decode_frame(ByteReader& body, std::uint64_t record_offset, int depth) {
+  Frame f;
+  const auto mode = body.get<std::uint8_t>("frame quantization");
+  if (mode > 1) body.fail_at(record_offset + 16, "unknown quantization mode " + std::to_string(mode));
+  f.quantization = static_cast<Quantization>(mode);
+  body.take(7, "frame padding");
+  for (double& o : f.origin) o = body.get<double>("frame origin");
+  f.voxel_size = body.get<double>("frame voxel size");
+  if (!(f.voxel_size > 0.0)) body.fail_at(record_offset + 48, "voxel size is not positive");
+  if (!std::isfinite(f.voxel_size)) body.fail_at(record_offset + 48, "voxel size is not finite");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(f.origin[a]))
+      body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a), "frame origin is not finite");
+  // The grid's far corner too: an origin of 1e308 and voxels of 1e307 put every voxel
+  // at infinity (coordinates printed as inf, a LAS export's scale search never ended).
+  const double side = std::ldexp(1.0, 2 * std::max(depth, 0)) * f.voxel_size;
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(f.origin[a] + side))
+      body.fail_at(record_offset + 24 + 8 * static_cast<std::uint64_t>(a),
+                   "the grid's far corner (origin + voxel size x 4^depth) is not a finite number");
   return f;
 }
 
@@ -335,7 +342,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
     r.skip_padding(8);
     switch (static_cast<RecordTag>(tag)) {
       case RecordTag::frame:
-        out.frame = decode_frame(body, record_offset);
+        out.frame = decode_frame(body, record_offset, depth);
         break;
       case RecordTag::crs_wkt: {
         const auto text = body.take(length, "CRS WKT");

@@ -200,9 +200,14 @@ class FieldStream {
   explicit FieldStream(const E57Field& field) : f_(field) {}
 
   void append(std::span<const std::uint8_t> bytes) {
-    const std::size_t consumed = static_cast<std::size_t>(bit_ >> 3);  // whole bytes read: dropped
-    bytes_.erase(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(consumed));
-    bit_ &= 7;
+    // Whole bytes read are dropped once they are half the buffer or more: dropping them at
+    // every packet moved the whole buffer each time, quadratic when another field's
+    // stream runs far ahead (a 30 MB file took minutes).
+    const std::size_t consumed = static_cast<std::size_t>(bit_ >> 3);
+    if (consumed > 0 && consumed >= bytes_.size() / 2) {
+      bytes_.erase(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(consumed));
+      bit_ &= 7;
+    }
     bytes_.insert(bytes_.end(), bytes.begin(), bytes.end());
   }
 

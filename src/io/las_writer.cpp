@@ -48,8 +48,11 @@ double power_of_ten(int exponent) {
 // from the offset) would then overflow a 32-bit coordinate: coarser by tens until it
 // fits. Even at depth 10 that stays below 1/100 of a voxel.
 double choose_scale(double voxel_size, double extent) {
+  if (!std::isfinite(extent) || !std::isfinite(voxel_size) || !(voxel_size > 0.0))
+    throw InvalidArgument("a LAS file needs finite coordinates: the grid spans " + std::to_string(extent) +
+                          " at voxels of " + std::to_string(voxel_size));
   int exponent = static_cast<int>(std::floor(std::log10(voxel_size / 1000.0)));
-  while (extent / power_of_ten(exponent) > 2.0e9) ++exponent;
+  while (extent / power_of_ten(exponent) > 2.0e9) ++exponent;  // ends: extent < 2e9 x 1e308
   return power_of_ten(exponent);
 }
 

@@ -17,6 +17,7 @@
 #include "point_colours.hpp"
 #include "polygon_triangles.hpp"
 #include "vola/error.hpp"
+#include "vola/io/mesh.hpp"
 #include "vola/little_endian.hpp"
 
 namespace vola::io {
@@ -514,8 +515,15 @@ Input parse_ply(std::span<const std::uint8_t> bytes, const std::string& name, co
     BinaryInput in(bytes, h.body, h.encoding == Encoding::binary_big_endian, name);
     read_body(in, h, options, out, mesh, remaining);
   }
+  // Polygons of n corners make n - 2 triangles of 72 bytes: one face of 40 M one-byte
+  // indices asked for 2.9 GB. The same bound as every other mesh reader, before any is made.
+  const std::uint64_t triangles = mesh.corners.size() - 2 * mesh.sizes.size();
+  if (triangles > kMaxMeshTriangles)
+    throw FormatError(
+        name, h.body,
+        "the faces make " + std::to_string(triangles) + " triangles, more than " + std::to_string(kMaxMeshTriangles));
   const auto& xyz = out.cloud.xyz;
-  out.triangles.reserve(mesh.corners.size() - 2 * mesh.sizes.size());
+  out.triangles.reserve(static_cast<std::size_t>(triangles));
   std::vector<Point> polygon;
   std::vector<std::array<std::uint32_t, 3>> cut;
   std::size_t at = 0;
