@@ -243,6 +243,45 @@ TEST(FileErrors, ExtensionFrameWhoseFarCornerIsNotFinite) {
                       "the grid's far corner (origin + voxel size x 4^depth) is not a finite number");
 }
 
+// `bytes` (from file_with_extension) with `record` (tag, flags, length, body padded to 8)
+// inserted after the frame record, and the record count raised: the record's offset.
+std::uint64_t insert_record(std::vector<std::uint8_t>& bytes, std::uint64_t at, std::uint32_t tag,
+                            const std::vector<std::uint8_t>& body) {
+  std::vector<std::uint8_t> record(16);
+  put_le<std::uint32_t>(record, 0, tag);
+  put_le<std::uint64_t>(record, 8, body.size());
+  record.insert(record.end(), body.begin(), body.end());
+  record.resize((record.size() + 7) / 8 * 8, 0);
+  const std::uint64_t where = at + 16 + 56;  // extension head (16) + the frame record (16 + 40)
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(where), record.begin(), record.end());
+  put_le<std::uint32_t>(bytes, at + 12, get_le<std::uint32_t>(bytes, at + 12) + 1);
+  return where;
+}
+
+TEST(FileErrors, ASecondFrameOrCrsRecordAndANulInTheCrsAreRefused) {
+  // The last of two records won silently, and PROJ read "EPSG:4326\0junk" as EPSG:4326.
+  std::uint64_t at = 0;
+  const auto valid = file_with_extension(at);
+  auto bytes = valid;
+  const std::vector<std::uint8_t> frame(valid.begin() + static_cast<std::ptrdiff_t>(at + 32),
+                                        valid.begin() + static_cast<std::ptrdiff_t>(at + 72));
+  std::uint64_t where = insert_record(bytes, at, 1, frame);
+  expect_format_error(bytes, where, "a second frame record (a file holds one)");
+
+  const std::string epsg = "EPSG:4326";
+  bytes = valid;
+  insert_record(bytes, at, 2, std::vector<std::uint8_t>(epsg.begin(), epsg.end()));
+  where = insert_record(bytes, at, 2, std::vector<std::uint8_t>(epsg.begin(), epsg.end()));
+  expect_format_error(bytes, where + 32, "a second CRS record (a file holds one)");  // after a 32-byte record
+
+  bytes = valid;
+  std::vector<std::uint8_t> with_nul(epsg.begin(), epsg.end());
+  with_nul.push_back(0);
+  with_nul.insert(with_nul.end(), {'j', 'u', 'n', 'k'});
+  where = insert_record(bytes, at, 2, with_nul);
+  expect_format_error(bytes, where + 16 + epsg.size(), "the CRS text holds a NUL byte");
+}
+
 TEST(FileErrors, AttributeValueCountDiffersFromTheVoxelCount) {
   // The extension of a 5-voxel tree with an attribute, after a 3-voxel tree's levels.
   vola::PointCloud five;

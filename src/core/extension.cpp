@@ -333,6 +333,7 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
                             " is not known to this vola (knows 1.." + std::to_string(kExtensionVersion) + ")");
   const auto records = r.get<std::uint32_t>("extension record count");
   std::unordered_set<std::string> attribute_names;  // one search per name made 80,000 columns take seconds
+  bool seen_crs = false;
   for (std::uint32_t i = 0; i < records; ++i) {
     const std::uint64_t record_offset = r.offset();
     const auto tag = r.get<std::uint32_t>("record tag");
@@ -342,10 +343,18 @@ ExtensionContents decode_extension(std::span<const std::uint8_t> bytes, const st
     r.skip_padding(8);
     switch (static_cast<RecordTag>(tag)) {
       case RecordTag::frame:
+        // One of each: a second frame or CRS record silently replaced the first.
+        if (out.frame) body.fail_at(record_offset, "a second frame record (a file holds one)");
         out.frame = decode_frame(body, record_offset, depth);
         break;
       case RecordTag::crs_wkt: {
+        if (seen_crs) body.fail_at(record_offset, "a second CRS record (a file holds one)");
+        seen_crs = true;
         const auto text = body.take(length, "CRS WKT");
+        // A NUL ends the text for PROJ: "EPSG:4326\0junk" read as EPSG:4326.
+        if (const auto nul = std::find(text.begin(), text.end(), std::uint8_t{0}); nul != text.end())
+          body.fail_at(record_offset + 16 + static_cast<std::uint64_t>(nul - text.begin()),
+                       "the CRS text holds a NUL byte");
         out.crs_wkt.assign(text.begin(), text.end());
         break;
       }

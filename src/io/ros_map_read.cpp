@@ -293,8 +293,19 @@ RosMapImage read_ros_image(const std::string& path) {
       while (at < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[at])) && at - begin < 6)
         value = value * 10 + static_cast<unsigned>(bytes[at++] - '0');
       if (at == begin) throw FormatError(path, begin, "PGM: sample " + std::to_string(i) + " is missing");
-      image.pixels[i] = static_cast<std::uint16_t>(std::min(value, image.maxval));
+      // A sample above maxval (or a run of digits cut after six, whose rest read as the
+      // next sample: a phantom obstacle) is damage, not a value to clamp.
+      if (value > image.maxval || (at < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[at]))))
+        throw FormatError(
+            path, begin,
+            "PGM: sample " + std::to_string(i) + " is above the header's maxval " + std::to_string(image.maxval));
+      image.pixels[i] = static_cast<std::uint16_t>(value);
     }
+    skip_space();
+    if (at != size)
+      throw FormatError(
+          path, at,
+          "PGM: more samples than the header's " + std::to_string(image.width) + " x " + std::to_string(image.height));
   }
   for (std::uint16_t& p : image.pixels) p = std::min<std::uint16_t>(p, static_cast<std::uint16_t>(image.maxval));
   return image;

@@ -367,6 +367,30 @@ TEST(OctomapImport, CraftedFilesAreRefused) {
   EXPECT_NE(error_of(write("count.bt", "# Octomap OcTree binary file\nid OcTree\nsize 7\nres 0.1\ndata\n" + std::string("\x01\x00", 2)))
                 .find("says 7 nodes"),
             std::string::npos);
+  // A root without children: liboctomap makes it one occupied leaf of 2^48 cells, and vola
+  // listed them one by one (minutes, then out of memory).
+  const std::string bt_head = "# Octomap OcTree binary file\nid OcTree\nsize 17\nres 0.1\ndata\n";
+  EXPECT_NE(error_of(write("bare.bt",
+                           "# Octomap OcTree binary file\nid OcTree\nsize 1\nres 0.1\ndata\n" + std::string(2, '\0')))
+                .find("the root has no children: liboctomap reads it as one occupied leaf of 2^48 cells"),
+            std::string::npos);
+  // Bytes after the tree: a .bt's stream under an .ot's first line read as an empty map,
+  // and a file written twice read as its first copy. One occupied cell: fifteen inner
+  // nodes (code 3) down to a leaf (code 2) at OctoMap's 16th level.
+  std::string one_cell;
+  for (int level = 0; level < 15; ++level) one_cell += std::string("\x03\x00", 2);
+  one_cell += std::string("\x02\x00", 2);
+  EXPECT_EQ(error_of(write("one.bt", bt_head + one_cell)), "");
+  EXPECT_NE(error_of(write("twice.bt", bt_head + one_cell + bt_head + one_cell))
+                .find(std::to_string(bt_head.size() + one_cell.size()) + " bytes follow the end of the tree"),
+            std::string::npos);
+  std::string free_root(4, '\0');  // an .ot root leaf of log-odds -2: free, its 64 bytes after it ignored
+  const float minus_two = -2.0f;
+  std::memcpy(free_root.data(), &minus_two, 4);
+  EXPECT_NE(error_of(write("kind.ot", "# Octomap OcTree file\nid OcTree\nsize 1\nres 0.1\ndata\n" + free_root +
+                                          std::string(1, '\0') + std::string(64, '\x55')))
+                .find("64 bytes follow the end of the tree"),
+            std::string::npos);
 }
 
 // A real survey: Autzen (UTM metres) at 2 m, far from OctoMap's 0, so shifted to its corner.

@@ -293,6 +293,17 @@ TEST(RosMap, BadMapsAreFormatErrorsNamingTheFile) {
   EXPECT_NE(error_of("png.yaml", "image: noimage.yaml\nresolution: 1\norigin: [0, 0, 0]\n")
                 .find("not a PGM (P5 or P2) or PNG image"),
             std::string::npos);
+  // A text sample of seven digits was cut after six and its last digit read as the next
+  // sample (a phantom obstacle); samples beyond width x height were ignored.
+  write_text(dir / "long.pgm", "P2\n3 1\n255\n2550000 255 255\n");
+  EXPECT_NE(error_of("long.yaml", "image: long.pgm\nresolution: 1\norigin: [0, 0, 0]\n")
+                .find("byte 11: PGM: sample 0 is above the header's maxval 255"),
+            std::string::npos)
+      << error_of("long.yaml", "image: long.pgm\nresolution: 1\norigin: [0, 0, 0]\n");
+  write_text(dir / "more.pgm", "P2\n2 1\n255\n0 255 254 254 254 254\n");
+  EXPECT_NE(error_of("more.yaml", "image: more.pgm\nresolution: 1\norigin: [0, 0, 0]\n")
+                .find("PGM: more samples than the header's 2 x 1"),
+            std::string::npos);
 }
 
 TEST(RosMap, AMapWithNoOccupiedCellIsAnEmptyGrid) {

@@ -85,6 +85,7 @@ class NodeWalk {
   }
 
   std::uint64_t nodes() const noexcept { return nodes_; }
+  std::size_t offset() const noexcept { return at_; }
   std::uint64_t occupied() const noexcept { return occupied_; }
   std::size_t end() const noexcept { return at_; }
   [[noreturn]] void fail(std::size_t at, const std::string& why) const { throw FormatError(path_, at, why); }
@@ -151,6 +152,14 @@ OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& pat
   if (layout.binary) {
     if (size == 0) return layout;  // readBinary reads no nodes then
     walk.binary_node(0);           // the root's children (the root itself is not coded)
+    // A root with no children is a leaf spanning every key, which liboctomap reads as
+    // occupied (its log-odds stay 0, the threshold): 2^48 cells, which vola went on to
+    // list one by one.
+    if (walk.nodes() == 0)
+      walk.fail(layout.data_offset,
+                "the root has no children: liboctomap reads it as one occupied leaf of 2^48 "
+                "cells, more than " +
+                    std::to_string(max_cells) + " (vola's limit for a map)");
     if (walk.nodes() + 1 != size)
       walk.fail(layout.data_offset, "the header says " + std::to_string(size) + " nodes, the stream holds " +
                                         std::to_string(walk.nodes() + 1));
@@ -161,6 +170,12 @@ OctomapLayout check_octomap_bytes(std::string_view bytes, const std::string& pat
     walk.text_node(0);
     layout.nodes = walk.nodes();
   }
+  // liboctomap stops reading where the tree ends; bytes after it are another file's or
+  // damage (a .bt given an .ot first line read as an empty map).
+  if (walk.offset() != bytes.size())
+    walk.fail(walk.offset(),
+              std::to_string(bytes.size() - walk.offset()) +
+                  " bytes follow the end of the tree (the header's kind or size does not match the data?)");
   layout.occupied_cells = walk.occupied();
   return layout;
 }
