@@ -322,6 +322,10 @@ class PointSink {
     for (std::size_t k = 0; k < others_; ++k) cloud_.attributes[first_other_ + k].values.push_back(others[k]);
   }
   std::uint64_t not_finite() const noexcept { return not_finite_; }
+  // After the last point: float colour channels become 0..1, or 0..255 when any is above 1.
+  void finish() {
+    if (colours_) colours_->finish();
+  }
 
  private:
   PointCloud& cloud_;
@@ -442,6 +446,7 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
     // Every point takes at least one character and a separator per value.
     PointSink sink(layout, options, cloud, std::min<std::uint64_t>(h.points, remaining / (2 * h.components)));
     read_ascii(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), h, layout, sink, name);
+    sink.finish();
     if (not_finite) *not_finite = sink.not_finite();
   } else if (h.data == DataKind::binary) {
     if (h.points > remaining / h.point_size)
@@ -450,6 +455,7 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
                                           " bytes after the header (truncated file)");
     PointSink sink(layout, options, cloud, h.points);
     read_records(bytes.data() + h.body, false, h, layout, sink);
+    sink.finish();
     if (not_finite) *not_finite = sink.not_finite();
   } else {
     if (remaining < 8) throw FormatError(name, h.body, "binary_compressed data lacks its two 32-bit sizes (truncated file)");
@@ -469,6 +475,7 @@ PointCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& nam
       throw FormatError(name, h.body + 8, "the LZF data is corrupt (it does not decompress to " + std::to_string(raw) + " bytes)");
     PointSink sink(layout, options, cloud, h.points);
     read_records(columns.data(), true, h, layout, sink);
+    sink.finish();
     if (not_finite) *not_finite = sink.not_finite();
   }
   if (options.progress) options.progress(bytes.size(), bytes.size());

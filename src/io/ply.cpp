@@ -472,6 +472,7 @@ void read_body(In& in, const PlyHeader& h, const InputOptions& options, Input& o
       }
       in.end_record(e);
     }
+    if (colours) colours->finish();  // float channels: 0..1, or 0..255 when any is above 1
   }
   in.end_data();
 }

@@ -136,6 +136,12 @@ Input read_ptx(const std::string& path, const InputOptions& options) {
         lines.fail("a scan header's lines 7-10 hold four numbers each (its 4 x 4 transformation matrix)");
       for (std::size_t c = 0; c < 4; ++c) row[c] = v[c];
     }
+    // A rigid transformation's last column is 0 0 0 1; anything else is damage or a
+    // projective transformation, whose last column was dropped without a word.
+    for (std::size_t r = 0; r < 4; ++r)
+      if (std::fabs(m[r][3] - (r == 3 ? 1.0 : 0.0)) > 1e-9)
+        lines.fail("the transformation matrix's last column is not 0 0 0 1 (row " + std::to_string(r + 1) +
+                   " ends in " + std::to_string(m[r][3]) + ")");
     const std::uint64_t points = static_cast<std::uint64_t>(columns) * rows;
     for (std::uint64_t p = 0; p < points; ++p) {
       const auto line = lines.next();
@@ -144,16 +150,21 @@ Input read_ptx(const std::string& path, const InputOptions& options) {
                    " points (" + std::to_string(static_cast<std::uint64_t>(columns)) + " columns x " +
                    std::to_string(rows) + " rows)");
       const std::size_t n = numbers(*line, v, lines);
+      const bool no_return = v[0] == 0 && v[1] == 0 && v[2] == 0;
+      if (!values && n == 4 && no_return) {  // a miss written short: it says nothing of the lines' width
+        ++in.not_finite;
+        continue;
+      }
       if (!values) {
         if (n != 4 && n != 7) lines.fail("a point line holds x y z intensity [red green blue]: 4 or 7 values");
         values = n;
         if (options.attributes) cloud.attributes.push_back({"intensity", ValueType::f32, Reduction::mean, {}});
         if (n == 7 && (options.attributes || options.payload))
           colour.emplace(cloud, ColourScale::bits8, options.attributes, options.payload);
-      } else if (n != *values && !(n == 4 && *values == 7 && v[0] == 0 && v[1] == 0 && v[2] == 0)) {
+      } else if (n != *values && !(n == 4 && *values == 7 && no_return)) {
         lines.fail(std::to_string(n) + " values where the file's point lines hold " + std::to_string(*values));
       }
-      if (v[0] == 0 && v[1] == 0 && v[2] == 0) {  // no return
+      if (no_return) {
         ++in.not_finite;
         continue;
       }
@@ -164,6 +175,7 @@ Input read_ptx(const std::string& path, const InputOptions& options) {
       if (options.progress && (p & 0xFFFF) == 0) options.progress(lines.bytes_done(), lines.size());
     }
   }
+  if (colour) colour->finish();
   if (options.progress) options.progress(lines.size(), lines.size());
   return in;
 }

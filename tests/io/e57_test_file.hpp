@@ -31,6 +31,7 @@ struct E57TestScan {
   std::string name = "scan";
   std::vector<E57TestField> fields;
   std::optional<std::array<double, 7>> pose;  // rotation w x y z, translation x y z
+  std::string pose_xml;                       // else a <pose> element written as given (a damaged one)
   std::size_t records_per_packet = 1000;
   std::optional<std::uint64_t> stated_records;  // a lying recordCount
 };
@@ -152,7 +153,7 @@ inline std::vector<std::uint8_t> e57_test_file(const std::vector<E57TestScan>& s
         prototype += " scale=\"" + e57_test_number(f.scale) + "\" offset=\"" + e57_test_number(f.offset) + "\"";
       prototype += "/>";
     }
-    std::string pose;
+    std::string pose = s.pose_xml;
     if (s.pose) {
       const auto& q = *s.pose;
       pose = "<pose type=\"Structure\"><rotation type=\"Structure\"><w type=\"Float\">" + e57_test_number(q[0]) +

@@ -143,6 +143,24 @@ TEST(E57, SphericalPointsInvalidStatesAndPoses) {
   EXPECT_TRUE(summary.scans[0].has_pose);
 }
 
+// A pose missing a component (E2807 requires w x y z and x y z) took it from the identity:
+// a rotation of x alone became (1, 1, 0, 0) / sqrt 2, a quarter turn about x.
+TEST(E57, APoseMissingAComponentIsRefusedNamingTheScan) {
+  E57TestScan scan;
+  scan.name = "station 4";
+  scan.fields = {floats("cartesianX", {1}), floats("cartesianY", {2}), floats("cartesianZ", {3})};
+  scan.pose_xml = "<pose type=\"Structure\"><rotation type=\"Structure\"><x type=\"Float\">1</x></rotation></pose>";
+  const Written rotation({scan});
+  EXPECT_NE(read_error(rotation.path).find("scan 'station 4': its pose's rotation has no w"), std::string::npos)
+      << read_error(rotation.path);
+  scan.pose_xml =
+      "<pose type=\"Structure\"><translation type=\"Structure\"><x type=\"Float\">1</x>"
+      "<y type=\"Float\">2</y></translation></pose>";
+  const Written translation({scan});
+  EXPECT_NE(read_error(translation.path).find("its pose's translation has no z"), std::string::npos)
+      << read_error(translation.path);
+}
+
 // Two scans: the columns are the fields both have; the points of both, in file order.
 TEST(E57, ScansWithOtherFieldsKeepTheColumnsTheyShare) {
   E57TestScan a, b;

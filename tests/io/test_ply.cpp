@@ -266,6 +266,32 @@ TEST(Ply, SixteenBitColoursGiveTheHighByteAsPayload) {
   EXPECT_EQ(in.cloud.payload[1], 0xFFu | 1u << 8 | 1u << 16);
 }
 
+TEST(Ply, FloatColoursAreUnitOrByteRangedByTheirValues) {
+  // Float channels are 0..1 by convention, but many tools write 0..255: taken as 0..1,
+  // every such colour came out white (255 255 255).
+  const auto read = [](const std::string& values) {
+    const std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nproperty float red\nproperty float green\nproperty float blue\n"
+        "end_header\n" +
+        values;
+    vola::io::InputOptions options;
+    options.payload = true;
+    return vola::io::parse_ply(Bytes(text.begin(), text.end()), "float.ply", options);
+  };
+  const auto bytes = read("0 0 0 128 64 32\n1 1 1 200 100 0.5\n");
+  EXPECT_EQ(bytes.cloud.attributes[0].values, (std::vector<double>{128, 200}));
+  EXPECT_EQ(bytes.cloud.attributes[1].values, (std::vector<double>{64, 100}));
+  EXPECT_EQ(bytes.cloud.attributes[2].values,
+            (std::vector<double>{32, 1}));  // 0.5 of 0..255 rounds to 1 (half away from zero)
+  EXPECT_EQ(bytes.cloud.payload,
+            (std::vector<std::uint64_t>{128u | 64u << 8 | 32u << 16, 200u | 100u << 8 | 1u << 16}));
+  const auto unit = read("0 0 0 1 0.5 0\n1 1 1 0.2 0 1\n");
+  EXPECT_EQ(unit.cloud.attributes[0].values, (std::vector<double>{255, 51}));
+  EXPECT_EQ(unit.cloud.attributes[1].values, (std::vector<double>{128, 0}));
+  EXPECT_EQ(unit.cloud.payload, (std::vector<std::uint64_t>{255u | 128u << 8, 51u | 255u << 16}));
+}
+
 TEST(Ply, FacesBeforeVerticesAndPointsWithoutFaces) {
   const std::string text =
       "ply\nformat ascii 1.0\nelement face 1\nproperty list uint uint vertex_index\nelement vertex 4\n"

@@ -78,6 +78,21 @@ TEST(Ptx, MalformedFilesAreRefusedNamingTheLine) {
   expect("1\n-3\n", "line 2: a scan's number of rows must be one whole number");
   expect(header(1, 1, "1 0 0 0\n0 1 0\n"), "line 8: a scan header's lines 7-10 hold four numbers each");
   expect(header(1, 1, kIdentity) + "1 2 x 0.5\n", "line 11: 'x 0.5' is not a number");
+  // A projective matrix (or damage) was used without its last column.
+  expect(header(1, 1, "1 0 0 5\n0 1 0 0\n0 0 1 0\n0 0 0 2\n") + "1 2 3 0.5\n",
+         "line 10: the transformation matrix's last column is not 0 0 0 1 (row 1 ends in 5");
+}
+
+TEST(Ptx, AShortMissFirstDoesNotSetTheLinesWidth) {
+  // A coloured scan whose first point is a miss written with 4 values was refused ("7
+  // values where the file's point lines hold 4"); the same miss second was read.
+  vola_test::TempDir dir;
+  const fs::path path = dir / "first.ptx";
+  const vola::io::Input in = read(path, header(3, 1, kIdentity) + "0 0 0 0.5\n1 2 3 0.5 10 20 30\n0 0 0 0.5\n");
+  EXPECT_EQ(in.cloud.xyz, (std::vector<double>{1, 2, 3}));
+  EXPECT_EQ(in.not_finite, 2u);
+  ASSERT_EQ(in.cloud.attributes.size(), 4u);
+  EXPECT_EQ(in.cloud.attributes[1].values, (std::vector<double>{10}));
 }
 
 }  // namespace
