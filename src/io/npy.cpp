@@ -246,6 +246,23 @@ void with_value_type(const NpyArray& a, F&& f) {
 
 }  // namespace
 
+namespace {
+
+// Refuses `count` points or voxels from a compressed array beyond what its compressed
+// bytes justify (NpyArray::compressed_bytes): a 210 KB .npz of ones took gigabytes.
+void refuse_inflated(const NpyArray& array, std::uint64_t count, const char* what, const std::string& name) {
+  if (!array.compressed_bytes) return;
+  const std::uint64_t limit = kNpyValuesAllowance + kNpyValuesPerStoredByte * array.compressed_bytes;
+  if (count > limit)
+    throw FormatError(name, {},
+                      std::to_string(count) + " " + what + " from " + std::to_string(array.compressed_bytes) +
+                          " compressed bytes, more than the " + std::to_string(limit) +
+                          " vola reads from them (2^25 + 8 per byte); save the array uncompressed "
+                          "(numpy.save or numpy.savez) if it is meant");
+}
+
+}  // namespace
+
 PointCloud npy_points(const NpyArray& array, const std::string& name, bool payload_columns) {
   if (array.shape.size() != 2 || array.shape[1] < 3)
     throw FormatError(name, {}, "expected an (N, 3) or (N, >3) point array, got shape with " +
@@ -262,6 +279,7 @@ PointCloud npy_points(const NpyArray& array, const std::string& name, bool paylo
                           std::to_string(n) + " points of " + std::to_string(columns) +
                           " columns; points are rows, (N, 3): for " + std::to_string(columns) +
                           " points stored as rows x, y, z, save the transpose (numpy.save(path, points.T))");
+  refuse_inflated(array, n, "points", name);
   PointCloud cloud;
   cloud.xyz.resize(3 * n);
   // Element (row i, column c) lies at i * row_step + c * column_step values.
@@ -317,11 +335,20 @@ VoxelGrid npy_grid(const NpyArray& array, const std::string& name) {
   const std::size_t top = array.big_endian ? 0 : item - 1;
   const std::uint8_t top_mask = array.kind == 'f' ? 0x7F : 0xFF;
   const std::uint64_t count = array.size();
-  for (std::uint64_t s = 0; s < count; ++s) {
+  const auto occupied_at = [&](std::uint64_t s) {
     const std::uint8_t* value = array.data.data() + s * item;
     bool occupied = (value[top] & top_mask) != 0;
     for (std::size_t b = 0; b < item && !occupied; ++b) occupied = b != top && value[b] != 0;
-    if (!occupied) continue;
+    return occupied;
+  };
+  if (array.compressed_bytes) {  // counted first: 12 bytes a voxel from a deflated byte of cells
+    std::uint64_t occupied = 0;
+    for (std::uint64_t s = 0; s < count; ++s) occupied += occupied_at(s);
+    refuse_inflated(array, occupied, "occupied cells", name);
+    grid.voxels.reserve(static_cast<std::size_t>(occupied));
+  }
+  for (std::uint64_t s = 0; s < count; ++s) {
+    if (!occupied_at(s)) continue;
     // Storage position -> (x, y, z): C order runs the last index fastest, Fortran the first.
     const Voxel v = array.fortran_order
                         ? Voxel{static_cast<std::uint32_t>(s % nx), static_cast<std::uint32_t>(s / nx % ny),

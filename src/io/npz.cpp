@@ -123,7 +123,9 @@ NpyArray read_npz_array(const std::string& path, const std::string& name) {
   const zip_stat_t stat = checked_stat(archive.get(), index, path, member);
   std::unique_ptr<zip_file_t, ZipFileCloser> file(zip_fopen_index(archive.get(), static_cast<zip_uint64_t>(index), 0));
   if (!file) throw FormatError(path, std::nullopt, member + ": cannot open: " + archive_error(archive.get()));
-  return parse_npy(read_member(file.get(), stat.size, path, member), path + ":" + member);
+  NpyArray array = parse_npy(read_member(file.get(), stat.size, path, member), path + ":" + member);
+  if (stat.comp_method != ZIP_CM_STORE) array.compressed_bytes = stat.comp_size;
+  return array;
 }
 
 std::string npz_points_member(const std::string& path, const std::string& wanted) {

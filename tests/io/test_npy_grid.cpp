@@ -124,6 +124,24 @@ TEST(NpyGrid, PointsSavedAsRowsOfXYZAreRefusedNotReadAsThreePoints) {
   EXPECT_EQ(vola::io::npy_input(twelve, "r.npy", {}).cloud.size(), 12u);
 }
 
+TEST(NpyGrid, ACompressedArrayGivesNoMoreThanItsCompressedBytesJustify) {
+  // numpy.savez_compressed of a 600^3 grid of ones is 210 KB: 216 M voxels of 12 bytes.
+  // A compressed member is held to 2^25 + 8 values per compressed byte, as binvox's runs.
+  auto small = vola::io::parse_npy(npy_bytes("|u1", {4, 4, 4}, false, Bytes(64, 1)), "g.npz:a.npy");
+  small.compressed_bytes = 1;
+  EXPECT_EQ(vola::io::npy_grid(small, "g.npz:a.npy").voxels.size(), 64u);  // within the allowance
+  const std::uint64_t limit = vola::io::kNpyValuesAllowance + vola::io::kNpyValuesPerStoredByte;
+  auto big = vola::io::parse_npy(npy_bytes("|u1", {limit + 1, 1, 1}, false, Bytes(limit + 1, 1)), "big.npz:a.npy");
+  big.compressed_bytes = 1;
+  const auto error = vola_test::format_error_of([&] { vola::io::npy_grid(big, "big.npz:a.npy"); });
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->cause().find(std::to_string(limit + 1) + " occupied cells from 1 compressed bytes"),
+            std::string::npos)
+      << error->what();
+  big.compressed_bytes = 0;  // the same array stored uncompressed: its bytes are its cells
+  EXPECT_EQ(vola::io::npy_grid(big, "big.npy").voxels.size(), limit + 1);
+}
+
 TEST(NpyGrid, ReadInputDispatchesOnTheShape) {
   vola_test::TempDir dir;
   Bytes cells(8, 0);

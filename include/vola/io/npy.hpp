@@ -23,6 +23,9 @@ struct NpyField {
   std::uint64_t offset = 0;    // bytes from the start of the record
 };
 
+inline constexpr std::uint64_t kNpyValuesAllowance = std::uint64_t{1} << 25;
+inline constexpr std::uint64_t kNpyValuesPerStoredByte = 8;
+
 struct NpyArray {
   char kind = 'f';          // 'f' float, 'i' signed, 'u' unsigned, 'b' bool; 'V' records (`fields`)
   int item_size = 8;        // bytes per value (per record for 'V')
@@ -32,6 +35,11 @@ struct NpyArray {
   // The values as the file lays them out (size() * item_size bytes), viewed in `storage`.
   std::span<const std::uint8_t> data;
   std::shared_ptr<const std::vector<std::uint8_t>> storage;
+  // The bytes the array took in its file when they were compressed (an .npz member's
+  // deflated size), else 0. Deflate packs a thousand cells of ones in a byte, so the
+  // voxels or points read from it are bounded by these bytes (kNpyValuesAllowance +
+  // kNpyValuesPerStoredByte per byte, as binvox's runs are), not by the inflated array.
+  std::uint64_t compressed_bytes = 0;
   // A structured array's fields (kind 'V'), in record order, padding included.
   std::vector<NpyField> fields;
 
