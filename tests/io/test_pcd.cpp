@@ -367,6 +367,18 @@ TEST(Pcd, CorruptedInputIsAFormatErrorNamingTheProblem) {
   const auto short_literal = compressed(3, 12, {11, 1, 2});
   ASSERT_TRUE(short_literal);
   EXPECT_NE(short_literal->cause().find("corrupt"), std::string::npos) << short_literal->what();
+  // One-byte fields at LZF's best ratio: 40 M points of 3 values (8-byte doubles each, 960
+  // MB) from 1.4 MB. Refused before inflating, by 2^25 + 8 values per compressed byte.
+  const std::uint32_t points = 40'000'000, raw = 3 * points, packed = raw / 88 + 1;
+  Bytes bomb = with_text("FIELDS x y z\nSIZE 1 1 1\nTYPE U U U\nPOINTS 40000000\nDATA binary_compressed\n");
+  put<std::uint32_t>(bomb, packed);
+  put<std::uint32_t>(bomb, raw);
+  bomb.resize(bomb.size() + packed, 0);
+  const auto values = error_of(bomb);
+  ASSERT_TRUE(values);
+  EXPECT_NE(values->cause().find("40000000 points of 3 values from 1363637 LZF bytes: more than the 44463528 values"),
+            std::string::npos)
+      << values->what();
 }
 
 }  // namespace
