@@ -245,6 +245,22 @@ std::optional<std::string> drop_unreadable_wkt(const std::string& path, io::Inpu
   }
 }
 
+// An EPSG code PROJ does not know (an E57's coordinateMetadata "EPSG:99999999") stopped
+// the conversion with PROJ's words and no file named; it is left out as an unreadable
+// WKT is, with a warning saying so.
+std::optional<std::string> drop_unknown_epsg(const std::string& path, io::Input& input, bool crs_given) {
+  if (!input.epsg || !input.wkt.empty()) return std::nullopt;
+  try {
+    geo::describe_crs("EPSG:" + std::to_string(*input.epsg), geo::EpsgLookup::own_id_only);
+    return std::nullopt;
+  } catch (const Error&) {
+    const std::uint32_t code = *input.epsg;
+    input.epsg.reset();
+    return path + ": its CRS, EPSG:" + std::to_string(code) + ", is not a code PROJ knows: it is not kept" +
+           (crs_given ? "" : "; give `assign_crs` if you know the CRS");
+  }
+}
+
 // A grid the points cannot be put on (an extent beyond a double or beyond depth 10, a
 // file's grid too large) is said by the core without the file's name; an option's
 // error already names what to change.
@@ -289,6 +305,8 @@ Tree convert(const std::string& path, const ConvertOptions& options, const Conve
                                "voxels, as the reference toolkit clips them; grid quantization (a voxel size) "
                                "drops what lies outside its grid, and `crop` cuts the points first");
   if (const auto dropped = drop_unreadable_wkt(path, input, !given_crs(options).empty()))
+    value_warnings.push_back(*dropped);
+  if (const auto dropped = drop_unknown_epsg(path, input, !given_crs(options).empty()))
     value_warnings.push_back(*dropped);
   const ResolvedCrs crs =
       options.target_crs.empty() ? input_crs(path, options, input) : reproject(path, options, input);

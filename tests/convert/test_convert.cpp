@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../io/e57_test_file.hpp"
 #include "../io/io_test_data.hpp"
 #include "vola/builder.hpp"
 #include "vola/convert.hpp"
@@ -890,6 +891,30 @@ TEST(Convert, AGridBboxSkipsTheEptNodesOutsideIt) {
   EXPECT_EQ(tree.voxel_count(), 1u);
   EXPECT_EQ(voxels(tree), voxels(same));
   EXPECT_EQ(tree.frame(), same.frame());
+}
+
+// An E57 whose coordinateMetadata is an EPSG code PROJ does not know stopped `vola
+// convert` with "CRS EPSG:99999999 is not known to PROJ" and no file named; the code is
+// now left out with a warning, as an unreadable WKT is.
+TEST(Convert, AnEpsgCodeProjDoesNotKnowIsLeftOutWithAWarning) {
+  vola_test::TempDir dir;
+  vola_io_test::E57TestScan scan;
+  for (const char* axis : {"cartesianX", "cartesianY", "cartesianZ"})
+    scan.fields.push_back({axis, "Float", false, 0, 0, 1.0, 0.0, {0.0, 1.0, 2.0}});
+  const auto path = dir / "unknown_code.e57";
+  vola_test::write_bytes(path, vola_io_test::e57_test_file({scan}, "EPSG:99999999"));
+  vola::ConvertOptions options;
+  options.voxel_size = 1.0;
+  vola::ConvertReport report;
+  vola::Tree tree;
+  ASSERT_NO_THROW(tree = vola::convert(path.string(), options, {}, &report));
+  const bool warned = std::any_of(report.warnings.begin(), report.warnings.end(), [](const std::string& w) {
+    return w.find("unknown_code.e57: its CRS, EPSG:99999999, is not a code PROJ knows: it is not kept") !=
+           std::string::npos;
+  });
+  EXPECT_TRUE(warned);
+  EXPECT_FALSE(report.epsg);
+  EXPECT_EQ(tree.voxel_count(), 3u);
 }
 
 }  // namespace
